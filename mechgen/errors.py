@@ -1,0 +1,69 @@
+"""Error types of mechgen.
+
+Every error a user can cause with a file or a flag is an :class:`InputError`; the
+CLI turns it into one paragraph on stderr and exit code 2. Other errors are
+numerical (:class:`ConvergenceError`, :class:`KernelError`) or environmental
+(:class:`CompilerUnavailable`).
+"""
+from __future__ import annotations
+
+
+class MechgenError(Exception):
+    """Base class of every error mechgen raises on purpose."""
+
+
+class InputError(MechgenError):
+    """Bad user input: names the file, the key and what was expected.
+
+    Args:
+        message: what is wrong, in one sentence.
+        file: the file the input came from (scene, model module), if any.
+        key: the dotted key inside that file (``analysis[1].kind``), if any.
+        expected: what would have been accepted.
+    """
+
+    def __init__(self, message: str, *, file: str | None = None, key: str | None = None,
+                 expected: str | None = None) -> None:
+        self.message = message
+        self.file = file
+        self.key = key
+        self.expected = expected
+        super().__init__(self.paragraph())
+
+    def paragraph(self) -> str:
+        """The one-paragraph message the CLI prints."""
+        where = []
+        if self.file:
+            where.append(f"in {self.file}")
+        if self.key:
+            where.append(f"at key '{self.key}'")
+        text = self.message.rstrip(".")
+        if where:
+            text = f"{' '.join(where)}: {text}"
+        if self.expected:
+            text += f"; expected {self.expected}"
+        return text + "."
+
+
+class SceneError(InputError):
+    """A scene file (or a ``--set`` override) is malformed."""
+
+
+class ModelError(InputError):
+    """A model declaration is invalid (bad identifier, unknown parameter, ...)."""
+
+
+class CompilerUnavailable(MechgenError):
+    """No working C compiler was found; callers fall back to numpy."""
+
+
+class BuildError(MechgenError):
+    """The C compiler rejected generated code (a bug in mechgen, not in the input)."""
+
+
+class KernelError(MechgenError):
+    """A kernel produced NaN or Inf; names the kernel and the offending input."""
+
+
+class ConvergenceError(MechgenError):
+    """An iterative solver did not converge; says how far it got."""
