@@ -1,0 +1,6 @@
+"""``python -m mechgen`` is the ``mechgen`` command."""
+import sys
+
+from mechgen.cli import main
+
+sys.exit(main())

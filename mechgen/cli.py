@@ -1,0 +1,124 @@
+"""Command line: ``mechgen models | show MODEL | run SCENE | regen [--check] | bench``.
+
+Exit code 0 on success, 2 on bad input (one paragraph on stderr, no traceback),
+1 when a computation fails (convergence, kernel error) with its message.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+from mechgen.errors import InputError, MechgenError
+
+
+def _parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="mechgen", description=__doc__.splitlines()[0])
+    sub = ap.add_subparsers(dest="command", required=True)
+    sub.add_parser("models", help="list the built-in models")
+    show = sub.add_parser("show", help="print a model's derived equations and matrices")
+    show.add_argument("model")
+    run = sub.add_parser("run", help="run a scene file")
+    run.add_argument("scene")
+    run.add_argument("--set", dest="overrides", action="append", default=[], metavar="NAME=VALUE")
+    run.add_argument("--backend", choices=None)
+    run.add_argument("--json", dest="json_path")
+    run.add_argument("--plot", dest="plot_dir")
+    regen = sub.add_parser("regen", help="rewrite mechgen/generated for the built-in models")
+    regen.add_argument("--check", action="store_true", help="fail if mechgen/generated is stale")
+    bench = sub.add_parser("bench", help="run the benchmarks")
+    bench.add_argument("models", nargs="*")
+    bench.add_argument("--out", default="bench-out")
+    bench.add_argument("--quick", action="store_true")
+    return ap
+
+
+class _Parser(argparse.ArgumentParser):
+    pass
+
+
+def _write_json(path: str, results: dict) -> None:
+    target = Path(path)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=".tmp-", suffix=".json")
+    with os.fdopen(fd, "w") as fh:
+        json.dump(results, fh, indent=2, default=float)
+    os.replace(tmp, target)
+
+
+def _cmd_run(args) -> int:
+    from mechgen.scene.report import summary
+    from mechgen.scene.run import check_backend, run_scene
+
+    check_backend(args.backend)
+    results = run_scene(args.scene, overrides=args.overrides, backend=args.backend)
+    print(summary(results))
+    if args.json_path:
+        _write_json(args.json_path, results)
+    if args.plot_dir:
+        from mechgen.scene.plots import plot_results
+
+        for path in plot_results(results, Path(args.plot_dir)):
+            print(f"wrote {path}")
+    return 0
+
+
+def _cmd_models(_args) -> int:
+    from mechgen import models
+
+    for name in models.names():
+        print(f"{name:18s} {models.get(name).summary()}")
+    return 0
+
+
+def _cmd_show(args) -> int:
+    from mechgen.scene.show import show_model
+
+    print(show_model(args.model))
+    return 0
+
+
+def _cmd_regen(args) -> int:
+    from mechgen.regen import regen
+
+    stale = regen(check=args.check)
+    if args.check and stale:
+        print("mechgen/generated is stale: " + ", ".join(stale) + " (run `mechgen regen`)", file=sys.stderr)
+        return 1
+    for path in stale:
+        print(f"wrote {path}")
+    return 0
+
+
+def _cmd_bench(args) -> int:
+    from mechgen.bench import run_benchmarks
+
+    run_benchmarks(args.models, out=Path(args.out), quick=args.quick)
+    return 0
+
+
+COMMANDS = {"run": _cmd_run, "models": _cmd_models, "show": _cmd_show, "regen": _cmd_regen, "bench": _cmd_bench}
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``mechgen`` console script."""
+    parser = _parser()
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:
+        return int(exc.code or 0)
+    try:
+        return COMMANDS[args.command](args)
+    except InputError as exc:
+        print(f"mechgen: {exc.paragraph()}", file=sys.stderr)
+        return 2
+    except MechgenError as exc:
+        print(f"mechgen: {type(exc).__name__}: {exc}", file=sys.stderr)
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

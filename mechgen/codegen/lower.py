@@ -1,0 +1,64 @@
+"""lower: derived equations -> Kernel IR (renumbered symbols, one CSE pass per block).
+
+Input: :class:`~mechgen.symbolic.derive.LumpedEquations` or
+:class:`~mechgen.symbolic.lattice.LatticeEquations` and a kernel name.
+Output: a :class:`~mechgen.codegen.ir.KernelIR` whose expressions use only
+gathered locals ``g0, g1, ...`` and temporaries ``t0, t1, ...``, so user names
+never become program identifiers and the signature depends on structure only.
+"""
+from __future__ import annotations
+
+import sympy as sp
+
+from mechgen.codegen.ir import Block, Gather, KernelIR, Port, Write
+from mechgen.errors import ModelError
+
+
+def canonical_block(gathers: list[tuple[sp.Symbol, str, int, bool]], writes: list[Write], *,
+                    loop=None, cse: bool = True, model: str = "") -> Block:
+    """Rename gathered symbols to g0.., check coverage, and CSE the write expressions.
+
+    Gathers of symbols that no write uses are dropped.
+    """
+    used = set().union(*(w.expr.free_symbols for w in writes)) if writes else set()
+    rename, kept = {}, []
+    for sym, port, index, relative in gathers:
+        if sym in used and sym not in rename:
+            local = sp.Symbol(f"g{len(kept)}", real=True)
+            rename[sym] = local
+            kept.append(Gather(local, port, index, relative))
+    exprs = [w.expr.xreplace(rename) for w in writes]
+    stray = set().union(*(e.free_symbols for e in exprs)) - set(rename.values()) if exprs else set()
+    if stray:
+        names = ", ".join(sorted(s.name for s in stray))
+        raise ModelError(f"expressions of model {model} use symbols {names} that are not coordinates, "
+                         "velocities, internal variables, time or parameters", key=names,
+                         expected="only declared names")
+    assignments: list = []
+    if cse and exprs:
+        temps = sp.numbered_symbols("t", real=True)
+        assignments, exprs = sp.cse(exprs, symbols=temps, order="canonical")
+    new_writes = tuple(Write(w.port, w.index, e, w.accumulate, w.relative, w.entry)
+                       for w, e in zip(writes, exprs))
+    return Block(tuple(kept), new_writes, tuple((s, e) for s, e in assignments), loop)
+
+
+def dense_writes(port: str, matrix: sp.Matrix) -> list[Write]:
+    """Row-major writes of a matrix into a flat port, skipping structural zeros."""
+    return [Write(port, i * matrix.cols + j, matrix[i, j]) for i in range(matrix.rows)
+            for j in range(matrix.cols) if matrix[i, j] != 0]
+
+
+def kernel(name: str, doc: str, inputs: list[Port], outputs: list[Port], blocks: list[Block],
+           sizes: tuple[str, ...] = (), meta: dict | None = None) -> KernelIR:
+    """Assemble a KernelIR, appending one integer slot input per block with sparse writes."""
+    ir = KernelIR(name, doc, tuple(inputs), tuple(outputs), tuple(blocks), sizes, meta or {})
+    slots = [Port(port, _scaled(ir.blocks[i].loop.count, len(ir.blocks[i].entries)), batched=False,
+                  integer=True, doc=f"CSR slots of block {i}") for i, port in ir.slot_ports()]
+    if slots:
+        ir = KernelIR(name, doc, tuple(inputs) + tuple(slots), tuple(outputs), tuple(blocks), sizes, meta or {})
+    return ir
+
+
+def _scaled(extent, factor: int):
+    return extent.__class__(extent.const * factor, tuple((n, c * factor) for n, c in extent.terms))

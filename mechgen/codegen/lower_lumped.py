@@ -1,0 +1,75 @@
+"""Kernels of a lumped model (no repetition): one straight-line block each.
+
+Kernel names and what they compute (n coordinates, m internal variables):
+
+* ``residual``  r(q, v, a, z, t)                       -> r[n]
+* ``tangent``   dr/dq, dr/dv, dr/da, dr/dz            -> r_q[n*n], r_v[n*n], r_a[n*n], r_z[n*m]
+* ``linear``    M, D, G, K at (q, v, z, t) with a = 0  -> M, D, G, K [n*n]
+* ``force``     -dV/dq                                 -> f[n]
+* ``rates``     dz/dt = g(q, v, z, t)                  -> g[m]
+* ``rates_tangent``                                    -> g_q[m*n], g_v[m*n], g_z[m*m]
+* ``outputs``   declared outputs and energies          -> one port of length 1 each
+"""
+from __future__ import annotations
+
+import sympy as sp
+
+from mechgen.codegen.ir import KernelIR, Port, fixed
+from mechgen.codegen.lower import canonical_block, dense_writes, kernel
+from mechgen.symbolic.derive import LumpedEquations
+
+LUMPED_KERNELS = ("residual", "tangent", "linear", "force", "rates", "rates_tangent", "outputs")
+
+
+def _inputs(eqs: LumpedEquations, with_accel: bool = True) -> tuple[list[Port], list]:
+    n, m = len(eqs.q), len(eqs.z)
+    ports = [Port("q", fixed(n))] + [Port("v", fixed(n))]
+    if with_accel:
+        ports.append(Port("a", fixed(n)))
+    ports += [Port("z", fixed(m)), Port("t", fixed(1)), Port("p", fixed(len(eqs.params)), batched=False)]
+    gathers = [(s, "q", i, False) for i, s in enumerate(eqs.q)]
+    gathers += [(s, "v", i, False) for i, s in enumerate(eqs.v)]
+    if with_accel:
+        gathers += [(s, "a", i, False) for i, s in enumerate(eqs.a)]
+    gathers += [(s, "z", i, False) for i, s in enumerate(eqs.z)] + [(eqs.t, "t", 0, False)]
+    gathers += [(s, "p", i, False) for i, s in enumerate(eqs.params)]
+    return ports, gathers
+
+
+def _matrix_kernel(eqs: LumpedEquations, name: str, doc: str, mats: dict[str, sp.Matrix], *, accel: bool,
+                   cse: bool, symmetric: tuple[str, ...] = ()) -> KernelIR:
+    inputs, gathers = _inputs(eqs, accel)
+    outputs = [Port(k, fixed(m.rows * m.cols), shape=(m.rows, m.cols), symmetric=k in symmetric)
+               for k, m in mats.items()]
+    writes = [w for k, m in mats.items() for w in dense_writes(k, m)]
+    block = canonical_block(gathers, writes, cse=cse, model=eqs.model)
+    return kernel(name, doc, inputs, outputs, [block], meta=_meta(eqs))
+
+
+def _meta(eqs: LumpedEquations) -> dict:
+    return {"model": eqs.model, "coordinates": list(eqs.coordinates), "internal": list(eqs.internal_names),
+            "params": list(eqs.param_names), "kind": "lumped"}
+
+
+def lower_lumped(eqs: LumpedEquations, name: str, *, cse: bool = True) -> KernelIR:
+    """Build the KernelIR of kernel ``name`` (one of :data:`LUMPED_KERNELS`)."""
+    r = eqs.residual
+    if name == "residual":
+        return _matrix_kernel(eqs, name, "Lagrange residual r = M a - f", {"r": r}, accel=True, cse=cse)
+    if name == "tangent":
+        mats = {f"r_{w}": eqs.jacobian(r, w) for w in ("q", "v", "a", "z")}
+        return _matrix_kernel(eqs, name, "Jacobians of the residual", mats, accel=True, cse=cse)
+    if name == "linear":
+        return _matrix_kernel(eqs, name, "M, D, G, K of the linearisation (a = 0)", eqs.linear_matrices(),
+                              accel=False, cse=cse, symmetric=("M", "D"))
+    if name == "force":
+        return _matrix_kernel(eqs, name, "potential force -dV/dq", {"f": eqs.force()}, accel=False, cse=cse)
+    if name == "rates":
+        return _matrix_kernel(eqs, name, "internal rates dz/dt", {"g": eqs.rates}, accel=False, cse=cse)
+    if name == "rates_tangent":
+        mats = {f"g_{w}": eqs.jacobian(eqs.rates, w) for w in ("q", "v", "z")}
+        return _matrix_kernel(eqs, name, "Jacobians of the internal rates", mats, accel=False, cse=cse)
+    if name == "outputs":
+        mats = {k: sp.Matrix([[e]]) for k, e in eqs.outputs.items()}
+        return _matrix_kernel(eqs, name, "named outputs", mats, accel=False, cse=cse)
+    raise KeyError(name)

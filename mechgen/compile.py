@@ -1,0 +1,154 @@
+"""The compiler pipeline: declare -> derive -> lower -> emit -> build -> load.
+
+``compile_model(model, spec, kernels, backend)`` returns a
+:class:`~mechgen.runtime.system.System` ready for the analyses and a
+:class:`BuildReport` saying which kernels were built, their operation counts,
+the time of each stage and whether the artefact came from the cache.
+"""
+from __future__ import annotations
+
+import logging
+import os
+import tempfile
+import time
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from mechgen.codegen.emit_c import emit_c
+from mechgen.codegen.emit_casadi import emit_casadi
+from mechgen.codegen.emit_numpy import emit_numpy
+from mechgen.codegen.ir import KernelIR
+from mechgen.codegen.lower_lattice import LATTICE_KERNELS, lower_lattice
+from mechgen.codegen.lower_lumped import LUMPED_KERNELS, lower_lumped
+from mechgen.codegen.spec import kernel_spec
+from mechgen.errors import CompilerUnavailable, InputError
+from mechgen.runtime.kernels import c_kernels, casadi_kernels, load_module, numpy_kernels
+from mechgen.runtime.system import System
+from mechgen.symbolic.derive import derive_lumped
+from mechgen.symbolic.lattice import derive_lattice
+from mechgen.symbolic.model import Model
+from mechgen.symbolic.specialize import Specialization
+
+log = logging.getLogger("mechgen")
+BACKENDS = ("c", "numpy", "casadi")
+_warned_no_compiler = False
+
+
+@dataclass
+class BuildReport:
+    """What a compilation did: kernels, operation counts, stage times (s), cache use."""
+
+    backend: str
+    kernels: dict = field(default_factory=dict)
+    seconds: dict = field(default_factory=dict)
+    cached: bool = False
+
+    def to_json(self) -> dict:
+        """JSON form for results."""
+        return {"backend": self.backend, "kernels": self.kernels, "seconds": self.seconds, "cached": self.cached}
+
+
+def all_kernels(model: Model) -> tuple[str, ...]:
+    """Every kernel a model can have."""
+    if model.is_lattice:
+        return LATTICE_KERNELS
+    if model.internals:
+        return LUMPED_KERNELS
+    return tuple(k for k in LUMPED_KERNELS if not k.startswith("rates"))
+
+
+def derive(model: Model, spec: Specialization):
+    """Derived equations (lumped or lattice) of a specialisation."""
+    return derive_lattice(model, spec) if model.is_lattice else derive_lumped(model, spec)
+
+
+def lower_all(model: Model, eqs, kernels, *, cse: bool = True) -> list[KernelIR]:
+    """KernelIRs of the requested kernels, in canonical order."""
+    lower = lower_lattice if model.is_lattice else lower_lumped
+    return [lower(eqs, k, cse=cse) for k in all_kernels(model) if k in kernels]
+
+
+def emit(backend: str, irs: list[KernelIR], *, model: str, title: str) -> str:
+    """Source text of one backend."""
+    return {"c": emit_c, "numpy": emit_numpy, "casadi": emit_casadi}[backend](irs, model=model, title=title)
+
+
+def _store_text(kind: str, key: str, filename: str, text: str) -> Path:
+    """Write a generated text into the cache atomically (temp file + rename)."""
+    from mechgen.codegen.cache import cache_root
+
+    folder = cache_root() / kind / key[:2]
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / f"{key}_{filename}"
+    if path.exists() and path.read_text() == text:
+        return path
+    fd, tmp = tempfile.mkstemp(dir=folder, prefix=".tmp-")
+    with os.fdopen(fd, "w") as fh:
+        fh.write(text)
+    os.replace(tmp, path)
+    return path
+
+
+def _load(backend: str, text: str, specs: dict, key: str, report: BuildReport):
+    if backend == "c":
+        from mechgen.codegen.build import build_shared, get_caller
+
+        try:
+            lib = build_shared(text, stem="mgkernels")
+        except CompilerUnavailable:
+            global _warned_no_compiler
+            if not _warned_no_compiler:
+                warnings.warn("no C compiler found: falling back to the numpy backend", RuntimeWarning,
+                              stacklevel=3)
+                _warned_no_compiler = True
+            report.backend = "numpy"
+            return None
+        return c_kernels(lib, specs, get_caller())
+    name = f"mg_{backend}_{key[:16]}"
+    path = _store_text(backend, key, f"{name}.py", text)
+    module = load_module(path, name)
+    return numpy_kernels(module) if backend == "numpy" else casadi_kernels(module, specs)
+
+
+def compile_model(model: Model, spec: Specialization, *, kernels=None, backend: str = "c", cse: bool = True,
+                  sites: int | None = None) -> tuple[System, BuildReport]:
+    """Derive, generate, build and load the kernels a set of analyses needs."""
+    from mechgen.codegen.cache import content_key
+
+    if backend not in BACKENDS:
+        raise InputError(f"unknown backend {backend!r}", key="backend", expected=", ".join(BACKENDS))
+    kernels = set(kernels or all_kernels(model))
+    report = BuildReport(backend)
+    clock = time.perf_counter()
+    eqs = derive(model, spec)
+    report.seconds["derive"] = time.perf_counter() - clock
+    clock = time.perf_counter()
+    irs = lower_all(model, eqs, kernels, cse=cse)
+    report.seconds["lower"] = time.perf_counter() - clock
+    loaded = None
+    while loaded is None:
+        clock = time.perf_counter()
+        text = emit(report.backend, irs, model=model.name, title=spec.key())
+        report.seconds["emit"] = time.perf_counter() - clock
+        clock = time.perf_counter()
+        specs = {ir.name: kernel_spec(ir) for ir in irs}
+        key = content_key(report.backend, text)
+        loaded = _load(report.backend, text, specs, key, report)
+        report.seconds["build"] = time.perf_counter() - clock
+    report.kernels = {ir.name: {"ops": specs[ir.name]["ops"]} for ir in irs}
+    values = np.array([float(spec_value(model, spec, n)) for n in eqs.param_names])
+    meta = dict(next(iter(specs.values()))["meta"]) if specs else {}
+    if model.is_lattice:
+        sites = int(sites if sites is not None else spec.values.get(model.chain_spec.sites,
+                                                                    model.param(model.chain_spec.sites).default))
+    system = System(loaded, meta, values, sites or 0, report.backend)
+    log.info("built %s [%s]: %s", model.name, report.backend, report.seconds)
+    return system, report
+
+
+def spec_value(model: Model, spec: Specialization, name: str) -> float:
+    """Value of a free parameter: the scene's starting value, else the default."""
+    return spec.free_values.get(name, model.param(name).default)

@@ -1,0 +1,171 @@
+"""A compiled system: the kernels of one model specialisation with its parameter values.
+
+State of a lumped model: coordinates q (n), velocities v (n), internal
+variables z (m), time t. Equations (see mechgen.symbolic.derive):
+
+    r(q, v, a, z, t) = M(q) a - f(q, v, z, t) = 0,    dz/dt = g(q, v, z, t).
+
+First-order form x = (q, v, z): dq/dt = v, dv/dt = a = -M^-1 r(q, v, 0, z, t), dz/dt = g,
+with the exact Jacobian da/dx = -M^-1 dr/dx evaluated at the current a.
+Chain models have the same interface with sparse (CSR) matrices.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sps
+import scipy.sparse.linalg as spla
+
+from mechgen.runtime.kernels import Kernel
+from mechgen.runtime.pattern import Pattern, build_pattern
+
+
+@dataclass
+class System:
+    """Kernels plus numbers: the object every analysis works on."""
+
+    kernels: dict[str, Kernel]
+    meta: dict
+    params: np.ndarray
+    sites: int = 0
+    backend: str = "numpy"
+    patterns: dict = field(default_factory=dict)
+
+    # -- shape --------------------------------------------------------------
+    @property
+    def is_lattice(self) -> bool:
+        """True for chain models (sparse matrices)."""
+        return self.meta.get("kind") == "lattice"
+
+    @property
+    def n(self) -> int:
+        """Number of degrees of freedom."""
+        return self.sites if self.is_lattice else len(self.meta["coordinates"])
+
+    @property
+    def m(self) -> int:
+        """Number of internal variables."""
+        return len(self.meta.get("internal", []))
+
+    @property
+    def coordinates(self) -> list[str]:
+        """Coordinate names (for a chain: name_1 .. name_N)."""
+        if self.is_lattice:
+            return [f"{self.meta['coordinates'][0]}_{i + 1}" for i in range(self.sites)]
+        return list(self.meta["coordinates"])
+
+    def sizes(self, kernel: str) -> dict:
+        """Runtime sizes of ``kernel``."""
+        if not self.is_lattice:
+            return {}
+        sizes = {"sites": self.sites}
+        if "nnz" in self.kernels[kernel].spec["sizes"]:
+            sizes["nnz"] = self.pattern(kernel).nnz
+        return sizes
+
+    def pattern(self, kernel: str) -> Pattern:
+        """CSR pattern of ``kernel``'s sparse outputs (built once)."""
+        if kernel not in self.patterns:
+            self.patterns[kernel] = build_pattern(self.kernels[kernel].spec, self.sites)
+        return self.patterns[kernel]
+
+    # -- evaluation -----------------------------------------------------------
+    def call(self, kernel: str, **state) -> dict:
+        """Evaluate ``kernel`` at a state (missing state entries are zero)."""
+        k = self.kernels[kernel]
+        inputs = {}
+        for port in k.spec["inputs"]:
+            name = port["name"]
+            if name == "p":
+                inputs[name] = self.params
+            elif port["integer"]:
+                inputs[name] = self.pattern(kernel).slots[name]
+            elif name == "t":
+                inputs[name] = np.atleast_1d(np.asarray(state.get("t", 0.0), dtype=float))
+            else:
+                length = self.m if name == "z" else self.n
+                value = state.get(name)
+                inputs[name] = np.zeros(length) if value is None else np.asarray(value, dtype=float)
+        out = k.evaluate(inputs, self.sizes(kernel))
+        return self._shape(kernel, out)
+
+    def _shape(self, kernel: str, out: dict) -> dict:
+        shaped = {}
+        for port in self.kernels[kernel].spec["outputs"]:
+            value = out[port["name"]]
+            if port["sparse"]:
+                shaped[port["name"]] = self.pattern(kernel).matrix(value)
+            elif port["shape"] and value.ndim == 1:
+                shaped[port["name"]] = value.reshape(port["shape"])
+            else:
+                shaped[port["name"]] = value
+        return shaped
+
+    def residual(self, q, v=None, a=None, z=None, t=0.0) -> np.ndarray:
+        """r(q, v, a, z, t)."""
+        return self.call("residual", q=q, v=v, a=a, z=z, t=t)["r"].ravel()
+
+    def linear(self, q=None, v=None, z=None, t=0.0) -> dict:
+        """M, D, G, K of the linearisation at (q, v, z, t) (a = 0)."""
+        mats = self.call("linear", q=q, v=v, z=z, t=t)
+        if self.is_lattice:
+            mats["G"] = sps.csr_matrix((self.n, self.n))
+        return mats
+
+    def outputs(self, q, v=None, z=None, t=0.0) -> dict[str, float]:
+        """Named outputs and energies at a state."""
+        return {k: float(np.asarray(val).ravel()[0]) for k, val in
+                self.call("outputs", q=q, v=v, z=z, t=t).items()}
+
+    def force(self, q, t=0.0) -> np.ndarray:
+        """Potential force -dV/dq."""
+        return self.call("force", q=q, t=t)["f"].ravel()
+
+    # -- first-order form -----------------------------------------------------
+    def split(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(q, v, z) of a first-order state x."""
+        n = self.n
+        return x[:n], x[n:2 * n], x[2 * n:]
+
+    def _solve(self, M, rhs):
+        if sps.issparse(M):
+            return spla.spsolve(M.tocsc(), rhs)
+        return sla.solve(M, rhs, assume_a="sym") if rhs.ndim == 1 else sla.solve(M, rhs)
+
+    def acceleration(self, q, v, z=None, t=0.0) -> tuple[np.ndarray, object]:
+        """a = -M^-1 r(q, v, 0, z, t), and M."""
+        tan = self.call("tangent", q=q, v=v, z=z, t=t)
+        M = tan["r_a"]
+        return self._solve(M, -self.residual(q, v, None, z, t)), M
+
+    def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
+        """dx/dt of the first-order form."""
+        q, v, z = self.split(x)
+        a, _ = self.acceleration(q, v, z, t)
+        parts = [v, a]
+        if self.m:
+            parts.append(self.call("rates", q=q, v=v, z=z, t=t)["g"].ravel())
+        return np.concatenate(parts)
+
+    def jacobian(self, t: float, x: np.ndarray):
+        """d(dx/dt)/dx, exact: da/dx = -M^-1 [r_q, r_v, r_z] at the current acceleration."""
+        q, v, z = self.split(x)
+        a, _ = self.acceleration(q, v, z, t)
+        tan = self.call("tangent", q=q, v=v, a=a, z=z, t=t)
+        n, m = self.n, self.m
+        blocks = [tan["r_q"], tan["r_v"]] + ([tan["r_z"]] if m else [])
+        if self.is_lattice:
+            rhs = sps.hstack(blocks).tocsc()
+            da = -spla.spsolve(tan["r_a"].tocsc(), rhs)
+            top = sps.hstack([sps.csr_matrix((n, n)), sps.identity(n), sps.csr_matrix((n, m))])
+            return sps.vstack([top, sps.csr_matrix(da)]).tocsc()
+        da = -self._solve(tan["r_a"], np.hstack(blocks))
+        J = np.zeros((2 * n + m, 2 * n + m))
+        J[:n, n:2 * n] = np.eye(n)
+        J[n:2 * n] = da
+        if m:
+            g = self.call("rates_tangent", q=q, v=v, z=z, t=t)
+            J[2 * n:] = np.hstack([g["g_q"], g["g_v"], g["g_z"]])
+        return J

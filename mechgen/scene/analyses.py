@@ -1,0 +1,150 @@
+"""One function per analysis kind: (system, options, context) -> outputs dict.
+
+Each states the kernels it needs in :data:`NEEDS`, so a scene compiles only those.
+Output names follow DESIGN.md: ``frequencies``; ``eigenvalues`` (list of [re, im])
+and ``verdict``; ``grid`` plus one array per output for sweeps.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from mechgen.errors import SceneError
+from mechgen.runtime.integrate import integrate_first_order, leapfrog
+from mechgen.runtime.modes import modes as solve_modes
+from mechgen.runtime.newton import newton
+from mechgen.runtime.stability import stability as solve_stability
+from mechgen.runtime.system import System
+
+
+def needs(kind: str, options: dict, *, internal: bool) -> set[str]:
+    """Kernels an analysis needs."""
+    if kind in ("modes", "stability"):
+        return {"linear"}
+    if kind == "steady":
+        return {"residual", "tangent", "outputs"} | ({"rates", "rates_tangent"} if internal else set())
+    if kind == "simulate":
+        if options.get("method") == "leapfrog":
+            return {"force", "outputs", "linear"}
+        return {"residual", "tangent", "outputs"} | ({"rates", "rates_tangent"} if internal else set())
+    if kind == "sweep":
+        inner = options["analysis"]
+        return needs(inner.kind, inner.options, internal=internal)
+    raise KeyError(kind)
+
+
+def _vector(system: System, table: dict | None, base: np.ndarray | None = None) -> np.ndarray:
+    q = np.zeros(system.n) if base is None else np.array(base, dtype=float)
+    names = system.coordinates
+    for name, value in (table or {}).items():
+        q[names.index(name)] = float(value)
+    return q
+
+
+def operating_point(system: System, options: dict, context: dict) -> np.ndarray:
+    """q about which to linearise: a previous steady state, an explicit point, or zero."""
+    if options.get("about"):
+        return np.asarray(context[options["about"]]["_q"])
+    return _vector(system, options.get("at"))
+
+
+def run_modes(system: System, options: dict, context: dict) -> dict:
+    """Natural frequencies (rad/s or the model's unit) about the operating point."""
+    q = operating_point(system, options, context)
+    mats = system.linear(q)
+    res = solve_modes(mats["M"], mats["K"], count=options.get("count"))
+    return {"frequencies": [float(f) for f in res.frequencies], "_shapes": res.shapes}
+
+
+def run_stability(system: System, options: dict, context: dict) -> dict:
+    """Eigenvalues of M q'' + (D + G) q' + K q = 0 and the verdict."""
+    q = operating_point(system, options, context)
+    mats = system.linear(q)
+    dense = {k: (v.toarray() if hasattr(v, "toarray") else v) for k, v in mats.items()}
+    res = solve_stability(dense["M"], dense["D"] + dense["G"], dense["K"], tolerance=options.get("tolerance", 1e-8))
+    eig = [[float(s.real), float(s.imag)] for s in res.eigenvalues]
+    freqs = [float(f) for f in res.frequencies]
+    if options.get("count"):
+        freqs = freqs[: options["count"]]
+    return {"eigenvalues": eig, "verdict": res.verdict, "frequencies": freqs, "growth_rate": float(res.growth_rate)}
+
+
+def run_steady(system: System, options: dict, context: dict) -> dict:
+    """Equilibrium r(q, 0, 0) = 0 by Newton with the generated Jacobian dr/dq."""
+    q0 = _vector(system, options.get("guess"))
+    res = newton(lambda q: system.residual(q), lambda q: system.call("tangent", q=q)["r_q"], q0,
+                 tol=options.get("tol", 1e-10), max_iter=options.get("max_iter", 50))
+    out = {"iterations": int(res.iterations), "residual_norm": float(res.residual_norm)}
+    if not system.is_lattice:
+        out["coordinates"] = {n: float(x) for n, x in zip(system.coordinates, res.x)}
+    out.update(system.outputs(res.x))
+    out["_q"] = res.x
+    return out
+
+
+def initial_state(system: System, options: dict) -> tuple[np.ndarray, np.ndarray]:
+    """(q0, v0) from the options: tables of coordinates, or a linear mode times an amplitude."""
+    q0, v0 = _vector(system, options.get("q0")), _vector(system, options.get("v0"))
+    if options.get("initial_mode"):
+        k = int(options["initial_mode"])
+        if k > system.n:
+            raise SceneError(f"initial_mode {k} exceeds the {system.n} degrees of freedom", key="initial_mode",
+                             expected=f"an integer from 1 to {system.n}")
+        mats = system.linear(np.zeros(system.n))
+        shapes = solve_modes(mats["M"], mats["K"]).shapes
+        shape = shapes[:, k - 1] / np.max(np.abs(shapes[:, k - 1]))
+        q0 = q0 + options.get("amplitude", 1.0) * shape * np.sign(shape[np.argmax(np.abs(shape))])
+    return q0, v0
+
+
+def mode_energies(system: System, q: np.ndarray, v: np.ndarray, count: int = 8) -> list[float]:
+    """Harmonic energies E_k = (P_k^2 + omega_k^2 Q_k^2)/2 of a fixed-end chain (FPU's observable).
+
+    Q_k = sqrt(2/(N+1)) sum_n q_n sin(n k pi/(N+1)); omega_k from the linear stiffness.
+    """
+    n = system.n
+    idx = np.arange(1, n + 1)
+    k = np.arange(1, min(count, n) + 1)
+    S = np.sqrt(2.0 / (n + 1)) * np.sin(np.outer(k, idx) * np.pi / (n + 1))
+    mats = system.linear(np.zeros(n))
+    omega2 = np.einsum("ki,ij,kj->k", S, mats["K"].toarray(), S)
+    Q, P = S @ q, S @ v
+    return [float(e) for e in 0.5 * (P**2 + omega2 * Q**2)]
+
+
+def run_simulate(system: System, options: dict, context: dict) -> dict:
+    """Time response; reports the model's outputs at t_end and the energy drift."""
+    q0, v0 = initial_state(system, options)
+    t_end = float(options["t_end"])
+    energy = lambda q, v: system.outputs(q, v)["energy"]  # noqa: E731
+    if options.get("method") == "leapfrog":
+        dt = float(options["dt"])
+        steps = int(round(t_end / dt))
+        mats = system.linear(np.zeros(system.n))
+        M = mats["M"]
+        minv = 1.0 / (M.diagonal() if hasattr(M, "diagonal") else np.diag(M))
+        traj = leapfrog(lambda q: system.force(q) * minv, q0, v0, dt, steps,
+                        record_every=max(1, steps // 1000), energy=energy)
+        q_end, v_end, ts, energies = traj.q[-1], traj.v[-1], traj.t, np.asarray(traj.energy)
+    else:
+        x0 = np.concatenate([q0, v0, np.zeros(system.m)])
+        n_out = int(options.get("samples", 201))
+        t_eval = np.linspace(0.0, t_end, n_out)
+        traj = integrate_first_order(system.rhs, x0, t_end, jac=system.jacobian, method=options.get("method", "BDF"),
+                                     rtol=options.get("rtol", 1e-8), atol=options.get("atol", 1e-10), t_eval=t_eval)
+        xs = traj.x if traj.x.shape[0] == len(traj.t) else traj.x.T
+        q_end, v_end = xs[-1, :system.n], xs[-1, system.n:2 * system.n]
+        ts = traj.t
+        energies = np.array([energy(x[:system.n], x[system.n:2 * system.n]) for x in xs])
+    out = system.outputs(q_end, v_end)
+    e0 = energies[0]
+    out["energy_drift"] = float(np.max(np.abs(energies - e0)) / max(abs(e0), 1e-300))
+    out["t_end"] = t_end
+    if system.is_lattice and system.meta.get("ends") == "fixed":
+        out["mode_energies"] = mode_energies(system, q_end, v_end)
+    if options.get("series"):
+        out["t"] = [float(t) for t in ts]
+        out["energy_series"] = [float(e) for e in energies]
+    return out
+
+
+RUNNERS = {"modes": run_modes, "stability": run_stability, "steady": run_steady, "simulate": run_simulate}

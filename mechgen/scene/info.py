@@ -1,0 +1,40 @@
+"""Model facts the scene loader validates against (names only, nothing symbolic)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from mechgen import models
+from mechgen.errors import InputError
+
+
+@dataclass(frozen=True)
+class ParamInfo:
+    """What a scene may set for one parameter."""
+
+    default: float | str
+    choices: tuple[str, ...] | None
+    integer: bool
+
+
+@dataclass(frozen=True)
+class ModelInfo:
+    """Names of a model's parameters, coordinates and outputs."""
+
+    name: str
+    params: dict
+    coordinates: tuple[str, ...]
+    outputs: tuple[str, ...]
+
+
+def lookup_model(name: str) -> ModelInfo | None:
+    """ModelInfo of a built-in model, or None when there is no such model."""
+    try:
+        model = models.get(name)
+    except InputError:
+        return None
+    params = {p.name: ParamInfo(p.default, p.choices, p.integer) for p in model.param_list}
+    coords = model.coordinates_all
+    if model.is_lattice:
+        n = int(model.param(model.chain_spec.sites).default)
+        coords = tuple(f"{model.chain_spec.coordinate}_{i + 1}" for i in range(n))
+    return ModelInfo(model.name, params, coords, model.output_names)

@@ -1,0 +1,92 @@
+"""Running a scene: load and validate, compile what the analyses need, run them, collect results.
+
+Result dict (DESIGN.md): {"scene", "model", "backend", "analyses": [{"name", "kind", "outputs", "seconds"}]}
+plus "build" (kernels built, operation counts, stage times). Entries whose name
+starts with "_" are working data and never reach JSON.
+"""
+from __future__ import annotations
+
+import time
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from mechgen import models
+from mechgen.compile import compile_model
+from mechgen.errors import InputError
+from mechgen.runtime.sweep import sweep
+from mechgen.scene.analyses import RUNNERS, needs
+from mechgen.scene.info import lookup_model
+from mechgen.scene.load import load_scene
+from mechgen.symbolic.specialize import specialize
+
+
+def _public(outputs: dict) -> dict:
+    return {k: v for k, v in outputs.items() if not k.startswith("_")}
+
+
+@lru_cache(maxsize=8)
+def _system_for(model_name: str, values: tuple, free: tuple, active, kernels: tuple, backend: str):
+    model = models.get(model_name)
+    spec = specialize(model, dict(values), free=free, active=active)
+    return compile_model(model, spec, kernels=set(kernels), backend=backend)
+
+
+def _sweep_point(task: tuple) -> dict:
+    """Run the inner analysis of a sweep at one grid point (module level: picklable)."""
+    model_name, values, free, active, kernels, backend, kind, options, point = task
+    system, _ = _system_for(model_name, values, free, active, kernels, backend)
+    model = models.get(model_name)
+    sizes = {k: v for k, v in point.items() if model.param(k).size}
+    if sizes:
+        system, _ = _system_for(model_name, tuple(sorted({**dict(values), **sizes}.items())), free, active,
+                                kernels, backend)
+    system.params = np.array([float(point.get(n, dict(values).get(n, model.param(n).default)))
+                              for n in system.meta.get("params", [])])
+    return _public(RUNNERS[kind](system, options, {}))
+
+
+def _collect(grid: list[dict], results: list[dict]) -> dict:
+    out: dict = {"grid": grid}
+    for key in results[0] if results else []:
+        out[key] = [r.get(key) for r in results]
+    return out
+
+
+def run_scene(scene, *, overrides=(), backend: str | None = None) -> dict:
+    """Run every analysis of a scene file and return the results dict."""
+    scn = load_scene(str(scene), overrides=list(overrides), lookup_model=lookup_model, model_names=models.names)
+    model = models.get(scn.model)
+    backend = backend or scn.backend
+    internal = bool(model.internals)
+    kernels = sorted(set().union(*(needs(a.kind, a.options, internal=internal) for a in scn.analyses)))
+    free = tuple(scn.free)
+    fixed = tuple(sorted((k, v) for k, v in scn.params.items()))
+    started = time.perf_counter()
+    system, report = _system_for(scn.model, fixed, free, scn.active, tuple(kernels), backend)
+    results = {"scene": Path(scn.path).name, "title": scn.title, "model": scn.model, "backend": report.backend,
+               "params": dict(scn.params), "build": report.to_json(), "analyses": []}
+    results["build"]["seconds_total"] = time.perf_counter() - started
+    context: dict = {}
+    for analysis in scn.analyses:
+        clock = time.perf_counter()
+        if analysis.kind == "sweep":
+            inner = analysis.options["analysis"]
+            tasks = [(scn.model, fixed, free, scn.active, tuple(kernels), backend, inner.kind, dict(inner.options),
+                      point) for point in analysis.options["grid"]]
+            res = sweep(_sweep_point, tasks, workers=analysis.options.get("workers", 0),
+                        progress=analysis.options.get("progress", True), desc=analysis.name)
+            outputs = _collect(analysis.options["grid"], res)
+        else:
+            outputs = RUNNERS[analysis.kind](system, dict(analysis.options), context)
+        context[analysis.name] = outputs
+        results["analyses"].append({"name": analysis.name, "kind": analysis.kind, "outputs": _public(outputs),
+                                    "seconds": time.perf_counter() - clock})
+    return results
+
+
+def check_backend(name: str | None) -> None:
+    """Validate a --backend value."""
+    if name is not None and name not in ("c", "numpy", "casadi"):
+        raise InputError(f"unknown backend {name!r}", key="--backend", expected="c, numpy or casadi")

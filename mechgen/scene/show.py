@@ -1,0 +1,44 @@
+"""``mechgen show MODEL``: the derived equations and matrices, as text."""
+from __future__ import annotations
+
+import sympy as sp
+
+from mechgen import models
+from mechgen.compile import derive
+from mechgen.symbolic.specialize import all_free
+
+
+def _lumped(eqs) -> list[str]:
+    lines = [f"coordinates q = {list(eqs.coordinates)}; velocities v = dq/dt; accelerations a = dv/dt",
+             f"internal variables z = {list(eqs.internal_names)}" if eqs.z else "no internal variables",
+             f"T = {eqs.kinetic}", f"V = {eqs.potential}", "", "residual r = d/dt(dT/dv) - dT/dq + dV/dq + dR/dv - Q:"]
+    lines += [f"  r[{n}] = {sp.simplify(e)}" for n, e in zip(eqs.coordinates, eqs.residual)]
+    if eqs.z:
+        lines += [f"  d{n}/dt = {e}" for n, e in zip(eqs.internal_names, eqs.rates)]
+    lines.append("")
+    lines.append("linearisation at q = 0, v = 0 (M q'' + (D + G) q' + K q = 0):")
+    rest = {s: 0 for s in eqs.q + eqs.v + eqs.z}
+    for name, mat in eqs.linear_matrices().items():
+        lines.append(f"{name} =")
+        lines += ["  " + line for line in sp.pretty(sp.simplify(mat.subs(rest)), use_unicode=False).splitlines()]
+    return lines
+
+
+def _lattice(eqs) -> list[str]:
+    return [f"chain of {eqs.sites} sites, coordinate {eqs.coordinate}, {eqs.ends} ends",
+            f"site kinetic T_s = {eqs.site_kinetic}", f"site potential V_s = {eqs.site_potential}",
+            f"bond potential V_b = {eqs.bond_potential}", f"site residual r_s = {eqs.site_residual}",
+            f"bond gradient = {eqs.bond_gradient()}", f"bond Hessian = {eqs.bond_hessian()}"]
+
+
+def show_model(name: str) -> str:
+    """Text of a model's parameters, derived residual and linear matrices (all parameters symbolic)."""
+    model = models.get(name)
+    eqs = derive(model, all_free(model))
+    lines = [f"model {model.name}: {model.summary()}", "parameters:"]
+    lines += [f"  {p.name:10s} = {p.default!r:10} {p.unit:10s} {p.doc}" for p in model.param_list]
+    lines.append("")
+    lines += _lattice(eqs) if model.is_lattice else _lumped(eqs)
+    lines.append("")
+    lines.append("outputs: " + ", ".join(model.output_names))
+    return "\n".join(lines)

@@ -1,0 +1,135 @@
+"""derive: declared energies of a lumped model -> equations of motion and their Jacobians.
+
+Lagrange's equations with Rayleigh dissipation R and non-conservative forces Q,
+written as a residual in the accelerations a = dv/dt::
+
+    r(q, v, a, z, t) = d/dt(dT/dv) - dT/dq + dV/dq + dR/dv - Q = M(q) a - f(q, v, z, t)
+
+with d/dt(dT/dv) = (d2T/dv dv) a + (d2T/dv dq) v + d2T/dv dt. Internal variables
+obey dz/dt = g(q, v, z, t). Everything downstream (time integration, Newton,
+linearisation) uses r, g and their Jacobians:
+
+    M = dr/da,  C = dr/dv,  K = dr/dq   (at a = 0: the linearised system M q'' + C q' + K q = 0)
+    G = (C - C^T)/2 (gyroscopic),  D = (C + C^T)/2 (damping).
+
+K holds the centrifugal terms (-d2T/dq2) and any circulatory part of Q.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import sympy as sp
+
+from mechgen.errors import ModelError
+from mechgen.symbolic.model import Model, call_declared
+from mechgen.symbolic.params import Namespace
+from mechgen.symbolic.specialize import Specialization, param_namespace
+
+TIME = sp.Symbol("t", real=True)
+
+
+@dataclass(frozen=True)
+class LumpedEquations:
+    """The derived equations of a lumped model under one specialisation."""
+
+    model: str
+    coordinates: tuple[str, ...]
+    q: tuple[sp.Symbol, ...]
+    v: tuple[sp.Symbol, ...]
+    a: tuple[sp.Symbol, ...]
+    z: tuple[sp.Symbol, ...]
+    params: tuple[sp.Symbol, ...]
+    param_names: tuple[str, ...]
+    internal_names: tuple[str, ...]
+    kinetic: sp.Expr
+    potential: sp.Expr
+    residual: sp.Matrix
+    rates: sp.Matrix
+    outputs: dict
+
+    @property
+    def t(self) -> sp.Symbol:
+        """The time symbol."""
+        return TIME
+
+    def jacobian(self, what: sp.Matrix, wrt: str) -> sp.Matrix:
+        """d(what)/d(wrt) for wrt in 'q', 'v', 'a', 'z' (an empty matrix when wrt is empty)."""
+        syms = getattr(self, wrt)
+        if not syms:
+            return sp.zeros(what.rows, 0)
+        return what.jacobian(sp.Matrix(syms))
+
+    def linear_matrices(self) -> dict[str, sp.Matrix]:
+        """M, D, G, K of the linearisation about (q, v, z) with a = 0."""
+        at_rest = {ai: 0 for ai in self.a}
+        M = self.jacobian(self.residual, "a").subs(at_rest)
+        C = self.jacobian(self.residual, "v").subs(at_rest)
+        K = self.jacobian(self.residual, "q").subs(at_rest)
+        return {"M": M, "D": (C + C.T) / 2, "G": (C - C.T) / 2, "K": K}
+
+    def force(self) -> sp.Matrix:
+        """Potential force -dV/dq (for symplectic integration of separable systems)."""
+        return -sp.Matrix([self.potential]).jacobian(sp.Matrix(self.q)).T
+
+
+def _state_symbols(model: Model, spec: Specialization):
+    names = [c for c in model.coordinate_names if spec.active is None or c in spec.active]
+    q = tuple(sp.Symbol(n, real=True) for n in names)
+    v = tuple(sp.Symbol(f"{n}_dot", real=True) for n in names)
+    a = tuple(sp.Symbol(f"{n}_ddot", real=True) for n in names)
+    frozen = {n: sp.Integer(0) for n in model.coordinate_names if n not in names}
+    q_ns = Namespace({**{n: s for n, s in zip(names, q)}, **frozen})
+    v_ns = Namespace({**{n: s for n, s in zip(names, v)}, **frozen})
+    z = tuple(sp.Symbol(i.name, real=True) for i in model.internals)
+    z_ns = Namespace({i.name: s for i, s in zip(model.internals, z)})
+    return tuple(names), q, v, a, z, q_ns, v_ns, z_ns
+
+
+def _scalar(value: object, what: str, model: Model) -> sp.Expr:
+    expr = sp.sympify(value) if isinstance(value, (int, float)) else value
+    if not isinstance(expr, sp.Expr):
+        raise ModelError(f"{what} of model {model.name} returned {type(value).__name__}", file=model.file,
+                         key=what, expected="a sympy expression")
+    return expr
+
+
+def _forces(model: Model, names, env) -> list[sp.Expr]:
+    if model.forces_fn is None:
+        return [sp.Integer(0)] * len(names)
+    raw = call_declared(model.forces_fn, **env)
+    if not isinstance(raw, dict):
+        raw = dict(zip(model.coordinate_names, raw))
+    unknown = set(raw) - set(model.coordinate_names)
+    if unknown:
+        raise ModelError(f"forces name unknown coordinates {sorted(unknown)}", file=model.file, key="forces",
+                         expected=f"keys among {', '.join(model.coordinate_names)}")
+    return [_scalar(raw.get(n, 0), "forces", model) for n in names]
+
+
+def derive_lumped(model: Model, spec: Specialization) -> LumpedEquations:
+    """Derive the residual, internal rates and outputs of a lumped model."""
+    if model.is_lattice:
+        raise ModelError(f"model {model.name} is a lattice; use derive_lattice", file=model.file)
+    names, q, v, a, z, q_ns, v_ns, z_ns = _state_symbols(model, spec)
+    p_ns, free = param_namespace(model, spec)
+    env = {"q": q_ns, "v": v_ns, "z": z_ns, "p": p_ns, "t": TIME}
+    zero = sp.Integer(0)
+    T = _scalar(call_declared(model.kinetic_fn, **env), "kinetic", model) if model.kinetic_fn else zero
+    V = _scalar(call_declared(model.potential_fn, **env), "potential", model) if model.potential_fn else zero
+    R = _scalar(call_declared(model.dissipation_fn, **env), "dissipation", model) if model.dissipation_fn else zero
+    Q = _forces(model, names, env)
+    res = []
+    for i, vi in enumerate(v):
+        dT_dv = sp.diff(T, vi)
+        ddt = sum((sp.diff(dT_dv, aj_v) * aj for aj_v, aj in zip(v, a)), zero)
+        ddt += sum((sp.diff(dT_dv, qj) * vj for qj, vj in zip(q, v)), zero) + sp.diff(dT_dv, TIME)
+        res.append(ddt - sp.diff(T, q[i]) + sp.diff(V, q[i]) + sp.diff(R, vi) - Q[i])
+    rates = [_scalar(call_declared(i.rate, **env), f"rate of {i.name}", model) for i in model.internals]
+    outputs = {o.name: _scalar(call_declared(o.fn, **env), f"output {o.name}", model) for o in model.outputs}
+    outputs.update(kinetic_energy=T, potential_energy=V, energy=T + V)
+    return LumpedEquations(
+        model=model.name, coordinates=names, q=q, v=v, a=a, z=z, params=free,
+        param_names=tuple(s.name for s in free), internal_names=tuple(i.name for i in model.internals),
+        kinetic=T, potential=V, residual=sp.Matrix(res) if res else sp.zeros(0, 1),
+        rates=sp.Matrix(rates) if rates else sp.zeros(0, 1), outputs=outputs,
+    )

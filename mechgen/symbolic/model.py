@@ -1,0 +1,216 @@
+"""Declaring a model: parameters, coordinates, energies, forces, internal variables, outputs.
+
+A :class:`Model` only records what the user declares; nothing symbolic happens
+until :func:`mechgen.symbolic.derive.derive` calls the declared functions on
+symbols. Declared functions receive, by parameter name, any of
+
+* ``q`` - generalized coordinates (a :class:`Namespace` of sympy symbols),
+* ``v`` - generalized velocities dq/dt,
+* ``z`` - internal variables (their own first-order evolution laws),
+* ``p`` - parameters (symbols, numbers once a scene fixes them, strings for choices),
+* ``t`` - time.
+
+A lattice model (:meth:`Model.chain`) declares instead one *site* and one
+*bond* energy; see :mod:`mechgen.symbolic.lattice`.
+"""
+from __future__ import annotations
+
+import inspect
+from dataclasses import dataclass
+from typing import Callable
+
+from mechgen.errors import ModelError
+from mechgen.symbolic.names import RESERVED, check_identifier
+from mechgen.symbolic.params import Namespace, Param
+
+ARG_NAMES = ("q", "v", "z", "p", "t")
+
+
+@dataclass(frozen=True)
+class Output:
+    """A named output evaluated on demand from the state."""
+
+    name: str
+    fn: Callable
+    unit: str = ""
+    doc: str = ""
+
+
+@dataclass(frozen=True)
+class Internal:
+    """An internal variable z with dz/dt = rate(q, v, z, p, t)."""
+
+    name: str
+    rate: Callable
+    initial: float = 0.0
+    doc: str = ""
+
+
+@dataclass(frozen=True)
+class Chain:
+    """A one-dimensional lattice: ``sites`` (a size parameter) identical sites.
+
+    ``ends`` is ``"fixed"`` (ghost sites 0 and N+1 held at zero) or
+    ``"periodic"`` (site N+1 is site 1).
+    """
+
+    coordinate: str
+    sites: str
+    ends: str
+
+
+def call_declared(fn: Callable, **available: object) -> object:
+    """Call a declared function with the arguments it names among ``available``."""
+    names = list(inspect.signature(fn).parameters)
+    unknown = [n for n in names if n not in available]
+    if unknown:
+        raise ModelError(f"function {fn.__name__} asks for {unknown}, which this declaration does not provide",
+                         key=fn.__name__, expected=f"parameters among {sorted(available)}")
+    return fn(**{n: available[n] for n in names})
+
+
+class Model:
+    """A mechanical model declared by its energies.
+
+    Example::
+
+        model = Model("spring_pendulum", doc=__doc__)
+        model.params(Param("m", 1.0, "kg"), Param("k", 10.0, "N/m"))
+        model.coordinates("r", "theta")
+
+        @model.kinetic
+        def kinetic(q, v, p):
+            return p.m / 2 * (v.r**2 + q.r**2 * v.theta**2)
+    """
+
+    def __init__(self, name: str, doc: str = "", *, file: str | None = None) -> None:
+        self.name = check_identifier(name, what="model")
+        self.doc = (doc or "").strip()
+        self.file = file
+        self.param_list: list[Param] = []
+        self.coordinate_names: list[str] = []
+        self.internals: list[Internal] = []
+        self.outputs: list[Output] = []
+        self.kinetic_fn: Callable | None = None
+        self.potential_fn: Callable | None = None
+        self.dissipation_fn: Callable | None = None
+        self.forces_fn: Callable | None = None
+        self.chain_spec: Chain | None = None
+        self.site_kinetic_fn: Callable | None = None
+        self.site_potential_fn: Callable | None = None
+        self.bond_potential_fn: Callable | None = None
+
+    # -- declarations ---------------------------------------------------
+    def params(self, *params: Param) -> Namespace:
+        """Declare parameters; returns a namespace of their symbols."""
+        for prm in params:
+            self._claim(prm.name, "parameter")
+            self.param_list.append(prm)
+        return Namespace({prm.name: prm.symbol for prm in self.param_list})
+
+    def coordinates(self, *names: str) -> tuple[str, ...]:
+        """Declare generalized coordinates (their velocities are ``v.<name>``)."""
+        for name in names:
+            self._claim(name, "coordinate")
+            self.coordinate_names.append(name)
+        return tuple(names)
+
+    def internal(self, name: str, rate: Callable, *, initial: float = 0.0, doc: str = "") -> None:
+        """Declare an internal variable with its evolution law dz/dt = rate(...)."""
+        self._claim(name, "internal variable")
+        self.internals.append(Internal(name, rate, float(initial), doc))
+
+    def output(self, name: str, fn: Callable, *, unit: str = "", doc: str = "") -> None:
+        """Declare a named output, a function of (q, v, z, p, t)."""
+        self._claim(name, "output")
+        self.outputs.append(Output(name, fn, unit, doc))
+
+    def chain(self, coordinate: str, *, sites: str, ends: str = "fixed") -> None:
+        """Declare a lattice of identical sites; ``sites`` names a size parameter."""
+        self._claim(coordinate, "coordinate")
+        if ends not in ("fixed", "periodic"):
+            raise ModelError(f"unknown chain ends {ends!r}", file=self.file, key="chain.ends",
+                             expected="'fixed' or 'periodic'")
+        prm = self.param(sites)
+        if not prm.size:
+            raise ModelError(f"chain sites parameter {sites!r} is not a size parameter", file=self.file,
+                             key="chain.sites", expected="a Param declared with size=True")
+        self.chain_spec = Chain(coordinate, sites, ends)
+
+    def kinetic(self, fn: Callable) -> Callable:
+        """Decorator: kinetic energy T(q, v, p, t)."""
+        self.kinetic_fn = fn
+        return fn
+
+    def potential(self, fn: Callable) -> Callable:
+        """Decorator: potential (strain) energy V(q, p, t)."""
+        self.potential_fn = fn
+        return fn
+
+    def dissipation(self, fn: Callable) -> Callable:
+        """Decorator: Rayleigh dissipation function R(q, v, p), force -dR/dv."""
+        self.dissipation_fn = fn
+        return fn
+
+    def forces(self, fn: Callable) -> Callable:
+        """Decorator: generalized non-conservative forces Q(q, v, z, p, t) as {coordinate: expr}."""
+        self.forces_fn = fn
+        return fn
+
+    def site_kinetic(self, fn: Callable) -> Callable:
+        """Decorator (lattice): kinetic energy of one site, fn(s, p) with s.q, s.v."""
+        self.site_kinetic_fn = fn
+        return fn
+
+    def site_potential(self, fn: Callable) -> Callable:
+        """Decorator (lattice): on-site potential energy, fn(s, p)."""
+        self.site_potential_fn = fn
+        return fn
+
+    def bond_potential(self, fn: Callable) -> Callable:
+        """Decorator (lattice): energy of the bond between neighbours, fn(a, b, p)."""
+        self.bond_potential_fn = fn
+        return fn
+
+    # -- queries ----------------------------------------------------------
+    def param(self, name: str) -> Param:
+        """The parameter called ``name``."""
+        for prm in self.param_list:
+            if prm.name == name:
+                return prm
+        raise ModelError(f"model {self.name} has no parameter {name!r}", file=self.file, key=name,
+                         expected=f"one of {', '.join(p.name for p in self.param_list)}")
+
+    @property
+    def is_lattice(self) -> bool:
+        """True for a chain model (site and bond energies)."""
+        return self.chain_spec is not None
+
+    @property
+    def coordinates_all(self) -> tuple[str, ...]:
+        """Names of the coordinates (the chain's coordinate for a lattice)."""
+        if self.chain_spec:
+            return (self.chain_spec.coordinate,)
+        return tuple(self.coordinate_names)
+
+    @property
+    def output_names(self) -> tuple[str, ...]:
+        """Declared output names plus the energies every model provides."""
+        return tuple(o.name for o in self.outputs) + ("kinetic_energy", "potential_energy", "energy")
+
+    def summary(self) -> str:
+        """First line of the docstring."""
+        return self.doc.splitlines()[0] if self.doc else self.name
+
+    def _claim(self, name: str, what: str) -> None:
+        check_identifier(name, what=what, file=self.file)
+        if name in RESERVED:
+            raise ModelError(f"{what} name {name!r} is reserved", file=self.file, key=name,
+                             expected=f"a name other than {', '.join(sorted(RESERVED))}")
+        taken = ({p.name for p in self.param_list} | set(self.coordinate_names)
+                 | {i.name for i in self.internals} | {o.name for o in self.outputs})
+        if self.chain_spec:
+            taken.add(self.chain_spec.coordinate)
+        if name in taken or name.endswith(("_dot", "_ddot")) and name.rsplit("_", 1)[0] in taken:
+            raise ModelError(f"{what} name {name!r} is already used in model {self.name}", file=self.file,
+                             key=name, expected="a name not yet declared")

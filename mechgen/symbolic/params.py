@@ -1,0 +1,97 @@
+"""Model parameters: name, default, unit, description.
+
+A parameter is either numeric (a float, or an integer *size* such as the
+number of chain sites, which never enters an expression) or a *choice* among
+strings (a constitutive law, a boundary condition), which selects code paths
+at declaration time and never enters an expression either.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import sympy as sp
+
+from mechgen.symbolic.names import check_identifier
+
+
+@dataclass(frozen=True)
+class Param:
+    """A model parameter.
+
+    Args:
+        name: identifier used in scenes (``--set name=value``) and JSON.
+        default: default value (float, int for sizes, str for choices).
+        unit: unit string for documentation ("kg", "N/m", "" for nondimensional).
+        doc: one-line description.
+        integer: the parameter is an integer (implied for sizes).
+        size: the parameter is a runtime size (number of sites); never symbolic.
+        choices: allowed strings for a choice parameter.
+        positive: the parameter must be > 0 (also used as a sympy assumption).
+    """
+
+    name: str
+    default: float | int | str
+    unit: str = ""
+    doc: str = ""
+    integer: bool = False
+    size: bool = False
+    choices: tuple[str, ...] | None = None
+    positive: bool = False
+    symbol: sp.Symbol = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        check_identifier(self.name, what="parameter")
+        if self.size:
+            object.__setattr__(self, "integer", True)
+        if isinstance(self.default, str) and not self.choices:
+            object.__setattr__(self, "choices", (self.default,))
+        assumptions = {"real": True}
+        if self.positive:
+            assumptions["positive"] = True
+        object.__setattr__(self, "symbol", sp.Symbol(self.name, **assumptions))
+
+    @property
+    def is_choice(self) -> bool:
+        """True for string-valued parameters (selectors, not numbers)."""
+        return self.choices is not None
+
+    @property
+    def is_numeric(self) -> bool:
+        """True for parameters that may appear in expressions."""
+        return not self.is_choice and not self.size
+
+
+class Namespace:
+    """Attribute and index access to a fixed, ordered set of named values.
+
+    ``ns.x`` and ``ns["x"]`` and ``ns[0]`` give the same entry; ``list(ns)``
+    iterates the values in declaration order.
+    """
+
+    def __init__(self, items: dict[str, object]) -> None:
+        object.__setattr__(self, "_items", dict(items))
+        object.__setattr__(self, "_order", list(items))
+
+    def __getattr__(self, name: str) -> object:
+        try:
+            return self._items[name]
+        except KeyError:
+            raise AttributeError(f"no entry {name!r}; known: {', '.join(self._order)}") from None
+
+    def __getitem__(self, key: int | str) -> object:
+        if isinstance(key, int):
+            return self._items[self._order[key]]
+        return self._items[key]
+
+    def __setattr__(self, name: str, value: object) -> None:
+        raise AttributeError("namespaces are read-only")
+
+    def __iter__(self):
+        return iter(self._items[k] for k in self._order)
+
+    def __len__(self) -> int:
+        return len(self._order)
+
+    def names(self) -> list[str]:
+        """Entry names in declaration order."""
+        return list(self._order)
