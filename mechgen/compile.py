@@ -88,6 +88,7 @@ def _store_text(kind: str, key: str, filename: str, text: str) -> Path:
     fd, tmp = tempfile.mkstemp(dir=folder, prefix=".tmp-")
     with os.fdopen(fd, "w") as fh:
         fh.write(text)
+    os.chmod(tmp, 0o644)
     os.replace(tmp, path)
     return path
 

@@ -86,9 +86,24 @@ def _guard(offset: int) -> str:
     return f"ok{offset + 8}"
 
 
+def _carried_ports(block: Block) -> dict[str, int]:
+    """Ports written at two adjacent site offsets (k, k+1): port -> k.
+
+    In the unchecked interior, the contribution at offset k+1 of iteration e
+    lands on the same site as the offset-k contribution of iteration e+1, so it
+    is carried in a register instead of a read-modify-write of memory.
+    """
+    offsets: dict[str, set] = {}
+    for w in block.writes:
+        if w.relative and w.entry is None and w.accumulate:
+            offsets.setdefault(w.port, set()).add(w.index)
+    return {port: min(o) for port, o in offsets.items() if len(o) == 2 and max(o) == min(o) + 1}
+
+
 def _loop_body(block: Block, names: _Names, *, checked: bool) -> list[str]:
     periodic = block.loop.boundary == "periodic"
     guard = checked and not periodic
+    carried = {} if checked else _carried_ports(block)
     offsets = sorted({g.index for g in block.gathers if g.relative} | {w.index for w in block.writes if w.relative
                                                                        and w.entry is None})
     lines = [f"const int {_guard(k)} = (e + {k} >= 0) && (e + {k} < ns);" for k in offsets if guard]
@@ -100,16 +115,25 @@ def _loop_body(block: Block, names: _Names, *, checked: bool) -> list[str]:
     lines += [f"const double {s.name} = {c_code(e)};" for s, e in block.assignments]
     entries = {entry: col for col, entry in enumerate(block.entries)}
     width = len(entries)
+    pending: dict[str, list[str]] = {}
     for w in block.writes:
         op = "+=" if w.accumulate else "="
         if w.entry is not None:
             slot = f"slot[e * {width} + {entries[w.entry]}]"
             lines.append(f"if ({slot} >= 0) {names.out[w.port]}[{slot}] {op} {c_code(w.expr)};")
+        elif w.port in carried:
+            pending.setdefault(f"{w.port}:{w.index - carried[w.port]}", []).append(c_code(w.expr))
         elif w.relative:
             target = f"{names.out[w.port]}[{_site(w.index, periodic, checked)}]"
             lines.append(f"{'if (' + _guard(w.index) + ') ' if guard else ''}{target} {op} {c_code(w.expr)};")
         else:
             lines.append(f"{names.out[w.port]}[{w.index}] {op} {c_code(w.expr)};")
+    for port, k in carried.items():
+        out = names.out[port]
+        now = " + ".join(pending.get(f"{port}:0", ["0.0"]))
+        nxt = " + ".join(pending.get(f"{port}:1", ["0.0"]))
+        lines.append(f"{out}[{_site(k, periodic, checked)}] += carry_{out} + {now};")
+        lines.append(f"carry_{out} = {nxt};")
     return lines
 
 
@@ -127,7 +151,10 @@ def _loop(block: Block, names: _Names, slot_port: str | None) -> list[str]:
     checked = ["    " + s for s in _loop_body(block, names, checked=True)]
     fast = ["    " + s for s in _loop_body(block, names, checked=False)]
     lines = head + ["for (long e = 0; e < lo; ++e) {"] + checked + ["}"]
+    carried = {names.out[port]: k for port, k in _carried_ports(block).items()}
+    lines += [f"double carry_{out} = 0.0;" for out in carried]
     lines += ["for (long e = lo; e < hi; ++e) {"] + fast + ["}"]
+    lines += [f"if (hi > lo) {out}[hi + {k}] += carry_{out};" for out, k in carried.items()]
     lines += ["for (long e = hi; e < cnt; ++e) {"] + checked + ["}"]
     return ["{"] + ["    " + s for s in lines] + ["}"]
 

@@ -1,0 +1,98 @@
+"""``--plot DIR``: PNG figures of scene results (matplotlib, the ``plot`` extra).
+
+* sweep of modes/stability: frequencies (and growth rates) against the swept parameter
+  (a Campbell diagram when the parameter is a spin speed);
+* modes/stability: the frequencies, or the eigenvalues in the complex plane;
+* simulate with ``series = true``: energy against time; chains: final mode energies.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+from mechgen.errors import InputError
+
+
+def _pyplot():
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError as exc:
+        raise InputError("plotting needs matplotlib", key="--plot",
+                         expected="matplotlib installed (pip install 'mechgen[plot]')") from exc
+    return plt
+
+
+def _sweep(plt, a: dict, path: Path) -> None:
+    grid = a["outputs"]["grid"]
+    name = next(iter(grid[0])) if grid else "parameter"
+    x = [g[name] for g in grid]
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for xi, freqs in zip(x, a["outputs"].get("frequencies", [])):
+        ax.plot([xi] * len(freqs), freqs, "k.", ms=3)
+    ax.set_xlabel(name)
+    ax.set_ylabel("frequency")
+    ax.set_title(f"{a['name']}: frequencies vs {name}")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def _eigen(plt, a: dict, path: Path) -> None:
+    fig, ax = plt.subplots(figsize=(5, 4))
+    if "eigenvalues" in a["outputs"]:
+        ev = a["outputs"]["eigenvalues"]
+        ax.plot([e[0] for e in ev], [e[1] for e in ev], "o")
+        ax.set_xlabel("Re s")
+        ax.set_ylabel("Im s")
+        ax.set_title(f"{a['name']}: {a['outputs'].get('verdict', '')}")
+    else:
+        freqs = a["outputs"]["frequencies"]
+        ax.bar(range(1, len(freqs) + 1), freqs)
+        ax.set_xlabel("mode")
+        ax.set_ylabel("frequency")
+        ax.set_title(a["name"])
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def _simulate(plt, a: dict, path: Path) -> bool:
+    out = a["outputs"]
+    if "energy_series" not in out and "mode_energies" not in out:
+        return False
+    fig, ax = plt.subplots(figsize=(6, 4))
+    if "energy_series" in out:
+        ax.plot(out["t"], out["energy_series"])
+        ax.set_xlabel("t")
+        ax.set_ylabel("energy")
+    else:
+        ax.bar(range(1, len(out["mode_energies"]) + 1), out["mode_energies"])
+        ax.set_xlabel("mode k")
+        ax.set_ylabel("E_k at t_end")
+    ax.set_title(a["name"])
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return True
+
+
+def plot_results(results: dict, folder: Path) -> list[Path]:
+    """Write one PNG per plottable analysis into ``folder``; returns the paths."""
+    plt = _pyplot()
+    folder.mkdir(parents=True, exist_ok=True)
+    written = []
+    for a in results["analyses"]:
+        path = folder / f"{Path(results['scene']).stem}_{a['name']}.png"
+        if a["kind"] == "sweep":
+            _sweep(plt, a, path)
+        elif a["kind"] in ("modes", "stability"):
+            _eigen(plt, a, path)
+        elif a["kind"] == "simulate":
+            if not _simulate(plt, a, path):
+                continue
+        else:
+            continue
+        written.append(path)
+    return written
