@@ -8,8 +8,6 @@ the time of each stage and whether the artefact came from the cache.
 from __future__ import annotations
 
 import logging
-import os
-import tempfile
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -76,29 +74,22 @@ def emit(backend: str, irs: list[KernelIR], *, model: str, title: str) -> str:
     return {"c": emit_c, "numpy": emit_numpy, "casadi": emit_casadi}[backend](irs, model=model, title=title)
 
 
-def _store_text(kind: str, key: str, filename: str, text: str) -> Path:
-    """Write a generated text into the cache atomically (temp file + rename)."""
-    from mechgen.codegen.cache import cache_root
+def _store_text(kind: str, key: str, filename: str, text: str) -> tuple[Path, bool]:
+    """A generated text as a verified, atomically published cache entry; returns the file."""
+    from mechgen.codegen.cache import get_or_create
 
-    folder = cache_root() / kind / key[:2]
-    folder.mkdir(parents=True, exist_ok=True)
-    path = folder / f"{key}_{filename}"
-    if path.exists() and path.read_text() == text:
-        return path
-    fd, tmp = tempfile.mkstemp(dir=folder, prefix=".tmp-")
-    with os.fdopen(fd, "w") as fh:
-        fh.write(text)
-    os.chmod(tmp, 0o644)
-    os.replace(tmp, path)
-    return path
+    entry, created = get_or_create(kind, key, lambda folder: (folder / filename).write_text(text))
+    return entry / filename, not created
 
 
 def _load(backend: str, text: str, specs: dict, key: str, report: BuildReport):
     if backend == "c":
-        from mechgen.codegen.build import build_shared, get_caller
+        from mechgen.codegen.build import STATS, get_caller, load_shared
 
+        hits = STATS["hit"]
         try:
-            lib = build_shared(text, stem="mgkernels")
+            lib = load_shared(text, stem="mgkernels")
+            report.cached = STATS["hit"] > hits
         except CompilerUnavailable:
             global _warned_no_compiler
             if not _warned_no_compiler:
@@ -109,7 +100,7 @@ def _load(backend: str, text: str, specs: dict, key: str, report: BuildReport):
             return None
         return c_kernels(lib, specs, get_caller())
     name = f"mg_{backend}_{key[:16]}"
-    path = _store_text(backend, key, f"{name}.py", text)
+    path, report.cached = _store_text(backend, key, f"{name}.py", text)
     module = load_module(path, name)
     return numpy_kernels(module) if backend == "numpy" else casadi_kernels(module, specs)
 

@@ -103,9 +103,8 @@ def numpy_kernels(module) -> dict[str, Kernel]:
     return {name: Kernel(spec, impl_of(getattr(module, f"mg_{name}")), "numpy") for name, spec in module.SPEC.items()}
 
 
-def c_kernels(lib_path: Path, spec: dict, caller) -> dict[str, Kernel]:
-    """Kernels of a compiled C library; ``caller.bind`` makes the prepared calls."""
-    lib = ctypes.CDLL(str(lib_path))
+def c_kernels(lib: ctypes.CDLL, spec: dict, caller) -> dict[str, Kernel]:
+    """Kernels of a loaded C library; ``caller.bind`` makes the prepared calls."""
     kernels = {}
     for name, kspec in spec.items():
         address = ctypes.cast(getattr(lib, f"mg_{name}"), ctypes.c_void_p).value

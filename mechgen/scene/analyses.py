@@ -13,6 +13,7 @@ from mechgen.runtime.integrate import integrate_first_order, leapfrog
 from mechgen.runtime.modes import modes as solve_modes
 from mechgen.runtime.newton import newton
 from mechgen.runtime.stability import stability as solve_stability
+from mechgen.runtime.stability import stability_first_order
 from mechgen.runtime.system import System
 
 
@@ -56,11 +57,21 @@ def run_modes(system: System, options: dict, context: dict) -> dict:
 
 
 def run_stability(system: System, options: dict, context: dict) -> dict:
-    """Eigenvalues of M q'' + (D + G) q' + K q = 0 and the verdict."""
+    """Eigenvalues of M q'' + (D + G) q' + K q = 0 and the verdict.
+
+    With internal variables z the linearisation is the first-order one,
+    x' = A x with A = d(dx/dt)/dx at (q, 0, z) (exact Jacobian, see System.jacobian).
+    """
     q = operating_point(system, options, context)
-    mats = system.linear(q)
-    dense = {k: (v.toarray() if hasattr(v, "toarray") else v) for k, v in mats.items()}
-    res = solve_stability(dense["M"], dense["D"] + dense["G"], dense["K"], tolerance=options.get("tolerance", 1e-8))
+    tol = options.get("tolerance", 1e-8)
+    if system.m:
+        z = np.asarray(context[options["about"]]["_z"]) if options.get("about") else np.zeros(system.m)
+        A = system.jacobian(0.0, np.concatenate([q, np.zeros(system.n), z]))
+        res = stability_first_order(A, np.eye(A.shape[0]), tolerance=tol)
+    else:
+        mats = system.linear(q)
+        dense = {k: (v.toarray() if hasattr(v, "toarray") else v) for k, v in mats.items()}
+        res = solve_stability(dense["M"], dense["D"] + dense["G"], dense["K"], tolerance=tol)
     eig = [[float(s.real), float(s.imag)] for s in res.eigenvalues]
     freqs = [float(f) for f in res.frequencies]
     if options.get("count"):
@@ -68,16 +79,37 @@ def run_stability(system: System, options: dict, context: dict) -> dict:
     return {"eigenvalues": eig, "verdict": res.verdict, "frequencies": freqs, "growth_rate": float(res.growth_rate)}
 
 
+def _equilibrium_functions(system: System):
+    """F(y) = [r(q, 0, 0, z); g(q, 0, z)] and dF/dy for y = (q, z)."""
+    n = system.n
+
+    def residual(y):
+        q, z = y[:n], y[n:]
+        r = system.residual(q, None, None, z if system.m else None)
+        return np.concatenate([r, system.call("rates", q=q, z=z)["g"].ravel()]) if system.m else r
+
+    def jacobian(y):
+        q, z = y[:n], y[n:]
+        tan = system.call("tangent", q=q, z=z if system.m else None)
+        if not system.m:
+            return tan["r_q"]
+        g = system.call("rates_tangent", q=q, z=z)
+        return np.block([[tan["r_q"], tan["r_z"]], [g["g_q"], g["g_z"]]])
+
+    return residual, jacobian
+
+
 def run_steady(system: System, options: dict, context: dict) -> dict:
-    """Equilibrium r(q, 0, 0) = 0 by Newton with the generated Jacobian dr/dq."""
-    q0 = _vector(system, options.get("guess"))
-    res = newton(lambda q: system.residual(q), lambda q: system.call("tangent", q=q)["r_q"], q0,
-                 tol=options.get("tol", 1e-10), max_iter=options.get("max_iter", 50))
+    """Equilibrium r(q, 0, 0, z) = 0, g(q, 0, z) = 0 by Newton with the generated Jacobians."""
+    y0 = np.concatenate([_vector(system, options.get("guess")), np.zeros(system.m)])
+    residual, jacobian = _equilibrium_functions(system)
+    res = newton(residual, jacobian, y0, tol=options.get("tol", 1e-10), max_iter=options.get("max_iter", 50))
+    q, z = res.x[:system.n], res.x[system.n:]
     out = {"iterations": int(res.iterations), "residual_norm": float(res.residual_norm)}
     if not system.is_lattice:
-        out["coordinates"] = {n: float(x) for n, x in zip(system.coordinates, res.x)}
-    out.update(system.outputs(res.x))
-    out["_q"] = res.x
+        out["coordinates"] = {n: float(x) for n, x in zip(system.coordinates, q)}
+    out.update(system.outputs(q, None, z if system.m else None))
+    out["_q"], out["_z"] = q, z
     return out
 
 
@@ -125,6 +157,7 @@ def run_simulate(system: System, options: dict, context: dict) -> dict:
         traj = leapfrog(lambda q: system.force(q) * minv, q0, v0, dt, steps,
                         record_every=max(1, steps // 1000), energy=energy)
         q_end, v_end, ts, energies = traj.q[-1], traj.v[-1], traj.t, np.asarray(traj.energy)
+        z_end = None
     else:
         x0 = np.concatenate([q0, v0, np.zeros(system.m)])
         n_out = int(options.get("samples", 201))
@@ -132,10 +165,12 @@ def run_simulate(system: System, options: dict, context: dict) -> dict:
         traj = integrate_first_order(system.rhs, x0, t_end, jac=system.jacobian, method=options.get("method", "BDF"),
                                      rtol=options.get("rtol", 1e-8), atol=options.get("atol", 1e-10), t_eval=t_eval)
         xs = traj.x if traj.x.shape[0] == len(traj.t) else traj.x.T
-        q_end, v_end = xs[-1, :system.n], xs[-1, system.n:2 * system.n]
+        n = system.n
+        q_end, v_end, z_end = xs[-1, :n], xs[-1, n:2 * n], xs[-1, 2 * n:]
         ts = traj.t
-        energies = np.array([energy(x[:system.n], x[system.n:2 * system.n]) for x in xs])
-    out = system.outputs(q_end, v_end)
+        energies = np.array([system.outputs(x[:n], x[n:2 * n], x[2 * n:] if system.m else None)["energy"]
+                             for x in xs])
+    out = system.outputs(q_end, v_end, z_end if system.m else None)
     e0 = energies[0]
     out["energy_drift"] = float(np.max(np.abs(energies - e0)) / max(abs(e0), 1e-300))
     out["t_end"] = t_end

@@ -1,0 +1,359 @@
+"""Build C sources into cached shared libraries and load them (stage: emit -> build -> load).
+
+Input: C source text (generated kernels with the mechgen ABI
+``int NAME(const double *const *in, double *const *out, const long *sizes, long nbatch)``).
+Output: the path of a verified shared library in the content-hash compile
+cache (:mod:`mechgen.codegen.cache`), a loaded :class:`ctypes.CDLL`, function
+addresses, and a *caller* whose ``bind`` prepares no-argument calls of a
+kernel: the ``mgcall`` CPython extension (vectorcall, tens of ns per call), or
+a ctypes fallback with the same semantics when the extension cannot be built.
+
+The compiler is run with an argument list (never a shell) and a timeout; the
+cache key covers the source, flags, include directories, compiler identity,
+machine and a format version, so a cached library is reused only when it
+would be rebuilt identically.
+"""
+from __future__ import annotations
+
+import ctypes
+import importlib.machinery
+import importlib.util
+import logging
+import os
+import platform
+import re
+import shlex
+import shutil
+import subprocess
+import sys
+import sysconfig
+import tempfile
+from collections import Counter
+from functools import lru_cache
+from pathlib import Path
+from typing import Callable, Sequence
+
+from mechgen.codegen import cache
+from mechgen.errors import BuildError, CompilerUnavailable
+
+log = logging.getLogger("mechgen")
+
+DEFAULT_CFLAGS = ("-std=c99", "-O3", "-fPIC", "-shared", "-Wall", "-Wextra", "-Werror", "-pedantic")
+BUILD_FORMAT = "mechgen-build-1"
+KIND = "c"
+COMPILE_TIMEOUT = 120.0
+VERSION_TIMEOUT = 30.0
+_STEM_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,63}")
+MGCALL_SOURCE = Path(__file__).parent / "templates" / "c99" / "mgcall.c"
+
+#: Counters of this process: "compile" (compiler runs), "hit" (cache hits), "miss".
+STATS: Counter = Counter()
+
+_compilers: dict[tuple[str | None, str | None], tuple[str, str] | None] = {}
+
+
+# ---------------------------------------------------------------------------
+# compiler
+
+
+def reset_compiler_cache() -> None:
+    """Forget the compilers found so far (tests change ``CC``/``PATH``)."""
+    _compilers.clear()
+
+
+def _probe(command: str) -> tuple[str, str] | None:
+    """``(command, identity)`` if ``command --version`` runs, else None."""
+    try:
+        argv = shlex.split(command)
+    except ValueError:
+        return None
+    if not argv:
+        return None
+    exe = shutil.which(argv[0])
+    if exe is None:
+        return None
+    try:
+        done = subprocess.run([exe, *argv[1:], "--version"], capture_output=True, text=True,
+                              timeout=VERSION_TIMEOUT, check=False)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    lines = (done.stdout or done.stderr).strip().splitlines()
+    if done.returncode != 0 or not lines:
+        return None
+    return command, lines[0].strip()
+
+
+def _compiler() -> tuple[str, str] | None:
+    """The compiler command and its identity, probed once per ``(CC, PATH)``."""
+    env = (os.environ.get("CC"), os.environ.get("PATH"))
+    if env not in _compilers:
+        cc = env[0]
+        found = _probe(cc) if cc else next(filter(None, map(_probe, ("cc", "gcc", "clang"))), None)
+        if found is None:
+            log.info("no working C compiler (CC=%r)", cc)
+        _compilers[env] = found
+    return _compilers[env]
+
+
+def find_compiler() -> str | None:
+    """The C compiler command to use, or None.
+
+    ``$CC`` if set (it may hold arguments, e.g. ``"ccache gcc"``; a broken
+    ``$CC`` is not silently replaced), else the first of ``cc``, ``gcc``,
+    ``clang`` on ``PATH`` whose ``--version`` runs. Checked once per process
+    (per value of ``CC`` and ``PATH``).
+    """
+    found = _compiler()
+    return found[0] if found else None
+
+
+def compiler_identity() -> str | None:
+    """The first line of the compiler's ``--version``, or None without a compiler."""
+    found = _compiler()
+    return found[1] if found else None
+
+
+# ---------------------------------------------------------------------------
+# build
+
+
+def _check_stem(stem: str) -> None:
+    if not isinstance(stem, str) or not _STEM_RE.fullmatch(stem):
+        raise ValueError(f"invalid library stem {stem!r}: expected an identifier of at most 64 characters")
+
+
+def build_key(source: str, cflags: Sequence[str], include_dirs: Sequence[str], ldflags: Sequence[str],
+              identity: str, *extra: str) -> str:
+    """The cache key of a build: everything that changes the library."""
+    return cache.content_key(BUILD_FORMAT, source, "\0".join(cflags), "\0".join(map(str, include_dirs)),
+                             "\0".join(ldflags), identity, platform.machine(), *extra)
+
+
+def _failed_source_path(key: str, stem: str, source: str) -> Path:
+    """Keep the source of a failed build in the cache for reading; return its path."""
+    folder = cache.cache_root() / "failed"
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / f"{stem}-{key[:16]}.c"
+    fd, tmp = tempfile.mkstemp(dir=folder, prefix=cache.TMP_PREFIX)
+    with os.fdopen(fd, "w", encoding="utf-8") as fh:
+        fh.write(source)
+    os.chmod(tmp, 0o644)
+    os.replace(tmp, path)
+    return path
+
+
+def _compile(command: str, source_path: Path, output: Path, cflags: Sequence[str],
+             include_dirs: Sequence[str], ldflags: Sequence[str]) -> subprocess.CompletedProcess:
+    """Run the compiler once; raise CompilerUnavailable if it cannot be started."""
+    argv = [*shlex.split(command), *cflags, *(f"-I{d}" for d in include_dirs),
+            "-o", str(output), str(source_path), *ldflags]
+    STATS["compile"] += 1
+    try:
+        return subprocess.run(argv, capture_output=True, text=True, timeout=COMPILE_TIMEOUT, check=False)
+    except OSError as exc:
+        raise CompilerUnavailable(f"cannot run C compiler {command!r}: {exc}") from exc
+
+
+def _build_error(message: str, stderr: str, key: str, stem: str, source: str) -> BuildError:
+    path = _failed_source_path(key, stem, source)
+    err = BuildError(f"{message} on {path}:\n{stderr.strip()}")
+    err.stderr = stderr
+    err.source_path = path
+    return err
+
+
+def _build_entry(source: str, *, stem: str, output_name: str, cflags: Sequence[str],
+                 include_dirs: Sequence[str], ldflags: Sequence[str], extra_key: Sequence[str] = ()) -> Path:
+    """Build ``source`` into ``output_name`` inside a cache entry; return the output's path."""
+    _check_stem(stem)
+    found = _compiler()
+    if found is None:
+        raise CompilerUnavailable("no working C compiler found (set CC, or install cc/gcc/clang)")
+    command, identity = found
+    cflags, include_dirs, ldflags = tuple(cflags), tuple(map(str, include_dirs)), tuple(ldflags)
+    key = build_key(source, cflags, include_dirs, ldflags, identity, *extra_key)
+
+    def fill(tmp: Path) -> None:
+        source_path = tmp / f"lib{stem}.c"
+        source_path.write_text(source, encoding="utf-8")
+        try:
+            done = _compile(command, source_path, tmp / output_name, cflags, include_dirs, ldflags)
+        except subprocess.TimeoutExpired as exc:
+            stderr = exc.stderr.decode(errors="replace") if isinstance(exc.stderr, bytes) else (exc.stderr or "")
+            raise _build_error(f"C compiler timed out after {COMPILE_TIMEOUT:.0f} s", stderr, key, stem,
+                               source) from exc
+        if done.returncode != 0 or not (tmp / output_name).is_file():
+            raise _build_error(f"C compiler {command!r} failed (exit {done.returncode})",
+                               done.stderr or done.stdout, key, stem, source)
+
+    entry, created = cache.get_or_create(KIND, key, fill)
+    STATS["miss" if created else "hit"] += 1
+    return entry / output_name
+
+
+def build_shared(source: str, *, stem: str, cflags: Sequence[str] = DEFAULT_CFLAGS,
+                 include_dirs: Sequence[str] = (), ldflags: Sequence[str] = ()) -> Path:
+    """Compile C source to a shared library in the compile cache.
+
+    Args:
+        source: the C source text.
+        stem: library name: the file is ``lib{stem}.so`` (an identifier, at most 64 characters).
+        cflags: compiler flags (default: C99, -O3, warnings are errors).
+        include_dirs: directories passed as ``-I``.
+        ldflags: flags appended after the source file (e.g. ``-lm``).
+
+    Returns:
+        The path of the cached, verified ``.so`` (``lib{stem}.c`` lies beside it).
+
+    Raises:
+        ValueError: if ``stem`` is not a plain identifier.
+        CompilerUnavailable: if no working C compiler is found.
+        BuildError: if compilation fails; carries ``stderr`` and ``source_path``.
+    """
+    return _build_entry(source, stem=stem, output_name=f"lib{stem}.so", cflags=cflags,
+                        include_dirs=include_dirs, ldflags=ldflags)
+
+
+def invalidate(path: Path) -> None:
+    """Remove the cache entry holding ``path`` (a library that would not load)."""
+    entry = Path(path).resolve().parent
+    if entry.parent.parent == cache.cache_root().resolve():
+        cache.discard(entry)
+
+
+# ---------------------------------------------------------------------------
+# load
+
+
+def load_library(path: Path | str) -> ctypes.CDLL:
+    """Load a shared library (``dlopen``); raises OSError if it cannot be loaded."""
+    return ctypes.CDLL(str(path))
+
+
+def _with_retry(build: Callable[[], Path], load: Callable[[Path], object]):
+    """Build and load; if loading fails, invalidate the entry and rebuild once."""
+    path = build()
+    try:
+        return load(path)
+    except (OSError, ImportError) as exc:
+        log.warning("cached library %s would not load (%s); rebuilding", path, exc)
+        invalidate(path)
+    path = build()
+    try:
+        return load(path)
+    except (OSError, ImportError) as exc:
+        raise BuildError(f"freshly built library {path} would not load: {exc}") from exc
+
+
+def load_shared(source: str, *, stem: str, cflags: Sequence[str] = DEFAULT_CFLAGS,
+                include_dirs: Sequence[str] = (), ldflags: Sequence[str] = ()) -> ctypes.CDLL:
+    """Build (or find in the cache) and load a shared library, rebuilding once if it will not load.
+
+    Arguments and errors are those of :func:`build_shared`; a library that
+    still will not load after a rebuild raises BuildError.
+    """
+    return _with_retry(lambda: build_shared(source, stem=stem, cflags=cflags, include_dirs=include_dirs,
+                                            ldflags=ldflags), load_library)
+
+
+def function_address(lib: ctypes.CDLL, name: str) -> int:
+    """The address of the exported function ``name`` of ``lib`` (AttributeError if absent)."""
+    return ctypes.cast(getattr(lib, name), ctypes.c_void_p).value
+
+
+# ---------------------------------------------------------------------------
+# callers
+
+
+KERNEL_FUNCTYPE = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_long)
+
+
+class CtypesBound:
+    """A prepared kernel call (ctypes): ``bound()`` runs the kernel and returns its int."""
+
+    __slots__ = ("_fn", "_in", "_out", "_sizes", "_nbatch", "_args", "keepalive")
+
+    def __init__(self, fn_address: int, in_ptrs: Sequence[int], out_ptrs: Sequence[int],
+                 sizes: Sequence[int], nbatch: int, keepalive: object) -> None:
+        if not fn_address:
+            raise ValueError("bind: fn_address is NULL")
+        if nbatch < 0:
+            raise ValueError("bind: nbatch must be >= 0")
+        self._fn = KERNEL_FUNCTYPE(int(fn_address))
+        self._in = (ctypes.c_void_p * max(len(in_ptrs), 1))(*map(int, in_ptrs))
+        self._out = (ctypes.c_void_p * max(len(out_ptrs), 1))(*map(int, out_ptrs))
+        self._sizes = (ctypes.c_long * max(len(sizes), 1))(*map(int, sizes))
+        self._nbatch = int(nbatch)
+        self._args = (ctypes.addressof(self._in), ctypes.addressof(self._out), ctypes.addressof(self._sizes),
+                      self._nbatch)
+        self.keepalive = keepalive
+
+    def __call__(self) -> int:
+        return self._fn(*self._args)
+
+
+class CtypesCaller:
+    """Pure-Python fallback of the ``mgcall`` module: the same ``bind``."""
+
+    Bound = CtypesBound
+
+    @staticmethod
+    def bind(fn_address: int, in_ptrs: Sequence[int], out_ptrs: Sequence[int], sizes: Sequence[int],
+             nbatch: int, keepalive: object) -> CtypesBound:
+        """A no-argument callable running the kernel at ``fn_address`` with these pointers."""
+        return CtypesBound(fn_address, in_ptrs, out_ptrs, sizes, nbatch, keepalive)
+
+
+def _python_key() -> tuple[str, ...]:
+    """What makes an extension module specific to this interpreter."""
+    return (sys.version, sys.implementation.cache_tag or "", sysconfig.get_config_var("EXT_SUFFIX") or "",
+            getattr(sys, "abiflags", ""))
+
+
+def _import_extension(name: str, path: Path):
+    """Import the extension module at ``path`` (no sys.path or sys.modules changes)."""
+    loader = importlib.machinery.ExtensionFileLoader(name, str(path))
+    spec = importlib.util.spec_from_file_location(name, path, loader=loader)
+    module = importlib.util.module_from_spec(spec)
+    loader.exec_module(module)
+    return module
+
+
+def load_mgcall():
+    """Build (or find in the cache) and import the ``mgcall`` extension module.
+
+    Raises:
+        CompilerUnavailable: without a compiler.
+        BuildError: if it does not compile (e.g. no Python headers) or load.
+    """
+    include = sysconfig.get_paths()["include"]
+    if not (Path(include) / "Python.h").is_file():
+        raise BuildError(f"Python headers not found in {include}")
+    source = MGCALL_SOURCE.read_text(encoding="utf-8")
+    suffix = sysconfig.get_config_var("EXT_SUFFIX") or ".so"
+    cflags = tuple(f for f in DEFAULT_CFLAGS if f != "-pedantic")
+
+    def build() -> Path:
+        return _build_entry(source, stem="mgcall", output_name=f"mgcall{suffix}", cflags=cflags,
+                            include_dirs=(include,), ldflags=(), extra_key=_python_key())
+
+    return _with_retry(build, lambda path: _import_extension("mgcall", path))
+
+
+def _make_caller():
+    """The mgcall module, or the ctypes fallback if it cannot be built."""
+    try:
+        return load_mgcall()
+    except (CompilerUnavailable, BuildError, OSError) as exc:
+        log.info("mgcall extension unavailable (%s); using the ctypes caller", exc)
+        return CtypesCaller()
+
+
+@lru_cache(maxsize=1)
+def get_caller():
+    """An object with ``bind(fn_address, in_ptrs, out_ptrs, sizes, nbatch, keepalive)``, cached per process.
+
+    ``bind`` returns a callable with no arguments that runs the kernel with the
+    stored pointers and returns its int result, keeping ``keepalive`` alive.
+    """
+    return _make_caller()
