@@ -15,6 +15,8 @@ omega_f,b = (+-Ip Omega + sqrt(Ip^2 Omega^2 + 4 Id k_r)) / (2 Id), forward and
 backward, so omega_f - omega_b = Ip Omega / Id (the gyroscopic moment Ip Omega).
 Frequencies in rad/s. SI units.
 """
+import sympy as sp
+
 from mechgen.symbolic.kinematics import angular_velocity_cardan_xy
 from mechgen.symbolic.model import Model
 from mechgen.symbolic.params import Param
@@ -49,4 +51,4 @@ def dissipation(v, p):
     return p.c / 2 * (v.x**2 + v.y**2) + p.c_r / 2 * (v.theta_x**2 + v.theta_y**2)
 
 
-model.output("orbit_radius", lambda q: (q.x**2 + q.y**2) ** 0.5, unit="m", doc="disk-centre orbit radius")
+model.output("orbit_radius", lambda q: sp.sqrt(q.x**2 + q.y**2), unit="m", doc="disk-centre orbit radius")

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from mechgen.errors import ModelError
-from mechgen.symbolic.model import Model, call_declared
+from mechgen.symbolic.model import Model, as_expr, call_declared
 from mechgen.symbolic.params import Namespace
 from mechgen.symbolic.specialize import Specialization, param_namespace
 
@@ -86,11 +86,7 @@ def _state_symbols(model: Model, spec: Specialization):
 
 
 def _scalar(value: object, what: str, model: Model) -> sp.Expr:
-    expr = sp.sympify(value) if isinstance(value, (int, float)) else value
-    if not isinstance(expr, sp.Expr):
-        raise ModelError(f"{what} of model {model.name} returned {type(value).__name__}", file=model.file,
-                         key=what, expected="a sympy expression")
-    return expr
+    return as_expr(value, what, model)
 
 
 def _forces(model: Model, names, env) -> list[sp.Expr]:

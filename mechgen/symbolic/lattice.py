@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from mechgen.errors import ModelError
-from mechgen.symbolic.model import Model, call_declared
+from mechgen.symbolic.model import Model, as_expr, call_declared
 from mechgen.symbolic.params import Namespace
 from mechgen.symbolic.specialize import Specialization, param_namespace
 
@@ -80,7 +80,7 @@ def derive_lattice(model: Model, spec: Specialization) -> LatticeEquations:
     zero = sp.Integer(0)
 
     def local(fn, **kw):
-        return sp.sympify(call_declared(fn, p=p_ns, **kw)) if fn else zero
+        return as_expr(call_declared(fn, p=p_ns, **kw), fn.__name__, model) if fn else zero
 
     return LatticeEquations(
         model=model.name, coordinate=name, sites=chain.sites, ends=chain.ends,

@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import inspect
 from dataclasses import dataclass
+
+import sympy as sp
 from typing import Callable
 
 from mechgen.errors import ModelError
@@ -57,6 +59,19 @@ class Chain:
     coordinate: str
     sites: str
     ends: str
+
+
+def as_expr(value: object, what: str, model: "Model") -> sp.Expr:
+    """A declared function's result as a sympy expression (numbers allowed, text never parsed)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, sp.Basic)):
+        raise ModelError(f"{what} of model {model.name} returned {type(value).__name__}", file=model.file,
+                         key=what, expected="a sympy expression or a number")
+    if isinstance(value, (int, float)):
+        return sp.Float(value, precision=53) if isinstance(value, float) else sp.Integer(value)
+    if not isinstance(value, sp.Expr):
+        raise ModelError(f"{what} of model {model.name} returned a {type(value).__name__}", file=model.file,
+                         key=what, expected="a scalar sympy expression")
+    return value
 
 
 def call_declared(fn: Callable, **available: object) -> object:

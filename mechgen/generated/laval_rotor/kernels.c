@@ -304,7 +304,7 @@ int mg_outputs(const double *const *in, double *const *out, const long *sizes, l
             const double t0 = g0*g0 + g1*g1;
             const double t1 = (1.0/2.0)*g10*(g6*g6*cos(g3)*cos(g3) + g7*g7) + (1.0/2.0)*g8*(g4*g4 + g5*g5) + (1.0/2.0)*g9*(g13 + g6*sin(g3))*(g13 + g6*sin(g3));
             const double t2 = (1.0/2.0)*g11*t0 + (1.0/2.0)*g12*(g2*g2 + g3*g3);
-            out0[0] = pow(t0, 0.5);
+            out0[0] = sqrt(t0);
             out1[0] = t1;
             out2[0] = t2;
             out3[0] = t1 + t2;

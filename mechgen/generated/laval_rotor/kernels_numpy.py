@@ -175,7 +175,7 @@ SPEC = {'force': {'doc': 'potential force -dV/dq',
                       'model': 'laval_rotor',
                       'params': ['m', 'Ip', 'Id', 'k_t', 'k_r', 'Omega', 'c', 'c_r']},
              'name': 'outputs',
-             'ops': 34,
+             'ops': 35,
              'outputs': [{'batched': True,
                           'extent': {'const': 1, 'terms': []},
                           'integer': False,
@@ -204,7 +204,7 @@ SPEC = {'force': {'doc': 'potential force -dV/dq',
                           'shape': [1, 1],
                           'sparse': False,
                           'symmetric': False}],
-             'signature': '30c79037aedf5ebd4f79c915677b18a568e9a889655e8935def1b17af1091e49',
+             'signature': '3d49f853d2bb5b37fc37f20d112f7455bf18e80eee50e881c4f8e7b8739adc00',
              'sizes': [],
              'slots': []},
  'residual': {'doc': 'Lagrange residual r = M a - f',
@@ -553,7 +553,7 @@ def mg_outputs(ins, outs, sizes):
     t0 = g0*g0 + g1*g1
     t1 = ((1.0/2.0))*g10*(g6*g6*np.cos(g3)*np.cos(g3) + g7*g7) + ((1.0/2.0))*g8*(g4*g4 + g5*g5) + ((1.0/2.0))*g9*(g13 + g6*np.sin(g3))*(g13 + g6*np.sin(g3))
     t2 = ((1.0/2.0))*g11*t0 + ((1.0/2.0))*g12*(g2*g2 + g3*g3)
-    out0[:, 0] = t0**0.5
+    out0[:, 0] = np.sqrt(t0)
     out1[:, 0] = t1
     out2[:, 0] = t2
     out3[:, 0] = t1 + t2
