@@ -7,10 +7,12 @@ the time of each stage and whether the artefact came from the cache.
 """
 from __future__ import annotations
 
+import json
 import logging
 import time
 import warnings
 from dataclasses import dataclass, field
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -105,6 +107,58 @@ def _load(backend: str, text: str, specs: dict, key: str, report: BuildReport):
     return numpy_kernels(module) if backend == "numpy" else casadi_kernels(module, specs)
 
 
+@lru_cache(maxsize=1)
+def _mechgen_sources_digest() -> str:
+    """Digest of the sources that shape generated code (symbolic, codegen, templates)."""
+    from mechgen.codegen.cache import content_key
+
+    root = Path(__file__).resolve().parent
+    files = sorted(p for sub in ("symbolic", "codegen") for p in (root / sub).rglob("*")
+                   if p.is_file() and p.suffix in (".py", ".j2"))
+    return content_key(*(f"{p.relative_to(root)}\n".encode() + p.read_bytes() for p in files))
+
+
+def _index_key(model: Model, spec: Specialization, kernels: set, backend: str, cse: bool) -> str | None:
+    """Key of the index entry mapping a compile request to its generated text (None: not cacheable)."""
+    from mechgen.codegen.cache import content_key
+
+    if not model.file or not Path(model.file).is_file():
+        return None
+    return content_key("index-1", _mechgen_sources_digest(), Path(model.file).read_bytes(), spec.key(),
+                       ",".join(sorted(kernels)), backend, str(cse))
+
+
+def _generate(model: Model, spec: Specialization, kernels: set, backend: str, cse: bool,
+              report: BuildReport) -> dict:
+    """derive -> lower -> emit; returns {'text', 'specs'} (timed into ``report``)."""
+    clock = time.perf_counter()
+    eqs = derive(model, spec)
+    report.seconds["derive"] = time.perf_counter() - clock
+    clock = time.perf_counter()
+    irs = lower_all(model, eqs, kernels, cse=cse)
+    report.seconds["lower"] = time.perf_counter() - clock
+    clock = time.perf_counter()
+    text = emit(backend, irs, model=model.name, title=spec.key())
+    report.seconds["emit"] = time.perf_counter() - clock
+    return {"text": text, "specs": {ir.name: kernel_spec(ir) for ir in irs}}
+
+
+def _generated(model: Model, spec: Specialization, kernels: set, backend: str, cse: bool,
+               report: BuildReport) -> dict:
+    """The generated text and specs, from the index cache when this exact request was seen before."""
+    from mechgen.codegen.cache import get_or_create, lookup
+
+    key = _index_key(model, spec, kernels, backend, cse)
+    entry = lookup("index", key) if key else None
+    if entry is not None:
+        report.seconds.update(derive=0.0, lower=0.0, emit=0.0)
+        return json.loads((entry / "generated.json").read_text())
+    result = _generate(model, spec, kernels, backend, cse, report)
+    if key:
+        get_or_create("index", key, lambda folder: (folder / "generated.json").write_text(json.dumps(result)))
+    return result
+
+
 def compile_model(model: Model, spec: Specialization, *, kernels=None, backend: str = "c", cse: bool = True,
                   sites: int | None = None) -> tuple[System, BuildReport]:
     """Derive, generate, build and load the kernels a set of analyses needs."""
@@ -114,25 +168,16 @@ def compile_model(model: Model, spec: Specialization, *, kernels=None, backend: 
         raise InputError(f"unknown backend {backend!r}", key="backend", expected=", ".join(BACKENDS))
     kernels = set(kernels or all_kernels(model))
     report = BuildReport(backend)
-    clock = time.perf_counter()
-    eqs = derive(model, spec)
-    report.seconds["derive"] = time.perf_counter() - clock
-    clock = time.perf_counter()
-    irs = lower_all(model, eqs, kernels, cse=cse)
-    report.seconds["lower"] = time.perf_counter() - clock
     loaded = None
     while loaded is None:
+        generated = _generated(model, spec, kernels, report.backend, cse, report)
+        text, specs = generated["text"], generated["specs"]
         clock = time.perf_counter()
-        text = emit(report.backend, irs, model=model.name, title=spec.key())
-        report.seconds["emit"] = time.perf_counter() - clock
-        clock = time.perf_counter()
-        specs = {ir.name: kernel_spec(ir) for ir in irs}
-        key = content_key(report.backend, text)
-        loaded = _load(report.backend, text, specs, key, report)
+        loaded = _load(report.backend, text, specs, content_key(report.backend, text), report)
         report.seconds["build"] = time.perf_counter() - clock
-    report.kernels = {ir.name: {"ops": specs[ir.name]["ops"]} for ir in irs}
-    values = np.array([float(spec_value(model, spec, n)) for n in eqs.param_names])
+    report.kernels = {name: {"ops": s["ops"]} for name, s in specs.items()}
     meta = dict(next(iter(specs.values()))["meta"]) if specs else {}
+    values = np.array([float(spec_value(model, spec, n)) for n in meta.get("params", [])])
     if model.is_lattice:
         sites = int(sites if sites is not None else spec.values.get(model.chain_spec.sites,
                                                                     model.param(model.chain_spec.sites).default))
