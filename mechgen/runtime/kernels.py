@@ -86,11 +86,13 @@ class Kernel:
         if self._binder is not None:
             return self._binder(ins, outs, sizes, nbatch)
         impl = self._impl
+        shaped_in = [a.reshape(nbatch, -1) if p["batched"] else a for p, a in zip(self.spec["inputs"], ins)]
+        shaped_out = [o.reshape(nbatch, -1) for o in outs]
 
         def call() -> int:
             for o in outs:
                 o[...] = 0.0
-            return impl(ins, [o.reshape(nbatch, -1) for o in outs], sizes, nbatch)
+            return impl(shaped_in, shaped_out, sizes, nbatch)
 
         return call
 

@@ -18,8 +18,9 @@ import scipy.linalg as sla
 import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
+from mechgen.errors import KernelError
 from mechgen.runtime.kernels import Kernel
-from mechgen.runtime.pattern import Pattern, build_pattern
+from mechgen.runtime.pattern import Pattern, build_pattern, extent
 
 
 @dataclass
@@ -72,6 +73,13 @@ class System:
         return self.patterns[kernel]
 
     # -- evaluation -----------------------------------------------------------
+    def bound(self, kernel: str) -> "BoundKernel":
+        """A prepared single-state evaluator of ``kernel`` (inputs and outputs allocated once)."""
+        key = ("bound", kernel)
+        if key not in self.patterns:
+            self.patterns[key] = BoundKernel(self, kernel)
+        return self.patterns[key]
+
     def call(self, kernel: str, **state) -> dict:
         """Evaluate ``kernel`` at a state (missing state entries are zero)."""
         k = self.kernels[kernel]
@@ -115,13 +123,18 @@ class System:
         return mats
 
     def outputs(self, q, v=None, z=None, t=0.0) -> dict[str, float]:
-        """Named outputs and energies at a state."""
-        return {k: float(np.asarray(val).ravel()[0]) for k, val in
-                self.call("outputs", q=q, v=v, z=z, t=t).items()}
+        """Named outputs and energies at a state (NaN/Inf raises KernelError naming the output)."""
+        raw = self.bound("outputs").evaluate(q=q, v=v, z=z, t=t)
+        values = {k: float(val[0]) for k, val in raw.items()}
+        bad = [k for k, val in values.items() if not np.isfinite(val)]
+        if bad:
+            raise KernelError(f"kernel outputs of {self.meta.get('model')} produced NaN/Inf in {', '.join(bad)} "
+                              f"at q = {np.asarray(q).ravel()[:6].tolist()}")
+        return values
 
     def force(self, q, t=0.0) -> np.ndarray:
         """Potential force -dV/dq."""
-        return self.call("force", q=q, t=t)["f"].ravel()
+        return self.bound("force").evaluate(q=q, t=t)["f"].copy()
 
     # -- first-order form -----------------------------------------------------
     def split(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -136,9 +149,14 @@ class System:
 
     def acceleration(self, q, v, z=None, t=0.0) -> tuple[np.ndarray, object]:
         """a = -M^-1 r(q, v, 0, z, t), and M."""
-        tan = self.call("tangent", q=q, v=v, z=z, t=t)
-        M = tan["r_a"]
-        return self._solve(M, -self.residual(q, v, None, z, t)), M
+        if self.is_lattice:
+            tan = self.call("tangent", q=q, v=v, z=z, t=t)
+            M = tan["r_a"]
+            return self._solve(M, -self.residual(q, v, None, z, t)), M
+        state = {"q": q, "v": v, "z": z, "t": t}
+        r = self.bound("residual").evaluate(**state)["r"]
+        M = self.bound("tangent").evaluate(**state)["r_a"].reshape(self.n, self.n)
+        return np.linalg.solve(M, -r), M
 
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
         """dx/dt of the first-order form."""
@@ -146,15 +164,23 @@ class System:
         a, _ = self.acceleration(q, v, z, t)
         parts = [v, a]
         if self.m:
-            parts.append(self.call("rates", q=q, v=v, z=z, t=t)["g"].ravel())
-        return np.concatenate(parts)
+            parts.append(self.bound("rates").evaluate(q=q, v=v, z=z, t=t)["g"].copy())
+        out = np.concatenate(parts)
+        if not np.all(np.isfinite(out)):
+            raise KernelError(f"kernel residual/tangent of {self.meta.get('model')} gave NaN/Inf at t = {t}, "
+                              f"x = {np.asarray(x)[:6]}")
+        return out
 
     def jacobian(self, t: float, x: np.ndarray):
         """d(dx/dt)/dx, exact: da/dx = -M^-1 [r_q, r_v, r_z] at the current acceleration."""
         q, v, z = self.split(x)
         a, _ = self.acceleration(q, v, z, t)
-        tan = self.call("tangent", q=q, v=v, a=a, z=z, t=t)
         n, m = self.n, self.m
+        if self.is_lattice:
+            tan = self.call("tangent", q=q, v=v, a=a, z=z, t=t)
+        else:
+            raw = self.bound("tangent").evaluate(q=q, v=v, a=a, z=z, t=t)
+            tan = {k: raw[k].reshape(n, -1) for k in raw}
         blocks = [tan["r_q"], tan["r_v"]] + ([tan["r_z"]] if m else [])
         if self.is_lattice:
             rhs = sps.hstack(blocks).tocsc()
@@ -166,6 +192,46 @@ class System:
         J[:n, n:2 * n] = np.eye(n)
         J[n:2 * n] = da
         if m:
-            g = self.call("rates_tangent", q=q, v=v, z=z, t=t)
-            J[2 * n:] = np.hstack([g["g_q"], g["g_v"], g["g_z"]])
+            g = self.bound("rates_tangent").evaluate(q=q, v=v, z=z, t=t)
+            J[2 * n:] = np.hstack([g["g_q"].reshape(m, n), g["g_v"].reshape(m, n), g["g_z"].reshape(m, m)])
         return J
+
+
+class BoundKernel:
+    """Single-state evaluation with preallocated arrays and a prepared call (the hot path).
+
+    ``evaluate(q=..., v=...)`` copies the given state into the kernel's input
+    arrays (absent entries are zero), calls the kernel and returns its output
+    arrays (views that the next call overwrites; copy to keep them).
+    """
+
+    def __init__(self, system: System, kernel: str) -> None:
+        k = system.kernels[kernel]
+        sizes = system.sizes(kernel)
+        self.inputs: dict[str, np.ndarray] = {}
+        for port in k.spec["inputs"]:
+            name = port["name"]
+            if name == "p":
+                self.inputs[name] = np.ascontiguousarray(system.params, dtype=float)
+            elif port["integer"]:
+                self.inputs[name] = system.pattern(kernel).slots[name]
+            else:
+                self.inputs[name] = np.zeros(extent(port["extent"], sizes))
+        self.outputs = {p["name"]: np.zeros(extent(p["extent"], sizes)) for p in k.spec["outputs"]}
+        self._system = system
+        self._call = k.bind(self.inputs, self.outputs, sizes)
+
+    def evaluate(self, **state) -> dict[str, np.ndarray]:
+        """Outputs at ``state`` (q, v, a, z as arrays, t as a number)."""
+        if self.inputs.get("p") is not None and self.inputs["p"] is not self._system.params:
+            self.inputs["p"][...] = self._system.params
+        for name, arr in self.inputs.items():
+            if name in ("p",) or name.startswith("slots"):
+                continue
+            value = state.get(name)
+            if value is None:
+                arr[...] = 0.0
+            else:
+                arr[...] = value
+        self._call()
+        return self.outputs

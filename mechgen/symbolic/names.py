@@ -12,7 +12,7 @@ import re
 from mechgen.errors import ModelError
 
 _IDENT = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,63}\Z")
-RESERVED = frozenset({"t", "p", "q", "v", "a", "z", "pi", "e", "I", "E", "S", "N_sites"})
+RESERVED = frozenset({"t", "pi", "e", "I", "E", "S", "oo", "nan", "zoo"})
 
 
 def check_identifier(name: object, *, what: str, file: str | None = None) -> str:

@@ -1,0 +1,72 @@
+"""Natural frequencies and mode shapes: K phi = omega^2 M phi (M symmetric positive definite).
+
+Frequencies are sign(lambda) sqrt(|lambda|) for the eigenvalues lambda = omega^2,
+ascending: a negative frequency flags a divergence (negative-stiffness) mode.
+Shapes are mass-normalised (phi^T M phi = I). Units: rad/s, or the model's
+nondimensional frequency unit.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sps
+import scipy.sparse.linalg as spla
+
+from mechgen.errors import InputError
+
+
+@dataclass(frozen=True)
+class ModesResult:
+    """Eigenvalues omega^2, signed frequencies and mass-normalised shapes (columns)."""
+
+    eigenvalues: np.ndarray
+    frequencies: np.ndarray
+    shapes: np.ndarray
+
+
+def _check_symmetric(A: np.ndarray, name: str) -> None:
+    scale = max(np.abs(A).max(), 1e-300)
+    if np.abs(A - A.T).max() > 1e-10 * scale:
+        raise InputError(f"{name} is not symmetric (asymmetry {np.abs(A - A.T).max():.3g} of scale {scale:.3g})",
+                         key=name, expected="a symmetric matrix (use a stability analysis for circulatory systems)")
+
+
+def _dense(M, K) -> ModesResult:
+    M, K = np.asarray(M, float), np.asarray(K, float)
+    _check_symmetric(M, "M")
+    _check_symmetric(K, "K")
+    try:
+        lam, phi = sla.eigh(K, M)
+    except np.linalg.LinAlgError as exc:
+        raise InputError("the mass matrix is not positive definite (singular or indefinite)", key="M",
+                         expected="a positive definite mass matrix (check masses and inertias are > 0)") from exc
+    return ModesResult(lam, np.sign(lam) * np.sqrt(np.abs(lam)), phi)
+
+
+def _sparse(M, K, count: int) -> ModesResult:
+    diag = np.abs(K.diagonal()).max() if K.nnz else 1.0
+    sigma = -1e-6 * max(diag, 1e-300)
+    try:
+        lam, phi = spla.eigsh(K.tocsc(), k=count, M=M.tocsc(), sigma=sigma, which="LM")
+    except (RuntimeError, spla.ArpackError) as exc:
+        raise InputError(f"sparse eigensolver failed: {exc}", key="M",
+                         expected="a positive definite mass matrix") from exc
+    order = np.argsort(lam)
+    lam, phi = lam[order], phi[:, order]
+    return ModesResult(lam, np.sign(lam) * np.sqrt(np.abs(lam)), phi)
+
+
+def modes(M, K, count: int | None = None) -> ModesResult:
+    """Solve K phi = omega^2 M phi; dense (eigh) or sparse shift-invert about 0 for the lowest ``count``."""
+    n = M.shape[0]
+    if sps.issparse(M) or sps.issparse(K):
+        if count is not None and count < n - 1 and n > 200:
+            return _sparse(sps.csr_matrix(M), sps.csr_matrix(K), count)
+        M = M.toarray() if sps.issparse(M) else M
+        K = K.toarray() if sps.issparse(K) else K
+    res = _dense(M, K)
+    if count is not None:
+        res = ModesResult(res.eigenvalues[:count], res.frequencies[:count], res.shapes[:, :count])
+    return res

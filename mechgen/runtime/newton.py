@@ -1,0 +1,84 @@
+"""Newton's method with a backtracking line search: solve r(x) = 0 with the Jacobian J = dr/dx.
+
+Each step solves J dx = -r (dense LU or sparse LU) and accepts the largest
+alpha in 1, 1/2, 1/4, ... that decreases ||r||; it stops when ||r|| <= tol (or
+the step is below tol relative to ||x||), and raises ConvergenceError after
+``max_iter`` iterations with the residual history.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sps
+import scipy.sparse.linalg as spla
+
+from mechgen.errors import ConvergenceError, KernelError
+
+
+@dataclass(frozen=True)
+class NewtonResult:
+    """Solution, iterations used, final residual norm, converged flag."""
+
+    x: np.ndarray
+    iterations: int
+    residual_norm: float
+    converged: bool
+
+
+def _finite_residual(residual, x):
+    r = np.asarray(residual(x), float)
+    if not np.all(np.isfinite(r)):
+        raise KernelError(f"residual is not finite at x = {x[:6]}")
+    return r
+
+
+def _step(J, r) -> np.ndarray:
+    if sps.issparse(J):
+        if not np.all(np.isfinite(J.data)):
+            raise KernelError("Jacobian is not finite")
+        try:
+            dx = spla.splu(J.tocsc()).solve(-r)
+        except RuntimeError as exc:
+            raise ConvergenceError(f"singular Jacobian: {exc}") from exc
+    else:
+        J = np.atleast_2d(np.asarray(J, float))
+        if not np.all(np.isfinite(J)):
+            raise KernelError("Jacobian is not finite")
+        try:
+            lu = sla.lu_factor(J, check_finite=False)
+        except (np.linalg.LinAlgError, ValueError) as exc:
+            raise ConvergenceError(f"singular Jacobian: {exc}") from exc
+        if np.min(np.abs(np.diag(lu[0]))) <= 1e-14 * max(np.abs(J).max(), 1e-300):
+            raise ConvergenceError("singular Jacobian (a zero pivot): the equilibrium is not isolated or the "
+                                   "guess is at a degenerate point")
+        dx = sla.lu_solve(lu, -r, check_finite=False)
+    return dx
+
+
+def newton(residual, jacobian, x0, *, tol: float = 1e-10, max_iter: int = 50, damping: bool = True) -> NewtonResult:
+    """Solve residual(x) = 0 from x0."""
+    x = np.array(x0, dtype=float)
+    r = _finite_residual(residual, x)
+    history = [float(np.linalg.norm(r))]
+    for it in range(1, max_iter + 1):
+        if history[-1] <= tol:
+            return NewtonResult(x, it - 1, history[-1], True)
+        dx = _step(jacobian(x), r)
+        alpha = 1.0
+        while True:
+            trial = x + alpha * dx
+            r_trial = residual(trial)
+            norm = float(np.linalg.norm(r_trial)) if np.all(np.isfinite(r_trial)) else np.inf
+            if not damping or norm < history[-1] or alpha < 1e-6:
+                break
+            alpha /= 2
+        if not np.isfinite(norm):
+            raise KernelError(f"residual is not finite after a Newton step at x = {trial[:6]}")
+        x, r = trial, np.asarray(r_trial, float)
+        history.append(norm)
+        if norm <= tol or np.linalg.norm(alpha * dx) <= tol * max(1.0, np.linalg.norm(x)) and norm <= 1e3 * tol:
+            return NewtonResult(x, it, norm, True)
+    tail = ", ".join(f"{h:.3g}" for h in history[-5:])
+    raise ConvergenceError(f"Newton did not converge in {max_iter} iterations; last residual norms: {tail}")

@@ -1,0 +1,65 @@
+"""Stability of M q'' + C q' + K q = 0 (C = D + G, K possibly non-symmetric), and of E x' = A x.
+
+First-order form with x = (q, q'): A = [[0, I], [-K, -C]], B = [[I, 0], [0, M]],
+eigenvalues s of A x = s B x (``scipy.linalg.eig``). The verdict uses a tolerance
+relative to the spectrum's scale, ``tol = tolerance * scale`` with scale the
+largest finite |s| (at least sqrt(||K|| / ||M||)), so round-off never turns a
+conservative gyroscopic system into "flutter":
+
+* ``stable``      - every Re s <= tol,
+* ``divergence``  - the most unstable s has Re s > tol and |Im s| <= tol,
+* ``flutter``     - the most unstable s has Re s > tol and |Im s| > tol.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+
+
+@dataclass(frozen=True)
+class StabilityResult:
+    """Eigenvalues (sorted by imaginary, then real part), verdict, growth rate, frequencies, scale."""
+
+    eigenvalues: np.ndarray
+    verdict: str
+    growth_rate: float
+    frequencies: np.ndarray
+    scale: float
+
+
+def _verdict(s: np.ndarray, tolerance: float, floor: float = 0.0) -> StabilityResult:
+    s = s[np.isfinite(s)]
+    scale = max(float(np.max(np.abs(s))) if s.size else 0.0, floor, 1e-300)
+    tol = tolerance * scale
+    order = np.lexsort((s.real, s.imag))
+    s = s[order]
+    growth = float(np.max(s.real)) if s.size else 0.0
+    if growth <= tol:
+        verdict = "stable"
+    else:
+        worst = s[np.argmax(s.real)]
+        verdict = "divergence" if abs(worst.imag) <= tol else "flutter"
+    pos = np.sort(s.imag[s.imag > tol])
+    freqs = pos[np.concatenate([[True], np.diff(pos) > tol])] if pos.size else pos
+    return StabilityResult(s, verdict, growth, freqs, scale)
+
+
+def stability(M, C, K, *, tolerance: float = 1e-8) -> StabilityResult:
+    """Eigenvalues and verdict of M q'' + C q' + K q = 0 (dense)."""
+    M, C, K = (np.atleast_2d(np.asarray(x, float)) for x in (M, C, K))
+    n = M.shape[0]
+    eye, zero = np.eye(n), np.zeros((n, n))
+    A = np.block([[zero, eye], [-K, -C]])
+    B = np.block([[eye, zero], [zero, M]])
+    s = sla.eig(A, B, right=False)
+    norm_m = np.linalg.norm(M, 2)
+    floor = np.sqrt(np.linalg.norm(K, 2) / norm_m) if norm_m > 0 else 0.0
+    return _verdict(np.asarray(s), tolerance, floor)
+
+
+def stability_first_order(A, E, *, tolerance: float = 1e-8) -> StabilityResult:
+    """Eigenvalues and verdict of E x' = A x (E may be singular: infinite eigenvalues are dropped)."""
+    s = sla.eig(np.asarray(A, float), np.asarray(E, float), right=False)
+    return _verdict(np.asarray(s), tolerance)
