@@ -61,7 +61,7 @@ def run_scene(scene, *, overrides=(), backend: str | None = None) -> dict:
     backend = backend or scn.backend
     internal = bool(model.internals)
     kernels = sorted(set().union(*(needs(a.kind, a.options, internal=internal) for a in scn.analyses)))
-    free = tuple(scn.free)
+    free = tuple(n for n in scn.free if model.param(n).is_numeric)
     fixed = tuple(sorted((k, v) for k, v in scn.params.items()))
     started = time.perf_counter()
     system, report = _system_for(scn.model, fixed, free, scn.active, tuple(kernels), backend)
