@@ -118,3 +118,12 @@ def test_console_script_exit_code_for_bad_input(tmp_path):
                           capture_output=True, text=True, env=env)
     assert proc.returncode == 2
     assert "missing.toml" in proc.stderr and "Traceback" not in proc.stderr
+
+
+def test_plot_writes_pngs(tmp_path, capsys):
+    pytest.importorskip("matplotlib")
+    code, out, err = _run(["run", str(ROOT / "scenes" / "laval_rotor.toml"), "--plot", str(tmp_path)], capsys)
+    assert code == 0, err
+    pngs = sorted(p.name for p in tmp_path.glob("*.png"))
+    assert pngs == ["laval_rotor_campbell.png", "laval_rotor_whirl.png"]
+    assert all((tmp_path / p).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for p in pngs)

@@ -31,6 +31,9 @@ def _sweep(plt, a: dict, path: Path) -> None:
     fig, ax = plt.subplots(figsize=(6, 4))
     for xi, freqs in zip(x, a["outputs"].get("frequencies", [])):
         ax.plot([xi] * len(freqs), freqs, "k.", ms=3)
+    if name == "Omega" and x:
+        ax.plot([min(x), max(x)], [min(x), max(x)], "r--", lw=1, label="1x (synchronous)")
+        ax.legend(loc="upper left")
     ax.set_xlabel(name)
     ax.set_ylabel("frequency")
     ax.set_title(f"{a['name']}: frequencies vs {name}")

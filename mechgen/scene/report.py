@@ -23,7 +23,11 @@ def summary(results: dict) -> str:
     for a in results["analyses"]:
         lines.append(f"[{a['kind']}] {a['name']} ({a['seconds']:.3f} s)")
         for key, value in a["outputs"].items():
-            if key in ("t", "energy_series", "grid"):
+            if key in ("t", "energy_series", "grid") or (a["kind"] == "sweep" and key == "eigenvalues"):
                 continue
-            lines.append(f"    {key}: {_fmt(value)}")
+            lines.append(f"    {key}: {_fmt(value, width=4 if a['kind'] == 'sweep' else 8)}")
+        if a["kind"] == "sweep":
+            grid = a["outputs"].get("grid", [])
+            if grid:
+                lines.append(f"    grid: {len(grid)} points from {grid[0]} to {grid[-1]}")
     return "\n".join(lines)
