@@ -7,7 +7,8 @@ Sparse matrices are written into the data array of one CSR pattern (runtime
 size ``nnz``) through slot tables the runtime fills once.
 
 Kernel names as for lumped models (:mod:`mechgen.codegen.lower_lumped`):
-``residual``, ``tangent``, ``linear``, ``force``, ``outputs``.
+``residual``, ``tangent``, ``linear``, ``force``, ``outputs``; plus ``stiffness``,
+K = d2V/du2 alone (at a = 0), the Jacobian Newton and the benchmarks need.
 """
 from __future__ import annotations
 
@@ -17,7 +18,7 @@ from mechgen.codegen.ir import Block, Extent, KernelIR, Loop, Port, Write, fixed
 from mechgen.codegen.lower import canonical_block, kernel
 from mechgen.symbolic.lattice import LatticeEquations
 
-LATTICE_KERNELS = ("residual", "tangent", "linear", "force", "outputs")
+LATTICE_KERNELS = ("residual", "tangent", "linear", "stiffness", "force", "outputs")
 SITES = sized("sites")
 NNZ = sized("nnz")
 
@@ -83,14 +84,16 @@ def lower_lattice(eqs: LatticeEquations, name: str, *, cse: bool = True) -> Kern
         port = "r" if name == "residual" else "f"
         site, bond = _vector_writes(port, sign * site_expr, [sign * g for g in eqs.bond_gradient()], offsets)
         outputs = [Port(port, SITES)]
-    elif name in ("tangent", "linear"):
+    elif name in ("tangent", "linear", "stiffness"):
         tan = eqs.site_tangent()
         if name == "tangent":
             mats = {"r_q": tan["q"], "r_v": tan["v"], "r_a": tan["a"]}
-        else:
+        elif name == "linear":
             mats = {"M": tan["a"].subs(at_rest), "D": tan["v"].subs(at_rest), "K": tan["q"].subs(at_rest)}
+        else:
+            mats = {"K": tan["q"].subs(at_rest)}
         site, bond = _matrix_writes(mats, eqs.bond_hessian(), offsets)
-        names = list(mats) if name == "tangent" else ["M", "D", "G", "K"]
+        names = {"tangent": list(mats), "linear": ["M", "D", "G", "K"], "stiffness": ["K"]}[name]
         outputs = [Port(k, NNZ, sparse=True, symmetric=k in ("M", "D", "K")) for k in names]
         sizes = ("sites", "nnz")
     elif name == "outputs":

@@ -295,6 +295,80 @@ int mg_linear(const double *const *in, double *const *out, const long *sizes, lo
     return 0;
 }
 
+/* stiffness: chain kernel stiffness
+ *   in[0]  q: length sites per state
+ *   in[1]  v: length sites per state
+ *   in[2]  p: length 3
+ *   in[3]  slots0: int64 length 4*sites + 4
+ *   out[0] K: length nnz per state (CSR data)
+ *   sizes: sites, nnz
+ */
+int mg_stiffness(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    const long sites = sizes[0];
+    const long nnz = sizes[1];
+    const long len_in0 = sites;
+    const double *const in2 = in[2];
+    const long *const in3 = (const long *)(const void *)in[3];
+    const long len_out0 = nnz;
+    for (long b = 0; b < nbatch; ++b) {
+        const double *const in0 = in[0] + b * len_in0;
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        {
+            const long cnt = sites + 1;
+            const long ns = sites;
+            const long *const slot = in3;
+            const double g2 = in2[0];
+            const double g3 = in2[1];
+            const double g4 = in2[2];
+            const long lo = 1 < cnt ? 1 : cnt;
+            const long hi = ns - 0 > lo ? (ns - 0 < cnt ? ns - 0 : cnt) : lo;
+            for (long e = 0; e < lo; ++e) {
+                const int ok7 = (e + -1 >= 0) && (e + -1 < ns);
+                const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
+                const double g0 = ok7 ? in0[e - 1] : 0.0;
+                const double g1 = ok8 ? in0[e] : 0.0;
+                const double t0 = 2.0*g0 - 2.0*g1;
+                const double t1 = g2 + 3.0*g4*(-g0 + g1)*(-g0 + g1);
+                const double t2 = -g3*t0 + t1;
+                const double t3 = -g3*t0 + t1;
+                if (slot[e * 4 + 0] >= 0) out0[slot[e * 4 + 0]] += t2;
+                if (slot[e * 4 + 1] >= 0) out0[slot[e * 4 + 1]] += -t3;
+                if (slot[e * 4 + 2] >= 0) out0[slot[e * 4 + 2]] += -t2;
+                if (slot[e * 4 + 3] >= 0) out0[slot[e * 4 + 3]] += t3;
+            }
+            for (long e = lo; e < hi; ++e) {
+                const double g0 = in0[e - 1];
+                const double g1 = in0[e];
+                const double t0 = 2.0*g0 - 2.0*g1;
+                const double t1 = g2 + 3.0*g4*(-g0 + g1)*(-g0 + g1);
+                const double t2 = -g3*t0 + t1;
+                const double t3 = -g3*t0 + t1;
+                if (slot[e * 4 + 0] >= 0) out0[slot[e * 4 + 0]] += t2;
+                if (slot[e * 4 + 1] >= 0) out0[slot[e * 4 + 1]] += -t3;
+                if (slot[e * 4 + 2] >= 0) out0[slot[e * 4 + 2]] += -t2;
+                if (slot[e * 4 + 3] >= 0) out0[slot[e * 4 + 3]] += t3;
+            }
+            for (long e = hi; e < cnt; ++e) {
+                const int ok7 = (e + -1 >= 0) && (e + -1 < ns);
+                const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
+                const double g0 = ok7 ? in0[e - 1] : 0.0;
+                const double g1 = ok8 ? in0[e] : 0.0;
+                const double t0 = 2.0*g0 - 2.0*g1;
+                const double t1 = g2 + 3.0*g4*(-g0 + g1)*(-g0 + g1);
+                const double t2 = -g3*t0 + t1;
+                const double t3 = -g3*t0 + t1;
+                if (slot[e * 4 + 0] >= 0) out0[slot[e * 4 + 0]] += t2;
+                if (slot[e * 4 + 1] >= 0) out0[slot[e * 4 + 1]] += -t3;
+                if (slot[e * 4 + 2] >= 0) out0[slot[e * 4 + 2]] += -t2;
+                if (slot[e * 4 + 3] >= 0) out0[slot[e * 4 + 3]] += t3;
+            }
+        }
+    }
+    return 0;
+}
+
 /* force: chain kernel force
  *   in[0]  q: length sites per state
  *   in[1]  v: length sites per state

@@ -236,6 +236,58 @@ SPEC = {'force': {'doc': 'chain kernel force',
               'signature': '825f7a9c165f1fc6f0be3962e2709708501c0fcc767ba461beb1cd6ef826c70a',
               'sizes': ['sites'],
               'slots': []},
+ 'stiffness': {'doc': 'chain kernel stiffness',
+               'inputs': [{'batched': True,
+                           'extent': {'const': 0, 'terms': [['sites', 1]]},
+                           'integer': False,
+                           'name': 'q',
+                           'shape': None,
+                           'sparse': False,
+                           'symmetric': False},
+                          {'batched': True,
+                           'extent': {'const': 0, 'terms': [['sites', 1]]},
+                           'integer': False,
+                           'name': 'v',
+                           'shape': None,
+                           'sparse': False,
+                           'symmetric': False},
+                          {'batched': False,
+                           'extent': {'const': 3, 'terms': []},
+                           'integer': False,
+                           'name': 'p',
+                           'shape': None,
+                           'sparse': False,
+                           'symmetric': False},
+                          {'batched': False,
+                           'extent': {'const': 4, 'terms': [['sites', 4]]},
+                           'integer': True,
+                           'name': 'slots0',
+                           'shape': None,
+                           'sparse': False,
+                           'symmetric': False}],
+               'meta': {'bond_offsets': [-1, 0],
+                        'coordinates': ['u'],
+                        'ends': 'fixed',
+                        'kind': 'lattice',
+                        'model': 'fpu_chain',
+                        'params': ['gamma', 'alpha', 'beta'],
+                        'sites_param': 'N'},
+               'name': 'stiffness',
+               'ops': 14,
+               'outputs': [{'batched': True,
+                            'extent': {'const': 0, 'terms': [['nnz', 1]]},
+                            'integer': False,
+                            'name': 'K',
+                            'shape': None,
+                            'sparse': True,
+                            'symmetric': True}],
+               'signature': '6e4a5e15a2ddf86b2c379bc40136f40ecdd315c2f105d86e3fbb05f0fbd68f40',
+               'sizes': ['sites', 'nnz'],
+               'slots': [{'boundary': 'zero',
+                          'count': {'const': 1, 'terms': [['sites', 1]]},
+                          'entries': [[-1, -1], [-1, 0], [0, -1], [0, 0]],
+                          'port': 'slots0',
+                          'sites': {'const': 0, 'terms': [['sites', 1]]}}]},
  'tangent': {'doc': 'chain kernel tangent',
              'inputs': [{'batched': True,
                          'extent': {'const': 0, 'terms': [['sites', 1]]},
@@ -439,6 +491,33 @@ def build_linear(sizes, slots):
     out3 = out3 + _scatter(out3.numel(), cnt, np.asarray(slots['slots1']).reshape(cnt, 4)[:, 2]) @ vals[2, :].T
     out3 = out3 + _scatter(out3.numel(), cnt, np.asarray(slots['slots1']).reshape(cnt, 4)[:, 3]) @ vals[3, :].T
     return ca.Function('linear', [in0, in1, in2], [out0, out1, out2, out3], ['q', 'v', 'p'], ['M', 'D', 'G', 'K'])
+
+
+def build_stiffness(sizes, slots):
+    """chain kernel stiffness"""
+    in0 = ca.SX.sym('q', 1 * sizes['sites'])
+    in1 = ca.SX.sym('v', 1 * sizes['sites'])
+    in2 = ca.SX.sym('p', 3)
+    out0 = ca.SX.zeros(1 * sizes['nnz'])
+    cnt = 1 * sizes['sites'] + 1
+    ns = 1 * sizes['sites']
+    g0 = ca.SX.sym('g0')
+    g1 = ca.SX.sym('g1')
+    g2 = ca.SX.sym('g2')
+    g3 = ca.SX.sym('g3')
+    g4 = ca.SX.sym('g4')
+    t0 = 2.0*g0 - 2.0*g1
+    t1 = g2 + 3.0*g4*(-g0 + g1)*(-g0 + g1)
+    t2 = -g3*t0 + t1
+    t3 = -g3*t0 + t1
+    local = ca.Function('local0', [g0, g1, g2, g3, g4], [ca.vertcat(t2, -t3, -t2, t3)])
+    mapped = local.map(cnt)
+    vals = mapped((_shift(ns, cnt, -1, False).T @ in0).T, (_shift(ns, cnt, 0, False).T @ in0).T, in2[0], in2[1], in2[2])
+    out0 = out0 + _scatter(out0.numel(), cnt, np.asarray(slots['slots0']).reshape(cnt, 4)[:, 0]) @ vals[0, :].T
+    out0 = out0 + _scatter(out0.numel(), cnt, np.asarray(slots['slots0']).reshape(cnt, 4)[:, 1]) @ vals[1, :].T
+    out0 = out0 + _scatter(out0.numel(), cnt, np.asarray(slots['slots0']).reshape(cnt, 4)[:, 2]) @ vals[2, :].T
+    out0 = out0 + _scatter(out0.numel(), cnt, np.asarray(slots['slots0']).reshape(cnt, 4)[:, 3]) @ vals[3, :].T
+    return ca.Function('stiffness', [in0, in1, in2], [out0], ['q', 'v', 'p'], ['K'])
 
 
 def build_force(sizes, slots):

@@ -235,6 +235,58 @@ SPEC = {'force': {'doc': 'chain kernel force',
               'signature': '825f7a9c165f1fc6f0be3962e2709708501c0fcc767ba461beb1cd6ef826c70a',
               'sizes': ['sites'],
               'slots': []},
+ 'stiffness': {'doc': 'chain kernel stiffness',
+               'inputs': [{'batched': True,
+                           'extent': {'const': 0, 'terms': [['sites', 1]]},
+                           'integer': False,
+                           'name': 'q',
+                           'shape': None,
+                           'sparse': False,
+                           'symmetric': False},
+                          {'batched': True,
+                           'extent': {'const': 0, 'terms': [['sites', 1]]},
+                           'integer': False,
+                           'name': 'v',
+                           'shape': None,
+                           'sparse': False,
+                           'symmetric': False},
+                          {'batched': False,
+                           'extent': {'const': 3, 'terms': []},
+                           'integer': False,
+                           'name': 'p',
+                           'shape': None,
+                           'sparse': False,
+                           'symmetric': False},
+                          {'batched': False,
+                           'extent': {'const': 4, 'terms': [['sites', 4]]},
+                           'integer': True,
+                           'name': 'slots0',
+                           'shape': None,
+                           'sparse': False,
+                           'symmetric': False}],
+               'meta': {'bond_offsets': [-1, 0],
+                        'coordinates': ['u'],
+                        'ends': 'fixed',
+                        'kind': 'lattice',
+                        'model': 'fpu_chain',
+                        'params': ['gamma', 'alpha', 'beta'],
+                        'sites_param': 'N'},
+               'name': 'stiffness',
+               'ops': 14,
+               'outputs': [{'batched': True,
+                            'extent': {'const': 0, 'terms': [['nnz', 1]]},
+                            'integer': False,
+                            'name': 'K',
+                            'shape': None,
+                            'sparse': True,
+                            'symmetric': True}],
+               'signature': '6e4a5e15a2ddf86b2c379bc40136f40ecdd315c2f105d86e3fbb05f0fbd68f40',
+               'sizes': ['sites', 'nnz'],
+               'slots': [{'boundary': 'zero',
+                          'count': {'const': 1, 'terms': [['sites', 1]]},
+                          'entries': [[-1, -1], [-1, 0], [0, -1], [0, 0]],
+                          'port': 'slots0',
+                          'sites': {'const': 0, 'terms': [['sites', 1]]}}]},
  'tangent': {'doc': 'chain kernel tangent',
              'inputs': [{'batched': True,
                          'extent': {'const': 0, 'terms': [['sites', 1]]},
@@ -467,6 +519,47 @@ def mg_linear(ins, outs, sizes):
     s = in4.reshape(cnt, 4)[:, 3]
     m = s >= 0
     out3[:, s[m]] += _bc(t3, shape)[:, m]
+
+
+def mg_stiffness(ins, outs, sizes):
+    """chain kernel stiffness"""
+    in0 = ins[0]
+    in1 = ins[1]
+    in2 = ins[2]
+    in3 = ins[3]
+    out0 = outs[0]
+    nb = outs[0].shape[0]
+    cnt = 1 * sizes['sites'] + 1
+    ns = 1 * sizes['sites']
+    e = np.arange(cnt)
+    shape = (nb, cnt)
+    i7 = e + -1
+    ok7 = (i7 >= 0) & (i7 < ns)
+    i7 = np.clip(i7, 0, max(ns - 1, 0))
+    i8 = e + 0
+    ok8 = (i8 >= 0) & (i8 < ns)
+    i8 = np.clip(i8, 0, max(ns - 1, 0))
+    g0 = np.where(ok7, in0[:, i7], 0.0)
+    g1 = np.where(ok8, in0[:, i8], 0.0)
+    g2 = in2[0]
+    g3 = in2[1]
+    g4 = in2[2]
+    t0 = 2.0*g0 - 2.0*g1
+    t1 = g2 + 3.0*g4*(-g0 + g1)*(-g0 + g1)
+    t2 = -g3*t0 + t1
+    t3 = -g3*t0 + t1
+    s = in3.reshape(cnt, 4)[:, 0]
+    m = s >= 0
+    out0[:, s[m]] += _bc(t2, shape)[:, m]
+    s = in3.reshape(cnt, 4)[:, 1]
+    m = s >= 0
+    out0[:, s[m]] += _bc(-t3, shape)[:, m]
+    s = in3.reshape(cnt, 4)[:, 2]
+    m = s >= 0
+    out0[:, s[m]] += _bc(-t2, shape)[:, m]
+    s = in3.reshape(cnt, 4)[:, 3]
+    m = s >= 0
+    out0[:, s[m]] += _bc(t3, shape)[:, m]
 
 
 def mg_force(ins, outs, sizes):

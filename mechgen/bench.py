@@ -1,0 +1,298 @@
+"""``mechgen bench``: speed of generated kernels against hand-written and library baselines.
+
+FPU chain (bond force f(r) = gamma r + alpha r^2 + beta r^3, fixed ends): the force
+F = -dV/du and its sparse (tridiagonal) stiffness K = dF/du... as CSR data, at N = 64,
+1024, 16384 and for a batch of 10 000 states, computed by
+
+* generated C (mechgen, prepared call),
+* a hand-written C loop (benchmarks/hand_fpu.c) built with the same flags and called the same way,
+* hand-written vectorised numpy,
+* ``sympy.lambdify`` of the whole-chain expressions (N <= 1024; expanding bigger chains takes minutes),
+* a CasADi SX ``Function`` of the whole chain (vectorised SX operations).
+
+Also: the Python-level overhead of a prepared call of a small kernel, derivation +
+generation + compile time (first run and cached), and the time a cached scene
+takes to start solving. Every ratio is measured in one run on one machine; the
+numbers of the methods are checked against each other before timing.
+"""
+from __future__ import annotations
+
+import csv
+import json
+import os
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+GAMMA, ALPHA, BETA = 1.0, 0.25, 0.1
+HAND_C = Path(__file__).resolve().parents[1] / "benchmarks" / "hand_fpu.c"
+
+
+def best_time(fn, *, min_time: float = 0.1, repeats: int = 5) -> float:
+    """Best over ``repeats`` of the mean time of enough calls to last ``min_time`` seconds."""
+    fn()
+    number, elapsed = 1, 0.0
+    while True:
+        start = time.perf_counter()
+        for _ in range(number):
+            fn()
+        elapsed = time.perf_counter() - start
+        if elapsed >= min_time:
+            break
+        number *= 2 if elapsed <= 0 else max(2, int(min_time / max(elapsed, 1e-9)))
+    best = elapsed / number
+    for _ in range(repeats - 1):
+        start = time.perf_counter()
+        for _ in range(number):
+            fn()
+        best = min(best, (time.perf_counter() - start) / number)
+    return best
+
+
+def numpy_force(u: np.ndarray) -> np.ndarray:
+    """Vectorised numpy FPU force for (..., N) arrays."""
+    pad = np.zeros(u.shape[:-1] + (1,))
+    r = np.diff(np.concatenate([pad, u, pad], axis=-1), axis=-1)
+    f = r * (GAMMA + r * (ALPHA + r * BETA))
+    return f[..., 1:] - f[..., :-1]
+
+
+def numpy_stiffness(u: np.ndarray) -> np.ndarray:
+    """CSR data of the tridiagonal K (rows ascending) in numpy."""
+    n = u.shape[-1]
+    r = np.diff(np.concatenate([[0.0], u, [0.0]]))
+    k = GAMMA + r * (2 * ALPHA + 3 * BETA * r)
+    data = np.empty(3 * n - 2)
+    data[0::3] = k[:-1] + k[1:]
+    data[1::3] = -k[1:-1]
+    data[2::3] = -k[1:-1]
+    return data
+
+
+def _generated(n: int):
+    from mechgen import models
+    from mechgen.compile import compile_model
+    from mechgen.symbolic.specialize import specialize
+
+    model = models.get("fpu_chain")
+    spec = specialize(model, {"N": n, "gamma": GAMMA, "alpha": ALPHA, "beta": BETA})
+    return compile_model(model, spec, kernels={"force", "stiffness"}, backend="c")
+
+
+def _bind_force(system, u: np.ndarray, out: np.ndarray):
+    nb = u.shape[0] if u.ndim == 2 else 1
+    inputs = {"q": u, "v": np.zeros_like(u), "z": np.zeros(0), "t": np.zeros((nb, 1)), "p": system.params}
+    return system.kernels["force"].bind(inputs, {"f": out}, system.sizes("force"))
+
+
+def _bind_stiffness(system, u: np.ndarray, outs: dict):
+    pat = system.pattern("stiffness")
+    inputs = {"q": u, "v": np.zeros_like(u), "p": system.params, **pat.slots}
+    return system.kernels["stiffness"].bind(inputs, outs, system.sizes("stiffness"))
+
+
+def _hand(lib, name: str, u: np.ndarray, out: np.ndarray, n: int, nbatch: int):
+    from mechgen.codegen.build import function_address, get_caller
+
+    params = np.array([GAMMA, ALPHA, BETA])
+    return get_caller().bind(function_address(lib, name), [u.ctypes.data, params.ctypes.data], [out.ctypes.data],
+                             [n], nbatch, (u, out, params, lib))
+
+
+def _lambdified(n: int):
+    import sympy as sp
+
+    u = sp.symbols(f"u1:{n + 1}", real=True)
+    ext = (0,) + u + (0,)
+    f = [GAMMA * r + ALPHA * r**2 + BETA * r**3 for r in (ext[i + 1] - ext[i] for i in range(n + 1))]
+    start = time.perf_counter()
+    force = sp.lambdify([u], [f[i + 1] - f[i] for i in range(n)], "numpy")
+    return force, time.perf_counter() - start
+
+
+def _casadi_force(n: int):
+    import casadi as ca
+
+    u = ca.SX.sym("u", n)
+    ext = ca.vertcat(0, u, 0)
+    r = ext[1:] - ext[:-1]
+    f = r * (GAMMA + r * (ALPHA + r * BETA))
+    F = ca.Function("F", [u], [f[1:] - f[:-1]])
+    K = ca.Function("K", [u], [ca.jacobian(-(f[1:] - f[:-1]), u)])
+    return F, K
+
+
+def _row(rows: list, method: str, quantity: str, n: int, batch: int, seconds: float) -> None:
+    rows.append({"method": method, "quantity": quantity, "N": n, "batch": batch, "seconds": seconds})
+
+
+def kernel_rows(sizes, batch_n: int, batch: int, lambdify_max: int) -> list[dict]:
+    """Time every method for the force and the stiffness; checks agreement first."""
+    from mechgen.codegen.build import load_shared
+
+    lib = load_shared(HAND_C.read_text(), stem="hand_fpu")
+    rows: list = []
+    rng = np.random.default_rng(0)
+    for n, nb in [(n, 1) for n in sizes] + [(batch_n, batch)]:
+        system, _ = _generated(n)
+        u = np.ascontiguousarray(rng.normal(scale=0.1, size=(nb, n)))
+        u1 = u[0].copy()
+        f_gen, f_hand = np.zeros((nb, n)), np.zeros((nb, n))
+        gen, hand = _bind_force(system, u if nb > 1 else u1, f_gen if nb > 1 else f_gen[0]), \
+            _hand(lib, "hand_force", u, f_hand, n, nb)
+        gen(), hand()
+        ref = numpy_force(u)
+        assert np.allclose(f_gen, ref, rtol=1e-12, atol=1e-15) and np.allclose(f_hand, ref, rtol=1e-12, atol=1e-15)
+        _row(rows, "generated C", "force", n, nb, best_time(gen))
+        _row(rows, "hand C -O3", "force", n, nb, best_time(hand))
+        _row(rows, "numpy", "force", n, nb, best_time(lambda: numpy_force(u)))
+        F, Kc = _casadi_force(n)
+        if nb == 1:
+            assert np.allclose(np.asarray(F(u1)).ravel(), ref[0], rtol=1e-12, atol=1e-15)
+            _row(rows, "casadi SX", "force", n, nb, best_time(lambda: F(u1)))
+        else:
+            Fm = F.map(nb)
+            _row(rows, "casadi SX map", "force", n, nb, best_time(lambda: Fm(u.T)))
+        if n <= lambdify_max and nb == 1:
+            lam, _ = _lambdified(n)
+            assert np.allclose(lam(u1), ref[0], rtol=1e-12, atol=1e-15)
+            _row(rows, "sympy.lambdify", "force", n, nb, best_time(lambda: lam(u1)))
+        if nb == 1:
+            pat = system.pattern("stiffness")
+            outs = {"K": np.zeros(pat.nnz)}
+            k_gen = _bind_stiffness(system, u1, outs)
+            k_hand_out = np.zeros(3 * n - 2)
+            k_hand = _hand(lib, "hand_stiffness", u1, k_hand_out, n, 1)
+            k_gen(), k_hand()
+            ref_k = numpy_stiffness(u1)
+            assert np.allclose(outs["K"], ref_k, rtol=1e-12) and np.allclose(k_hand_out, ref_k, rtol=1e-12)
+            _row(rows, "generated C", "stiffness", n, 1, best_time(k_gen))
+            _row(rows, "hand C -O3", "stiffness", n, 1, best_time(k_hand))
+            _row(rows, "numpy", "stiffness", n, 1, best_time(lambda: numpy_stiffness(u1)))
+            _row(rows, "casadi SX", "stiffness", n, 1, best_time(lambda: Kc(u1)))
+    return rows
+
+
+def call_overhead() -> dict:
+    """Prepared-call overhead of a small kernel: one call vs its share of a 10^6-state batch."""
+    from mechgen import models
+    from mechgen.compile import compile_model
+    from mechgen.symbolic.specialize import specialize
+
+    model = models.get("laval_rotor")
+    system, _ = compile_model(model, specialize(model, {"Omega": 100.0}), kernels={"force"}, backend="c")
+    one = {"q": np.full(4, 0.01), "v": np.zeros(4), "z": np.zeros(0), "t": np.zeros(1), "p": system.params}
+    out = {"f": np.zeros(4)}
+    single = best_time(system.kernels["force"].bind(one, out), min_time=0.3)
+    nb = 1_000_000
+    many = {"q": np.full((nb, 4), 0.01), "v": np.zeros((nb, 4)), "z": np.zeros(0), "t": np.zeros((nb, 1)),
+            "p": system.params}
+    per_state = best_time(system.kernels["force"].bind(many, {"f": np.zeros((nb, 4))}), repeats=3) / nb
+    return {"single_call_ns": single * 1e9, "kernel_per_state_ns": per_state * 1e9,
+            "overhead_ns": (single - per_state) * 1e9}
+
+
+def build_times(sizes) -> list[dict]:
+    """Derivation + generation + compile, first run (empty cache) and cached, for each N."""
+    rows = []
+    old = os.environ.get("MECHGEN_CACHE")
+    with tempfile.TemporaryDirectory() as tmp:
+        os.environ["MECHGEN_CACHE"] = tmp
+        try:
+            for n in sizes:
+                for label in ("first", "cached"):
+                    start = time.perf_counter()
+                    _, report = _generated(n)
+                    rows.append({"N": n, "run": label, "seconds": time.perf_counter() - start,
+                                 **{f"{k}_s": v for k, v in report.seconds.items()}, "cached": report.cached})
+        finally:
+            if old is None:
+                os.environ.pop("MECHGEN_CACHE", None)
+            else:
+                os.environ["MECHGEN_CACHE"] = old
+    return rows
+
+
+def scene_start(scene: Path) -> dict:
+    """Seconds from run_scene() to its first analysis, first and cached (in-process, imports warm)."""
+    from mechgen.scene.run import _system_for, run_scene
+
+    out = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        old = os.environ.get("MECHGEN_CACHE")
+        os.environ["MECHGEN_CACHE"] = tmp
+        try:
+            for label in ("first", "cached"):
+                _system_for.cache_clear()
+                out[label] = run_scene(scene)["build"]["seconds_total"]
+        finally:
+            if old is None:
+                os.environ.pop("MECHGEN_CACHE", None)
+            else:
+                os.environ["MECHGEN_CACHE"] = old
+    return out
+
+
+def _ratio(rows, method, quantity, n, batch, base) -> float | None:
+    def pick(m):
+        for r in rows:
+            if (r["method"], r["quantity"], r["N"], r["batch"]) == (m, quantity, n, batch):
+                return r["seconds"]
+        return None
+
+    a, b = pick(method), pick(base)
+    return None if a is None or b is None else a / b
+
+
+def report_markdown(rows, overhead, builds, start) -> str:
+    """The summary table with the issue's targets."""
+    lines = ["| quantity | N | batch | generated C | hand C | gen/hand (target <= 1.3) | numpy/gen | "
+             "lambdify/gen (target >= 100 at N >= 1024) | casadi/gen |", "|---|---|---|---|---|---|---|---|---|"]
+    keys = sorted({(r["quantity"], r["N"], r["batch"]) for r in rows}, key=lambda k: (k[0], k[2], k[1]))
+    for q, n, b in keys:
+        gen = next(r["seconds"] for r in rows if (r["method"], r["quantity"], r["N"], r["batch"]) ==
+                   ("generated C", q, n, b))
+        hand = _ratio(rows, "hand C -O3", q, n, b, "generated C")
+        fmt = lambda x: "-" if x is None else f"{x:.2f}"  # noqa: E731
+        gh = None if hand is None else 1 / hand
+        lam = _ratio(rows, "sympy.lambdify", q, n, b, "generated C")
+        cas = _ratio(rows, "casadi SX", q, n, b, "generated C") or _ratio(rows, "casadi SX map", q, n, b,
+                                                                          "generated C")
+        hand_s = next((r["seconds"] for r in rows if (r["method"], r["quantity"], r["N"], r["batch"]) ==
+                       ("hand C -O3", q, n, b)), None)
+        lines.append(f"| {q} | {n} | {b} | {gen * 1e6:.2f} us | "
+                     f"{'-' if hand_s is None else f'{hand_s * 1e6:.2f} us'} | {fmt(gh)} | "
+                     f"{fmt(_ratio(rows, 'numpy', q, n, b, 'generated C'))} | {fmt(lam)} | {fmt(cas)} |")
+    lines.append("")
+    lines.append(f"prepared call of a 4-DOF kernel: {overhead['single_call_ns']:.0f} ns per call, kernel "
+                 f"{overhead['kernel_per_state_ns']:.0f} ns per state -> overhead {overhead['overhead_ns']:.0f} ns "
+                 "(target about 250 ns)")
+    for b in builds:
+        lines.append(f"build N={b['N']} {b['run']}: {b['seconds']:.3f} s (target < 2 s)")
+    lines.append(f"scene start (run_scene to first analysis): first {start['first']:.3f} s, "
+                 f"cached {start['cached']:.3f} s (target < 0.5 s cached)")
+    return "\n".join(lines)
+
+
+def run_benchmarks(models_: list[str] | None = None, *, out: Path, quick: bool = False) -> dict:
+    """Run the FPU benchmark and write ``out/fpu_kernels.{csv,json,md}``."""
+    sizes = (64, 256) if quick else (64, 1024, 16384)
+    batch = (64, 100) if quick else (64, 10_000)
+    rows = kernel_rows(sizes, batch[0], batch[1], lambdify_max=256 if quick else 1024)
+    overhead = call_overhead()
+    builds = build_times((8, 100_000) if not quick else (8, 1000))
+    start = scene_start(Path(__file__).resolve().parents[1] / "scenes" / "spring_pendulum.toml")
+    out.mkdir(parents=True, exist_ok=True)
+    with open(out / "fpu_kernels.csv", "w", newline="") as fh:
+        writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    result = {"kernels": rows, "call_overhead": overhead, "builds": builds, "scene_start": start}
+    (out / "fpu_kernels.json").write_text(json.dumps(result, indent=2, default=float))
+    table = report_markdown(rows, overhead, builds, start)
+    (out / "fpu_kernels.md").write_text(table + "\n")
+    print(table)
+    print(f"\nwrote {out / 'fpu_kernels.csv'}, {out / 'fpu_kernels.json'}, {out / 'fpu_kernels.md'}")
+    return result
