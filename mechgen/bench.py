@@ -22,6 +22,7 @@ import json
 import os
 import tempfile
 import time
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -194,24 +195,31 @@ def call_overhead() -> dict:
             "overhead_ns": (single - per_state) * 1e9}
 
 
-def build_times(sizes) -> list[dict]:
-    """Derivation + generation + compile, first run (empty cache) and cached, for each N."""
-    rows = []
+@contextmanager
+def empty_cache():
+    """Point $MECHGEN_CACHE at a fresh temporary directory for the duration (first-run timings)."""
     old = os.environ.get("MECHGEN_CACHE")
     with tempfile.TemporaryDirectory() as tmp:
         os.environ["MECHGEN_CACHE"] = tmp
         try:
-            for n in sizes:
-                for label in ("first", "cached"):
-                    start = time.perf_counter()
-                    _, report = _generated(n)
-                    rows.append({"N": n, "run": label, "seconds": time.perf_counter() - start,
-                                 **{f"{k}_s": v for k, v in report.seconds.items()}, "cached": report.cached})
+            yield
         finally:
             if old is None:
                 os.environ.pop("MECHGEN_CACHE", None)
             else:
                 os.environ["MECHGEN_CACHE"] = old
+
+
+def build_times(sizes) -> list[dict]:
+    """Derivation + generation + compile, first run (empty cache) and cached, for each N."""
+    rows = []
+    with empty_cache():
+        for n in sizes:
+            for label in ("first", "cached"):
+                start = time.perf_counter()
+                _, report = _generated(n)
+                rows.append({"N": n, "run": label, "seconds": time.perf_counter() - start,
+                             **{f"{k}_s": v for k, v in report.seconds.items()}, "cached": report.cached})
     return rows
 
 
@@ -220,18 +228,10 @@ def scene_start(scene: Path) -> dict:
     from mechgen.scene.run import _system_for, run_scene
 
     out = {}
-    with tempfile.TemporaryDirectory() as tmp:
-        old = os.environ.get("MECHGEN_CACHE")
-        os.environ["MECHGEN_CACHE"] = tmp
-        try:
-            for label in ("first", "cached"):
-                _system_for.cache_clear()
-                out[label] = run_scene(scene)["build"]["seconds_total"]
-        finally:
-            if old is None:
-                os.environ.pop("MECHGEN_CACHE", None)
-            else:
-                os.environ["MECHGEN_CACHE"] = old
+    with empty_cache():
+        for label in ("first", "cached"):
+            _system_for.cache_clear()
+            out[label] = run_scene(scene)["build"]["seconds_total"]
     return out
 
 

@@ -7,6 +7,7 @@ the step is below tol relative to ||x||), and raises ConvergenceError after
 """
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -47,8 +48,10 @@ def _step(J, r) -> np.ndarray:
         if not np.all(np.isfinite(J)):
             raise KernelError("Jacobian is not finite")
         try:
-            lu = sla.lu_factor(J, check_finite=False)
-        except (np.linalg.LinAlgError, ValueError) as exc:
+            with warnings.catch_warnings():
+                warnings.simplefilter("error", sla.LinAlgWarning)
+                lu = sla.lu_factor(J, check_finite=False)
+        except (np.linalg.LinAlgError, ValueError, sla.LinAlgWarning) as exc:
             raise ConvergenceError(f"singular Jacobian: {exc}") from exc
         if np.min(np.abs(np.diag(lu[0]))) <= 1e-14 * max(np.abs(J).max(), 1e-300):
             raise ConvergenceError("singular Jacobian (a zero pivot): the equilibrium is not isolated or the "
