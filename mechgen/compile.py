@@ -26,14 +26,17 @@ from mechgen.codegen.lower_lumped import LUMPED_KERNELS, lower_lumped
 from mechgen.codegen.spec import kernel_spec
 from mechgen.errors import CompilerUnavailable, InputError
 from mechgen.runtime.kernels import c_kernels, casadi_kernels, load_module, numpy_kernels
+from mechgen.runtime.continuum import FieldSystem
 from mechgen.runtime.system import System
 from mechgen.symbolic.derive import derive_lumped
+from mechgen.symbolic.field import derive_field
 from mechgen.symbolic.lattice import derive_lattice
 from mechgen.symbolic.model import Model
 from mechgen.symbolic.specialize import Specialization
 
 log = logging.getLogger("mechgen")
 BACKENDS = ("c", "numpy", "casadi")
+FIELD_KERNELS = ("residual", "tangent", "linear", "outputs")
 _warned_no_compiler = False
 
 
@@ -55,6 +58,8 @@ def all_kernels(model: Model) -> tuple[str, ...]:
     """Every kernel a model can have."""
     if model.is_lattice:
         return LATTICE_KERNELS
+    if model.is_field:
+        return FIELD_KERNELS
     if model.internals:
         return LUMPED_KERNELS
     return tuple(k for k in LUMPED_KERNELS if not k.startswith("rates"))
@@ -62,11 +67,20 @@ def all_kernels(model: Model) -> tuple[str, ...]:
 
 def derive(model: Model, spec: Specialization):
     """Derived equations (lumped or lattice) of a specialisation."""
+    if model.is_field:
+        return derive_field(model, spec)
     return derive_lattice(model, spec) if model.is_lattice else derive_lumped(model, spec)
 
 
 def lower_all(model: Model, eqs, kernels, *, cse: bool = True) -> list[KernelIR]:
     """KernelIRs of the requested kernels, in canonical order."""
+    if model.is_field:
+        irs = [lower_lumped(eqs.local, k, cse=cse) for k in all_kernels(model) if k in kernels]
+        for ir in irs:
+            ir.meta["field"] = {"fields": list(eqs.fields), "jets": [list(j) for j in eqs.jets],
+                                "length": eqs.length, "constraints": [[c.field, c.order, c.at]
+                                                                      for c in eqs.constraints]}
+        return irs
     lower = lower_lattice if model.is_lattice else lower_lumped
     return [lower(eqs, k, cse=cse) for k in all_kernels(model) if k in kernels]
 
@@ -181,7 +195,13 @@ def compile_model(model: Model, spec: Specialization, *, kernels=None, backend: 
     if model.is_lattice:
         sites = int(sites if sites is not None else spec.values.get(model.chain_spec.sites,
                                                                     model.param(model.chain_spec.sites).default))
-    system = System(loaded, meta, values, sites or 0, report.backend)
+    if model.is_field:
+        fixed = {k: v for k, v in spec.values.items() if model.param(k).is_numeric}
+        choices = {k: spec.values.get(k, model.param(k).default)
+                   for k in ("discretisation", "N", "quadrature", "constraints")}
+        system = FieldSystem(loaded, meta, values, fixed, choices, report.backend)
+    else:
+        system = System(loaded, meta, values, sites or 0, report.backend)
     log.info("built %s [%s]: %s", model.name, report.backend, report.seconds)
     return system, report
 

@@ -136,12 +136,12 @@ def test_full_scene_round_trips(tmp_path):
     assert scene.free == ("k", "Omega", "N")
     eq, lin, sim, sweep = scene.analyses
     assert eq.options == {"guess": {"x": 0.5}, "tol": 1e-10, "max_iter": 50}
-    assert lin.options == {"about": "eq", "count": 2, "tolerance": 1e-8}
+    assert lin.options == {"about": "eq", "count": 2, "tolerance": 1e-8, "refine": True, "refine_rtol": 1e-2}
     assert sim.options == {"t_end": 20.0, "method": "leapfrog", "dt": 0.01, "rtol": 1e-8, "atol": 1e-10,
                            "q0": {"x": 0.1}, "v0": {}, "initial_mode": 1, "amplitude": 1.0,
                            "outputs": ["energy"], "series": True, "samples": 201}
     assert sweep.options["workers"] == 2 and sweep.options["progress"] is True
-    assert sweep.options["analysis"] == AnalysisSpec("campbell", "stability", {"tolerance": 1e-6})
+    assert sweep.options["analysis"] == AnalysisSpec("campbell", "stability", {"tolerance": 1e-6, "refine": True, "refine_rtol": 1e-2})
 
 
 def test_sweep_grid_is_cartesian_product_in_order(tmp_path):
@@ -323,8 +323,10 @@ ERRORS = [
      "analysis = { kind = 'modes' }\n", "analysis[1].over.Omega.step", ["unknown key"]),
     (MINIMAL.replace("modes", "sweep") + "over = { Omega = [] }\nanalysis = { kind = 'modes' }\n",
      "analysis[1].over.Omega", ["non-empty"]),
-    (MINIMAL.replace("modes", "sweep") + "over = { law = ['linear'] }\nanalysis = { kind = 'modes' }\n",
-     "analysis[1].over.law", ["choice"]),
+    (MINIMAL.replace("modes", "sweep") + "over = { law = ['linear', 'rubber'] }\nanalysis = { kind = 'modes' }\n",
+     "analysis[1].over.law[2]", ["rubber", "neo_hookean"]),
+    (MINIMAL.replace("modes", "sweep") + "over = { law = 'linear' }\nanalysis = { kind = 'modes' }\n",
+     "analysis[1].over.law", ["array of choices"]),
     (MINIMAL.replace("modes", "sweep") + "over = { N = [1.5] }\nanalysis = { kind = 'modes' }\n",
      "analysis[1].over.N", ["integer"]),
     (MINIMAL.replace("modes", "sweep") + "over = { nope = [1] }\nanalysis = { kind = 'modes' }\n",

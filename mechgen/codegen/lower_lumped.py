@@ -26,12 +26,16 @@ def _inputs(eqs: LumpedEquations, with_accel: bool = True) -> tuple[list[Port], 
     ports = [Port("q", fixed(n))] + [Port("v", fixed(n))]
     if with_accel:
         ports.append(Port("a", fixed(n)))
-    ports += [Port("z", fixed(m)), Port("t", fixed(1)), Port("p", fixed(len(eqs.params)), batched=False)]
+    ports += [Port("z", fixed(m)), Port("t", fixed(1))]
+    if eqs.position:
+        ports.append(Port("s", fixed(len(eqs.position)), doc="position along the domain"))
+    ports.append(Port("p", fixed(len(eqs.params)), batched=False))
     gathers = [(s, "q", i, False) for i, s in enumerate(eqs.q)]
     gathers += [(s, "v", i, False) for i, s in enumerate(eqs.v)]
     if with_accel:
         gathers += [(s, "a", i, False) for i, s in enumerate(eqs.a)]
     gathers += [(s, "z", i, False) for i, s in enumerate(eqs.z)] + [(eqs.t, "t", 0, False)]
+    gathers += [(s, "s", i, False) for i, s in enumerate(eqs.position)]
     gathers += [(s, "p", i, False) for i, s in enumerate(eqs.params)]
     return ports, gathers
 
@@ -48,7 +52,7 @@ def _matrix_kernel(eqs: LumpedEquations, name: str, doc: str, mats: dict[str, sp
 
 def _meta(eqs: LumpedEquations) -> dict:
     return {"model": eqs.model, "coordinates": list(eqs.coordinates), "internal": list(eqs.internal_names),
-            "params": list(eqs.param_names), "kind": "lumped"}
+            "params": list(eqs.param_names), "kind": "field" if eqs.position else "lumped"}
 
 
 def lower_lumped(eqs: LumpedEquations, name: str, *, cse: bool = True) -> KernelIR:

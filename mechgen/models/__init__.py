@@ -8,7 +8,8 @@ import importlib
 
 from mechgen.errors import InputError
 
-BUILTIN = ("fpu_chain", "laval_rotor", "spring_pendulum")
+BUILTIN = ("euler_bernoulli_beam", "fpu_chain", "laval_rotor", "moving_string", "rotating_string",
+           "spring_pendulum")
 
 
 def names() -> list[str]:

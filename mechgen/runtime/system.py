@@ -34,6 +34,8 @@ class System:
     backend: str = "numpy"
     patterns: dict = field(default_factory=dict)
 
+    is_field = False
+
     # -- shape --------------------------------------------------------------
     @property
     def is_lattice(self) -> bool:
@@ -114,6 +116,10 @@ class System:
     def residual(self, q, v=None, a=None, z=None, t=0.0) -> np.ndarray:
         """r(q, v, a, z, t)."""
         return self.call("residual", q=q, v=v, a=a, z=z, t=t)["r"].ravel()
+
+    def tangent(self, q, v=None, a=None, z=None, t=0.0) -> dict:
+        """dr/dq, dr/dv, dr/da (and dr/dz): dense n x n, or CSR for chains."""
+        return self.call("tangent", q=q, v=v, a=a, z=z, t=t)
 
     def linear(self, q=None, v=None, z=None, t=0.0) -> dict:
         """M, D, G, K of the linearisation at (q, v, z, t) (a = 0)."""

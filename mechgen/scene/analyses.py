@@ -56,27 +56,59 @@ def run_modes(system: System, options: dict, context: dict) -> dict:
     return {"frequencies": [float(f) for f in res.frequencies], "_shapes": res.shapes}
 
 
+def _stability_of(system, q, options: dict, context: dict):
+    tol = options.get("tolerance", 1e-8)
+    if system.m:
+        z = np.asarray(context[options["about"]]["_z"]) if options.get("about") else np.zeros(system.m)
+        A = system.jacobian(0.0, np.concatenate([q, np.zeros(system.n), z]))
+        return stability_first_order(A, np.eye(A.shape[0]), tolerance=tol)
+    mats = system.linear(q)
+    dense = {k: (v.toarray() if hasattr(v, "toarray") else v) for k, v in mats.items()}
+    return solve_stability(dense["M"], dense["D"] + dense["G"], dense["K"], tolerance=tol)
+
+
+def refinement_verdict(verdicts: list[str], growth: list[float], scales: list[float], tolerance: float,
+                       rtol: float) -> str:
+    """The continuum's verdict from verdicts at two refinements.
+
+    Equal verdicts stand when stable, or when the growth rates agree to ``rtol``
+    (relative); otherwise ``unconverged``.
+    """
+    if verdicts[0] != verdicts[1]:
+        return "unconverged"
+    if verdicts[0] == "stable":
+        return "stable"
+    g0, g1 = growth
+    floor = tolerance * max(scales)
+    return verdicts[0] if abs(g0 - g1) <= rtol * max(abs(g0), abs(g1)) + floor else "unconverged"
+
+
 def run_stability(system: System, options: dict, context: dict) -> dict:
     """Eigenvalues of M q'' + (D + G) q' + K q = 0 and the verdict.
 
     With internal variables z the linearisation is the first-order one,
     x' = A x with A = d(dx/dt)/dx at (q, 0, z) (exact Jacobian, see System.jacobian).
+    For a continuum (with ``refine``), the verdict is checked on the same model
+    discretised twice as finely: ``unconverged`` when the verdict changes or the
+    growth rate does not settle (``refinement`` reports both).
     """
     q = operating_point(system, options, context)
-    tol = options.get("tolerance", 1e-8)
-    if system.m:
-        z = np.asarray(context[options["about"]]["_z"]) if options.get("about") else np.zeros(system.m)
-        A = system.jacobian(0.0, np.concatenate([q, np.zeros(system.n), z]))
-        res = stability_first_order(A, np.eye(A.shape[0]), tolerance=tol)
-    else:
-        mats = system.linear(q)
-        dense = {k: (v.toarray() if hasattr(v, "toarray") else v) for k, v in mats.items()}
-        res = solve_stability(dense["M"], dense["D"] + dense["G"], dense["K"], tolerance=tol)
+    res = _stability_of(system, q, options, context)
     eig = [[float(s.real), float(s.imag)] for s in res.eigenvalues]
     freqs = [float(f) for f in res.frequencies]
     if options.get("count"):
         freqs = freqs[: options["count"]]
-    return {"eigenvalues": eig, "verdict": res.verdict, "frequencies": freqs, "growth_rate": float(res.growth_rate)}
+    out = {"eigenvalues": eig, "verdict": res.verdict, "frequencies": freqs, "growth_rate": float(res.growth_rate)}
+    if hasattr(system, "refined") and options.get("refine", True) and not options.get("about"):
+        size = int(system.choices["N"])
+        fine = system.refined(2 * size)
+        res2 = _stability_of(fine, np.zeros(fine.n), options, context)
+        out["verdict"] = refinement_verdict([res.verdict, res2.verdict], [res.growth_rate, res2.growth_rate],
+                                            [res.scale, res2.scale], options.get("tolerance", 1e-8),
+                                            options.get("refine_rtol", 1e-2))
+        out["refinement"] = {"N": [size, 2 * size], "verdicts": [res.verdict, res2.verdict],
+                             "growth_rates": [float(res.growth_rate), float(res2.growth_rate)]}
+    return out
 
 
 def _equilibrium_functions(system: System):
@@ -90,7 +122,7 @@ def _equilibrium_functions(system: System):
 
     def jacobian(y):
         q, z = y[:n], y[n:]
-        tan = system.call("tangent", q=q, z=z if system.m else None)
+        tan = system.tangent(q, z=z if system.m else None)
         if not system.m:
             return tan["r_q"]
         g = system.call("rates_tangent", q=q, z=z)
@@ -106,7 +138,7 @@ def run_steady(system: System, options: dict, context: dict) -> dict:
     res = newton(residual, jacobian, y0, tol=options.get("tol", 1e-10), max_iter=options.get("max_iter", 50))
     q, z = res.x[:system.n], res.x[system.n:]
     out = {"iterations": int(res.iterations), "residual_norm": float(res.residual_norm)}
-    if not system.is_lattice:
+    if not system.is_lattice and not system.is_field:
         out["coordinates"] = {n: float(x) for n, x in zip(system.coordinates, q)}
     out.update(system.outputs(q, None, z if system.m else None))
     out["_q"], out["_z"] = q, z

@@ -504,7 +504,9 @@ def _range(ctx: _Ctx, key: str, table: dict) -> list[float]:
 def _sweep_values(ctx: _Ctx, key: str, name: str, value: object) -> list[float | int]:
     info = _param_info(ctx.file, key, ctx.model, name)
     if _is_choice(info):
-        raise _fail(ctx.file, key, f"parameter '{name}' is a choice and cannot be swept", "a numeric parameter")
+        if not isinstance(value, list) or not value:
+            raise _fail(ctx.file, key, f"value is {_type_name(value)}", "a non-empty array of choices")
+        return [_choice_value(ctx.file, f"{key}[{i}]", info, v) for i, v in enumerate(value, 1)]
     if isinstance(value, dict):
         values = _range(ctx, key, value)
     elif isinstance(value, list) and value:
@@ -563,7 +565,8 @@ _ALL_OUTPUTS = object()
 _LINEAR = {"about": (_about, _ABSENT), "at": (_coord_table, _ABSENT), "count": (_count, _ABSENT)}
 SCHEMAS: dict[str, dict[str, tuple[Callable, Any]]] = {
     "modes": dict(_LINEAR),
-    "stability": {**_LINEAR, "tolerance": (_positive, 1e-8)},
+    "stability": {**_LINEAR, "tolerance": (_positive, 1e-8), "refine": (_bool, True),
+                  "refine_rtol": (_positive, 1e-2)},
     "steady": {"guess": (_coord_table, {}), "tol": (_positive, 1e-10), "max_iter": (_count, 50)},
     "simulate": {"t_end": (_positive, _REQUIRED), "method": (_method, "BDF"), "dt": (_positive, _ABSENT),
                  "rtol": (_positive, 1e-8), "atol": (_positive, 1e-10), "q0": (_coord_table, {}),

@@ -38,7 +38,7 @@ def _sweep_point(task: tuple) -> dict:
     model_name, values, free, active, kernels, backend, kind, options, point = task
     system, _ = _system_for(model_name, values, free, active, kernels, backend)
     model = models.get(model_name)
-    sizes = {k: v for k, v in point.items() if model.param(k).size}
+    sizes = {k: v for k, v in point.items() if not model.param(k).is_numeric}
     if sizes:
         system, _ = _system_for(model_name, tuple(sorted({**dict(values), **sizes}.items())), free, active,
                                 kernels, backend)

@@ -31,6 +31,22 @@ def _lattice(eqs) -> list[str]:
             f"bond gradient = {eqs.bond_gradient()}", f"bond Hessian = {eqs.bond_hessian()}"]
 
 
+def _field(eqs) -> list[str]:
+    local = eqs.local
+    lines = [f"fields {list(eqs.fields)} on s in [0, {eqs.length}]; jets j = {list(local.coordinates)}",
+             f"kinetic density T = {local.kinetic}", f"potential density V = {local.potential}",
+             "boundary conditions: " + (", ".join(f"D^{c.order} {c.field} = 0 at the {c.at}" for c in eqs.constraints)
+                                        or "none (natural)"),
+             "", "local residual rho_a = d/dt(dT/dj_t,a) - dT/dj_a + dV/dj_a + dR/dj_t,a  (r = sum_g w_g B_g^T rho):"]
+    lines += [f"  rho[{n}] = {sp.simplify(e)}" for n, e in zip(local.coordinates, local.residual)]
+    lines += ["", "pointwise coefficients at the zero state (M = sum B^T m B, ...):"]
+    rest = {s: 0 for s in local.q + local.v}
+    for name, mat in local.linear_matrices().items():
+        lines.append(f"{name.lower()} =")
+        lines += ["  " + line for line in sp.pretty(sp.simplify(mat.subs(rest)), use_unicode=False).splitlines()]
+    return lines
+
+
 def show_model(name: str) -> str:
     """Text of a model's parameters, derived residual and linear matrices (all parameters symbolic)."""
     model = models.get(name)
@@ -38,7 +54,7 @@ def show_model(name: str) -> str:
     lines = [f"model {model.name}: {model.summary()}", "parameters:"]
     lines += [f"  {p.name:10s} = {p.default!r:10} {p.unit:10s} {p.doc}" for p in model.param_list]
     lines.append("")
-    lines += _lattice(eqs) if model.is_lattice else _lumped(eqs)
+    lines += _field(eqs) if model.is_field else _lattice(eqs) if model.is_lattice else _lumped(eqs)
     lines.append("")
     lines.append("outputs: " + ", ".join(model.output_names))
     return "\n".join(lines)

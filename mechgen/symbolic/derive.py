@@ -46,6 +46,7 @@ class LumpedEquations:
     residual: sp.Matrix
     rates: sp.Matrix
     outputs: dict
+    position: tuple[sp.Symbol, ...] = ()
 
     @property
     def t(self) -> sp.Symbol:
@@ -102,6 +103,21 @@ def _forces(model: Model, names, env) -> list[sp.Expr]:
     return [_scalar(raw.get(n, 0), "forces", model) for n in names]
 
 
+def lagrange_residual(T: sp.Expr, V: sp.Expr, R: sp.Expr, q, v, a) -> list[sp.Expr]:
+    """Lagrange's equations r_i = d/dt(dT/dv_i) - dT/dq_i + dV/dq_i + dR/dv_i, linear in a.
+
+    d/dt(dT/dv_i) = sum_j (d2T/dv_i dv_j) a_j + (d2T/dv_i dq_j) v_j + d2T/dv_i dt.
+    """
+    zero = sp.Integer(0)
+    res = []
+    for i, vi in enumerate(v):
+        dT_dv = sp.diff(T, vi)
+        ddt = sum((sp.diff(dT_dv, vj) * aj for vj, aj in zip(v, a)), zero)
+        ddt += sum((sp.diff(dT_dv, qj) * vj for qj, vj in zip(q, v)), zero) + sp.diff(dT_dv, TIME)
+        res.append(ddt - sp.diff(T, q[i]) + sp.diff(V, q[i]) + sp.diff(R, vi))
+    return res
+
+
 def derive_lumped(model: Model, spec: Specialization) -> LumpedEquations:
     """Derive the residual, internal rates and outputs of a lumped model."""
     if model.is_lattice:
@@ -114,12 +130,7 @@ def derive_lumped(model: Model, spec: Specialization) -> LumpedEquations:
     V = _scalar(call_declared(model.potential_fn, **env), "potential", model) if model.potential_fn else zero
     R = _scalar(call_declared(model.dissipation_fn, **env), "dissipation", model) if model.dissipation_fn else zero
     Q = _forces(model, names, env)
-    res = []
-    for i, vi in enumerate(v):
-        dT_dv = sp.diff(T, vi)
-        ddt = sum((sp.diff(dT_dv, aj_v) * aj for aj_v, aj in zip(v, a)), zero)
-        ddt += sum((sp.diff(dT_dv, qj) * vj for qj, vj in zip(q, v)), zero) + sp.diff(dT_dv, TIME)
-        res.append(ddt - sp.diff(T, q[i]) + sp.diff(V, q[i]) + sp.diff(R, vi) - Q[i])
+    res = [r - Qi for r, Qi in zip(lagrange_residual(T, V, R, q, v, a), Q)]
     rates = [_scalar(call_declared(i.rate, **env), f"rate of {i.name}", model) for i in model.internals]
     outputs = {o.name: _scalar(call_declared(o.fn, **env), f"output {o.name}", model) for o in model.outputs}
     outputs.update(kinetic_energy=T, potential_energy=V, energy=T + V)

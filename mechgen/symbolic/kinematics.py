@@ -45,3 +45,14 @@ def angular_velocity_cardan_xy(theta_x, theta_y, dtheta_x, dtheta_y, spin_rate) 
         omega = (theta_x' cos(theta_y), theta_y', phi' + theta_x' sin(theta_y)).
     """
     return sp.Matrix([dtheta_x * sp.cos(theta_y), dtheta_y, spin_rate + dtheta_x * sp.sin(theta_y)])
+
+
+def frame_velocity(omega, position, velocity) -> sp.Matrix:
+    """Inertial velocity of a point given in a frame spinning at ``omega``: v_rel + omega x r.
+
+    All three vectors have components on the rotating axes. Squared and halved
+    times a mass (density), it yields the Coriolis (gyroscopic) and centrifugal
+    terms of a rotating-frame model by itself.
+    """
+    w, r, v = sp.Matrix(omega), sp.Matrix(position), sp.Matrix(velocity)
+    return v + w.cross(r)

@@ -39,6 +39,14 @@ class Output:
 
 
 @dataclass(frozen=True)
+class Continuum:
+    """Scalar fields on s in [0, L], L the value of parameter ``length``."""
+
+    fields: tuple[str, ...]
+    length: str
+
+
+@dataclass(frozen=True)
 class Internal:
     """An internal variable z with dz/dt = rate(q, v, z, p, t)."""
 
@@ -114,6 +122,9 @@ class Model:
         self.site_kinetic_fn: Callable | None = None
         self.site_potential_fn: Callable | None = None
         self.bond_potential_fn: Callable | None = None
+        self.continuum: Continuum | None = None
+        self.weak_fn: Callable | None = None
+        self.boundary_fn: Callable | None = None
 
     # -- declarations ---------------------------------------------------
     def params(self, *params: Param) -> Namespace:
@@ -151,6 +162,56 @@ class Model:
             raise ModelError(f"chain sites parameter {sites!r} is not a size parameter", file=self.file,
                              key="chain.sites", expected="a Param declared with size=True")
         self.chain_spec = Chain(coordinate, sites, ends)
+
+    def field(self, *names: str, length: str = "L", discretisation: str = "hermite", N: int = 16) -> None:
+        """Declare scalar fields on s in [0, p.<length>] (a continuum model).
+
+        Adds the discretisation parameters every continuum has: ``discretisation``
+        (a choice, see :data:`mechgen.runtime.discretise.DISCRETISATIONS`), ``N``
+        (elements, or basis functions per field), ``quadrature`` (Gauss points per
+        element, 0 = chosen from the basis) and ``constraints`` (``eliminate`` or
+        ``penalty``). Densities are then declared with :meth:`kinetic_density`,
+        :meth:`potential_density`, :meth:`dissipation_density` or :meth:`weak_form`.
+        """
+        from mechgen.symbolic.discretisations import DISCRETISATIONS
+
+        if self.continuum is not None or self.coordinate_names or self.chain_spec:
+            raise ModelError(f"model {self.name} already declares its unknowns", file=self.file, key="field",
+                             expected="one field(...) call and no coordinates or chain")
+        self.param(length)
+        for name in names:
+            self._claim(name, "field")
+        self.continuum = Continuum(tuple(names), length)
+        self.params(Param("discretisation", discretisation, "", "basis or element family", choices=DISCRETISATIONS),
+                    Param("N", N, "", "elements, or basis functions per field", size=True),
+                    Param("quadrature", 0, "", "Gauss points per element (0: chosen from the basis)", size=True),
+                    Param("constraints", "eliminate", "", "essential boundary conditions by",
+                          choices=("eliminate", "penalty")))
+
+    def kinetic_density(self, fn: Callable) -> Callable:
+        """Decorator (continuum): kinetic energy per unit length T(u, p, s, t) of the jets u."""
+        self.kinetic_fn = fn
+        return fn
+
+    def potential_density(self, fn: Callable) -> Callable:
+        """Decorator (continuum): strain/potential energy per unit length V(u, p, s, t)."""
+        self.potential_fn = fn
+        return fn
+
+    def dissipation_density(self, fn: Callable) -> Callable:
+        """Decorator (continuum): Rayleigh dissipation per unit length R(u, p, s)."""
+        self.dissipation_fn = fn
+        return fn
+
+    def weak_form(self, fn: Callable) -> Callable:
+        """Decorator (continuum): a residual density W(test, u, p, s, t), linear in the test jets."""
+        self.weak_fn = fn
+        return fn
+
+    def boundary(self, fn: Callable) -> Callable:
+        """Decorator (continuum): essential boundary conditions fn(p) -> [fix(jet, 'start' | 'end'), ...]."""
+        self.boundary_fn = fn
+        return fn
 
     def kinetic(self, fn: Callable) -> Callable:
         """Decorator: kinetic energy T(q, v, p, t)."""
@@ -202,6 +263,16 @@ class Model:
         return self.chain_spec is not None
 
     @property
+    def is_field(self) -> bool:
+        """True for a continuum model (fields and densities)."""
+        return self.continuum is not None
+
+    @property
+    def field_names(self) -> tuple[str, ...]:
+        """Names of the declared fields."""
+        return self.continuum.fields if self.continuum else ()
+
+    @property
     def coordinates_all(self) -> tuple[str, ...]:
         """Names of the coordinates (the chain's coordinate for a lattice)."""
         if self.chain_spec:
@@ -226,6 +297,7 @@ class Model:
                  | {i.name for i in self.internals} | {o.name for o in self.outputs})
         if self.chain_spec:
             taken.add(self.chain_spec.coordinate)
+        taken |= set(self.field_names)
         if name in taken or name.endswith(("_dot", "_ddot")) and name.rsplit("_", 1)[0] in taken:
             raise ModelError(f"{what} name {name!r} is already used in model {self.name}", file=self.file,
                              key=name, expected="a name not yet declared")

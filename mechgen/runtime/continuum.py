@@ -1,0 +1,225 @@
+"""A compiled continuum: pointwise kernels + a discretisation = the discretised system.
+
+The generated kernels evaluate, at a batch of points, the local residual rho(j,
+j_t, j_tt) of the jets and its Jacobians (see mechgen.symbolic.field); this
+class supplies the repetition numerically: jets at the Gauss points from the dof
+vector, one batched kernel call over all points, assembly, and the boundary
+conditions. With x = Z q (constraints eliminated):
+
+    r(q, q', q'') = Z^T sum_e B_e^T W_e rho(B_e Z q, B_e Z q', B_e Z q''),
+    M = Z^T (sum_e B^T W m B) Z with m = d rho/dj_tt, and likewise D, G (from
+    d rho/dj_t) and K (from d rho/dj, incl. centrifugal and geometric terms).
+
+Linearisation about a base state uses its jets at the points: either from a dof
+vector q, or given directly as data (``jets=``, shape (elements, points, jets)).
+The interface matches :class:`~mechgen.runtime.system.System` (``n``, ``m``,
+``linear``, ``residual``, ``tangent``, ``outputs``, ``rhs``, ``jacobian``), so
+every analysis runs on it; :meth:`refined` gives the same model at another size.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sps
+import scipy.sparse.linalg as spla
+
+from mechgen.errors import KernelError
+from mechgen.runtime.assemble import Assembler, element_matrices, element_vectors, jets_at_points
+from mechgen.runtime.constrain import PENALTY_FACTOR, Reduction, reduction
+from mechgen.runtime.discretise import Discretisation, discretise
+from mechgen.runtime.kernels import Kernel
+
+
+@dataclass
+class FieldSystem:
+    """Kernels of a continuum's local piece, parameter values and the discretisation choices.
+
+    ``info`` (from the kernel meta): fields, jets [[field, order]], length
+    parameter, constraints [[field, order, 'start'|'end']]. ``choices``:
+    discretisation, N, quadrature, constraints (method).
+    """
+
+    kernels: dict[str, Kernel]
+    meta: dict
+    params: np.ndarray
+    fixed: dict
+    choices: dict
+    backend: str = "numpy"
+    _cache: dict = field(default_factory=dict, repr=False)
+
+    is_lattice = False
+    is_field = True
+    m = 0
+
+    # -- discretisation -------------------------------------------------------
+    @property
+    def info(self) -> dict:
+        """Field facts from the kernel meta."""
+        return self.meta["field"]
+
+    def value(self, name: str) -> float:
+        """Current value of a numeric parameter (free ones from ``params``)."""
+        names = self.meta.get("params", [])
+        return float(self.params[names.index(name)]) if name in names else float(self.fixed[name])
+
+    @property
+    def disc(self) -> Discretisation:
+        """The discretisation at the current length (built once per length)."""
+        length = self.value(self.info["length"])
+        key = ("disc", length)
+        if key not in self._cache:
+            self._cache.clear()
+            jets = tuple((f, int(k)) for f, k in self.info["jets"])
+            try:
+                self._cache[key] = discretise(self.choices["discretisation"], int(self.choices["N"]), length,
+                                              self.info["fields"], jets, quadrature=int(self.choices["quadrature"]),
+                                              constraints=[tuple(c) for c in self.info["constraints"]])
+            except ValueError as exc:
+                from mechgen.errors import InputError
+
+                raise InputError(str(exc), key="discretisation",
+                                 expected="a discretisation that fits the model's energies") from None
+        return self._cache[key]
+
+    @property
+    def reduction(self) -> Reduction:
+        """x = Z q for the essential boundary conditions."""
+        disc = self.disc
+        if "red" not in self._cache:
+            rows, scales = [], []
+            for f, k, at in self.info["constraints"]:
+                rows.append(disc.row(f, int(k), 0.0 if at == "start" else disc.length))
+                a = disc.jets.index((f, int(k)))
+                scales.append(float(np.abs(disc.tables[:, :, a, :]).max()))
+            red = reduction(np.array(rows), np.array(scales), disc.ndof, self.choices["constraints"],
+                            sparse=not disc.is_global)
+            if red.penalty_rows is not None and disc.is_global:
+                from mechgen.errors import InputError
+
+                raise InputError(f"penalty constraints with the global {disc.kind} basis couple every function "
+                                 "to the penalty and wreck the conditioning", key="constraints",
+                                 expected="'eliminate' for global bases (penalty with finite elements)")
+            self._cache["red"] = red
+        return self._cache["red"]
+
+    @property
+    def assembler(self) -> Assembler:
+        """Scatter into global dofs."""
+        disc = self.disc
+        if "asm" not in self._cache:
+            self._cache["asm"] = Assembler(disc.dofs, disc.ndof, dense=disc.is_global)
+        return self._cache["asm"]
+
+    @property
+    def n(self) -> int:
+        """Unknowns after the boundary conditions."""
+        return self.reduction.n
+
+    @property
+    def coordinates(self) -> list[str]:
+        """Names of the reduced unknowns."""
+        return [f"q{i + 1}" for i in range(self.n)]
+
+    def refined(self, size: int) -> "FieldSystem":
+        """The same model discretised with ``size`` elements or basis functions."""
+        return replace(self, choices={**self.choices, "N": int(size)}, _cache={})
+
+    # -- pointwise kernels ----------------------------------------------------
+    def _jets(self, x) -> np.ndarray:
+        disc = self.disc
+        if x is None:
+            return np.zeros(disc.points.shape + (len(disc.jets),))
+        return jets_at_points(disc.tables, disc.dofs, self.reduction.expand(x))
+
+    def _pointwise(self, kernel: str, j, j_t=None, j_tt=None, t: float = 0.0) -> dict:
+        disc = self.disc
+        npts, na = disc.points.size, len(disc.jets)
+        flat = lambda x: np.zeros((npts, na)) if x is None else np.ascontiguousarray(x.reshape(npts, na))  # noqa: E731
+        inputs = {"q": flat(j), "v": flat(j_t), "a": flat(j_tt), "z": np.zeros((npts, 0)),
+                  "t": np.full((npts, 1), float(t)), "s": disc.points.reshape(npts, 1), "p": self.params}
+        try:
+            out = self.kernels[kernel].evaluate(inputs)
+        except KernelError as exc:
+            raise KernelError(f"{exc} (pointwise kernel of {self.meta.get('model')} at the Gauss points)") from None
+        shape = disc.points.shape
+        return {k: v.reshape(shape + ((na, na) if v.shape[-1] == na * na and na > 1 else (v.shape[-1],)))
+                for k, v in out.items()}
+
+    def _matrix(self, coeff: np.ndarray, stiffness: bool = False):
+        disc = self.disc
+        pairs = [tuple(ab) for ab in np.argwhere(np.any(coeff != 0, axis=(0, 1)))]
+        ke = element_matrices(disc.tables, disc.weights, coeff, pairs)
+        return self.reduction.matrix(self.assembler.matrix(ke), self.penalty if stiffness else 0.0)
+
+    def _coeff(self, arr: np.ndarray) -> np.ndarray:
+        na = len(self.disc.jets)
+        return arr.reshape(arr.shape[:2] + (na, na))
+
+    # -- the discretised system ---------------------------------------------
+    def linear(self, q=None, v=None, z=None, t: float = 0.0, *, jets=None) -> dict:
+        """M, D, G, K about the base state q (or its jets at the points) with zero velocity."""
+        j = self._jets(q) if jets is None else np.asarray(jets, float)
+        local = self._pointwise("linear", j, self._jets(v) if v is not None else None, t=t)
+        return {k: self._matrix(self._coeff(local[k]), stiffness=k == "K") for k in ("M", "D", "G", "K")}
+
+    def residual(self, q, v=None, a=None, z=None, t: float = 0.0) -> np.ndarray:
+        """r(q, q', q'') = Z^T sum_e B^T W rho."""
+        rho = self._pointwise("residual", self._jets(q), self._jets(v) if v is not None else None,
+                              self._jets(a) if a is not None else None, t)["r"]
+        r = self.assembler.vector(element_vectors(self.disc.tables, self.disc.weights, rho))
+        red = self.reduction
+        return red.vector(r + red.penalty_force(red.expand(q), self.penalty))
+
+    @property
+    def penalty(self) -> float:
+        """alpha = PENALTY_FACTOR * max|diag K| of the unconstrained zero-state K (0 without penalty rows)."""
+        if self.reduction.penalty_rows is None:
+            return 0.0
+        if "alpha" not in self._cache:
+            local = self._pointwise("linear", self._jets(None))
+            ke = element_matrices(self.disc.tables, self.disc.weights, self._coeff(local["K"]))
+            K = self.assembler.matrix(ke)
+            self._cache["alpha"] = PENALTY_FACTOR * max(float(np.abs(K.diagonal()).max()), 1e-300)
+        return self._cache["alpha"]
+
+    def tangent(self, q, v=None, a=None, z=None, t: float = 0.0) -> dict:
+        """dr/dq, dr/dq', dr/dq'' (reduced; penalty included in dr/dq)."""
+        local = self._pointwise("tangent", self._jets(q), self._jets(v) if v is not None else None,
+                                self._jets(a) if a is not None else None, t)
+        return {k: self._matrix(self._coeff(local[k]), stiffness=k == "r_q") for k in ("r_q", "r_v", "r_a")}
+
+    def outputs(self, q, v=None, z=None, t: float = 0.0) -> dict[str, float]:
+        """Energies: integrals of the kinetic and potential densities."""
+        local = self._pointwise("outputs", self._jets(q), self._jets(v) if v is not None else None, t=t)
+        w = self.disc.weights
+        values = {k: float(np.sum(w * arr[..., 0])) for k, arr in local.items()}
+        bad = [k for k, val in values.items() if not np.isfinite(val)]
+        if bad:
+            raise KernelError(f"outputs of {self.meta.get('model')} are NaN/Inf: {', '.join(bad)}")
+        return values
+
+    # -- first-order form (time integration) ------------------------------------
+    def split(self, x: np.ndarray):
+        """(q, v, z) of a first-order state."""
+        n = self.n
+        return x[:n], x[n:2 * n], x[2 * n:]
+
+    def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
+        """dx/dt = (v, -M^-1 r(q, v, 0))."""
+        q, v, _ = self.split(x)
+        M = self.tangent(q, v, t=t)["r_a"]
+        r = self.residual(q, v, None, None, t)
+        a = spla.spsolve(sps.csc_matrix(M), -r) if sps.issparse(M) else sla.solve(M, -r, assume_a="sym")
+        return np.concatenate([v, a])
+
+    def jacobian(self, t: float, x: np.ndarray):
+        """d(dx/dt)/dx with da/d(q, v) = -M^-1 [r_q, r_v] at the current acceleration."""
+        q, v, _ = self.split(x)
+        a = self.rhs(t, x)[self.n:]
+        tan = self.tangent(q, v, a, t=t)
+        dense = lambda A: A.toarray() if sps.issparse(A) else A  # noqa: E731
+        da = -sla.solve(dense(tan["r_a"]), np.hstack([dense(tan["r_q"]), dense(tan["r_v"])]))
+        n = self.n
+        return np.block([[np.zeros((n, n)), np.eye(n)], [da]])

@@ -1,0 +1,188 @@
+"""Continua on a 1D domain s in [0, L]: fields, their jets, densities, and derivation on the local piece.
+
+A continuum model declares scalar fields u_f(s, t) and energy densities written
+in the fields' *jets* at a point: ``u.w`` (w), ``u.w_s`` (dw/ds), ``u.w_ss``,
+``u.w_t`` (dw/dt), ``u.w_st`` (d2w/ds dt), ``u.w_tt`` ... Densities are per unit
+length: kinetic T(j, j_t, s, t), strain/potential V(j, s, t), Rayleigh
+dissipation R(j, j_t), or, for a model that is not variational, a weak form
+W(test, j, j_t, j_tt) linear in the test jets.
+
+Derivation happens at one point, once (DESIGN.md, "symbolic on the local
+piece"): with the jet vector j = (D^k u_f) over fields f and orders k, the
+local residual of Lagrange's equations is
+
+    rho_a = d/dt(dT/dj_t,a) - dT/dj_a + dV/dj_a + dR/dj_t,a   (+ dW/dtest_a),
+
+so that the discretised residual is r = sum_g w_g B_g^T rho(B_g q, B_g q', B_g q'')
+with B_g the basis table (jets x dofs) at quadrature point g. Its local
+Jacobians d rho/dj_tt, d rho/dj_t, d rho/dj are the pointwise mass, damping +
+gyroscopic and stiffness (incl. centrifugal and geometric) coefficients. The
+local equations are a :class:`~mechgen.symbolic.derive.LumpedEquations` whose
+"coordinates" are the jets and which takes the position s as an extra input;
+every kernel kind of a lumped model (residual, tangent, linear, outputs) follows.
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+import sympy as sp
+
+from mechgen.errors import ModelError
+from mechgen.symbolic.derive import TIME, LumpedEquations, lagrange_residual
+from mechgen.symbolic.model import Model, as_expr, call_declared
+from mechgen.symbolic.params import Namespace
+from mechgen.symbolic.specialize import Specialization, param_namespace
+
+POSITION = sp.Symbol("s", real=True)
+_SUFFIX = re.compile(r"(s*)(t{0,2})\Z")
+ENDS = ("start", "end")
+
+
+@dataclass(frozen=True)
+class Constraint:
+    """An essential boundary condition: the jet ``D^order field`` vanishes at ``at`` ('start' or 'end')."""
+
+    field: str
+    order: int
+    at: str
+
+
+def fix(jet: str, at: str) -> tuple[str, str]:
+    """Boundary condition helper for ``@model.boundary``: ``fix("w_s", "end")`` means w_s(L) = 0."""
+    return (jet, at)
+
+
+class Jets(Namespace):
+    """Jets of the declared fields at one point, created on first use.
+
+    ``u.w`` is w, ``u.w_s`` dw/ds, ``u.w_sst`` d3w/ds2 dt; at most two time
+    derivatives. Used jets are recorded as (field, space order, time order).
+    """
+
+    def __init__(self, fields: tuple[str, ...], prefix: str = "") -> None:
+        object.__setattr__(self, "_fields", tuple(sorted(fields, key=len, reverse=True)))
+        object.__setattr__(self, "_prefix", prefix)
+        object.__setattr__(self, "_used", {})
+        super().__init__({})
+
+    @staticmethod
+    def parse(name: str, fields) -> tuple[str, int, int] | None:
+        """(field, space order, time order) of a jet name, or None."""
+        for f in sorted(fields, key=len, reverse=True):
+            if name == f:
+                return f, 0, 0
+            if name.startswith(f + "_"):
+                m = _SUFFIX.match(name[len(f) + 1:])
+                if m and m.group(0):
+                    return f, len(m.group(1)), len(m.group(2))
+        return None
+
+    def symbol(self, field: str, k: int, m: int) -> sp.Symbol:
+        """The symbol of jet (field, k, m)."""
+        key = (field, k, m)
+        if key not in self._used:
+            suffix = "s" * k + "t" * m
+            self._used[key] = sp.Symbol(f"{self._prefix}{field}{'_' + suffix if suffix else ''}", real=True)
+        return self._used[key]
+
+    def __getattr__(self, name: str) -> sp.Symbol:
+        if name.startswith("_"):
+            raise AttributeError(name)
+        jet = self.parse(name, self._fields)
+        if jet is None:
+            raise AttributeError(f"no jet {name!r}: fields are {', '.join(sorted(self._fields))}; a jet is a field "
+                                 "name, optionally followed by '_' and s's then at most two t's (w_s, w_sst)")
+        return self.symbol(*jet)
+
+    __getitem__ = __getattr__
+
+    @property
+    def used(self) -> dict:
+        """{(field, k, m): symbol} of every jet touched so far."""
+        return dict(self._used)
+
+
+@dataclass(frozen=True)
+class FieldEquations:
+    """The derived local piece of a continuum model.
+
+    Attributes:
+        local: pointwise equations; ``local.q`` are the jets ``jets`` in order,
+            ``local.v``/``local.a`` their first/second time derivatives.
+        jets: (field, space order) of each jet, fields in declaration order.
+        fields: field names.
+        length: name of the length parameter L.
+        constraints: essential boundary conditions.
+    """
+
+    local: LumpedEquations
+    jets: tuple[tuple[str, int], ...]
+    fields: tuple[str, ...]
+    length: str
+    constraints: tuple[Constraint, ...]
+
+
+def _density(model: Model, fn, what: str, env: dict) -> sp.Expr:
+    return as_expr(call_declared(fn, **env), what, model) if fn else sp.Integer(0)
+
+
+def _constraints(model: Model, p_ns: Namespace) -> tuple[Constraint, ...]:
+    if model.boundary_fn is None:
+        return ()
+    raw = call_declared(model.boundary_fn, p=p_ns)
+    out = []
+    for item in raw or ():
+        if not (isinstance(item, tuple) and len(item) == 2 and all(isinstance(x, str) for x in item)):
+            raise ModelError(f"boundary of model {model.name} returned {item!r}", file=model.file, key="boundary",
+                             expected="a list of fix(jet, 'start' | 'end')")
+        jet, at = item
+        parsed = Jets.parse(jet, model.field_names)
+        if parsed is None or parsed[2] or at not in ENDS:
+            raise ModelError(f"boundary condition {item!r} of model {model.name} is not a spatial jet at an end",
+                             file=model.file, key="boundary", expected="fix('w' or 'w_s' ..., 'start' or 'end')")
+        out.append(Constraint(parsed[0], parsed[1], at))
+    return tuple(out)
+
+
+def derive_field(model: Model, spec: Specialization) -> FieldEquations:
+    """Derive the pointwise residual of a continuum model from its densities (and weak form)."""
+    cont = model.continuum
+    if cont is None:
+        raise ModelError(f"model {model.name} declares no field", file=model.file, expected="model.field(...)")
+    p_ns, free = param_namespace(model, spec)
+    u, test = Jets(model.field_names), Jets(model.field_names, prefix="test_")
+    env = {"u": u, "p": p_ns, "s": POSITION, "t": TIME}
+    T = _density(model, model.kinetic_fn, "kinetic_density", env)
+    V = _density(model, model.potential_fn, "potential_density", env)
+    R = _density(model, model.dissipation_fn, "dissipation_density", env)
+    W = _density(model, model.weak_fn, "weak_form", {**env, "test": test})
+    orders = {f: -1 for f in model.field_names}
+    for f, k, _ in list(u.used) + list(test.used):
+        orders[f] = max(orders[f], k)
+    constraints = _constraints(model, p_ns)
+    for c in constraints:
+        orders[c.field] = max(orders[c.field], c.order)
+    jets = tuple((f, k) for f in model.field_names for k in range(orders[f] + 1))
+    q = tuple(u.symbol(f, k, 0) for f, k in jets)
+    v = tuple(u.symbol(f, k, 1) for f, k in jets)
+    a = tuple(u.symbol(f, k, 2) for f, k in jets)
+    stray = {key for key in u.used if key[2] > 2}
+    if stray:
+        raise ModelError(f"densities of {model.name} use more than two time derivatives", file=model.file)
+    rho = lagrange_residual(T, V, R, q, v, a)
+    if model.weak_fn is not None:
+        rho = [r + sp.diff(W, test.symbol(f, k, 0)) for r, (f, k) in zip(rho, jets)]
+        leftover = W.subs({s: 0 for s in test.used.values()}) if test.used else W
+        if sp.expand(leftover) != 0 or any(sp.diff(W, s1, s2) != 0 for s1 in test.used.values()
+                                           for s2 in test.used.values()):
+            raise ModelError(f"weak form of {model.name} is not linear in the test jets", file=model.file,
+                             key="weak_form", expected="a sum of test jets times expressions of the trial jets")
+    names = tuple(s.name for s in q)
+    local = LumpedEquations(
+        model=model.name, coordinates=names, q=q, v=v, a=a, z=(), params=free,
+        param_names=tuple(s.name for s in free), internal_names=(), kinetic=T, potential=V,
+        residual=sp.Matrix(rho) if rho else sp.zeros(0, 1), rates=sp.zeros(0, 1),
+        outputs={"kinetic_energy": T, "potential_energy": V, "energy": T + V}, position=(POSITION,),
+    )
+    return FieldEquations(local, jets, tuple(model.field_names), cont.length, constraints)
