@@ -11,7 +11,7 @@ import json
 import logging
 import time
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from pathlib import Path
 
@@ -75,11 +75,14 @@ def derive(model: Model, spec: Specialization):
 def lower_all(model: Model, eqs, kernels, *, cse: bool = True) -> list[KernelIR]:
     """KernelIRs of the requested kernels, in canonical order."""
     if model.is_field:
-        irs = [lower_lumped(eqs.local, k, cse=cse) for k in all_kernels(model) if k in kernels]
+        wanted = [k for k in all_kernels(model) if k in kernels]
+        irs = [lower_lumped(eqs.local, k, cse=cse) for k in wanted]
+        irs += [replace(lower_lumped(local, k, cse=cse), name=f"{k}_at_{at}") for at, local in eqs.points.items()
+                for k in wanted]
         for ir in irs:
             ir.meta["field"] = {"fields": list(eqs.fields), "jets": [list(j) for j in eqs.jets],
-                                "length": eqs.length, "constraints": [[c.field, c.order, c.at]
-                                                                      for c in eqs.constraints]}
+                                "length": eqs.length, "points": sorted(eqs.points),
+                                "constraints": [[c.field, c.order, c.at] for c in eqs.constraints]}
         return irs
     lower = lower_lattice if model.is_lattice else lower_lumped
     return [lower(eqs, k, cse=cse) for k in all_kernels(model) if k in kernels]

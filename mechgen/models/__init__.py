@@ -8,8 +8,8 @@ import importlib
 
 from mechgen.errors import InputError
 
-BUILTIN = ("euler_bernoulli_beam", "fpu_chain", "laval_rotor", "moving_string", "rotating_string",
-           "spring_pendulum")
+BUILTIN = ("euler_bernoulli_beam", "follower_column", "fpu_chain", "laval_rotor", "moving_string",
+           "rotating_string", "spring_pendulum", "timoshenko_beam")
 
 
 def names() -> list[str]:

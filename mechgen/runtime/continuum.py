@@ -133,44 +133,89 @@ class FieldSystem:
             return np.zeros(disc.points.shape + (len(disc.jets),))
         return jets_at_points(disc.tables, disc.dofs, self.reduction.expand(x))
 
-    def _pointwise(self, kernel: str, j, j_t=None, j_tt=None, t: float = 0.0) -> dict:
-        disc = self.disc
-        npts, na = disc.points.size, len(disc.jets)
-        flat = lambda x: np.zeros((npts, na)) if x is None else np.ascontiguousarray(x.reshape(npts, na))  # noqa: E731
+    def _evaluate(self, kernel: str, j, j_t, j_tt, t: float, s: np.ndarray) -> dict:
+        """One batched call of a pointwise kernel at positions s; jets arrays (..., jets); outputs (..., length)."""
+        na = len(self.disc.jets)
+        shape = s.shape
+        npts = s.size
+        flat = lambda x: np.zeros((npts, na)) if x is None else np.ascontiguousarray(np.reshape(x, (npts, na)))  # noqa: E731
         inputs = {"q": flat(j), "v": flat(j_t), "a": flat(j_tt), "z": np.zeros((npts, 0)),
-                  "t": np.full((npts, 1), float(t)), "s": disc.points.reshape(npts, 1), "p": self.params}
+                  "t": np.full((npts, 1), float(t)), "s": s.reshape(npts, 1), "p": self.params}
         try:
             out = self.kernels[kernel].evaluate(inputs)
         except KernelError as exc:
-            raise KernelError(f"{exc} (pointwise kernel of {self.meta.get('model')} at the Gauss points)") from None
-        shape = disc.points.shape
-        return {k: v.reshape(shape + ((na, na) if v.shape[-1] == na * na and na > 1 else (v.shape[-1],)))
-                for k, v in out.items()}
+            raise KernelError(f"{exc} (pointwise kernel of {self.meta.get('model')})") from None
+        return {k: v.reshape(shape + (v.shape[-1],)) for k, v in out.items()}
 
-    def _matrix(self, coeff: np.ndarray, stiffness: bool = False):
+    def _pointwise(self, kernel: str, j, j_t=None, j_tt=None, t: float = 0.0) -> dict:
+        return self._evaluate(kernel, j, j_t, j_tt, t, self.disc.points)
+
+    def _point_table(self, at: str):
+        """B_at (jets x dofs, CSR): the jets at an end from the full dof vector."""
+        key = ("point", at)
+        if key not in self._cache:
+            disc = self.disc
+            x = 0.0 if at == "start" else disc.length
+            self._cache[key] = sps.csr_matrix(np.array([disc.row(f, k, x) for f, k in disc.jets]))
+        return self._cache[key]
+
+    def _ends(self, kernel: str, states, t: float):
+        """(B_at, local outputs) of every end term: states are full dof vectors (q, q', q'') or None."""
+        for at in self.info.get("points", []):
+            B = self._point_table(at)
+            at_end = [None if x is None else (B @ x)[None] for x in states]
+            x = np.array([0.0 if at == "start" else self.disc.length])
+            yield B, self._evaluate(f"{kernel}_at_{at}", *at_end, t, x)
+
+    def _full(self, states):
+        red = self.reduction
+        return [None if x is None else red.expand(x) for x in states]
+
+    def _matrices(self, kernel: str, names, q, v, a, t: float, jets=None) -> dict:
+        """Reduced global matrices ``names`` of a tangent-type kernel at the state (q, v, a)."""
         disc = self.disc
-        pairs = [tuple(ab) for ab in np.argwhere(np.any(coeff != 0, axis=(0, 1)))]
-        ke = element_matrices(disc.tables, disc.weights, coeff, pairs)
-        return self.reduction.matrix(self.assembler.matrix(ke), self.penalty if stiffness else 0.0)
+        full = self._full((q, v, a))
+        j = [jets_at_points(disc.tables, disc.dofs, x) if x is not None else None for x in full]
+        if jets is not None:
+            j[0] = np.asarray(jets, float)
+        local = self._pointwise(kernel, *j, t=t)
+        mats = {}
+        for k in names:
+            coeff = self._coeff(local[k])
+            pairs = [tuple(ab) for ab in np.argwhere(np.any(coeff != 0, axis=(0, 1)))]
+            mats[k] = self.assembler.matrix(element_matrices(disc.tables, disc.weights, coeff, pairs))
+        for B, loc in self._ends(kernel, full, t):
+            for k in names:
+                extra = B.T @ sps.csr_matrix(self._coeff(loc[k])[0]) @ B
+                mats[k] = mats[k] + (extra if sps.issparse(mats[k]) else extra.toarray())
+        stiff = {"linear": "K", "tangent": "r_q"}[kernel]
+        return {k: self.reduction.matrix(mats[k], self.penalty if k == stiff else 0.0) for k in names}
 
     def _coeff(self, arr: np.ndarray) -> np.ndarray:
+        """A flat (..., jets * jets) kernel output as (..., jets, jets) coefficients."""
         na = len(self.disc.jets)
-        return arr.reshape(arr.shape[:2] + (na, na))
+        return arr.reshape(arr.shape[:-1] + (na, na))
 
     # -- the discretised system ---------------------------------------------
     def linear(self, q=None, v=None, z=None, t: float = 0.0, *, jets=None) -> dict:
-        """M, D, G, K about the base state q (or its jets at the points) with zero velocity."""
-        j = self._jets(q) if jets is None else np.asarray(jets, float)
-        local = self._pointwise("linear", j, self._jets(v) if v is not None else None, t=t)
-        return {k: self._matrix(self._coeff(local[k]), stiffness=k == "K") for k in ("M", "D", "G", "K")}
+        """M, D, G, K about the base state q (or its jets at the Gauss points) with zero acceleration."""
+        return self._matrices("linear", ("M", "D", "G", "K"), q, v, None, t, jets)
+
+    def tangent(self, q, v=None, a=None, z=None, t: float = 0.0) -> dict:
+        """dr/dq, dr/dq', dr/dq'' (reduced; the penalty term in dr/dq)."""
+        return self._matrices("tangent", ("r_q", "r_v", "r_a"), q, v, a, t)
 
     def residual(self, q, v=None, a=None, z=None, t: float = 0.0) -> np.ndarray:
-        """r(q, q', q'') = Z^T sum_e B^T W rho."""
-        rho = self._pointwise("residual", self._jets(q), self._jets(v) if v is not None else None,
-                              self._jets(a) if a is not None else None, t)["r"]
-        r = self.assembler.vector(element_vectors(self.disc.tables, self.disc.weights, rho))
+        """r(q, q', q'') = Z^T (sum_e B^T W rho + sum_ends B_at^T rho_at + penalty C^T C x)."""
+        disc = self.disc
+        full = self._full((q, v, a))
+        j = [jets_at_points(disc.tables, disc.dofs, x) if x is not None else None for x in full]
+        rho = self._pointwise("residual", *j, t=t)["r"]
+        r = self.assembler.vector(element_vectors(disc.tables, disc.weights, rho))
+        for B, loc in self._ends("residual", full, t):
+            r = r + B.T @ loc["r"][0]
         red = self.reduction
-        return red.vector(r + red.penalty_force(red.expand(q), self.penalty))
+        return red.vector(r + red.penalty_force(full[0], self.penalty))
 
     @property
     def penalty(self) -> float:
@@ -184,17 +229,16 @@ class FieldSystem:
             self._cache["alpha"] = PENALTY_FACTOR * max(float(np.abs(K.diagonal()).max()), 1e-300)
         return self._cache["alpha"]
 
-    def tangent(self, q, v=None, a=None, z=None, t: float = 0.0) -> dict:
-        """dr/dq, dr/dq', dr/dq'' (reduced; penalty included in dr/dq)."""
-        local = self._pointwise("tangent", self._jets(q), self._jets(v) if v is not None else None,
-                                self._jets(a) if a is not None else None, t)
-        return {k: self._matrix(self._coeff(local[k]), stiffness=k == "r_q") for k in ("r_q", "r_v", "r_a")}
-
     def outputs(self, q, v=None, z=None, t: float = 0.0) -> dict[str, float]:
-        """Energies: integrals of the kinetic and potential densities."""
-        local = self._pointwise("outputs", self._jets(q), self._jets(v) if v is not None else None, t=t)
-        w = self.disc.weights
-        values = {k: float(np.sum(w * arr[..., 0])) for k, arr in local.items()}
+        """Energies: integrals of the kinetic and potential densities plus the end terms."""
+        disc = self.disc
+        full = self._full((q, v))
+        j = [jets_at_points(disc.tables, disc.dofs, x) if x is not None else None for x in full]
+        local = self._pointwise("outputs", *j, t=t)
+        values = {k: float(np.sum(disc.weights * arr[..., 0])) for k, arr in local.items()}
+        for _, loc in self._ends("outputs", full + [None], t):
+            for k, arr in loc.items():
+                values[k] += float(arr.ravel()[0])
         bad = [k for k, val in values.items() if not np.isfinite(val)]
         if bad:
             raise KernelError(f"outputs of {self.meta.get('model')} are NaN/Inf: {', '.join(bad)}")

@@ -24,7 +24,7 @@ every kernel kind of a lumped model (residual, tangent, linear, outputs) follows
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import sympy as sp
 
@@ -114,6 +114,7 @@ class FieldEquations:
         fields: field names.
         length: name of the length parameter L.
         constraints: essential boundary conditions.
+        points: pointwise equations of the end terms, by end ('start', 'end').
     """
 
     local: LumpedEquations
@@ -121,6 +122,7 @@ class FieldEquations:
     fields: tuple[str, ...]
     length: str
     constraints: tuple[Constraint, ...]
+    points: dict = field(default_factory=dict)
 
 
 def _density(model: Model, fn, what: str, env: dict) -> sp.Expr:
@@ -145,44 +147,69 @@ def _constraints(model: Model, p_ns: Namespace) -> tuple[Constraint, ...]:
     return tuple(out)
 
 
+def _local(model: Model, fns: dict, env: dict, u: Jets, test: Jets) -> tuple:
+    """Densities (or point terms) T, V, R, W of one piece."""
+    T = _density(model, fns.get("kinetic"), "kinetic_density", env)
+    V = _density(model, fns.get("potential"), "potential_density", env)
+    R = _density(model, fns.get("dissipation"), "dissipation_density", env)
+    W = _density(model, fns.get("weak"), "weak_form", {**env, "test": test})
+    return T, V, R, W
+
+
+def _residual(model: Model, pieces: tuple, jets, u: Jets, test: Jets) -> list[sp.Expr]:
+    """rho_a of Lagrange's equations in the jets, plus dW/dtest_a of a weak form."""
+    T, V, R, W = pieces
+    q = tuple(u.symbol(f, k, 0) for f, k in jets)
+    v = tuple(u.symbol(f, k, 1) for f, k in jets)
+    a = tuple(u.symbol(f, k, 2) for f, k in jets)
+    rho = lagrange_residual(T, V, R, q, v, a)
+    if W != 0:
+        tests = [test.symbol(f, k, 0) for f, k in jets]
+        rho = [r + sp.diff(W, s) for r, s in zip(rho, tests)]
+        leftover = W.subs({s: 0 for s in test.used.values()})
+        if sp.expand(leftover) != 0 or any(sp.diff(W, s1, s2) != 0 for s1 in test.used.values()
+                                           for s2 in test.used.values()):
+            raise ModelError(f"weak form of {model.name} is not linear in the test jets", file=model.file,
+                             key="weak_form", expected="a sum of test jets times expressions of the trial jets")
+    return rho
+
+
+def _equations(model: Model, pieces: tuple, rho: list, jets, u: Jets, free) -> LumpedEquations:
+    T, V = pieces[0], pieces[1]
+    q = tuple(u.symbol(f, k, 0) for f, k in jets)
+    return LumpedEquations(
+        model=model.name, coordinates=tuple(s.name for s in q), q=q,
+        v=tuple(u.symbol(f, k, 1) for f, k in jets), a=tuple(u.symbol(f, k, 2) for f, k in jets), z=(),
+        params=free, param_names=tuple(s.name for s in free), internal_names=(), kinetic=T, potential=V,
+        residual=sp.Matrix(rho) if rho else sp.zeros(0, 1), rates=sp.zeros(0, 1),
+        outputs={"kinetic_energy": T, "potential_energy": V, "energy": T + V}, position=(POSITION,),
+    )
+
+
 def derive_field(model: Model, spec: Specialization) -> FieldEquations:
-    """Derive the pointwise residual of a continuum model from its densities (and weak form)."""
+    """Derive the pointwise residual of a continuum model (and of its end terms) from its densities."""
     cont = model.continuum
     if cont is None:
         raise ModelError(f"model {model.name} declares no field", file=model.file, expected="model.field(...)")
     p_ns, free = param_namespace(model, spec)
     u, test = Jets(model.field_names), Jets(model.field_names, prefix="test_")
     env = {"u": u, "p": p_ns, "s": POSITION, "t": TIME}
-    T = _density(model, model.kinetic_fn, "kinetic_density", env)
-    V = _density(model, model.potential_fn, "potential_density", env)
-    R = _density(model, model.dissipation_fn, "dissipation_density", env)
-    W = _density(model, model.weak_fn, "weak_form", {**env, "test": test})
+    fns = {"kinetic": model.kinetic_fn, "potential": model.potential_fn, "dissipation": model.dissipation_fn,
+           "weak": model.weak_fn}
+    domain = _local(model, fns, env, u, test)
+    ends = {at: _local(model, model.point_terms[at], env, u, test) for at in sorted(model.point_terms)}
     orders = {f: -1 for f in model.field_names}
-    for f, k, _ in list(u.used) + list(test.used):
-        orders[f] = max(orders[f], k)
     constraints = _constraints(model, p_ns)
-    for c in constraints:
-        orders[c.field] = max(orders[c.field], c.order)
-    jets = tuple((f, k) for f in model.field_names for k in range(orders[f] + 1))
-    q = tuple(u.symbol(f, k, 0) for f, k in jets)
-    v = tuple(u.symbol(f, k, 1) for f, k in jets)
-    a = tuple(u.symbol(f, k, 2) for f, k in jets)
-    stray = {key for key in u.used if key[2] > 2}
-    if stray:
+    for f, k, _ in list(u.used) + list(test.used) + [(c.field, c.order, 0) for c in constraints]:
+        orders[f] = max(orders[f], k)
+    unused = [f for f, k in orders.items() if k < 0]
+    if unused:
+        raise ModelError(f"fields {unused} of model {model.name} appear in no density", file=model.file,
+                         key="field", expected="every declared field used by an energy or weak form")
+    if any(key[2] > 2 for key in u.used):
         raise ModelError(f"densities of {model.name} use more than two time derivatives", file=model.file)
-    rho = lagrange_residual(T, V, R, q, v, a)
-    if model.weak_fn is not None:
-        rho = [r + sp.diff(W, test.symbol(f, k, 0)) for r, (f, k) in zip(rho, jets)]
-        leftover = W.subs({s: 0 for s in test.used.values()}) if test.used else W
-        if sp.expand(leftover) != 0 or any(sp.diff(W, s1, s2) != 0 for s1 in test.used.values()
-                                           for s2 in test.used.values()):
-            raise ModelError(f"weak form of {model.name} is not linear in the test jets", file=model.file,
-                             key="weak_form", expected="a sum of test jets times expressions of the trial jets")
-    names = tuple(s.name for s in q)
-    local = LumpedEquations(
-        model=model.name, coordinates=names, q=q, v=v, a=a, z=(), params=free,
-        param_names=tuple(s.name for s in free), internal_names=(), kinetic=T, potential=V,
-        residual=sp.Matrix(rho) if rho else sp.zeros(0, 1), rates=sp.zeros(0, 1),
-        outputs={"kinetic_energy": T, "potential_energy": V, "energy": T + V}, position=(POSITION,),
-    )
-    return FieldEquations(local, jets, tuple(model.field_names), cont.length, constraints)
+    jets = tuple((f, k) for f in model.field_names for k in range(orders[f] + 1))
+    local = _equations(model, domain, _residual(model, domain, jets, u, test), jets, u, free)
+    points = {at: _equations(model, pieces, _residual(model, pieces, jets, u, test), jets, u, free)
+              for at, pieces in ends.items()}
+    return FieldEquations(local, jets, tuple(model.field_names), cont.length, constraints, points)

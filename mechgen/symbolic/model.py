@@ -125,6 +125,7 @@ class Model:
         self.continuum: Continuum | None = None
         self.weak_fn: Callable | None = None
         self.boundary_fn: Callable | None = None
+        self.point_terms: dict[str, dict[str, Callable]] = {}
 
     # -- declarations ---------------------------------------------------
     def params(self, *params: Param) -> Namespace:
@@ -207,6 +208,32 @@ class Model:
         """Decorator (continuum): a residual density W(test, u, p, s, t), linear in the test jets."""
         self.weak_fn = fn
         return fn
+
+    def _point(self, kind: str, at: str) -> Callable:
+        if at not in ("start", "end"):
+            raise ModelError(f"point term at {at!r}", file=self.file, key=f"point_{kind}", expected="'start' or 'end'")
+
+        def register(fn: Callable) -> Callable:
+            self.point_terms.setdefault(at, {})[kind] = fn
+            return fn
+
+        return register
+
+    def point_kinetic(self, at: str) -> Callable:
+        """Decorator (continuum): kinetic energy of a point mass/inertia at ``at`` ('start' or 'end'), T(u, p)."""
+        return self._point("kinetic", at)
+
+    def point_potential(self, at: str) -> Callable:
+        """Decorator (continuum): potential energy at an end (a spring, a dead load), V(u, p)."""
+        return self._point("potential", at)
+
+    def point_dissipation(self, at: str) -> Callable:
+        """Decorator (continuum): Rayleigh dissipation at an end (a dashpot), R(u, p)."""
+        return self._point("dissipation", at)
+
+    def point_weak_form(self, at: str) -> Callable:
+        """Decorator (continuum): a residual at an end, W(test, u, p), linear in the test jets (follower loads)."""
+        return self._point("weak", at)
 
     def boundary(self, fn: Callable) -> Callable:
         """Decorator (continuum): essential boundary conditions fn(p) -> [fix(jet, 'start' | 'end'), ...]."""
