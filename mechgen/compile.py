@@ -79,9 +79,12 @@ def lower_all(model: Model, eqs, kernels, *, cse: bool = True) -> list[KernelIR]
         irs = [lower_lumped(eqs.local, k, cse=cse) for k in wanted]
         irs += [replace(lower_lumped(local, k, cse=cse), name=f"{k}_at_{at}") for at, local in eqs.points.items()
                 for k in wanted]
+        state = set(eqs.local.q + eqs.local.v) | {eqs.local.t}
+        constant_mass = all(not (local.jacobian(local.residual, "a").free_symbols & state)
+                            for local in [eqs.local, *eqs.points.values()])
         for ir in irs:
             ir.meta["field"] = {"fields": list(eqs.fields), "jets": [list(j) for j in eqs.jets],
-                                "length": eqs.length, "points": sorted(eqs.points),
+                                "length": eqs.length, "points": sorted(eqs.points), "constant_mass": constant_mass,
                                 "constraints": [[c.field, c.order, c.at] for c in eqs.constraints]}
         return irs
     lower = lower_lattice if model.is_lattice else lower_lumped

@@ -142,3 +142,48 @@ def test_under_integration_warns():
         warnings.simplefilter("error")
         mats = system.linear()
     assert np.allclose(np.diag(mats["M"]), 0.5, rtol=1e-13)  # int sin^2 = L/2, exact with 2N + 8 points
+
+
+@pytest.mark.parametrize("bc,reactions,peak", [
+    # uniform load q on span L: the standard beam-table results (e.g. Roark, Formulas for Stress and Strain, Table 8.1)
+    ("pinned-pinned", [("w", "start", 0.5), ("w", "end", 0.5)], 5 / 384),
+    ("clamped-free", [("w", "start", 1.0), ("w_s", "start", 0.5)], 1 / 8),
+    ("clamped-clamped", [("w", "start", 0.5), ("w_s", "start", 1 / 12), ("w", "end", 0.5), ("w_s", "end", -1 / 12)],
+     1 / 384),
+])
+def test_reactions_and_deflection_under_uniform_load(bc, reactions, peak):
+    """Support forces (x q L) and moments (x q L^2), peak deflection (x q L^4 / EI): beam-table closed forms."""
+    from mechgen.scene.analyses import run_steady
+
+    q, L, EI = 2.0, 1.5, 3.0
+    model = models.get("euler_bernoulli_beam")
+    spec = specialize(model, {"discretisation": "quintic", "N": 4, "q": q, "EI": EI, "L": L, "bc": bc})
+    system, _ = compile_model(model, spec, kernels={"residual", "tangent", "outputs"})
+    out = run_steady(system, {"tol": 1e-12}, {})
+    got = [(r["jet"], r["at"], r["value"]) for r in out["reactions"]]
+    assert [g[:2] for g in got] == [r[:2] for r in reactions]
+    for (jet, _, value), (_, _, factor) in zip(got, reactions):
+        assert value == pytest.approx(factor * q * L ** (2 if jet == "w_s" else 1), rel=1e-10)
+    assert max(out["deflection"]["w"]) == pytest.approx(peak * q * L**4 / EI, rel=1e-9)
+
+
+def test_free_vibration_in_the_first_mode_returns_after_one_period():
+    """simulate: started in mode 1 (a standing wave), the cantilever is back after 2 pi / omega_1.
+
+    omega_1 = 1.8751^2 sqrt(EI / rhoA L^4); quintic elements (N = 2) are within 1e-7 of it.
+    """
+    from mechgen.runtime.integrate import integrate_first_order
+    from mechgen.scene.analyses import initial_state, run_simulate
+
+    model = models.get("euler_bernoulli_beam")
+    spec = specialize(model, {"discretisation": "quintic", "N": 2, "bc": "clamped-free"})
+    system, _ = compile_model(model, spec, kernels={"residual", "tangent", "outputs", "linear"})
+    period = 2 * np.pi / exact_roots("clamped-free", 1)[0] ** 2
+    q0, v0 = initial_state(system, {"initial_mode": 1, "amplitude": 0.1})
+    traj = integrate_first_order(system.rhs, np.concatenate([q0, v0]), period, jac=system.jacobian, method="Radau",
+                                 rtol=1e-9, atol=1e-12)
+    xs = traj.x if traj.x.shape[0] == len(traj.t) else traj.x.T
+    assert np.abs(xs[-1, :system.n] - q0).max() < 1e-6 * np.abs(q0).max()
+    out = run_simulate(system, {"t_end": period, "initial_mode": 1, "amplitude": 0.1, "method": "Radau",
+                                "rtol": 1e-9, "atol": 1e-12, "samples": 11, "outputs": ["energy"]}, {})
+    assert out["energy_drift"] < 1e-7

@@ -79,3 +79,26 @@ def test_rotating_string_hermite_converges_to_the_split():
     wn = np.arange(1, 6) * np.pi
     expected = np.sort(np.abs(np.concatenate([wn + 2.0, wn - 2.0])))[:4]
     assert np.allclose(out["frequencies"][:4], expected, rtol=1e-6)
+
+
+def test_sparse_shift_invert_stability_of_a_large_discretisation():
+    """1 200 unknowns: the lowest eigenvalues by ARPACK shift-invert equal the closed form omega_n +- Omega."""
+    system = system_of("rotating_string", Omega=2.0, discretisation="hermite", N=300)
+    assert system.n > 1000
+    out = run_stability(system, {"count": 6}, {})
+    wn = np.arange(1, 6) * np.pi
+    expected = np.sort(np.abs(np.concatenate([wn + 2.0, wn - 2.0])))[:6]
+    assert out["verdict"] == "stable"
+    assert np.allclose(out["frequencies"], expected, rtol=1e-7)
+
+
+def test_sparse_and_dense_stability_agree():
+    from mechgen.runtime.stability import stability, stability_sparse
+
+    system = system_of("follower_column", P=23.0, N=24)
+    mats = system.linear()
+    dense = stability(*(mats[k].toarray() for k in ("M",)), (mats["D"] + mats["G"]).toarray(), mats["K"].toarray())
+    sparse = stability_sparse(mats["M"], mats["D"] + mats["G"], mats["K"], 4)
+    assert sparse.verdict == dense.verdict == "flutter"
+    assert sparse.growth_rate == pytest.approx(dense.growth_rate, rel=1e-8)
+    assert np.allclose(sparse.frequencies[:2], dense.frequencies[:2], rtol=1e-8)

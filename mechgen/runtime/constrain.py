@@ -27,6 +27,7 @@ class Reduction:
     ndof: int
     Z: object
     penalty_rows: np.ndarray | None = None
+    keep: np.ndarray | None = None
 
     @property
     def n(self) -> int:
@@ -49,6 +50,8 @@ class Reduction:
             A = (A + extra).tocsr() if sps.issparse(A) else A + extra.toarray()
         if self.Z is None:
             return A
+        if self.keep is not None:  # a column selection: slicing, not two sparse products
+            return A[self.keep][:, self.keep] if sps.issparse(A) else A[np.ix_(self.keep, self.keep)]
         out = self.Z.T @ A @ self.Z
         return sps.csr_matrix(out) if sps.issparse(out) else np.asarray(out)
 
@@ -73,5 +76,5 @@ def reduction(rows: np.ndarray, scales: np.ndarray, ndof: int, method: str, spar
         fixed = {int(nz[0]) for nz in nonzero}
         free = np.array([i for i in range(ndof) if i not in fixed])
         Z = sps.csr_matrix((np.ones(len(free)), (free, np.arange(len(free)))), shape=(ndof, len(free)))
-        return Reduction(ndof, Z if sparse else Z.toarray())
+        return Reduction(ndof, Z if sparse else Z.toarray(), keep=free)
     return Reduction(ndof, sla.null_space(rows, rcond=1e-10))

@@ -205,17 +205,50 @@ class FieldSystem:
         """dr/dq, dr/dq', dr/dq'' (reduced; the penalty term in dr/dq)."""
         return self._matrices("tangent", ("r_q", "r_v", "r_a"), q, v, a, t)
 
-    def residual(self, q, v=None, a=None, z=None, t: float = 0.0) -> np.ndarray:
-        """r(q, q', q'') = Z^T (sum_e B^T W rho + sum_ends B_at^T rho_at + penalty C^T C x)."""
+    def _full_residual(self, full, t: float) -> np.ndarray:
+        """sum_e B^T W rho + sum_ends B_at^T rho_at over all dofs (no boundary conditions)."""
         disc = self.disc
-        full = self._full((q, v, a))
         j = [jets_at_points(disc.tables, disc.dofs, x) if x is not None else None for x in full]
         rho = self._pointwise("residual", *j, t=t)["r"]
         r = self.assembler.vector(element_vectors(disc.tables, disc.weights, rho))
         for B, loc in self._ends("residual", full, t):
             r = r + B.T @ loc["r"][0]
+        return r
+
+    def residual(self, q, v=None, a=None, z=None, t: float = 0.0) -> np.ndarray:
+        """r(q, q', q'') = Z^T (sum_e B^T W rho + sum_ends B_at^T rho_at + penalty C^T C x)."""
+        full = self._full((q, v, a))
         red = self.reduction
-        return red.vector(r + red.penalty_force(full[0], self.penalty))
+        return red.vector(self._full_residual(full, t) + red.penalty_force(full[0], self.penalty))
+
+    def reactions(self, q, t: float = 0.0) -> list[dict]:
+        """Boundary reactions of an equilibrium: the Lagrange multipliers lambda of C x = 0.
+
+        r(x) + C^T lambda = 0 at the equilibrium x = Z q, solved in least squares;
+        each reaction is the generalized force conjugate to its constrained jet
+        (w: a transverse force, w_s: a moment), positive along the jet. Conditions
+        that the basis satisfies by itself (sines at the ends) have none.
+        """
+        disc = self.disc
+        kept, rows = [], []
+        for f, k, at in self.info["constraints"]:
+            row = disc.row(f, int(k), 0.0 if at == "start" else disc.length)
+            a = disc.jets.index((f, int(k)))
+            if np.abs(row).max() > 1e-10 * max(float(np.abs(disc.tables[:, :, a, :]).max()), 1.0):
+                kept.append((f, int(k), at))
+                rows.append(row)
+        if not rows:
+            return []
+        r = self._full_residual(self._full((q, None, None)), t)
+        lam = np.linalg.lstsq(np.array(rows).T, -r, rcond=None)[0]
+        return [{"jet": f + ("_" + "s" * k if k else ""), "at": at, "value": float(v)}
+                for (f, k, at), v in zip(kept, lam)]
+
+    def field_values(self, q, points: np.ndarray, order: int = 0) -> dict[str, np.ndarray]:
+        """D_s^order of every field at ``points`` for the reduced state q (mode shapes, deflections)."""
+        disc = self.disc
+        x = self.reduction.expand(q)
+        return {f: np.array([disc.row(f, order, float(p)) @ x for p in points]) for f in disc.fields}
 
     @property
     def penalty(self) -> float:
@@ -250,20 +283,32 @@ class FieldSystem:
         n = self.n
         return x[:n], x[n:2 * n], x[2 * n:]
 
+    def _mass_solve(self, q, v, t: float, rhs: np.ndarray) -> np.ndarray:
+        """M^-1 rhs; a state-independent M (the usual case, known from the derivation) is factorised once."""
+        if self.info.get("constant_mass"):
+            if "mass" not in self._cache:
+                M = self.tangent(np.zeros(self.n), t=t)["r_a"]
+                self._cache["mass"] = (spla.splu(sps.csc_matrix(M)).solve if sps.issparse(M)
+                                       else (lambda b, f=sla.cho_factor(M): sla.cho_solve(f, b)))
+            return self._cache["mass"](rhs)
+        M = self.tangent(q, v, t=t)["r_a"]
+        return spla.spsolve(sps.csc_matrix(M), rhs) if sps.issparse(M) else sla.solve(M, rhs)
+
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
         """dx/dt = (v, -M^-1 r(q, v, 0))."""
         q, v, _ = self.split(x)
-        M = self.tangent(q, v, t=t)["r_a"]
-        r = self.residual(q, v, None, None, t)
-        a = spla.spsolve(sps.csc_matrix(M), -r) if sps.issparse(M) else sla.solve(M, -r, assume_a="sym")
-        return np.concatenate([v, a])
+        a = self._mass_solve(q, v, t, -self.residual(q, v, None, None, t))
+        out = np.concatenate([v, a])
+        if not np.all(np.isfinite(out)):
+            raise KernelError(f"residual of {self.meta.get('model')} gave NaN/Inf at t = {t}")
+        return out
 
     def jacobian(self, t: float, x: np.ndarray):
         """d(dx/dt)/dx with da/d(q, v) = -M^-1 [r_q, r_v] at the current acceleration."""
         q, v, _ = self.split(x)
-        a = self.rhs(t, x)[self.n:]
+        a = None if self.info.get("constant_mass") else self.rhs(t, x)[self.n:]
         tan = self.tangent(q, v, a, t=t)
         dense = lambda A: A.toarray() if sps.issparse(A) else A  # noqa: E731
-        da = -sla.solve(dense(tan["r_a"]), np.hstack([dense(tan["r_q"]), dense(tan["r_v"])]))
+        da = -self._mass_solve(q, v, t, np.hstack([dense(tan["r_q"]), dense(tan["r_v"])]))
         n = self.n
         return np.block([[np.zeros((n, n)), np.eye(n)], [da]])

@@ -13,7 +13,10 @@ from mechgen.runtime.integrate import integrate_first_order, leapfrog
 from mechgen.runtime.modes import modes as solve_modes
 from mechgen.runtime.newton import newton
 from mechgen.runtime.stability import stability as solve_stability
-from mechgen.runtime.stability import stability_first_order
+from mechgen.runtime.stability import stability_first_order, stability_sparse
+
+#: above this many unknowns, a stability analysis with a ``count`` of sparse matrices uses shift-invert
+SPARSE_STABILITY_N = 400
 from mechgen.runtime.system import System
 
 
@@ -26,7 +29,8 @@ def needs(kind: str, options: dict, *, internal: bool) -> set[str]:
     if kind == "simulate":
         if options.get("method") == "leapfrog":
             return {"force", "outputs", "linear"}
-        return {"residual", "tangent", "outputs"} | ({"rates", "rates_tangent"} if internal else set())
+        start = {"linear"} if options.get("initial_mode") else set()
+        return {"residual", "tangent", "outputs"} | start | ({"rates", "rates_tangent"} if internal else set())
     if kind == "sweep":
         inner = options["analysis"]
         return needs(inner.kind, inner.options, internal=internal)
@@ -53,7 +57,10 @@ def run_modes(system: System, options: dict, context: dict) -> dict:
     q = operating_point(system, options, context)
     mats = system.linear(q)
     res = solve_modes(mats["M"], mats["K"], count=options.get("count"))
-    return {"frequencies": [float(f) for f in res.frequencies], "_shapes": res.shapes}
+    out = {"frequencies": [float(f) for f in res.frequencies], "_shapes": res.shapes}
+    if system.is_field and options.get("count"):
+        out.update(_field_shapes(system, res.shapes, "shapes"))
+    return out
 
 
 def _stability_of(system, q, options: dict, context: dict):
@@ -63,6 +70,8 @@ def _stability_of(system, q, options: dict, context: dict):
         A = system.jacobian(0.0, np.concatenate([q, np.zeros(system.n), z]))
         return stability_first_order(A, np.eye(A.shape[0]), tolerance=tol)
     mats = system.linear(q)
+    if options.get("count") and hasattr(mats["M"], "toarray") and system.n > SPARSE_STABILITY_N:
+        return stability_sparse(mats["M"], mats["D"] + mats["G"], mats["K"], 2 * options["count"], tolerance=tol)
     dense = {k: (v.toarray() if hasattr(v, "toarray") else v) for k, v in mats.items()}
     return solve_stability(dense["M"], dense["D"] + dense["G"], dense["K"], tolerance=tol)
 
@@ -141,8 +150,32 @@ def run_steady(system: System, options: dict, context: dict) -> dict:
     if not system.is_lattice and not system.is_field:
         out["coordinates"] = {n: float(x) for n, x in zip(system.coordinates, q)}
     out.update(system.outputs(q, None, z if system.m else None))
+    if system.is_field:
+        out["reactions"] = system.reactions(q)
+        out.update(_field_shapes(system, q[:, None], "deflection"))
     out["_q"], out["_z"] = q, z
     return out
+
+
+def _field_shapes(system, columns: np.ndarray, name: str, samples: int = 101) -> dict:
+    """Fields of each column of reduced states on an even grid: {"s": [...], name: {field: curves}}.
+
+    Mode shapes ("shapes") are scaled to a largest |value| of 1 over all fields, that
+    value positive; a deflection keeps its units (one curve per field).
+    """
+    s = np.linspace(0.0, system.disc.length, samples)
+    curves: dict = {f: [] for f in system.disc.fields}
+    for col in columns.T:
+        values = system.field_values(col, s)
+        if name == "shapes":
+            stacked = np.concatenate(list(values.values()))
+            peak = stacked[np.argmax(np.abs(stacked))]
+            values = {f: v / peak if peak else v for f, v in values.items()}
+        for f, v in values.items():
+            curves[f].append([float(x) for x in v])
+    if name == "deflection":
+        curves = {f: c[0] for f, c in curves.items()}
+    return {"s": [float(v) for v in s], name: curves}
 
 
 def initial_state(system: System, options: dict) -> tuple[np.ndarray, np.ndarray]:

@@ -3,7 +3,8 @@
 * sweep of modes/stability: frequencies (and growth rates) against the swept parameter
   (a Campbell diagram when the parameter is a spin speed);
 * modes/stability: the frequencies, or the eigenvalues in the complex plane;
-* simulate with ``series = true``: energy against time; chains: final mode energies.
+* simulate with ``series = true``: energy against time; chains: final mode energies;
+* continua: mode shapes of a modes analysis, the deflection of a steady state.
 """
 from __future__ import annotations
 
@@ -81,6 +82,31 @@ def _simulate(plt, a: dict, path: Path) -> bool:
     return True
 
 
+def _shapes(plt, a: dict, path: Path) -> bool:
+    """Mode shapes (modes of a continuum) or the deflection (steady state of a continuum) against s."""
+    out = a["outputs"]
+    key = "shapes" if "shapes" in out else "deflection" if "deflection" in out else None
+    if key is None:
+        return False
+    fields = list(out[key])
+    fig, axes = plt.subplots(len(fields), 1, figsize=(6, 2.2 + 1.6 * len(fields)), squeeze=False)
+    for ax, f in zip(axes[:, 0], fields):
+        curves = out[key][f] if key == "shapes" else [out[key][f]]
+        for k, curve in enumerate(curves):
+            label = f"mode {k + 1}: {out['frequencies'][k]:.4g}" if key == "shapes" else None
+            ax.plot(out["s"], curve, label=label)
+        ax.axhline(0.0, color="0.6", lw=0.5)
+        ax.set_ylabel(f)
+    axes[-1, 0].set_xlabel("s")
+    if key == "shapes":
+        axes[0, 0].legend(fontsize=7, loc="best")
+    axes[0, 0].set_title(f"{a['name']}: {'mode shapes' if key == 'shapes' else 'deflection'}")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return True
+
+
 def plot_results(results: dict, folder: Path) -> list[Path]:
     """Write one PNG per plottable analysis into ``folder``; returns the paths."""
     plt = _pyplot()
@@ -92,6 +118,12 @@ def plot_results(results: dict, folder: Path) -> list[Path]:
             _sweep(plt, a, path)
         elif a["kind"] in ("modes", "stability"):
             _eigen(plt, a, path)
+            shapes = path.with_name(path.stem + "_shapes.png")
+            if _shapes(plt, a, shapes):
+                written.append(shapes)
+        elif a["kind"] == "steady":
+            if not _shapes(plt, a, path):
+                continue
         elif a["kind"] == "simulate":
             if not _simulate(plt, a, path):
                 continue
