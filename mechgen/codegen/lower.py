@@ -5,12 +5,15 @@ Input: :class:`~mechgen.symbolic.derive.LumpedEquations` or
 Output: a :class:`~mechgen.codegen.ir.KernelIR` whose expressions use only
 gathered locals ``g0, g1, ...`` and temporaries ``t0, t1, ...``, so user names
 never become program identifiers and the signature depends on structure only.
+With CSE on, writes equal up to sign share one temporary and polynomials in one
+linear form of the locals are put in Horner form (:mod:`mechgen.codegen.rewrite`).
 """
 from __future__ import annotations
 
 import sympy as sp
 
 from mechgen.codegen.ir import Block, Gather, KernelIR, Port, Write
+from mechgen.codegen.rewrite import optimise
 from mechgen.errors import ModelError
 
 
@@ -18,7 +21,9 @@ def canonical_block(gathers: list[tuple[sp.Symbol, str, int, bool]], writes: lis
                     loop=None, cse: bool = True, model: str = "") -> Block:
     """Rename gathered symbols to g0.., check coverage, and CSE the write expressions.
 
-    Gathers of symbols that no write uses are dropped.
+    Gathers of symbols that no write uses are dropped. With ``cse`` the writes
+    are also shared up to sign and put in Horner form (:func:`~mechgen.codegen.rewrite.optimise`);
+    without it they are printed as derived.
     """
     used = set().union(*(w.expr.free_symbols for w in writes)) if writes else set()
     rename, kept = {}, []
@@ -36,8 +41,7 @@ def canonical_block(gathers: list[tuple[sp.Symbol, str, int, bool]], writes: lis
                          expected="only declared names")
     assignments: list = []
     if cse and exprs:
-        temps = sp.numbered_symbols("t", real=True)
-        assignments, exprs = sp.cse(exprs, symbols=temps, order="canonical")
+        assignments, exprs = optimise(exprs, set(rename.values()))
     new_writes = tuple(Write(w.port, w.index, e, w.accumulate, w.relative, w.entry)
                        for w, e in zip(writes, exprs))
     return Block(tuple(kept), new_writes, tuple((s, e) for s, e in assignments), loop)

@@ -57,21 +57,19 @@ int mg_residual(const double *const *in, double *const *out, const long *sizes, 
                 const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
                 const double g0 = ok7 ? in0[e - 1] : 0.0;
                 const double g1 = ok8 ? in0[e] : 0.0;
-                const double t0 = 2.0*g0 - 2.0*g1;
-                const double t1 = -g0 + g1;
-                const double t2 = g3*t1*t1 + g4*t1*t1*t1;
-                if (ok7) out0[e - 1] += (1.0/2.0)*g2*t0 - t2;
-                if (ok8) out0[e] += -1.0/2.0*g2*t0 + t2;
+                const double t0 = -g0 + g1;
+                const double t1 = t0*(-g2 + t0*(-g3 - g4*t0));
+                if (ok7) out0[e - 1] += t1;
+                if (ok8) out0[e] += -t1;
             }
             double carry_out0 = 0.0;
             for (long e = lo; e < hi; ++e) {
                 const double g0 = in0[e - 1];
                 const double g1 = in0[e];
-                const double t0 = 2.0*g0 - 2.0*g1;
-                const double t1 = -g0 + g1;
-                const double t2 = g3*t1*t1 + g4*t1*t1*t1;
-                out0[e - 1] += carry_out0 + (1.0/2.0)*g2*t0 - t2;
-                carry_out0 = -1.0/2.0*g2*t0 + t2;
+                const double t0 = -g0 + g1;
+                const double t1 = t0*(-g2 + t0*(-g3 - g4*t0));
+                out0[e - 1] += carry_out0 + t1;
+                carry_out0 = -t1;
             }
             if (hi > lo) out0[hi + -1] += carry_out0;
             for (long e = hi; e < cnt; ++e) {
@@ -79,11 +77,10 @@ int mg_residual(const double *const *in, double *const *out, const long *sizes, 
                 const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
                 const double g0 = ok7 ? in0[e - 1] : 0.0;
                 const double g1 = ok8 ? in0[e] : 0.0;
-                const double t0 = 2.0*g0 - 2.0*g1;
-                const double t1 = -g0 + g1;
-                const double t2 = g3*t1*t1 + g4*t1*t1*t1;
-                if (ok7) out0[e - 1] += (1.0/2.0)*g2*t0 - t2;
-                if (ok8) out0[e] += -1.0/2.0*g2*t0 + t2;
+                const double t0 = -g0 + g1;
+                const double t1 = t0*(-g2 + t0*(-g3 - g4*t0));
+                if (ok7) out0[e - 1] += t1;
+                if (ok8) out0[e] += -t1;
             }
         }
     }
@@ -151,40 +148,34 @@ int mg_tangent(const double *const *in, double *const *out, const long *sizes, l
                 const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
                 const double g0 = ok7 ? in0[e - 1] : 0.0;
                 const double g1 = ok8 ? in0[e] : 0.0;
-                const double t0 = 2.0*g0 - 2.0*g1;
-                const double t1 = g2 + 3.0*g4*(-g0 + g1)*(-g0 + g1);
-                const double t2 = -g3*t0 + t1;
-                const double t3 = -g3*t0 + t1;
-                if (slot[e * 4 + 0] >= 0) out0[slot[e * 4 + 0]] += t2;
-                if (slot[e * 4 + 1] >= 0) out0[slot[e * 4 + 1]] += -t3;
-                if (slot[e * 4 + 2] >= 0) out0[slot[e * 4 + 2]] += -t2;
-                if (slot[e * 4 + 3] >= 0) out0[slot[e * 4 + 3]] += t3;
+                const double t0 = -g0 + g1;
+                const double t1 = g2 + t0*(2.0*g3 + 3.0*g4*t0);
+                if (slot[e * 4 + 0] >= 0) out0[slot[e * 4 + 0]] += t1;
+                if (slot[e * 4 + 1] >= 0) out0[slot[e * 4 + 1]] += -t1;
+                if (slot[e * 4 + 2] >= 0) out0[slot[e * 4 + 2]] += -t1;
+                if (slot[e * 4 + 3] >= 0) out0[slot[e * 4 + 3]] += t1;
             }
             for (long e = lo; e < hi; ++e) {
                 const double g0 = in0[e - 1];
                 const double g1 = in0[e];
-                const double t0 = 2.0*g0 - 2.0*g1;
-                const double t1 = g2 + 3.0*g4*(-g0 + g1)*(-g0 + g1);
-                const double t2 = -g3*t0 + t1;
-                const double t3 = -g3*t0 + t1;
-                if (slot[e * 4 + 0] >= 0) out0[slot[e * 4 + 0]] += t2;
-                if (slot[e * 4 + 1] >= 0) out0[slot[e * 4 + 1]] += -t3;
-                if (slot[e * 4 + 2] >= 0) out0[slot[e * 4 + 2]] += -t2;
-                if (slot[e * 4 + 3] >= 0) out0[slot[e * 4 + 3]] += t3;
+                const double t0 = -g0 + g1;
+                const double t1 = g2 + t0*(2.0*g3 + 3.0*g4*t0);
+                if (slot[e * 4 + 0] >= 0) out0[slot[e * 4 + 0]] += t1;
+                if (slot[e * 4 + 1] >= 0) out0[slot[e * 4 + 1]] += -t1;
+                if (slot[e * 4 + 2] >= 0) out0[slot[e * 4 + 2]] += -t1;
+                if (slot[e * 4 + 3] >= 0) out0[slot[e * 4 + 3]] += t1;
             }
             for (long e = hi; e < cnt; ++e) {
                 const int ok7 = (e + -1 >= 0) && (e + -1 < ns);
                 const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
                 const double g0 = ok7 ? in0[e - 1] : 0.0;
                 const double g1 = ok8 ? in0[e] : 0.0;
-                const double t0 = 2.0*g0 - 2.0*g1;
-                const double t1 = g2 + 3.0*g4*(-g0 + g1)*(-g0 + g1);
-                const double t2 = -g3*t0 + t1;
-                const double t3 = -g3*t0 + t1;
-                if (slot[e * 4 + 0] >= 0) out0[slot[e * 4 + 0]] += t2;
-                if (slot[e * 4 + 1] >= 0) out0[slot[e * 4 + 1]] += -t3;
-                if (slot[e * 4 + 2] >= 0) out0[slot[e * 4 + 2]] += -t2;
-                if (slot[e * 4 + 3] >= 0) out0[slot[e * 4 + 3]] += t3;
+                const double t0 = -g0 + g1;
+                const double t1 = g2 + t0*(2.0*g3 + 3.0*g4*t0);
+                if (slot[e * 4 + 0] >= 0) out0[slot[e * 4 + 0]] += t1;
+                if (slot[e * 4 + 1] >= 0) out0[slot[e * 4 + 1]] += -t1;
+                if (slot[e * 4 + 2] >= 0) out0[slot[e * 4 + 2]] += -t1;
+                if (slot[e * 4 + 3] >= 0) out0[slot[e * 4 + 3]] += t1;
             }
         }
     }
@@ -255,40 +246,34 @@ int mg_linear(const double *const *in, double *const *out, const long *sizes, lo
                 const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
                 const double g0 = ok7 ? in0[e - 1] : 0.0;
                 const double g1 = ok8 ? in0[e] : 0.0;
-                const double t0 = 2.0*g0 - 2.0*g1;
-                const double t1 = g2 + 3.0*g4*(-g0 + g1)*(-g0 + g1);
-                const double t2 = -g3*t0 + t1;
-                const double t3 = -g3*t0 + t1;
-                if (slot[e * 4 + 0] >= 0) out3[slot[e * 4 + 0]] += t2;
-                if (slot[e * 4 + 1] >= 0) out3[slot[e * 4 + 1]] += -t3;
-                if (slot[e * 4 + 2] >= 0) out3[slot[e * 4 + 2]] += -t2;
-                if (slot[e * 4 + 3] >= 0) out3[slot[e * 4 + 3]] += t3;
+                const double t0 = -g0 + g1;
+                const double t1 = g2 + t0*(2.0*g3 + 3.0*g4*t0);
+                if (slot[e * 4 + 0] >= 0) out3[slot[e * 4 + 0]] += t1;
+                if (slot[e * 4 + 1] >= 0) out3[slot[e * 4 + 1]] += -t1;
+                if (slot[e * 4 + 2] >= 0) out3[slot[e * 4 + 2]] += -t1;
+                if (slot[e * 4 + 3] >= 0) out3[slot[e * 4 + 3]] += t1;
             }
             for (long e = lo; e < hi; ++e) {
                 const double g0 = in0[e - 1];
                 const double g1 = in0[e];
-                const double t0 = 2.0*g0 - 2.0*g1;
-                const double t1 = g2 + 3.0*g4*(-g0 + g1)*(-g0 + g1);
-                const double t2 = -g3*t0 + t1;
-                const double t3 = -g3*t0 + t1;
-                if (slot[e * 4 + 0] >= 0) out3[slot[e * 4 + 0]] += t2;
-                if (slot[e * 4 + 1] >= 0) out3[slot[e * 4 + 1]] += -t3;
-                if (slot[e * 4 + 2] >= 0) out3[slot[e * 4 + 2]] += -t2;
-                if (slot[e * 4 + 3] >= 0) out3[slot[e * 4 + 3]] += t3;
+                const double t0 = -g0 + g1;
+                const double t1 = g2 + t0*(2.0*g3 + 3.0*g4*t0);
+                if (slot[e * 4 + 0] >= 0) out3[slot[e * 4 + 0]] += t1;
+                if (slot[e * 4 + 1] >= 0) out3[slot[e * 4 + 1]] += -t1;
+                if (slot[e * 4 + 2] >= 0) out3[slot[e * 4 + 2]] += -t1;
+                if (slot[e * 4 + 3] >= 0) out3[slot[e * 4 + 3]] += t1;
             }
             for (long e = hi; e < cnt; ++e) {
                 const int ok7 = (e + -1 >= 0) && (e + -1 < ns);
                 const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
                 const double g0 = ok7 ? in0[e - 1] : 0.0;
                 const double g1 = ok8 ? in0[e] : 0.0;
-                const double t0 = 2.0*g0 - 2.0*g1;
-                const double t1 = g2 + 3.0*g4*(-g0 + g1)*(-g0 + g1);
-                const double t2 = -g3*t0 + t1;
-                const double t3 = -g3*t0 + t1;
-                if (slot[e * 4 + 0] >= 0) out3[slot[e * 4 + 0]] += t2;
-                if (slot[e * 4 + 1] >= 0) out3[slot[e * 4 + 1]] += -t3;
-                if (slot[e * 4 + 2] >= 0) out3[slot[e * 4 + 2]] += -t2;
-                if (slot[e * 4 + 3] >= 0) out3[slot[e * 4 + 3]] += t3;
+                const double t0 = -g0 + g1;
+                const double t1 = g2 + t0*(2.0*g3 + 3.0*g4*t0);
+                if (slot[e * 4 + 0] >= 0) out3[slot[e * 4 + 0]] += t1;
+                if (slot[e * 4 + 1] >= 0) out3[slot[e * 4 + 1]] += -t1;
+                if (slot[e * 4 + 2] >= 0) out3[slot[e * 4 + 2]] += -t1;
+                if (slot[e * 4 + 3] >= 0) out3[slot[e * 4 + 3]] += t1;
             }
         }
     }
@@ -329,40 +314,34 @@ int mg_stiffness(const double *const *in, double *const *out, const long *sizes,
                 const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
                 const double g0 = ok7 ? in0[e - 1] : 0.0;
                 const double g1 = ok8 ? in0[e] : 0.0;
-                const double t0 = 2.0*g0 - 2.0*g1;
-                const double t1 = g2 + 3.0*g4*(-g0 + g1)*(-g0 + g1);
-                const double t2 = -g3*t0 + t1;
-                const double t3 = -g3*t0 + t1;
-                if (slot[e * 4 + 0] >= 0) out0[slot[e * 4 + 0]] += t2;
-                if (slot[e * 4 + 1] >= 0) out0[slot[e * 4 + 1]] += -t3;
-                if (slot[e * 4 + 2] >= 0) out0[slot[e * 4 + 2]] += -t2;
-                if (slot[e * 4 + 3] >= 0) out0[slot[e * 4 + 3]] += t3;
+                const double t0 = -g0 + g1;
+                const double t1 = g2 + t0*(2.0*g3 + 3.0*g4*t0);
+                if (slot[e * 4 + 0] >= 0) out0[slot[e * 4 + 0]] += t1;
+                if (slot[e * 4 + 1] >= 0) out0[slot[e * 4 + 1]] += -t1;
+                if (slot[e * 4 + 2] >= 0) out0[slot[e * 4 + 2]] += -t1;
+                if (slot[e * 4 + 3] >= 0) out0[slot[e * 4 + 3]] += t1;
             }
             for (long e = lo; e < hi; ++e) {
                 const double g0 = in0[e - 1];
                 const double g1 = in0[e];
-                const double t0 = 2.0*g0 - 2.0*g1;
-                const double t1 = g2 + 3.0*g4*(-g0 + g1)*(-g0 + g1);
-                const double t2 = -g3*t0 + t1;
-                const double t3 = -g3*t0 + t1;
-                if (slot[e * 4 + 0] >= 0) out0[slot[e * 4 + 0]] += t2;
-                if (slot[e * 4 + 1] >= 0) out0[slot[e * 4 + 1]] += -t3;
-                if (slot[e * 4 + 2] >= 0) out0[slot[e * 4 + 2]] += -t2;
-                if (slot[e * 4 + 3] >= 0) out0[slot[e * 4 + 3]] += t3;
+                const double t0 = -g0 + g1;
+                const double t1 = g2 + t0*(2.0*g3 + 3.0*g4*t0);
+                if (slot[e * 4 + 0] >= 0) out0[slot[e * 4 + 0]] += t1;
+                if (slot[e * 4 + 1] >= 0) out0[slot[e * 4 + 1]] += -t1;
+                if (slot[e * 4 + 2] >= 0) out0[slot[e * 4 + 2]] += -t1;
+                if (slot[e * 4 + 3] >= 0) out0[slot[e * 4 + 3]] += t1;
             }
             for (long e = hi; e < cnt; ++e) {
                 const int ok7 = (e + -1 >= 0) && (e + -1 < ns);
                 const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
                 const double g0 = ok7 ? in0[e - 1] : 0.0;
                 const double g1 = ok8 ? in0[e] : 0.0;
-                const double t0 = 2.0*g0 - 2.0*g1;
-                const double t1 = g2 + 3.0*g4*(-g0 + g1)*(-g0 + g1);
-                const double t2 = -g3*t0 + t1;
-                const double t3 = -g3*t0 + t1;
-                if (slot[e * 4 + 0] >= 0) out0[slot[e * 4 + 0]] += t2;
-                if (slot[e * 4 + 1] >= 0) out0[slot[e * 4 + 1]] += -t3;
-                if (slot[e * 4 + 2] >= 0) out0[slot[e * 4 + 2]] += -t2;
-                if (slot[e * 4 + 3] >= 0) out0[slot[e * 4 + 3]] += t3;
+                const double t0 = -g0 + g1;
+                const double t1 = g2 + t0*(2.0*g3 + 3.0*g4*t0);
+                if (slot[e * 4 + 0] >= 0) out0[slot[e * 4 + 0]] += t1;
+                if (slot[e * 4 + 1] >= 0) out0[slot[e * 4 + 1]] += -t1;
+                if (slot[e * 4 + 2] >= 0) out0[slot[e * 4 + 2]] += -t1;
+                if (slot[e * 4 + 3] >= 0) out0[slot[e * 4 + 3]] += t1;
             }
         }
     }
@@ -399,23 +378,19 @@ int mg_force(const double *const *in, double *const *out, const long *sizes, lon
                 const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
                 const double g0 = ok7 ? in0[e - 1] : 0.0;
                 const double g1 = ok8 ? in0[e] : 0.0;
-                const double t0 = 2.0*g0 - 2.0*g1;
-                const double t1 = (1.0/2.0)*g2;
-                const double t2 = -g0 + g1;
-                const double t3 = g3*t2*t2 + g4*t2*t2*t2;
-                if (ok7) out0[e - 1] += -t0*t1 + t3;
-                if (ok8) out0[e] += t0*t1 - t3;
+                const double t0 = -g0 + g1;
+                const double t1 = t0*(g2 + t0*(g3 + g4*t0));
+                if (ok7) out0[e - 1] += t1;
+                if (ok8) out0[e] += -t1;
             }
             double carry_out0 = 0.0;
             for (long e = lo; e < hi; ++e) {
                 const double g0 = in0[e - 1];
                 const double g1 = in0[e];
-                const double t0 = 2.0*g0 - 2.0*g1;
-                const double t1 = (1.0/2.0)*g2;
-                const double t2 = -g0 + g1;
-                const double t3 = g3*t2*t2 + g4*t2*t2*t2;
-                out0[e - 1] += carry_out0 + -t0*t1 + t3;
-                carry_out0 = t0*t1 - t3;
+                const double t0 = -g0 + g1;
+                const double t1 = t0*(g2 + t0*(g3 + g4*t0));
+                out0[e - 1] += carry_out0 + t1;
+                carry_out0 = -t1;
             }
             if (hi > lo) out0[hi + -1] += carry_out0;
             for (long e = hi; e < cnt; ++e) {
@@ -423,12 +398,10 @@ int mg_force(const double *const *in, double *const *out, const long *sizes, lon
                 const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
                 const double g0 = ok7 ? in0[e - 1] : 0.0;
                 const double g1 = ok8 ? in0[e] : 0.0;
-                const double t0 = 2.0*g0 - 2.0*g1;
-                const double t1 = (1.0/2.0)*g2;
-                const double t2 = -g0 + g1;
-                const double t3 = g3*t2*t2 + g4*t2*t2*t2;
-                if (ok7) out0[e - 1] += -t0*t1 + t3;
-                if (ok8) out0[e] += t0*t1 - t3;
+                const double t0 = -g0 + g1;
+                const double t1 = t0*(g2 + t0*(g3 + g4*t0));
+                if (ok7) out0[e - 1] += t1;
+                if (ok8) out0[e] += -t1;
             }
         }
     }
@@ -502,7 +475,7 @@ int mg_outputs(const double *const *in, double *const *out, const long *sizes, l
                 const double g0 = ok7 ? in0[e - 1] : 0.0;
                 const double g1 = ok8 ? in0[e] : 0.0;
                 const double t0 = -g0 + g1;
-                const double t1 = (1.0/2.0)*g2*t0*t0 + (1.0/3.0)*g3*t0*t0*t0 + (1.0/4.0)*g4*t0*t0*t0*t0;
+                const double t1 = t0*t0*((1.0/2.0)*g2 + t0*((1.0/3.0)*g3 + (1.0/4.0)*g4*t0));
                 out1[0] += t1;
                 out2[0] += t1;
             }
@@ -510,7 +483,7 @@ int mg_outputs(const double *const *in, double *const *out, const long *sizes, l
                 const double g0 = in0[e - 1];
                 const double g1 = in0[e];
                 const double t0 = -g0 + g1;
-                const double t1 = (1.0/2.0)*g2*t0*t0 + (1.0/3.0)*g3*t0*t0*t0 + (1.0/4.0)*g4*t0*t0*t0*t0;
+                const double t1 = t0*t0*((1.0/2.0)*g2 + t0*((1.0/3.0)*g3 + (1.0/4.0)*g4*t0));
                 out1[0] += t1;
                 out2[0] += t1;
             }
@@ -520,7 +493,7 @@ int mg_outputs(const double *const *in, double *const *out, const long *sizes, l
                 const double g0 = ok7 ? in0[e - 1] : 0.0;
                 const double g1 = ok8 ? in0[e] : 0.0;
                 const double t0 = -g0 + g1;
-                const double t1 = (1.0/2.0)*g2*t0*t0 + (1.0/3.0)*g3*t0*t0*t0 + (1.0/4.0)*g4*t0*t0*t0*t0;
+                const double t1 = t0*t0*((1.0/2.0)*g2 + t0*((1.0/3.0)*g3 + (1.0/4.0)*g4*t0));
                 out1[0] += t1;
                 out2[0] += t1;
             }

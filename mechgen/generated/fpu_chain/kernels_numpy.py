@@ -36,7 +36,7 @@ SPEC = {'force': {'doc': 'chain kernel force',
                     'params': ['gamma', 'alpha', 'beta'],
                     'sites_param': 'N'},
            'name': 'force',
-           'ops': 14,
+           'ops': 7,
            'outputs': [{'batched': True,
                         'extent': {'const': 0, 'terms': [['sites', 1]]},
                         'integer': False,
@@ -44,7 +44,7 @@ SPEC = {'force': {'doc': 'chain kernel force',
                         'shape': None,
                         'sparse': False,
                         'symmetric': False}],
-           'signature': '7b8991369c8914f3331d8dd4bc468456c5fb8631f4f9598f08ff77813a407703',
+           'signature': 'eb9e6be8ed8ed6eab4075ef519b990118bcadcc378ab0858aad995f22451c645',
            'sizes': ['sites'],
            'slots': []},
  'linear': {'doc': 'chain kernel linear',
@@ -91,7 +91,7 @@ SPEC = {'force': {'doc': 'chain kernel force',
                      'params': ['gamma', 'alpha', 'beta'],
                      'sites_param': 'N'},
             'name': 'linear',
-            'ops': 14,
+            'ops': 9,
             'outputs': [{'batched': True,
                          'extent': {'const': 0, 'terms': [['nnz', 1]]},
                          'integer': False,
@@ -120,7 +120,7 @@ SPEC = {'force': {'doc': 'chain kernel force',
                          'shape': None,
                          'sparse': True,
                          'symmetric': True}],
-            'signature': '593c0974955f558dcd6067fb60fac0551e78ac42954b575694cb69bf571c8885',
+            'signature': 'b9a8d364e1edb2be12170f3eb776f6d401ed86f1a615b537a0b72251bc5aa58c',
             'sizes': ['sites', 'nnz'],
             'slots': [{'boundary': 'zero',
                        'count': {'const': 0, 'terms': [['sites', 1]]},
@@ -162,7 +162,7 @@ SPEC = {'force': {'doc': 'chain kernel force',
                       'params': ['gamma', 'alpha', 'beta'],
                       'sites_param': 'N'},
              'name': 'outputs',
-             'ops': 14,
+             'ops': 12,
              'outputs': [{'batched': True,
                           'extent': {'const': 1, 'terms': []},
                           'integer': False,
@@ -184,7 +184,7 @@ SPEC = {'force': {'doc': 'chain kernel force',
                           'shape': [1, 1],
                           'sparse': False,
                           'symmetric': False}],
-             'signature': 'c440e1ddfd2ba85cff9e0cc6ab9a60b8d1d2f02e4ab4854c67d08a9f8e574875',
+             'signature': '619f7b06fd7d2b1f85337f494bdb0dc0f545b682d26c8c5e0589e59e207e5d76',
              'sizes': ['sites'],
              'slots': []},
  'residual': {'doc': 'chain kernel residual',
@@ -224,7 +224,7 @@ SPEC = {'force': {'doc': 'chain kernel force',
                        'params': ['gamma', 'alpha', 'beta'],
                        'sites_param': 'N'},
               'name': 'residual',
-              'ops': 15,
+              'ops': 8,
               'outputs': [{'batched': True,
                            'extent': {'const': 0, 'terms': [['sites', 1]]},
                            'integer': False,
@@ -232,7 +232,7 @@ SPEC = {'force': {'doc': 'chain kernel force',
                            'shape': None,
                            'sparse': False,
                            'symmetric': False}],
-              'signature': '825f7a9c165f1fc6f0be3962e2709708501c0fcc767ba461beb1cd6ef826c70a',
+              'signature': '14e4bc5abc707decb12e3b6c7a6413a0f74614ffd2ff164c62e02ce3460f3893',
               'sizes': ['sites'],
               'slots': []},
  'stiffness': {'doc': 'chain kernel stiffness',
@@ -272,7 +272,7 @@ SPEC = {'force': {'doc': 'chain kernel force',
                         'params': ['gamma', 'alpha', 'beta'],
                         'sites_param': 'N'},
                'name': 'stiffness',
-               'ops': 14,
+               'ops': 9,
                'outputs': [{'batched': True,
                             'extent': {'const': 0, 'terms': [['nnz', 1]]},
                             'integer': False,
@@ -280,7 +280,7 @@ SPEC = {'force': {'doc': 'chain kernel force',
                             'shape': None,
                             'sparse': True,
                             'symmetric': True}],
-               'signature': '6e4a5e15a2ddf86b2c379bc40136f40ecdd315c2f105d86e3fbb05f0fbd68f40',
+               'signature': '7bc5201ba10de1d66079ff24ce104715ca7679d3d162d7f54485e82a785433ce',
                'sizes': ['sites', 'nnz'],
                'slots': [{'boundary': 'zero',
                           'count': {'const': 1, 'terms': [['sites', 1]]},
@@ -338,7 +338,7 @@ SPEC = {'force': {'doc': 'chain kernel force',
                       'params': ['gamma', 'alpha', 'beta'],
                       'sites_param': 'N'},
              'name': 'tangent',
-             'ops': 14,
+             'ops': 9,
              'outputs': [{'batched': True,
                           'extent': {'const': 0, 'terms': [['nnz', 1]]},
                           'integer': False,
@@ -360,7 +360,7 @@ SPEC = {'force': {'doc': 'chain kernel force',
                           'shape': None,
                           'sparse': True,
                           'symmetric': False}],
-             'signature': '8af0e696c761453c5b0d52cfcb030a29d50ced47d2946dd4ee467a71f371607a',
+             'signature': '9825b09fd904cb18932957cff08bca26958d4acd6bf31266f2384a1697dee184',
              'sizes': ['sites', 'nnz'],
              'slots': [{'boundary': 'zero',
                         'count': {'const': 0, 'terms': [['sites', 1]]},
@@ -410,11 +410,10 @@ def mg_residual(ins, outs, sizes):
     g2 = in3[0]
     g3 = in3[1]
     g4 = in3[2]
-    t0 = 2.0*g0 - 2.0*g1
-    t1 = -g0 + g1
-    t2 = g3*t1*t1 + g4*t1*t1*t1
-    out0[:, i7[ok7]] += _bc(((1.0/2.0))*g2*t0 - t2, shape)[:, ok7]
-    out0[:, i8[ok8]] += _bc(-(1.0/2.0)*g2*t0 + t2, shape)[:, ok8]
+    t0 = -g0 + g1
+    t1 = t0*(-g2 + t0*(-g3 - g4*t0))
+    out0[:, i7[ok7]] += _bc(t1, shape)[:, ok7]
+    out0[:, i8[ok8]] += _bc(-t1, shape)[:, ok8]
 
 
 def mg_tangent(ins, outs, sizes):
@@ -451,22 +450,20 @@ def mg_tangent(ins, outs, sizes):
     g2 = in3[0]
     g3 = in3[1]
     g4 = in3[2]
-    t0 = 2.0*g0 - 2.0*g1
-    t1 = g2 + 3.0*g4*(-g0 + g1)*(-g0 + g1)
-    t2 = -g3*t0 + t1
-    t3 = -g3*t0 + t1
+    t0 = -g0 + g1
+    t1 = g2 + t0*(2.0*g3 + 3.0*g4*t0)
     s = in5.reshape(cnt, 4)[:, 0]
     m = s >= 0
-    out0[:, s[m]] += _bc(t2, shape)[:, m]
+    out0[:, s[m]] += _bc(t1, shape)[:, m]
     s = in5.reshape(cnt, 4)[:, 1]
     m = s >= 0
-    out0[:, s[m]] += _bc(-t3, shape)[:, m]
+    out0[:, s[m]] += _bc(-t1, shape)[:, m]
     s = in5.reshape(cnt, 4)[:, 2]
     m = s >= 0
-    out0[:, s[m]] += _bc(-t2, shape)[:, m]
+    out0[:, s[m]] += _bc(-t1, shape)[:, m]
     s = in5.reshape(cnt, 4)[:, 3]
     m = s >= 0
-    out0[:, s[m]] += _bc(t3, shape)[:, m]
+    out0[:, s[m]] += _bc(t1, shape)[:, m]
 
 
 def mg_linear(ins, outs, sizes):
@@ -503,22 +500,20 @@ def mg_linear(ins, outs, sizes):
     g2 = in2[0]
     g3 = in2[1]
     g4 = in2[2]
-    t0 = 2.0*g0 - 2.0*g1
-    t1 = g2 + 3.0*g4*(-g0 + g1)*(-g0 + g1)
-    t2 = -g3*t0 + t1
-    t3 = -g3*t0 + t1
+    t0 = -g0 + g1
+    t1 = g2 + t0*(2.0*g3 + 3.0*g4*t0)
     s = in4.reshape(cnt, 4)[:, 0]
     m = s >= 0
-    out3[:, s[m]] += _bc(t2, shape)[:, m]
+    out3[:, s[m]] += _bc(t1, shape)[:, m]
     s = in4.reshape(cnt, 4)[:, 1]
     m = s >= 0
-    out3[:, s[m]] += _bc(-t3, shape)[:, m]
+    out3[:, s[m]] += _bc(-t1, shape)[:, m]
     s = in4.reshape(cnt, 4)[:, 2]
     m = s >= 0
-    out3[:, s[m]] += _bc(-t2, shape)[:, m]
+    out3[:, s[m]] += _bc(-t1, shape)[:, m]
     s = in4.reshape(cnt, 4)[:, 3]
     m = s >= 0
-    out3[:, s[m]] += _bc(t3, shape)[:, m]
+    out3[:, s[m]] += _bc(t1, shape)[:, m]
 
 
 def mg_stiffness(ins, outs, sizes):
@@ -544,22 +539,20 @@ def mg_stiffness(ins, outs, sizes):
     g2 = in2[0]
     g3 = in2[1]
     g4 = in2[2]
-    t0 = 2.0*g0 - 2.0*g1
-    t1 = g2 + 3.0*g4*(-g0 + g1)*(-g0 + g1)
-    t2 = -g3*t0 + t1
-    t3 = -g3*t0 + t1
+    t0 = -g0 + g1
+    t1 = g2 + t0*(2.0*g3 + 3.0*g4*t0)
     s = in3.reshape(cnt, 4)[:, 0]
     m = s >= 0
-    out0[:, s[m]] += _bc(t2, shape)[:, m]
+    out0[:, s[m]] += _bc(t1, shape)[:, m]
     s = in3.reshape(cnt, 4)[:, 1]
     m = s >= 0
-    out0[:, s[m]] += _bc(-t3, shape)[:, m]
+    out0[:, s[m]] += _bc(-t1, shape)[:, m]
     s = in3.reshape(cnt, 4)[:, 2]
     m = s >= 0
-    out0[:, s[m]] += _bc(-t2, shape)[:, m]
+    out0[:, s[m]] += _bc(-t1, shape)[:, m]
     s = in3.reshape(cnt, 4)[:, 3]
     m = s >= 0
-    out0[:, s[m]] += _bc(t3, shape)[:, m]
+    out0[:, s[m]] += _bc(t1, shape)[:, m]
 
 
 def mg_force(ins, outs, sizes):
@@ -584,12 +577,10 @@ def mg_force(ins, outs, sizes):
     g2 = in2[0]
     g3 = in2[1]
     g4 = in2[2]
-    t0 = 2.0*g0 - 2.0*g1
-    t1 = ((1.0/2.0))*g2
-    t2 = -g0 + g1
-    t3 = g3*t2*t2 + g4*t2*t2*t2
-    out0[:, i7[ok7]] += _bc(-t0*t1 + t3, shape)[:, ok7]
-    out0[:, i8[ok8]] += _bc(t0*t1 - t3, shape)[:, ok8]
+    t0 = -g0 + g1
+    t1 = t0*(g2 + t0*(g3 + g4*t0))
+    out0[:, i7[ok7]] += _bc(t1, shape)[:, ok7]
+    out0[:, i8[ok8]] += _bc(-t1, shape)[:, ok8]
 
 
 def mg_outputs(ins, outs, sizes):
@@ -628,6 +619,6 @@ def mg_outputs(ins, outs, sizes):
     g3 = in2[1]
     g4 = in2[2]
     t0 = -g0 + g1
-    t1 = ((1.0/2.0))*g2*t0*t0 + ((1.0/3.0))*g3*t0*t0*t0 + ((1.0/4.0))*g4*t0*t0*t0*t0
+    t1 = t0*t0*(((1.0/2.0))*g2 + t0*(((1.0/3.0))*g3 + ((1.0/4.0))*g4*t0))
     out1[:, 0] += np.sum(_bc(t1, shape), axis=-1)
     out2[:, 0] += np.sum(_bc(t1, shape), axis=-1)

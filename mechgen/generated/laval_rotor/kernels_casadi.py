@@ -102,7 +102,7 @@ SPEC = {'force': {'doc': 'potential force -dV/dq',
                      'model': 'laval_rotor',
                      'params': ['m', 'Ip', 'Id', 'k_t', 'k_r', 'Omega', 'c', 'c_r']},
             'name': 'linear',
-            'ops': 51,
+            'ops': 45,
             'outputs': [{'batched': True,
                          'extent': {'const': 16, 'terms': []},
                          'integer': False,
@@ -131,7 +131,7 @@ SPEC = {'force': {'doc': 'potential force -dV/dq',
                          'shape': [4, 4],
                          'sparse': False,
                          'symmetric': False}],
-            'signature': '01273c90868b2f3a7c4eb8106df3c5fa019e343c7aedb505d201500a93817765',
+            'signature': '8f7e10255b73f0dc81aee09f8aabfb8c5bfbb3bf86f593409d21e163d1c5044a',
             'sizes': [],
             'slots': []},
  'outputs': {'doc': 'named outputs',
@@ -257,7 +257,7 @@ SPEC = {'force': {'doc': 'potential force -dV/dq',
                        'model': 'laval_rotor',
                        'params': ['m', 'Ip', 'Id', 'k_t', 'k_r', 'Omega', 'c', 'c_r']},
               'name': 'residual',
-              'ops': 45,
+              'ops': 47,
               'outputs': [{'batched': True,
                            'extent': {'const': 4, 'terms': []},
                            'integer': False,
@@ -265,7 +265,7 @@ SPEC = {'force': {'doc': 'potential force -dV/dq',
                            'shape': [4, 1],
                            'sparse': False,
                            'symmetric': False}],
-              'signature': '08f8eaeb246ecc72f12e75fc0bcb5a7f25453cd27f75660924c2eec33b4cb051',
+              'signature': '04bc0d7d8eb0e9f802b99d69da041d7b244cdc92f866afb475c05c4c363de1f3',
               'sizes': [],
               'slots': []},
  'tangent': {'doc': 'Jacobians of the residual',
@@ -317,7 +317,7 @@ SPEC = {'force': {'doc': 'potential force -dV/dq',
                       'model': 'laval_rotor',
                       'params': ['m', 'Ip', 'Id', 'k_t', 'k_r', 'Omega', 'c', 'c_r']},
              'name': 'tangent',
-             'ops': 53,
+             'ops': 50,
              'outputs': [{'batched': True,
                           'extent': {'const': 16, 'terms': []},
                           'integer': False,
@@ -346,7 +346,7 @@ SPEC = {'force': {'doc': 'potential force -dV/dq',
                           'shape': [4, 0],
                           'sparse': False,
                           'symmetric': False}],
-             'signature': '4ff291378005837d72700b9f53894b5072d8a6990238b286b2902993442a4ddb',
+             'signature': '931674d998e04fbec09454123c551b897db05474e29a9a3840e3c8cb4fd24993',
              'sizes': [],
              'slots': []}}
 
@@ -394,16 +394,15 @@ def build_residual(sizes, slots):
     g17 = in5[5]
     g18 = in5[6]
     g19 = in5[7]
-    t0 = ca.sin(g3)
-    t1 = ca.cos(g3)
-    t2 = g6*t0
-    t3 = g13*t1
-    t4 = g14*t1
-    t5 = t3*(g17 + t2)
+    t0 = ca.cos(g3)
+    t1 = ca.sin(g3)
+    t2 = g6*t1
+    t3 = g7*t0
+    t4 = 2.0*t2*t3
     out0[0] = g0*g15 + g12*g8 + g18*g4
     out0[1] = g1*g15 + g12*g9 + g18*g5
-    out0[2] = g10*(g13*t0*t0 + g14*t1*t1) + g16*g2 + g19*g6 + g7*(t2*t3 - 2.0*t2*t4 + t5)
-    out0[3] = g11*g14 + g16*g3 + g19*g7 + g6*g6*t0*t4 - g6*t5
+    out0[2] = g10*g14*t0*t0 + g13*(g10*t1*t1 + g17*t3 + t4) - g14*t4 + g16*g2 + g19*g6
+    out0[3] = g11*g14 - g13*g6*t0*(g17 + t2) + g14*g6*g6*t0*t1 + g16*g3 + g19*g7
     return ca.Function('residual', [in0, in1, in2, in3, in4, in5], [out0], ['q', 'v', 'a', 'z', 't', 'p'], ['r'])
 
 
@@ -432,32 +431,35 @@ def build_tangent(sizes, slots):
     g10 = in5[6]
     g11 = in5[7]
     t0 = ca.sin(g0)
-    t1 = ca.cos(g0)
-    t2 = 2.0*t0*t1
-    t3 = g5*t2 - g6*t2
-    t4 = t0*t0
-    t5 = g5*t4
-    t6 = t1*t1
-    t7 = g6*t6
-    t8 = g1*t0
-    t9 = g5*(g9 + t8)
-    t10 = g1*g1
-    t11 = t1*t8
-    t12 = g5*t11 - 2.0*g6*t11 + t1*t9
+    t1 = g5*t0
+    t2 = ca.cos(g0)
+    t3 = 2.0*t2
+    t4 = t1*t3
+    t5 = g6*t0
+    t6 = t3*t5
+    t7 = g9*t1
+    t8 = t0*t0
+    t9 = g5*t8
+    t10 = 2.0*g1
+    t11 = t2*t2
+    t12 = g6*t11
+    t13 = t12 + t9
+    t14 = t10*t2
+    t15 = g5*(g9*t2 + t0*t14) - t14*t5
     out0[0] = g7
     out0[5] = g7
     out0[10] = g8
-    out0[11] = g2*(2.0*g1*g5*t6 + 2.0*g1*g6*t4 - g1*t5 - 2.0*g1*t7 - t0*t9) + g3*t3
-    out0[15] = -g5*t10*t6 - g6*t10*t4 + g8 + t10*t7 + t8*t9
+    out0[11] = g2*(2.0*g1*g5*t11 + 2.0*g1*g6*t8 - t10*t12 - t10*t9 - t7) + g3*t4 - g3*t6
+    out0[15] = g1*(g1*(-g5*t11 - g6*t8 + t13) + t7) + g8
     out1[0] = g10
     out1[5] = g10
-    out1[10] = g11 + g2*t3
-    out1[11] = t12
-    out1[14] = -t12
+    out1[10] = g11 + g2*(t4 - t6)
+    out1[11] = t15
+    out1[14] = -t15
     out1[15] = g11
     out2[0] = g4
     out2[5] = g4
-    out2[10] = t5 + t7
+    out2[10] = t13
     out2[15] = g6
     return ca.Function('tangent', [in0, in1, in2, in3, in4, in5], [out0, out1, out2, out3], ['q', 'v', 'a', 'z', 't', 'p'], ['r_q', 'r_v', 'r_a', 'r_z'])
 
@@ -490,27 +492,29 @@ def build_linear(sizes, slots):
     t3 = ca.cos(g0)
     t4 = t3*t3
     t5 = g5*t4
-    t6 = 2.0*t0*t3
-    t7 = g1*t0
-    t8 = t3*t7
-    t9 = g4*(g8 + t7)
-    t10 = g4*t8 - 2.0*g5*t8 + t3*t9
-    t11 = g1*g1
+    t6 = t2 + t5
+    t7 = g4*t0
+    t8 = 2.0*t3
+    t9 = t0*t8
+    t10 = g5*t9
+    t11 = g8*t7
+    t12 = 2.0*g1
+    t13 = -g1*t10 + g4*(g1*t9 + g8*t3)
     out0[0] = g3
     out0[5] = g3
-    out0[10] = t2 + t5
+    out0[10] = t6
     out0[15] = g5
     out1[0] = g9
     out1[5] = g9
-    out1[10] = g10 + g2*(g4*t6 - g5*t6)
+    out1[10] = g10 + g2*(-t10 + t7*t8)
     out1[15] = g10
-    out2[11] = t10
-    out2[14] = -t10
+    out2[11] = t13
+    out2[14] = -t13
     out3[0] = g6
     out3[5] = g6
     out3[10] = g7
-    out3[11] = g2*(2.0*g1*g4*t4 + 2.0*g1*g5*t1 - g1*t2 - 2.0*g1*t5 - t0*t9)
-    out3[15] = -g4*t11*t4 - g5*t1*t11 + g7 + t11*t5 + t7*t9
+    out3[11] = g2*(2.0*g1*g4*t4 + 2.0*g1*g5*t1 - t11 - t12*t2 - t12*t5)
+    out3[15] = g1*(g1*(-g4*t4 - g5*t1 + t6) + t11) + g7
     return ca.Function('linear', [in0, in1, in2, in3, in4], [out0, out1, out2, out3], ['q', 'v', 'z', 't', 'p'], ['M', 'D', 'G', 'K'])
 
 

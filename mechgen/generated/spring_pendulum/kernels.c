@@ -38,10 +38,9 @@ int mg_residual(const double *const *in, double *const *out, const long *sizes, 
             const double g7 = in5[1];
             const double g8 = in5[2];
             const double g9 = in5[3];
-            const double t0 = g0*g6;
-            const double t1 = 2.0*g0;
-            out0[0] = -g3*g3*t0 + g4*g6 - g6*g9*cos(g1) + (1.0/2.0)*g7*(-2.0*g8 + t1);
-            out0[1] = g0*g0*g5*g6 + g2*g3*g6*t1 + g9*t0*sin(g1);
+            const double t0 = g6*g9;
+            out0[0] = g0*(-g3*g3*g6 + g7) + g4*g6 - g7*g8 - t0*cos(g1);
+            out0[1] = g0*(g0*g5*g6 + 2.0*g2*g3*g6 + t0*sin(g1));
         }
     }
     return 0;
@@ -91,18 +90,17 @@ int mg_tangent(const double *const *in, double *const *out, const long *sizes, l
             const double g5 = in5[0];
             const double g6 = in5[1];
             const double g7 = in5[3];
-            const double t0 = g5*g7;
-            const double t1 = t0*sin(g1);
-            const double t2 = 2.0*g5;
-            const double t3 = g0*t2;
-            const double t4 = g3*t3;
+            const double t0 = g7*sin(g1);
+            const double t1 = 2.0*g0;
+            const double t2 = g5*t1;
+            const double t3 = -g3*t2;
             out0[0] = -g3*g3*g5 + g6;
-            out0[1] = t1;
-            out0[2] = g2*g3*t2 + g4*t3 + t1;
-            out0[3] = g0*t0*cos(g1);
-            out1[1] = -t4;
-            out1[2] = t4;
-            out1[3] = g2*t3;
+            out0[1] = g5*t0;
+            out0[2] = g5*(2.0*g2*g3 + g4*t1 + t0);
+            out0[3] = g0*g5*g7*cos(g1);
+            out1[1] = t3;
+            out1[2] = -t3;
+            out1[3] = g2*t2;
             out2[0] = g5;
             out2[3] = g0*g0*g5;
         }
@@ -150,19 +148,19 @@ int mg_linear(const double *const *in, double *const *out, const long *sizes, lo
             const double g4 = in4[0];
             const double g5 = in4[1];
             const double g6 = in4[3];
-            const double t0 = 2.0*g0*g4;
-            const double t1 = g3*t0;
-            const double t2 = g4*g6;
-            const double t3 = t2*sin(g1);
+            const double t0 = 2.0*g2;
+            const double t1 = g0*g4;
+            const double t2 = g6*sin(g1);
+            const double t3 = -2.0*g3*t1;
             out0[0] = g4;
             out0[3] = g0*g0*g4;
-            out1[3] = g2*t0;
-            out2[1] = -t1;
-            out2[2] = t1;
+            out1[3] = t0*t1;
+            out2[1] = t3;
+            out2[2] = -t3;
             out3[0] = -g3*g3*g4 + g5;
-            out3[1] = t3;
-            out3[2] = 2.0*g2*g3*g4 + t3;
-            out3[3] = g0*t2*cos(g1);
+            out3[1] = g4*t2;
+            out3[2] = g4*(g3*t0 + t2);
+            out3[3] = g6*t1*cos(g1);
         }
     }
     return 0;
@@ -193,9 +191,10 @@ int mg_force(const double *const *in, double *const *out, const long *sizes, lon
             const double g3 = in4[1];
             const double g4 = in4[2];
             const double g5 = in4[3];
-            const double t0 = g2*g5;
-            out0[0] = -1.0/2.0*g3*(2.0*g0 - 2.0*g4) + t0*cos(g1);
-            out0[1] = -g0*t0*sin(g1);
+            const double t0 = -g0 + g4;
+            const double t1 = g2*g5;
+            out0[0] = g3*t0 + t1*cos(g1);
+            out0[1] = -g0*t1*sin(g1);
         }
     }
     return 0;

@@ -48,7 +48,7 @@ SPEC = {'force': {'doc': 'potential force -dV/dq',
                     'model': 'spring_pendulum',
                     'params': ['m', 'k', 'l0', 'g']},
            'name': 'force',
-           'ops': 13,
+           'ops': 10,
            'outputs': [{'batched': True,
                         'extent': {'const': 2, 'terms': []},
                         'integer': False,
@@ -56,7 +56,7 @@ SPEC = {'force': {'doc': 'potential force -dV/dq',
                         'shape': [2, 1],
                         'sparse': False,
                         'symmetric': False}],
-           'signature': 'a4421f8b181832ce46c3c53a15b6193ba8a90352a2c16bce22294d7473bf6b45',
+           'signature': 'a69c78d0d40052bf4fc3ab304c4c5a3bbf996b61dc24b4669de4566517db84f0',
            'sizes': [],
            'slots': []},
  'linear': {'doc': 'M, D, G, K of the linearisation (a = 0)',
@@ -101,7 +101,7 @@ SPEC = {'force': {'doc': 'potential force -dV/dq',
                      'model': 'spring_pendulum',
                      'params': ['m', 'k', 'l0', 'g']},
             'name': 'linear',
-            'ops': 20,
+            'ops': 21,
             'outputs': [{'batched': True,
                          'extent': {'const': 4, 'terms': []},
                          'integer': False,
@@ -130,7 +130,7 @@ SPEC = {'force': {'doc': 'potential force -dV/dq',
                          'shape': [2, 2],
                          'sparse': False,
                          'symmetric': False}],
-            'signature': '96ab6435da5dc7590d3c54c90581f6b0372dafb9f2358cf3f41ceefe69e85805',
+            'signature': '986c122a8a8c0a9de596105b62b255e0174771b2c17e98362dc422a7b36e33f4',
             'sizes': [],
             'slots': []},
  'outputs': {'doc': 'named outputs',
@@ -263,7 +263,7 @@ SPEC = {'force': {'doc': 'potential force -dV/dq',
                        'model': 'spring_pendulum',
                        'params': ['m', 'k', 'l0', 'g']},
               'name': 'residual',
-              'ops': 26,
+              'ops': 22,
               'outputs': [{'batched': True,
                            'extent': {'const': 2, 'terms': []},
                            'integer': False,
@@ -271,7 +271,7 @@ SPEC = {'force': {'doc': 'potential force -dV/dq',
                            'shape': [2, 1],
                            'sparse': False,
                            'symmetric': False}],
-              'signature': '646460bdaba4c670f4b6c4969ef73a71e1e7f7ce3fcbd5b4e5414eee6feea8df',
+              'signature': '7e85dba4dae19da2b48598b75279b3db31d7f7a9449d91fef375eeef78151bf7',
               'sizes': [],
               'slots': []},
  'tangent': {'doc': 'Jacobians of the residual',
@@ -323,7 +323,7 @@ SPEC = {'force': {'doc': 'potential force -dV/dq',
                       'model': 'spring_pendulum',
                       'params': ['m', 'k', 'l0', 'g']},
              'name': 'tangent',
-             'ops': 21,
+             'ops': 24,
              'outputs': [{'batched': True,
                           'extent': {'const': 4, 'terms': []},
                           'integer': False,
@@ -352,7 +352,7 @@ SPEC = {'force': {'doc': 'potential force -dV/dq',
                           'shape': [2, 0],
                           'sparse': False,
                           'symmetric': False}],
-             'signature': '5ee85e41d57220f8ffbe5abb8abd5850865552b329e41d69527c748eaa0f9d55',
+             'signature': '44928196e001c7e86bed5e904f3de709e7b4467b8dcac24915460685d2043979',
              'sizes': [],
              'slots': []}}
 
@@ -381,10 +381,9 @@ def mg_residual(ins, outs, sizes):
     g7 = in5[1]
     g8 = in5[2]
     g9 = in5[3]
-    t0 = g0*g6
-    t1 = 2.0*g0
-    out0[:, 0] = -g3*g3*t0 + g4*g6 - g6*g9*np.cos(g1) + ((1.0/2.0))*g7*(-2.0*g8 + t1)
-    out0[:, 1] = g0*g0*g5*g6 + g2*g3*g6*t1 + g9*t0*np.sin(g1)
+    t0 = g6*g9
+    out0[:, 0] = g0*(-g3*g3*g6 + g7) + g4*g6 - g7*g8 - t0*np.cos(g1)
+    out0[:, 1] = g0*(g0*g5*g6 + 2.0*g2*g3*g6 + t0*np.sin(g1))
 
 
 def mg_tangent(ins, outs, sizes):
@@ -408,18 +407,17 @@ def mg_tangent(ins, outs, sizes):
     g5 = in5[0]
     g6 = in5[1]
     g7 = in5[3]
-    t0 = g5*g7
-    t1 = t0*np.sin(g1)
-    t2 = 2.0*g5
-    t3 = g0*t2
-    t4 = g3*t3
+    t0 = g7*np.sin(g1)
+    t1 = 2.0*g0
+    t2 = g5*t1
+    t3 = -g3*t2
     out0[:, 0] = -g3*g3*g5 + g6
-    out0[:, 1] = t1
-    out0[:, 2] = g2*g3*t2 + g4*t3 + t1
-    out0[:, 3] = g0*t0*np.cos(g1)
-    out1[:, 1] = -t4
-    out1[:, 2] = t4
-    out1[:, 3] = g2*t3
+    out0[:, 1] = g5*t0
+    out0[:, 2] = g5*(2.0*g2*g3 + g4*t1 + t0)
+    out0[:, 3] = g0*g5*g7*np.cos(g1)
+    out1[:, 1] = t3
+    out1[:, 2] = -t3
+    out1[:, 3] = g2*t2
     out2[:, 0] = g5
     out2[:, 3] = g0*g0*g5
 
@@ -443,19 +441,19 @@ def mg_linear(ins, outs, sizes):
     g4 = in4[0]
     g5 = in4[1]
     g6 = in4[3]
-    t0 = 2.0*g0*g4
-    t1 = g3*t0
-    t2 = g4*g6
-    t3 = t2*np.sin(g1)
+    t0 = 2.0*g2
+    t1 = g0*g4
+    t2 = g6*np.sin(g1)
+    t3 = -2.0*g3*t1
     out0[:, 0] = g4
     out0[:, 3] = g0*g0*g4
-    out1[:, 3] = g2*t0
-    out2[:, 1] = -t1
-    out2[:, 2] = t1
+    out1[:, 3] = t0*t1
+    out2[:, 1] = t3
+    out2[:, 2] = -t3
     out3[:, 0] = -g3*g3*g4 + g5
-    out3[:, 1] = t3
-    out3[:, 2] = 2.0*g2*g3*g4 + t3
-    out3[:, 3] = g0*t2*np.cos(g1)
+    out3[:, 1] = g4*t2
+    out3[:, 2] = g4*(g3*t0 + t2)
+    out3[:, 3] = g6*t1*np.cos(g1)
 
 
 def mg_force(ins, outs, sizes):
@@ -473,9 +471,10 @@ def mg_force(ins, outs, sizes):
     g3 = in4[1]
     g4 = in4[2]
     g5 = in4[3]
-    t0 = g2*g5
-    out0[:, 0] = -(1.0/2.0)*g3*(2.0*g0 - 2.0*g4) + t0*np.cos(g1)
-    out0[:, 1] = -g0*t0*np.sin(g1)
+    t0 = -g0 + g4
+    t1 = g2*g5
+    out0[:, 0] = g3*t0 + t1*np.cos(g1)
+    out0[:, 1] = -g0*t1*np.sin(g1)
 
 
 def mg_outputs(ins, outs, sizes):
