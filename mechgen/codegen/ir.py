@@ -8,6 +8,12 @@ every index. Each block: gathers (port entries -> local symbols), CSE'd
 assignments, writes (set or accumulate into an output entry, or into a sparse
 output through a slot table that the runtime fills from the pattern).
 
+A loop block with sparse writes also gets an *affine* input: where the slot of
+entry j is ``base_j + stride*e`` over a run of loop indices (the interior of a
+banded pattern) the runtime says so once, and the C interior addresses the CSR
+data directly (:meth:`KernelIR.stored_ports` says which outputs it then stores
+instead of accumulating).
+
 Every C kernel has the signature
 ``int NAME(const double *const *in, double *const *out, const long *sizes, long nbatch)``.
 """
@@ -126,6 +132,33 @@ class Block:
                 seen.setdefault(w.entry, None)
         return tuple(seen)
 
+    def offset_range(self) -> tuple[int, int]:
+        """(lowest, highest) site offset a loop iteration reads or writes (0 included)."""
+        offsets = [g.index for g in self.gathers if g.relative] + [w.index for w in self.writes if w.relative]
+        return min(offsets, default=0), max(offsets, default=0)
+
+    def written_ports(self) -> tuple[str, ...]:
+        """Ports this block writes, in first-use order."""
+        return tuple(dict.fromkeys(w.port for w in self.writes))
+
+    def port_entries(self, port: str) -> tuple[int, ...]:
+        """Columns (positions in :attr:`entries`) of the sparse entries ``port`` gets from this block."""
+        cols = {entry: j for j, entry in enumerate(self.entries)}
+        return tuple(dict.fromkeys(cols[w.entry] for w in self.writes if w.port == port and w.entry is not None))
+
+    def carried_entries(self, port: str) -> tuple[tuple[int, int], ...]:
+        """Pairs (j_in, j_out) of ``port``'s entries with entry j_out = entry j_in + (1, 1).
+
+        Entry j_out of iteration e and entry j_in of iteration e + 1 are the same
+        matrix entry, so the interior carries that value in a register. Entries
+        in a chain of such pairs (a longer stencil) are not carried.
+        """
+        mine = self.port_entries(port)
+        pos = {self.entries[j]: j for j in mine}
+        pairs = [(j, pos[(r + 1, c + 1)]) for j in mine for r, c in [self.entries[j]] if (r + 1, c + 1) in pos]
+        used = [j for pair in pairs for j in pair]
+        return tuple(p for p in pairs if used.count(p[0]) == 1 and used.count(p[1]) == 1)
+
 
 @dataclass(frozen=True)
 class KernelIR:
@@ -142,6 +175,33 @@ class KernelIR:
     def slot_ports(self) -> list[tuple[int, str]]:
         """(block index, slot port name) for blocks that write sparse entries."""
         return [(i, f"slots{i}") for i, b in enumerate(self.blocks) if b.entries]
+
+    def affine_ports(self) -> list[tuple[int, str]]:
+        """(block index, affine port name) for blocks that write sparse entries.
+
+        The port holds ``[a, b, stride, base_0 .. base_{w-1}, (zlo, zhi) per stored port]``:
+        for a <= e < b the slot of entry j is base_j + stride*e; each port of
+        :meth:`stored_ports` is stored (not accumulated) there, exactly once per
+        CSR position, on the positions zlo <= s < zhi (zlo = zhi = 0: positions
+        not contiguous, zero all first). a = b when the runtime found no such run.
+        """
+        return [(i, f"slots{i}_affine") for i, b in enumerate(self.blocks) if b.entries]
+
+    def first_writer(self, port: str) -> int | None:
+        """Index of the first block that writes ``port`` (None if none does)."""
+        return next((i for i, b in enumerate(self.blocks) if port in b.written_ports()), None)
+
+    def stored_ports(self, i: int) -> tuple[str, ...]:
+        """Ports that loop block ``i`` is first to write, each written only at sparse entries.
+
+        In the block's affine interior these are stored, not accumulated, and the
+        block zeroes the rest of them first.
+        """
+        b = self.blocks[i]
+        if b.loop is None or not b.entries:
+            return ()
+        return tuple(p for p in b.written_ports() if self.first_writer(p) == i
+                     and all(w.entry is not None and w.accumulate for w in b.writes if w.port == p))
 
     def op_count(self) -> int:
         """Arithmetic operations in the kernel text (sympy's count_ops)."""

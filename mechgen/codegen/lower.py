@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from mechgen.codegen.ir import Block, Gather, KernelIR, Port, Write
+from mechgen.codegen.ir import Block, Gather, KernelIR, Port, Write, fixed
 from mechgen.codegen.rewrite import optimise
 from mechgen.errors import ModelError
 
@@ -55,12 +55,15 @@ def dense_writes(port: str, matrix: sp.Matrix) -> list[Write]:
 
 def kernel(name: str, doc: str, inputs: list[Port], outputs: list[Port], blocks: list[Block],
            sizes: tuple[str, ...] = (), meta: dict | None = None) -> KernelIR:
-    """Assemble a KernelIR, appending one integer slot input per block with sparse writes."""
+    """Assemble a KernelIR, appending a slot table and an affine summary input per block with sparse writes."""
     ir = KernelIR(name, doc, tuple(inputs), tuple(outputs), tuple(blocks), sizes, meta or {})
     slots = [Port(port, _scaled(ir.blocks[i].loop.count, len(ir.blocks[i].entries)), batched=False,
                   integer=True, doc=f"CSR slots of block {i}") for i, port in ir.slot_ports()]
+    affine = [Port(port, fixed(3 + len(ir.blocks[i].entries) + 2 * len(ir.stored_ports(i))), batched=False,
+                   integer=True, doc=f"affine run of the slots of block {i}") for i, port in ir.affine_ports()]
     if slots:
-        ir = KernelIR(name, doc, tuple(inputs) + tuple(slots), tuple(outputs), tuple(blocks), sizes, meta or {})
+        ir = KernelIR(name, doc, tuple(inputs) + tuple(slots) + tuple(affine), tuple(outputs), tuple(blocks), sizes,
+                      meta or {})
     return ir
 
 

@@ -15,12 +15,21 @@ def _port(p: Port) -> dict:
 
 
 def kernel_spec(ir: KernelIR) -> dict:
-    """Spec of one kernel: ports, sizes, slot recipes (loop count and entry offsets) and op count."""
+    """Spec of one kernel: ports, sizes, slot recipes and op count.
+
+    A slot recipe has the loop count, sites and boundary, the entry offsets, the
+    block's site offset range (its unchecked interior) and, for the affine
+    summary, the ports stored there with their entries and carried pairs
+    (see :meth:`~mechgen.codegen.ir.KernelIR.affine_ports`).
+    """
     slots = []
-    for i, port in ir.slot_ports():
+    for (i, port), (_, affine) in zip(ir.slot_ports(), ir.affine_ports()):
         b = ir.blocks[i]
+        stored = [{"port": p, "entries": list(b.port_entries(p)), "carried": [list(c) for c in b.carried_entries(p)]}
+                  for p in ir.stored_ports(i)]
         slots.append({"port": port, "count": b.loop.count.to_json(), "sites": b.loop.sites.to_json(),
-                      "boundary": b.loop.boundary, "entries": [list(e) for e in b.entries]})
+                      "boundary": b.loop.boundary, "entries": [list(e) for e in b.entries],
+                      "affine": affine, "offsets": list(b.offset_range()), "stored": stored})
     return {"name": ir.name, "doc": ir.doc, "inputs": [_port(p) for p in ir.inputs],
             "outputs": [_port(p) for p in ir.outputs], "sizes": list(ir.sizes), "slots": slots,
             "ops": ir.op_count(), "signature": ir.signature(), "meta": ir.meta}

@@ -23,20 +23,23 @@ int mg_residual(const double *const *in, double *const *out, const long *sizes, 
         const double *const in0 = in[0] + b * len_in0;
         const double *const in2 = in[2] + b * len_in2;
         double *const out0 = out[0] + b * len_out0;
-        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
         {
             const long cnt = sites;
             const long ns = sites;
             const long lo = 0 < cnt ? 0 : cnt;
             const long hi = ns - 0 > lo ? (ns - 0 < cnt ? ns - 0 : cnt) : lo;
+            const long zlo_out0 = hi > lo ? lo : 0;
+            const long zhi_out0 = hi > lo ? hi : 0;
+            for (long i = 0; i < zlo_out0; ++i) out0[i] = 0.0;
+            for (long i = zhi_out0; i < len_out0; ++i) out0[i] = 0.0;
+            for (long e = lo; e < hi; ++e) {
+                const double g0 = in2[e];
+                out0[e] = g0;
+            }
             for (long e = 0; e < lo; ++e) {
                 const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
                 const double g0 = ok8 ? in2[e] : 0.0;
                 if (ok8) out0[e] += g0;
-            }
-            for (long e = lo; e < hi; ++e) {
-                const double g0 = in2[e];
-                out0[e] += g0;
             }
             for (long e = hi; e < cnt; ++e) {
                 const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
@@ -52,6 +55,16 @@ int mg_residual(const double *const *in, double *const *out, const long *sizes, 
             const double g4 = in3[2];
             const long lo = 1 < cnt ? 1 : cnt;
             const long hi = ns - 0 > lo ? (ns - 0 < cnt ? ns - 0 : cnt) : lo;
+            double carry_out0 = 0.0;
+            for (long e = lo; e < hi; ++e) {
+                const double g0 = in0[e - 1];
+                const double g1 = in0[e];
+                const double t0 = -g0 + g1;
+                const double t1 = t0*(-g2 + t0*(-g3 - g4*t0));
+                out0[e - 1] += t1 - carry_out0;
+                carry_out0 = t1;
+            }
+            if (hi > lo) out0[hi - 1] -= carry_out0;
             for (long e = 0; e < lo; ++e) {
                 const int ok7 = (e + -1 >= 0) && (e + -1 < ns);
                 const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
@@ -62,16 +75,6 @@ int mg_residual(const double *const *in, double *const *out, const long *sizes, 
                 if (ok7) out0[e - 1] += t1;
                 if (ok8) out0[e] += -t1;
             }
-            double carry_out0 = 0.0;
-            for (long e = lo; e < hi; ++e) {
-                const double g0 = in0[e - 1];
-                const double g1 = in0[e];
-                const double t0 = -g0 + g1;
-                const double t1 = t0*(-g2 + t0*(-g3 - g4*t0));
-                out0[e - 1] += carry_out0 + t1;
-                carry_out0 = -t1;
-            }
-            if (hi > lo) out0[hi + -1] += carry_out0;
             for (long e = hi; e < cnt; ++e) {
                 const int ok7 = (e + -1 >= 0) && (e + -1 < ns);
                 const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
@@ -94,6 +97,8 @@ int mg_residual(const double *const *in, double *const *out, const long *sizes, 
  *   in[3]  p: length 3
  *   in[4]  slots0: int64 length sites
  *   in[5]  slots1: int64 length 4*sites + 4
+ *   in[6]  slots0_affine: int64 length 6
+ *   in[7]  slots1_affine: int64 length 9
  *   out[0] r_q: length nnz per state (CSR data)
  *   out[1] r_v: length nnz per state (CSR data)
  *   out[2] r_a: length nnz per state (CSR data)
@@ -107,27 +112,41 @@ int mg_tangent(const double *const *in, double *const *out, const long *sizes, l
     const double *const in3 = in[3];
     const long *const in4 = (const long *)(const void *)in[4];
     const long *const in5 = (const long *)(const void *)in[5];
+    const long *const in6 = (const long *)(const void *)in[6];
+    const long *const in7 = (const long *)(const void *)in[7];
     const long len_out0 = nnz;
     const long len_out1 = nnz;
     const long len_out2 = nnz;
     for (long b = 0; b < nbatch; ++b) {
         const double *const in0 = in[0] + b * len_in0;
         double *const out0 = out[0] + b * len_out0;
-        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
         double *const out1 = out[1] + b * len_out1;
         for (long i = 0; i < len_out1; ++i) out1[i] = 0.0;
         double *const out2 = out[2] + b * len_out2;
-        for (long i = 0; i < len_out2; ++i) out2[i] = 0.0;
         {
             const long cnt = sites;
             const long ns = sites;
             const long *const slot = in4;
             const long lo = 0 < cnt ? 0 : cnt;
             const long hi = ns - 0 > lo ? (ns - 0 < cnt ? ns - 0 : cnt) : lo;
-            for (long e = 0; e < lo; ++e) {
+            const long ea = in6[0] < lo ? lo : (in6[0] > hi ? hi : in6[0]);
+            const long eb = in6[1] < ea ? ea : (in6[1] > hi ? hi : in6[1]);
+            const long stride = in6[2];
+            const long base0 = in6[3];
+            const long zlo_out2 = in6[4];
+            const long zhi_out2 = in6[5];
+            for (long i = 0; i < zlo_out2; ++i) out2[i] = 0.0;
+            for (long i = zhi_out2; i < len_out2; ++i) out2[i] = 0.0;
+            for (long e = ea; e < eb; ++e) {
+                out2[base0 + stride * e] = 1.0;
+            }
+            for (long e = lo; e < ea; ++e) {
                 if (slot[e * 1 + 0] >= 0) out2[slot[e * 1 + 0]] += 1.0;
             }
-            for (long e = lo; e < hi; ++e) {
+            for (long e = eb; e < hi; ++e) {
+                if (slot[e * 1 + 0] >= 0) out2[slot[e * 1 + 0]] += 1.0;
+            }
+            for (long e = 0; e < lo; ++e) {
                 if (slot[e * 1 + 0] >= 0) out2[slot[e * 1 + 0]] += 1.0;
             }
             for (long e = hi; e < cnt; ++e) {
@@ -143,11 +162,32 @@ int mg_tangent(const double *const *in, double *const *out, const long *sizes, l
             const double g4 = in3[2];
             const long lo = 1 < cnt ? 1 : cnt;
             const long hi = ns - 0 > lo ? (ns - 0 < cnt ? ns - 0 : cnt) : lo;
-            for (long e = 0; e < lo; ++e) {
-                const int ok7 = (e + -1 >= 0) && (e + -1 < ns);
-                const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
-                const double g0 = ok7 ? in0[e - 1] : 0.0;
-                const double g1 = ok8 ? in0[e] : 0.0;
+            const long ea = in7[0] < lo ? lo : (in7[0] > hi ? hi : in7[0]);
+            const long eb = in7[1] < ea ? ea : (in7[1] > hi ? hi : in7[1]);
+            const long stride = in7[2];
+            const long base0 = in7[3];
+            const long base1 = in7[4];
+            const long base2 = in7[5];
+            const long base3 = in7[6];
+            const long zlo_out0 = in7[7];
+            const long zhi_out0 = in7[8];
+            for (long i = 0; i < zlo_out0; ++i) out0[i] = 0.0;
+            for (long i = zhi_out0; i < len_out0; ++i) out0[i] = 0.0;
+            double carry_out0_3 = 0.0;
+            for (long e = ea; e < eb; ++e) {
+                const double g0 = in0[e - 1];
+                const double g1 = in0[e];
+                const double t0 = -g0 + g1;
+                const double t1 = g2 + t0*(2.0*g3 + 3.0*g4*t0);
+                out0[base0 + stride * e] = carry_out0_3 + t1;
+                out0[base1 + stride * e] = -t1;
+                out0[base2 + stride * e] = -t1;
+                carry_out0_3 = t1;
+            }
+            if (eb > ea) out0[base3 + stride * (eb - 1)] = carry_out0_3;
+            for (long e = lo; e < ea; ++e) {
+                const double g0 = in0[e - 1];
+                const double g1 = in0[e];
                 const double t0 = -g0 + g1;
                 const double t1 = g2 + t0*(2.0*g3 + 3.0*g4*t0);
                 if (slot[e * 4 + 0] >= 0) out0[slot[e * 4 + 0]] += t1;
@@ -155,9 +195,21 @@ int mg_tangent(const double *const *in, double *const *out, const long *sizes, l
                 if (slot[e * 4 + 2] >= 0) out0[slot[e * 4 + 2]] += -t1;
                 if (slot[e * 4 + 3] >= 0) out0[slot[e * 4 + 3]] += t1;
             }
-            for (long e = lo; e < hi; ++e) {
+            for (long e = eb; e < hi; ++e) {
                 const double g0 = in0[e - 1];
                 const double g1 = in0[e];
+                const double t0 = -g0 + g1;
+                const double t1 = g2 + t0*(2.0*g3 + 3.0*g4*t0);
+                if (slot[e * 4 + 0] >= 0) out0[slot[e * 4 + 0]] += t1;
+                if (slot[e * 4 + 1] >= 0) out0[slot[e * 4 + 1]] += -t1;
+                if (slot[e * 4 + 2] >= 0) out0[slot[e * 4 + 2]] += -t1;
+                if (slot[e * 4 + 3] >= 0) out0[slot[e * 4 + 3]] += t1;
+            }
+            for (long e = 0; e < lo; ++e) {
+                const int ok7 = (e + -1 >= 0) && (e + -1 < ns);
+                const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
+                const double g0 = ok7 ? in0[e - 1] : 0.0;
+                const double g1 = ok8 ? in0[e] : 0.0;
                 const double t0 = -g0 + g1;
                 const double t1 = g2 + t0*(2.0*g3 + 3.0*g4*t0);
                 if (slot[e * 4 + 0] >= 0) out0[slot[e * 4 + 0]] += t1;
@@ -188,6 +240,8 @@ int mg_tangent(const double *const *in, double *const *out, const long *sizes, l
  *   in[2]  p: length 3
  *   in[3]  slots0: int64 length sites
  *   in[4]  slots1: int64 length 4*sites + 4
+ *   in[5]  slots0_affine: int64 length 6
+ *   in[6]  slots1_affine: int64 length 9
  *   out[0] M: length nnz per state (CSR data)
  *   out[1] D: length nnz per state (CSR data)
  *   out[2] G: length nnz per state (CSR data)
@@ -202,6 +256,8 @@ int mg_linear(const double *const *in, double *const *out, const long *sizes, lo
     const double *const in2 = in[2];
     const long *const in3 = (const long *)(const void *)in[3];
     const long *const in4 = (const long *)(const void *)in[4];
+    const long *const in5 = (const long *)(const void *)in[5];
+    const long *const in6 = (const long *)(const void *)in[6];
     const long len_out0 = nnz;
     const long len_out1 = nnz;
     const long len_out2 = nnz;
@@ -209,23 +265,35 @@ int mg_linear(const double *const *in, double *const *out, const long *sizes, lo
     for (long b = 0; b < nbatch; ++b) {
         const double *const in0 = in[0] + b * len_in0;
         double *const out0 = out[0] + b * len_out0;
-        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
         double *const out1 = out[1] + b * len_out1;
         for (long i = 0; i < len_out1; ++i) out1[i] = 0.0;
         double *const out2 = out[2] + b * len_out2;
         for (long i = 0; i < len_out2; ++i) out2[i] = 0.0;
         double *const out3 = out[3] + b * len_out3;
-        for (long i = 0; i < len_out3; ++i) out3[i] = 0.0;
         {
             const long cnt = sites;
             const long ns = sites;
             const long *const slot = in3;
             const long lo = 0 < cnt ? 0 : cnt;
             const long hi = ns - 0 > lo ? (ns - 0 < cnt ? ns - 0 : cnt) : lo;
-            for (long e = 0; e < lo; ++e) {
+            const long ea = in5[0] < lo ? lo : (in5[0] > hi ? hi : in5[0]);
+            const long eb = in5[1] < ea ? ea : (in5[1] > hi ? hi : in5[1]);
+            const long stride = in5[2];
+            const long base0 = in5[3];
+            const long zlo_out0 = in5[4];
+            const long zhi_out0 = in5[5];
+            for (long i = 0; i < zlo_out0; ++i) out0[i] = 0.0;
+            for (long i = zhi_out0; i < len_out0; ++i) out0[i] = 0.0;
+            for (long e = ea; e < eb; ++e) {
+                out0[base0 + stride * e] = 1.0;
+            }
+            for (long e = lo; e < ea; ++e) {
                 if (slot[e * 1 + 0] >= 0) out0[slot[e * 1 + 0]] += 1.0;
             }
-            for (long e = lo; e < hi; ++e) {
+            for (long e = eb; e < hi; ++e) {
+                if (slot[e * 1 + 0] >= 0) out0[slot[e * 1 + 0]] += 1.0;
+            }
+            for (long e = 0; e < lo; ++e) {
                 if (slot[e * 1 + 0] >= 0) out0[slot[e * 1 + 0]] += 1.0;
             }
             for (long e = hi; e < cnt; ++e) {
@@ -241,11 +309,32 @@ int mg_linear(const double *const *in, double *const *out, const long *sizes, lo
             const double g4 = in2[2];
             const long lo = 1 < cnt ? 1 : cnt;
             const long hi = ns - 0 > lo ? (ns - 0 < cnt ? ns - 0 : cnt) : lo;
-            for (long e = 0; e < lo; ++e) {
-                const int ok7 = (e + -1 >= 0) && (e + -1 < ns);
-                const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
-                const double g0 = ok7 ? in0[e - 1] : 0.0;
-                const double g1 = ok8 ? in0[e] : 0.0;
+            const long ea = in6[0] < lo ? lo : (in6[0] > hi ? hi : in6[0]);
+            const long eb = in6[1] < ea ? ea : (in6[1] > hi ? hi : in6[1]);
+            const long stride = in6[2];
+            const long base0 = in6[3];
+            const long base1 = in6[4];
+            const long base2 = in6[5];
+            const long base3 = in6[6];
+            const long zlo_out3 = in6[7];
+            const long zhi_out3 = in6[8];
+            for (long i = 0; i < zlo_out3; ++i) out3[i] = 0.0;
+            for (long i = zhi_out3; i < len_out3; ++i) out3[i] = 0.0;
+            double carry_out3_3 = 0.0;
+            for (long e = ea; e < eb; ++e) {
+                const double g0 = in0[e - 1];
+                const double g1 = in0[e];
+                const double t0 = -g0 + g1;
+                const double t1 = g2 + t0*(2.0*g3 + 3.0*g4*t0);
+                out3[base0 + stride * e] = carry_out3_3 + t1;
+                out3[base1 + stride * e] = -t1;
+                out3[base2 + stride * e] = -t1;
+                carry_out3_3 = t1;
+            }
+            if (eb > ea) out3[base3 + stride * (eb - 1)] = carry_out3_3;
+            for (long e = lo; e < ea; ++e) {
+                const double g0 = in0[e - 1];
+                const double g1 = in0[e];
                 const double t0 = -g0 + g1;
                 const double t1 = g2 + t0*(2.0*g3 + 3.0*g4*t0);
                 if (slot[e * 4 + 0] >= 0) out3[slot[e * 4 + 0]] += t1;
@@ -253,9 +342,21 @@ int mg_linear(const double *const *in, double *const *out, const long *sizes, lo
                 if (slot[e * 4 + 2] >= 0) out3[slot[e * 4 + 2]] += -t1;
                 if (slot[e * 4 + 3] >= 0) out3[slot[e * 4 + 3]] += t1;
             }
-            for (long e = lo; e < hi; ++e) {
+            for (long e = eb; e < hi; ++e) {
                 const double g0 = in0[e - 1];
                 const double g1 = in0[e];
+                const double t0 = -g0 + g1;
+                const double t1 = g2 + t0*(2.0*g3 + 3.0*g4*t0);
+                if (slot[e * 4 + 0] >= 0) out3[slot[e * 4 + 0]] += t1;
+                if (slot[e * 4 + 1] >= 0) out3[slot[e * 4 + 1]] += -t1;
+                if (slot[e * 4 + 2] >= 0) out3[slot[e * 4 + 2]] += -t1;
+                if (slot[e * 4 + 3] >= 0) out3[slot[e * 4 + 3]] += t1;
+            }
+            for (long e = 0; e < lo; ++e) {
+                const int ok7 = (e + -1 >= 0) && (e + -1 < ns);
+                const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
+                const double g0 = ok7 ? in0[e - 1] : 0.0;
+                const double g1 = ok8 ? in0[e] : 0.0;
                 const double t0 = -g0 + g1;
                 const double t1 = g2 + t0*(2.0*g3 + 3.0*g4*t0);
                 if (slot[e * 4 + 0] >= 0) out3[slot[e * 4 + 0]] += t1;
@@ -285,6 +386,7 @@ int mg_linear(const double *const *in, double *const *out, const long *sizes, lo
  *   in[1]  v: length sites per state
  *   in[2]  p: length 3
  *   in[3]  slots0: int64 length 4*sites + 4
+ *   in[4]  slots0_affine: int64 length 9
  *   out[0] K: length nnz per state (CSR data)
  *   sizes: sites, nnz
  */
@@ -295,11 +397,11 @@ int mg_stiffness(const double *const *in, double *const *out, const long *sizes,
     const long len_in0 = sites;
     const double *const in2 = in[2];
     const long *const in3 = (const long *)(const void *)in[3];
+    const long *const in4 = (const long *)(const void *)in[4];
     const long len_out0 = nnz;
     for (long b = 0; b < nbatch; ++b) {
         const double *const in0 = in[0] + b * len_in0;
         double *const out0 = out[0] + b * len_out0;
-        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
         {
             const long cnt = sites + 1;
             const long ns = sites;
@@ -309,11 +411,32 @@ int mg_stiffness(const double *const *in, double *const *out, const long *sizes,
             const double g4 = in2[2];
             const long lo = 1 < cnt ? 1 : cnt;
             const long hi = ns - 0 > lo ? (ns - 0 < cnt ? ns - 0 : cnt) : lo;
-            for (long e = 0; e < lo; ++e) {
-                const int ok7 = (e + -1 >= 0) && (e + -1 < ns);
-                const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
-                const double g0 = ok7 ? in0[e - 1] : 0.0;
-                const double g1 = ok8 ? in0[e] : 0.0;
+            const long ea = in4[0] < lo ? lo : (in4[0] > hi ? hi : in4[0]);
+            const long eb = in4[1] < ea ? ea : (in4[1] > hi ? hi : in4[1]);
+            const long stride = in4[2];
+            const long base0 = in4[3];
+            const long base1 = in4[4];
+            const long base2 = in4[5];
+            const long base3 = in4[6];
+            const long zlo_out0 = in4[7];
+            const long zhi_out0 = in4[8];
+            for (long i = 0; i < zlo_out0; ++i) out0[i] = 0.0;
+            for (long i = zhi_out0; i < len_out0; ++i) out0[i] = 0.0;
+            double carry_out0_3 = 0.0;
+            for (long e = ea; e < eb; ++e) {
+                const double g0 = in0[e - 1];
+                const double g1 = in0[e];
+                const double t0 = -g0 + g1;
+                const double t1 = g2 + t0*(2.0*g3 + 3.0*g4*t0);
+                out0[base0 + stride * e] = carry_out0_3 + t1;
+                out0[base1 + stride * e] = -t1;
+                out0[base2 + stride * e] = -t1;
+                carry_out0_3 = t1;
+            }
+            if (eb > ea) out0[base3 + stride * (eb - 1)] = carry_out0_3;
+            for (long e = lo; e < ea; ++e) {
+                const double g0 = in0[e - 1];
+                const double g1 = in0[e];
                 const double t0 = -g0 + g1;
                 const double t1 = g2 + t0*(2.0*g3 + 3.0*g4*t0);
                 if (slot[e * 4 + 0] >= 0) out0[slot[e * 4 + 0]] += t1;
@@ -321,9 +444,21 @@ int mg_stiffness(const double *const *in, double *const *out, const long *sizes,
                 if (slot[e * 4 + 2] >= 0) out0[slot[e * 4 + 2]] += -t1;
                 if (slot[e * 4 + 3] >= 0) out0[slot[e * 4 + 3]] += t1;
             }
-            for (long e = lo; e < hi; ++e) {
+            for (long e = eb; e < hi; ++e) {
                 const double g0 = in0[e - 1];
                 const double g1 = in0[e];
+                const double t0 = -g0 + g1;
+                const double t1 = g2 + t0*(2.0*g3 + 3.0*g4*t0);
+                if (slot[e * 4 + 0] >= 0) out0[slot[e * 4 + 0]] += t1;
+                if (slot[e * 4 + 1] >= 0) out0[slot[e * 4 + 1]] += -t1;
+                if (slot[e * 4 + 2] >= 0) out0[slot[e * 4 + 2]] += -t1;
+                if (slot[e * 4 + 3] >= 0) out0[slot[e * 4 + 3]] += t1;
+            }
+            for (long e = 0; e < lo; ++e) {
+                const int ok7 = (e + -1 >= 0) && (e + -1 < ns);
+                const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
+                const double g0 = ok7 ? in0[e - 1] : 0.0;
+                const double g1 = ok8 ? in0[e] : 0.0;
                 const double t0 = -g0 + g1;
                 const double t1 = g2 + t0*(2.0*g3 + 3.0*g4*t0);
                 if (slot[e * 4 + 0] >= 0) out0[slot[e * 4 + 0]] += t1;
@@ -364,7 +499,6 @@ int mg_force(const double *const *in, double *const *out, const long *sizes, lon
     for (long b = 0; b < nbatch; ++b) {
         const double *const in0 = in[0] + b * len_in0;
         double *const out0 = out[0] + b * len_out0;
-        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
         {
             const long cnt = sites + 1;
             const long ns = sites;
@@ -373,6 +507,20 @@ int mg_force(const double *const *in, double *const *out, const long *sizes, lon
             const double g4 = in2[2];
             const long lo = 1 < cnt ? 1 : cnt;
             const long hi = ns - 0 > lo ? (ns - 0 < cnt ? ns - 0 : cnt) : lo;
+            const long zlo_out0 = hi > lo ? lo - 1 : 0;
+            const long zhi_out0 = hi > lo ? hi : 0;
+            for (long i = 0; i < zlo_out0; ++i) out0[i] = 0.0;
+            for (long i = zhi_out0; i < len_out0; ++i) out0[i] = 0.0;
+            double carry_out0 = 0.0;
+            for (long e = lo; e < hi; ++e) {
+                const double g0 = in0[e - 1];
+                const double g1 = in0[e];
+                const double t0 = -g0 + g1;
+                const double t1 = t0*(g2 + t0*(g3 + g4*t0));
+                out0[e - 1] = t1 - carry_out0;
+                carry_out0 = t1;
+            }
+            if (hi > lo) out0[hi - 1] = -carry_out0;
             for (long e = 0; e < lo; ++e) {
                 const int ok7 = (e + -1 >= 0) && (e + -1 < ns);
                 const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
@@ -383,16 +531,6 @@ int mg_force(const double *const *in, double *const *out, const long *sizes, lon
                 if (ok7) out0[e - 1] += t1;
                 if (ok8) out0[e] += -t1;
             }
-            double carry_out0 = 0.0;
-            for (long e = lo; e < hi; ++e) {
-                const double g0 = in0[e - 1];
-                const double g1 = in0[e];
-                const double t0 = -g0 + g1;
-                const double t1 = t0*(g2 + t0*(g3 + g4*t0));
-                out0[e - 1] += carry_out0 + t1;
-                carry_out0 = -t1;
-            }
-            if (hi > lo) out0[hi + -1] += carry_out0;
             for (long e = hi; e < cnt; ++e) {
                 const int ok7 = (e + -1 >= 0) && (e + -1 < ns);
                 const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
@@ -440,15 +578,15 @@ int mg_outputs(const double *const *in, double *const *out, const long *sizes, l
             const long ns = sites;
             const long lo = 0 < cnt ? 0 : cnt;
             const long hi = ns - 0 > lo ? (ns - 0 < cnt ? ns - 0 : cnt) : lo;
-            for (long e = 0; e < lo; ++e) {
-                const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
-                const double g0 = ok8 ? in1[e] : 0.0;
+            for (long e = lo; e < hi; ++e) {
+                const double g0 = in1[e];
                 const double t0 = (1.0/2.0)*g0*g0;
                 out0[0] += t0;
                 out2[0] += t0;
             }
-            for (long e = lo; e < hi; ++e) {
-                const double g0 = in1[e];
+            for (long e = 0; e < lo; ++e) {
+                const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
+                const double g0 = ok8 ? in1[e] : 0.0;
                 const double t0 = (1.0/2.0)*g0*g0;
                 out0[0] += t0;
                 out2[0] += t0;
@@ -469,19 +607,19 @@ int mg_outputs(const double *const *in, double *const *out, const long *sizes, l
             const double g4 = in2[2];
             const long lo = 1 < cnt ? 1 : cnt;
             const long hi = ns - 0 > lo ? (ns - 0 < cnt ? ns - 0 : cnt) : lo;
-            for (long e = 0; e < lo; ++e) {
-                const int ok7 = (e + -1 >= 0) && (e + -1 < ns);
-                const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
-                const double g0 = ok7 ? in0[e - 1] : 0.0;
-                const double g1 = ok8 ? in0[e] : 0.0;
+            for (long e = lo; e < hi; ++e) {
+                const double g0 = in0[e - 1];
+                const double g1 = in0[e];
                 const double t0 = -g0 + g1;
                 const double t1 = t0*t0*((1.0/2.0)*g2 + t0*((1.0/3.0)*g3 + (1.0/4.0)*g4*t0));
                 out1[0] += t1;
                 out2[0] += t1;
             }
-            for (long e = lo; e < hi; ++e) {
-                const double g0 = in0[e - 1];
-                const double g1 = in0[e];
+            for (long e = 0; e < lo; ++e) {
+                const int ok7 = (e + -1 >= 0) && (e + -1 < ns);
+                const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
+                const double g0 = ok7 ? in0[e - 1] : 0.0;
+                const double g1 = ok8 ? in0[e] : 0.0;
                 const double t0 = -g0 + g1;
                 const double t1 = t0*t0*((1.0/2.0)*g2 + t0*((1.0/3.0)*g3 + (1.0/4.0)*g4*t0));
                 out1[0] += t1;

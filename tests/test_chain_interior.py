@@ -1,0 +1,166 @@
+"""Chain kernels on fixed and periodic ends, with and without an on-site potential.
+
+Reference: derivatives of the whole-chain energy built directly in sympy
+(V = sum of bond energies V_b(u_{i+1} - u_i) + sum of on-site energies V_s(u_i),
+u_0 = u_{N+1} = 0 for fixed ends, u_{N+1} = u_1 when periodic), for every
+backend, with and without CSE, down to N = 1 where a periodic bond joins a
+site to itself. The C interior that addresses the CSR data through the
+runtime's affine summary (and stores rather than accumulates) must equal the
+same kernel run through the slot table alone.
+"""
+import dataclasses
+
+import numpy as np
+import pytest
+import sympy as sp
+
+from mechgen.compile import compile_model
+from mechgen.runtime.pattern import affine_summary, interior
+from mechgen.symbolic.model import Model
+from mechgen.symbolic.params import Param
+from mechgen.symbolic.specialize import specialize
+
+VALUES = {"gamma": 1.3, "alpha": 0.4, "beta": 0.7, "k0": 0.6, "k4": 0.9}
+
+
+def _chain(ends: str, onsite: bool) -> Model:
+    model = Model(f"chain_{ends}_{'kg' if onsite else 'fpu'}", doc="test chain")
+    model.params(Param("N", 4, "", "sites", size=True), Param("gamma", 1.0), Param("alpha", 0.0),
+                 Param("beta", 0.0), Param("k0", 0.0), Param("k4", 0.0))
+    model.chain("u", sites="N", ends=ends)
+
+    @model.site_kinetic
+    def kinetic(s):
+        return s.v**2 / 2
+
+    if onsite:
+        @model.site_potential
+        def onsite_potential(s, p):
+            return p.k0 * s.q**2 / 2 + p.k4 * s.q**4 / 4
+
+    @model.bond_potential
+    def bond(a, b, p):
+        r = b.q - a.q
+        return p.gamma * r**2 / 2 + p.alpha * r**3 / 3 + p.beta * r**4 / 4
+
+    return model
+
+
+def _whole_chain(n: int, ends: str, onsite: bool):
+    u = sp.symbols(f"u1:{n + 1}", real=True)
+    ext = (0,) + u + (0,) if ends == "fixed" else u + (u[0],)
+    g, a, b, k0, k4 = (VALUES[k] for k in ("gamma", "alpha", "beta", "k0", "k4"))
+    V = sum(g * r**2 / 2 + a * r**3 / 3 + b * r**4 / 4 for r in (ext[i + 1] - ext[i] for i in range(len(ext) - 1)))
+    if onsite:
+        V += sum(k0 * x**2 / 2 + k4 * x**4 / 4 for x in u)
+    return u, sp.Matrix([V]).jacobian(sp.Matrix(u)), sp.hessian(V, u)
+
+
+def _system(ends, onsite, backend, cse, n):
+    model = _chain(ends, onsite)
+    spec = specialize(model, {"N": n, **VALUES})
+    return compile_model(model, spec, backend=backend, cse=cse)[0]
+
+
+@pytest.mark.parametrize("backend", ["c", "numpy", "casadi"])
+@pytest.mark.parametrize("cse", [True, False])
+@pytest.mark.parametrize("onsite", [False, True])
+@pytest.mark.parametrize("ends", ["fixed", "periodic"])
+def test_chain_kernels_match_whole_chain(ends, onsite, cse, backend):
+    rng = np.random.default_rng(5)
+    for n in ((1, 2, 3, 7) if backend == "c" else (1, 2, 5)):
+        system = _system(ends, onsite, backend, cse, n)
+        u, grad, hess = _whole_chain(n, ends, onsite)
+        q, v, a = rng.uniform(-0.7, 0.7, n), rng.uniform(-1, 1, n), rng.uniform(-2, 2, n)
+        values = dict(zip(u, q))
+        g = np.array(grad.subs(values).evalf(), float).ravel()
+        H = np.array(hess.subs(values).evalf(), float)
+        np.testing.assert_allclose(system.force(q), -g, rtol=1e-12, atol=1e-13, err_msg=f"force N={n}")
+        np.testing.assert_allclose(system.residual(q, v, a), a + g, rtol=1e-12, atol=1e-13)
+        lin = system.linear(q, v)
+        np.testing.assert_allclose(lin["K"].toarray(), H, rtol=1e-12, atol=1e-13, err_msg=f"K N={n}")
+        np.testing.assert_allclose(lin["M"].toarray(), np.eye(n), atol=0)
+        tan = system.call("tangent", q=q, v=v, a=a)
+        np.testing.assert_allclose(tan["r_q"].toarray(), H, rtol=1e-12, atol=1e-13)
+        np.testing.assert_allclose(tan["r_a"].toarray(), np.eye(n), atol=0)
+        K = system.call("stiffness", q=q)["K"].toarray()
+        np.testing.assert_allclose(K, H, rtol=1e-12, atol=1e-13, err_msg=f"stiffness N={n}")
+
+
+def _without_affine(pattern):
+    """The same pattern with every affine summary emptied: the kernel then uses the slot table alone."""
+    slots = {k: (np.zeros_like(v) if k.endswith("_affine") else v) for k, v in pattern.slots.items()}
+    return dataclasses.replace(pattern, slots=slots)
+
+
+@pytest.mark.parametrize("onsite", [False, True])
+@pytest.mark.parametrize("ends", ["fixed", "periodic"])
+def test_affine_interior_equals_slot_table(ends, onsite):
+    rng = np.random.default_rng(9)
+    for n in (1, 2, 3, 4, 5, 8, 41):
+        system = _system(ends, onsite, "c", True, n)
+        for kernel in ("tangent", "linear", "stiffness"):
+            q = rng.uniform(-0.5, 0.5, (3, n))
+            pattern = system.pattern(kernel)
+            run = pattern.slots["slots1_affine" if "slots1_affine" in pattern.slots else "slots0_affine"]
+            fast = [system.call(kernel, q=x) for x in q]
+            system.patterns[kernel] = _without_affine(pattern)
+            slow = [system.call(kernel, q=x) for x in q]
+            system.patterns[kernel] = pattern
+            for f, s in zip(fast, slow):
+                for port in f:
+                    np.testing.assert_allclose(f[port].toarray(), s[port].toarray(), rtol=1e-14, atol=1e-15,
+                                               err_msg=f"{kernel}.{port} N={n} run={run.tolist()}")
+
+
+def test_affine_summary_covers_the_interior_of_a_banded_pattern():
+    system = _system("fixed", False, "c", True, 50)
+    spec, pattern = system.kernels["stiffness"].spec, system.pattern("stiffness")
+    recipe = spec["slots"][0]
+    a, b, stride, *rest = pattern.slots[recipe["affine"]].tolist()
+    assert (a, b) == interior(51, 50, *recipe["offsets"]) and stride == 3
+    zlo, zhi = rest[-2:]
+    assert (zlo, zhi) == (0, 3 * 50 - 2)       # the interior stores every entry of the tridiagonal K
+
+
+def test_affine_summary_is_withheld_when_positions_repeat():
+    """A run whose stored positions repeat (or a non-affine table) must fall back to the slot table."""
+    recipe = {"count": {"const": 6, "terms": []}, "sites": {"const": 6, "terms": []}, "boundary": "zero",
+              "entries": [[0, 0]], "offsets": [0, 0], "stored": [{"entries": [0], "carried": []}]}
+    repeated = np.array([0, 1, 1, 2, 3, 4])
+    out = affine_summary(recipe, repeated, {})
+    assert out[0] == 0 or out[1] - out[0] < 6           # the run stops where the step changes
+    a, b, stride = out[:3]
+    assert len(set(out[3] + stride * np.arange(a, b))) == b - a
+    duplicate = dict(recipe, entries=[[0, 0], [0, 0]], stored=[{"entries": [0, 1], "carried": []}])
+    table = np.stack([np.arange(6), np.arange(6)], axis=1)
+    assert not affine_summary(duplicate, table, {}).any()
+
+
+def test_batched_sparse_kernel_matches_single_states():
+    system = _system("periodic", True, "c", True, 9)
+    q = np.random.default_rng(2).uniform(-0.5, 0.5, (7, 9))
+    k = system.kernels["stiffness"]
+    pattern = system.pattern("stiffness")
+    batch = k.evaluate({"q": q, "v": np.zeros_like(q), "p": system.params, **pattern.slots},
+                       system.sizes("stiffness"))["K"]
+    single = np.array([system.call("stiffness", q=x)["K"].data for x in q])
+    np.testing.assert_array_equal(batch, single)
+
+
+@pytest.mark.parametrize("onsite", [False, True])
+@pytest.mark.parametrize("ends", ["fixed", "periodic"])
+def test_c_kernels_define_every_output_entry(ends, onsite):
+    """Outputs the C interior stores are zeroed elsewhere by the kernel itself: stale values never leak."""
+    rng = np.random.default_rng(4)
+    for n in (1, 2, 3, 6, 17):
+        system = _system(ends, onsite, "c", True, n)
+        for name, kernel in system.kernels.items():
+            sizes = system.sizes(name)
+            inputs = {p["name"]: (system.params if p["name"] == "p" else system.pattern(name).slots[p["name"]]
+                                  if p["integer"] else rng.uniform(-0.5, 0.5, n)) for p in kernel.spec["inputs"]}
+            expected = kernel.evaluate(inputs, sizes)
+            outputs = {k: np.full_like(v, np.nan) for k, v in expected.items()}
+            kernel.bind(inputs, outputs, sizes)()
+            for port, value in expected.items():
+                np.testing.assert_array_equal(outputs[port], value, err_msg=f"{name}.{port} N={n}")
