@@ -13,11 +13,21 @@ degree <= 2P exact); sine/cosine/beam bases with N functions use 2N + 8 points
 (products oscillate up to wavenumber 2 N pi / L: 64 points for 60 sines leave a
 15 % mass error, 128 give 1e-14); Legendre bases of N polynomials N + 1 points.
 Fewer points than the minimum give an :class:`UnderIntegrationWarning`.
+
+Elements are uniform, so every element has the same table: ``tables`` is then a
+read-only broadcast view (stride 0 along the elements) of one reference table,
+which the assembly recognises and uses (mechgen.runtime.assemble). Gauss rules and
+global-basis tables are memoised (read-only arrays): the beam basis needs its
+roots and a high-order normalisation rule, and a sweep or a refinement study
+rebuilds the same discretisation many times.
 """
 from __future__ import annotations
 
 import warnings
+from collections import OrderedDict
+from contextlib import suppress
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -79,18 +89,49 @@ class Discretisation:
         return out
 
 
-def _element_field_dofs(ref, e: int) -> np.ndarray:
+def _element_field_dofs(ref, e) -> np.ndarray:
+    """Local-to-global dofs of element e (an int: (ndof,); an array of elements: (len(e), ndof))."""
     per_node = len(ref.orders)
-    start = e * (len(ref.nodes) - 1) * per_node
-    return start + np.arange(ref.ndof)
+    start = np.asarray(e) * (len(ref.nodes) - 1) * per_node
+    return start[..., None] + np.arange(ref.ndof) if np.ndim(start) else start + np.arange(ref.ndof)
+
+
+_TABLES: OrderedDict = OrderedDict()  # memoised global-basis tables, least recently used first
+_TABLES_MAX_BYTES = 64 << 20
 
 
 def _global_table(kind, s, n, length, max_order, ends) -> np.ndarray:
+    """D_s^k phi_j at the points s: (len(s), max_order + 1, n), memoised (read-only; 64 MiB in all at most)."""
+    s = np.ascontiguousarray(s, dtype=float)
+    key = (kind, s.tobytes(), int(n), float(length), int(max_order), tuple(ends))
+    table = _TABLES.get(key)
+    if table is not None:
+        with suppress(KeyError):  # another thread may just have dropped it
+            _TABLES.move_to_end(key)
+        return table
     if kind in ("sine", "cosine"):
-        return bases.trig(kind, s, n, length, max_order)
-    if kind == "legendre":
-        return bases.legendre(s, n, length, max_order)
-    return bases.beam(s, n, length, max_order, ends)
+        table = bases.trig(kind, s, n, length, max_order)
+    elif kind == "legendre":
+        table = bases.legendre(s, n, length, max_order)
+    else:
+        table = bases.beam(s, n, length, max_order, ends)
+    table.setflags(write=False)
+    if table.nbytes <= _TABLES_MAX_BYTES // 8:
+        _TABLES[key] = table
+        while len(_TABLES) > 1 and sum(t.nbytes for t in list(_TABLES.values())) > _TABLES_MAX_BYTES:
+            with suppress(KeyError):
+                _TABLES.popitem(last=False)
+    return table
+
+
+@lru_cache(maxsize=64)
+def _gauss(nq: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre points and weights on [0, 1] (read-only)."""
+    xg, wg = np.polynomial.legendre.leggauss(nq)
+    xi, wi = (xg + 1) / 2, wg / 2
+    xi.setflags(write=False)
+    wi.setflags(write=False)
+    return xi, wi
 
 
 def minimum_points(kind: str, size: int) -> tuple[int, int]:
@@ -127,8 +168,7 @@ def discretise(kind: str, size: int, length: float, fields, jets, *, quadrature:
     if nq < minimum:
         warnings.warn(f"{nq} Gauss points per element under-integrate the {kind} basis of size {size} "
                       f"(at least {minimum} needed)", UnderIntegrationWarning, stacklevel=2)
-    xg, wg = np.polynomial.legendre.leggauss(nq)
-    xi, wi = (xg + 1) / 2, wg / 2
+    xi, wi = _gauss(nq)
     max_order = max((k for _, k in jets), default=0)
     ends = {f: end_conditions(constraints, f) for f in fields}
     for f in fields:
@@ -153,13 +193,16 @@ def discretise(kind: str, size: int, length: float, fields, jets, *, quadrature:
         weights = wi[None, :] * h[:, None]
         per = (size * (len(ref.nodes) - 1) + 1) * len(ref.orders)
         shared = ref.tabulate(xi, max_order, h[:1])
-        local = {f: np.broadcast_to(shared, (size,) + shared.shape[1:]) for f in fields}
-        base_dofs = np.stack([_element_field_dofs(ref, e) for e in range(size)])
+        local = {f: shared for f in fields}  # one table for every (equal) element
+        base_dofs = _element_field_dofs(ref, np.arange(size))
     nloc = base_dofs.shape[1]
-    tables = np.zeros(points.shape + (len(jets), nloc * len(fields)))
+    tables = np.zeros((1,) + points.shape[1:] + (len(jets), nloc * len(fields)))
     for a, (f, k) in enumerate(jets):
         i = fields.index(f)
         tables[:, :, a, i * nloc:(i + 1) * nloc] = local[f][:, :, k, :]
+    if tables.shape[0] != points.shape[0]:
+        tables.setflags(write=False)
+        tables = np.broadcast_to(tables, points.shape + tables.shape[2:])
     dofs = np.concatenate([base_dofs + i * per for i in range(len(fields))], axis=1)
     return Discretisation(kind, size, float(length), fields, tuple(jets), points, weights, tables, dofs,
                           per * len(fields), ends)
