@@ -126,7 +126,15 @@ class FieldEquations:
 
 
 def _density(model: Model, fn, what: str, env: dict) -> sp.Expr:
-    return as_expr(call_declared(fn, **env), what, model) if fn else sp.Integer(0)
+    if not fn:
+        return sp.Integer(0)
+    try:
+        value = call_declared(fn, **env)
+    except AttributeError as exc:
+        raise ModelError(f"{what} {fn.__name__} of model {model.name}: {exc}", file=model.file, key=fn.__name__,
+                         expected="jets of the declared fields (u.w, u.w_s, u.w_t ...) and declared parameters") \
+            from None
+    return as_expr(value, what, model)
 
 
 def _constraints(model: Model, p_ns: Namespace) -> tuple[Constraint, ...]:

@@ -36,9 +36,8 @@ int mg_residual(const double *const *in, double *const *out, const long *sizes, 
             const double g4 = in6[0];
             const double g5 = in6[1];
             const double g6 = in6[2];
-            const double t0 = g5*g6;
-            out0[0] = g2*t0 + g3*g5;
-            out0[1] = g0*g4 - t0*(g0*g6 + g1);
+            out0[0] = g5*(g2*g6 + g3);
+            out0[1] = g0*g4 - g5*g6*(g0*g6 + g1);
         }
     }
     return 0;

@@ -40,10 +40,9 @@ int mg_residual(const double *const *in, double *const *out, const long *sizes, 
             const double g8 = in6[0];
             const double g9 = in6[1];
             const double g10 = in6[2];
-            const double t0 = g10*g9;
-            out0[0] = -g5*t0 + g6*g9 - t0*(g0*g10 + g5);
+            out0[0] = g10*(-g0*g10*g9 - 2.0*g5*g9) + g6*g9;
             out0[1] = g1*g8;
-            out0[2] = g4*t0 + g7*g9 + t0*(-g10*g2 + g4);
+            out0[2] = g9*(-g10*g10*g2 + 2.0*g10*g4 + g7);
             out0[3] = g3*g8;
         }
     }
@@ -85,13 +84,13 @@ int mg_tangent(const double *const *in, double *const *out, const long *sizes, l
             const double g1 = in6[1];
             const double g2 = in6[2];
             const double t0 = -g1*g2*g2;
-            const double t1 = 2.0*g1*g2;
+            const double t1 = -2.0*g1*g2;
             out0[0] = t0;
             out0[5] = g0;
             out0[10] = t0;
             out0[15] = g0;
-            out1[2] = -t1;
-            out1[8] = t1;
+            out1[2] = t1;
+            out1[8] = -t1;
             out2[0] = g1;
             out2[10] = g1;
         }
@@ -132,12 +131,12 @@ int mg_linear(const double *const *in, double *const *out, const long *sizes, lo
             const double g0 = in5[0];
             const double g1 = in5[1];
             const double g2 = in5[2];
-            const double t0 = 2.0*g1*g2;
+            const double t0 = -2.0*g1*g2;
             const double t1 = -g1*g2*g2;
             out0[0] = g1;
             out0[10] = g1;
-            out2[2] = -t0;
-            out2[8] = t0;
+            out2[2] = t0;
+            out2[8] = -t0;
             out3[0] = t1;
             out3[5] = g0;
             out3[10] = t1;

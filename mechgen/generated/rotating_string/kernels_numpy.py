@@ -50,19 +50,21 @@ SPEC = {'linear': {'doc': 'M, D, G, K of the linearisation (a = 0)',
                         'sparse': False,
                         'symmetric': False}],
             'meta': {'coordinates': ['v', 'v_s', 'w', 'w_s'],
-                     'field': {'constraints': [['v', 0, 'start'],
+                     'field': {'constant_mass': True,
+                               'constraints': [['v', 0, 'start'],
                                                ['v', 0, 'end'],
                                                ['w', 0, 'start'],
                                                ['w', 0, 'end']],
                                'fields': ['v', 'w'],
                                'jets': [['v', 0], ['v', 1], ['w', 0], ['w', 1]],
-                               'length': 'L'},
+                               'length': 'L',
+                               'points': []},
                      'internal': [],
                      'kind': 'field',
                      'model': 'rotating_string',
                      'params': ['P', 'rhoA', 'Omega', 'L']},
             'name': 'linear',
-            'ops': 6,
+            'ops': 7,
             'outputs': [{'batched': True,
                          'extent': {'const': 16, 'terms': []},
                          'integer': False,
@@ -91,7 +93,7 @@ SPEC = {'linear': {'doc': 'M, D, G, K of the linearisation (a = 0)',
                          'shape': [4, 4],
                          'sparse': False,
                          'symmetric': False}],
-            'signature': 'd452e4ef238c9a9ebadc6078b1aa022c8e185490d5695d599eecb11e411f26b3',
+            'signature': 'e6b3abcc232ffa7235fe10ee29f41e8684f8d0c2a723ee9631e673bfb8890345',
             'sizes': [],
             'slots': []},
  'outputs': {'doc': 'named outputs',
@@ -138,13 +140,15 @@ SPEC = {'linear': {'doc': 'M, D, G, K of the linearisation (a = 0)',
                          'sparse': False,
                          'symmetric': False}],
              'meta': {'coordinates': ['v', 'v_s', 'w', 'w_s'],
-                      'field': {'constraints': [['v', 0, 'start'],
+                      'field': {'constant_mass': True,
+                                'constraints': [['v', 0, 'start'],
                                                 ['v', 0, 'end'],
                                                 ['w', 0, 'start'],
                                                 ['w', 0, 'end']],
                                 'fields': ['v', 'w'],
                                 'jets': [['v', 0], ['v', 1], ['w', 0], ['w', 1]],
-                                'length': 'L'},
+                                'length': 'L',
+                                'points': []},
                       'internal': [],
                       'kind': 'field',
                       'model': 'rotating_string',
@@ -226,19 +230,21 @@ SPEC = {'linear': {'doc': 'M, D, G, K of the linearisation (a = 0)',
                           'sparse': False,
                           'symmetric': False}],
               'meta': {'coordinates': ['v', 'v_s', 'w', 'w_s'],
-                       'field': {'constraints': [['v', 0, 'start'],
+                       'field': {'constant_mass': True,
+                                 'constraints': [['v', 0, 'start'],
                                                  ['v', 0, 'end'],
                                                  ['w', 0, 'start'],
                                                  ['w', 0, 'end']],
                                  'fields': ['v', 'w'],
                                  'jets': [['v', 0], ['v', 1], ['w', 0], ['w', 1]],
-                                 'length': 'L'},
+                                 'length': 'L',
+                                 'points': []},
                        'internal': [],
                        'kind': 'field',
                        'model': 'rotating_string',
                        'params': ['P', 'rhoA', 'Omega', 'L']},
               'name': 'residual',
-              'ops': 17,
+              'ops': 18,
               'outputs': [{'batched': True,
                            'extent': {'const': 4, 'terms': []},
                            'integer': False,
@@ -246,7 +252,7 @@ SPEC = {'linear': {'doc': 'M, D, G, K of the linearisation (a = 0)',
                            'shape': [4, 1],
                            'sparse': False,
                            'symmetric': False}],
-              'signature': 'c7fccb757954eafaec6cd2965e2827d7590a6b014580f38a814210df0f8d97f9',
+              'signature': '33f6d390f50ee16f4833d699f9970a3c9c0a0d3bf13bb24587d28bf63a49eed9',
               'sizes': [],
               'slots': []},
  'tangent': {'doc': 'Jacobians of the residual',
@@ -300,19 +306,21 @@ SPEC = {'linear': {'doc': 'M, D, G, K of the linearisation (a = 0)',
                          'sparse': False,
                          'symmetric': False}],
              'meta': {'coordinates': ['v', 'v_s', 'w', 'w_s'],
-                      'field': {'constraints': [['v', 0, 'start'],
+                      'field': {'constant_mass': True,
+                                'constraints': [['v', 0, 'start'],
                                                 ['v', 0, 'end'],
                                                 ['w', 0, 'start'],
                                                 ['w', 0, 'end']],
                                 'fields': ['v', 'w'],
                                 'jets': [['v', 0], ['v', 1], ['w', 0], ['w', 1]],
-                                'length': 'L'},
+                                'length': 'L',
+                                'points': []},
                       'internal': [],
                       'kind': 'field',
                       'model': 'rotating_string',
                       'params': ['P', 'rhoA', 'Omega', 'L']},
              'name': 'tangent',
-             'ops': 6,
+             'ops': 7,
              'outputs': [{'batched': True,
                           'extent': {'const': 16, 'terms': []},
                           'integer': False,
@@ -341,7 +349,7 @@ SPEC = {'linear': {'doc': 'M, D, G, K of the linearisation (a = 0)',
                           'shape': [4, 0],
                           'sparse': False,
                           'symmetric': False}],
-             'signature': '116201430353cbda2c7aa5a948d3a078996d6e811dd9cc189a0109dcf6c2d1fb',
+             'signature': '2a49cf262c605eabdf2773c941644bd67c2998c957b7026d9d33af9ab0d198e0',
              'sizes': [],
              'slots': []}}
 
@@ -372,10 +380,9 @@ def mg_residual(ins, outs, sizes):
     g8 = in6[0]
     g9 = in6[1]
     g10 = in6[2]
-    t0 = g10*g9
-    out0[:, 0] = -g5*t0 + g6*g9 - t0*(g0*g10 + g5)
+    out0[:, 0] = g10*(-g0*g10*g9 - 2.0*g5*g9) + g6*g9
     out0[:, 1] = g1*g8
-    out0[:, 2] = g4*t0 + g7*g9 + t0*(-g10*g2 + g4)
+    out0[:, 2] = g9*(-g10*g10*g2 + 2.0*g10*g4 + g7)
     out0[:, 3] = g3*g8
 
 
@@ -397,13 +404,13 @@ def mg_tangent(ins, outs, sizes):
     g1 = in6[1]
     g2 = in6[2]
     t0 = -g1*g2*g2
-    t1 = 2.0*g1*g2
+    t1 = -2.0*g1*g2
     out0[:, 0] = t0
     out0[:, 5] = g0
     out0[:, 10] = t0
     out0[:, 15] = g0
-    out1[:, 2] = -t1
-    out1[:, 8] = t1
+    out1[:, 2] = t1
+    out1[:, 8] = -t1
     out2[:, 0] = g1
     out2[:, 10] = g1
 
@@ -424,12 +431,12 @@ def mg_linear(ins, outs, sizes):
     g0 = in5[0]
     g1 = in5[1]
     g2 = in5[2]
-    t0 = 2.0*g1*g2
+    t0 = -2.0*g1*g2
     t1 = -g1*g2*g2
     out0[:, 0] = g1
     out0[:, 10] = g1
-    out2[:, 2] = -t0
-    out2[:, 8] = t0
+    out2[:, 2] = t0
+    out2[:, 8] = -t0
     out3[:, 0] = t1
     out3[:, 5] = g0
     out3[:, 10] = t1
