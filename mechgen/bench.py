@@ -313,7 +313,32 @@ def report_markdown(rows, overhead, builds, start) -> str:
     return "\n".join(lines)
 
 
+SUITES = ("fpu", "beam")
+
+
 def run_benchmarks(models_: list[str] | None = None, *, out: Path, quick: bool = False) -> dict:
+    """Run the benchmark suites named in ``models_`` (default: all of :data:`SUITES`).
+
+    ``fpu``: FPU chain kernels, writes ``out/fpu_kernels.{csv,json,md}``; ``beam``: the
+    continua work-precision and assembly study (:mod:`mechgen.bench_field`).
+    """
+    from mechgen.errors import InputError
+
+    chosen = list(models_ or SUITES)
+    unknown = [m for m in chosen if m not in SUITES]
+    if unknown:
+        raise InputError(f"unknown benchmark {unknown[0]!r}", key="bench", expected=f"one of {', '.join(SUITES)}")
+    results = {}
+    if "fpu" in chosen:
+        results["fpu"] = run_fpu_benchmarks(out=out, quick=quick)
+    if "beam" in chosen:
+        from mechgen.bench_field import run_field_benchmarks
+
+        results["beam"] = run_field_benchmarks(out, quick=quick)
+    return results
+
+
+def run_fpu_benchmarks(*, out: Path, quick: bool = False) -> dict:
     """Run the FPU benchmark and write ``out/fpu_kernels.{csv,json,md}``."""
     sizes = (64, 256) if quick else (64, 1024, 16384)
     batch = (64, 100) if quick else (64, 10_000)

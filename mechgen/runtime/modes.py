@@ -70,13 +70,21 @@ def _dense(M, K) -> ModesResult:
 
 
 def _sparse(M, K, count: int) -> ModesResult:
-    diag = np.abs(K.diagonal()).max() if K.nnz else 1.0
-    sigma = -1e-6 * max(diag, 1e-300)
-    try:
-        lam, phi = spla.eigsh(K.tocsc(), k=count, M=M.tocsc(), sigma=sigma, which="LM")
-    except (RuntimeError, spla.ArpackError) as exc:
-        raise InputError(f"sparse eigensolver failed: {exc}", key="M",
-                         expected="a positive definite mass matrix") from exc
+    """Shift-invert about sigma = 0 (the lowest modes converge fastest there); if K is singular (rigid
+    modes), about a small negative sigma scaled by the smallest diagonal ratio K_ii / M_ii."""
+    kd, md = np.abs(K.diagonal()), np.abs(M.diagonal())
+    ratios = kd[(kd > 0) & (md > 0)] / md[(kd > 0) & (md > 0)]
+    fallback = -1e-3 * (ratios.min() if ratios.size else 1.0)
+    last: Exception | None = None
+    for sigma in (0.0, fallback):
+        try:
+            lam, phi = spla.eigsh(K.tocsc(), k=count, M=M.tocsc(), sigma=sigma, which="LM")
+            break
+        except (RuntimeError, spla.ArpackError) as exc:
+            last = exc
+    else:
+        raise InputError(f"sparse eigensolver failed: {last}", key="M",
+                         expected="a positive definite mass matrix") from last
     order = np.argsort(lam)
     lam, phi = lam[order], phi[:, order]
     return ModesResult(lam, np.sign(lam) * np.sqrt(np.abs(lam)), phi)
