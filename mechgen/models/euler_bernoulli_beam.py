@@ -10,7 +10,7 @@ sin = 0 (pinned-pinned), cos cosh = 1 (clamped-clamped), cos cosh = -1
 (clamped-free). A uniform load q (N/m) deflects a pinned-pinned beam to
 w(s) = q s (L^3 - 2 L s^2 + s^3) / (24 EI), total potential -q^2 L^5 / (240 EI). SI units.
 """
-from mechgen.symbolic.field import fix
+from mechgen.symbolic.field import fix_ends
 from mechgen.symbolic.model import Model
 from mechgen.symbolic.params import Param
 
@@ -41,5 +41,4 @@ def potential(u, p):
 
 @model.boundary
 def boundary(p):
-    start, end = p.bc.split("-")
-    return [fix(jet, "start") for jet in _END[start]] + [fix(jet, "end") for jet in _END[end]]
+    return fix_ends(p.bc, _END)

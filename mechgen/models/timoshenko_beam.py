@@ -11,7 +11,7 @@ have two frequencies each (two spectra), the roots in omega^2 of
 (kGA k^2 - rhoA omega^2)(EI k^2 + kGA - rhoI omega^2) = kGA^2 k^2. As kGA -> oo
 and rhoI -> 0 the lower spectrum tends to the Euler-Bernoulli one. SI units.
 """
-from mechgen.symbolic.field import fix
+from mechgen.symbolic.field import fix_ends
 from mechgen.symbolic.model import Model
 from mechgen.symbolic.params import Param
 
@@ -43,5 +43,4 @@ def potential(u, p):
 
 @model.boundary
 def boundary(p):
-    start, end = p.bc.split("-")
-    return [fix(jet, "start") for jet in _END[start]] + [fix(jet, "end") for jet in _END[end]]
+    return fix_ends(p.bc, _END)

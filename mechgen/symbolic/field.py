@@ -53,6 +53,12 @@ def fix(jet: str, at: str) -> tuple[str, str]:
     return (jet, at)
 
 
+def fix_ends(bc: str, conditions: dict[str, tuple[str, ...]]) -> list[tuple[str, str]]:
+    """Boundary conditions from a 'start-end' choice: ``fix_ends("clamped-free", {"clamped": ("w", "w_s"), ...})``."""
+    start, end = bc.split("-")
+    return [fix(jet, "start") for jet in conditions[start]] + [fix(jet, "end") for jet in conditions[end]]
+
+
 class Jets(Namespace):
     """Jets of the declared fields at one point, created on first use.
 
