@@ -8,6 +8,10 @@
 * penalty: x = q and K gets alpha C^T C with alpha = PENALTY_FACTOR * max|diag K|
   (K unconstrained, at the zero state), the paper's way (seed 002); frequencies
   converge to the constrained ones as 1/PENALTY_FACTOR.
+* multiplier: the unknowns are (x, lambda); K is bordered, [[K, C^T], [C, 0]], the
+  residual is (r + C^T lambda, C x) and M, D, G get zero rows and columns for
+  lambda (a singular mass: modes and stability solve the generalized problem and
+  drop its infinite eigenvalues). lambda are the boundary reactions.
 """
 from __future__ import annotations
 
@@ -28,22 +32,41 @@ class Reduction:
     Z: object
     penalty_rows: np.ndarray | None = None
     keep: np.ndarray | None = None
+    multiplier_rows: np.ndarray | None = None
 
     @property
     def n(self) -> int:
-        """Reduced unknowns."""
+        """Reduced unknowns (dofs plus multipliers for the multiplier method)."""
+        if self.multiplier_rows is not None:
+            return self.ndof + len(self.multiplier_rows)
         return self.ndof if self.Z is None else self.Z.shape[1]
 
     def expand(self, q: np.ndarray) -> np.ndarray:
-        """Full dof vector x = Z q."""
-        return np.asarray(q, float) if self.Z is None else self.Z @ np.asarray(q, float)
+        """Full dof vector x = Z q (the first ndof unknowns with multipliers)."""
+        q = np.asarray(q, float)
+        if self.multiplier_rows is not None:
+            return q[:self.ndof]
+        return q if self.Z is None else self.Z @ q
 
-    def vector(self, r: np.ndarray) -> np.ndarray:
-        """Z^T r."""
+    def vector(self, r: np.ndarray, q: np.ndarray | None = None) -> np.ndarray:
+        """Z^T r; with multipliers (r + C^T lambda, C x) at the unknowns q = (x, lambda)."""
+        if self.multiplier_rows is not None:
+            C = self.multiplier_rows
+            q = np.zeros(self.n) if q is None else np.asarray(q, float)
+            return np.concatenate([r + C.T @ q[self.ndof:], C @ q[:self.ndof]])
         return r if self.Z is None else self.Z.T @ r
 
-    def matrix(self, A, penalty: float = 0.0):
-        """Z^T A Z, plus penalty * C^T C (the penalty method's stiffness term)."""
+    def _bordered(self, A, border: bool):
+        C = sps.csr_matrix(self.multiplier_rows)
+        m = C.shape[0]
+        top, bottom = (C.T, C) if border else (None, sps.csr_matrix((m, self.ndof)))
+        out = sps.bmat([[sps.csr_matrix(A), top], [bottom, sps.csr_matrix((m, m))]], format="csr")
+        return out if sps.issparse(A) else out.toarray()
+
+    def matrix(self, A, penalty: float = 0.0, border: bool = False):
+        """Z^T A Z, plus penalty * C^T C (the penalty method's stiffness term); bordered for multipliers."""
+        if self.multiplier_rows is not None:
+            return self._bordered(A, border)
         if penalty and self.penalty_rows is not None:
             C = sps.csr_matrix(self.penalty_rows)
             extra = penalty * (C.T @ C)
@@ -71,6 +94,8 @@ def reduction(rows: np.ndarray, scales: np.ndarray, ndof: int, method: str, spar
         return Reduction(ndof, None)
     if method == "penalty":
         return Reduction(ndof, None, rows)
+    if method == "multiplier":
+        return Reduction(ndof, None, multiplier_rows=rows)
     nonzero = [np.flatnonzero(np.abs(r) > 1e-12 * np.abs(r).max()) for r in rows]
     if all(len(nz) == 1 for nz in nonzero):
         fixed = {int(nz[0]) for nz in nonzero}

@@ -105,6 +105,11 @@ class FieldSystem:
         return self._cache["red"]
 
     @property
+    def has_multipliers(self) -> bool:
+        """True when the unknowns include Lagrange multipliers (massless: a singular M)."""
+        return self.reduction.multiplier_rows is not None
+
+    @property
     def assembler(self) -> Assembler:
         """Scatter into global dofs."""
         disc = self.disc
@@ -189,7 +194,8 @@ class FieldSystem:
                 extra = B.T @ sps.csr_matrix(self._coeff(loc[k])[0]) @ B
                 mats[k] = mats[k] + (extra if sps.issparse(mats[k]) else extra.toarray())
         stiff = {"linear": "K", "tangent": "r_q"}[kernel]
-        return {k: self.reduction.matrix(mats[k], self.penalty if k == stiff else 0.0) for k in names}
+        return {k: self.reduction.matrix(mats[k], self.penalty if k == stiff else 0.0, border=k == stiff)
+                for k in names}
 
     def _coeff(self, arr: np.ndarray) -> np.ndarray:
         """A flat (..., jets * jets) kernel output as (..., jets, jets) coefficients."""
@@ -219,7 +225,7 @@ class FieldSystem:
         """r(q, q', q'') = Z^T (sum_e B^T W rho + sum_ends B_at^T rho_at + penalty C^T C x)."""
         full = self._full((q, v, a))
         red = self.reduction
-        return red.vector(self._full_residual(full, t) + red.penalty_force(full[0], self.penalty))
+        return red.vector(self._full_residual(full, t) + red.penalty_force(full[0], self.penalty), q)
 
     def reactions(self, q, t: float = 0.0) -> list[dict]:
         """Boundary reactions of an equilibrium: the Lagrange multipliers lambda of C x = 0.
@@ -285,6 +291,11 @@ class FieldSystem:
 
     def _mass_solve(self, q, v, t: float, rhs: np.ndarray) -> np.ndarray:
         """M^-1 rhs; a state-independent M (the usual case, known from the derivation) is factorised once."""
+        if self.reduction.multiplier_rows is not None:
+            from mechgen.errors import InputError
+
+            raise InputError("time integration with Lagrange multipliers is a DAE (singular mass)",
+                             key="constraints", expected="'eliminate' or 'penalty' for simulate")
         if self.info.get("constant_mass"):
             if "mass" not in self._cache:
                 M = self.tangent(np.zeros(self.n), t=t)["r_a"]

@@ -53,7 +53,7 @@ def _dense_inverse(M: np.ndarray, K: np.ndarray) -> ModesResult | None:
     return ModesResult(lam, np.sqrt(lam), phi / np.sqrt(mu)[None, :])
 
 
-def _dense(M, K) -> ModesResult:
+def _dense(M, K, allow_singular_mass: bool = False) -> ModesResult:
     M, K = np.asarray(M, float), np.asarray(K, float)
     _check_symmetric(M, "M")
     _check_symmetric(K, "K")
@@ -64,9 +64,29 @@ def _dense(M, K) -> ModesResult:
     try:
         lam, phi = sla.eigh(K, M)
     except np.linalg.LinAlgError as exc:
+        singular = _semidefinite_mass(M, K) if allow_singular_mass else None
+        if singular is not None:
+            return singular
         raise InputError("the mass matrix is not positive definite (singular or indefinite)", key="M",
                          expected="a positive definite mass matrix (check masses and inertias are > 0)") from exc
     return ModesResult(lam, np.sign(lam) * np.sqrt(np.abs(lam)), phi)
+
+
+def _semidefinite_mass(M: np.ndarray, K: np.ndarray) -> ModesResult | None:
+    """K phi = lambda M phi with M positive semi-definite (constraint multipliers carry no mass).
+
+    The QZ algorithm gives infinite eigenvalues for the massless directions; the
+    finite ones are the constrained system's (None when M has a negative direction).
+    """
+    if np.linalg.eigvalsh(M).min() < -1e-12 * max(np.abs(M).max(), 1e-300):
+        return None
+    w, vr = sla.eig(K, M)
+    finite = np.isfinite(w)
+    lam, phi = w[finite].real, vr[:, finite].real
+    order = np.argsort(lam)
+    lam, phi = lam[order], phi[:, order]
+    norms = np.sqrt(np.abs(np.einsum("ik,ij,jk->k", phi, M, phi)))
+    return ModesResult(lam, np.sign(lam) * np.sqrt(np.abs(lam)), phi / np.where(norms > 0, norms, 1.0))
 
 
 def _sparse(M, K, count: int) -> ModesResult:
@@ -90,15 +110,19 @@ def _sparse(M, K, count: int) -> ModesResult:
     return ModesResult(lam, np.sign(lam) * np.sqrt(np.abs(lam)), phi)
 
 
-def modes(M, K, count: int | None = None) -> ModesResult:
-    """Solve K phi = omega^2 M phi; dense (eigh) or sparse shift-invert about 0 for the lowest ``count``."""
+def modes(M, K, count: int | None = None, *, allow_singular_mass: bool = False) -> ModesResult:
+    """Solve K phi = omega^2 M phi; dense (eigh) or sparse shift-invert about 0 for the lowest ``count``.
+
+    ``allow_singular_mass``: M may be semi-definite (massless Lagrange multipliers); its
+    infinite eigenvalues are dropped. Otherwise a singular M is an input error.
+    """
     n = M.shape[0]
     if sps.issparse(M) or sps.issparse(K):
         if count is not None and count < n - 1 and n > 200:
             return _sparse(sps.csr_matrix(M), sps.csr_matrix(K), count)
         M = M.toarray() if sps.issparse(M) else M
         K = K.toarray() if sps.issparse(K) else K
-    res = _dense(M, K)
+    res = _dense(M, K, allow_singular_mass)
     if count is not None:
         res = ModesResult(res.eigenvalues[:count], res.frequencies[:count], res.shapes[:, :count])
     return res

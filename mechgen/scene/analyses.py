@@ -56,7 +56,8 @@ def run_modes(system: System, options: dict, context: dict) -> dict:
     """Natural frequencies (rad/s or the model's unit) about the operating point."""
     q = operating_point(system, options, context)
     mats = system.linear(q)
-    res = solve_modes(mats["M"], mats["K"], count=options.get("count"))
+    res = solve_modes(mats["M"], mats["K"], count=options.get("count"),
+                      allow_singular_mass=getattr(system, "has_multipliers", False))
     out = {"frequencies": [float(f) for f in res.frequencies], "_shapes": res.shapes}
     if system.is_field and options.get("count"):
         out.update(_field_shapes(system, res.shapes, "shapes"))
