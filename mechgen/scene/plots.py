@@ -26,18 +26,28 @@ def _pyplot():
 
 
 def _sweep(plt, a: dict, path: Path) -> None:
+    """Frequencies against the swept parameter; with stability results, growth rates in a second panel."""
     grid = a["outputs"]["grid"]
     name = next(iter(grid[0])) if grid else "parameter"
     x = [g[name] for g in grid]
-    fig, ax = plt.subplots(figsize=(6, 4))
-    for xi, freqs in zip(x, a["outputs"].get("frequencies", [])):
-        ax.plot([xi] * len(freqs), freqs, "k.", ms=3)
-    if name == "Omega" and x:
+    growth = a["outputs"].get("growth_rate")
+    fig, axes = plt.subplots(2 if growth else 1, 1, figsize=(6, 6 if growth else 4), squeeze=False, sharex=True)
+    ax = axes[0, 0]
+    verdicts = a["outputs"].get("verdict") or ["stable"] * len(x)
+    colours = {"stable": "k", "divergence": "tab:blue", "flutter": "tab:red", "unconverged": "tab:orange"}
+    for xi, freqs, verdict in zip(x, a["outputs"].get("frequencies", []), verdicts):
+        ax.plot([xi] * len(freqs), freqs, ".", color=colours.get(verdict, "k"), ms=3)
+    if name == "Omega" and x and isinstance(x[0], (int, float)):
         ax.plot([min(x), max(x)], [min(x), max(x)], "r--", lw=1, label="1x (synchronous)")
         ax.legend(loc="upper left")
-    ax.set_xlabel(name)
     ax.set_ylabel("frequency")
-    ax.set_title(f"{a['name']}: frequencies vs {name}")
+    ax.set_title(f"{a['name']}: frequencies vs {name}" + (" (red: flutter, blue: divergence, orange: unconverged)"
+                                                          if growth else ""), fontsize=9)
+    if growth:
+        axes[1, 0].plot(x, growth, "o-", ms=3)
+        axes[1, 0].axhline(0.0, color="0.6", lw=0.5)
+        axes[1, 0].set_ylabel("growth rate max Re s")
+    axes[-1, 0].set_xlabel(name)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
