@@ -127,3 +127,12 @@ def test_plot_writes_pngs(tmp_path, capsys):
     pngs = sorted(p.name for p in tmp_path.glob("*.png"))
     assert pngs == ["laval_rotor_campbell.png", "laval_rotor_whirl.png"]
     assert all((tmp_path / p).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for p in pngs)
+
+
+def test_plot_continuum_shapes_and_sweep(tmp_path, capsys):
+    pytest.importorskip("matplotlib")
+    code, out, err = _run(["run", str(ROOT / "scenes" / "beam_modes.toml"), "--plot", str(tmp_path)], capsys)
+    assert code == 0, err
+    pngs = sorted(p.name for p in tmp_path.glob("*.png"))
+    assert pngs == ["beam_modes_boundary_conditions.png", "beam_modes_modes.png", "beam_modes_modes_shapes.png"]
+    assert all((tmp_path / p).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for p in pngs)
