@@ -69,7 +69,30 @@ def _dense(M, K, allow_singular_mass: bool = False) -> ModesResult:
             return singular
         raise InputError("the mass matrix is not positive definite (singular or indefinite)", key="M",
                          expected="a positive definite mass matrix (check masses and inertias are > 0)") from exc
+    _warn_if_inaccurate(lam)
     return ModesResult(lam, np.sign(lam) * np.sqrt(np.abs(lam)), phi)
+
+
+class AccuracyWarning(UserWarning):
+    """Round-off limits the accuracy of the computed frequencies."""
+
+
+def _warn_if_inaccurate(lam: np.ndarray, target: float = 1e-4) -> None:
+    """Warn when the symmetric solver's error bound, about eps * max|lambda|, exceeds ``target`` * |lambda_min|.
+
+    The lowest nonzero eigenvalue is then accurate only to that bound (a stiffness
+    contrast of 1e12 between modes, e.g. a nearly rigid shear term, leaves ~1e-4; a worst-case bound).
+    """
+    nonzero = np.abs(lam[np.abs(lam) > 64 * np.finfo(float).eps * np.abs(lam).max()])
+    if not nonzero.size:
+        return
+    bound = np.finfo(float).eps * np.abs(lam).max() / nonzero.min()
+    if bound > target:
+        import warnings
+
+        warnings.warn(f"the lowest eigenvalues are accurate only to about {bound:.1g} (relative): the spectrum spans "
+                      f"{np.abs(lam).max() / nonzero.min():.1g}; refine less, rescale, or stiffen less",
+                      AccuracyWarning, stacklevel=3)
 
 
 def _semidefinite_mass(M: np.ndarray, K: np.ndarray) -> ModesResult | None:
