@@ -85,10 +85,15 @@ class Reduction:
         return penalty * (self.penalty_rows.T @ (self.penalty_rows @ x))
 
 
+def binding(row: np.ndarray, scale: float) -> bool:
+    """False for a condition the basis satisfies by itself (its row vanishes at the jet's scale)."""
+    return bool(np.abs(row).max() > 1e-10 * max(scale, 1.0))
+
+
 def reduction(rows: np.ndarray, scales: np.ndarray, ndof: int, method: str, sparse: bool) -> Reduction:
     """Reduction for constraint rows (one per condition) whose jets have table magnitudes ``scales``."""
     rows = np.atleast_2d(np.asarray(rows, float)).reshape(-1, ndof)
-    keep = [np.abs(r).max() > 1e-10 * max(s, 1.0) for r, s in zip(rows, scales)]
+    keep = [binding(r, s) for r, s in zip(rows, scales)]
     rows = rows[np.asarray(keep, bool)] if len(rows) else rows
     if not len(rows):
         return Reduction(ndof, None)

@@ -25,9 +25,9 @@ import scipy.linalg as sla
 import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
-from mechgen.errors import KernelError
+from mechgen.errors import InputError, KernelError
 from mechgen.runtime.assemble import Assembler, element_matrices, element_vectors, jets_at_points
-from mechgen.runtime.constrain import PENALTY_FACTOR, Reduction, reduction
+from mechgen.runtime.constrain import PENALTY_FACTOR, Reduction, binding, reduction
 from mechgen.runtime.discretise import Discretisation, discretise
 from mechgen.runtime.kernels import Kernel
 
@@ -77,8 +77,6 @@ class FieldSystem:
                                               self.info["fields"], jets, quadrature=int(self.choices["quadrature"]),
                                               constraints=[tuple(c) for c in self.info["constraints"]])
             except ValueError as exc:
-                from mechgen.errors import InputError
-
                 raise InputError(str(exc), key="discretisation",
                                  expected="a discretisation that fits the model's energies") from None
         return self._cache[key]
@@ -88,21 +86,25 @@ class FieldSystem:
         """x = Z q for the essential boundary conditions."""
         disc = self.disc
         if "red" not in self._cache:
-            rows, scales = [], []
-            for f, k, at in self.info["constraints"]:
-                rows.append(disc.row(f, int(k), 0.0 if at == "start" else disc.length))
-                a = disc.jets.index((f, int(k)))
-                scales.append(float(np.abs(disc.tables[:, :, a, :]).max()))
+            _, rows, scales = self._constraint_rows()
             red = reduction(np.array(rows), np.array(scales), disc.ndof, self.choices["constraints"],
                             sparse=not disc.is_global)
             if red.penalty_rows is not None and disc.is_global:
-                from mechgen.errors import InputError
-
                 raise InputError(f"penalty constraints with the global {disc.kind} basis couple every function "
                                  "to the penalty and wreck the conditioning", key="constraints",
                                  expected="'eliminate' for global bases (penalty with finite elements)")
             self._cache["red"] = red
         return self._cache["red"]
+
+    def _constraint_rows(self) -> tuple[list, list, list]:
+        """(field, order, end), dense row C_i and the jet's table magnitude of every essential condition."""
+        disc = self.disc
+        keys, rows, scales = [], [], []
+        for f, k, at in self.info["constraints"]:
+            keys.append((f, int(k), at))
+            rows.append(disc.row(f, int(k), 0.0 if at == "start" else disc.length))
+            scales.append(float(np.abs(disc.tables[:, :, disc.jets.index((f, int(k))), :]).max()))
+        return keys, rows, scales
 
     @property
     def has_multipliers(self) -> bool:
@@ -176,11 +178,16 @@ class FieldSystem:
         red = self.reduction
         return [None if x is None else red.expand(x) for x in states]
 
+    def _jets_of(self, full) -> list:
+        """Jets at the Gauss points of each full dof vector (None stays None: a zero state)."""
+        disc = self.disc
+        return [None if x is None else jets_at_points(disc.tables, disc.dofs, x) for x in full]
+
     def _matrices(self, kernel: str, names, q, v, a, t: float, jets=None) -> dict:
         """Reduced global matrices ``names`` of a tangent-type kernel at the state (q, v, a)."""
         disc = self.disc
         full = self._full((q, v, a))
-        j = [jets_at_points(disc.tables, disc.dofs, x) if x is not None else None for x in full]
+        j = self._jets_of(full)
         if jets is not None:
             j[0] = np.asarray(jets, float)
         local = self._pointwise(kernel, *j, t=t)
@@ -214,7 +221,7 @@ class FieldSystem:
     def _full_residual(self, full, t: float) -> np.ndarray:
         """sum_e B^T W rho + sum_ends B_at^T rho_at over all dofs (no boundary conditions)."""
         disc = self.disc
-        j = [jets_at_points(disc.tables, disc.dofs, x) if x is not None else None for x in full]
+        j = self._jets_of(full)
         rho = self._pointwise("residual", *j, t=t)["r"]
         r = self.assembler.vector(element_vectors(disc.tables, disc.weights, rho))
         for B, loc in self._ends("residual", full, t):
@@ -235,13 +242,10 @@ class FieldSystem:
         (w: a transverse force, w_s: a moment), positive along the jet. Conditions
         that the basis satisfies by itself (sines at the ends) have none.
         """
-        disc = self.disc
         kept, rows = [], []
-        for f, k, at in self.info["constraints"]:
-            row = disc.row(f, int(k), 0.0 if at == "start" else disc.length)
-            a = disc.jets.index((f, int(k)))
-            if np.abs(row).max() > 1e-10 * max(float(np.abs(disc.tables[:, :, a, :]).max()), 1.0):
-                kept.append((f, int(k), at))
+        for key, row, scale in zip(*self._constraint_rows()):
+            if binding(row, scale):
+                kept.append(key)
                 rows.append(row)
         if not rows:
             return []
@@ -272,7 +276,7 @@ class FieldSystem:
         """Energies: integrals of the kinetic and potential densities plus the end terms."""
         disc = self.disc
         full = self._full((q, v))
-        j = [jets_at_points(disc.tables, disc.dofs, x) if x is not None else None for x in full]
+        j = self._jets_of(full)
         local = self._pointwise("outputs", *j, t=t)
         values = {k: float(np.sum(disc.weights * arr[..., 0])) for k, arr in local.items()}
         for _, loc in self._ends("outputs", full + [None], t):
@@ -292,8 +296,6 @@ class FieldSystem:
     def _mass_solve(self, q, v, t: float, rhs: np.ndarray) -> np.ndarray:
         """M^-1 rhs; a state-independent M (the usual case, known from the derivation) is factorised once."""
         if self.reduction.multiplier_rows is not None:
-            from mechgen.errors import InputError
-
             raise InputError("time integration with Lagrange multipliers is a DAE (singular mass)",
                              key="constraints", expected="'eliminate' or 'penalty' for simulate")
         if self.info.get("constant_mass"):
