@@ -84,11 +84,24 @@ def lower_all(model: Model, eqs, kernels, *, cse: bool = True) -> list[KernelIR]
                             for local in [eqs.local, *eqs.points.values()])
         for ir in irs:
             ir.meta["field"] = {"fields": list(eqs.fields), "jets": [list(j) for j in eqs.jets],
-                                "length": eqs.length, "points": sorted(eqs.points), "constant_mass": constant_mass,
+                                "length": eqs.length, "points": sorted(at for at in eqs.points if at not in eqs.parts),
+                                "constant_mass": constant_mass,
                                 "constraints": [[c.field, c.order, c.at] for c in eqs.constraints]}
-        return irs
+            if eqs.parts:
+                ir.meta["field"]["parts"] = {k: list(v) for k, v in sorted(eqs.parts.items())}
+            if eqs.shear_pairs:
+                ir.meta["field"]["shear_pairs"] = [list(p) for p in eqs.shear_pairs]
+        return _with_whirl(model, irs)
     lower = lower_lattice if model.is_lattice else lower_lumped
-    return [lower(eqs, k, cse=cse) for k in all_kernels(model) if k in kernels]
+    return _with_whirl(model, [lower(eqs, k, cse=cse) for k in all_kernels(model) if k in kernels])
+
+
+def _with_whirl(model: Model, irs: list[KernelIR]) -> list[KernelIR]:
+    """Record the model's whirl pair (Model.whirl_pair) in every kernel's meta."""
+    if model.whirl:
+        for ir in irs:
+            ir.meta["whirl"] = list(model.whirl)
+    return irs
 
 
 def emit(backend: str, irs: list[KernelIR], *, model: str, title: str) -> str:

@@ -33,6 +33,7 @@ model.params(
     Param("c_r", 0.0, "N m s/rad", "tilt damping"),
 )
 model.coordinates("x", "y", "theta_x", "theta_y")
+model.whirl_pair("x", "y")
 
 
 @model.kinetic

@@ -28,8 +28,10 @@ import scipy.sparse.linalg as spla
 from mechgen.errors import InputError, KernelError
 from mechgen.runtime.assemble import Assembler, element_matrices, element_vectors, jets_at_points
 from mechgen.runtime.constrain import PENALTY_FACTOR, Reduction, binding, reduction
-from mechgen.runtime.discretise import Discretisation, discretise
+from mechgen.runtime.discretise import GLOBAL, Discretisation, discretise
+from mechgen.runtime.elements import reference
 from mechgen.runtime.kernels import Kernel
+from mechgen.runtime.mesh import Layout, build_mesh
 
 
 @dataclass
@@ -47,6 +49,7 @@ class FieldSystem:
     fixed: dict
     choices: dict
     backend: str = "numpy"
+    layout: Layout | None = None
     _cache: dict = field(default_factory=dict, repr=False)
 
     is_lattice = False
@@ -60,7 +63,9 @@ class FieldSystem:
         return self.meta["field"]
 
     def value(self, name: str) -> float:
-        """Current value of a numeric parameter (free ones from ``params``)."""
+        """Current value of a numeric parameter (free ones from ``params``; the length from the segments)."""
+        if name == self.info["length"] and self.layout is not None and self.layout.segments:
+            return self.layout.length
         names = self.meta.get("params", [])
         return float(self.params[names.index(name)]) if name in names else float(self.fixed[name])
 
@@ -72,10 +77,20 @@ class FieldSystem:
         if key not in self._cache:
             self._cache.clear()
             jets = tuple((f, int(k)) for f, k in self.info["jets"])
+            kind = self.choices["discretisation"]
             try:
-                self._cache[key] = discretise(self.choices["discretisation"], int(self.choices["N"]), length,
-                                              self.info["fields"], jets, quadrature=int(self.choices["quadrature"]),
-                                              constraints=[tuple(c) for c in self.info["constraints"]])
+                mesh = None
+                if self.layout is not None and (self.layout.segments or self.layout.parts) and kind not in GLOBAL:
+                    mesh = build_mesh(self.layout, int(self.choices["N"]), length)
+                elif self.layout is not None and self.layout.segments:
+                    raise ValueError(f"segments need finite elements; {kind} is a global basis")
+                mesh = mesh if mesh is not None or kind != "timoshenko2" else build_mesh(None, int(self.choices["N"]),
+                                                                                          length)
+                shear = self._shear_ratios(mesh) if kind == "timoshenko2" else None
+                self._cache[key] = discretise(kind, int(self.choices["N"]), length, self.info["fields"], jets,
+                                              quadrature=int(self.choices["quadrature"]),
+                                              constraints=[tuple(c) for c in self.info["constraints"]], mesh=mesh,
+                                              shear=shear)
             except ValueError as exc:
                 raise InputError(str(exc), key="discretisation",
                                  expected="a discretisation that fits the model's energies") from None
@@ -130,8 +145,71 @@ class FieldSystem:
         return [f"q{i + 1}" for i in range(self.n)]
 
     def refined(self, size: int) -> "FieldSystem":
-        """The same model discretised with ``size`` elements or basis functions."""
-        return replace(self, choices={**self.choices, "N": int(size)}, _cache={})
+        """The same model discretised with ``size`` elements or basis functions (segments: scaled alike)."""
+        layout = self.layout
+        if layout is not None and layout.segments:
+            factor = size / int(self.choices["N"])
+            layout = replace(layout, segments=tuple(replace(seg, elements=max(1, round(seg.elements * factor)))
+                                                    for seg in layout.segments))
+        return replace(self, choices={**self.choices, "N": int(size)}, layout=layout, _cache={})
+
+    # -- segments and parts -----------------------------------------------------
+    def _with(self, values: dict, prefix: str = "", what: str = "segment") -> np.ndarray:
+        """The parameter vector with ``values`` (names prefixed by ``prefix``) in place of the current ones."""
+        names = self.meta.get("params", [])
+        params = np.array(self.params, float)
+        for name, value in values.items():
+            full = prefix + name
+            if full not in names:
+                raise InputError(f"{what} sets {name!r}, which the compiled kernels do not take as an input",
+                                 key=name, expected=f"a parameter kept free: {', '.join(names) or 'none'}")
+            params[names.index(full)] = float(value)
+        return params
+
+    def _segment_params(self) -> list[np.ndarray] | None:
+        """One parameter vector per segment (None: every element uses ``params``)."""
+        if self.layout is None or not any(seg.values for seg in self.layout.segments):
+            return None
+        return [self._with(seg.values) for seg in self.layout.segments]
+
+    def _shear_ratios(self, mesh) -> tuple[list, np.ndarray]:
+        """Shear pairs and phi = 12 EI / (kGA h^2) per element and pair, from the pointwise stiffness.
+
+        EI is the coefficient of psi_s^2 and kGA that of w_s^2 in the linearised
+        stiffness density (d rho / d j), at each element's midpoint.
+        """
+        pairs = [tuple(p) for p in self.info.get("shear_pairs", [])]
+        if not pairs:
+            raise ValueError("the timoshenko2 element needs shear pairs (model.shear_pair) in the model")
+        jets = [tuple(j) for j in self.info["jets"]]
+        kernel, out = ("linear", "K") if "linear" in self.kernels else ("tangent", "r_q")
+        mids = (mesh.nodes[:-1] + mesh.nodes[1:]) / 2
+        K = self._by_segment(kernel, mesh.segment, [None, None, None], 0.0, mids[:, None])[out][:, 0]
+        K = K.reshape(len(mids), len(jets), len(jets))
+        h = np.diff(mesh.nodes)
+        phi = np.zeros((len(mids), len(pairs)))
+        for k, (w, psi, _) in enumerate(pairs):
+            if (w, 1) not in jets or (psi, 1) not in jets:
+                raise ValueError(f"shear pair ({w}, {psi}): the energy uses no {w}_s or {psi}_s")
+            EI = K[:, jets.index((psi, 1)), jets.index((psi, 1))]
+            kGA = K[:, jets.index((w, 1)), jets.index((w, 1))]
+            if np.any(kGA <= 0) or np.any(EI < 0):
+                raise ValueError(f"shear pair ({w}, {psi}): the stiffness of {w}_s^2 ({kGA.min():g}) and of "
+                                 f"{psi}_s^2 ({EI.min():g}) must be positive")
+            phi[:, k] = 12 * EI / (kGA * h**2)
+        return pairs, phi
+
+    def _by_segment(self, kernel: str, segment: np.ndarray, jets: list, t: float, s: np.ndarray) -> dict:
+        """A pointwise kernel over elements (first axis of s and jets), each segment with its parameters."""
+        params = self._segment_params()
+        if params is None:
+            return self._evaluate(kernel, *jets, t, s)
+        parts = []
+        for k, p in enumerate(params):
+            rows = np.flatnonzero(segment == k)
+            sl = slice(rows[0], rows[-1] + 1)
+            parts.append(self._evaluate(kernel, *[None if x is None else x[sl] for x in jets], t, s[sl], params=p))
+        return {name: np.concatenate([part[name] for part in parts]) for name in parts[0]}
 
     # -- pointwise kernels ----------------------------------------------------
     def _jets(self, x) -> np.ndarray:
@@ -140,14 +218,15 @@ class FieldSystem:
             return np.zeros(disc.points.shape + (len(disc.jets),))
         return jets_at_points(disc.tables, disc.dofs, self.reduction.expand(x))
 
-    def _evaluate(self, kernel: str, j, j_t, j_tt, t: float, s: np.ndarray) -> dict:
+    def _evaluate(self, kernel: str, j, j_t, j_tt, t: float, s: np.ndarray, params=None) -> dict:
         """One batched call of a pointwise kernel at positions s; jets arrays (..., jets); outputs (..., length)."""
-        na = len(self.disc.jets)
+        na = len(self.info["jets"])
         shape = s.shape
         npts = s.size
         flat = lambda x: np.zeros((npts, na)) if x is None else np.ascontiguousarray(np.reshape(x, (npts, na)))  # noqa: E731
         inputs = {"q": flat(j), "v": flat(j_t), "a": flat(j_tt), "z": np.zeros((npts, 0)),
-                  "t": np.full((npts, 1), float(t)), "s": s.reshape(npts, 1), "p": self.params}
+                  "t": np.full((npts, 1), float(t)), "s": s.reshape(npts, 1),
+                  "p": self.params if params is None else params}
         try:
             out = self.kernels[kernel].evaluate(inputs)
         except KernelError as exc:
@@ -155,24 +234,31 @@ class FieldSystem:
         return {k: v.reshape(shape + (v.shape[-1],)) for k, v in out.items()}
 
     def _pointwise(self, kernel: str, j, j_t=None, j_tt=None, t: float = 0.0) -> dict:
-        return self._evaluate(kernel, j, j_t, j_tt, t, self.disc.points)
+        disc = self.disc
+        segment = disc.mesh.segment if disc.mesh is not None else np.zeros(len(disc.points), int)
+        return self._by_segment(kernel, segment, [j, j_t, j_tt], t, disc.points)
 
-    def _point_table(self, at: str):
-        """B_at (jets x dofs, CSR): the jets at an end from the full dof vector."""
-        key = ("point", at)
+    def _point_table(self, x: float):
+        """B_x (jets x dofs, CSR): the jets at s = x from the full dof vector."""
+        key = ("point", float(x))
         if key not in self._cache:
             disc = self.disc
-            x = 0.0 if at == "start" else disc.length
             self._cache[key] = sps.csr_matrix(np.array([disc.row(f, k, x) for f, k in disc.jets]))
         return self._cache[key]
 
     def _ends(self, kernel: str, states, t: float):
-        """(B_at, local outputs) of every end term: states are full dof vectors (q, q', q'') or None."""
-        for at in self.info.get("points", []):
-            B = self._point_table(at)
-            at_end = [None if x is None else (B @ x)[None] for x in states]
-            x = np.array([0.0 if at == "start" else self.disc.length])
-            yield B, self._evaluate(f"{kernel}_at_{at}", *at_end, t, x)
+        """(B_x, local outputs) of every end term and placed part: states are full dof vectors (q, q', q'') or None."""
+        placed = [(at, 0.0 if at == "start" else self.disc.length, None) for at in self.info.get("points", [])]
+        kinds = self.info.get("parts", {})
+        for part in (self.layout.parts if self.layout is not None else ()):
+            if part.kind not in kinds:
+                raise InputError(f"part kind {part.kind!r} is not declared by model {self.meta.get('model')}",
+                                 key="parts.kind", expected=f"one of: {', '.join(kinds) or 'none'}")
+            placed.append((part.kind, part.at, self._with(part.values, f"{part.kind}_", f"part {part.kind}")))
+        for name, x, params in placed:
+            B = self._point_table(x)
+            at_point = [None if y is None else (B @ y)[None] for y in states]
+            yield B, self._evaluate(f"{kernel}_at_{name}", *at_point, t, np.array([x]), params=params)
 
     def _full(self, states):
         red = self.reduction
@@ -253,6 +339,34 @@ class FieldSystem:
         lam = np.linalg.lstsq(np.array(rows).T, -r, rcond=None)[0]
         return [{"jet": f + ("_" + "s" * k if k else ""), "at": at, "value": float(v)}
                 for (f, k, at), v in zip(kept, lam)]
+
+    def nodal_indices(self, fields) -> tuple[np.ndarray, ...]:
+        """Reduced-unknown indices of the nodal values of ``fields`` at the mesh vertices where none is eliminated.
+
+        Element discretisations only (a nodal value dof *is* the field there): the
+        whirl stations of a rotor. One array per field, paired by vertex.
+        """
+        disc, red = self.disc, self.reduction
+        if disc.mesh is None:
+            raise InputError(f"whirl stations need finite elements; {disc.kind} is a global basis",
+                             key="discretisation", expected="an element discretisation (quintic, timoshenko2, ...)")
+        nloc = disc.dofs.shape[1] // len(disc.fields)
+        nodes = 2 if disc.kind == "timoshenko2" else len(reference(disc.kind).nodes)
+        last = nloc - nloc // nodes  # the value dof of an element's last node
+        out = []
+        for f in fields:
+            i = disc.fields.index(f)
+            block = disc.dofs[:, i * nloc:(i + 1) * nloc]
+            out.append(np.concatenate([block[:, 0], block[-1:, last]]))
+        index = np.arange(red.ndof) if red.keep is None else np.full(red.ndof, -1)
+        if red.keep is not None:
+            index[red.keep] = np.arange(len(red.keep))
+        elif red.Z is not None:
+            raise InputError("whirl stations need boundary conditions that eliminate single dofs", key="constraints",
+                             expected="'eliminate', 'penalty' or 'multiplier' with finite elements")
+        mapped = [index[dofs] for dofs in out]
+        kept = np.all([m >= 0 for m in mapped], axis=0)
+        return tuple(m[kept] for m in mapped)
 
     def field_values(self, q, points: np.ndarray, order: int = 0) -> dict[str, np.ndarray]:
         """D_s^order of every field at ``points`` for the reduced state q (mode shapes, deflections)."""

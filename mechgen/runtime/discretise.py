@@ -28,13 +28,15 @@ from collections import OrderedDict
 from contextlib import suppress
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import Callable
 
 import numpy as np
 
 from mechgen.runtime import bases
-from mechgen.runtime.elements import reference
+from mechgen.runtime.elements import reference, timoshenko_shapes
+from mechgen.runtime.mesh import Mesh, build_mesh, dof_map
 
-ELEMENTS = ("hermite", "quintic", "lagrange1", "lagrange2")
+ELEMENTS = ("hermite", "quintic", "lagrange1", "lagrange2", "timoshenko2")
 GLOBAL = ("sine", "cosine", "legendre", "beam")
 DISCRETISATIONS = ELEMENTS + GLOBAL
 
@@ -58,6 +60,8 @@ class Discretisation:
     dofs: np.ndarray
     ndof: int
     ends: dict
+    mesh: Mesh | None = None
+    tabulate: Callable | None = None
 
     @property
     def is_global(self) -> bool:
@@ -80,20 +84,86 @@ class Discretisation:
                                   self.ends.get(field, ("free", "free")))
             out[offset:offset + per] = table[0, order]
             return out
-        ref = reference(self.kind)
-        nodes = self.size
-        h = self.length / nodes
-        e = min(int(at / h), nodes - 1)
-        table = ref.tabulate(np.array([at / h - e]), order, np.array([h]))[0, 0, order]
-        out[offset + _element_field_dofs(ref, e)] = table
+        mesh = self.mesh
+        e = mesh.element_at(at)
+        h = mesh.nodes[e + 1] - mesh.nodes[e]
+        table = self.tabulate(np.array([e]), np.array([(at - mesh.nodes[e]) / h]))[0, 0]
+        out[self.dofs[e]] = table[self.jets.index((field, order))]
         return out
 
 
-def _element_field_dofs(ref, e) -> np.ndarray:
-    """Local-to-global dofs of element e (an int: (ndof,); an array of elements: (len(e), ndof))."""
-    per_node = len(ref.orders)
-    start = np.asarray(e) * (len(ref.nodes) - 1) * per_node
-    return start[..., None] + np.arange(ref.ndof) if np.ndim(start) else start + np.arange(ref.ndof)
+def _elements(kind, size, length, fields, jets, xi, wi, max_order, ends, mesh, shear) -> Discretisation:
+    """Finite elements on ``mesh`` (default: ``size`` equal elements); see :func:`discretise`."""
+    mesh = mesh or build_mesh(None, size, length)
+    if kind == "timoshenko2":
+        if max_order > 1:
+            raise ValueError("the timoshenko2 element interpolates w (cubic) and psi (quadratic) for energies "
+                             f"of first order in s; these energies need order {max_order}")
+        nodes, orders, continuity = (0.0, 1.0), (0,), 0
+    else:
+        ref = reference(kind)
+        nodes, orders, continuity = ref.nodes, ref.orders, ref.continuity
+        if max_order > max(continuity, 0) + 1:
+            raise ValueError(f"the {kind} element is C{continuity}: energies with derivatives of order "
+                             f"{max_order} need a C{max_order - 1} discretisation (hermite or quintic, or a global basis)")
+    h = np.diff(mesh.nodes)
+    points = mesh.nodes[:-1, None] + xi[None, :] * h[:, None]
+    weights = wi[None, :] * h[:, None]
+    split = mesh.breaks if max_order <= 1 and max(orders) > 0 else None
+    base_dofs, per = dof_map(len(nodes), orders, mesh.elements, split)
+    nloc = base_dofs.shape[1]
+    if kind == "timoshenko2":
+        tabulate = _timoshenko_tabulator(fields, jets, h, shear, nloc)
+    else:
+        tabulate = _reference_tabulator(ref, fields, jets, h, max_order, nloc)
+    if np.ptp(h) <= 1e-14 * h[0] and kind != "timoshenko2":
+        tables = tabulate(np.zeros(1, int), xi)  # one table for every (equal) element
+        tables.setflags(write=False)
+        tables = np.broadcast_to(tables, points.shape + tables.shape[2:])
+    else:
+        tables = tabulate(np.arange(mesh.elements), xi)
+    dofs = np.concatenate([base_dofs + i * per for i in range(len(fields))], axis=1)
+    return Discretisation(kind, mesh.elements, float(mesh.nodes[-1]), fields, tuple(jets), points, weights, tables,
+                          dofs, per * len(fields), ends, mesh, tabulate)
+
+
+def _reference_tabulator(ref, fields, jets, h, max_order, nloc) -> Callable:
+    """(elements, xi) -> tables (len(elements), len(xi), jets, dofs) of a reference element, fields independent."""
+
+    def tabulate(elements: np.ndarray, xi: np.ndarray) -> np.ndarray:
+        local = ref.tabulate(xi, max_order, h[elements])
+        out = np.zeros(local.shape[:2] + (len(jets), nloc * len(fields)))
+        for a, (f, k) in enumerate(jets):
+            i = fields.index(f)
+            out[:, :, a, i * nloc:(i + 1) * nloc] = local[:, :, k, :]
+        return out
+
+    return tabulate
+
+
+def _timoshenko_tabulator(fields, jets, h, shear, nloc) -> Callable:
+    """(elements, xi) -> tables of the two-node Timoshenko element: each pair (w, psi) shares its four dofs."""
+    if shear is None:
+        raise ValueError("the timoshenko2 element needs the model's shear pairs (model.shear_pair) and ratios")
+    pairs, phi = shear
+    paired = {f for w, psi, _ in pairs for f in (w, psi)}
+    lone = [f for f in fields if f not in paired]
+    if lone:
+        raise ValueError(f"the timoshenko2 element pairs displacements with section rotations; fields {lone} are "
+                         "in no shear pair (model.shear_pair)")
+
+    def tabulate(elements: np.ndarray, xi: np.ndarray) -> np.ndarray:
+        out = np.zeros((len(elements), len(xi), len(jets), nloc * len(fields)))
+        for k, (w, psi, sign) in enumerate(pairs):
+            shapes = timoshenko_shapes(xi, h[elements], phi[elements, k], sign, 1)
+            iw, ip = fields.index(w), fields.index(psi)
+            cols = np.r_[iw * nloc:(iw + 1) * nloc, ip * nloc:(ip + 1) * nloc]
+            for a, (f, order) in enumerate(jets):
+                if f in (w, psi):
+                    out[:, :, a, cols] = shapes[:, :, 0 if f == w else 1, order, :]
+        return out
+
+    return tabulate
 
 
 _TABLES: OrderedDict = OrderedDict()  # memoised global-basis tables, least recently used first
@@ -136,6 +206,8 @@ def _gauss(nq: int) -> tuple[np.ndarray, np.ndarray]:
 
 def minimum_points(kind: str, size: int) -> tuple[int, int]:
     """(automatic, minimum) Gauss points per element for a discretisation of this size."""
+    if kind == "timoshenko2":
+        return 4, 4  # cubic w, quadratic psi: products of degree <= 6 exact
     if kind in ELEMENTS:
         p = reference(kind).degree
         return p + 1, p + 1
@@ -154,8 +226,12 @@ def end_conditions(constraints, field: str) -> tuple[str, str]:
 
 
 def discretise(kind: str, size: int, length: float, fields, jets, *, quadrature: int = 0,
-               constraints=()) -> Discretisation:
-    """Tables of ``jets`` ((field, order) pairs) for ``size`` elements or basis functions per field."""
+               constraints=(), mesh: Mesh | None = None, shear=None) -> Discretisation:
+    """Tables of ``jets`` ((field, order) pairs) for ``size`` elements or basis functions per field.
+
+    Elements may lie on a given ``mesh`` (segments and parts, mechgen.runtime.mesh);
+    ``timoshenko2`` needs ``shear`` = ([(w, psi, sign), ...], phi of shape (elements, pairs)).
+    """
     if kind not in DISCRETISATIONS:
         raise ValueError(f"unknown discretisation {kind!r}")
     if size < 1:
@@ -176,33 +252,16 @@ def discretise(kind: str, size: int, length: float, fields, jets, *, quadrature:
             raise ValueError(f"the sine basis forces {f} = 0 at both ends, but the boundary conditions leave {f} "
                              f"free at the {'start' if ends[f][0] == 'free' else 'end'}: choose legendre, beam, "
                              "cosine or finite elements")
-    if kind in GLOBAL:
-        points = (xi * length)[None, :]
-        weights = (wi * length)[None, :]
-        per = size
-        local = {f: _global_table(kind, points[0], size, length, max_order, ends[f])[None] for f in fields}
-        base_dofs = np.arange(per)[None, :]
-    else:
-        ref = reference(kind)
-        if max_order > max(ref.continuity, 0) + 1:
-            raise ValueError(f"the {kind} element is C{ref.continuity}: energies with derivatives of order "
-                             f"{max_order} need a C{max_order - 1} discretisation (hermite or quintic, or a global basis)")
-        h = np.full(size, length / size)
-        starts = np.arange(size) * (length / size)
-        points = starts[:, None] + xi[None, :] * h[:, None]
-        weights = wi[None, :] * h[:, None]
-        per = (size * (len(ref.nodes) - 1) + 1) * len(ref.orders)
-        shared = ref.tabulate(xi, max_order, h[:1])
-        local = {f: shared for f in fields}  # one table for every (equal) element
-        base_dofs = _element_field_dofs(ref, np.arange(size))
-    nloc = base_dofs.shape[1]
-    tables = np.zeros((1,) + points.shape[1:] + (len(jets), nloc * len(fields)))
+    if kind not in GLOBAL:
+        return _elements(kind, size, length, fields, jets, xi, wi, max_order, ends, mesh, shear)
+    points = (xi * length)[None, :]
+    weights = (wi * length)[None, :]
+    per = size
+    tables = np.zeros((1, len(xi), len(jets), per * len(fields)))
     for a, (f, k) in enumerate(jets):
         i = fields.index(f)
-        tables[:, :, a, i * nloc:(i + 1) * nloc] = local[f][:, :, k, :]
-    if tables.shape[0] != points.shape[0]:
-        tables.setflags(write=False)
-        tables = np.broadcast_to(tables, points.shape + tables.shape[2:])
+        tables[0, :, a, i * per:(i + 1) * per] = _global_table(kind, points[0], size, length, max_order, ends[f])[:, k, :]
+    base_dofs = np.arange(per)[None, :]
     dofs = np.concatenate([base_dofs + i * per for i in range(len(fields))], axis=1)
     return Discretisation(kind, size, float(length), fields, tuple(jets), points, weights, tables, dofs,
                           per * len(fields), ends)

@@ -14,15 +14,16 @@ from mechgen.runtime.modes import modes as solve_modes
 from mechgen.runtime.newton import newton
 from mechgen.runtime.stability import stability as solve_stability
 from mechgen.runtime.stability import stability_first_order, stability_sparse
+from mechgen.runtime.system import System
+from mechgen.scene.whirl import is_gyroscopic, run_campbell, run_damped_modes
 
 #: above this many unknowns, a stability analysis with a ``count`` of sparse matrices uses shift-invert
 SPARSE_STABILITY_N = 400
-from mechgen.runtime.system import System
 
 
 def needs(kind: str, options: dict, *, internal: bool) -> set[str]:
     """Kernels an analysis needs."""
-    if kind in ("modes", "stability"):
+    if kind in ("modes", "stability", "campbell"):
         return {"linear"}
     if kind == "steady":
         return {"residual", "tangent", "outputs"} | ({"rates", "rates_tangent"} if internal else set())
@@ -53,9 +54,20 @@ def operating_point(system: System, options: dict, context: dict) -> np.ndarray:
 
 
 def run_modes(system: System, options: dict, context: dict) -> dict:
-    """Natural frequencies (rad/s or the model's unit) about the operating point."""
+    """Natural frequencies (rad/s or the model's unit) about the operating point.
+
+    A system with damping, gyroscopic terms or a non-symmetric stiffness, and any
+    rotor (a model with a whirl pair), gets its damped modes instead
+    (mechgen.scene.whirl): ``frequencies`` are then the damped natural frequencies,
+    with ``eigenvalues``, ``log_dec`` and (rotors) ``whirl``.
+    """
     q = operating_point(system, options, context)
     mats = system.linear(q)
+    if is_gyroscopic(mats) or system.meta.get("whirl"):
+        out = run_damped_modes(system, mats, options)
+        if system.is_field and options.get("count"):
+            out.update(_field_shapes(system, np.real(out["_shapes"]), "shapes"))
+        return out
     res = solve_modes(mats["M"], mats["K"], count=options.get("count"),
                       allow_singular_mass=getattr(system, "has_multipliers", False))
     out = {"frequencies": [float(f) for f in res.frequencies], "_shapes": res.shapes}
@@ -251,4 +263,5 @@ def run_simulate(system: System, options: dict, context: dict) -> dict:
     return out
 
 
-RUNNERS = {"modes": run_modes, "stability": run_stability, "steady": run_steady, "simulate": run_simulate}
+RUNNERS = {"modes": run_modes, "stability": run_stability, "steady": run_steady, "simulate": run_simulate,
+           "campbell": run_campbell}

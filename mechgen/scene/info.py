@@ -24,6 +24,9 @@ class ModelInfo:
     params: dict
     coordinates: tuple[str, ...]
     outputs: tuple[str, ...]
+    continuum: bool = False
+    length: str | None = None
+    parts: dict | None = None
 
 
 def lookup_model(name: str) -> ModelInfo | None:
@@ -37,4 +40,6 @@ def lookup_model(name: str) -> ModelInfo | None:
     if model.is_lattice:
         n = int(model.param(model.chain_spec.sites).default)
         coords = tuple(f"{model.chain_spec.coordinate}_{i + 1}" for i in range(n))
-    return ModelInfo(model.name, params, coords, model.output_names)
+    cont = model.continuum
+    return ModelInfo(model.name, params, coords, model.output_names, cont is not None,
+                     cont.length if cont else None, dict(model.parts))

@@ -32,10 +32,10 @@ except ImportError:  # pragma: no cover - Python 3.10
 from mechgen.errors import InputError, SceneError
 from mechgen.scene.expr import CONSTANTS, Expression, is_identifier, parse_expression
 
-KINDS = ("modes", "stability", "steady", "simulate", "sweep")
+KINDS = ("modes", "stability", "steady", "simulate", "sweep", "campbell")
 BACKENDS = ("c", "numpy", "casadi")
 METHODS = ("BDF", "Radau", "LSODA", "RK45", "DOP853", "leapfrog")
-TOP_KEYS = ("title", "model", "backend", "free", "params", "coordinates", "analysis")
+TOP_KEYS = ("title", "model", "backend", "free", "params", "coordinates", "analysis", "segments", "parts")
 MAX_SCENE_BYTES = 10 * 1024 * 1024
 MAX_GRID = 1_000_000
 MAX_TITLE = 500
@@ -88,6 +88,8 @@ class Scene:
     free: tuple[str, ...]
     active: tuple[str, ...] | None
     analyses: tuple[AnalysisSpec, ...]
+    segments: tuple = ()
+    parts: tuple = ()
 
 
 @dataclass
@@ -541,9 +543,28 @@ def _over(ctx: _Ctx, key: str, value: object) -> dict[str, list]:
     return over
 
 
+def _speeds(ctx: _Ctx, key: str, value: object) -> dict[str, list]:
+    """A campbell range: one numeric parameter (the spin speed) with increasing values."""
+    over = _over(ctx, key, value)
+    if len(over) != 1:
+        raise _fail(ctx.file, key, f"a campbell diagram runs over one parameter, got {len(over)}",
+                    "one entry: Omega = {start, stop, num} or an array")
+    (name, values), = over.items()
+    if _is_choice(_param_info(ctx.file, key, ctx.model, name)) or len(values) < 2 or np.any(np.diff(values) <= 0):
+        raise _fail(ctx.file, _join(key, name), "campbell speeds must be two or more increasing numbers",
+                    "increasing numbers, e.g. {start = 0, stop = 1000, num = 50}")
+    return over
+
+
+def _multiples(ctx: _Ctx, key: str, value: object) -> list[float]:
+    if not isinstance(value, list) or not value:
+        raise _fail(ctx.file, key, f"value is {_type_name(value)}", "a non-empty array of positive numbers")
+    return [_positive(ctx, f"{key}[{i}]", v) for i, v in enumerate(value, 1)]
+
+
 def _inner(ctx: _Ctx, key: str, value: object) -> AnalysisSpec:
     """The analysis a sweep repeats: a table with ``kind`` (not sweep) and that kind's keys."""
-    inner_kinds = [k for k in KINDS if k != "sweep"]
+    inner_kinds = [k for k in KINDS if k not in ("sweep", "campbell")]
     if not isinstance(value, dict):
         raise _fail(ctx.file, key, f"value is {_type_name(value)}", "a table with kind and its options")
     kind = _kind(ctx, key, value, inner_kinds)
@@ -574,6 +595,8 @@ SCHEMAS: dict[str, dict[str, tuple[Callable, Any]]] = {
                  "outputs": (_outputs, _ALL_OUTPUTS), "series": (_bool, False), "samples": (_count, 201)},
     "sweep": {"over": (_over, _REQUIRED), "analysis": (_inner, _REQUIRED), "workers": (_workers, 0),
               "progress": (_bool, True)},
+    "campbell": {"over": (_speeds, _REQUIRED), "count": (_count, 8), "multiples": (_multiples, [1.0]),
+                 "about": (_about, _ABSENT), "at": (_coord_table, _ABSENT)},
 }
 
 
@@ -691,6 +714,10 @@ def load_scene(path: str, *, overrides: Sequence[str] = (), lookup_model: Callab
     ctx = _Ctx(file, model, params, depends, active or tuple(model.coordinates), active)
     analyses = _analyses(ctx, data)
     for spec in analyses:
-        if spec.kind == "sweep":
+        if spec.kind in ("sweep", "campbell"):
             free += [n for n in spec.options["over"] if n not in free]
-    return Scene(file, title, model.name, backend, params, tuple(free), active, analyses)
+    from mechgen.scene.layout import load_layout
+
+    segments, parts = load_layout(file, data, model, params)
+    free += sorted({n for seg in segments for n in seg.values if n not in free})
+    return Scene(file, title, model.name, backend, params, tuple(free), active, analyses, segments, parts)

@@ -117,6 +117,33 @@ def _shapes(plt, a: dict, path: Path) -> bool:
     return True
 
 
+def _campbell(plt, a: dict, path: Path) -> None:
+    """Tracked whirl frequencies against spin speed (forward solid, backward dashed), multiples of the
+    speed as excitation lines and the critical speeds where they cross."""
+    out = a["outputs"]
+    speeds, freqs = out["speeds"], list(zip(*out["frequencies"]))
+    whirls = list(zip(*out["whirl"]))
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    for k, (curve, labels) in enumerate(zip(freqs, whirls)):
+        forward = labels[len(labels) // 2] == "forward"
+        ax.plot(speeds, curve, "-" if forward else "--", color=f"C{k % 10}", lw=1.2,
+                label=f"mode {k + 1} ({'F' if forward else 'B'})")
+    top = max(max(c) for c in freqs)
+    for r in sorted({c["multiple"] for c in out.get("critical_speeds", [])} or {1.0}):
+        reach = min(speeds[-1], top / r)
+        ax.plot([0, reach], [0, r * reach], "k:", lw=1)
+        ax.annotate(f"{r:g}x", (reach, r * reach), fontsize=7)
+    for c in out.get("critical_speeds", []):
+        ax.plot(c["speed"], c["frequency"], "kx", ms=6)
+    ax.set_xlabel(f"{out.get('parameter', 'speed')} (rad/s)")
+    ax.set_ylabel("damped natural frequency (rad/s)")
+    ax.set_title(f"{a['name']}: Campbell diagram (solid forward, dashed backward; x critical speeds)", fontsize=9)
+    ax.legend(fontsize=7, ncol=2, loc="upper left")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
 def plot_results(results: dict, folder: Path) -> list[Path]:
     """Write one PNG per plottable analysis into ``folder``; returns the paths."""
     plt = _pyplot()
@@ -126,6 +153,8 @@ def plot_results(results: dict, folder: Path) -> list[Path]:
         path = folder / f"{Path(results['scene']).stem}_{a['name']}.png"
         if a["kind"] == "sweep":
             _sweep(plt, a, path)
+        elif a["kind"] == "campbell":
+            _campbell(plt, a, path)
         elif a["kind"] in ("modes", "stability"):
             _eigen(plt, a, path)
             shapes = path.with_name(path.stem + "_shapes.png")

@@ -2,14 +2,19 @@
 from __future__ import annotations
 
 
-def _fmt(value, width: int = 8) -> str:
+def _fmt(value, width: int = 8, depth: int = 0) -> str:
+    """One line: numbers to 6 digits, lists cut at ``width`` items, nesting below two levels only sized."""
     if isinstance(value, float):
         return f"{value:.6g}"
     if isinstance(value, list):
-        shown = ", ".join(_fmt(v) for v in value[:width])
+        if depth >= 2:
+            return f"[...] ({len(value)})"
+        shown = ", ".join(_fmt(v, width, depth + 1) for v in value[:width])
         return f"[{shown}{', ...' if len(value) > width else ''}] ({len(value)})" if len(value) > width else f"[{shown}]"
     if isinstance(value, dict):
-        return "{" + ", ".join(f"{k}: {_fmt(v)}" for k, v in list(value.items())[:width]) + "}"
+        if depth >= 2:
+            return "{" + ", ".join(str(k) for k in list(value)[:width]) + "}"
+        return "{" + ", ".join(f"{k}: {_fmt(v, width, depth + 1)}" for k, v in list(value.items())[:width]) + "}"
     return str(value)
 
 
@@ -23,7 +28,8 @@ def summary(results: dict) -> str:
     for a in results["analyses"]:
         lines.append(f"[{a['kind']}] {a['name']} ({a['seconds']:.3f} s)")
         for key, value in a["outputs"].items():
-            if key in ("t", "energy_series", "grid") or (a["kind"] == "sweep" and key == "eigenvalues"):
+            if key in ("t", "energy_series", "grid", "s", "shapes") or (a["kind"] in ("sweep", "campbell")
+                                                                      and key in ("eigenvalues", "log_dec")):
                 continue
             lines.append(f"    {key}: {_fmt(value, width=4 if a['kind'] == 'sweep' else 8)}")
         if a["kind"] == "sweep":

@@ -7,6 +7,7 @@ starts with "_" are working data and never reach JSON.
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from functools import lru_cache
 from pathlib import Path
 
@@ -15,6 +16,7 @@ import numpy as np
 from mechgen import models
 from mechgen.compile import compile_model
 from mechgen.errors import InputError
+from mechgen.runtime.mesh import Layout
 from mechgen.runtime.sweep import sweep
 from mechgen.scene.analyses import RUNNERS, needs
 from mechgen.scene.info import lookup_model
@@ -33,15 +35,23 @@ def _system_for(model_name: str, values: tuple, free: tuple, active, kernels: tu
     return compile_model(model, spec, kernels=set(kernels), backend=backend)
 
 
+def _laid_out(system, layout: Layout | None):
+    """The system with the scene's segments and parts (a copy; the cached system stays bare)."""
+    if layout is None or not (layout.segments or layout.parts):
+        return system
+    return replace(system, layout=layout, _cache={})
+
+
 def _sweep_point(task: tuple) -> dict:
     """Run the inner analysis of a sweep at one grid point (module level: picklable)."""
-    model_name, values, free, active, kernels, backend, kind, options, point = task
+    model_name, values, free, active, kernels, backend, kind, options, point, layout = task
     system, _ = _system_for(model_name, values, free, active, kernels, backend)
     model = models.get(model_name)
     sizes = {k: v for k, v in point.items() if not model.param(k).is_numeric}
     if sizes:
         system, _ = _system_for(model_name, tuple(sorted({**dict(values), **sizes}.items())), free, active,
                                 kernels, backend)
+    system = _laid_out(system, layout)
     system.params = np.array([float(point.get(n, dict(values).get(n, model.param(n).default)))
                               for n in system.meta.get("params", [])])
     return _public(RUNNERS[kind](system, options, {}))
@@ -65,6 +75,8 @@ def run_scene(scene, *, overrides=(), backend: str | None = None) -> dict:
     fixed = tuple(sorted((k, v) for k, v in scn.params.items()))
     started = time.perf_counter()
     system, report = _system_for(scn.model, fixed, free, scn.active, tuple(kernels), backend)
+    layout = Layout(scn.segments, scn.parts)
+    system = _laid_out(system, layout)
     results = {"scene": Path(scn.path).name, "title": scn.title, "model": scn.model, "backend": report.backend,
                "params": dict(scn.params), "build": report.to_json(), "analyses": []}
     results["build"]["seconds_total"] = time.perf_counter() - started
@@ -74,7 +86,7 @@ def run_scene(scene, *, overrides=(), backend: str | None = None) -> dict:
         if analysis.kind == "sweep":
             inner = analysis.options["analysis"]
             tasks = [(scn.model, fixed, free, scn.active, tuple(kernels), backend, inner.kind, dict(inner.options),
-                      point) for point in analysis.options["grid"]]
+                      point, layout) for point in analysis.options["grid"]]
             res = sweep(_sweep_point, tasks, workers=analysis.options.get("workers", 0),
                         progress=analysis.options.get("progress", True), desc=analysis.name)
             outputs = _collect(analysis.options["grid"], res)

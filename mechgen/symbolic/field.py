@@ -120,7 +120,10 @@ class FieldEquations:
         fields: field names.
         length: name of the length parameter L.
         constraints: essential boundary conditions.
-        points: pointwise equations of the end terms, by end ('start', 'end').
+        points: pointwise equations of the end terms, by end ('start', 'end'), and of
+            each part kind (placed by the scene), by kind.
+        parts: parameter names (model-level, ``<kind>_<name>``) of each part kind.
+        shear_pairs: (displacement, rotation, sign) of a Timoshenko-type model.
     """
 
     local: LumpedEquations
@@ -129,6 +132,8 @@ class FieldEquations:
     length: str
     constraints: tuple[Constraint, ...]
     points: dict = field(default_factory=dict)
+    parts: dict = field(default_factory=dict)
+    shear_pairs: tuple = ()
 
 
 def _density(model: Model, fn, what: str, env: dict) -> sp.Expr:
@@ -211,7 +216,12 @@ def derive_field(model: Model, spec: Specialization) -> FieldEquations:
     fns = {"kinetic": model.kinetic_fn, "potential": model.potential_fn, "dissipation": model.dissipation_fn,
            "weak": model.weak_fn}
     domain = _local(model, fns, env, u, test)
-    ends = {at: _local(model, model.point_terms[at], env, u, test) for at in sorted(model.point_terms)}
+    ends = {}
+    for at in sorted(model.point_terms):
+        here = dict(env)
+        if at in model.parts:
+            here["part"] = Namespace({n: p_ns[f"{at}_{n}"] for n in model.parts[at]})
+        ends[at] = _local(model, model.point_terms[at], here, u, test)
     orders = {f: -1 for f in model.field_names}
     constraints = _constraints(model, p_ns)
     for f, k, _ in list(u.used) + list(test.used) + [(c.field, c.order, 0) for c in constraints]:
@@ -226,4 +236,6 @@ def derive_field(model: Model, spec: Specialization) -> FieldEquations:
     local = _equations(model, domain, _residual(model, domain, jets, u, test), jets, u, free)
     points = {at: _equations(model, pieces, _residual(model, pieces, jets, u, test), jets, u, free)
               for at, pieces in ends.items()}
-    return FieldEquations(local, jets, tuple(model.field_names), cont.length, constraints, points)
+    parts = {kind: [f"{kind}_{n}" for n in names] for kind, names in model.parts.items()}
+    return FieldEquations(local, jets, tuple(model.field_names), cont.length, constraints, points, parts,
+                          tuple(model.shear_pairs))

@@ -16,7 +16,7 @@ A lattice model (:meth:`Model.chain`) declares instead one *site* and one
 from __future__ import annotations
 
 import inspect
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import sympy as sp
 from typing import Callable
@@ -126,6 +126,9 @@ class Model:
         self.weak_fn: Callable | None = None
         self.boundary_fn: Callable | None = None
         self.point_terms: dict[str, dict[str, Callable]] = {}
+        self.parts: dict[str, tuple[str, ...]] = {}
+        self.shear_pairs: list[tuple[str, str, int]] = []
+        self.whirl: tuple[str, str] | None = None
 
     # -- declarations ---------------------------------------------------
     def params(self, *params: Param) -> Namespace:
@@ -209,9 +212,67 @@ class Model:
         self.weak_fn = fn
         return fn
 
+    def part(self, kind: str, *params: Param, doc: str = "") -> None:
+        """Declare a kind of lumped part that a scene places along a continuum (a disk, a bearing).
+
+        Its energies are point terms, ``@model.point_kinetic(kind)`` etc., whose
+        functions may ask for ``part``: a namespace of the part's own parameters
+        ``params`` (each instance in the scene gives its own values). They are
+        model parameters named ``<kind>_<name>``, always kept symbolic (kernel
+        inputs), so one kernel serves every instance.
+        """
+        if self.continuum is None:
+            raise ModelError(f"part {kind!r} of model {self.name} declared before its fields", file=self.file,
+                             key="part", expected="model.field(...) first")
+        check_identifier(kind, what="part kind", file=self.file)
+        if kind in ("start", "end") or kind in self.parts:
+            raise ModelError(f"part kind {kind!r} is reserved or declared twice", file=self.file, key="part",
+                             expected="a new name other than 'start' and 'end'")
+        names = []
+        for prm in params:
+            full = replace(prm, name=f"{kind}_{prm.name}")
+            self.params(full)
+            names.append(prm.name)
+        self.parts[kind] = tuple(names)
+
+    def shear_pair(self, displacement: str, rotation: str, sign: int = 1) -> None:
+        """Declare that field ``rotation`` is the section rotation whose shear-free value is sign * d(displacement)/ds.
+
+        A Timoshenko-type model with shear strain gamma = u_s - sign * psi. The
+        two-node shaft element (discretisation ``timoshenko2``) interpolates each
+        pair with the shape functions that solve the static, unloaded equations
+        exactly (Friedman & Kosmatka 1993; the usual rotordynamics shaft element).
+        """
+        for name in (displacement, rotation):
+            if name not in self.field_names:
+                raise ModelError(f"shear pair names {name!r}, which is not a field of {self.name}", file=self.file,
+                                 key="shear_pair", expected=f"fields among {', '.join(self.field_names)}")
+        if sign not in (1, -1):
+            raise ModelError(f"shear pair sign {sign!r}", file=self.file, key="shear_pair", expected="1 or -1")
+        self.shear_pairs.append((displacement, rotation, int(sign)))
+
+    def whirl_pair(self, x: str, y: str) -> None:
+        """Declare the lateral displacements (coordinates or fields) whose orbit classifies whirl.
+
+        A mode whirls *forward* when its orbit turns from x towards y, the sense of a
+        positive spin about z = x cross y, and *backward* otherwise; modes analyses
+        of gyroscopic systems then report ``whirl`` per mode.
+        """
+        names = set(self.coordinates_all) | set(self.field_names)
+        for name in (x, y):
+            if name not in names:
+                raise ModelError(f"whirl pair names {name!r}, which is not a coordinate or field of {self.name}",
+                                 file=self.file, key="whirl_pair", expected=f"names among {', '.join(sorted(names))}")
+        self.whirl = (x, y)
+
+    def part_params(self) -> tuple[str, ...]:
+        """Model parameter names of every part kind's parameters (always symbolic)."""
+        return tuple(f"{kind}_{name}" for kind, names in self.parts.items() for name in names)
+
     def _point(self, kind: str, at: str) -> Callable:
-        if at not in ("start", "end"):
-            raise ModelError(f"point term at {at!r}", file=self.file, key=f"point_{kind}", expected="'start' or 'end'")
+        if at not in ("start", "end") and at not in self.parts:
+            raise ModelError(f"point term at {at!r}", file=self.file, key=f"point_{kind}",
+                             expected="'start', 'end' or a part kind declared with model.part(...)")
 
         def register(fn: Callable) -> Callable:
             self.point_terms.setdefault(at, {})[kind] = fn
@@ -220,7 +281,10 @@ class Model:
         return register
 
     def point_kinetic(self, at: str) -> Callable:
-        """Decorator (continuum): kinetic energy of a point mass/inertia at ``at`` ('start' or 'end'), T(u, p)."""
+        """Decorator (continuum): kinetic energy of a point mass/inertia at ``at`` ('start', 'end' or a part kind).
+
+        The function gets the jets ``u`` at the point, ``p`` and, for a part, ``part``.
+        """
         return self._point("kinetic", at)
 
     def point_potential(self, at: str) -> Callable:

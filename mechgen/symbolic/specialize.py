@@ -47,8 +47,10 @@ def all_free(model: Model) -> Specialization:
 def specialize(model: Model, values: dict, *, free: tuple[str, ...] = (), active=None) -> Specialization:
     """Build a :class:`Specialization` from resolved scene values.
 
-    Every numeric parameter not in ``free`` is fixed (to ``values`` or its default).
+    Every numeric parameter not in ``free`` is fixed (to ``values`` or its default);
+    the parameters of part kinds (:meth:`Model.part`) are always free.
     """
+    free = tuple(free) + tuple(n for n in model.part_params() if n not in free)
     fixed: dict = {}
     free_values: dict = {}
     for prm in model.param_list:
