@@ -217,7 +217,7 @@ def compile_model(model: Model, spec: Specialization, *, kernels=None, backend: 
     if model.is_field:
         fixed = {k: v for k, v in spec.values.items() if model.param(k).is_numeric}
         choices = {k: spec.values.get(k, model.param(k).default)
-                   for k in ("discretisation", "N", "quadrature", "constraints")}
+                   for k in ("discretisation", "N", "quadrature", "constraints", "joints")}
         system = FieldSystem(loaded, meta, values, fixed, choices, report.backend)
     else:
         system = System(loaded, meta, values, sites or 0, report.backend)

@@ -8,6 +8,9 @@
 * penalty: x = q and K gets alpha C^T C with alpha = PENALTY_FACTOR * max|diag K|
   (K unconstrained, at the zero state), the paper's way (seed 002); frequencies
   converge to the constrained ones as 1/PENALTY_FACTOR.
+* joints (substructures joined at segment interfaces): their continuity rows are
+  eliminated by the null space together with eliminated boundary rows, kept beside
+  penalty boundary rows (x = null(J) q, penalty on C x), or bordered with multiplier ones.
 * multiplier: the unknowns are (x, lambda); K is bordered, [[K, C^T], [C, 0]], the
   residual is (r + C^T lambda, C x) and M, D, G get zero rows and columns for
   lambda (a singular mass: modes and stability solve the generalized problem and
@@ -90,11 +93,25 @@ def binding(row: np.ndarray, scale: float) -> bool:
     return bool(np.abs(row).max() > 1e-10 * max(scale, 1.0))
 
 
-def reduction(rows: np.ndarray, scales: np.ndarray, ndof: int, method: str, sparse: bool) -> Reduction:
-    """Reduction for constraint rows (one per condition) whose jets have table magnitudes ``scales``."""
+def reduction(rows: np.ndarray, scales: np.ndarray, ndof: int, method: str, sparse: bool,
+              joints: np.ndarray | None = None) -> Reduction:
+    """Reduction for constraint rows (one per condition) whose jets have table magnitudes ``scales``.
+
+    ``joints`` are further rows that join substructures (continuity at segment
+    interfaces): eliminated exactly by their null space, x = null(J) q (the
+    reduction of the constrained problem to a standard one), together with the
+    boundary rows when those are eliminated too; kept as multipliers with them.
+    """
     rows = np.atleast_2d(np.asarray(rows, float)).reshape(-1, ndof)
     keep = [binding(r, s) for r, s in zip(rows, scales)]
     rows = rows[np.asarray(keep, bool)] if len(rows) else rows
+    joints = np.zeros((0, ndof)) if joints is None else np.atleast_2d(np.asarray(joints, float)).reshape(-1, ndof)
+    if len(joints) and method != "multiplier":
+        if method == "penalty":
+            return Reduction(ndof, sla.null_space(joints, rcond=1e-10), rows if len(rows) else None)
+        rows = np.vstack([rows, joints])
+    elif len(joints):
+        rows = np.vstack([rows, joints])
     if not len(rows):
         return Reduction(ndof, None)
     if method == "penalty":

@@ -90,7 +90,7 @@ class FieldSystem:
                 self._cache[key] = discretise(kind, int(self.choices["N"]), length, self.info["fields"], jets,
                                               quadrature=int(self.choices["quadrature"]),
                                               constraints=[tuple(c) for c in self.info["constraints"]], mesh=mesh,
-                                              shear=shear)
+                                              shear=shear, joints=self.choices.get("joints", "assembly"))
             except ValueError as exc:
                 raise InputError(str(exc), key="discretisation",
                                  expected="a discretisation that fits the model's energies") from None
@@ -102,8 +102,9 @@ class FieldSystem:
         disc = self.disc
         if "red" not in self._cache:
             _, rows, scales = self._constraint_rows()
+            joints = self._joint_rows()
             red = reduction(np.array(rows), np.array(scales), disc.ndof, self.choices["constraints"],
-                            sparse=not disc.is_global)
+                            sparse=not disc.is_global and not joints, joints=np.array(joints) if joints else None)
             if red.penalty_rows is not None and disc.is_global:
                 raise InputError(f"penalty constraints with the global {disc.kind} basis couple every function "
                                  "to the penalty and wreck the conditioning", key="constraints",
@@ -120,6 +121,45 @@ class FieldSystem:
             rows.append(disc.row(f, int(k), 0.0 if at == "start" else disc.length))
             scales.append(float(np.abs(disc.tables[:, :, disc.jets.index((f, int(k))), :]).max()))
         return keys, rows, scales
+
+    def _joint_rows(self) -> list[np.ndarray]:
+        """Continuity rows of substructures at segment interfaces (``joints = "multiplier"``), as in Yu & Cleghorn.
+
+        At an interface s_j: every field's value from the left equals that from
+        the right, and so do derivatives the energy needs continuous (orders below
+        its highest); a derivative dof the energy does not need continuous (C1
+        elements, first-order energy) is tied instead by continuity of the force
+        conjugate to it, the flux F_f = sum_b K[(f, 1), b] j_b with K the pointwise
+        stiffness of each side's segment (kGA (u_s - psi) and EI psi_s for a shaft).
+        Rows are scaled to a largest entry of 1.
+        """
+        disc = self.disc
+        mesh = disc.mesh
+        if self.choices.get("joints", "assembly") != "multiplier" or mesh is None or not len(mesh.interfaces):
+            return []
+        jets = list(disc.jets)
+        top = max(k for _, k in jets)
+        orders = (0,) if disc.kind in ("lagrange1", "lagrange2", "timoshenko2") else (0, 1)
+        seg_params = self._segment_params()
+        rows = []
+        for v in mesh.interfaces:
+            x = float(mesh.nodes[v])
+            for f in disc.fields:
+                for k in orders:
+                    if k < top:
+                        rows.append(disc.row(f, k, x, "left") - disc.row(f, k, x, "right"))
+                        continue
+                    a = jets.index((f, k))
+                    row = np.zeros(disc.ndof)
+                    for side, seg in (("left", mesh.segment[v - 1]), ("right", mesh.segment[v])):
+                        params = None if seg_params is None else seg_params[seg]
+                        K = self._evaluate("linear" if "linear" in self.kernels else "tangent", None, None, None, 0.0,
+                                           np.array([x]), params=params)
+                        K = next(iter(K[o] for o in ("K", "r_q") if o in K))[0].reshape(len(jets), len(jets))
+                        flux = sum(K[a, b] * disc.row(*jets[b], x, side) for b in np.flatnonzero(K[a]))
+                        row = row + (flux if side == "left" else -flux)
+                    rows.append(row)
+        return [r / max(np.abs(r).max(), 1e-300) for r in rows]
 
     @property
     def has_multipliers(self) -> bool:
@@ -340,13 +380,9 @@ class FieldSystem:
         return [{"jet": f + ("_" + "s" * k if k else ""), "at": at, "value": float(v)}
                 for (f, k, at), v in zip(kept, lam)]
 
-    def nodal_indices(self, fields) -> tuple[np.ndarray, ...]:
-        """Reduced-unknown indices of the nodal values of ``fields`` at the mesh vertices where none is eliminated.
-
-        Element discretisations only (a nodal value dof *is* the field there): the
-        whirl stations of a rotor. One array per field, paired by vertex.
-        """
-        disc, red = self.disc, self.reduction
+    def _nodal_dofs(self, fields) -> list[np.ndarray]:
+        """Full-dof numbers of the nodal values of ``fields`` at every mesh vertex (element discretisations)."""
+        disc = self.disc
         if disc.mesh is None:
             raise InputError(f"whirl stations need finite elements; {disc.kind} is a global basis",
                              key="discretisation", expected="an element discretisation (quintic, timoshenko2, ...)")
@@ -358,15 +394,36 @@ class FieldSystem:
             i = disc.fields.index(f)
             block = disc.dofs[:, i * nloc:(i + 1) * nloc]
             out.append(np.concatenate([block[:, 0], block[-1:, last]]))
+        return out
+
+    def nodal_indices(self, fields) -> tuple[np.ndarray, ...] | None:
+        """Reduced-unknown indices of the nodal values of ``fields`` at the vertices where none is eliminated.
+
+        A nodal value dof *is* the field there: the whirl stations of a rotor, one
+        array per field, paired by vertex. None when the unknowns are not a
+        selection of dofs (substructures joined by a null-space reduction): see
+        :meth:`nodal_rows`.
+        """
+        red = self.reduction
+        if red.Z is not None and red.keep is None:
+            return None
         index = np.arange(red.ndof) if red.keep is None else np.full(red.ndof, -1)
         if red.keep is not None:
             index[red.keep] = np.arange(len(red.keep))
-        elif red.Z is not None:
-            raise InputError("whirl stations need boundary conditions that eliminate single dofs", key="constraints",
-                             expected="'eliminate', 'penalty' or 'multiplier' with finite elements")
-        mapped = [index[dofs] for dofs in out]
+        mapped = [index[dofs] for dofs in self._nodal_dofs(fields)]
         kept = np.all([m >= 0 for m in mapped], axis=0)
         return tuple(m[kept] for m in mapped)
+
+    def nodal_rows(self, fields) -> np.ndarray:
+        """R with R q = the nodal values of ``fields`` (stacked field by field) for reduced unknowns q."""
+        red = self.reduction
+        dofs = np.concatenate(self._nodal_dofs(fields))
+        if red.Z is None:
+            R = np.zeros((len(dofs), red.n))
+            R[np.arange(len(dofs)), dofs] = 1.0
+            return R
+        Z = red.Z.toarray() if sps.issparse(red.Z) else np.asarray(red.Z)
+        return Z[dofs]
 
     def field_values(self, q, points: np.ndarray, order: int = 0) -> dict[str, np.ndarray]:
         """D_s^order of every field at ``points`` for the reduced state q (mode shapes, deflections)."""

@@ -74,8 +74,8 @@ class Discretisation:
         i = self.fields.index(field)
         return np.arange(i * per, (i + 1) * per)
 
-    def row(self, field: str, order: int, at: float) -> np.ndarray:
-        """The dense row c with c @ x = D_s^order u_field(at)."""
+    def row(self, field: str, order: int, at: float, side: str = "right") -> np.ndarray:
+        """The dense row c with c @ x = D_s^order u_field(at) (at a vertex: from the element to the ``side``)."""
         out = np.zeros(self.ndof)
         per = self.ndof // len(self.fields)
         offset = self.fields.index(field) * per
@@ -85,14 +85,14 @@ class Discretisation:
             out[offset:offset + per] = table[0, order]
             return out
         mesh = self.mesh
-        e = mesh.element_at(at)
+        e = mesh.element_at(at, side)
         h = mesh.nodes[e + 1] - mesh.nodes[e]
         table = self.tabulate(np.array([e]), np.array([(at - mesh.nodes[e]) / h]))[0, 0]
         out[self.dofs[e]] = table[self.jets.index((field, order))]
         return out
 
 
-def _elements(kind, size, length, fields, jets, xi, wi, max_order, ends, mesh, shear) -> Discretisation:
+def _elements(kind, size, length, fields, jets, xi, wi, max_order, ends, mesh, shear, joints) -> Discretisation:
     """Finite elements on ``mesh`` (default: ``size`` equal elements); see :func:`discretise`."""
     mesh = mesh or build_mesh(None, size, length)
     if kind == "timoshenko2":
@@ -110,7 +110,8 @@ def _elements(kind, size, length, fields, jets, xi, wi, max_order, ends, mesh, s
     points = mesh.nodes[:-1, None] + xi[None, :] * h[:, None]
     weights = wi[None, :] * h[:, None]
     split = mesh.breaks if max_order <= 1 and max(orders) > 0 else None
-    base_dofs, per = dof_map(len(nodes), orders, mesh.elements, split)
+    apart = mesh.interfaces if joints == "multiplier" else None
+    base_dofs, per = dof_map(len(nodes), orders, mesh.elements, split, apart)
     nloc = base_dofs.shape[1]
     if kind == "timoshenko2":
         tabulate = _timoshenko_tabulator(fields, jets, h, shear, nloc)
@@ -226,11 +227,13 @@ def end_conditions(constraints, field: str) -> tuple[str, str]:
 
 
 def discretise(kind: str, size: int, length: float, fields, jets, *, quadrature: int = 0,
-               constraints=(), mesh: Mesh | None = None, shear=None) -> Discretisation:
+               constraints=(), mesh: Mesh | None = None, shear=None, joints: str = "assembly") -> Discretisation:
     """Tables of ``jets`` ((field, order) pairs) for ``size`` elements or basis functions per field.
 
     Elements may lie on a given ``mesh`` (segments and parts, mechgen.runtime.mesh);
     ``timoshenko2`` needs ``shear`` = ([(w, psi, sign), ...], phi of shape (elements, pairs)).
+    ``joints = "multiplier"`` keeps the segments apart (no dof shared at their interfaces);
+    the caller then joins them by constraints.
     """
     if kind not in DISCRETISATIONS:
         raise ValueError(f"unknown discretisation {kind!r}")
@@ -253,7 +256,7 @@ def discretise(kind: str, size: int, length: float, fields, jets, *, quadrature:
                              f"free at the {'start' if ends[f][0] == 'free' else 'end'}: choose legendre, beam, "
                              "cosine or finite elements")
     if kind not in GLOBAL:
-        return _elements(kind, size, length, fields, jets, xi, wi, max_order, ends, mesh, shear)
+        return _elements(kind, size, length, fields, jets, xi, wi, max_order, ends, mesh, shear, joints)
     points = (xi * length)[None, :]
     weights = (wi * length)[None, :]
     per = size

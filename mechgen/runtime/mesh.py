@@ -50,20 +50,22 @@ class Layout:
 
 @dataclass(frozen=True)
 class Mesh:
-    """Vertices, the segment of each element and the interior break vertices."""
+    """Vertices, the segment of each element, the interior break vertices and the segment interfaces."""
 
     nodes: np.ndarray
     segment: np.ndarray
     breaks: np.ndarray
+    interfaces: np.ndarray = field(default_factory=lambda: np.zeros(0, int))
 
     @property
     def elements(self) -> int:
         """Number of elements."""
         return len(self.nodes) - 1
 
-    def element_at(self, s: float) -> int:
-        """The element containing s (the right one at an interior vertex)."""
-        return int(np.clip(np.searchsorted(self.nodes, s, side="right") - 1, 0, self.elements - 1))
+    def element_at(self, s: float, side: str = "right") -> int:
+        """The element containing s (at an interior vertex: the one to the ``side``, 'right' or 'left')."""
+        k = np.searchsorted(self.nodes, s, side="right" if side == "right" else "left") - 1
+        return int(np.clip(k, 0, self.elements - 1))
 
 
 def build_mesh(layout: Layout | None, size: int, length: float) -> Mesh:
@@ -94,23 +96,26 @@ def build_mesh(layout: Layout | None, size: int, length: float) -> Mesh:
                              "choose segment lengths and element counts that put a vertex there")
         at_parts.append(k)
     breaks = np.array(sorted({int(k) for k in list(interfaces) + at_parts if 0 < k < len(nodes) - 1}), int)
-    return Mesh(nodes, segment, breaks)
+    return Mesh(nodes, segment, breaks, np.asarray(interfaces, int))
 
 
 def dof_map(nodes_per_element: int, orders: tuple[int, ...], elements: int,
-            split: np.ndarray | None = None) -> tuple[np.ndarray, int]:
+            split: np.ndarray | None = None, apart: np.ndarray | None = None) -> tuple[np.ndarray, int]:
     """Local-to-global dofs (elements, nodes * len(orders)) of one field, and the field's dof count.
 
     Element e shares its first vertex with element e - 1; at a vertex in ``split``
-    only the order-0 dofs are shared, and the derivative dofs of the two sides are separate.
+    only the order-0 dofs are shared, and the derivative dofs of the two sides are
+    separate; at a vertex in ``apart`` nothing is shared (substructures joined by
+    constraints).
     """
     per_node = len(orders)
     nloc = nodes_per_element * per_node
-    if split is None or not len(split):
+    apart_set = {int(v) for v in (apart if apart is not None else ())}
+    if (split is None or not len(split)) and not apart_set:
         start = np.arange(elements) * (nodes_per_element - 1) * per_node
         count = (elements * (nodes_per_element - 1) + 1) * per_node
         return start[:, None] + np.arange(nloc), count
-    split_set = {int(v) for v in split}
+    split_set = {int(v) for v in (split if split is not None else ())}
     dofs = np.empty((elements, nloc), np.int64)
     nxt = 0
     previous_end: list[int] = []
@@ -118,7 +123,7 @@ def dof_map(nodes_per_element: int, orders: tuple[int, ...], elements: int,
         row = []
         for k in range(nodes_per_element):
             for i, order in enumerate(orders):
-                if k == 0 and e > 0 and not (order > 0 and e in split_set):
+                if k == 0 and e > 0 and e not in apart_set and not (order > 0 and e in split_set):
                     row.append(previous_end[i])
                 else:
                     row.append(nxt)

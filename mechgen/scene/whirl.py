@@ -30,7 +30,8 @@ def is_gyroscopic(mats: dict) -> bool:
 
 
 def whirl_stations(system) -> tuple[np.ndarray, np.ndarray] | None:
-    """Indices (into the unknowns) of the x and y displacements whose orbits classify whirl, or None."""
+    """Indices (into the unknowns) of the x and y displacements whose orbits classify whirl, or None
+    (no whirl pair, or unknowns that are not a selection of nodal values)."""
     pair = system.meta.get("whirl")
     if not pair:
         return None
@@ -53,9 +54,15 @@ def run_damped_modes(system, mats: dict, options: dict) -> dict:
     out = {"frequencies": [float(w) for w in res.wd],
            "eigenvalues": [[float(s.real), float(s.imag)] for s in res.eigenvalues],
            "log_dec": [float(d) for d in res.log_dec], "_shapes": res.shapes}
-    stations = whirl_stations(system)
-    if stations is not None:
-        out["whirl"] = _paired(whirl(res.shapes, *stations), res.wd)
+    pair = system.meta.get("whirl")
+    if pair:
+        stations = whirl_stations(system)
+        shapes = res.shapes
+        if stations is None:  # unknowns are no selection of nodal values: observe them through x = Z q
+            shapes = system.nodal_rows(pair) @ shapes
+            half = shapes.shape[0] // 2
+            stations = (np.arange(half), half + np.arange(half))
+        out["whirl"] = _paired(whirl(shapes, *stations), res.wd)
     return out
 
 
@@ -87,10 +94,13 @@ def run_campbell(system, options: dict, context: dict) -> dict:
     from mechgen.scene.analyses import operating_point
 
     name, speeds = _speed_parameter(system, options)
-    stations = whirl_stations(system)
-    if stations is None:
+    if not system.meta.get("whirl"):
         raise SceneError(f"model {system.meta.get('model')} declares no whirl pair", key="kind",
                          expected="a model with Model.whirl_pair (a rotor) for a campbell analysis")
+    stations = whirl_stations(system)
+    if stations is None:
+        raise SceneError("a campbell diagram tracks whirl at nodal values; substructures joined by multipliers have "
+                         "none", key="joints", expected="joints = 'assembly' for campbell (the same frequencies)")
     index = system.meta["params"].index(name)
     q = operating_point(system, options, context)
     saved = float(system.params[index])

@@ -173,8 +173,10 @@ class Model:
         Adds the discretisation parameters every continuum has: ``discretisation``
         (a choice, see :data:`mechgen.runtime.discretise.DISCRETISATIONS`), ``N``
         (elements, or basis functions per field), ``quadrature`` (Gauss points per
-        element, 0 = chosen from the basis) and ``constraints`` (``eliminate``,
-        ``penalty`` or ``multiplier``). Densities are then declared with :meth:`kinetic_density`,
+        element, 0 = chosen from the basis), ``constraints`` (``eliminate``,
+        ``penalty`` or ``multiplier``) and ``joints`` (``assembly``: segments share
+        their interface nodes; ``multiplier``: substructures joined by continuity
+        constraints). Densities are then declared with :meth:`kinetic_density`,
         :meth:`potential_density`, :meth:`dissipation_density` or :meth:`weak_form`.
         """
         from mechgen.symbolic.discretisations import DISCRETISATIONS
@@ -190,7 +192,9 @@ class Model:
                     Param("N", N, "", "elements, or basis functions per field", size=True),
                     Param("quadrature", 0, "", "Gauss points per element (0: chosen from the basis)", size=True),
                     Param("constraints", "eliminate", "", "essential boundary conditions by",
-                          choices=("eliminate", "penalty", "multiplier")))
+                          choices=("eliminate", "penalty", "multiplier")),
+                    Param("joints", "assembly", "", "segments of a scene joined by",
+                          choices=("assembly", "multiplier")))
 
     def kinetic_density(self, fn: Callable) -> Callable:
         """Decorator (continuum): kinetic energy per unit length T(u, p, s, t) of the jets u."""
