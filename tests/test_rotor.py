@@ -186,3 +186,59 @@ def test_penalty_supports_and_multiplier_joints_as_in_the_paper():
     assert 1e-8 < np.abs(penalised / exact - 1).max() < 1e-5
     bordered = _stepped("quintic", 4, joints="multiplier", constraints="multiplier")
     np.testing.assert_allclose(whirl_frequencies(bordered, 2000.0, 8), exact, rtol=1e-6)
+
+
+def test_shear_coefficients_of_hollow_sections():
+    """Cowper (1966) and Hutchinson (2001) shear coefficients for a hollow circle (m = d/D, nu = E/2G - 1),
+    as written in ROSS's shaft element: each selectable law gives the frequencies of the constant-kappa
+    shaft with that value, and the three differ (the laws are not silently the same)."""
+    E, G, D, d = 211e9, 81.2e9, 0.05, 0.03
+    nu, m2 = E / (2 * G) - 1, (d / D) ** 2
+    cowper = 6 * (1 + nu) * (1 + m2) ** 2 / ((7 + 6 * nu) * (1 + m2) ** 2 + (20 + 12 * nu) * m2)
+    hutchinson = 6 * (1 + nu) * (1 + m2) ** 2 / ((7 + 12 * nu + 4 * nu**2) * (1 + m2) ** 2
+                                                 + 4 * (5 + 6 * nu + 2 * nu**2) * m2)
+    base = {"bc": "pinned-pinned", "discretisation": "quintic", "N": 6, "d": d}
+    results = {}
+    for law, kappa in (("cowper", cowper), ("hutchinson", hutchinson)):
+        results[law] = whirl_frequencies(shaft({**base, "shear": law}), 1000.0, 8)
+        constant = whirl_frequencies(shaft({**base, "shear": "constant", "shear_kappa": kappa}), 1000.0, 8)
+        np.testing.assert_allclose(results[law], constant, rtol=1e-10)
+    assert np.abs(results["cowper"] / results["hutchinson"] - 1).max() > 1e-5
+
+
+def test_hard_case_free_free_shaft_drops_rigid_modes():
+    """Singular K: an unsupported shaft has four rigid modes (s = 0), which never count as frequencies; the
+    flexible ones of a stiff-shear shaft without rotary inertia are the free-free Euler-Bernoulli beam's,
+    beta_n L = 4.730040744862704, 7.853204624095838 (roots of cos(bL) cosh(bL) = 1), each twice."""
+    E, rho, D, L = 211e9, 7810.0, 0.05, 1.0
+    A, I = np.pi / 4 * D**2, np.pi / 64 * D**4
+    beta = np.array([4.730040744862704, 7.853204624095838]) / L
+    eb = np.repeat(beta**2 * np.sqrt(E * I / (rho * A)), 2)
+    system = shaft({"bc": "free-free", "discretisation": "quintic", "N": 8, "G_s": 1e4 * E, "shear": "constant",
+                    "shear_kappa": 1.0, "rotary": 0.0})
+    mats = system.linear(np.zeros(system.n))
+    res = damped_modes(mats["M"], mats["D"] + mats["G"], mats["K"], 4)
+    assert len(res.real_eigenvalues) == 8 and np.abs(res.real_eigenvalues).max() < 1e-7 * res.scale  # round-off
+    np.testing.assert_allclose(res.wd, eb, rtol=1e-5)
+
+
+def test_hard_case_stiff_bearings_tend_to_pinned_supports():
+    """Bearings of 1e13 N/m (shaft stiffness ~1e6 N/m): the frequencies of the pinned-pinned shaft with the
+    same disk, to the support compliance O(1e-7); the solver copes with the 1e7 stiffness contrast."""
+    disk = Part("disk", 0.5, {"m": 30.0, "Id": 0.2, "Ip": 0.35})
+    soft = Layout(parts=(disk, Part("bearing", 0.0, {"kxx": 1e13, "kyy": 1e13}),
+                         Part("bearing", 1.0, {"kxx": 1e13, "kyy": 1e13})))
+    spring = whirl_frequencies(shaft({"bc": "free-free", "discretisation": "quintic", "N": 4}, soft), 1500.0, 6)
+    pinned = whirl_frequencies(shaft({"bc": "pinned-pinned", "discretisation": "quintic", "N": 4},
+                                     Layout(parts=(disk,))), 1500.0, 6)
+    np.testing.assert_allclose(spring, pinned, rtol=1e-6)
+
+
+def test_hard_case_high_speed_stays_conservative():
+    """Omega = 1e5 rad/s (far above every critical speed): sparse and dense solvers agree to 1e-9 and every
+    eigenvalue stays on the imaginary axis (no spurious growth from round-off)."""
+    layout = Layout(parts=(Part("disk", 0.5, {"m": 30.0, "Id": 0.2, "Ip": 0.35}),
+                           Part("bearing", 0.0, {"kxx": 1e7, "kyy": 5e6}), Part("bearing", 1.0, {"kxx": 1e7, "kyy": 5e6})))
+    system = shaft({"discretisation": "quintic", "N": 4}, layout)
+    dense = whirl_frequencies(system, 1e5, 8, sparse=False)
+    np.testing.assert_allclose(whirl_frequencies(system, 1e5, 8, sparse=True), dense, rtol=1e-9)
