@@ -188,13 +188,15 @@ class Model:
         for name in names:
             self._claim(name, "field")
         self.continuum = Continuum(tuple(names), length)
-        self.params(Param("discretisation", discretisation, "", "basis or element family", choices=DISCRETISATIONS),
-                    Param("N", N, "", "elements, or basis functions per field", size=True),
-                    Param("quadrature", 0, "", "Gauss points per element (0: chosen from the basis)", size=True),
+        self.params(Param("discretisation", discretisation, "", "basis or element family", choices=DISCRETISATIONS,
+                          runtime=True),
+                    Param("N", N, "", "elements, or basis functions per field", size=True, runtime=True),
+                    Param("quadrature", 0, "", "Gauss points per element (0: chosen from the basis)", size=True,
+                          runtime=True),
                     Param("constraints", "eliminate", "", "essential boundary conditions by",
-                          choices=("eliminate", "penalty", "multiplier")),
+                          choices=("eliminate", "penalty", "multiplier"), runtime=True),
                     Param("joints", "assembly", "", "segments of a scene joined by",
-                          choices=("assembly", "multiplier")))
+                          choices=("assembly", "multiplier"), runtime=True))
 
     def kinetic_density(self, fn: Callable) -> Callable:
         """Decorator (continuum): kinetic energy per unit length T(u, p, s, t) of the jets u."""

@@ -27,6 +27,8 @@ class Param:
         size: the parameter is a runtime size (number of sites); never symbolic.
         choices: allowed strings for a choice parameter.
         positive: the parameter must be > 0 (also used as a sympy assumption).
+        runtime: a choice of the numerics only (a continuum's discretisation, N ...):
+            declared functions never see it, so it never changes a derivation.
     """
 
     name: str
@@ -37,6 +39,7 @@ class Param:
     size: bool = False
     choices: tuple[str, ...] | None = None
     positive: bool = False
+    runtime: bool = False
     symbol: sp.Symbol = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:

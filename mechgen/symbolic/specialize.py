@@ -24,16 +24,20 @@ class Specialization:
         free: numeric parameters kept symbolic, in model declaration order.
         active: coordinates kept; ``None`` keeps all (others are frozen at zero).
         free_values: starting values of the free parameters (kernel inputs, not folded).
+        runtime: names of runtime-only choices (Param.runtime): in ``values`` for the
+            numerics, left out of the derivation and of :meth:`key`, so that a new mesh
+            size or discretisation reuses the same kernels.
     """
 
     values: dict = field(default_factory=dict)
     free: tuple[str, ...] = ()
     active: tuple[str, ...] | None = None
     free_values: dict = field(default_factory=dict, compare=False)
+    runtime: tuple[str, ...] = ()
 
     def key(self) -> str:
-        """A canonical text of the specialisation (part of the cache key)."""
-        vals = ",".join(f"{k}={self.values[k]!r}" for k in sorted(self.values))
+        """A canonical text of the specialisation (part of the cache key; runtime choices left out)."""
+        vals = ",".join(f"{k}={self.values[k]!r}" for k in sorted(self.values) if k not in self.runtime)
         return f"values[{vals}] free[{','.join(self.free)}] active[{','.join(self.active or ())}]"
 
 
@@ -41,7 +45,7 @@ def all_free(model: Model) -> Specialization:
     """Every numeric parameter symbolic; choices and sizes at their defaults."""
     values = {p.name: p.default for p in model.param_list if not p.is_numeric}
     free = tuple(p.name for p in model.param_list if p.is_numeric)
-    return Specialization(values=values, free=free)
+    return Specialization(values=values, free=free, runtime=tuple(p.name for p in model.param_list if p.runtime))
 
 
 def specialize(model: Model, values: dict, *, free: tuple[str, ...] = (), active=None) -> Specialization:
@@ -68,7 +72,8 @@ def specialize(model: Model, values: dict, *, free: tuple[str, ...] = (), active
             raise ModelError(f"unknown active coordinates {unknown}", file=model.file, key="active",
                              expected=f"names among {', '.join(model.coordinates_all)}")
         active = tuple(c for c in model.coordinates_all if c in active)
-    return Specialization(values=fixed, free=ordered_free, active=active, free_values=free_values)
+    runtime = tuple(p.name for p in model.param_list if p.runtime)
+    return Specialization(values=fixed, free=ordered_free, active=active, free_values=free_values, runtime=runtime)
 
 
 def exact_number(value: float | int) -> sp.Expr:
@@ -83,6 +88,8 @@ def param_namespace(model: Model, spec: Specialization) -> tuple[Namespace, tupl
     items: dict = {}
     free_syms = []
     for prm in model.param_list:
+        if prm.runtime:
+            continue
         if prm.name in spec.free:
             items[prm.name] = prm.symbol
             free_syms.append(prm.symbol)
