@@ -1,0 +1,428 @@
+"""Pseudo-arclength continuation of F(u, lam) = 0, F: R^{n+1} -> R^n, through turning points.
+
+With x = (u, lam) and the unit tangent t (the null vector of [F_u, F_lam]), one step of
+length ds from an accepted point x_i is
+
+    predictor  x = x_i + ds t_i,
+    corrector  Newton on  F(x) = 0,  t_i . (x - x_i) = ds   (the bordered system
+               [[F_u, F_lam], [t_i^T]] dx = -[F, t_i . (x - x_i) - ds]),
+    tangent    [[F_u, F_lam], [t_i^T]] t = (0, 1), normalised: t . t_i > 0 keeps the
+               orientation, so the branch goes round a fold instead of turning back.
+
+The step grows (x ``grow``) after fast corrections, shrinks after slow ones, and is halved
+and retried when the corrector fails or the tangent turns more than ``max_turn``; below
+``ds_min`` the continuation stops with a message. A fold (turning point in lam) is a
+sign change of the tangent's lam-component between two points; it is located by Brent's
+method on the arclength s of the segment, with t_lam(s) from a corrected point, so the
+fold's lam is accurate to the square of the location error. The branch ends at
+``max_points`` or where lam leaves [lam_min, lam_max] (the last point is then put exactly
+on the bound).
+
+:func:`continue_bvp` continues a BVP (:class:`mechgen.runtime.bvp.BVP`) in one of its
+parameters through a collocation or multiple-shooting :class:`Discretisation`;
+:func:`minimize_along_branch` locates an extremum of a scalar output phi(u, lam) along a
+branch as a zero of d phi/ds (exact with the output's gradient, else central differences
+along the branch).
+"""
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sps
+import scipy.sparse.linalg as spla
+from scipy.optimize import brentq
+
+from mechgen.errors import ConvergenceError, InputError
+from mechgen.runtime.bvp import BVP, BVPResult, Discretisation
+
+
+@dataclass(frozen=True)
+class System:
+    """F(u, lam) (n,), F_u(u, lam) (n, n) dense or sparse, F_lam(u, lam) (n,)."""
+
+    F: Callable
+    F_u: Callable
+    F_lam: Callable
+    name: str = "F"
+
+
+@dataclass(frozen=True)
+class Fold:
+    """A turning point in lam between branch points ``index`` and ``index + 1``."""
+
+    u: np.ndarray
+    lam: float
+    index: int
+    tangent: np.ndarray
+    located: bool = True
+
+
+@dataclass(frozen=True)
+class Branch:
+    """Accepted points ``u`` (m, n) and ``lam`` (m,), their arclength and unit tangents
+    (m, n + 1), the folds, the callback's value per point (``data``), why it stopped
+    (``status``: 'max_points', 'lam_max', 'lam_min' or 'min_step') and a message, and
+    the system (to correct further points, e.g. for :func:`minimize_along_branch`)."""
+
+    u: np.ndarray
+    lam: np.ndarray
+    arclength: np.ndarray
+    tangents: np.ndarray
+    folds: tuple
+    data: tuple
+    status: str
+    message: str
+    system: Any = field(repr=False)
+
+
+@dataclass(frozen=True)
+class Extremum:
+    """An extremum of an output along a branch: the point, the value, 'min' or 'max', the
+    segment it lies on and |d phi/ds| there (the residual of the location)."""
+
+    u: np.ndarray
+    lam: float
+    value: float
+    kind: str
+    index: int
+    slope: float
+
+
+# ----------------------------------------------------------------------------- linear algebra
+class _Singular(Exception):
+    pass
+
+
+def _eval(system, u, lam, jac=True):
+    with np.errstate(all="ignore"):
+        F = np.asarray(system.F(u, lam), float).ravel()
+        if not jac:
+            return F, None, None
+        if not np.all(np.isfinite(F)):
+            return F, None, None
+        Fu = system.F_u(u, lam)
+        Fl = np.asarray(system.F_lam(u, lam), float).ravel()
+    if Fu is not None and not sps.issparse(Fu):
+        Fu = np.atleast_2d(np.asarray(Fu, float))
+    return F, Fu, Fl
+
+
+def _bordered_solve(Fu, Fl, row, rhs):
+    """Solve [[Fu, Fl], [row^T]] x = rhs (dense LU, or sparse LU when Fu is sparse)."""
+    n = Fl.size
+    if sps.issparse(Fu):
+        A = sps.vstack([sps.hstack([Fu, sps.csc_matrix(Fl.reshape(n, 1))]),
+                        sps.csr_matrix(row.reshape(1, n + 1))], format="csc")
+        if not np.all(np.isfinite(A.data)):
+            raise _Singular("the Jacobian is not finite")
+        try:
+            x = spla.splu(A).solve(rhs)
+        except RuntimeError as exc:
+            raise _Singular(str(exc)) from exc
+    else:
+        A = np.vstack([np.hstack([Fu, Fl[:, None]]), row[None, :]])
+        if not np.all(np.isfinite(A)):
+            raise _Singular("the Jacobian is not finite")
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("error", sla.LinAlgWarning)
+                lu = sla.lu_factor(A, check_finite=False)
+        except (np.linalg.LinAlgError, ValueError, sla.LinAlgWarning) as exc:
+            raise _Singular(str(exc)) from exc
+        if np.min(np.abs(np.diag(lu[0]))) <= 1e-14 * max(np.abs(A).max(), 1e-300):
+            raise _Singular("a zero pivot")
+        x = sla.lu_solve(lu, rhs, check_finite=False)
+    if not np.all(np.isfinite(x)):
+        raise _Singular("the solution of the bordered system is not finite")
+    return x
+
+
+def _tangent(Fu, Fl, ref):
+    """Unit null vector of [Fu, Fl] with t . ref > 0."""
+    rhs = np.zeros(Fl.size + 1)
+    rhs[-1] = 1.0
+    t = _bordered_solve(Fu, Fl, ref, rhs)
+    return t / np.linalg.norm(t)
+
+
+def _correct(system, x_pred, row, target, *, tol, max_iter, polish=False):
+    """Newton on F(x) = 0, row . x = target from x_pred. Returns (x, iterations, Fu, Fl) or None.
+
+    With ``polish`` one more Newton step follows convergence (for folds, extrema and end
+    points, whose lam should be exact to rounding rather than to tol / |F_lam|)."""
+    x = np.array(x_pred, float)
+    n = x.size - 1
+    prev = np.inf
+    done = False
+    for it in range(max_iter + 2):
+        F, Fu, Fl = _eval(system, x[:n], x[n])
+        norm = float(np.linalg.norm(F))
+        if not np.isfinite(norm) or Fu is None or norm > 1e3 * prev + 1e3 * tol:
+            return None
+        converged = norm <= tol and abs(row @ x - target) <= tol * max(1.0, abs(target))
+        if done or (converged and not polish):
+            return (x, it, Fu, Fl) if converged or norm <= 1e3 * tol else None
+        if converged:
+            done = True
+        elif it >= max_iter:
+            return None
+        R = np.append(F, row @ x - target)
+        try:
+            dx = _bordered_solve(Fu, Fl, row, -R)
+        except _Singular:
+            return None
+        x = x + dx
+        prev = max(norm, tol)
+    return None
+
+
+# ----------------------------------------------------------------------------- driver
+def _check_system(system, u, lam):
+    for name in ("F", "F_u", "F_lam"):
+        if not callable(getattr(system, name, None)):
+            raise InputError(f"continuation: the system has no callable {name}", key=name,
+                             expected="F(u, lam), F_u(u, lam) and F_lam(u, lam)")
+    u = np.asarray(u, float).ravel()
+    if not (np.all(np.isfinite(u)) and np.isfinite(lam)):
+        raise InputError("continuation: the starting point is not finite", key="u0", expected="finite values")
+    n = u.size
+    F, Fu, Fl = _eval(system, u, float(lam))
+    if F.shape != (n,):
+        raise InputError(f"continuation: F returned {F.size} values for {n} unknowns", key="F",
+                         expected=f"{n} values (F: R^(n+1) -> R^n)")
+    shape = Fu.shape if Fu is not None else None
+    if shape != (n, n):
+        raise InputError(f"continuation: F_u has shape {shape}", key="F_u", expected=f"({n}, {n})")
+    if Fl.shape != (n,):
+        raise InputError(f"continuation: F_lam has shape {Fl.shape}", key="F_lam", expected=f"({n},)")
+    return u
+
+
+def continuation(system, u0, lam0: float, *, ds: float = 0.05, ds_min: float = 1e-8, ds_max: float = 1.0,
+                 direction: int = 1, max_points: int = 200, lam_min: float = -np.inf, lam_max: float = np.inf,
+                 tol: float = 1e-10, max_corrector: int = 8, grow: float = 1.5, max_turn: float = 0.5,
+                 callback: Callable | None = None, locate_folds: bool = True) -> Branch:
+    """Continue F(u, lam) = 0 from (u0, lam0) in the direction of increasing lam
+    (``direction=+1``) or decreasing lam (-1).
+
+    ``system`` has F, F_u, F_lam (a :class:`System`, a :class:`Discretisation`, ...). The
+    start is first corrected at fixed lam0 (Newton). ``max_turn`` is the largest angle
+    (radians) between consecutive tangents; ``callback(u, lam)`` is called at every
+    accepted point and its values are kept in ``Branch.data``.
+    """
+    if not (0 < ds_min <= ds <= ds_max) or direction not in (1, -1) or max_points < 1 or not lam_min < lam_max \
+            or not 0 < max_turn < math.pi or tol <= 0 or grow < 1:
+        raise InputError(f"continuation: ds_min = {ds_min}, ds = {ds}, ds_max = {ds_max}, direction = {direction}, "
+                         f"max_points = {max_points}, lam range [{lam_min}, {lam_max}], max_turn = {max_turn}",
+                         key="options", expected="0 < ds_min <= ds <= ds_max, direction +1 or -1, max_points >= 1, "
+                         "lam_min < lam_max, 0 < max_turn < pi, tol > 0, grow >= 1")
+    lam0 = float(lam0)
+    u = _check_system(system, u0, lam0)
+    if not lam_min <= lam0 <= lam_max:
+        raise InputError(f"continuation: lam0 = {lam0} lies outside [{lam_min}, {lam_max}]", key="lam0",
+                         expected="a start inside the lam range")
+    n = u.size
+    e_lam = np.zeros(n + 1)
+    e_lam[-1] = 1.0
+    got = _correct(system, np.append(u, lam0), e_lam, lam0, tol=tol, max_iter=4 * max_corrector)
+    if got is None:
+        F = _eval(system, u, lam0, jac=False)[0]
+        raise ConvergenceError(f"continuation of {getattr(system, 'name', 'F')}: the start (lam = {lam0:.6g}, "
+                               f"||F|| = {np.linalg.norm(F):.3g}) could not be corrected onto the branch (Newton at "
+                               "fixed lam failed: a bad start or a fold exactly at the start)")
+    x, _, Fu, Fl = got
+    t = None
+    for ref in (e_lam, np.random.default_rng(0).standard_normal(n + 1)):
+        try:
+            t = _tangent(Fu, Fl, ref)
+            break
+        except _Singular:
+            continue
+    if t is None:
+        raise ConvergenceError("continuation: no tangent at the start ([F_u, F_lam] is rank deficient: a "
+                               "branch point)")
+    if t[-1] * direction < 0:
+        t = -t
+    xs, ts, arc = [x], [t], [0.0]
+    data = [callback(x[:n].copy(), x[n]) if callback else None]
+    folds = []
+    cos_turn = math.cos(max_turn)
+    status, message = "max_points", f"reached max_points = {max_points}"
+    step = ds
+    while len(xs) < max_points:
+        x_i, t_i = xs[-1], ts[-1]
+        got = _correct(system, x_i + step * t_i, t_i, t_i @ x_i + step, tol=tol, max_iter=max_corrector)
+        ok = got is not None
+        if ok:
+            x_new, iters, Fu, Fl = got
+            try:
+                t_new = _tangent(Fu, Fl, t_i)
+            except _Singular:
+                ok = False
+            else:
+                ok = t_new @ t_i >= cos_turn
+        if not ok:
+            step *= 0.5
+            if step < ds_min:
+                status = "min_step"
+                message = (f"the step fell below ds_min = {ds_min:.3g} at lam = {x_i[n]:.10g} (the corrector fails "
+                           "or the branch turns too sharply: a singular point, or tol below the residual's noise)")
+                break
+            continue
+        # a fold between x_i and x_new?
+        if locate_folds and t_i[n] * t_new[n] < 0:
+            fold = _locate_fold(system, x_i, t_i, step, tol=tol, max_corrector=max_corrector)
+            if fold is None:
+                lam_f = max(x_i[n], x_new[n]) if t_i[n] > 0 else min(x_i[n], x_new[n])
+                fold = Fold(x_new[:n].copy(), float(lam_f), len(xs) - 1, t_new, located=False)
+            else:
+                fold = Fold(fold[0][:n].copy(), float(fold[0][n]), len(xs) - 1, fold[1], True)
+            if lam_min <= fold.lam <= lam_max:
+                folds.append(fold)
+        if not lam_min <= x_new[n] <= lam_max:
+            bound = lam_max if x_new[n] > lam_max else lam_min
+            status = "lam_max" if bound == lam_max else "lam_min"
+            message = f"lam left [{lam_min}, {lam_max}] after lam = {x_i[n]:.10g}"
+            theta = (bound - x_i[n]) / (x_new[n] - x_i[n])
+            end = _correct(system, x_i + theta * (x_new - x_i), e_lam, bound, tol=tol, max_iter=max_corrector,
+                           polish=True)
+            if end is not None and (t_i[n] * t_new[n] > 0):
+                x_end, _, Fu, Fl = end
+                try:
+                    t_end = _tangent(Fu, Fl, t_i)
+                except _Singular:
+                    t_end = t_new
+                xs.append(x_end)
+                ts.append(t_end)
+                arc.append(arc[-1] + float(np.linalg.norm(x_end - x_i)))
+                data.append(callback(x_end[:n].copy(), x_end[n]) if callback else None)
+                message = f"lam reached the bound {bound:.10g}"
+            break
+        xs.append(x_new)
+        ts.append(t_new)
+        arc.append(arc[-1] + step)
+        data.append(callback(x_new[:n].copy(), x_new[n]) if callback else None)
+        if iters <= 3:
+            step = min(step * grow, ds_max)
+        elif iters >= max(4, max_corrector - 2):
+            step = max(0.7 * step, ds_min)
+    X, T = np.array(xs), np.array(ts)
+    return Branch(X[:, :n], X[:, n], np.array(arc), T, tuple(folds), tuple(data), status, message, system)
+
+
+def _segment_point(system, x_i, t_i, sigma, *, tol, max_corrector):
+    """The corrected point at arclength parameter sigma on the segment from x_i, and its tangent."""
+    got = _correct(system, x_i + sigma * t_i, t_i, t_i @ x_i + sigma, tol=tol, max_iter=2 * max_corrector,
+                   polish=True)
+    if got is None:
+        raise _Singular(f"no corrected point at sigma = {sigma:.6g}")
+    x, _, Fu, Fl = got
+    return x, _tangent(Fu, Fl, t_i)
+
+
+def _locate_fold(system, x_i, t_i, step, *, tol, max_corrector):
+    """Zero of t_lam(sigma) on [0, step] (Brent); None when it cannot be bracketed."""
+    cache = {}
+
+    def tlam(sigma):
+        if sigma == 0.0:
+            return t_i[-1]
+        x, t = _segment_point(system, x_i, t_i, sigma, tol=tol, max_corrector=max_corrector)
+        cache[sigma] = (x, t)
+        return t[-1]
+
+    try:
+        a, b = 0.0, step
+        fa, fb = t_i[-1], tlam(b)
+        if fa * fb > 0:
+            return None
+        sigma = brentq(tlam, a, b, xtol=1e-14 * max(1.0, step), maxiter=100)
+        return cache[sigma] if sigma in cache else _segment_point(system, x_i, t_i, sigma, tol=tol,
+                                                                  max_corrector=max_corrector)
+    except (_Singular, ValueError, RuntimeError):
+        return None
+
+
+# ----------------------------------------------------------------------------- BVP continuation
+def continue_bvp(problem: BVP, guess: BVPResult, lam_index: int, *, method: str = "collocation", mesh=100,
+                 rtol_ivp: float = 1e-10, ivp_method: str = "DOP853", **options) -> Branch:
+    """Continue a BVP in the fixed parameter p[lam_index], starting from ``guess`` (a
+    BVPResult, e.g. from :func:`~mechgen.runtime.bvp.collocate`).
+
+    ``method`` is 'collocation' (fixed mesh; ``mesh`` an interval count or nodes) or
+    'multiple_shooting' (``mesh`` the shooting nodes); ``options`` go to
+    :func:`continuation`. ``branch.system`` is the :class:`Discretisation`; its
+    ``to_result(u, lam)`` turns a branch point into a BVPResult.
+    """
+    if not isinstance(guess, BVPResult):
+        raise InputError(f"{problem.name}: continue_bvp needs a BVPResult to start from, got "
+                         f"{type(guess).__name__}", key="guess", expected="a BVPResult")
+    disc = Discretisation(problem, lam_index, guess.p, mesh, method=method, rtol_ivp=rtol_ivp,
+                          ivp_method=ivp_method)
+    u0, lam0 = disc.start(guess)
+    return continuation(disc, u0, lam0, **options)
+
+
+# ----------------------------------------------------------------------------- extrema
+def minimize_along_branch(branch: Branch, output: Callable, *, gradient: Callable | None = None, kind: str = "min",
+                          fd_step: float | None = None, tol: float | None = None) -> Extremum:
+    """The interior minimum (``kind='min'``) or maximum of phi = output(u, lam) along a branch.
+
+    The sampled extremum at point j brackets a sign change of d phi/ds on the segments
+    j-1 -> j -> j+1; Brent's method finds the zero on that segment (arclength parameter
+    sigma, corrected points). d phi/ds = grad phi . t with ``gradient(u, lam) ->
+    (d phi/du, d phi/dlam)``, else a central difference of phi between the corrected
+    points at sigma +- ``fd_step``. Raises ConvergenceError when the extremum is at an end
+    of the branch (continue further).
+    """
+    if kind not in ("min", "max"):
+        raise InputError(f"minimize_along_branch: kind = {kind!r}", key="kind", expected="'min' or 'max'")
+    system = branch.system
+    m, n = branch.u.shape
+    if m < 3:
+        raise InputError(f"minimize_along_branch: the branch has {m} points", key="branch",
+                         expected="at least 3 points")
+    sign = 1.0 if kind == "min" else -1.0
+    vals = np.array([float(output(branch.u[j], branch.lam[j])) for j in range(m)])
+    j = int(np.argmin(sign * vals))
+    if j == 0 or j == m - 1:
+        raise ConvergenceError(f"minimize_along_branch: the {kind}imum of the sampled output ({vals[j]:.6g}) is at "
+                               f"an end of the branch (lam = {branch.lam[j]:.6g}); continue the branch further")
+    tol = 1e-10 if tol is None else tol
+    X = np.hstack([branch.u, branch.lam[:, None]])
+    T = branch.tangents
+    h = fd_step if fd_step is not None else 1e-5 * max(float(np.min(np.diff(branch.arclength)[j - 1:j + 1])), 1e-8)
+
+    def point(i, sigma):
+        if sigma == 0.0:
+            return X[i], T[i]
+        return _segment_point(system, X[i], T[i], sigma, tol=tol, max_corrector=10)
+
+    def slope(i, sigma):
+        if gradient is not None:
+            x, t = point(i, sigma)
+            gu, gl = gradient(x[:n], x[n])
+            return float(np.dot(np.asarray(gu, float).ravel(), t[:n]) + gl * t[n])
+        xp, _ = point(i, sigma + h)
+        xm, _ = point(i, sigma - h) if sigma - h != 0.0 else (X[i], None)
+        return (float(output(xp[:n], xp[n])) - float(output(xm[:n], xm[n]))) / (2 * h)
+
+    for i in (j - 1, j):
+        length = float(T[i] @ (X[i + 1] - X[i]))
+        try:
+            a, b = slope(i, 0.0), slope(i, length)
+            if a * b > 0:
+                continue
+            sigma = brentq(lambda s: slope(i, s), 0.0, length, xtol=1e-13 * max(1.0, length), maxiter=100)
+            x, _ = point(i, sigma)
+            return Extremum(x[:n].copy(), float(x[n]), float(output(x[:n], x[n])), kind, i, abs(slope(i, sigma)))
+        except (_Singular, ValueError, RuntimeError) as exc:
+            raise ConvergenceError(f"minimize_along_branch: correcting points near lam = {X[i][n]:.6g} failed "
+                                   f"({exc})") from None
+    raise ConvergenceError(f"minimize_along_branch: d phi/ds does not change sign around the sampled {kind}imum at "
+                           f"lam = {branch.lam[j]:.6g} (a kink, or the branch is too coarse there)")
