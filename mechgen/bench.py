@@ -313,7 +313,7 @@ def report_markdown(rows, overhead, builds, start) -> str:
     return "\n".join(lines)
 
 
-SUITES = ("fpu", "beam")
+SUITES = ("fpu", "beam", "rotor")
 
 
 def run_benchmarks(models_: list[str] | None = None, *, out: Path, quick: bool = False) -> dict:
@@ -335,6 +335,10 @@ def run_benchmarks(models_: list[str] | None = None, *, out: Path, quick: bool =
         from mechgen.bench_field import run_field_benchmarks
 
         results["beam"] = run_field_benchmarks(out, quick=quick)
+    if "rotor" in chosen:
+        from mechgen.bench_rotor import run_rotor_benchmarks
+
+        results["rotor"] = run_rotor_benchmarks(out, quick=quick)
     return results
 
 

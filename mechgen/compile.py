@@ -37,6 +37,8 @@ from mechgen.symbolic.specialize import Specialization
 log = logging.getLogger("mechgen")
 BACKENDS = ("c", "numpy", "casadi")
 FIELD_KERNELS = ("residual", "tangent", "linear", "outputs")
+#: kernels of a continuum's steady boundary value problem (mechgen.symbolic.steady)
+STEADY_KERNELS = ("bvp_residual", "bvp_tangent", "bvp_outputs")
 _warned_no_compiler = False
 
 
@@ -79,21 +81,29 @@ def lower_all(model: Model, eqs, kernels, *, cse: bool = True) -> list[KernelIR]
         irs = [lower_lumped(eqs.local, k, cse=cse) for k in wanted]
         irs += [replace(lower_lumped(local, k, cse=cse), name=f"{k}_at_{at}") for at, local in eqs.points.items()
                 for k in wanted]
-        state = set(eqs.local.q + eqs.local.v) | {eqs.local.t}
-        constant_mass = all(not (local.jacobian(local.residual, "a").free_symbols & state)
-                            for local in [eqs.local, *eqs.points.values()])
+        meta = field_meta(eqs)
         for ir in irs:
-            ir.meta["field"] = {"fields": list(eqs.fields), "jets": [list(j) for j in eqs.jets],
-                                "length": eqs.length, "points": sorted(at for at in eqs.points if at not in eqs.parts),
-                                "constant_mass": constant_mass,
-                                "constraints": [[c.field, c.order, c.at] for c in eqs.constraints]}
-            if eqs.parts:
-                ir.meta["field"]["parts"] = {k: list(v) for k, v in sorted(eqs.parts.items())}
-            if eqs.shear_pairs:
-                ir.meta["field"]["shear_pairs"] = [list(p) for p in eqs.shear_pairs]
+            ir.meta["field"] = meta
         return _with_whirl(model, irs)
     lower = lower_lattice if model.is_lattice else lower_lumped
     return _with_whirl(model, [lower(eqs, k, cse=cse) for k in all_kernels(model) if k in kernels])
+
+
+def field_meta(eqs) -> dict:
+    """What the runtime needs to know of a continuum: fields, jets, length, ends, parts, constraints."""
+    state = set(eqs.local.q + eqs.local.v) | {eqs.local.t}
+    constant_mass = all(not (local.jacobian(local.residual, "a").free_symbols & state)
+                        for local in [eqs.local, *eqs.points.values()])
+    meta = {"fields": list(eqs.fields), "jets": [list(j) for j in eqs.jets],
+            "length": eqs.length, "points": sorted(at for at in eqs.points if at not in eqs.parts),
+            "constant_mass": constant_mass, "constraints": [[c.field, c.order, c.at] for c in eqs.constraints]}
+    if eqs.parts:
+        meta["parts"] = {k: list(v) for k, v in sorted(eqs.parts.items())}
+    if eqs.shear_pairs:
+        meta["shear_pairs"] = [list(p) for p in eqs.shear_pairs]
+    if any(c.value != 0 for c in eqs.constraints):
+        meta["boundary_values"] = True
+    return meta
 
 
 def _with_whirl(model: Model, irs: list[KernelIR]) -> list[KernelIR]:
@@ -169,6 +179,15 @@ def _generate(model: Model, spec: Specialization, kernels: set, backend: str, cs
     report.seconds["derive"] = time.perf_counter() - clock
     clock = time.perf_counter()
     irs = lower_all(model, eqs, kernels, cse=cse)
+    steady = [k for k in STEADY_KERNELS if k in kernels] if model.is_field else []
+    if steady:
+        from mechgen.symbolic.steady import derive_steady
+
+        form = derive_steady(model, spec)
+        for k in steady:
+            ir = replace(lower_lumped(form, k.removeprefix("bvp_"), cse=cse), name=k)
+            ir.meta["field"] = field_meta(eqs)
+            irs.append(_with_whirl(model, [ir])[0])
     report.seconds["lower"] = time.perf_counter() - clock
     clock = time.perf_counter()
     text = emit(backend, irs, model=model.name, title=spec.key())

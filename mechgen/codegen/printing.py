@@ -1,7 +1,7 @@
 """Expression printers for the backends (C99, numpy, CasADi).
 
-Small integer powers become products (``x*x*x``: exact and fast without
--ffast-math), x**(1/2) becomes sqrt, x**-n becomes 1.0/(...). Numbers print
+Small integer powers become bracketed products (``(x*x*x)``: exact and fast
+without -ffast-math), x**(1/2) becomes sqrt, x**-n becomes (1.0/(...)). Numbers print
 with 17 significant digits so a double survives the round trip.
 """
 from __future__ import annotations
@@ -18,9 +18,11 @@ def _power_text(printer, expr: sp.Pow) -> str | None:
     if exp.is_Integer and 1 < abs(int(exp)) <= MAX_UNROLLED_POWER:
         b = printer.parenthesize(base, sp.printing.precedence.PRECEDENCE["Mul"])
         prod = "*".join([b] * abs(int(exp)))
-        return prod if exp > 0 else f"1.0/({prod})"
+        # parenthesised: the Mul printer places a Pow after '/' unbracketed (Pow binds tighter), and
+        # a/(b*b) printed as a/b*b would be (a/b)*b
+        return f"({prod})" if exp > 0 else f"(1.0/({prod}))"
     if exp == -1:
-        return f"1.0/{printer.parenthesize(base, sp.printing.precedence.PRECEDENCE['Mul'])}"
+        return f"(1.0/{printer.parenthesize(base, sp.printing.precedence.PRECEDENCE['Mul'])})"
     return None
 
 

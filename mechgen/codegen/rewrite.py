@@ -78,7 +78,10 @@ def _horner_in(expr: sp.Expr, form: sp.Expr, last: sp.Symbol, z: sp.Symbol) -> s
         in_z = sp.expand(in_z)
     if in_z.free_symbols & others or not in_z.is_polynomial(z):
         return None
-    coeffs = sp.Poly(in_z, z).all_coeffs()
+    # coefficients that are not polynomials themselves (roots, quotients of parameters) stay plain
+    # expressions: sympy's composite-domain construction for them costs minutes on a rational density
+    exact = in_z.is_polynomial(*in_z.free_symbols)
+    coeffs = (sp.Poly(in_z, z) if exact else sp.Poly(in_z, z, domain="EX")).all_coeffs()
     if len(coeffs) < 2:
         return None
     low = 0

@@ -8,7 +8,7 @@ import importlib
 
 from mechgen.errors import InputError
 
-BUILTIN = ("euler_bernoulli_beam", "follower_column", "fpu_chain", "laval_rotor", "moving_string", "spinning_shaft",
+BUILTIN = ("balloon_string", "euler_bernoulli_beam", "follower_column", "fpu_chain", "laval_rotor", "moving_string", "spinning_shaft",
            "rotating_string", "spring_pendulum", "timoshenko_beam")
 
 

@@ -193,6 +193,22 @@ class FieldSystem:
                                                     for seg in layout.segments))
         return replace(self, choices={**self.choices, "N": int(size)}, layout=layout, _cache={})
 
+    # -- steady boundary value problem --------------------------------------------
+    def steady_form(self):
+        """The steady equations in s as a lumped :class:`~mechgen.runtime.system.System` (kernels ``bvp_*``).
+
+        Its first-order form is the boundary value problem: ``rhs(s, y)`` and
+        ``jacobian(s, y)`` with y = (u, u_s), and ``outputs(u, u_s, t=s)`` the model's
+        outputs and the boundary values ``bc_<field>_<order>_<end>``.
+        """
+        from mechgen.runtime.system import System
+
+        kernels = {k.removeprefix("bvp_"): v for k, v in self.kernels.items() if k.startswith("bvp_")}
+        if "residual" not in kernels:
+            raise InputError(f"the kernels of {self.meta.get('model')} were built without the steady form",
+                             key="kernels", expected="bvp_residual, bvp_tangent and bvp_outputs (a steady bvp analysis)")
+        return System(kernels, dict(kernels["residual"].spec["meta"]), np.array(self.params, float), 0, self.backend)
+
     # -- segments and parts -----------------------------------------------------
     def _with(self, values: dict, prefix: str = "", what: str = "segment") -> np.ndarray:
         """The parameter vector with ``values`` (names prefixed by ``prefix``) in place of the current ones."""

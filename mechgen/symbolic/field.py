@@ -41,16 +41,23 @@ ENDS = ("start", "end")
 
 @dataclass(frozen=True)
 class Constraint:
-    """An essential boundary condition: the jet ``D^order field`` vanishes at ``at`` ('start' or 'end')."""
+    """An essential boundary condition: the jet ``D^order field`` equals ``value`` at ``at`` ('start' or 'end').
+
+    Perturbations (modes, stability) and Galerkin unknowns satisfy it with value 0;
+    steady boundary value problems (mechgen.symbolic.steady) use the value, an
+    expression of the parameters.
+    """
 
     field: str
     order: int
     at: str
+    value: object = 0
 
 
-def fix(jet: str, at: str) -> tuple[str, str]:
-    """Boundary condition helper for ``@model.boundary``: ``fix("w_s", "end")`` means w_s(L) = 0."""
-    return (jet, at)
+def fix(jet: str, at: str, value=0) -> tuple:
+    """Boundary condition helper for ``@model.boundary``: ``fix("w_s", "end")`` means w_s(L) = 0,
+    ``fix("x", "end", 1)`` x(L) = 1 (a number or an expression of the parameters)."""
+    return (jet, at) if isinstance(value, (int, float)) and value == 0 else (jet, at, value)
 
 
 def fix_ends(bc: str, conditions: dict[str, tuple[str, ...]]) -> list[tuple[str, str]]:
@@ -154,15 +161,16 @@ def _constraints(model: Model, p_ns: Namespace) -> tuple[Constraint, ...]:
     raw = call_declared(model.boundary_fn, p=p_ns)
     out = []
     for item in raw or ():
-        if not (isinstance(item, tuple) and len(item) == 2 and all(isinstance(x, str) for x in item)):
+        if not (isinstance(item, tuple) and len(item) in (2, 3) and all(isinstance(x, str) for x in item[:2])):
             raise ModelError(f"boundary of model {model.name} returned {item!r}", file=model.file, key="boundary",
-                             expected="a list of fix(jet, 'start' | 'end')")
-        jet, at = item
+                             expected="a list of fix(jet, 'start' | 'end'[, value])")
+        jet, at = item[:2]
+        value = as_expr(item[2], "boundary value", model) if len(item) == 3 else sp.Integer(0)
         parsed = Jets.parse(jet, model.field_names)
         if parsed is None or parsed[2] or at not in ENDS:
             raise ModelError(f"boundary condition {item!r} of model {model.name} is not a spatial jet at an end",
                              file=model.file, key="boundary", expected="fix('w' or 'w_s' ..., 'start' or 'end')")
-        out.append(Constraint(parsed[0], parsed[1], at))
+        out.append(Constraint(parsed[0], parsed[1], at, value))
     return tuple(out)
 
 

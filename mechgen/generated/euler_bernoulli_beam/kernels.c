@@ -154,9 +154,9 @@ int mg_outputs(const double *const *in, double *const *out, const long *sizes, l
             const double g3 = in5[0];
             const double g4 = in5[1];
             const double g5 = in5[3];
-            const double t0 = (1.0/2.0)*g2*g2*g4;
+            const double t0 = (1.0/2.0)*(g2*g2)*g4;
             const double t1 = g0*g5;
-            const double t2 = g1*g1;
+            const double t2 = (g1*g1);
             out0[0] = t0;
             out1[0] = (1.0/2.0)*g3*t2 - t1;
             out2[0] = (1.0/2.0)*g3*t2 + t0 - t1;

@@ -433,9 +433,9 @@ def build_outputs(sizes, slots):
     g3 = in5[0]
     g4 = in5[1]
     g5 = in5[3]
-    t0 = ((1.0/2.0))*g2*g2*g4
+    t0 = ((1.0/2.0))*(g2*g2)*g4
     t1 = g0*g5
-    t2 = g1*g1
+    t2 = (g1*g1)
     out0[0] = t0
     out1[0] = ((1.0/2.0))*g3*t2 - t1
     out2[0] = ((1.0/2.0))*g3*t2 + t0 - t1

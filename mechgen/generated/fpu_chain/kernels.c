@@ -580,21 +580,21 @@ int mg_outputs(const double *const *in, double *const *out, const long *sizes, l
             const long hi = ns - 0 > lo ? (ns - 0 < cnt ? ns - 0 : cnt) : lo;
             for (long e = lo; e < hi; ++e) {
                 const double g0 = in1[e];
-                const double t0 = (1.0/2.0)*g0*g0;
+                const double t0 = (1.0/2.0)*(g0*g0);
                 out0[0] += t0;
                 out2[0] += t0;
             }
             for (long e = 0; e < lo; ++e) {
                 const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
                 const double g0 = ok8 ? in1[e] : 0.0;
-                const double t0 = (1.0/2.0)*g0*g0;
+                const double t0 = (1.0/2.0)*(g0*g0);
                 out0[0] += t0;
                 out2[0] += t0;
             }
             for (long e = hi; e < cnt; ++e) {
                 const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
                 const double g0 = ok8 ? in1[e] : 0.0;
-                const double t0 = (1.0/2.0)*g0*g0;
+                const double t0 = (1.0/2.0)*(g0*g0);
                 out0[0] += t0;
                 out2[0] += t0;
             }
@@ -611,7 +611,7 @@ int mg_outputs(const double *const *in, double *const *out, const long *sizes, l
                 const double g0 = in0[e - 1];
                 const double g1 = in0[e];
                 const double t0 = -g0 + g1;
-                const double t1 = t0*t0*((1.0/2.0)*g2 + t0*((1.0/3.0)*g3 + (1.0/4.0)*g4*t0));
+                const double t1 = (t0*t0)*((1.0/2.0)*g2 + t0*((1.0/3.0)*g3 + (1.0/4.0)*g4*t0));
                 out1[0] += t1;
                 out2[0] += t1;
             }
@@ -621,7 +621,7 @@ int mg_outputs(const double *const *in, double *const *out, const long *sizes, l
                 const double g0 = ok7 ? in0[e - 1] : 0.0;
                 const double g1 = ok8 ? in0[e] : 0.0;
                 const double t0 = -g0 + g1;
-                const double t1 = t0*t0*((1.0/2.0)*g2 + t0*((1.0/3.0)*g3 + (1.0/4.0)*g4*t0));
+                const double t1 = (t0*t0)*((1.0/2.0)*g2 + t0*((1.0/3.0)*g3 + (1.0/4.0)*g4*t0));
                 out1[0] += t1;
                 out2[0] += t1;
             }
@@ -631,7 +631,7 @@ int mg_outputs(const double *const *in, double *const *out, const long *sizes, l
                 const double g0 = ok7 ? in0[e - 1] : 0.0;
                 const double g1 = ok8 ? in0[e] : 0.0;
                 const double t0 = -g0 + g1;
-                const double t1 = t0*t0*((1.0/2.0)*g2 + t0*((1.0/3.0)*g3 + (1.0/4.0)*g4*t0));
+                const double t1 = (t0*t0)*((1.0/2.0)*g2 + t0*((1.0/3.0)*g3 + (1.0/4.0)*g4*t0));
                 out1[0] += t1;
                 out2[0] += t1;
             }

@@ -597,7 +597,7 @@ def build_outputs(sizes, slots):
     cnt = 1 * sizes['sites']
     ns = 1 * sizes['sites']
     g0 = ca.SX.sym('g0')
-    t0 = ((1.0/2.0))*g0*g0
+    t0 = ((1.0/2.0))*(g0*g0)
     local = ca.Function('local0', [g0], [ca.vertcat(t0, t0)])
     mapped = local.map(cnt)
     vals = mapped((_shift(ns, cnt, 0, False).T @ in1).T)
@@ -611,7 +611,7 @@ def build_outputs(sizes, slots):
     g3 = ca.SX.sym('g3')
     g4 = ca.SX.sym('g4')
     t0 = -g0 + g1
-    t1 = t0*t0*(((1.0/2.0))*g2 + t0*(((1.0/3.0))*g3 + ((1.0/4.0))*g4*t0))
+    t1 = (t0*t0)*(((1.0/2.0))*g2 + t0*(((1.0/3.0))*g3 + ((1.0/4.0))*g4*t0))
     local = ca.Function('local1', [g0, g1, g2, g3, g4], [ca.vertcat(t1, t1)])
     mapped = local.map(cnt)
     vals = mapped((_shift(ns, cnt, -1, False).T @ in0).T, (_shift(ns, cnt, 0, False).T @ in0).T, in2[0], in2[1], in2[2])

@@ -655,7 +655,7 @@ def mg_outputs(ins, outs, sizes):
     ok8 = (i8 >= 0) & (i8 < ns)
     i8 = np.clip(i8, 0, max(ns - 1, 0))
     g0 = np.where(ok8, in1[:, i8], 0.0)
-    t0 = ((1.0/2.0))*g0*g0
+    t0 = ((1.0/2.0))*(g0*g0)
     out0[:, 0] += np.sum(_bc(t0, shape), axis=-1)
     out2[:, 0] += np.sum(_bc(t0, shape), axis=-1)
     cnt = 1 * sizes['sites'] + 1
@@ -674,6 +674,6 @@ def mg_outputs(ins, outs, sizes):
     g3 = in2[1]
     g4 = in2[2]
     t0 = -g0 + g1
-    t1 = t0*t0*(((1.0/2.0))*g2 + t0*(((1.0/3.0))*g3 + ((1.0/4.0))*g4*t0))
+    t1 = (t0*t0)*(((1.0/2.0))*g2 + t0*(((1.0/3.0))*g3 + ((1.0/4.0))*g4*t0))
     out1[:, 0] += np.sum(_bc(t1, shape), axis=-1)
     out2[:, 0] += np.sum(_bc(t1, shape), axis=-1)

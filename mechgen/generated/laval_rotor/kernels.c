@@ -55,8 +55,8 @@ int mg_residual(const double *const *in, double *const *out, const long *sizes, 
             const double t4 = 2.0*t2*t3;
             out0[0] = g0*g15 + g12*g8 + g18*g4;
             out0[1] = g1*g15 + g12*g9 + g18*g5;
-            out0[2] = g10*g14*t0*t0 + g13*(g10*t1*t1 + g17*t3 + t4) - g14*t4 + g16*g2 + g19*g6;
-            out0[3] = g11*g14 - g13*g6*t0*(g17 + t2) + g14*g6*g6*t0*t1 + g16*g3 + g19*g7;
+            out0[2] = g10*g14*(t0*t0) + g13*(g10*(t1*t1) + g17*t3 + t4) - g14*t4 + g16*g2 + g19*g6;
+            out0[3] = g11*g14 - g13*g6*t0*(g17 + t2) + g14*(g6*g6)*t0*t1 + g16*g3 + g19*g7;
         }
     }
     return 0;
@@ -118,10 +118,10 @@ int mg_tangent(const double *const *in, double *const *out, const long *sizes, l
             const double t5 = g6*t0;
             const double t6 = t3*t5;
             const double t7 = g9*t1;
-            const double t8 = t0*t0;
+            const double t8 = (t0*t0);
             const double t9 = g5*t8;
             const double t10 = 2.0*g1;
-            const double t11 = t2*t2;
+            const double t11 = (t2*t2);
             const double t12 = g6*t11;
             const double t13 = t12 + t9;
             const double t14 = t10*t2;
@@ -191,10 +191,10 @@ int mg_linear(const double *const *in, double *const *out, const long *sizes, lo
             const double g9 = in4[6];
             const double g10 = in4[7];
             const double t0 = sin(g0);
-            const double t1 = t0*t0;
+            const double t1 = (t0*t0);
             const double t2 = g4*t1;
             const double t3 = cos(g0);
-            const double t4 = t3*t3;
+            const double t4 = (t3*t3);
             const double t5 = g5*t4;
             const double t6 = t2 + t5;
             const double t7 = g4*t0;
@@ -305,9 +305,9 @@ int mg_outputs(const double *const *in, double *const *out, const long *sizes, l
             const double g11 = in4[3];
             const double g12 = in4[4];
             const double g13 = in4[5];
-            const double t0 = g0*g0 + g1*g1;
-            const double t1 = (1.0/2.0)*g10*(g6*g6*cos(g3)*cos(g3) + g7*g7) + (1.0/2.0)*g8*(g4*g4 + g5*g5) + (1.0/2.0)*g9*(g13 + g6*sin(g3))*(g13 + g6*sin(g3));
-            const double t2 = (1.0/2.0)*g11*t0 + (1.0/2.0)*g12*(g2*g2 + g3*g3);
+            const double t0 = (g0*g0) + (g1*g1);
+            const double t1 = (1.0/2.0)*g10*((g6*g6)*(cos(g3)*cos(g3)) + (g7*g7)) + (1.0/2.0)*g8*((g4*g4) + (g5*g5)) + (1.0/2.0)*g9*((g13 + g6*sin(g3))*(g13 + g6*sin(g3)));
+            const double t2 = (1.0/2.0)*g11*t0 + (1.0/2.0)*g12*((g2*g2) + (g3*g3));
             out0[0] = sqrt(t0);
             out1[0] = t1;
             out2[0] = t2;

@@ -406,8 +406,8 @@ def build_residual(sizes, slots):
     t4 = 2.0*t2*t3
     out0[0] = g0*g15 + g12*g8 + g18*g4
     out0[1] = g1*g15 + g12*g9 + g18*g5
-    out0[2] = g10*g14*t0*t0 + g13*(g10*t1*t1 + g17*t3 + t4) - g14*t4 + g16*g2 + g19*g6
-    out0[3] = g11*g14 - g13*g6*t0*(g17 + t2) + g14*g6*g6*t0*t1 + g16*g3 + g19*g7
+    out0[2] = g10*g14*(t0*t0) + g13*(g10*(t1*t1) + g17*t3 + t4) - g14*t4 + g16*g2 + g19*g6
+    out0[3] = g11*g14 - g13*g6*t0*(g17 + t2) + g14*(g6*g6)*t0*t1 + g16*g3 + g19*g7
     return ca.Function('residual', [in0, in1, in2, in3, in4, in5], [out0], ['q', 'v', 'a', 'z', 't', 'p'], ['r'])
 
 
@@ -443,10 +443,10 @@ def build_tangent(sizes, slots):
     t5 = g6*t0
     t6 = t3*t5
     t7 = g9*t1
-    t8 = t0*t0
+    t8 = (t0*t0)
     t9 = g5*t8
     t10 = 2.0*g1
-    t11 = t2*t2
+    t11 = (t2*t2)
     t12 = g6*t11
     t13 = t12 + t9
     t14 = t10*t2
@@ -492,10 +492,10 @@ def build_linear(sizes, slots):
     g9 = in4[6]
     g10 = in4[7]
     t0 = ca.sin(g0)
-    t1 = t0*t0
+    t1 = (t0*t0)
     t2 = g4*t1
     t3 = ca.cos(g0)
-    t4 = t3*t3
+    t4 = (t3*t3)
     t5 = g5*t4
     t6 = t2 + t5
     t7 = g4*t0
@@ -569,9 +569,9 @@ def build_outputs(sizes, slots):
     g11 = in4[3]
     g12 = in4[4]
     g13 = in4[5]
-    t0 = g0*g0 + g1*g1
-    t1 = ((1.0/2.0))*g10*(g6*g6*ca.cos(g3)*ca.cos(g3) + g7*g7) + ((1.0/2.0))*g8*(g4*g4 + g5*g5) + ((1.0/2.0))*g9*(g13 + g6*ca.sin(g3))*(g13 + g6*ca.sin(g3))
-    t2 = ((1.0/2.0))*g11*t0 + ((1.0/2.0))*g12*(g2*g2 + g3*g3)
+    t0 = (g0*g0) + (g1*g1)
+    t1 = ((1.0/2.0))*g10*((g6*g6)*(ca.cos(g3)*ca.cos(g3)) + (g7*g7)) + ((1.0/2.0))*g8*((g4*g4) + (g5*g5)) + ((1.0/2.0))*g9*((g13 + g6*ca.sin(g3))*(g13 + g6*ca.sin(g3)))
+    t2 = ((1.0/2.0))*g11*t0 + ((1.0/2.0))*g12*((g2*g2) + (g3*g3))
     out0[0] = ca.sqrt(t0)
     out1[0] = t1
     out2[0] = t2

@@ -78,7 +78,7 @@ int mg_tangent(const double *const *in, double *const *out, const long *sizes, l
             const double g1 = in6[1];
             const double g2 = in6[2];
             const double t0 = g1*g2;
-            out0[3] = g0 - g1*g2*g2;
+            out0[3] = g0 - g1*(g2*g2);
             out1[1] = t0;
             out1[2] = -t0;
             out2[0] = g1;
@@ -124,7 +124,7 @@ int mg_linear(const double *const *in, double *const *out, const long *sizes, lo
             out0[0] = g1;
             out2[1] = t0;
             out2[2] = -t0;
-            out3[3] = g0 - g1*g2*g2;
+            out3[3] = g0 - g1*(g2*g2);
         }
     }
     return 0;
@@ -165,8 +165,8 @@ int mg_outputs(const double *const *in, double *const *out, const long *sizes, l
             const double g2 = in5[0];
             const double g3 = in5[1];
             const double g4 = in5[2];
-            const double t0 = (1.0/2.0)*g3*(g0*g4 + g1)*(g0*g4 + g1);
-            const double t1 = (1.0/2.0)*g0*g0*g2;
+            const double t0 = (1.0/2.0)*g3*((g0*g4 + g1)*(g0*g4 + g1));
+            const double t1 = (1.0/2.0)*(g0*g0)*g2;
             out0[0] = t0;
             out1[0] = t1;
             out2[0] = t0 + t1;

@@ -396,7 +396,7 @@ def build_tangent(sizes, slots):
     g1 = in6[1]
     g2 = in6[2]
     t0 = g1*g2
-    out0[3] = g0 - g1*g2*g2
+    out0[3] = g0 - g1*(g2*g2)
     out1[1] = t0
     out1[2] = -t0
     out2[0] = g1
@@ -422,7 +422,7 @@ def build_linear(sizes, slots):
     out0[0] = g1
     out2[1] = t0
     out2[2] = -t0
-    out3[3] = g0 - g1*g2*g2
+    out3[3] = g0 - g1*(g2*g2)
     return ca.Function('linear', [in0, in1, in2, in3, in4, in5], [out0, out1, out2, out3], ['q', 'v', 'z', 't', 's', 'p'], ['M', 'D', 'G', 'K'])
 
 
@@ -442,8 +442,8 @@ def build_outputs(sizes, slots):
     g2 = in5[0]
     g3 = in5[1]
     g4 = in5[2]
-    t0 = ((1.0/2.0))*g3*(g0*g4 + g1)*(g0*g4 + g1)
-    t1 = ((1.0/2.0))*g0*g0*g2
+    t0 = ((1.0/2.0))*g3*((g0*g4 + g1)*(g0*g4 + g1))
+    t1 = ((1.0/2.0))*(g0*g0)*g2
     out0[0] = t0
     out1[0] = t1
     out2[0] = t0 + t1

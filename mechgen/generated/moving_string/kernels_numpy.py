@@ -386,7 +386,7 @@ def mg_tangent(ins, outs, sizes):
     g1 = in6[1]
     g2 = in6[2]
     t0 = g1*g2
-    out0[:, 3] = g0 - g1*g2*g2
+    out0[:, 3] = g0 - g1*(g2*g2)
     out1[:, 1] = t0
     out1[:, 2] = -t0
     out2[:, 0] = g1
@@ -412,7 +412,7 @@ def mg_linear(ins, outs, sizes):
     out0[:, 0] = g1
     out2[:, 1] = t0
     out2[:, 2] = -t0
-    out3[:, 3] = g0 - g1*g2*g2
+    out3[:, 3] = g0 - g1*(g2*g2)
 
 
 def mg_outputs(ins, outs, sizes):
@@ -432,8 +432,8 @@ def mg_outputs(ins, outs, sizes):
     g2 = in5[0]
     g3 = in5[1]
     g4 = in5[2]
-    t0 = ((1.0/2.0))*g3*(g0*g4 + g1)*(g0*g4 + g1)
-    t1 = ((1.0/2.0))*g0*g0*g2
+    t0 = ((1.0/2.0))*g3*((g0*g4 + g1)*(g0*g4 + g1))
+    t1 = ((1.0/2.0))*(g0*g0)*g2
     out0[:, 0] = t0
     out1[:, 0] = t1
     out2[:, 0] = t0 + t1

@@ -42,7 +42,7 @@ int mg_residual(const double *const *in, double *const *out, const long *sizes, 
             const double g10 = in6[2];
             out0[0] = g10*(-g0*g10*g9 - 2.0*g5*g9) + g6*g9;
             out0[1] = g1*g8;
-            out0[2] = g9*(-g10*g10*g2 + 2.0*g10*g4 + g7);
+            out0[2] = g9*(-(g10*g10)*g2 + 2.0*g10*g4 + g7);
             out0[3] = g3*g8;
         }
     }
@@ -83,7 +83,7 @@ int mg_tangent(const double *const *in, double *const *out, const long *sizes, l
             const double g0 = in6[0];
             const double g1 = in6[1];
             const double g2 = in6[2];
-            const double t0 = -g1*g2*g2;
+            const double t0 = -g1*(g2*g2);
             const double t1 = -2.0*g1*g2;
             out0[0] = t0;
             out0[5] = g0;
@@ -132,7 +132,7 @@ int mg_linear(const double *const *in, double *const *out, const long *sizes, lo
             const double g1 = in5[1];
             const double g2 = in5[2];
             const double t0 = -2.0*g1*g2;
-            const double t1 = -g1*g2*g2;
+            const double t1 = -g1*(g2*g2);
             out0[0] = g1;
             out0[10] = g1;
             out2[2] = t0;
@@ -185,8 +185,8 @@ int mg_outputs(const double *const *in, double *const *out, const long *sizes, l
             const double g6 = in5[0];
             const double g7 = in5[1];
             const double g8 = in5[2];
-            const double t0 = (1.0/2.0)*g7*((g0*g8 + g5)*(g0*g8 + g5) + (-g2*g8 + g4)*(-g2*g8 + g4));
-            const double t1 = (1.0/2.0)*g6*(g1*g1 + g3*g3);
+            const double t0 = (1.0/2.0)*g7*(((g0*g8 + g5)*(g0*g8 + g5)) + ((-g2*g8 + g4)*(-g2*g8 + g4)));
+            const double t1 = (1.0/2.0)*g6*((g1*g1) + (g3*g3));
             out0[0] = t0;
             out1[0] = t1;
             out2[0] = t0 + t1;

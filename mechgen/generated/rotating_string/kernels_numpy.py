@@ -382,7 +382,7 @@ def mg_residual(ins, outs, sizes):
     g10 = in6[2]
     out0[:, 0] = g10*(-g0*g10*g9 - 2.0*g5*g9) + g6*g9
     out0[:, 1] = g1*g8
-    out0[:, 2] = g9*(-g10*g10*g2 + 2.0*g10*g4 + g7)
+    out0[:, 2] = g9*(-(g10*g10)*g2 + 2.0*g10*g4 + g7)
     out0[:, 3] = g3*g8
 
 
@@ -403,7 +403,7 @@ def mg_tangent(ins, outs, sizes):
     g0 = in6[0]
     g1 = in6[1]
     g2 = in6[2]
-    t0 = -g1*g2*g2
+    t0 = -g1*(g2*g2)
     t1 = -2.0*g1*g2
     out0[:, 0] = t0
     out0[:, 5] = g0
@@ -432,7 +432,7 @@ def mg_linear(ins, outs, sizes):
     g1 = in5[1]
     g2 = in5[2]
     t0 = -2.0*g1*g2
-    t1 = -g1*g2*g2
+    t1 = -g1*(g2*g2)
     out0[:, 0] = g1
     out0[:, 10] = g1
     out2[:, 2] = t0
@@ -464,8 +464,8 @@ def mg_outputs(ins, outs, sizes):
     g6 = in5[0]
     g7 = in5[1]
     g8 = in5[2]
-    t0 = ((1.0/2.0))*g7*((g0*g8 + g5)*(g0*g8 + g5) + (-g2*g8 + g4)*(-g2*g8 + g4))
-    t1 = ((1.0/2.0))*g6*(g1*g1 + g3*g3)
+    t0 = ((1.0/2.0))*g7*(((g0*g8 + g5)*(g0*g8 + g5)) + ((-g2*g8 + g4)*(-g2*g8 + g4)))
+    t1 = ((1.0/2.0))*g6*((g1*g1) + (g3*g3))
     out0[:, 0] = t0
     out1[:, 0] = t1
     out2[:, 0] = t0 + t1

@@ -39,7 +39,7 @@ int mg_residual(const double *const *in, double *const *out, const long *sizes, 
             const double g8 = in5[2];
             const double g9 = in5[3];
             const double t0 = g6*g9;
-            out0[0] = g0*(-g3*g3*g6 + g7) + g4*g6 - g7*g8 - t0*cos(g1);
+            out0[0] = g0*(-(g3*g3)*g6 + g7) + g4*g6 - g7*g8 - t0*cos(g1);
             out0[1] = g0*(g0*g5*g6 + 2.0*g2*g3*g6 + t0*sin(g1));
         }
     }
@@ -94,7 +94,7 @@ int mg_tangent(const double *const *in, double *const *out, const long *sizes, l
             const double t1 = 2.0*g0;
             const double t2 = g5*t1;
             const double t3 = -g3*t2;
-            out0[0] = -g3*g3*g5 + g6;
+            out0[0] = -(g3*g3)*g5 + g6;
             out0[1] = g5*t0;
             out0[2] = g5*(2.0*g2*g3 + g4*t1 + t0);
             out0[3] = g0*g5*g7*cos(g1);
@@ -102,7 +102,7 @@ int mg_tangent(const double *const *in, double *const *out, const long *sizes, l
             out1[2] = -t3;
             out1[3] = g2*t2;
             out2[0] = g5;
-            out2[3] = g0*g0*g5;
+            out2[3] = (g0*g0)*g5;
         }
     }
     return 0;
@@ -153,11 +153,11 @@ int mg_linear(const double *const *in, double *const *out, const long *sizes, lo
             const double t2 = g6*sin(g1);
             const double t3 = -2.0*g3*t1;
             out0[0] = g4;
-            out0[3] = g0*g0*g4;
+            out0[3] = (g0*g0)*g4;
             out1[3] = t0*t1;
             out2[1] = t3;
             out2[2] = -t3;
-            out3[0] = -g3*g3*g4 + g5;
+            out3[0] = -(g3*g3)*g4 + g5;
             out3[1] = g4*t2;
             out3[2] = g4*(g3*t0 + t2);
             out3[3] = g6*t1*cos(g1);
@@ -246,9 +246,9 @@ int mg_outputs(const double *const *in, double *const *out, const long *sizes, l
             const double g6 = in4[2];
             const double g7 = in4[3];
             const double t0 = g0*cos(g1);
-            const double t1 = (1.0/2.0)*g4*(g0*g0*g3*g3 + g2*g2);
+            const double t1 = (1.0/2.0)*g4*((g0*g0)*(g3*g3) + (g2*g2));
             const double t2 = g4*g7*t0;
-            const double t3 = (g0 - g6)*(g0 - g6);
+            const double t3 = ((g0 - g6)*(g0 - g6));
             out0[0] = g0*sin(g1);
             out1[0] = -t0;
             out2[0] = t1;

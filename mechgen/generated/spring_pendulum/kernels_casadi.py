@@ -392,7 +392,7 @@ def build_residual(sizes, slots):
     g8 = in5[2]
     g9 = in5[3]
     t0 = g6*g9
-    out0[0] = g0*(-g3*g3*g6 + g7) + g4*g6 - g7*g8 - t0*ca.cos(g1)
+    out0[0] = g0*(-(g3*g3)*g6 + g7) + g4*g6 - g7*g8 - t0*ca.cos(g1)
     out0[1] = g0*(g0*g5*g6 + 2.0*g2*g3*g6 + t0*ca.sin(g1))
     return ca.Function('residual', [in0, in1, in2, in3, in4, in5], [out0], ['q', 'v', 'a', 'z', 't', 'p'], ['r'])
 
@@ -421,7 +421,7 @@ def build_tangent(sizes, slots):
     t1 = 2.0*g0
     t2 = g5*t1
     t3 = -g3*t2
-    out0[0] = -g3*g3*g5 + g6
+    out0[0] = -(g3*g3)*g5 + g6
     out0[1] = g5*t0
     out0[2] = g5*(2.0*g2*g3 + g4*t1 + t0)
     out0[3] = g0*g5*g7*ca.cos(g1)
@@ -429,7 +429,7 @@ def build_tangent(sizes, slots):
     out1[2] = -t3
     out1[3] = g2*t2
     out2[0] = g5
-    out2[3] = g0*g0*g5
+    out2[3] = (g0*g0)*g5
     return ca.Function('tangent', [in0, in1, in2, in3, in4, in5], [out0, out1, out2, out3], ['q', 'v', 'a', 'z', 't', 'p'], ['r_q', 'r_v', 'r_a', 'r_z'])
 
 
@@ -456,11 +456,11 @@ def build_linear(sizes, slots):
     t2 = g6*ca.sin(g1)
     t3 = -2.0*g3*t1
     out0[0] = g4
-    out0[3] = g0*g0*g4
+    out0[3] = (g0*g0)*g4
     out1[3] = t0*t1
     out2[1] = t3
     out2[2] = -t3
-    out3[0] = -g3*g3*g4 + g5
+    out3[0] = -(g3*g3)*g4 + g5
     out3[1] = g4*t2
     out3[2] = g4*(g3*t0 + t2)
     out3[3] = g6*t1*ca.cos(g1)
@@ -509,9 +509,9 @@ def build_outputs(sizes, slots):
     g6 = in4[2]
     g7 = in4[3]
     t0 = g0*ca.cos(g1)
-    t1 = ((1.0/2.0))*g4*(g0*g0*g3*g3 + g2*g2)
+    t1 = ((1.0/2.0))*g4*((g0*g0)*(g3*g3) + (g2*g2))
     t2 = g4*g7*t0
-    t3 = (g0 - g6)*(g0 - g6)
+    t3 = ((g0 - g6)*(g0 - g6))
     out0[0] = g0*ca.sin(g1)
     out1[0] = -t0
     out2[0] = t1

@@ -382,7 +382,7 @@ def mg_residual(ins, outs, sizes):
     g8 = in5[2]
     g9 = in5[3]
     t0 = g6*g9
-    out0[:, 0] = g0*(-g3*g3*g6 + g7) + g4*g6 - g7*g8 - t0*np.cos(g1)
+    out0[:, 0] = g0*(-(g3*g3)*g6 + g7) + g4*g6 - g7*g8 - t0*np.cos(g1)
     out0[:, 1] = g0*(g0*g5*g6 + 2.0*g2*g3*g6 + t0*np.sin(g1))
 
 
@@ -411,7 +411,7 @@ def mg_tangent(ins, outs, sizes):
     t1 = 2.0*g0
     t2 = g5*t1
     t3 = -g3*t2
-    out0[:, 0] = -g3*g3*g5 + g6
+    out0[:, 0] = -(g3*g3)*g5 + g6
     out0[:, 1] = g5*t0
     out0[:, 2] = g5*(2.0*g2*g3 + g4*t1 + t0)
     out0[:, 3] = g0*g5*g7*np.cos(g1)
@@ -419,7 +419,7 @@ def mg_tangent(ins, outs, sizes):
     out1[:, 2] = -t3
     out1[:, 3] = g2*t2
     out2[:, 0] = g5
-    out2[:, 3] = g0*g0*g5
+    out2[:, 3] = (g0*g0)*g5
 
 
 def mg_linear(ins, outs, sizes):
@@ -446,11 +446,11 @@ def mg_linear(ins, outs, sizes):
     t2 = g6*np.sin(g1)
     t3 = -2.0*g3*t1
     out0[:, 0] = g4
-    out0[:, 3] = g0*g0*g4
+    out0[:, 3] = (g0*g0)*g4
     out1[:, 3] = t0*t1
     out2[:, 1] = t3
     out2[:, 2] = -t3
-    out3[:, 0] = -g3*g3*g4 + g5
+    out3[:, 0] = -(g3*g3)*g4 + g5
     out3[:, 1] = g4*t2
     out3[:, 2] = g4*(g3*t0 + t2)
     out3[:, 3] = g6*t1*np.cos(g1)
@@ -499,9 +499,9 @@ def mg_outputs(ins, outs, sizes):
     g6 = in4[2]
     g7 = in4[3]
     t0 = g0*np.cos(g1)
-    t1 = ((1.0/2.0))*g4*(g0*g0*g3*g3 + g2*g2)
+    t1 = ((1.0/2.0))*g4*((g0*g0)*(g3*g3) + (g2*g2))
     t2 = g4*g7*t0
-    t3 = (g0 - g6)*(g0 - g6)
+    t3 = ((g0 - g6)*(g0 - g6))
     out0[:, 0] = g0*np.sin(g1)
     out1[:, 0] = -t0
     out2[:, 0] = t1

@@ -179,8 +179,8 @@ int mg_outputs(const double *const *in, double *const *out, const long *sizes, l
             const double g6 = in5[1];
             const double g7 = in5[2];
             const double g8 = in5[3];
-            const double t0 = (1.0/2.0)*g3*g3*g7 + (1.0/2.0)*g4*g4*g8;
-            const double t1 = (1.0/2.0)*g2*g2*g5 + (1.0/2.0)*g6*(g0 - g1)*(g0 - g1);
+            const double t0 = (1.0/2.0)*(g3*g3)*g7 + (1.0/2.0)*(g4*g4)*g8;
+            const double t1 = (1.0/2.0)*(g2*g2)*g5 + (1.0/2.0)*g6*((g0 - g1)*(g0 - g1));
             out0[0] = t0;
             out1[0] = t1;
             out2[0] = t0 + t1;

@@ -1,0 +1,627 @@
+"""Rotor benchmark (issue #5): Campbell diagrams of ROSS's example rotor, mechgen against ROSS.
+
+The rotor is ROSS's documented example (``ross.rotor_example()``: 1.5 m solid steel shaft, D = 0.05 m,
+two disks from geometry at s = 0.5 and 1.0 m, bearings kxx = 1e6, kyy = 0.8e6 N/m at both ends, no
+damping) with each of its six shaft elements split in eight:
+
+* mechgen: ``scenes/ross_example_rotor.toml`` with ``N = 48``, ``discretisation = "timoshenko2"`` (ROSS's
+  two-node Timoshenko element; the disks are mesh vertices), 196 lateral unknowns;
+* ROSS 2.3.0: 48 ``ShaftElement(0.03125, 0, 0.05, steel)``, disks at nodes 16 and 32, the same bearings
+  (as ``benchmarks/ross_reference.py`` builds it), 294 dofs (ROSS's nodes also carry the axial and
+  torsional dofs, exactly decoupled from the lateral ones).
+
+Steps, all in one process, BLAS limited to one thread for both tools (threadpoolctl):
+
+1. **Accuracy first.** The first eight damped natural frequencies of mechgen's ``modes`` analysis and of
+   ROSS's ``run_modal`` (its lateral modes; ROSS's lists also hold a torsional mode at 774 rad/s) agree
+   to ``TOL`` = 1e-6 relative at 0 and 1000 rad/s, and every lateral curve of ROSS's Campbell diagram
+   is matched at every speed by one of mechgen's eight curves to ``TOL``. Otherwise the benchmark raises:
+   it must compare equal computations.
+2. **Campbell timing.** mechgen's campbell analysis (``mechgen.scene.whirl.run_campbell``: 50 speeds over
+   0..1000 rad/s, 8 curves) against ``rotor.run_campbell(np.linspace(0, 1000, 50), frequencies=8)``,
+   median of 3, interleaved (ROSS, mechgen, ROSS, mechgen ...), ROSS's ``run_modal`` lru_cache cleared
+   before every run. ROSS's Campbell tracks its modes and computes no critical speeds, so the matched
+   comparison is mechgen's analysis with ``multiples = []`` (tracking only); the full analysis with
+   ``multiples = [1.0]`` (critical speeds refined by Brent's method) is timed too. Compilation (a
+   ``compile_model`` call with the compile cache as it is) and mechgen's first Campbell call (mesh and
+   discretisation tables built) are reported apart, as is ROSS's first ``run_modal`` (numba JIT).
+3. **Profile** of mechgen's campbell analysis (cProfile): where the time goes, and measured *candidate
+   fixes* - the same tracking (``mechgen.runtime.campbell.campbell``) fed with (a) matrices assembled once
+   (M, D, K at Omega = 0 and G at Omega = 1; G is exactly proportional to Omega in this model, checked
+   here), (b) the same with the sparse shift-invert solver, (c) a reduced basis: the exact modes at the
+   first and last speed (real and imaginary parts, orthonormalised) span a subspace onto which M, D, G, K
+   are projected once; every speed is then a small dense problem. These are *not* mechgen's analysis;
+   their frequencies are compared with it.
+4. **A 2 000-dof rotor**: the same rotor with ``N = 498`` (1 996 unknowns; ROSS's elements split 83 times);
+   ``modes`` with ``count = 8`` (ARPACK shift-invert) and a 10-speed Campbell. ROSS's ``run_modal`` of the
+   equal rotor (2 994 dofs) is timed once and compared (full run only).
+5. **Work against precision**: quintic (N = 12, 24) and two-node (N = 48, 96, 192) meshes: the largest
+   relative error of the first eight frequencies at 0 and 1000 rad/s against a Richardson-extrapolated
+   reference (two-node element, N = 384 and 768, second order; cross-checked against quintic N = 48),
+   and the time per Campbell speed.
+
+``quick=True`` (< 60 s): 10 Campbell speeds, one repeat, no critical-speed run, a 604-unknown "large"
+rotor, reference from N = 192 and 384, no ROSS run on the large rotor. Writes ``out/rotor_campbell.json`` and
+``out/rotor_campbell.md``. When ROSS is not installed, mechgen's parts run and the report says so.
+Timing targets live here, never in unit tests; absolute times drift with the machine's load
+(the load average is recorded).
+"""
+from __future__ import annotations
+
+import contextlib
+import cProfile
+import io
+import json
+import os
+import platform
+import pstats
+import statistics
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENE = ROOT / "scenes" / "ross_example_rotor.toml"
+COUNT = 8
+SPLIT = 8                 # every ROSS element split in 8: N = 48
+TOL = 1e-6                # agreement required of mechgen and ROSS (relative)
+TARGET = 20.0             # issue #5: mechgen at least 20x faster than ROSS's run_campbell
+MAX_SPEED = 1000.0
+BIG_SPLIT, BIG_SPLIT_QUICK = 83, 25   # 2 000-dof rotor: N = 498 (1 996 unknowns); quick: N = 150 (604)
+WP_LADDER = (("quintic", 12), ("quintic", 24), ("timoshenko2", 48), ("timoshenko2", 96), ("timoshenko2", 192))
+
+
+# -- helpers ------------------------------------------------------------------------------------------------
+@contextlib.contextmanager
+def _fd_stdout_to_stderr():
+    """Send fd-level stdout to stderr while ROSS imports (ccp -> CoolProp prints REFPROP noise)."""
+    try:
+        fd = sys.stdout.fileno()
+    except (AttributeError, OSError, ValueError):
+        yield
+        return
+    sys.stdout.flush()
+    saved = os.dup(fd)
+    try:
+        os.dup2(2, fd)
+        yield
+    finally:
+        sys.stdout.flush()
+        os.dup2(saved, fd)
+        os.close(saved)
+
+
+def import_ross():
+    """(ross module, None) or (None, why it was skipped)."""
+    try:
+        with _fd_stdout_to_stderr(), warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            import ross
+        return ross, None
+    except Exception as exc:  # noqa: BLE001 (any failure to import means: skip ROSS)
+        return None, f"{type(exc).__name__}: {exc}"
+
+
+@contextlib.contextmanager
+def blas_threads(n: int = 1):
+    """Limit BLAS/OpenMP threads of both tools alike (threadpoolctl, when installed)."""
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:
+        yield None
+        return
+    with threadpool_limits(limits=n):
+        yield n
+
+
+def _blas_info() -> list:
+    try:
+        from threadpoolctl import threadpool_info
+    except ImportError:
+        return []
+    return [{"api": i.get("internal_api"), "num_threads": i.get("num_threads")} for i in threadpool_info()]
+
+
+def _timed(fn):
+    start = time.perf_counter()
+    out = fn()
+    return time.perf_counter() - start, out
+
+
+def _summary(times: list[float]) -> dict:
+    return {"median_s": statistics.median(times), "all_s": list(times)}
+
+
+def speeds_of(count: int) -> list[float]:
+    return [float(w) for w in np.linspace(0.0, MAX_SPEED, count)]
+
+
+def rotor_system(N: int, discretisation: str = "timoshenko2", *, fresh: bool = False):
+    """mechgen's example rotor with N elements: (system laid out with the scene's parts, build info).
+
+    Built as ``mechgen run`` builds it (load_scene, compile_model of the 'linear' kernel with Omega free,
+    the scene's layout). ``fresh`` bypasses run_scene's in-process cache so that the compile time
+    (with the on-disk compile cache as it is) is measured.
+    """
+    from mechgen import models
+    from mechgen.runtime.mesh import Layout
+    from mechgen.scene.info import lookup_model
+    from mechgen.scene.load import load_scene
+    from mechgen.scene.run import _laid_out, _system_for
+
+    scn = load_scene(str(SCENE), overrides=[f"N={N}", f"discretisation={discretisation}"],
+                     lookup_model=lookup_model, model_names=models.names)
+    model = models.get(scn.model)
+    free = tuple(n for n in scn.free if model.param(n).is_numeric)
+    build = _system_for.__wrapped__ if fresh else _system_for
+    seconds, (system, report) = _timed(lambda: build(scn.model, tuple(sorted(scn.params.items())), free,
+                                                     scn.active, ("linear",), scn.backend))
+    info = {"N": N, "discretisation": discretisation, "unknowns": None, "compile_s": seconds,
+            "compile_cache_hit": bool(report.cached), "backend": report.backend}
+    system = _laid_out(system, Layout(scn.segments, scn.parts))
+    return system, info
+
+
+def _omega_index(system) -> int:
+    return system.meta["params"].index("Omega")
+
+
+def mechgen_modes(system, speed: float, count: int = COUNT) -> dict:
+    """mechgen's ``modes`` analysis at spin speed ``speed``: its outputs (frequencies, log_dec, whirl)."""
+    from mechgen.scene.analyses import RUNNERS
+
+    i = _omega_index(system)
+    saved = float(system.params[i])
+    system.params[i] = speed
+    try:
+        return RUNNERS["modes"](system, {"count": count}, {})
+    finally:
+        system.params[i] = saved
+
+
+def mechgen_damped_solve(system, speed: float, count: int = COUNT) -> dict:
+    """The ``modes`` analysis without its mode-shape sampling: linear() + run_damped_modes (the eigen-solve)."""
+    from mechgen.scene.whirl import run_damped_modes
+
+    i = _omega_index(system)
+    saved = float(system.params[i])
+    system.params[i] = speed
+    try:
+        return run_damped_modes(system, system.linear(np.zeros(system.n)), {"count": count})
+    finally:
+        system.params[i] = saved
+
+
+def mechgen_campbell(system, speeds, multiples=()) -> dict:
+    """mechgen's ``campbell`` analysis (the scene runner) over ``speeds``, 8 curves."""
+    from mechgen.scene.whirl import run_campbell
+
+    return run_campbell(system, {"over": {"Omega": list(speeds)}, "count": COUNT, "multiples": list(multiples)}, {})
+
+
+def ross_rotor(rs, nsub: int):
+    """rotor_example() with each of its six shaft elements split into ``nsub`` (benchmarks/ross_reference.py)."""
+    steel = rs.materials.steel
+    shaft = [rs.ShaftElement(0.25 / nsub, 0.0, 0.05, material=steel, shear_effects=True, rotary_inertia=True,
+                             gyroscopic=True) for _ in range(6 * nsub)]
+    disks = [rs.DiskElement.from_geometry(n=2 * nsub, material=steel, width=0.07, i_d=0.05, o_d=0.28),
+             rs.DiskElement.from_geometry(n=4 * nsub, material=steel, width=0.07, i_d=0.05, o_d=0.28)]
+    bearings = [rs.BearingElement(0, kxx=1e6, kyy=0.8e6, cxx=0), rs.BearingElement(6 * nsub, kxx=1e6, kyy=0.8e6, cxx=0)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return rs.Rotor(shaft, disks, bearings)
+
+
+def _lateral_columns(rotor, evectors) -> np.ndarray:
+    """True for eigenvectors whose displacement part lies mostly in the lateral dofs (x, y, alpha, beta).
+
+    ROSS's own ``mode_type`` is not used: on fine meshes it divides by round-off-level axial/torsional
+    amplitudes (NaN, with RuntimeWarnings) and mislabels lateral modes.
+    """
+    nd, ndof = rotor.number_dof, rotor.ndof
+    X = np.abs(np.asarray(evectors)[:ndof]) ** 2
+    local = np.arange(ndof) % nd
+    lat = X[np.isin(local, (0, 1, 3, 4))].sum(axis=0)
+    return lat > 0.5 * X.sum(axis=0)
+
+
+def ross_lateral(rotor, speed: float, count: int = COUNT) -> np.ndarray:
+    """The first ``count`` lateral damped frequencies of ROSS's run_modal (ARPACK, its default)."""
+    rotor.run_modal.cache_clear()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = rotor.run_modal(speed, num_modes=2 * (count + 4))
+    lateral = _lateral_columns(rotor, m.evectors)[:len(m.wd)]
+    wd = np.asarray(m.wd, dtype=float)[lateral][:count]
+    rotor.run_modal.cache_clear()
+    if len(wd) < count:
+        raise RuntimeError(f"ROSS returned only {len(wd)} lateral modes at {speed} rad/s")
+    return wd
+
+
+def ross_campbell(rotor, speeds):
+    rotor.run_modal.cache_clear()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        camp = rotor.run_campbell(speed_range=np.asarray(speeds, dtype=float), frequencies=COUNT)
+    rotor.run_modal.cache_clear()  # run_campbell reorders cached ModalResults in place
+    return camp
+
+
+def _rel(a, b) -> float:
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    return float(np.max(np.abs(a - b) / np.abs(b)))
+
+
+def campbell_agreement(mech_freqs, ross_camp) -> float:
+    """Largest relative distance from a lateral ROSS Campbell value to the nearest mechgen curve, same speed."""
+    wd = np.asarray(ross_camp.wd, dtype=float)
+    lateral = ~np.isnan(np.asarray(ross_camp.whirl_values, dtype=float))
+    mech = np.asarray(mech_freqs, dtype=float)
+    worst = 0.0
+    for i in range(wd.shape[0]):
+        for v in wd[i, lateral[i]]:
+            worst = max(worst, float(np.min(np.abs(mech[i] - v)) / abs(v)))
+    return worst
+
+
+# -- profile and candidate fixes ------------------------------------------------------------------------------
+_PROFILE_KEYS = {
+    "run_campbell (whole analysis)": ("whirl.py", "run_campbell"),
+    "campbell (tracking, incl. solves)": ("campbell.py", "campbell"),
+    "critical_speeds (Brent refinement)": ("campbell.py", "critical_speeds"),
+    "damped_modes (all calls)": ("damped.py", "damped_modes"),
+    "  dense scipy.linalg.eig": ("_decomp.py", "eig"),
+    "  sparse ARPACK path": ("damped.py", "_sparse_eig"),
+    "system.linear (assembly per speed)": ("whirl.py", "matrices_at"),
+    "_align (degenerate clusters)": ("campbell.py", "_align"),
+    "linear_sum_assignment": ("_lsap.py", "linear_sum_assignment"),
+}
+
+
+def profile_campbell(system, speeds, multiples) -> dict:
+    """cProfile of mechgen's campbell analysis: cumulative seconds of the parts that matter, and the top list."""
+    prof = cProfile.Profile()
+    prof.enable()
+    mechgen_campbell(system, speeds, multiples)
+    prof.disable()
+    stats = pstats.Stats(prof)
+    parts = {}
+    for label, (fname, func) in _PROFILE_KEYS.items():
+        hits = [(v[1], v[3]) for (f, _, fn), v in stats.stats.items() if fn == func and f.endswith(fname)]
+        if hits:
+            parts[label] = {"calls": int(sum(h[0] for h in hits)), "cumulative_s": float(sum(h[1] for h in hits))}
+    top = sorted(((v[3], v[2], v[1], f"{Path(f).name}:{ln}({fn})") for (f, ln, fn), v in stats.stats.items()),
+                 reverse=True)
+    buf = io.StringIO()
+    pstats.Stats(prof, stream=buf).sort_stats("tottime").print_stats(12)
+    return {"speeds": len(speeds), "multiples": list(multiples), "parts": parts,
+            "top_cumulative": [{"function": t[3], "cumulative_s": t[0], "own_s": t[1], "calls": t[2]}
+                               for t in top[:25]],
+            "text_tottime": buf.getvalue()}
+
+
+def affine_matrices(system) -> dict:
+    """M, D, K at Omega = 0 and G at Omega = 1, after checking that only G depends on Omega, linearly."""
+    i = _omega_index(system)
+    saved = float(system.params[i])
+    q = np.zeros(system.n)
+    try:
+        system.params[i] = 0.0
+        m0 = system.linear(q)
+        system.params[i] = 1.0
+        m1 = system.linear(q)
+        system.params[i] = MAX_SPEED
+        mw = system.linear(q)
+    finally:
+        system.params[i] = saved
+    dev = max(abs(m1[k] - m0[k]).max() for k in ("M", "D", "K"))
+    dev = max(dev, abs(m0["G"]).max(), abs(mw["G"] - MAX_SPEED * m1["G"]).max() / max(abs(mw["G"]).max(), 1e-300))
+    if dev > 1e-12:
+        raise RuntimeError(f"the rotor's matrices are not M, D, K + Omega G1 (deviation {dev:.2e})")
+    return {"M": m0["M"], "D": m0["D"], "K": m0["K"], "G1": m1["G"], "check": float(dev)}
+
+
+def candidate_fixes(system, speeds, reference_freqs, repeats: int) -> list[dict]:
+    """Time mechgen.runtime.campbell's tracking fed with cheaper, equal matrices/solvers (not mechgen's analysis)."""
+    from mechgen.runtime.campbell import campbell
+    from mechgen.runtime.damped import damped_modes
+    from mechgen.scene.whirl import whirl_stations
+
+    xi, yi = whirl_stations(system)
+    ref = np.asarray(reference_freqs)
+    rows = []
+
+    def assembled_once(sparse: bool):
+        mats = affine_matrices(system)
+        M, D, K, G1 = mats["M"], mats["D"], mats["K"], mats["G1"]
+        res = campbell(lambda w: {"M": M, "C": D + w * G1, "K": K}, speeds, COUNT, x_index=xi, y_index=yi,
+                       sparse=sparse)
+        return res.frequencies
+
+    def reduced_basis():
+        mats = affine_matrices(system)
+        M, D, K, G1 = mats["M"], mats["D"], mats["K"], mats["G1"]
+        m = COUNT + max(2, COUNT // 2)
+        cols = []
+        for w in (speeds[0], speeds[-1]):
+            dm = damped_modes(M, D + w * G1, K, m, sparse=True)
+            cols += [dm.shapes.real, dm.shapes.imag]
+        U, sv, _ = np.linalg.svd(np.hstack(cols), full_matrices=False)
+        W = U[:, sv > 1e-12 * sv[0]]
+        Mr, Dr, Kr, Gr = (W.T @ (X @ W) for X in (M, D, K, G1))
+        # reduced coordinates: the whirl stations are not unknowns there, so labels are not computed
+        res = campbell(lambda w: {"M": Mr, "C": Dr + w * Gr, "K": Kr}, speeds, COUNT, x_index=0, y_index=1,
+                       sparse=False)
+        return res.frequencies
+
+    for label, fn in (("(a) matrices assembled once, dense eig (as now)", lambda: assembled_once(False)),
+                      ("(b) matrices assembled once, sparse shift-invert", lambda: assembled_once(True)),
+                      ("(c) reduced basis from the modes at the first and last speed", reduced_basis)):
+        times, freqs = [], None
+        for _ in range(repeats):
+            t, freqs = _timed(fn)
+            times.append(t)
+        rows.append({"variant": label, **_summary(times), "max_rel_diff_vs_run_campbell": _rel(freqs, ref)})
+    return rows
+
+
+# -- the parts ------------------------------------------------------------------------------------------------
+def accuracy_check(system, rotor, speeds_check=(0.0, MAX_SPEED)) -> dict:
+    """mechgen's modes vs ROSS's run_modal (lateral) at the check speeds; raises beyond TOL."""
+    rows = []
+    for w in speeds_check:
+        mech = np.asarray(mechgen_modes(system, w)["frequencies"], dtype=float)
+        ross = ross_lateral(rotor, w)
+        rows.append({"speed": w, "mechgen": mech.tolist(), "ross": ross.tolist(), "max_rel_diff": _rel(mech, ross)})
+    worst = max(r["max_rel_diff"] for r in rows)
+    if not worst <= TOL:
+        raise AssertionError(f"mechgen and ROSS disagree: first {COUNT} frequencies differ by {worst:.3e} relative "
+                             f"(> {TOL:g}); the benchmark would compare different computations")
+    return {"speeds": list(speeds_check), "rows": rows, "max_rel_diff": worst, "tolerance": TOL, "passed": True}
+
+
+def campbell_timing(system, rotor, speeds, repeats: int, critical: bool = True) -> dict:
+    """Interleaved median-of-``repeats`` timings of ROSS's run_campbell and mechgen's campbell analysis.
+
+    ``critical``: also time mechgen's full analysis with critical speeds (``multiples = [1.0]``) once.
+    """
+    out: dict = {"speeds": len(speeds), "repeats": repeats}
+    first, res = _timed(lambda: mechgen_campbell(system, speeds))
+    out["mechgen_first_call_s"] = first
+    mech_t, ross_t, camp = [], [], None
+    for _ in range(repeats):
+        if rotor is not None:
+            t, camp = _timed(lambda: ross_campbell(rotor, speeds))
+            ross_t.append(t)
+        t, res = _timed(lambda: mechgen_campbell(system, speeds))
+        mech_t.append(t)
+    out["mechgen_tracking"] = _summary(mech_t)
+    out["mechgen_frequencies"] = res["frequencies"]
+    if critical:
+        t, full = _timed(lambda: mechgen_campbell(system, speeds, [1.0]))
+        out["mechgen_with_critical_speeds"] = {"median_s": t, "all_s": [t], "critical_speeds": full["critical_speeds"]}
+    if rotor is not None:
+        out["ross"] = _summary(ross_t)
+        agree = campbell_agreement(res["frequencies"], camp)
+        if not agree <= TOL:
+            raise AssertionError(f"Campbell diagrams of mechgen and ROSS differ by {agree:.3e} relative (> {TOL:g})")
+        out["campbell_max_rel_diff"] = agree
+        out["ratio_ross_over_mechgen"] = out["ross"]["median_s"] / out["mechgen_tracking"]["median_s"]
+        if critical:
+            out["ratio_ross_over_mechgen_with_critical_speeds"] = out["ross"]["median_s"] / t
+    return out
+
+
+def large_rotor(rs, split: int, repeats: int, with_ross: bool) -> dict:
+    """The rotor with every element split ``split`` times: mechgen modes (count 8) and a 10-speed Campbell."""
+    N = 6 * split
+    system, info = rotor_system(N)
+    info["unknowns"] = system.n
+    first, _ = _timed(lambda: mechgen_modes(system, 500.0))
+    times, res = [], None
+    for _ in range(repeats):
+        t, res = _timed(lambda: mechgen_modes(system, 500.0))
+        times.append(t)
+    solve = [_timed(lambda: mechgen_damped_solve(system, 500.0))[0] for _ in range(repeats)]
+    speeds = speeds_of(10)
+    ctimes = []
+    for _ in range(repeats):
+        t, _camp = _timed(lambda: mechgen_campbell(system, speeds))
+        ctimes.append(t)
+    out = {**info, "modes_speed": 500.0, "modes_first_call_s": first, "modes": _summary(times),
+           "frequencies_500": res["frequencies"], "modes_solve_only": _summary(solve),
+           "campbell_speeds": len(speeds), "campbell": _summary(ctimes)}
+    if with_ross and rs is not None:
+        build_t, rotor = _timed(lambda: ross_rotor(rs, split))
+        t, wd = _timed(lambda: ross_lateral(rotor, 500.0))
+        diff = _rel(res["frequencies"], wd)
+        if not diff <= TOL:
+            raise AssertionError(f"large rotor: mechgen and ROSS differ by {diff:.3e} relative (> {TOL:g})")
+        out["ross"] = {"dofs": int(rotor.ndof), "build_s": build_t, "run_modal_s": t,
+                       "call": f"rotor.run_modal(500.0, num_modes={2 * (COUNT + 4)})", "max_rel_diff": diff,
+                       "ratio_ross_over_mechgen_modes": t / out["modes"]["median_s"]}
+    return out
+
+
+def work_precision(repeats: int, quick: bool, ross_row: dict | None) -> dict:
+    """First-8-frequency error against a Richardson reference vs time per Campbell speed."""
+    check = (0.0, MAX_SPEED)
+
+    def freqs(system):
+        return np.array([mechgen_modes(system, w)["frequencies"] for w in check], dtype=float)
+
+    coarse, fine = (192, 384) if quick else (384, 768)
+    f_c, f_f = (freqs(rotor_system(n)[0]) for n in (coarse, fine))
+    ref = f_f + (f_f - f_c) / 3.0                      # second order: error ~ h^2
+    cross_n = 24 if quick else 48
+    cross = freqs(rotor_system(cross_n, "quintic")[0])
+    speeds = speeds_of(10 if quick else 50)
+    rows = []
+    for disc, n in WP_LADDER:
+        system, info = rotor_system(n, disc)
+        err = _rel(freqs(system), ref)
+        mechgen_campbell(system, speeds)           # first call (tables) untimed
+        times = [_timed(lambda: mechgen_campbell(system, speeds))[0] for _ in range(repeats)]
+        rows.append({"method": f"mechgen {disc}", "N": n, "unknowns": system.n, "max_rel_error": err,
+                     "seconds_per_speed": statistics.median(times) / len(speeds), "speeds": len(speeds)})
+    if ross_row is not None:
+        rows.append({"method": "ROSS two-node (elements split 8)", "N": 6 * SPLIT, "unknowns": ross_row["dofs"],
+                     "max_rel_error": _rel(ross_row["frequencies"], ref),
+                     "seconds_per_speed": ross_row["seconds_per_speed"], "speeds": ross_row["speeds"]})
+    return {"reference": {"method": f"Richardson (order 2) of timoshenko2 N = {coarse}, {fine}",
+                          "speeds": list(check), "frequencies": ref.tolist(),
+                          f"max_rel_diff_vs_quintic_N{cross_n}": _rel(cross, ref)},
+            "rows": rows}
+
+
+# -- report -------------------------------------------------------------------------------------------------
+def _fmt_s(x: float | None) -> str:
+    if x is None:
+        return "-"
+    return f"{x * 1e3:.1f} ms" if x < 1 else f"{x:.2f} s"
+
+
+def report_markdown(res: dict) -> str:
+    L = ["# Rotor Campbell benchmark (issue #5): mechgen vs ROSS", ""]
+    env = res["environment"]
+    L.append(f"{'QUICK run (fewer speeds, one repeat): ratios are indicative only. ' if res['quick'] else ''}"
+             f"Machine: {env['cpu_count']} cores, {env['machine']}, Python {env['python']}, numpy {env['numpy']}, "
+             f"scipy {env['scipy']}, ROSS {env.get('ross') or 'not installed'}; BLAS threads: {res['blas_threads']}; "
+             f"load average {env['loadavg_before'][0]:.2f} before, {env['loadavg_after'][0]:.2f} after. "
+             "All numbers from one run in one process.")
+    if res.get("ross_skipped"):
+        L += ["", f"**ROSS skipped** ({res['ross_skipped']}): only mechgen's parts ran."]
+    acc = res.get("accuracy")
+    if acc:
+        L += ["", "## Accuracy (checked before timing)", "",
+              f"First {COUNT} damped frequencies (rad/s), mechgen `modes` (timoshenko2, N = {6 * SPLIT}) vs ROSS "
+              f"`run_modal` lateral modes (elements split {SPLIT}); tolerance {TOL:g} relative.", "",
+              "| speed (rad/s) | mechgen | ROSS | max rel. diff |", "|---|---|---|---|"]
+        for r in acc["rows"]:
+            L.append(f"| {r['speed']:g} | {', '.join(f'{v:.6f}' for v in r['mechgen'])} | "
+                     f"{', '.join(f'{v:.6f}' for v in r['ross'])} | {r['max_rel_diff']:.2e} |")
+        ct = res["campbell"]
+        if "campbell_max_rel_diff" in ct:
+            L.append(f"\nCampbell diagrams: every lateral ROSS curve value is matched by a mechgen curve at the same "
+                     f"speed to {ct['campbell_max_rel_diff']:.2e} relative.")
+    ct = res["campbell"]
+    L += ["", f"## Campbell diagram: {ct['speeds']} speeds over 0..{MAX_SPEED:g} rad/s, {COUNT} modes, "
+              f"median of {ct['repeats']}", "",
+          "| run | median | all | per speed | ROSS / this (target >= 20) |", "|---|---|---|---|---|"]
+    ross_med = ct.get("ross", {}).get("median_s")
+
+    def row(label, d):
+        ratio = "-" if ross_med is None else f"{ross_med / d['median_s']:.2f}"
+        L.append(f"| {label} | {_fmt_s(d['median_s'])} | {', '.join(_fmt_s(x) for x in d['all_s'])} | "
+                 f"{_fmt_s(d['median_s'] / ct['speeds'])} | {ratio} |")
+
+    if ross_med is not None:
+        row(f"ROSS `run_campbell(np.linspace(0, {MAX_SPEED:g}, {ct['speeds']}), frequencies={COUNT})`", ct["ross"])
+    row("mechgen campbell analysis, `multiples = []` (tracking only: the matched comparison)", ct["mechgen_tracking"])
+    if "mechgen_with_critical_speeds" in ct:
+        row("mechgen campbell analysis, `multiples = [1.0]` (plus critical speeds by Brent)",
+            ct["mechgen_with_critical_speeds"])
+    b = res["build"]
+    L.append("")
+    L.append(f"Apart: mechgen compile_model {_fmt_s(b['compile_s'])} (compile cache "
+             f"{'hit' if b['compile_cache_hit'] else 'miss'}, backend {b['backend']}), mechgen first Campbell call "
+             f"{_fmt_s(ct['mechgen_first_call_s'])}; ROSS first run_modal (numba JIT) "
+             f"{_fmt_s(res.get('ross_first_run_modal_s'))}, then an untimed warm-up run_campbell of 2 speeds "
+             f"{_fmt_s(res.get('ross_first_run_campbell_2_speeds_s'))}.")
+    if ross_med is not None:
+        ratio = ct["ratio_ross_over_mechgen"]
+        crit = ct.get("ratio_ross_over_mechgen_with_critical_speeds")
+        crit = "" if crit is None else f"; {crit:.2f} with critical speeds"
+        L.append(f"\n**ROSS / mechgen = {ratio:.2f}** (tracking only{crit}): target >= {TARGET:g} "
+                 f"{'met' if ratio >= TARGET else 'NOT met'}.")
+    prof = res.get("profile")
+    if prof:
+        L += ["", f"## Where mechgen's time goes (cProfile, {prof['speeds']} speeds, multiples = {prof['multiples']})",
+              "", "| part | calls | cumulative |", "|---|---|---|"]
+        for k, v in prof["parts"].items():
+            L.append(f"| {k} | {v['calls']} | {_fmt_s(v['cumulative_s'])} |")
+    fixes = res.get("candidate_fixes")
+    if fixes:
+        L += ["", "## Candidate fixes, measured (the same tracking, `mechgen.runtime.campbell.campbell`; not "
+                  "mechgen's analysis)", "", "| variant | median | per speed | ROSS / this | max rel. diff vs "
+                  "analysis |", "|---|---|---|---|---|"]
+        for f in fixes:
+            ratio = "-" if ross_med is None else f"{ross_med / f['median_s']:.1f}"
+            L.append(f"| {f['variant']} | {_fmt_s(f['median_s'])} | {_fmt_s(f['median_s'] / ct['speeds'])} | {ratio} | "
+                     f"{f['max_rel_diff_vs_run_campbell']:.1e} |")
+    big = res["large"]
+    L += ["", f"## Large rotor: N = {big['N']} two-node elements, {big['unknowns']} unknowns", "",
+          f"* `modes`, count = {COUNT}, at {big['modes_speed']:g} rad/s (sparse shift-invert): median "
+          f"{_fmt_s(big['modes']['median_s'])} (first call {_fmt_s(big['modes_first_call_s'])}, compile "
+          f"{_fmt_s(big['compile_s'])}); of which the eigen-solve (linear() + run_damped_modes, no mode-shape "
+          f"sampling) {_fmt_s(big['modes_solve_only']['median_s'])}",
+          f"* Campbell, {big['campbell_speeds']} speeds, {COUNT} modes: median {_fmt_s(big['campbell']['median_s'])} "
+          f"({_fmt_s(big['campbell']['median_s'] / big['campbell_speeds'])} per speed)"]
+    if "ross" in big:
+        r = big["ross"]
+        L.append(f"* ROSS `{r['call']}` on the equal rotor ({r['dofs']} dofs): {_fmt_s(r['run_modal_s'])} "
+                 f"(Rotor built in {_fmt_s(r['build_s'])}); frequencies agree to {r['max_rel_diff']:.1e}; "
+                 f"ROSS / mechgen modes = {r['ratio_ross_over_mechgen_modes']:.0f}")
+    wp = res["work_precision"]
+    ref = wp["reference"]
+    cross = next(v for k, v in ref.items() if k.startswith("max_rel_diff_vs_quintic"))
+    L += ["", "## Work against precision", "",
+          f"Error: largest relative error of the first {COUNT} frequencies at 0 and {MAX_SPEED:g} rad/s against "
+          f"{ref['method']} (which agrees with quintic to {cross:.1e}). Time: Campbell analysis (tracking only) "
+          "per speed, median.", "", "| method | N | unknowns | max rel. error | time per speed |",
+          "|---|---|---|---|---|"]
+    for r in sorted(wp["rows"], key=lambda r: r["seconds_per_speed"]):
+        L.append(f"| {r['method']} | {r['N']} | {r['unknowns']} | {r['max_rel_error']:.1e} | "
+                 f"{_fmt_s(r['seconds_per_speed'])} |")
+    return "\n".join(L)
+
+
+# -- entry point ----------------------------------------------------------------------------------------------
+def run_rotor_benchmarks(out: Path, quick: bool = False) -> dict:
+    """Run the rotor benchmark; write ``out/rotor_campbell.json`` and ``out/rotor_campbell.md``; return the results."""
+    import scipy
+
+    out = Path(out)
+    repeats = 1 if quick else 3
+    speeds = speeds_of(10 if quick else 50)
+    rs, skipped = import_ross()
+    env = {"python": platform.python_version(), "numpy": np.__version__, "scipy": scipy.__version__,
+           "ross": getattr(rs, "__version__", None), "cpu_count": os.cpu_count(), "machine": platform.machine(),
+           "loadavg_before": list(os.getloadavg())}
+    res: dict = {"quick": quick, "environment": env, "ross_skipped": skipped}
+    with blas_threads(1) as nthreads:
+        res["blas_threads"] = nthreads if nthreads is not None else "unlimited (threadpoolctl missing)"
+        res["blas"] = _blas_info()
+        system, info = rotor_system(6 * SPLIT, fresh=True)
+        info["unknowns"] = system.n
+        res["build"] = info
+        rotor = None
+        if rs is not None:
+            rotor = ross_rotor(rs, SPLIT)
+            rotor.run_modal.cache_clear()
+            res["ross_first_run_modal_s"], _ = _timed(lambda: ross_lateral(rotor, 0.0))
+            res["ross_first_run_campbell_2_speeds_s"], _ = _timed(lambda: ross_campbell(rotor, [0.0, MAX_SPEED]))
+            res["accuracy"] = accuracy_check(system, rotor)
+        res["campbell"] = ct = campbell_timing(system, rotor, speeds, repeats, critical=not quick)
+        res["profile"] = profile_campbell(system, speeds, [] if quick else [1.0])
+        res["candidate_fixes"] = candidate_fixes(system, speeds, ct["mechgen_frequencies"], repeats)
+        split = BIG_SPLIT_QUICK if quick else BIG_SPLIT
+        res["large"] = large_rotor(rs, split, repeats, with_ross=not quick)
+        ross_row = None
+        if rotor is not None:
+            ross_row = {"dofs": int(rotor.ndof), "speeds": ct["speeds"],
+                        "seconds_per_speed": ct["ross"]["median_s"] / ct["speeds"],
+                        "frequencies": [res["accuracy"]["rows"][k]["ross"] for k in range(2)]}
+        res["work_precision"] = work_precision(repeats, quick, ross_row)
+    env["loadavg_after"] = list(os.getloadavg())
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "rotor_campbell.json").write_text(json.dumps(res, indent=1, default=float) + "\n")
+    table = report_markdown(res)
+    (out / "rotor_campbell.md").write_text(table + "\n")
+    print(table)
+    print(f"\nwrote {out / 'rotor_campbell.json'}, {out / 'rotor_campbell.md'}")
+    return res

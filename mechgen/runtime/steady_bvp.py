@@ -1,0 +1,214 @@
+"""Steady states of a continuum as a two-point boundary value problem, solved with the generated kernels.
+
+The steady equations in s (mechgen.symbolic.steady) have the first-order form
+y' = F(s, y), y = (u, u_s) (fields, then slopes), with the exact Jacobian dF/dy
+from the generated tangent kernel (FieldSystem.steady_form). On the unit
+interval sigma = s / L (L the model's length parameter, so that a branch may
+vary it):
+
+    dy/dsigma = L F(L sigma, y),   y_i(0) or y_i(1) = the boundary values,
+
+one condition per essential boundary condition of the model (a field or its
+slope at an end; 2n of them). The BVP's parameter vector is the kernels' free
+parameters (so a branch may follow any of them: dF/dp by central differences);
+L is one of them when the length parameter is free. Solved by shooting, multiple shooting or
+collocation (mechgen.runtime.bvp). The solution's jets at any points feed the
+linearisation about it (FieldSystem.linear(jets=...)): modes and stability of
+the steady state with the model's Galerkin discretisation.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from mechgen.errors import InputError
+from mechgen.runtime.bvp import BVP, BVPResult, collocate, multiple_shoot, shoot
+
+METHODS = ("shooting", "multiple_shooting", "collocation")
+
+
+@dataclass(frozen=True)
+class SteadyBVP:
+    """The boundary value problem of a continuum's steady state, and how to read its solutions.
+
+    ``params`` names the BVP's parameters (the kernels' free parameters, in order);
+    ``length_index`` is the length's among them (None: the length is fixed, ``length``).
+    """
+
+    problem: BVP
+    fields: tuple[str, ...]
+    length: float
+    system: object
+    params: tuple[str, ...] = ()
+    length_index: int | None = None
+    start: np.ndarray | None = None
+
+    @property
+    def n(self) -> int:
+        """Number of fields."""
+        return len(self.fields)
+
+    def length_of(self, result: BVPResult) -> float:
+        """The domain length L of a solution."""
+        return float(result.p[self.length_index]) if self.length_index is not None else self.length
+
+    def values(self, result: BVPResult, s: np.ndarray) -> np.ndarray:
+        """y = (u, u_s) at positions s (in [0, L]) of a solution: shape (2n, len(s))."""
+        sigma = np.atleast_1d(np.asarray(s, float)) / self.length_of(result)
+        return np.asarray(result(sigma), float).reshape(2 * self.n, -1)
+
+    def jets(self, result: BVPResult, points: np.ndarray, jets) -> np.ndarray:
+        """The solution's jets (field, order <= 1) at ``points`` (any shape): array points.shape + (len(jets),)."""
+        y = self.values(result, np.ravel(points))
+        cols = [y[self.fields.index(f) + self.n * k] for f, k in jets]
+        return np.stack(cols, axis=-1).reshape(np.shape(points) + (len(jets),))
+
+    def outputs(self, result: BVPResult, s: np.ndarray) -> dict[str, np.ndarray]:
+        """The model's outputs along the solution at positions s (one batched kernel call)."""
+        s = np.atleast_1d(np.asarray(s, float))
+        y = self.values(result, s)
+        m = len(s)
+        state = {"q": np.ascontiguousarray(y[:self.n].T), "v": np.ascontiguousarray(y[self.n:].T),
+                 "z": np.zeros((m, 0)), "t": s.reshape(m, 1), "p": np.asarray(result.p, float)}
+        out = self.system.kernels["outputs"].evaluate(state)
+        return {k: np.asarray(v).reshape(m) for k, v in out.items() if not k.startswith("bc_")}
+
+
+def steady_bvp(field_system) -> SteadyBVP:
+    """The BVP of ``field_system``'s steady state (kernels bvp_*); its parameters are the free ones."""
+    st = field_system.steady_form()
+    fields = tuple(field_system.info["fields"])
+    n = len(fields)
+    names = tuple(field_system.meta.get("params", []))
+    length_name = field_system.info["length"]
+    length_index = names.index(length_name) if length_name in names else None
+    fixed_length = field_system.value(length_name)
+    bc = st.outputs(np.zeros(n), np.ones(n))  # boundary values depend on parameters only (unit slopes: finite)
+    conditions = []
+    for f, k, at in field_system.info["constraints"]:
+        if k > 1:
+            raise InputError(f"steady BVP: condition on {f} of order {k}", key="boundary",
+                             expected="values and slopes only (first-order densities)")
+        conditions.append((fields.index(f) + n * int(k), at, bc[f"bc_{f}_{k}_{at}"]))
+    if len(conditions) != 2 * n:
+        raise InputError(f"the steady BVP of {field_system.meta.get('model')} has {len(conditions)} boundary "
+                         f"conditions for {2 * n} first-order unknowns", key="boundary",
+                         expected="n conditions per field pair: values or slopes at the two ends")
+    start = [(i, v) for i, at, v in conditions if at == "start"]
+    end = [(i, v) for i, at, v in conditions if at == "end"]
+    eye = np.eye(2 * n)
+    residual, tangent = st.kernels["residual"], st.kernels["tangent"]
+
+    def L_of(p):
+        return p[length_index] if length_index is not None else fixed_length
+
+    def accelerations(s_pts, y, p, with_jacobian: bool):
+        """u_ss = -H^-1 r(u, u_s, 0) at every point (batched kernels), and optionally
+        d u_ss / d y = -H^-1 [r_u, r_us] at that u_ss."""
+        m = y.shape[1]
+        state = {"q": np.ascontiguousarray(y[:n].T), "v": np.ascontiguousarray(y[n:].T), "a": np.zeros((m, n)),
+                 "z": np.zeros((m, 0)), "t": np.reshape(np.asarray(s_pts, float), (m, 1)),
+                 "p": np.asarray(p, float)}
+        r = residual.evaluate(state)["r"].reshape(m, n)
+        H = tangent.evaluate(state)["r_a"].reshape(m, n, n)
+        acc = -np.linalg.solve(H, r[..., None])[..., 0]
+        if not with_jacobian:
+            return acc, None
+        tan = tangent.evaluate({**state, "a": acc})  # r_q, r_v at the actual u_ss (H depends on u_s)
+        rhs = np.concatenate([tan["r_q"].reshape(m, n, n), tan["r_v"].reshape(m, n, n)], axis=2)
+        return acc, -np.linalg.solve(H, rhs)
+
+    def use(p) -> None:
+        """Point the single-state kernels (shooting's hot path) at the parameters p."""
+        if not np.array_equal(st.params, p):
+            st.params[...] = p
+
+    def F(s_pts, y, p):
+        if y.shape[1] == 1:  # one state (shooting): the prepared single-state kernels
+            use(p)
+            return st.rhs(float(np.ravel(s_pts)[0]), y[:, 0])[:, None]
+        acc, _ = accelerations(s_pts, y, p, False)
+        return np.vstack([y[n:], acc.T])
+
+    def f(sigma, y, p):
+        L = L_of(p)
+        return L * F(L * np.asarray(sigma), y, p)
+
+    def f_y(sigma, y, p):
+        L = L_of(p)
+        if y.shape[1] == 1:
+            use(p)
+            return L * st.jacobian(L * float(np.ravel(sigma)[0]), y[:, 0])[:, :, None]
+        _, jac = accelerations(L * np.asarray(sigma), y, p, True)
+        J = np.zeros((2 * n, 2 * n, y.shape[1]))
+        J[:n, n:] = np.eye(n)[:, :, None]
+        J[n:] = np.transpose(jac, (1, 2, 0))
+        return L * J
+
+    def f_p(sigma, y, p):
+        """d f / d p by central differences (relative steps 1e-6), for continuation's F_lam."""
+        p = np.asarray(p, float)
+        out = np.zeros((2 * n, len(p), y.shape[1]))
+        for j in range(len(p)):
+            step = 1e-6 * max(abs(p[j]), 1e-3)
+            up, down = p.copy(), p.copy()
+            up[j] += step
+            down[j] -= step
+            out[:, j] = (f(sigma, y, up) - f(sigma, y, down)) / (2 * step)
+        return out
+
+    def g(ya, yb, p):
+        return np.array([ya[i] - v for i, v in start] + [yb[i] - v for i, v in end])
+
+    g_ya = lambda ya, yb, p: np.vstack([eye[[i for i, _ in start]], np.zeros((len(end), 2 * n))])  # noqa: E731
+    g_yb = lambda ya, yb, p: np.vstack([np.zeros((len(start), 2 * n)), eye[[i for i, _ in end]]])  # noqa: E731
+    g_p = lambda ya, yb, p: np.zeros((2 * n, len(names)))  # noqa: E731
+    problem = BVP(f, f_y, g, g_ya, g_yb, (0.0, 1.0), 2 * n, n_p=len(names), f_p=f_p if names else None,
+                  g_p=g_p if names else None, vectorized=True,
+                  name=f"steady state of {field_system.meta.get('model')}")
+    return SteadyBVP(problem, fields, fixed_length, st, names, length_index,
+                     np.array(field_system.params, float))
+
+
+def initial_guess(bvp: SteadyBVP, sigma: np.ndarray, modes: dict | None = None) -> np.ndarray:
+    """Boundary values joined linearly, plus sum_j a_j sin(j pi sigma) per field (``modes``: field -> [a_1, ...])."""
+    n = bvp.n
+    y0 = np.zeros(2 * n)
+    y1 = np.zeros(2 * n)
+    ya = bvp.problem.g(np.zeros(2 * n), np.zeros(2 * n), bvp.start)
+    # boundary values: g = y - v at the constrained entries, so v = -g(0, 0)
+    rows_a = bvp.problem.g_ya(y0, y1, bvp.start)
+    rows_b = bvp.problem.g_yb(y0, y1, bvp.start)
+    for row, value in zip(rows_a, -ya):
+        if row.any():
+            y0[np.argmax(row)] = value
+    for row, value in zip(rows_b, -ya):
+        if row.any():
+            y1[np.argmax(row)] = value
+    L = bvp.start[bvp.length_index] if bvp.length_index is not None else bvp.length
+    y = np.zeros((2 * n, len(sigma)))
+    for i in range(n):
+        y[i] = y0[i] + (y1[i] - y0[i]) * sigma
+        y[n + i] = (y1[i] - y0[i]) / L
+    for field, amplitudes in (modes or {}).items():
+        i = bvp.fields.index(field)
+        for j, a in enumerate(amplitudes, 1):
+            y[i] += a * np.sin(j * np.pi * sigma)
+            y[n + i] += a * j * np.pi / L * np.cos(j * np.pi * sigma)
+    return y
+
+
+def solve_steady(bvp: SteadyBVP, *, method: str = "collocation", guess: BVPResult | None = None, modes=None,
+                 mesh: int = 200, nodes: int = 20, tol: float = 1e-10) -> BVPResult:
+    """A steady state by ``method`` from a previous solution or the guess of :func:`initial_guess`."""
+    if method not in METHODS:
+        raise InputError(f"unknown steady method {method!r}", key="method", expected=", ".join(METHODS))
+    p = bvp.start
+    sigma = np.linspace(0.0, 1.0, mesh + 1)
+    values = guess(sigma) if guess is not None else initial_guess(bvp, sigma, modes)
+    if method == "collocation":
+        return collocate(bvp.problem, sigma, values, p=p, tol=tol)
+    if method == "multiple_shooting":
+        return multiple_shoot(bvp.problem, sigma, values, p=p, nodes=nodes, tol=tol)
+    return shoot(bvp.problem, values[:, 0], p=p, tol=tol)
