@@ -161,3 +161,31 @@ def test_generated_bvp_jacobians_match_central_differences(law):
     y = np.array([0.4, 0.05, 3.0, 2.0, 0.3, 10.5])
     errors = check_jacobians(bvp.problem, 0.3, y, bvp.start)
     assert errors["f_y"] < 1e-7 and errors["f_p"] < 1e-6
+
+
+def test_branches_scene_locates_the_minimum_eyelet_tension(tmp_path):
+    """scenes/balloon_branches.toml: the single-loop branch by continuation in lambda0 with stability at every
+    point; p_e,min against the hand-written reference's minimum (balloon_notes.md: 14.70509 at -0.08853), the
+    single loops all stable (the paper's finding), p_e along the branch = the reference's shooting at a few
+    lambda0."""
+    import json
+
+    from mechgen.cli import main
+
+    target = tmp_path / "out.json"
+    root = Path(__file__).resolve().parents[1]
+    assert main(["run", str(root / "scenes" / "balloon_branches.toml"), "--json", str(target)]) == 0
+    results = {a["name"]: a["outputs"] for a in json.loads(target.read_text())["analyses"]}
+    branch = results["single_loop"]
+    assert branch["p_e_min"] == pytest.approx(14.70509, abs=2e-5)
+    assert branch["lambda0_at_p_e_min"] == pytest.approx(-0.08853, abs=2e-4)
+    points = branch["branch"]
+    assert len(points) >= 100 and points[-1]["lambda0"] == pytest.approx(0.27, abs=1e-12)
+    assert {p["verdict"] for p in points} == {"stable"}
+    law = reference.Law("neo", 100.0)
+    for p in points[::30]:
+        l0 = l0_of(p["lambda0"])
+        scale = p["p_e"] / (l0 * p["eyelet_stretch"])  # tension vector p r_s / lambda, r_s = r_sigma / l0
+        guess = (1.01 * scale * p["x_s_start"], 0.99 * scale * p["z_s_start"])
+        # fixed-mesh collocation (200 Hermite-Simpson intervals, error ~ h^4): 1e-7 against adaptive shooting
+        assert p["p_e"] == pytest.approx(np.hypot(*reference.shoot(law, H, l0, guess)), rel=1e-7)

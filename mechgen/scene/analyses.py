@@ -15,6 +15,7 @@ from mechgen.runtime.newton import newton
 from mechgen.runtime.stability import stability as solve_stability
 from mechgen.runtime.stability import stability_first_order, stability_sparse
 from mechgen.runtime.system import System
+from mechgen.scene.branches import linear_about_steady, run_continuation, run_steady_bvp
 from mechgen.scene.whirl import is_gyroscopic, run_campbell, run_damped_modes
 
 #: above this many unknowns, a stability analysis with a ``count`` of sparse matrices uses shift-invert
@@ -25,6 +26,10 @@ def needs(kind: str, options: dict, *, internal: bool) -> set[str]:
     """Kernels an analysis needs."""
     if kind in ("modes", "stability", "campbell"):
         return {"linear"}
+    if kind == "continuation":
+        return {"linear", "bvp_residual", "bvp_tangent", "bvp_outputs"}
+    if kind == "steady" and options.get("method", "newton") != "newton":
+        return {"linear", "bvp_residual", "bvp_tangent", "bvp_outputs"}
     if kind == "steady":
         return {"residual", "tangent", "outputs"} | ({"rates", "rates_tangent"} if internal else set())
     if kind == "simulate":
@@ -46,10 +51,18 @@ def _vector(system: System, table: dict | None, base: np.ndarray | None = None) 
     return q
 
 
+def _linear(system, q, options: dict, context: dict) -> dict:
+    """M, D, G, K about the operating point, or about a boundary-value steady state named by ``about``."""
+    if options.get("about") and "_bvp" in context[options["about"]]:
+        return linear_about_steady(system, context[options["about"]])
+    return system.linear(q)
+
+
 def operating_point(system: System, options: dict, context: dict) -> np.ndarray:
     """q about which to linearise: a previous steady state, an explicit point, or zero."""
     if options.get("about"):
-        return np.asarray(context[options["about"]]["_q"])
+        steady = context[options["about"]]
+        return np.zeros(system.n) if "_bvp" in steady else np.asarray(steady["_q"])
     return _vector(system, options.get("at"))
 
 
@@ -62,7 +75,7 @@ def run_modes(system: System, options: dict, context: dict) -> dict:
     with ``eigenvalues``, ``log_dec`` and (rotors) ``whirl``.
     """
     q = operating_point(system, options, context)
-    mats = system.linear(q)
+    mats = _linear(system, q, options, context)
     if is_gyroscopic(mats) or system.meta.get("whirl"):
         out = run_damped_modes(system, mats, options)
         if system.is_field and options.get("count"):
@@ -82,7 +95,7 @@ def _stability_of(system, q, options: dict, context: dict):
         z = np.asarray(context[options["about"]]["_z"]) if options.get("about") else np.zeros(system.m)
         A = system.jacobian(0.0, np.concatenate([q, np.zeros(system.n), z]))
         return stability_first_order(A, np.eye(A.shape[0]), tolerance=tol)
-    mats = system.linear(q)
+    mats = _linear(system, q, options, context)
     if options.get("count") and hasattr(mats["M"], "toarray") and system.n > SPARSE_STABILITY_N:
         return stability_sparse(mats["M"], mats["D"] + mats["G"], mats["K"], 2 * options["count"], tolerance=tol)
     dense = {k: (v.toarray() if hasattr(v, "toarray") else v) for k, v in mats.items()}
@@ -154,7 +167,19 @@ def _equilibrium_functions(system: System):
 
 
 def run_steady(system: System, options: dict, context: dict) -> dict:
-    """Equilibrium r(q, 0, 0, z) = 0, g(q, 0, z) = 0 by Newton with the generated Jacobians."""
+    """Equilibrium r(q, 0, 0, z) = 0, g(q, 0, z) = 0 by Newton with the generated Jacobians.
+
+    ``method`` shooting / multiple_shooting / collocation: a continuum's steady state as a
+    boundary value problem in s (mechgen.scene.branches)."""
+    if options.get("method", "newton") != "newton":
+        if not system.is_field:
+            raise SceneError(f"steady method {options['method']!r} is for continua", key="method",
+                             expected="'newton' for a lumped or chain model")
+        return run_steady_bvp(system, options, context)
+    if system.is_field and system.info.get("boundary_values"):
+        raise SceneError(f"model {system.meta.get('model')} fixes its ends at nonzero values: its steady state is "
+                         "a boundary value problem in s", key="method",
+                         expected="method = 'collocation', 'shooting' or 'multiple_shooting'")
     y0 = np.concatenate([_vector(system, options.get("guess")), np.zeros(system.m)])
     residual, jacobian = _equilibrium_functions(system)
     res = newton(residual, jacobian, y0, tol=options.get("tol", 1e-10), max_iter=options.get("max_iter", 50))
@@ -264,4 +289,4 @@ def run_simulate(system: System, options: dict, context: dict) -> dict:
 
 
 RUNNERS = {"modes": run_modes, "stability": run_stability, "steady": run_steady, "simulate": run_simulate,
-           "campbell": run_campbell}
+           "campbell": run_campbell, "continuation": run_continuation}

@@ -32,7 +32,8 @@ except ImportError:  # pragma: no cover - Python 3.10
 from mechgen.errors import InputError, SceneError
 from mechgen.scene.expr import CONSTANTS, Expression, is_identifier, parse_expression
 
-KINDS = ("modes", "stability", "steady", "simulate", "sweep", "campbell")
+KINDS = ("modes", "stability", "steady", "simulate", "sweep", "campbell", "continuation")
+STEADY_METHODS = ("newton", "shooting", "multiple_shooting", "collocation")
 BACKENDS = ("c", "numpy", "casadi")
 METHODS = ("BDF", "Radau", "LSODA", "RK45", "DOP853", "leapfrog")
 TOP_KEYS = ("title", "model", "backend", "free", "params", "coordinates", "analysis", "segments", "parts")
@@ -439,6 +440,53 @@ def _method(ctx: _Ctx, key: str, value: object) -> str:
     return value
 
 
+def _steady_method(ctx: _Ctx, key: str, value: object) -> str:
+    if not isinstance(value, str) or value not in STEADY_METHODS:
+        raise _fail(ctx.file, key, f"unknown steady method {_show(value)}", "one of: " + ", ".join(STEADY_METHODS))
+    return value
+
+
+def _modes_table(ctx: _Ctx, key: str, value: object) -> dict[str, list[float]]:
+    """{field: [a_1, a_2, ...]}: sine amplitudes added to a boundary-value problem's initial guess."""
+    if not isinstance(value, dict):
+        raise _fail(ctx.file, key, f"value is {_type_name(value)}", "a table: field = [amplitudes of sin(j pi s/L)]")
+    out = {}
+    for name, amps in value.items():
+        sub = _join(key, name)
+        if not is_identifier(name):
+            raise _fail(ctx.file, sub, f"{_show(name)} is not a field name", IDENTIFIER_RULE)
+        if not isinstance(amps, list) or not amps:
+            raise _fail(ctx.file, sub, f"value is {_type_name(amps)}", "an array of numbers")
+        out[name] = [_number(ctx, f"{sub}[{i}]", a) for i, a in enumerate(amps, 1)]
+    return out
+
+
+def _aliases(ctx: _Ctx, key: str, value: object) -> dict[str, str]:
+    """{new_name: output_name}: report an output (e.g. tension_start) under a name of the scene's choosing."""
+    if not isinstance(value, dict):
+        raise _fail(ctx.file, key, f"value is {_type_name(value)}", "a table: name = \"output_name\"")
+    for name, target in value.items():
+        if not is_identifier(name) or not isinstance(target, str) or not is_identifier(target):
+            raise _fail(ctx.file, _join(key, name), f"alias {_show(name)} = {_show(target)}",
+                        "identifiers on both sides: name = \"output_name\"")
+    return dict(value)
+
+
+def _parameter(ctx: _Ctx, key: str, value: object) -> str:
+    info = _param_info(ctx.file, key, ctx.model, value)
+    if _is_choice(info) or info.integer:
+        raise _fail(ctx.file, key, f"parameter {_show(value)} is not a real number", "a numeric model parameter")
+    _check_not_derived(ctx, key, value)
+    ctx.swept = (value,)
+    return value
+
+
+def _name(ctx: _Ctx, key: str, value: object) -> str:
+    if not isinstance(value, str) or not is_identifier(value):
+        raise _fail(ctx.file, key, f"value is {_show(value)}", IDENTIFIER_RULE)
+    return value
+
+
 def _coord_table(ctx: _Ctx, key: str, value: object) -> dict[str, float]:
     """A table coordinate name -> number or expression."""
     if not isinstance(value, dict):
@@ -564,7 +612,7 @@ def _multiples(ctx: _Ctx, key: str, value: object) -> list[float]:
 
 def _inner(ctx: _Ctx, key: str, value: object) -> AnalysisSpec:
     """The analysis a sweep repeats: a table with ``kind`` (not sweep) and that kind's keys."""
-    inner_kinds = [k for k in KINDS if k not in ("sweep", "campbell")]
+    inner_kinds = [k for k in KINDS if k not in ("sweep", "campbell", "continuation")]
     if not isinstance(value, dict):
         raise _fail(ctx.file, key, f"value is {_type_name(value)}", "a table with kind and its options")
     kind = _kind(ctx, key, value, inner_kinds)
@@ -588,13 +636,18 @@ SCHEMAS: dict[str, dict[str, tuple[Callable, Any]]] = {
     "modes": dict(_LINEAR),
     "stability": {**_LINEAR, "tolerance": (_positive, 1e-8), "refine": (_bool, True),
                   "refine_rtol": (_positive, 1e-2)},
-    "steady": {"guess": (_coord_table, {}), "tol": (_positive, 1e-10), "max_iter": (_count, 50)},
+    "steady": {"guess": (_coord_table, {}), "tol": (_positive, 1e-10), "max_iter": (_count, 50),
+               "method": (_steady_method, "newton"), "bulge": (_modes_table, {}), "mesh": (_count, 200),
+               "nodes": (_count, 20), "aliases": (_aliases, {})},
     "simulate": {"t_end": (_positive, _REQUIRED), "method": (_method, "BDF"), "dt": (_positive, _ABSENT),
                  "rtol": (_positive, 1e-8), "atol": (_positive, 1e-10), "q0": (_coord_table, {}),
                  "v0": (_coord_table, {}), "initial_mode": (_count, _ABSENT), "amplitude": (_number, 1.0),
                  "outputs": (_outputs, _ALL_OUTPUTS), "series": (_bool, False), "samples": (_count, 201)},
     "sweep": {"over": (_over, _REQUIRED), "analysis": (_inner, _REQUIRED), "workers": (_workers, 0),
               "progress": (_bool, True)},
+    "continuation": {"about": (_about, _REQUIRED), "parameter": (_parameter, _REQUIRED), "stop": (_number, _REQUIRED),
+                     "step": (_positive, 0.05), "max_points": (_count, 200), "mesh": (_count, 100),
+                     "stability": (_bool, True), "minimize": (_name, _ABSENT), "aliases": (_aliases, {})},
     "campbell": {"over": (_speeds, _REQUIRED), "count": (_count, 8), "multiples": (_multiples, [1.0]),
                  "about": (_about, _ABSENT), "at": (_coord_table, _ABSENT)},
 }
@@ -716,6 +769,8 @@ def load_scene(path: str, *, overrides: Sequence[str] = (), lookup_model: Callab
     for spec in analyses:
         if spec.kind in ("sweep", "campbell"):
             free += [n for n in spec.options["over"] if n not in free]
+        if spec.kind == "continuation" and spec.options["parameter"] not in free:
+            free.append(spec.options["parameter"])
     from mechgen.scene.layout import load_layout
 
     segments, parts = load_layout(file, data, model, params)
