@@ -404,7 +404,7 @@ def _dense_solve(J, r):
 
 def _sparse_solve(J, r):
     try:
-        dx = spla.splu(sps.csc_matrix(J)).solve(-r)
+        dx = spla.splu(sps.csc_matrix(J), permc_spec="MMD_AT_PLUS_A").solve(-r)
     except RuntimeError as exc:
         raise _Singular(str(exc)) from exc
     if not np.all(np.isfinite(dx)):
