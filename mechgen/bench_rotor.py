@@ -22,16 +22,18 @@ Steps, all in one process, BLAS limited to one thread for both tools (threadpool
    median of 3, interleaved (ROSS, mechgen, ROSS, mechgen ...), ROSS's ``run_modal`` lru_cache cleared
    before every run. ROSS's Campbell tracks its modes and computes no critical speeds, so the matched
    comparison is mechgen's analysis with ``multiples = []`` (tracking only); the full analysis with
-   ``multiples = [1.0]`` (critical speeds refined by Brent's method) is timed too. Compilation (a
+   ``multiples = [1.0]`` (critical speeds refined by secant steps on the reduced model, each confirmed by
+   one exact solve) is timed too. The analysis is the library path: the matrices are detected to be
+   polynomial in Omega (``fit_speed_polynomial``: three assemblies, then sparse adds), the modes are
+   solved at full size (sparse shift-invert) at the first and last speed and on a reduced basis at the
+   others, with a residual safeguard that solves at full size where the basis falls short
+   (``mechgen.runtime.campbell``). Compilation (a
    ``compile_model`` call with the compile cache as it is) and mechgen's first Campbell call (mesh and
    discretisation tables built) are reported apart, as is ROSS's first ``run_modal`` (numba JIT).
-3. **Profile** of mechgen's campbell analysis (cProfile): where the time goes, and measured *candidate
-   fixes* - the same tracking (``mechgen.runtime.campbell.campbell``) fed with (a) matrices assembled once
-   (M, D, K at Omega = 0 and G at Omega = 1; G is exactly proportional to Omega in this model, checked
-   here), (b) the same with the sparse shift-invert solver, (c) a reduced basis: the exact modes at the
-   first and last speed (real and imaginary parts, orthonormalised) span a subspace onto which M, D, G, K
-   are projected once; every speed is then a small dense problem. These are *not* mechgen's analysis;
-   their frequencies are compared with it.
+3. **Profile** of mechgen's campbell analysis (cProfile): where the time goes, and the library's two
+   paths timed apart (``candidate_fixes``): ``method = "exact"`` (a full-size sparse solve at every speed,
+   matrices from the speed polynomial) and the default reduced basis; their frequencies are compared
+   with the analysis's.
 4. **A 2 000-dof rotor**: the same rotor with ``N = 498`` (1 996 unknowns; ROSS's elements split 83 times);
    ``modes`` with ``count = 8`` (ARPACK shift-invert) and a 10-speed Campbell. ROSS's ``run_modal`` of the
    equal rotor (2 994 dofs) is timed once and compared (full run only).
@@ -195,11 +197,13 @@ def mechgen_damped_solve(system, speed: float, count: int = COUNT) -> dict:
         system.params[i] = saved
 
 
-def mechgen_campbell(system, speeds, multiples=()) -> dict:
-    """mechgen's ``campbell`` analysis (the scene runner) over ``speeds``, 8 curves."""
+def mechgen_campbell(system, speeds, multiples=(), method: str = "auto") -> dict:
+    """mechgen's ``campbell`` analysis (the scene runner) over ``speeds``, 8 curves (``method``: see
+    mechgen.runtime.campbell.campbell; 'auto' is the scene's)."""
     from mechgen.scene.whirl import run_campbell
 
-    return run_campbell(system, {"over": {"Omega": list(speeds)}, "count": COUNT, "multiples": list(multiples)}, {})
+    return run_campbell(system, {"over": {"Omega": list(speeds)}, "count": COUNT, "multiples": list(multiples),
+                                 "method": method}, {})
 
 
 def ross_rotor(rs, nsub: int):
@@ -272,11 +276,15 @@ def campbell_agreement(mech_freqs, ross_camp) -> float:
 _PROFILE_KEYS = {
     "run_campbell (whole analysis)": ("whirl.py", "run_campbell"),
     "campbell (tracking, incl. solves)": ("campbell.py", "campbell"),
-    "critical_speeds (Brent refinement)": ("campbell.py", "critical_speeds"),
+    "critical_speeds (secant refinement)": ("campbell.py", "critical_speeds"),
     "damped_modes (all calls)": ("damped.py", "damped_modes"),
     "  dense scipy.linalg.eig": ("_decomp.py", "eig"),
     "  sparse ARPACK path": ("damped.py", "_sparse_eig"),
-    "system.linear (assembly per speed)": ("whirl.py", "matrices_at"),
+    "fit_speed_polynomial (assemblies)": ("campbell.py", "fit_speed_polynomial"),
+    "system.linear (all assemblies)": ("whirl.py", "assembled"),
+    "full-size solves (tracking)": ("campbell.py", "_modes_at"),
+    "reduced-basis solves": ("campbell.py", "modes"),
+    "basis enrichment / projection": ("campbell.py", "enrich"),
     "_align (degenerate clusters)": ("campbell.py", "_align"),
     "linear_sum_assignment": ("_lsap.py", "linear_sum_assignment"),
 }
@@ -304,68 +312,20 @@ def profile_campbell(system, speeds, multiples) -> dict:
             "text_tottime": buf.getvalue()}
 
 
-def affine_matrices(system) -> dict:
-    """M, D, K at Omega = 0 and G at Omega = 1, after checking that only G depends on Omega, linearly."""
-    i = _omega_index(system)
-    saved = float(system.params[i])
-    q = np.zeros(system.n)
-    try:
-        system.params[i] = 0.0
-        m0 = system.linear(q)
-        system.params[i] = 1.0
-        m1 = system.linear(q)
-        system.params[i] = MAX_SPEED
-        mw = system.linear(q)
-    finally:
-        system.params[i] = saved
-    dev = max(abs(m1[k] - m0[k]).max() for k in ("M", "D", "K"))
-    dev = max(dev, abs(m0["G"]).max(), abs(mw["G"] - MAX_SPEED * m1["G"]).max() / max(abs(mw["G"]).max(), 1e-300))
-    if dev > 1e-12:
-        raise RuntimeError(f"the rotor's matrices are not M, D, K + Omega G1 (deviation {dev:.2e})")
-    return {"M": m0["M"], "D": m0["D"], "K": m0["K"], "G1": m1["G"], "check": float(dev)}
-
-
-def candidate_fixes(system, speeds, reference_freqs, repeats: int) -> list[dict]:
-    """Time mechgen.runtime.campbell's tracking fed with cheaper, equal matrices/solvers (not mechgen's analysis)."""
-    from mechgen.runtime.campbell import campbell
-    from mechgen.runtime.damped import damped_modes
-    from mechgen.scene.whirl import whirl_stations
-
-    xi, yi = whirl_stations(system)
+def candidate_fixes(system, speeds, reference_freqs, repeats: int, reference_whirl=None) -> list[dict]:
+    """Time the library's two Campbell paths (run_campbell, tracking only) against the analysis's frequencies."""
     ref = np.asarray(reference_freqs)
     rows = []
-
-    def assembled_once(sparse: bool):
-        mats = affine_matrices(system)
-        M, D, K, G1 = mats["M"], mats["D"], mats["K"], mats["G1"]
-        res = campbell(lambda w: {"M": M, "C": D + w * G1, "K": K}, speeds, COUNT, x_index=xi, y_index=yi,
-                       sparse=sparse)
-        return res.frequencies
-
-    def reduced_basis():
-        mats = affine_matrices(system)
-        M, D, K, G1 = mats["M"], mats["D"], mats["K"], mats["G1"]
-        m = COUNT + max(2, COUNT // 2)
-        cols = []
-        for w in (speeds[0], speeds[-1]):
-            dm = damped_modes(M, D + w * G1, K, m, sparse=True)
-            cols += [dm.shapes.real, dm.shapes.imag]
-        U, sv, _ = np.linalg.svd(np.hstack(cols), full_matrices=False)
-        W = U[:, sv > 1e-12 * sv[0]]
-        Mr, Dr, Kr, Gr = (W.T @ (X @ W) for X in (M, D, K, G1))
-        # reduced coordinates: the whirl stations are not unknowns there, so labels are not computed
-        res = campbell(lambda w: {"M": Mr, "C": Dr + w * Gr, "K": Kr}, speeds, COUNT, x_index=0, y_index=1,
-                       sparse=False)
-        return res.frequencies
-
-    for label, fn in (("(a) matrices assembled once, dense eig (as now)", lambda: assembled_once(False)),
-                      ("(b) matrices assembled once, sparse shift-invert", lambda: assembled_once(True)),
-                      ("(c) reduced basis from the modes at the first and last speed", reduced_basis)):
-        times, freqs = [], None
+    for label, method in (("library, method = 'exact': speed polynomial, full-size sparse solve at every speed",
+                           "exact"),
+                          ("library, reduced basis (the default): full-size solves at the end speeds + safeguard",
+                           "auto")):
+        times, res = [], None
         for _ in range(repeats):
-            t, freqs = _timed(fn)
+            t, res = _timed(lambda: mechgen_campbell(system, speeds, (), method))
             times.append(t)
-        rows.append({"variant": label, **_summary(times), "max_rel_diff_vs_run_campbell": _rel(freqs, ref)})
+        rows.append({"variant": label, **_summary(times), "max_rel_diff_vs_run_campbell": _rel(res["frequencies"], ref),
+                     "whirl_equal": None if reference_whirl is None else res["whirl"] == reference_whirl})
     return rows
 
 
@@ -401,6 +361,7 @@ def campbell_timing(system, rotor, speeds, repeats: int, critical: bool = True) 
         mech_t.append(t)
     out["mechgen_tracking"] = _summary(mech_t)
     out["mechgen_frequencies"] = res["frequencies"]
+    out["mechgen_whirl"] = res["whirl"]
     if critical:
         t, full = _timed(lambda: mechgen_campbell(system, speeds, [1.0]))
         out["mechgen_with_critical_speeds"] = {"median_s": t, "all_s": [t], "critical_speeds": full["critical_speeds"]}
@@ -523,7 +484,7 @@ def report_markdown(res: dict) -> str:
         row(f"ROSS `run_campbell(np.linspace(0, {MAX_SPEED:g}, {ct['speeds']}), frequencies={COUNT})`", ct["ross"])
     row("mechgen campbell analysis, `multiples = []` (tracking only: the matched comparison)", ct["mechgen_tracking"])
     if "mechgen_with_critical_speeds" in ct:
-        row("mechgen campbell analysis, `multiples = [1.0]` (plus critical speeds by Brent)",
+        row("mechgen campbell analysis, `multiples = [1.0]` (plus critical speeds, secant on the reduced model)",
             ct["mechgen_with_critical_speeds"])
     b = res["build"]
     L.append("")
@@ -546,13 +507,13 @@ def report_markdown(res: dict) -> str:
             L.append(f"| {k} | {v['calls']} | {_fmt_s(v['cumulative_s'])} |")
     fixes = res.get("candidate_fixes")
     if fixes:
-        L += ["", "## Candidate fixes, measured (the same tracking, `mechgen.runtime.campbell.campbell`; not "
-                  "mechgen's analysis)", "", "| variant | median | per speed | ROSS / this | max rel. diff vs "
-                  "analysis |", "|---|---|---|---|---|"]
+        L += ["", "## The library's Campbell paths (tracking only, `run_campbell`)", "",
+              "| variant | median | per speed | ROSS / this | max rel. diff vs analysis |", "|---|---|---|---|---|"]
         for f in fixes:
             ratio = "-" if ross_med is None else f"{ross_med / f['median_s']:.1f}"
+            same = {True: ", whirl equal", False: ", whirl DIFFERS", None: ""}[f.get("whirl_equal")]
             L.append(f"| {f['variant']} | {_fmt_s(f['median_s'])} | {_fmt_s(f['median_s'] / ct['speeds'])} | {ratio} | "
-                     f"{f['max_rel_diff_vs_run_campbell']:.1e} |")
+                     f"{f['max_rel_diff_vs_run_campbell']:.1e}{same} |")
     big = res["large"]
     L += ["", f"## Large rotor: N = {big['N']} two-node elements, {big['unknowns']} unknowns", "",
           f"* `modes`, count = {COUNT}, at {big['modes_speed']:g} rad/s (sparse shift-invert): median "
@@ -608,7 +569,8 @@ def run_rotor_benchmarks(out: Path, quick: bool = False) -> dict:
             res["accuracy"] = accuracy_check(system, rotor)
         res["campbell"] = ct = campbell_timing(system, rotor, speeds, repeats, critical=not quick)
         res["profile"] = profile_campbell(system, speeds, [] if quick else [1.0])
-        res["candidate_fixes"] = candidate_fixes(system, speeds, ct["mechgen_frequencies"], repeats)
+        res["candidate_fixes"] = candidate_fixes(system, speeds, ct["mechgen_frequencies"], repeats,
+                                                 ct["mechgen_whirl"])
         split = BIG_SPLIT_QUICK if quick else BIG_SPLIT
         res["large"] = large_rotor(rs, split, repeats, with_ross=not quick)
         ross_row = None

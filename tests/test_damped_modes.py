@@ -23,7 +23,8 @@ import scipy.sparse as sps
 from scipy.optimize import brentq
 
 from mechgen.errors import ConvergenceError, InputError
-from mechgen.runtime.campbell import campbell, critical_speeds, mac_matrix
+from mechgen.runtime.campbell import (SpeedPolynomial, campbell, critical_speeds, fit_speed_polynomial,
+                                      mac_matrix)
 from mechgen.runtime.damped import damped_modes, orbit_kappa, whirl, whirl_sign
 
 
@@ -274,9 +275,10 @@ def test_no_forward_critical_speed_when_ip_exceeds_id():
 # ------------------------------------------------------------------------------------------- sparse chain
 
 
-def chain(n_masses, speed=3.0):
+def chain(n_masses, speed=3.0, damping=True):
     """n_masses lumped masses, lateral dofs (x_i, y_i) interleaved, anisotropic springs to neighbours and
-    to ground at the ends, gyroscopic coupling g_i Omega between x_i and y_i, proportional damping."""
+    to ground at the ends, gyroscopic coupling g_i Omega between x_i and y_i, proportional damping
+    (none with ``damping=False``: a conservative gyroscopic system)."""
     i = np.arange(n_masses)
     m = 1.0 + 0.3 * np.sin(i)
 
@@ -294,7 +296,7 @@ def chain(n_masses, speed=3.0):
     M = sps.diags(np.repeat(m, 2)).tocsr()
     g = 0.2 * m * speed
     G = sps.csr_matrix((np.r_[g, -g], (np.r_[2 * i, 2 * i + 1], np.r_[2 * i + 1, 2 * i])), shape=K.shape)
-    return M, (1e-4 * K + 0.01 * M + G).tocsr(), K
+    return M, ((1e-4 * K + 0.01 * M + G) if damping else G).tocsr(), K
 
 
 def test_sparse_chain_agrees_with_dense():
@@ -319,6 +321,91 @@ def test_dense_path_matches_the_qz_pencil():
     s = s[s.imag > 0]
     assert np.allclose(de.eigenvalues, s[np.argsort(s.imag)], rtol=1e-9)
     assert de.eigenvalues.size == n
+
+
+# ------------------------------------------------------------------------------------------- reduced basis
+
+
+def chain_at(n_masses, damping=True):
+    def mats(speed):
+        M, C, K = chain(n_masses, speed, damping)
+        return {"M": M, "C": C, "K": K}
+    return mats
+
+
+CHAIN_STATIONS = {"x_index": np.arange(0, 120, 2), "y_index": np.arange(1, 120, 2)}
+
+
+def test_speed_polynomial_detection_and_fallback():
+    K0, K2, G1 = (sps.random(30, 30, density=0.2, random_state=k, format="csr") for k in range(3))
+    M = sps.identity(30, format="csr")
+    lin = fit_speed_polynomial(lambda w: {"M": M, "G": w * G1}, 0.0, 100.0)
+    assert isinstance(lin, SpeedPolynomial) and lin.degree == 1 and len(lin.terms["M"]) == 1  # M constant
+    quad = fit_speed_polynomial(lambda w: {"M": M, "K": K0 - w**2 * K2, "G": w * G1}, 10.0, 60.0)
+    assert quad.degree == 2
+    for w in (10.0, 23.7, 60.0, 45.0):
+        at = quad(w)
+        assert abs(at["K"] - (K0 - w**2 * K2)).max() <= 1e-12 * abs(K0 - w**2 * K2).max()
+        assert abs(at["G"] - w * G1).max() <= 1e-12 * abs(w * G1).max()
+    both = quad.combined({"C": ("G",), "KM": ("K", "M")})
+    assert abs(both(30.0)["KM"] - (K0 - 900.0 * K2 + M)).max() < 1e-9
+    # not polynomial (or cubic): no fit, the caller assembles at every speed
+    assert fit_speed_polynomial(lambda w: {"M": M, "G": np.sin(w / 50.0) * G1}, 0.0, 100.0) is None
+    assert fit_speed_polynomial(lambda w: {"M": M, "K": K0 + (w / 10.0) ** 3 * K2}, 0.0, 100.0) is None
+    assert fit_speed_polynomial(lambda w: {"M": M}, 5.0, 5.0) is None
+
+
+@pytest.mark.parametrize("damping", [True, False])
+def test_reduced_campbell_equals_exact(damping):
+    # 60 masses (120 dofs): modes solved at full size at the ends only, the rest on the reduced basis
+    mats = chain_at(60, damping)
+    speeds = np.linspace(0.0, 30.0, 25)
+    poly = fit_speed_polynomial(mats, speeds[0], speeds[-1])
+    assert poly is not None and poly.degree == 1
+    red = campbell(poly, speeds, 6, **CHAIN_STATIONS, sparse=True)
+    ex = campbell(mats, speeds, 6, **CHAIN_STATIONS, sparse=True)
+    assert red.method == "reduced" and ex.method == "exact" and ex.exact_solves == 25
+    assert red.exact_solves < 8 and 0 < red.basis_size < 120
+    assert np.allclose(red.frequencies, ex.frequencies, rtol=1e-8, atol=0)
+    assert red.whirl == ex.whirl
+    assert np.allclose(red.log_dec, ex.log_dec, rtol=1e-5, atol=1e-12)
+    assert np.all(np.abs(np.sum(red.shapes.conj() * ex.shapes, axis=1)) ** 2
+                  / (np.sum(np.abs(red.shapes) ** 2, axis=1) * np.sum(np.abs(ex.shapes) ** 2, axis=1)) > 1 - 1e-8)
+    forced = campbell(poly, speeds, 6, **CHAIN_STATIONS, sparse=True, method="exact")
+    assert forced.method == "exact" and np.allclose(forced.frequencies, ex.frequencies, rtol=1e-12)
+    # critical speeds: secant on the reduced model, one exact solve, equal to the exact path's
+    cr, ce = critical_speeds(red, refine=poly, sparse=True), critical_speeds(ex, refine=mats, sparse=True)
+    assert len(cr) == len(ce) > 0
+    assert [(c["mode"], c["whirl"]) for c in cr] == [(c["mode"], c["whirl"]) for c in ce]
+    assert np.allclose([c["speed"] for c in cr], [c["speed"] for c in ce], rtol=1e-10)
+    for c in cr:  # each is a fixed point: some mode at that speed has wd = speed
+        wd = damped_modes(**mats(c["speed"]), count=8, sparse=True).wd
+        assert np.min(np.abs(wd - c["speed"])) <= 1e-9 * c["speed"]
+
+
+def test_reduced_campbell_enriches_where_the_basis_fails():
+    # a wide range (the gyroscopic terms dominate at the top): the ends' modes do not span the middle's,
+    # the safeguard solves there at full size and enriches the basis; the result equals the exact path
+    mats = chain_at(60)
+    speeds = np.linspace(0.0, 400.0, 30)
+    poly = fit_speed_polynomial(mats, speeds[0], speeds[-1])
+    red = campbell(poly, speeds, 6, **CHAIN_STATIONS, sparse=True)
+    ex = campbell(mats, speeds, 6, **CHAIN_STATIONS, sparse=True)
+    assert red.method == "reduced" and red.exact_solves > 2
+    assert np.allclose(red.frequencies, ex.frequencies, rtol=1e-8, atol=0)
+    assert red.whirl == ex.whirl
+
+
+def test_reduced_campbell_through_a_crossing_and_degenerate_start():
+    # the two Laval rotors (isotropic: a double eigenvalue at rest) as a 'reduced' problem: the degenerate
+    # start and the crossing are handled as on the exact path
+    speeds = np.linspace(0.0, 8.0, 33)
+    poly = fit_speed_polynomial(two_rotors, speeds[0], speeds[-1])
+    red = campbell(poly, speeds, 4, x_index=[0, 2], y_index=[1, 3], method="reduced")
+    ex = campbell(two_rotors, speeds, 4, x_index=[0, 2], y_index=[1, 3])
+    assert red.method == "reduced"
+    assert np.allclose(red.frequencies, ex.frequencies, rtol=1e-9)
+    assert red.whirl == ex.whirl == [["backward", "forward", "backward", "forward"]] * 33
 
 
 # ------------------------------------------------------------------------------------------- bad input
@@ -351,6 +438,10 @@ def test_bad_input():
         campbell(lambda w: (M, G, K), [0.0], 1, x_index=0, y_index=1)
     with pytest.raises(InputError, match="oscillatory"):  # overdamped: no whirl mode to track
         campbell(lambda w: {"M": np.eye(2), "C": 5 * np.eye(2), "K": np.eye(2)}, [0.0], 1, x_index=0, y_index=1)
+    with pytest.raises(InputError, match="SpeedPolynomial"):  # the reduced basis needs the speed polynomial
+        campbell(mats, [0.0, 1.0], 1, x_index=0, y_index=1, method="reduced")
+    with pytest.raises(InputError, match="method"):
+        campbell(mats, [0.0, 1.0], 1, x_index=0, y_index=1, method="fast")
     with pytest.raises(InputError, match="needs a mode count"):
         damped_modes(M, G, K, sparse=True)
     # a shift exactly on an eigenvalue (negative stiffness -4: s = 2) makes A - sigma B singular

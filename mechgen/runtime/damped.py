@@ -39,7 +39,7 @@ import scipy.sparse.linalg as spla
 from mechgen.errors import ConvergenceError, InputError
 
 #: with sparse input and ``sparse=None``, systems of at most this many unknowns are solved densely
-SPARSE_MIN_N = 200
+SPARSE_MIN_N = 100
 
 #: |s| beyond this many times the scale counts as an infinite eigenvalue (singular M).
 INFINITE_FACTOR = 1e10

@@ -14,11 +14,11 @@ from __future__ import annotations
 import numpy as np
 
 from mechgen.errors import InputError, SceneError
-from mechgen.runtime.campbell import campbell, critical_speeds
+from mechgen.runtime.campbell import campbell, critical_speeds, fit_speed_polynomial
 from mechgen.runtime.damped import damped_modes, whirl
 
 #: above this many unknowns a damped-modes analysis with a ``count`` uses sparse shift-invert
-SPARSE_N = 300
+SPARSE_N = 100
 
 
 def is_gyroscopic(mats: dict) -> bool:
@@ -90,7 +90,12 @@ def _speed_parameter(system, options: dict) -> tuple[str, list[float]]:
 
 
 def run_campbell(system, options: dict, context: dict) -> dict:
-    """Campbell diagram: tracked damped frequencies over the speed range, whirl, log_dec, critical speeds."""
+    """Campbell diagram: tracked damped frequencies over the speed range, whirl, log_dec, critical speeds.
+
+    With more than four speeds the matrices are tested for a polynomial dependence on the speed
+    (fit_speed_polynomial: three or four assemblies); when it holds, no further assembly is needed and
+    the Campbell runs on the reduced basis (mechgen.runtime.campbell), else it assembles at every speed.
+    ``options['method'] = 'exact'`` forces full-size solves at every speed."""
     from mechgen.scene.analyses import operating_point
 
     name, speeds = _speed_parameter(system, options)
@@ -105,15 +110,24 @@ def run_campbell(system, options: dict, context: dict) -> dict:
     q = operating_point(system, options, context)
     saved = float(system.params[index])
 
-    def matrices_at(speed: float) -> dict:
+    def assembled(speed: float) -> dict:
         system.params[index] = speed
         mats = system.linear(q)
+        return {"M": mats["M"], "D": mats["D"], "G": mats["G"], "K": mats["K"]}
+
+    def matrices_at(speed: float) -> dict:
+        mats = assembled(speed)
         return {"M": mats["M"], "C": mats["D"] + mats["G"], "K": mats["K"]}
 
     count = int(options.get("count", 8))
     sparse = system.n > SPARSE_N
     try:
-        res = campbell(matrices_at, speeds, count, x_index=stations[0], y_index=stations[1], sparse=sparse)
+        # matrices polynomial in the speed (a rotor's G = Omega G1): four assemblies, then sparse adds
+        poly = fit_speed_polynomial(assembled, speeds[0], speeds[-1]) if len(speeds) > 4 else None
+        if poly is not None:
+            matrices_at = poly.combined({"M": ("M",), "C": ("D", "G"), "K": ("K",)})
+        res = campbell(matrices_at, speeds, count, x_index=stations[0], y_index=stations[1], sparse=sparse,
+                       method=options.get("method", "auto"))
         crit = critical_speeds(res, options.get("multiples", [1.0]), refine=matrices_at, sparse=sparse)
     finally:
         system.params[index] = saved
