@@ -40,6 +40,8 @@ def test_ross_example_scene_reports_whirl_campbell_and_critical_speeds(tmp_path,
         curve = np.array(camp["frequencies"])[:, crit["mode"] - 1]
         assert np.interp(crit["speed"], camp["speeds"], curve) == pytest.approx(crit["speed"], rel=1e-3)
     assert len(camp["critical_speeds"]) == 6
+    # 28 unknowns: too few for a reduced basis of 4 x (8 + 4) vectors, so every speed is solved at full size
+    assert camp["method"] == "exact" and camp["exact_solves"] == 50
 
 
 def test_stepped_scene_pairs_split_with_spin(capsys, tmp_path):
@@ -55,6 +57,12 @@ def test_stepped_scene_pairs_split_with_spin(capsys, tmp_path):
         assert np.all(np.diff(freqs) > 0)
     joined = results["joined_both_ways"]["frequencies"]
     np.testing.assert_allclose(joined[1], joined[0], rtol=1e-8)
+    # the Campbell's reduced basis against the full-size modes at the five spin rates (0, 1000 ... 4000 rad/s)
+    camp = results["campbell"]
+    assert camp["method"] == "reduced" and camp["exact_solves"] < len(camp["speeds"])
+    for k, speed in enumerate((0.0, 1000.0, 2000.0, 3000.0, 4000.0)):
+        row = camp["frequencies"][camp["speeds"].index(speed)]
+        np.testing.assert_allclose(sorted(row), results["spin_rates"]["frequencies"][k][:6], rtol=1e-9)
 
 
 BASE = '''model = "spinning_shaft"
@@ -80,6 +88,8 @@ count = 2
     ('[[segments]]\nlength = 0.5\nelements = 2.5\n', "segments[1].elements", ["integer"]),
     ('[[segments]]\nlength = 0.5\nelements = 2\nbc = "free-free"\n', "segments[1].bc", ["unknown segment key"]),
     ('segments = 3\n', "segments", ["tables"]),
+    ('[[analysis]]\nname = "c"\nkind = "campbell"\nover = { Omega = [0.0, 1.0] }\nmethod = "fast"\n',
+     "analysis[1].method", ["unknown campbell method"]),
 ])
 def test_bad_layouts_exit_2_naming_the_key(tmp_path, capsys, extra, key, words):
     scene = tmp_path / "bad.toml"

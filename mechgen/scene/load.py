@@ -604,6 +604,13 @@ def _speeds(ctx: _Ctx, key: str, value: object) -> dict[str, list]:
     return over
 
 
+def _campbell_method(ctx: _Ctx, key: str, value: object) -> str:
+    methods = ("auto", "exact", "reduced")
+    if not isinstance(value, str) or value not in methods:
+        raise _fail(ctx.file, key, f"unknown campbell method {_show(value)}", "one of: " + ", ".join(methods))
+    return value
+
+
 def _multiples(ctx: _Ctx, key: str, value: object) -> list[float]:
     if not isinstance(value, list) or not value:
         raise _fail(ctx.file, key, f"value is {_type_name(value)}", "a non-empty array of positive numbers")
@@ -649,6 +656,7 @@ SCHEMAS: dict[str, dict[str, tuple[Callable, Any]]] = {
                      "step": (_positive, 0.05), "max_points": (_count, 200), "mesh": (_count, 100),
                      "stability": (_bool, True), "minimize": (_name, _ABSENT), "aliases": (_aliases, {})},
     "campbell": {"over": (_speeds, _REQUIRED), "count": (_count, 8), "multiples": (_multiples, [1.0]),
+                 "method": (_campbell_method, _ABSENT),
                  "about": (_about, _ABSENT), "at": (_coord_table, _ABSENT)},
 }
 

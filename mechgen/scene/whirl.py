@@ -137,4 +137,4 @@ def run_campbell(system, options: dict, context: dict) -> dict:
             "critical_speeds": [{"mode": int(c["mode"]) + 1, "multiple": float(c["multiple"]),
                                  "speed": float(c["speed"]), "frequency": float(c["frequency"]), "whirl": c["whirl"]}
                                 for c in crit],
-            "parameter": name}
+            "parameter": name, "method": res.method, "exact_solves": int(res.exact_solves)}
