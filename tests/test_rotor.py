@@ -242,3 +242,13 @@ def test_hard_case_high_speed_stays_conservative():
     system = shaft({"discretisation": "quintic", "N": 4}, layout)
     dense = whirl_frequencies(system, 1e5, 8, sparse=False)
     np.testing.assert_allclose(whirl_frequencies(system, 1e5, 8, sparse=True), dense, rtol=1e-9)
+
+
+def test_two_node_element_follows_a_parameter_change():
+    """timoshenko2's shape functions hold phi = 12 EI/(kGA h^2): changing G_s on the same system (a sweep) must
+    rebuild them, giving the frequencies of a shaft built with that G_s from the start."""
+    system = shaft({"bc": "pinned-pinned", "discretisation": "timoshenko2", "N": 16})
+    whirl_frequencies(system, 0.0, 4)
+    system.params[system.meta["params"].index("G_s")] = 20e9
+    fresh = shaft({"bc": "pinned-pinned", "discretisation": "timoshenko2", "N": 16, "G_s": 20e9})
+    np.testing.assert_allclose(whirl_frequencies(system, 0.0, 4), whirl_frequencies(fresh, 0.0, 4), rtol=1e-12)

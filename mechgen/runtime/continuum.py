@@ -71,21 +71,22 @@ class FieldSystem:
 
     @property
     def disc(self) -> Discretisation:
-        """The discretisation at the current length (built once per length)."""
+        """The discretisation at the current length (built once per length; for timoshenko2, whose shape
+        functions hold EI / kGA, once per parameter vector)."""
         length = self.value(self.info["length"])
-        key = ("disc", length)
+        key = ("disc", length, np.asarray(self.params, float).tobytes()
+               if self.choices["discretisation"] == "timoshenko2" else None)
         if key not in self._cache:
             self._cache.clear()
             jets = tuple((f, int(k)) for f, k in self.info["jets"])
             kind = self.choices["discretisation"]
             try:
-                mesh = None
-                if self.layout is not None and (self.layout.segments or self.layout.parts) and kind not in GLOBAL:
+                if kind in GLOBAL:
+                    if self.layout is not None and self.layout.segments:
+                        raise ValueError(f"segments need finite elements; {kind} is a global basis")
+                    mesh = None
+                else:
                     mesh = build_mesh(self.layout, int(self.choices["N"]), length)
-                elif self.layout is not None and self.layout.segments:
-                    raise ValueError(f"segments need finite elements; {kind} is a global basis")
-                mesh = mesh if mesh is not None or kind != "timoshenko2" else build_mesh(None, int(self.choices["N"]),
-                                                                                          length)
                 shear = self._shear_ratios(mesh) if kind == "timoshenko2" else None
                 self._cache[key] = discretise(kind, int(self.choices["N"]), length, self.info["fields"], jets,
                                               quadrature=int(self.choices["quadrature"]),
