@@ -63,11 +63,11 @@ meaningful on an otherwise idle machine.
 
 How to run
 ----------
-    /tmp/rossvenv/bin/python benchmarks/ross_reference.py --out benchmarks/ross_data/ross_reference.json
-    /tmp/rossvenv/bin/python benchmarks/ross_reference.py            # JSON to stdout
+    .venv/bin/python benchmarks/ross_reference.py --out benchmarks/ross_data/ross_reference.json
+    .venv/bin/python benchmarks/ross_reference.py            # JSON to stdout
 
-The venv: ``python3 -m venv /tmp/rossvenv &&
-/tmp/rossvenv/bin/pip install 'ross-rotordynamics==2.3.0' 'plotly<6'``.
+ROSS comes with the project's test and bench extras (``pip install -e '.[bench]'``:
+``ross-rotordynamics==2.3.0`` and ``plotly<6``); it is not a runtime dependency.
 """
 
 from __future__ import annotations
