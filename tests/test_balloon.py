@@ -189,3 +189,31 @@ def test_branches_scene_locates_the_minimum_eyelet_tension(tmp_path):
         guess = (1.01 * scale * p["x_s_start"], 0.99 * scale * p["z_s_start"])
         # fixed-mesh collocation (200 Hermite-Simpson intervals, error ~ h^4): 1e-7 against adaptive shooting
         assert p["p_e"] == pytest.approx(np.hypot(*reference.shoot(law, H, l0, guess)), rel=1e-7)
+
+
+def test_hard_case_large_stretch_soft_string():
+    """beta = 3, lambda0 = -3 (the string stretched to about 4.3 times its length, cf. the paper's eyelet stretch up
+    to 5.9): collocation converges from a bulge guess and matches the hand-written shooting to 1e-8."""
+    system = balloon("neo_hookean", -3.0, beta=3.0)
+    bvp = steady_bvp(system)
+    res = solve_steady(bvp, method="collocation", modes={"x": [1.0]})
+    out = bvp.outputs(res, np.array([0.0]))
+    assert out["stretch"][0] > 4.0
+    Q0, T = tension_vector(bvp, res, -3.0)
+    ref = reference.shoot(reference.Law("neo", 3.0), H, l0_of(-3.0), (Q0 * 1.01, T * 0.99))
+    np.testing.assert_allclose((Q0, T), ref, rtol=1e-8)
+
+
+def test_lambda0_at_or_above_one_is_refused(tmp_path):
+    """l0 = h/(1 - lambda0) would be infinite or negative (silent nonsense): exit 2 naming the key."""
+    from mechgen.cli import main
+
+    root = Path(__file__).resolve().parents[1]
+    scene = tmp_path / "bad.toml"
+    scene.write_text((root / "scenes" / "balloon_branches.toml").read_text().replace("lambda0 = -0.5",
+                                                                                      "lambda0 = 1.5"))
+    assert main(["run", str(scene)]) == 2
+    scene.write_text((root / "scenes" / "balloon_branches.toml").read_text().replace("stop = 0.27", "stop = 1.0"))
+    assert main(["run", str(scene)]) == 2
+    with pytest.raises(Exception, match="not below 1.0"):
+        specialize(models.get("balloon_string"), {"lambda0": 1.0})

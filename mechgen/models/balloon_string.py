@@ -36,7 +36,7 @@ model = Model("balloon_string", doc=__doc__, file=__file__)
 model.params(
     Param("h", 10.0, "", "axial distance of the eyelets / a", positive=True),
     Param("beta", 100.0, "", "stiffness E / (rho omega^2 a^2)", positive=True),
-    Param("lambda0", 0.0, "", "length parameter (l0 - h)/l0, below 1"),
+    Param("lambda0", 0.0, "", "length parameter (l0 - h)/l0, below 1", below=1.0),
     Param("L", 1.0, "", "domain length in sigma = s / l0 (keep 1)", positive=True),
     Param("drag", 0.0, "", "linear air drag coefficient"),
     Param("law", "neo_hookean", "", "constitutive law", choices=("neo_hookean", "linear")),

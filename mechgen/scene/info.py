@@ -14,6 +14,7 @@ class ParamInfo:
     default: float | str
     choices: tuple[str, ...] | None
     integer: bool
+    below: float | None = None
 
 
 @dataclass(frozen=True)
@@ -35,7 +36,7 @@ def lookup_model(name: str) -> ModelInfo | None:
         model = models.get(name)
     except InputError:
         return None
-    params = {p.name: ParamInfo(p.default, p.choices, p.integer) for p in model.param_list}
+    params = {p.name: ParamInfo(p.default, p.choices, p.integer, p.below) for p in model.param_list}
     coords = model.coordinates_all
     if model.is_lattice:
         n = int(model.param(model.chain_spec.sites).default)

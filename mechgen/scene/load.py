@@ -770,15 +770,26 @@ def load_scene(path: str, *, overrides: Sequence[str] = (), lookup_model: Callab
     data = _read(file)
     title, model, backend = _top_level(file, data, lookup_model, model_names)
     params, depends = _resolve_params(file, data, model, overrides)
+    for name, info in model.params.items():
+        below = getattr(info, "below", None)
+        if below is not None and not params[name] < below:
+            raise _fail(file, f"params.{name}", f"{name} = {params[name]!r} is not below {below!r}",
+                        f"a value below {below!r}")
     free = _free(file, data, model)
     active = _active(file, data, model)
     ctx = _Ctx(file, model, params, depends, active or tuple(model.coordinates), active)
     analyses = _analyses(ctx, data)
-    for spec in analyses:
+    for index, spec in enumerate(analyses, 1):
         if spec.kind in ("sweep", "campbell"):
             free += [n for n in spec.options["over"] if n not in free]
-        if spec.kind == "continuation" and spec.options["parameter"] not in free:
-            free.append(spec.options["parameter"])
+        if spec.kind == "continuation":
+            name = spec.options["parameter"]
+            below = getattr(model.params[name], "below", None)
+            if below is not None and not spec.options["stop"] < below:
+                raise _fail(file, f"analysis[{index}].stop", f"stop {spec.options['stop']!r} is not below "
+                            f"{below!r}, the bound of parameter '{name}'", f"a value below {below!r}")
+            if name not in free:
+                free.append(name)
     from mechgen.scene.layout import load_layout
 
     segments, parts = load_layout(file, data, model, params)

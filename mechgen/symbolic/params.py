@@ -29,6 +29,9 @@ class Param:
         positive: the parameter must be > 0 (also used as a sympy assumption).
         runtime: a choice of the numerics only (a continuum's discretisation, N ...):
             declared functions never see it, so it never changes a derivation.
+        below: an exclusive upper bound the value must stay under (checked when a
+            scene or a specialisation sets it), e.g. 1 for a length parameter
+            lambda0 = (l0 - h)/l0 that would make l0 negative.
     """
 
     name: str
@@ -40,6 +43,7 @@ class Param:
     choices: tuple[str, ...] | None = None
     positive: bool = False
     runtime: bool = False
+    below: float | None = None
     symbol: sp.Symbol = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:

@@ -72,6 +72,11 @@ def specialize(model: Model, values: dict, *, free: tuple[str, ...] = (), active
             raise ModelError(f"unknown active coordinates {unknown}", file=model.file, key="active",
                              expected=f"names among {', '.join(model.coordinates_all)}")
         active = tuple(c for c in model.coordinates_all if c in active)
+    for prm in model.param_list:
+        value = values.get(prm.name, prm.default)
+        if prm.below is not None and prm.is_numeric and not float(value) < prm.below:
+            raise ModelError(f"parameter {prm.name} = {value!r} of model {model.name} is not below {prm.below!r}",
+                             file=model.file, key=prm.name, expected=f"a value below {prm.below!r}")
     runtime = tuple(p.name for p in model.param_list if p.runtime)
     return Specialization(values=fixed, free=ordered_free, active=active, free_values=free_values, runtime=runtime)
 
