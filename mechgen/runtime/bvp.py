@@ -489,7 +489,7 @@ def shoot(problem: BVP, guess, *, p=None, tol: float = 1e-10, max_iter: int = 40
     y0 = _state(problem, guess, "guess")
     problem.check(y0, p)
     opts = _ivp_options(problem, rtol_ivp, atol_ivp, ivp_method, max_nfev, blowup)
-    n, k, unk = problem.n, problem.k, list(problem.unknown)
+    n, unk = problem.n, list(problem.unknown)
     a, b = problem.interval
 
     def unpack(x):

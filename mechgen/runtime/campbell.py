@@ -542,7 +542,7 @@ def _pick(dm: DampedModes, ref: np.ndarray, pred: complex) -> float:
 def _secant(g, a: float, b: float, ga: float, gb: float, x: float, tol: float, maxit: int = 30):
     """Root of g in [a, b] (g(a) g(b) < 0) by the secant method from x, kept in the bracket (bisection
     when a step leaves it); returns (root, slope of the last secant, evaluations)."""
-    lo, hi, glo, ghi = a, b, ga, gb
+    lo, hi, glo = a, b, ga
     px, pg = (a, ga) if abs(x - a) <= abs(b - x) else (b, gb)
     slope = (gb - ga) / (b - a)
     for k in range(1, maxit + 1):
@@ -552,7 +552,7 @@ def _secant(g, a: float, b: float, ga: float, gb: float, x: float, tol: float, m
         if (gx < 0) == (glo < 0):
             lo, glo = x, gx
         else:
-            hi, ghi = x, gx
+            hi = x
         if gx != pg:
             slope = (gx - pg) / (x - px)
         nx = x - gx / slope if slope != 0 else 0.5 * (lo + hi)

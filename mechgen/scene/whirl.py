@@ -115,7 +115,7 @@ def run_campbell(system, options: dict, context: dict) -> dict:
         mats = system.linear(q)
         return {"M": mats["M"], "D": mats["D"], "G": mats["G"], "K": mats["K"]}
 
-    def matrices_at(speed: float) -> dict:
+    def assembled_at(speed: float) -> dict:
         mats = assembled(speed)
         return {"M": mats["M"], "C": mats["D"] + mats["G"], "K": mats["K"]}
 
@@ -124,8 +124,7 @@ def run_campbell(system, options: dict, context: dict) -> dict:
     try:
         # matrices polynomial in the speed (a rotor's G = Omega G1): four assemblies, then sparse adds
         poly = fit_speed_polynomial(assembled, speeds[0], speeds[-1]) if len(speeds) > 4 else None
-        if poly is not None:
-            matrices_at = poly.combined({"M": ("M",), "C": ("D", "G"), "K": ("K",)})
+        matrices_at = assembled_at if poly is None else poly.combined({"M": ("M",), "C": ("D", "G"), "K": ("K",)})
         res = campbell(matrices_at, speeds, count, x_index=stations[0], y_index=stations[1], sparse=sparse,
                        method=options.get("method", "auto"))
         crit = critical_speeds(res, options.get("multiples", [1.0]), refine=matrices_at, sparse=sparse)
