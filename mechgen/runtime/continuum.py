@@ -154,9 +154,7 @@ class FieldSystem:
                     row = np.zeros(disc.ndof)
                     for side, seg in (("left", mesh.segment[v - 1]), ("right", mesh.segment[v])):
                         params = None if seg_params is None else seg_params[seg]
-                        K = self._evaluate("linear" if "linear" in self.kernels else "tangent", None, None, None, 0.0,
-                                           np.array([x]), params=params)
-                        K = next(iter(K[o] for o in ("K", "r_q") if o in K))[0].reshape(len(jets), len(jets))
+                        K = self._stiffness(np.array([x]), params=params)[0]
                         flux = sum(K[a, b] * disc.row(*jets[b], x, side) for b in np.flatnonzero(K[a]))
                         row = row + (flux if side == "left" else -flux)
                     rows.append(row)
@@ -229,6 +227,20 @@ class FieldSystem:
             return None
         return [self._with(seg.values) for seg in self.layout.segments]
 
+    def _stiffness(self, s: np.ndarray, *, params=None, segment=None) -> np.ndarray:
+        """Pointwise stiffness coefficients d rho / d j at rest at positions s: (len(s), jets, jets).
+
+        From the linear kernel (its K) or else the tangent one (r_q); ``segment`` gives each point's
+        segment (its parameters), ``params`` one parameter vector for all.
+        """
+        kernel, out = ("linear", "K") if "linear" in self.kernels else ("tangent", "r_q")
+        na = len(self.info["jets"])
+        if segment is not None:
+            values = self._by_segment(kernel, segment, [None, None, None], 0.0, s[:, None])[out][:, 0]
+        else:
+            values = self._evaluate(kernel, None, None, None, 0.0, s, params=params)[out]
+        return values.reshape(len(s), na, na)
+
     def _shear_ratios(self, mesh) -> tuple[list, np.ndarray]:
         """Shear pairs and phi = 12 EI / (kGA h^2) per element and pair, from the pointwise stiffness.
 
@@ -239,10 +251,8 @@ class FieldSystem:
         if not pairs:
             raise ValueError("the timoshenko2 element needs shear pairs (model.shear_pair) in the model")
         jets = [tuple(j) for j in self.info["jets"]]
-        kernel, out = ("linear", "K") if "linear" in self.kernels else ("tangent", "r_q")
         mids = (mesh.nodes[:-1] + mesh.nodes[1:]) / 2
-        K = self._by_segment(kernel, mesh.segment, [None, None, None], 0.0, mids[:, None])[out][:, 0]
-        K = K.reshape(len(mids), len(jets), len(jets))
+        K = self._stiffness(mids, segment=mesh.segment)
         h = np.diff(mesh.nodes)
         phi = np.zeros((len(mids), len(pairs)))
         for k, (w, psi, _) in enumerate(pairs):

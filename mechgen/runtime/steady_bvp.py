@@ -176,14 +176,14 @@ def initial_guess(bvp: SteadyBVP, sigma: np.ndarray, modes: dict | None = None) 
     n = bvp.n
     y0 = np.zeros(2 * n)
     y1 = np.zeros(2 * n)
-    ya = bvp.problem.g(np.zeros(2 * n), np.zeros(2 * n), bvp.start)
     # boundary values: g = y - v at the constrained entries, so v = -g(0, 0)
+    values = -bvp.problem.g(np.zeros(2 * n), np.zeros(2 * n), bvp.start)
     rows_a = bvp.problem.g_ya(y0, y1, bvp.start)
     rows_b = bvp.problem.g_yb(y0, y1, bvp.start)
-    for row, value in zip(rows_a, -ya):
+    for row, value in zip(rows_a, values):
         if row.any():
             y0[np.argmax(row)] = value
-    for row, value in zip(rows_b, -ya):
+    for row, value in zip(rows_b, values):
         if row.any():
             y1[np.argmax(row)] = value
     L = bvp.start[bvp.length_index] if bvp.length_index is not None else bvp.length
