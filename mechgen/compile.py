@@ -39,6 +39,8 @@ BACKENDS = ("c", "numpy", "casadi")
 FIELD_KERNELS = ("residual", "tangent", "linear", "outputs")
 #: kernels of a continuum's steady boundary value problem (mechgen.symbolic.steady)
 STEADY_KERNELS = ("bvp_residual", "bvp_tangent", "bvp_outputs")
+#: kernels of its Hamiltonian (stress) form, y = (u, n) (mechgen.symbolic.steady.derive_steady_hamiltonian)
+HAMILTONIAN_KERNELS = ("hbvp_rates", "hbvp_rates_tangent", "hbvp_outputs")
 _warned_no_compiler = False
 
 
@@ -175,10 +177,12 @@ def _generate(model: Model, spec: Specialization, kernels: set, backend: str, cs
               report: BuildReport) -> dict:
     """derive -> lower -> emit; returns {'text', 'specs'} (timed into ``report``)."""
     clock = time.perf_counter()
-    eqs = derive(model, spec)
+    hamiltonian_only = model.is_field and set(kernels) <= set(HAMILTONIAN_KERNELS)
+    # a steady state in stress form needs no dynamics (an inextensible string has no strain energy)
+    eqs = None if hamiltonian_only else derive(model, spec)
     report.seconds["derive"] = time.perf_counter() - clock
     clock = time.perf_counter()
-    irs = lower_all(model, eqs, kernels, cse=cse)
+    irs = [] if hamiltonian_only else lower_all(model, eqs, kernels, cse=cse)
     steady = [k for k in STEADY_KERNELS if k in kernels] if model.is_field else []
     if steady:
         from mechgen.symbolic.steady import derive_steady
@@ -188,6 +192,18 @@ def _generate(model: Model, spec: Specialization, kernels: set, backend: str, cs
             ir = replace(lower_lumped(form, k.removeprefix("bvp_"), cse=cse), name=k)
             ir.meta["field"] = field_meta(eqs)
             irs.append(_with_whirl(model, [ir])[0])
+    hamiltonian = [k for k in HAMILTONIAN_KERNELS if k in kernels] if model.is_field else []
+    if hamiltonian:
+        from mechgen.symbolic.steady import derive_steady_hamiltonian
+
+        from mechgen.symbolic.steady import steady_field_meta
+
+        form = derive_steady_hamiltonian(model, spec)
+        meta = steady_field_meta(model, spec) if eqs is None else field_meta(eqs)
+        for k in hamiltonian:
+            ir = replace(lower_lumped(form, k.removeprefix("hbvp_"), cse=cse), name=k)
+            ir.meta["field"] = meta
+            irs.append(ir)
     report.seconds["lower"] = time.perf_counter() - clock
     clock = time.perf_counter()
     text = emit(backend, irs, model=model.name, title=spec.key())

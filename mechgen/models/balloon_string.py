@@ -27,6 +27,7 @@ A = (p/lambda) I + (p' - p/lambda) t t^T, t = r_s/lambda, and u = 0 at both eyel
 """
 import sympy as sp
 
+from mechgen.errors import ModelError
 from mechgen.symbolic.field import fix
 from mechgen.symbolic.kinematics import frame_velocity
 from mechgen.symbolic.model import Model
@@ -39,7 +40,7 @@ model.params(
     Param("lambda0", 0.0, "", "length parameter (l0 - h)/l0, below 1", below=1.0),
     Param("L", 1.0, "", "domain length in sigma = s / l0 (keep 1)", positive=True),
     Param("drag", 0.0, "", "linear air drag coefficient"),
-    Param("law", "neo_hookean", "", "constitutive law", choices=("neo_hookean", "linear")),
+    Param("law", "neo_hookean", "", "constitutive law", choices=("neo_hookean", "linear", "inextensible")),
 )
 model.field("x", "y", "z", length="L", discretisation="sine", N=10)
 
@@ -56,9 +57,37 @@ def stretch(u, p):
 
 def strain_energy(lam, p):
     """W(lambda) per unit undeformed length."""
+    if p.law == "inextensible":
+        raise ModelError("the inextensible string has no strain energy (its tension is a constraint force): its "
+                         "steady balloons use the Hamiltonian form (steady form = 'hamiltonian'); for its "
+                         "dynamics use law = 'linear' with a large beta", file=__file__, key="law",
+                         expected="neo_hookean or linear for modes, stability and continuation with stability")
     if p.law == "neo_hookean":
         return p.beta / 3 * (lam**2 / 2 + 1 / lam)
     return p.beta / 2 * (lam - 1) ** 2
+
+
+def stretch_of_tension(t, p):
+    """lambda(p), the inverse of the law: neo-Hookean lambda^3 - (3p/beta) lambda^2 - 1 = 0 by Cardano's
+    formula, lambda = q + cbrt(S) + cbrt(q^6 / S), q = p/beta, S = 1/2 + q^3 + sqrt(1/4 + q^3) (the second
+    root written without cancellation; real for q^3 > -1/4); linear 1 + p/beta; inextensible 1."""
+    if p.law == "inextensible":
+        return sp.Integer(1)
+    if p.law == "linear":
+        return 1 + t / p.beta
+    q = t / p.beta
+    S = sp.Rational(1, 2) + q**3 + sp.sqrt(sp.Rational(1, 4) + q**3)
+    return q + sp.cbrt(S) + sp.cbrt(q**6 / S)
+
+
+def complementary_energy(t, p):
+    """W*(p) = p lambda(p) - W(lambda(p)) = integral of lambda dp: per unit undeformed length, up to a constant."""
+    if p.law == "inextensible":
+        return t
+    if p.law == "linear":
+        return t + t**2 / (2 * p.beta)
+    lam = stretch_of_tension(t, p)
+    return t * lam - strain_energy(lam, p)
 
 
 def inertial_velocity(u):
@@ -76,6 +105,13 @@ def potential(u, p):
     return length(p) * strain_energy(stretch(u, p), p)
 
 
+@model.complementary_density
+def complementary(u, n, p):
+    """C(n) = l0 W*(|n|): n = (n.x, n.y, n.z) is the tension vector p t, conjugate to r_sigma, so that
+    r_sigma = dC/dn = l0 lambda(p) n / p (the tension-vector form of Zhu et al. and Hall et al.)."""
+    return length(p) * complementary_energy(sp.sqrt(n.x**2 + n.y**2 + n.z**2), p)
+
+
 @model.dissipation_density
 def dissipation(u, p):
     w = inertial_velocity(u)
@@ -88,11 +124,6 @@ def boundary(p):
             fix("x", "end", 1), fix("y", "end"), fix("z", "end", p.h)]
 
 
-def _tension(u, p):
-    lam = sp.Symbol("lam", positive=True)
-    return sp.diff(strain_energy(lam, p), lam).subs(lam, stretch(u, p))
-
-
-model.output("tension", _tension, doc="p = W'(lambda)")
+model.output("tension", lambda n: sp.sqrt(n.x**2 + n.y**2 + n.z**2), doc="p = |n| = W'(lambda)")
 model.output("stretch", stretch, doc="lambda = |r_s|")
 model.output("radius", lambda u: sp.sqrt(u.x**2 + u.y**2), doc="distance from the axis")

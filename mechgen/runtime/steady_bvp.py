@@ -18,7 +18,8 @@ the steady state with the model's Galerkin discretisation.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -34,6 +35,8 @@ class SteadyBVP:
 
     ``params`` names the BVP's parameters (the kernels' free parameters, in order);
     ``length_index`` is the length's among them (None: the length is fixed, ``length``).
+    ``form``: 'lagrangian' (the unknowns are y = (u, u_s)) or 'hamiltonian' (y = (u, n),
+    the stress resultants; the slopes are u_s = dH/dn from the rates kernel).
     """
 
     problem: BVP
@@ -43,6 +46,7 @@ class SteadyBVP:
     params: tuple[str, ...] = ()
     length_index: int | None = None
     start: np.ndarray | None = None
+    form: str = "lagrangian"
 
     @property
     def n(self) -> int:
@@ -53,10 +57,27 @@ class SteadyBVP:
         """The domain length L of a solution."""
         return float(result.p[self.length_index]) if self.length_index is not None else self.length
 
-    def values(self, result: BVPResult, s: np.ndarray) -> np.ndarray:
-        """y = (u, u_s) at positions s (in [0, L]) of a solution: shape (2n, len(s))."""
+    def unknowns(self, result: BVPResult, s: np.ndarray) -> np.ndarray:
+        """The BVP's own unknowns y at positions s (in [0, L]): (u, u_s) or (u, n), shape (2n, len(s))."""
         sigma = np.atleast_1d(np.asarray(s, float)) / self.length_of(result)
         return np.asarray(result(sigma), float).reshape(2 * self.n, -1)
+
+    def _state(self, y: np.ndarray, s: np.ndarray, p) -> dict:
+        m = y.shape[1]
+        if self.form == "hamiltonian":
+            return {"q": np.zeros((m, 0)), "v": np.zeros((m, 0)), "z": np.ascontiguousarray(y.T),
+                    "t": np.reshape(s, (m, 1)), "p": np.asarray(p, float)}
+        return {"q": np.ascontiguousarray(y[:self.n].T), "v": np.ascontiguousarray(y[self.n:].T),
+                "z": np.zeros((m, 0)), "t": np.reshape(s, (m, 1)), "p": np.asarray(p, float)}
+
+    def values(self, result: BVPResult, s: np.ndarray) -> np.ndarray:
+        """(u, u_s) at positions s (in [0, L]) of a solution: shape (2n, len(s))."""
+        s = np.atleast_1d(np.asarray(s, float))
+        y = self.unknowns(result, s)
+        if self.form == "hamiltonian":
+            g = self.system.kernels["rates"].evaluate(self._state(y, s, result.p))["g"].reshape(len(s), -1)
+            y = np.vstack([y[:self.n], g[:, :self.n].T])
+        return y
 
     def jets(self, result: BVPResult, points: np.ndarray, jets) -> np.ndarray:
         """The solution's jets (field, order <= 1) at ``points`` (any shape): array points.shape + (len(jets),)."""
@@ -67,12 +88,9 @@ class SteadyBVP:
     def outputs(self, result: BVPResult, s: np.ndarray) -> dict[str, np.ndarray]:
         """The model's outputs along the solution at positions s (one batched kernel call)."""
         s = np.atleast_1d(np.asarray(s, float))
-        y = self.values(result, s)
-        m = len(s)
-        state = {"q": np.ascontiguousarray(y[:self.n].T), "v": np.ascontiguousarray(y[self.n:].T),
-                 "z": np.zeros((m, 0)), "t": s.reshape(m, 1), "p": np.asarray(result.p, float)}
+        state = self._state(self.unknowns(result, s), s, result.p)
         out = self.system.kernels["outputs"].evaluate(state)
-        return {k: np.asarray(v).reshape(m) for k, v in out.items() if not k.startswith("bc_")}
+        return {k: np.asarray(v).reshape(len(s)) for k, v in out.items() if not k.startswith("bc_")}
 
 
 def steady_bvp(field_system) -> SteadyBVP:
@@ -171,6 +189,100 @@ def steady_bvp(field_system) -> SteadyBVP:
                      np.array(field_system.params, float))
 
 
+def hamiltonian_bvp(field_system) -> SteadyBVP:
+    """The BVP of the steady state in Hamiltonian (stress) form y = (u, n) (kernels hbvp_*).
+
+    dy/dsigma = L rates(L sigma, y) with the exact Jacobian L rates_z; the
+    boundary conditions fix the fields' values at the ends (n is free there).
+    """
+    kernels = {k.removeprefix("hbvp_"): v for k, v in field_system.kernels.items() if k.startswith("hbvp_")}
+    if "rates" not in kernels:
+        raise InputError(f"the kernels of {field_system.meta.get('model')} were built without the Hamiltonian "
+                         "steady form", key="form", expected="a model with a complementary_density and the "
+                         "hbvp_rates, hbvp_rates_tangent and hbvp_outputs kernels")
+    fields = tuple(field_system.info["fields"])
+    n = len(fields)
+    names = tuple(field_system.meta.get("params", []))
+    length_name = field_system.info["length"]
+    length_index = names.index(length_name) if length_name in names else None
+    fixed_length = field_system.value(length_name)
+    params0 = np.array(field_system.params, float)
+    reader = SteadyBVP(None, fields, fixed_length, SimpleNamespace(kernels=kernels), names, length_index, params0,
+                       form="hamiltonian")
+    bc = kernels["outputs"].evaluate(reader._state(np.ones((2 * n, 1)), np.zeros(1), params0))
+    start, end = [], []
+    for f, k, at in field_system.info["constraints"]:
+        if k > 0:
+            raise InputError(f"the Hamiltonian steady form fixes field values only, not {f} of order {k}",
+                             key="form", expected="form = 'lagrangian' for conditions on slopes")
+        (start if at == "start" else end).append((fields.index(f), float(np.ravel(bc[f"bc_{f}_{k}_{at}"])[0])))
+    if len(start) + len(end) != 2 * n:
+        raise InputError(f"the Hamiltonian steady BVP of {field_system.meta.get('model')} has {len(start) + len(end)} "
+                         f"boundary conditions for {2 * n} unknowns", key="boundary",
+                         expected="every field's value fixed at both ends")
+    rates, tangent = kernels["rates"], kernels["rates_tangent"]
+
+    def L_of(p):
+        return p[length_index] if length_index is not None else fixed_length
+
+    def state(sigma, y, p):
+        L = L_of(p)
+        return L, reader._state(np.asarray(y, float).reshape(2 * n, -1), L * np.atleast_1d(sigma), p)
+
+    def f(sigma, y, p):
+        L, st = state(sigma, y, p)
+        return L * rates.evaluate(st)["g"].reshape(-1, 2 * n).T
+
+    def f_y(sigma, y, p):
+        L, st = state(sigma, y, p)
+        return L * np.transpose(tangent.evaluate(st)["g_z"].reshape(-1, 2 * n, 2 * n), (1, 2, 0))
+
+    def f_p(sigma, y, p):
+        """d f / d p by central differences (relative steps 1e-6)."""
+        p = np.asarray(p, float)
+        out = np.zeros((2 * n, len(p), np.shape(y)[1]))
+        for j in range(len(p)):
+            step = 1e-6 * max(abs(p[j]), 1e-3)
+            up, down = p.copy(), p.copy()
+            up[j] += step
+            down[j] -= step
+            out[:, j] = (f(sigma, y, up) - f(sigma, y, down)) / (2 * step)
+        return out
+
+    eye = np.eye(2 * n)
+    g = lambda ya, yb, p: np.array([ya[i] - v for i, v in start] + [yb[i] - v for i, v in end])  # noqa: E731
+    g_ya = lambda ya, yb, p: np.vstack([eye[[i for i, _ in start]], np.zeros((len(end), 2 * n))])  # noqa: E731
+    g_yb = lambda ya, yb, p: np.vstack([np.zeros((len(start), 2 * n)), eye[[i for i, _ in end]]])  # noqa: E731
+    g_p = lambda ya, yb, p: np.zeros((2 * n, len(names)))  # noqa: E731
+    problem = BVP(f, f_y, g, g_ya, g_yb, (0.0, 1.0), 2 * n, n_p=len(names), f_p=f_p if names else None,
+                  g_p=g_p if names else None, vectorized=True,
+                  name=f"steady state of {field_system.meta.get('model')} (Hamiltonian form)")
+    return replace(reader, problem=problem)
+
+
+def stress_guess(bvp: SteadyBVP, sigma: np.ndarray, y: np.ndarray, *, iterations: int = 30) -> np.ndarray:
+    """Stress resultants n for a guess of (u, u_s): dH/dn(u, n) = u_s solved per point by Gauss-Newton from n = u_s.
+
+    A constrained law (dH/dn homogeneous of degree 0 in n: an inextensible string) keeps the
+    starting scale along u_s (the minimum-norm step does not change it).
+    """
+    n = bvp.n
+    L = bvp.length if bvp.length_index is None else bvp.start[bvp.length_index]
+    s = L * np.asarray(sigma, float)
+    target = y[n:].copy()
+    z = np.vstack([y[:n], target])
+    for _ in range(iterations):
+        st = bvp._state(z, s, bvp.start)
+        g = bvp.system.kernels["rates"].evaluate(st, check=False)["g"].reshape(len(s), 2 * n)[:, :n]
+        J = bvp.system.kernels["rates_tangent"].evaluate(st, check=False)["g_z"].reshape(len(s), 2 * n, 2 * n)
+        r = g - target.T
+        if not np.all(np.isfinite(r)) or np.max(np.abs(r)) < 1e-12 * (1 + np.max(np.abs(target))):
+            break
+        step = np.stack([np.linalg.lstsq(Ji[:n, n:], ri, rcond=1e-10)[0] for Ji, ri in zip(J, r)], axis=1)
+        z[n:] -= step
+    return z
+
+
 def initial_guess(bvp: SteadyBVP, sigma: np.ndarray, modes: dict | None = None) -> np.ndarray:
     """Boundary values joined linearly, plus sum_j a_j sin(j pi sigma) per field (``modes``: field -> [a_1, ...])."""
     n = bvp.n
@@ -196,7 +308,7 @@ def initial_guess(bvp: SteadyBVP, sigma: np.ndarray, modes: dict | None = None) 
         for j, a in enumerate(amplitudes, 1):
             y[i] += a * np.sin(j * np.pi * sigma)
             y[n + i] += a * j * np.pi / L * np.cos(j * np.pi * sigma)
-    return y
+    return stress_guess(bvp, sigma, y) if bvp.form == "hamiltonian" else y
 
 
 def solve_steady(bvp: SteadyBVP, *, method: str = "collocation", guess: BVPResult | None = None, modes=None,

@@ -26,10 +26,12 @@ def needs(kind: str, options: dict, *, internal: bool) -> set[str]:
     """Kernels an analysis needs."""
     if kind in ("modes", "stability", "campbell"):
         return {"linear"}
-    if kind == "continuation":
-        return {"linear", "bvp_residual", "bvp_tangent", "bvp_outputs"}
+    if kind == "continuation":  # its steady start brings the BVP kernels
+        return {"linear"} if options.get("stability", True) else set()
     if kind == "steady" and options.get("method", "newton") != "newton":
-        return {"linear", "bvp_residual", "bvp_tangent", "bvp_outputs"}
+        if options.get("form", "lagrangian") == "hamiltonian":
+            return {"hbvp_rates", "hbvp_rates_tangent", "hbvp_outputs"}
+        return {"bvp_residual", "bvp_tangent", "bvp_outputs"}
     if kind == "steady":
         return {"residual", "tangent", "outputs"} | ({"rates", "rates_tangent"} if internal else set())
     if kind == "simulate":

@@ -19,7 +19,7 @@ import numpy as np
 
 from mechgen.runtime.continuation import continue_bvp, minimize_along_branch
 from mechgen.runtime.stability import stability as solve_stability
-from mechgen.runtime.steady_bvp import solve_steady, steady_bvp
+from mechgen.runtime.steady_bvp import hamiltonian_bvp, solve_steady, steady_bvp
 
 SAMPLES = 201
 
@@ -29,7 +29,7 @@ def _summary(bvp, result, aliases: dict) -> dict:
     s = np.linspace(0.0, bvp.length_of(result), SAMPLES)
     out = {}
     for name, values in bvp.outputs(result, s).items():
-        if name == "potential_density":
+        if name in ("potential_density", "hamiltonian"):
             continue
         out.update({f"{name}_start": float(values[0]), f"{name}_end": float(values[-1]),
                     f"{name}_max": float(values.max()), f"{name}_min": float(values.min())})
@@ -51,7 +51,7 @@ def linear_about_steady(system, steady: dict) -> dict:
 
 def run_steady_bvp(system, options: dict, context: dict) -> dict:
     """A steady state of a continuum with boundary values, by the BVP method the scene names."""
-    bvp = steady_bvp(system)
+    bvp = hamiltonian_bvp(system) if options.get("form") == "hamiltonian" else steady_bvp(system)
     method = "collocation" if options.get("method", "newton") == "newton" else options["method"]
     result = solve_steady(bvp, method=method, modes=options.get("bulge"), mesh=options.get("mesh", 200),
                           nodes=options.get("nodes", 20), tol=options.get("tol", 1e-10))

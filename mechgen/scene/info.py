@@ -28,6 +28,7 @@ class ModelInfo:
     continuum: bool = False
     length: str | None = None
     parts: dict | None = None
+    stress_form: bool = False
 
 
 def lookup_model(name: str) -> ModelInfo | None:
@@ -43,4 +44,4 @@ def lookup_model(name: str) -> ModelInfo | None:
         coords = tuple(f"{model.chain_spec.coordinate}_{i + 1}" for i in range(n))
     cont = model.continuum
     return ModelInfo(model.name, params, coords, model.output_names, cont is not None,
-                     cont.length if cont else None, dict(model.parts))
+                     cont.length if cont else None, dict(model.parts), model.complementary_fn is not None)

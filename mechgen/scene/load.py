@@ -446,6 +446,16 @@ def _steady_method(ctx: _Ctx, key: str, value: object) -> str:
     return value
 
 
+def _steady_form(ctx: _Ctx, key: str, value: object) -> str:
+    forms = ("lagrangian", "hamiltonian")
+    if not isinstance(value, str) or value not in forms:
+        raise _fail(ctx.file, key, f"unknown steady form {_show(value)}", "one of: " + ", ".join(forms))
+    if value == "hamiltonian" and not ctx.model.stress_form:
+        raise _fail(ctx.file, key, f"model {ctx.model.name} declares no complementary energy density",
+                    "form = 'lagrangian' (the Hamiltonian form needs @model.complementary_density)")
+    return value
+
+
 def _modes_table(ctx: _Ctx, key: str, value: object) -> dict[str, list[float]]:
     """{field: [a_1, a_2, ...]}: sine amplitudes added to a boundary-value problem's initial guess."""
     if not isinstance(value, dict):
@@ -645,7 +655,7 @@ SCHEMAS: dict[str, dict[str, tuple[Callable, Any]]] = {
                   "refine_rtol": (_positive, 1e-2)},
     "steady": {"guess": (_coord_table, {}), "tol": (_positive, 1e-10), "max_iter": (_count, 50),
                "method": (_steady_method, _ABSENT), "bulge": (_modes_table, _ABSENT), "mesh": (_count, _ABSENT),
-               "nodes": (_count, _ABSENT), "aliases": (_aliases, _ABSENT)},
+               "nodes": (_count, _ABSENT), "aliases": (_aliases, _ABSENT), "form": (_steady_form, _ABSENT)},
     "simulate": {"t_end": (_positive, _REQUIRED), "method": (_method, "BDF"), "dt": (_positive, _ABSENT),
                  "rtol": (_positive, 1e-8), "atol": (_positive, 1e-10), "q0": (_coord_table, {}),
                  "v0": (_coord_table, {}), "initial_mode": (_count, _ABSENT), "amplitude": (_number, 1.0),

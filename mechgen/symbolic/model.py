@@ -117,6 +117,7 @@ class Model:
         self.kinetic_fn: Callable | None = None
         self.potential_fn: Callable | None = None
         self.dissipation_fn: Callable | None = None
+        self.complementary_fn: Callable | None = None
         self.forces_fn: Callable | None = None
         self.chain_spec: Chain | None = None
         self.site_kinetic_fn: Callable | None = None
@@ -211,6 +212,20 @@ class Model:
     def dissipation_density(self, fn: Callable) -> Callable:
         """Decorator (continuum): Rayleigh dissipation per unit length R(u, p, s)."""
         self.dissipation_fn = fn
+        return fn
+
+    def complementary_density(self, fn: Callable) -> Callable:
+        """Decorator (continuum): complementary (stress) energy C(u, n, p, s) per unit length.
+
+        C is the Legendre transform of the potential density in the slopes,
+        C(u, n) = sup_{u_s} (n . u_s - V(u, u_s)), with n.w the stress resultant
+        conjugate to w_s (n = dV/du_s: a string's tension vector). It gives the
+        steady equations their Hamiltonian (stress) form u_s = dH/dn,
+        n_s = -dH/du (mechgen.symbolic.steady.derive_steady_hamiltonian), which
+        stays well conditioned for stiff and constrained (inextensible) laws where
+        the displacement form does not; a law without V (a constraint) declares C only.
+        """
+        self.complementary_fn = fn
         return fn
 
     def weak_form(self, fn: Callable) -> Callable:
