@@ -219,3 +219,32 @@ def test_scene_bad_form_and_inextensible_dynamics_are_refused(tmp_path, capsys):
     scene.write_text(SCENE.format(lambda0=0.1, method="collocation", form="lagrangian"))
     assert main(["run", str(scene)]) == 2
     assert "inextensible" in capsys.readouterr().err
+
+
+def test_frequencies_scene_follows_fixed_eyelet_tension_in_beta(tmp_path):
+    """scenes/balloon_frequencies.toml (the paper's Fig. 4): the vs-beta branches hold p_e = 17.5 while
+    lambda0 is solved for. At beta = 10 the eyelet stretch is the neo-Hookean law's at p = 17.5
+    (17.5 = beta/3 (lambda - lambda^-2)); at beta = 1e6 the balloon is the inextensible one with p_e = 17.5
+    (lambda0 = 0.0360008 from the hand-written shooting and Brent's method) to O(1/beta); every point is stable
+    (single loops)."""
+    import json
+
+    from scipy.optimize import brentq
+
+    from mechgen.cli import main
+
+    root = Path(__file__).resolve().parents[1]
+    target = tmp_path / "out.json"
+    assert main(["run", str(root / "scenes" / "balloon_frequencies.toml"), "--json", str(target)]) == 0
+    out = {a["name"]: a["outputs"] for a in json.loads(target.read_text())["analyses"]}
+    stiff, soft = out["vs_beta"]["branch"], out["vs_beta_soft"]["branch"]
+    assert stiff[-1]["beta"] == pytest.approx(1e6) and soft[-1]["beta"] == pytest.approx(10.0)
+    for point in stiff + soft:
+        assert point["p_e"] == pytest.approx(17.5, rel=1e-9)
+        assert point["verdict"] == "stable"
+    lam = brentq(lambda v: 10.0 / 3 * (v - v**-2) - 17.5, 1.0, 10.0, xtol=1e-14)
+    assert soft[-1]["eyelet_stretch"] == pytest.approx(lam, rel=1e-9)
+    law = reference.Law("inext")
+    l0 = brentq(lambda l: np.hypot(*reference.shoot(law, H, l, [6.0, 16.0])) - 17.5, 10.2, 10.6, xtol=1e-13)
+    assert stiff[-1]["lambda0"] == pytest.approx(lambda0_of(l0), abs=1e-4)
+    assert {p["verdict"] for p in out["vs_lambda0"]["branch"]} == {"stable"}

@@ -289,9 +289,10 @@ def initial_guess(bvp: SteadyBVP, sigma: np.ndarray, modes: dict | None = None) 
     y0 = np.zeros(2 * n)
     y1 = np.zeros(2 * n)
     # boundary values: g = y - v at the constrained entries, so v = -g(0, 0)
-    values = -bvp.problem.g(np.zeros(2 * n), np.zeros(2 * n), bvp.start)
-    rows_a = bvp.problem.g_ya(y0, y1, bvp.start)
-    rows_b = bvp.problem.g_yb(y0, y1, bvp.start)
+    with np.errstate(all="ignore"):  # the first 2n rows: the end values (a held output may follow)
+        values = -bvp.problem.g(np.zeros(2 * n), np.zeros(2 * n), bvp.start)[:2 * n]
+    rows_a = bvp.problem.g_ya(y0, y1, bvp.start)[:2 * n]
+    rows_b = bvp.problem.g_yb(y0, y1, bvp.start)[:2 * n]
     for row, value in zip(rows_a, values):
         if row.any():
             y0[np.argmax(row)] = value
@@ -324,3 +325,60 @@ def solve_steady(bvp: SteadyBVP, *, method: str = "collocation", guess: BVPResul
     if method == "multiple_shooting":
         return multiple_shoot(bvp.problem, sigma, values, p=p, nodes=nodes, tol=tol)
     return shoot(bvp.problem, values[:, 0], p=p, tol=tol)
+
+
+def holding(bvp: SteadyBVP, output: str, at: str, value: float, free: str) -> SteadyBVP:
+    """The same steady state with one more condition, ``output`` at the ``at`` end = ``value``, and the
+    parameter ``free`` solved for (e.g. the eyelet tension held while the string's length adjusts).
+
+    The condition's Jacobians (in y at that end and in p) are central differences of the outputs kernel.
+    """
+    if free not in bvp.params:
+        raise InputError(f"hold: {free!r} is not a free parameter of the compiled kernels", key="free",
+                         expected=f"one of: {', '.join(bvp.params) or 'none'}")
+    base = bvp.problem
+    index = bvp.params.index(free)
+    sigma_end = 0.0 if at == "start" else 1.0
+
+    def out(y, p):
+        L = bvp.length_of(SimpleNamespace(p=p))
+        state = bvp._state(np.asarray(y, float).reshape(-1, 1), np.array([L * sigma_end]), p)
+        values = bvp.system.kernels["outputs"].evaluate(state, check=False)  # NaN fails Newton's own checks
+        if output not in values:
+            raise InputError(f"hold: the model has no output {output!r}", key="hold",
+                             expected=", ".join(k for k in values if not k.startswith("bc_")))
+        return float(np.ravel(values[output])[0])
+
+    def d_out(y, p):
+        y, p = np.asarray(y, float), np.asarray(p, float)
+        dy, dp = np.zeros(len(y)), np.zeros(len(p))
+        for vec, grad in ((y, dy), (p, dp)):
+            for j in range(len(vec)):
+                step = 1e-7 * max(abs(vec[j]), 1.0)
+                up, down = vec.copy(), vec.copy()
+                up[j] += step
+                down[j] -= step
+                args = (up, p) if vec is y else (y, up)
+                back = (down, p) if vec is y else (y, down)
+                grad[j] = (out(*args) - out(*back)) / (2 * step)
+        return dy, dp
+
+    end_y = (lambda ya, yb: ya) if at == "start" else (lambda ya, yb: yb)
+
+    def g(ya, yb, p):
+        return np.append(base.g(ya, yb, p), out(end_y(ya, yb), p) - value)
+
+    def g_ya(ya, yb, p):
+        row = d_out(ya, p)[0] if at == "start" else np.zeros(len(ya))
+        return np.vstack([base.g_ya(ya, yb, p), row])
+
+    def g_yb(ya, yb, p):
+        row = d_out(yb, p)[0] if at == "end" else np.zeros(len(yb))
+        return np.vstack([base.g_yb(ya, yb, p), row])
+
+    def g_p(ya, yb, p):
+        return np.vstack([base.g_p(ya, yb, p), d_out(end_y(ya, yb), p)[1]])
+
+    problem = replace(base, g=g, g_ya=g_ya, g_yb=g_yb, g_p=g_p, unknown=(index,),
+                      name=f"{base.name} with {output} at the {at} = {value:g} ({free} free)")
+    return replace(bvp, problem=problem)

@@ -29,9 +29,10 @@ def needs(kind: str, options: dict, *, internal: bool) -> set[str]:
     if kind == "continuation":  # its steady start brings the BVP kernels
         return {"linear"} if options.get("stability", True) else set()
     if kind == "steady" and options.get("method", "newton") != "newton":
+        linear = {"linear"} if options.get("stability") else set()
         if options.get("form", "lagrangian") == "hamiltonian":
-            return {"hbvp_rates", "hbvp_rates_tangent", "hbvp_outputs"}
-        return {"bvp_residual", "bvp_tangent", "bvp_outputs"}
+            return {"hbvp_rates", "hbvp_rates_tangent", "hbvp_outputs"} | linear
+        return {"bvp_residual", "bvp_tangent", "bvp_outputs"} | linear
     if kind == "steady":
         return {"residual", "tangent", "outputs"} | ({"rates", "rates_tangent"} if internal else set())
     if kind == "simulate":

@@ -17,9 +17,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from mechgen import models
+from mechgen.errors import ConvergenceError
+
 from mechgen.runtime.continuation import continue_bvp, minimize_along_branch
 from mechgen.runtime.stability import stability as solve_stability
-from mechgen.runtime.steady_bvp import hamiltonian_bvp, solve_steady, steady_bvp
+from mechgen.runtime.steady_bvp import hamiltonian_bvp, holding, solve_steady, steady_bvp
 
 SAMPLES = 201
 
@@ -49,14 +52,44 @@ def linear_about_steady(system, steady: dict) -> dict:
     return system.linear(jets=bvp.jets(result, disc.points, disc.jets))
 
 
+def _stability_about(system, bvp, result) -> dict:
+    """Verdict, lowest ten frequencies and the eigenvalues of the Galerkin linearisation about a steady state."""
+    saved = np.array(system.params, float)
+    try:
+        system.params[...] = result.p
+        mats = linear_about_steady(system, {"_bvp": bvp, "_result": result})
+    finally:
+        system.params[...] = saved
+    dense = {k: v.toarray() if hasattr(v, "toarray") else np.asarray(v) for k, v in mats.items()}
+    verdict = solve_stability(dense["M"], dense["D"] + dense["G"], dense["K"])
+    return {"verdict": verdict.verdict, "frequencies": [float(f) for f in verdict.frequencies[:10]],
+            "eigenvalues": [[float(e.real), float(e.imag)] for e in verdict.eigenvalues]}
+
+
 def run_steady_bvp(system, options: dict, context: dict) -> dict:
     """A steady state of a continuum with boundary values, by the BVP method the scene names."""
     bvp = hamiltonian_bvp(system) if options.get("form") == "hamiltonian" else steady_bvp(system)
+    aliases = options.get("aliases", {})
+    if options.get("hold"):
+        (name, value), = options["hold"].items()
+        output, at = aliases.get(name, name).rsplit("_", 1)
+        bvp = holding(bvp, output, at, float(value), options["free"])
     method = "collocation" if options.get("method", "newton") == "newton" else options["method"]
     result = solve_steady(bvp, method=method, modes=options.get("bulge"), mesh=options.get("mesh", 200),
                           nodes=options.get("nodes", 20), tol=options.get("tol", 1e-10))
     out = {"method": method, "iterations": int(result.iterations), "residual_norm": float(result.residual_norm)}
-    out.update(_summary(bvp, result, options.get("aliases", {})))
+    if options.get("hold"):
+        free = options["free"]
+        solved = float(result.p[bvp.params.index(free)])
+        below = models.get(system.meta["model"]).param(free).below
+        if below is not None and not solved < below:
+            raise ConvergenceError(f"steady state with {next(iter(options['hold']))} held: the solved {free} = "
+                                   f"{solved:.6g} is not below {below:g} (no such state near the start; try "
+                                   f"another start value of {free} or another bulge)")
+        out[free] = solved
+    out.update(_summary(bvp, result, aliases))
+    if options.get("stability"):
+        out.update(_stability_about(system, bvp, result))
     s = np.linspace(0.0, bvp.length_of(result), 101)
     y = bvp.values(result, s)
     out["s"] = [float(v) for v in s]
@@ -75,6 +108,7 @@ def run_continuation(system, options: dict, context: dict) -> dict:
     direction = 1 if stop >= here else -1
     bound = {"lam_max": stop} if direction > 0 else {"lam_min": stop}
     branch = continue_bvp(bvp.problem, result, index, mesh=options.get("mesh", 100), ds=options.get("step", 0.05),
+                          ds_max=max(1.0, abs(stop - here) / 20),
                           max_points=options.get("max_points", 200), direction=direction, **bound)
     aliases = options.get("aliases", {})
     saved = np.array(system.params, float)
@@ -82,7 +116,8 @@ def run_continuation(system, options: dict, context: dict) -> dict:
     try:
         for u, lam in zip(branch.u, branch.lam):
             res = branch.system.to_result(u, lam)
-            point = {name: float(lam), **_summary(bvp, res, aliases)}
+            point = {name: float(lam), **{bvp.params[i]: float(res.p[i]) for i in bvp.problem.unknown},
+                     **_summary(bvp, res, aliases)}
             if options.get("stability", True):
                 system.params[...] = res.p
                 mats = linear_about_steady(system, {"_bvp": bvp, "_result": res})

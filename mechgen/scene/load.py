@@ -482,6 +482,27 @@ def _aliases(ctx: _Ctx, key: str, value: object) -> dict[str, str]:
     return dict(value)
 
 
+def _hold(ctx: _Ctx, key: str, value: object) -> dict[str, float]:
+    """{output_end: value}: one output at an end of a steady BVP held fixed (e.g. p_e = 17.5)."""
+    if not isinstance(value, dict) or len(value) != 1:
+        raise _fail(ctx.file, key, f"value is {_show(value)}", "a table with one entry: output = number, e.g. "
+                    "{ tension_start = 17.5 } (or an alias)")
+    (name, number), = value.items()
+    if not is_identifier(name):
+        raise _fail(ctx.file, _join(key, name), f"{_show(name)} is not an output name", IDENTIFIER_RULE)
+    return {name: _number(ctx, _join(key, name), number)}
+
+
+def _free_parameter(ctx: _Ctx, key: str, value: object) -> str:
+    """A numeric parameter a steady BVP solves for (with ``hold``)."""
+    info = _param_info(ctx.file, key, ctx.model, value)
+    if _is_choice(info) or info.integer:
+        raise _fail(ctx.file, key, f"parameter {_show(value)} is not a real number", "a numeric model parameter")
+    if value in ctx.swept:
+        raise _fail(ctx.file, key, f"parameter {_show(value)} is swept", "a parameter the sweep does not set")
+    return value
+
+
 def _parameter(ctx: _Ctx, key: str, value: object) -> str:
     info = _param_info(ctx.file, key, ctx.model, value)
     if _is_choice(info) or info.integer:
@@ -655,7 +676,8 @@ SCHEMAS: dict[str, dict[str, tuple[Callable, Any]]] = {
                   "refine_rtol": (_positive, 1e-2)},
     "steady": {"guess": (_coord_table, {}), "tol": (_positive, 1e-10), "max_iter": (_count, 50),
                "method": (_steady_method, _ABSENT), "bulge": (_modes_table, _ABSENT), "mesh": (_count, _ABSENT),
-               "nodes": (_count, _ABSENT), "aliases": (_aliases, _ABSENT), "form": (_steady_form, _ABSENT)},
+               "nodes": (_count, _ABSENT), "aliases": (_aliases, _ABSENT), "form": (_steady_form, _ABSENT),
+               "hold": (_hold, _ABSENT), "free": (_free_parameter, _ABSENT), "stability": (_bool, _ABSENT)},
     "simulate": {"t_end": (_positive, _REQUIRED), "method": (_method, "BDF"), "dt": (_positive, _ABSENT),
                  "rtol": (_positive, 1e-8), "atol": (_positive, 1e-10), "q0": (_coord_table, {}),
                  "v0": (_coord_table, {}), "initial_mode": (_count, _ABSENT), "amplitude": (_number, 1.0),
@@ -721,6 +743,14 @@ def _cross_checks(ctx: _Ctx, base: str, kind: str, options: dict[str, Any]) -> N
                         f"{len(ctx.coordinates)} coordinates", f"an integer from 1 to {len(ctx.coordinates)}")
     if kind == "sweep":
         options["grid"] = _grid(options["over"])
+    if kind == "steady" and ("hold" in options) != ("free" in options):
+        missing = "free" if "hold" in options else "hold"
+        raise _fail(ctx.file, f"{base}.{missing}", f"'hold' and 'free' go together; '{missing}' is missing",
+                    "hold = { output = value } with free = \"parameter\"")
+    if kind == "steady" and ("hold" in options or options.get("stability") or "form" in options) \
+            and options.get("method", "newton") == "newton":
+        raise _fail(ctx.file, f"{base}.method", "hold, stability and form need a boundary-value steady state",
+                    "method = shooting, multiple_shooting or collocation")
 
 
 def _analysis_name(ctx: _Ctx, base: str, table: dict) -> str:
@@ -792,6 +822,9 @@ def load_scene(path: str, *, overrides: Sequence[str] = (), lookup_model: Callab
     for index, spec in enumerate(analyses, 1):
         if spec.kind in ("sweep", "campbell"):
             free += [n for n in spec.options["over"] if n not in free]
+        inner = spec.options["analysis"] if spec.kind == "sweep" else spec
+        if inner.kind == "steady" and inner.options.get("free") and inner.options["free"] not in free:
+            free.append(inner.options["free"])
         if spec.kind == "continuation":
             name = spec.options["parameter"]
             below = getattr(model.params[name], "below", None)
