@@ -313,14 +313,16 @@ def report_markdown(rows, overhead, builds, start) -> str:
     return "\n".join(lines)
 
 
-SUITES = ("fpu", "beam", "rotor")
+SUITES = ("fpu", "beam", "rotor", "balloon")
 
 
 def run_benchmarks(models_: list[str] | None = None, *, out: Path, quick: bool = False) -> dict:
     """Run the benchmark suites named in ``models_`` (default: all of :data:`SUITES`).
 
     ``fpu``: FPU chain kernels, writes ``out/fpu_kernels.{csv,json,md}``; ``beam``: the
-    continua work-precision and assembly study (:mod:`mechgen.bench_field`).
+    continua work-precision and assembly study (:mod:`mechgen.bench_field`); ``rotor``: Campbell
+    diagrams against ROSS (:mod:`mechgen.bench_rotor`); ``balloon``: the ballooning string's
+    branch with stability against a hand-written scipy baseline (:mod:`mechgen.bench_balloon`).
     """
     from mechgen.errors import InputError
 
@@ -339,6 +341,10 @@ def run_benchmarks(models_: list[str] | None = None, *, out: Path, quick: bool =
         from mechgen.bench_rotor import run_rotor_benchmarks
 
         results["rotor"] = run_rotor_benchmarks(out, quick=quick)
+    if "balloon" in chosen:
+        from mechgen.bench_balloon import run_balloon_benchmarks
+
+        results["balloon"] = run_balloon_benchmarks(out, quick=quick)
     return results
 
 

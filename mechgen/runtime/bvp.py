@@ -25,13 +25,15 @@ are given (mechgen generates them); nothing here differentiates numerically.
   the Jacobian is block-bidiagonal plus the boundary rows, factored by SuperLU.
 * :func:`collocate` - ``scipy.integrate.solve_bvp`` (3-stage Lobatto IIIA, 4th order,
   adaptive mesh) fed with the analytic ``fun_jac`` and ``bc_jac``.
-* :class:`Discretisation` - the same residuals as a square system F(u, lam) = 0 with a
-  sparse Jacobian, lam = p[lam_index] (for :mod:`mechgen.runtime.continuation`): the
-  multiple-shooting residual above, or the 3-stage Lobatto IIIA (Hermite-Simpson)
-  collocation residual on a fixed mesh (4th order at the nodes), interval i::
+* :class:`Discretisation` (module :mod:`mechgen.runtime.collocation`, re-exported here) -
+  the same residuals as a square system F(u, lam) = 0 with a sparse Jacobian, lam =
+  p[lam_index] (for :mod:`mechgen.runtime.continuation`): the multiple-shooting residual
+  above, or collocation on a fixed mesh (Hermite-Simpson, 4th order at the nodes, or
+  s-stage Gauss-Legendre, order 2s).
 
-      y_m = (y_i + y_{i+1})/2 - h (f_{i+1} - f_i)/8,
-      r_i = y_{i+1} - y_i - h (f_i + 4 f(s_i + h/2, y_m) + f_{i+1})/6.
+``f_p`` may take a keyword ``cols`` (parameter indices) and return only those columns,
+(n, len(cols)[, m]); the discretisations then ask for the continuation parameter and the
+unknown parameters alone.
 
 Newton (shooting and multiple shooting) uses a backtracking line search on ||R||_2; a
 trajectory that overflows (|y| > ``blowup``, NaN/Inf) or stops (``solve_ivp`` failure)
@@ -42,6 +44,7 @@ the residual; inconsistent shapes raise :class:`InputError`.
 """
 from __future__ import annotations
 
+import inspect
 import warnings
 from dataclasses import dataclass, field
 from typing import Callable
@@ -50,9 +53,11 @@ import numpy as np
 import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 from scipy.integrate import solve_bvp, solve_ivp
-from scipy.interpolate import CubicHermiteSpline
 
 from mechgen.errors import ConvergenceError, InputError
+
+__all__ = ["BVP", "BVPResult", "Discretisation", "IVP_METHODS", "check_jacobians", "collocate", "multiple_shoot",
+           "on_unit_interval", "shoot"]
 
 IVP_METHODS = ("DOP853", "Radau", "RK45", "BDF", "LSODA")
 _IMPLICIT = ("Radau", "BDF", "LSODA")
@@ -112,6 +117,11 @@ class BVP:
             raise InputError(f"{self.name}: unknown parameter indices {list(unknown)} with n_p = {self.n_p}",
                              key="unknown", expected=f"distinct indices in 0..{self.n_p - 1}")
         object.__setattr__(self, "unknown", unknown)
+        try:
+            takes = self.f_p is not None and "cols" in inspect.signature(self.f_p).parameters
+        except (TypeError, ValueError):
+            takes = False
+        object.__setattr__(self, "_f_p_takes_cols", takes)
         for name in ("f", "f_y", "g", "g_ya", "g_yb"):
             if not callable(getattr(self, name)):
                 raise InputError(f"{self.name}: {name} is not callable", key=name, expected="a function")
@@ -161,12 +171,21 @@ class BVP:
             return self._call("f_y", s, Y, p).reshape(self.n, self.n, len(s))
         return np.stack([self._call("f_y", s[j], Y[:, j], p) for j in range(len(s))], axis=2)
 
-    def f_pv(self, s, Y, p):
-        if self.n_p == 0:
-            return np.zeros((self.n, 0, len(s)))
+    def f_pv(self, s, Y, p, cols=None):
+        """d f / d p at many points: (n, n_p, m), or (n, len(cols), m) for the columns ``cols`` (an
+        f_p that takes a keyword ``cols`` computes only those)."""
+        if self.n_p == 0 or (cols is not None and not len(cols)):
+            return np.zeros((self.n, 0 if cols is None else len(cols), len(s)))
+        if cols is not None and self._f_p_takes_cols:
+            with np.errstate(all="ignore"):
+                out = np.asarray(self.f_p(s, Y, p, cols=list(cols)), dtype=float)
+            return out.reshape(self.n, len(cols), len(s))
         if self.vectorized:
-            return self._call("f_p", s, Y, p).reshape(self.n, self.n_p, len(s))
-        return np.stack([self._call("f_p", s[j], Y[:, j], p) for j in range(len(s))], axis=2)
+            out = self._call("f_p", s, Y, p).reshape(self.n, self.n_p, len(s))
+        else:
+            out = np.stack([self._call("f_p", s[j], Y[:, j], p) for j in range(len(s))], axis=2)
+        return out if cols is None else out[:, list(cols)]
+
 
     def bc(self, ya, yb, p):
         return self._call("g", ya, yb, p)
@@ -720,195 +739,6 @@ def collocate(problem: BVP, mesh, guess, *, p=None, tol: float = 1e-8, bc_tol: f
     return BVPResult(sol.x, sol.y, q, res, int(sol.niter), "collocation", sol.sol)
 
 
-# ----------------------------------------------------------------------------- discretisation
-class Discretisation:
-    """A BVP discretised as F(u, lam) = 0, lam = p[lam_index], with a sparse Jacobian.
-
-    ``method="collocation"``: u = (y_0, ..., y_M, p[unknown]) on the fixed ``mesh``,
-    rows r_0..r_{M-1} (Hermite-Simpson / 3-stage Lobatto IIIA) then g. ``method=
-    "multiple_shooting"``: u = (Y_0, ..., Y_K, p[unknown]) on the nodes ``mesh``, rows the
-    continuity conditions then g. ``F_u`` is a CSC matrix, ``F_lam`` a vector. The other
-    parameters are fixed at ``p``.
-    """
-
-    def __init__(self, problem: BVP, lam_index: int, p, mesh, *, method: str = "collocation",
-                 rtol_ivp: float = 1e-10, atol_ivp: float | None = None, ivp_method: str = "DOP853",
-                 max_nfev: int = 200_000, blowup: float = 1e12):
-        if method not in ("collocation", "multiple_shooting"):
-            raise InputError(f"{problem.name}: unknown discretisation {method!r}", key="method",
-                             expected="'collocation' or 'multiple_shooting'")
-        self.problem, self.method = problem, method
-        self.p = _full_p(problem, p)
-        if not (isinstance(lam_index, (int, np.integer)) and 0 <= lam_index < problem.n_p) \
-                or lam_index in problem.unknown:
-            raise InputError(f"{problem.name}: lam_index = {lam_index!r} (unknown parameters: "
-                             f"{list(problem.unknown)}, n_p = {problem.n_p})", key="lam_index",
-                             expected="the index of a fixed parameter")
-        self.lam_index = int(lam_index)
-        self.mesh = _nodes(problem, mesh)
-        self.name = f"{problem.name} ({method.replace('_', ' ')}, {len(self.mesh) - 1} intervals)"
-        n, M = problem.n, len(self.mesh) - 1
-        self.n_unknowns = n * (M + 1) + problem.k
-        if method == "multiple_shooting":
-            opts = _ivp_options(problem, rtol_ivp, atol_ivp, ivp_method, max_nfev, blowup)
-            self._ms = _MultipleShooting(problem, self.mesh, opts)
-        self._cache_key, self._cache = None, None
-
-    # layout --------------------------------------------------------------------------
-    def pack(self, Y, p=None) -> np.ndarray:
-        """u from node values Y (n, M + 1) and the parameter vector (default: the fixed one)."""
-        Y = np.asarray(Y, float)
-        q = self.p if p is None else _full_p(self.problem, p)
-        if Y.shape != (self.problem.n, len(self.mesh)):
-            raise InputError(f"{self.name}: node values of shape {Y.shape}", key="Y",
-                             expected=f"shape ({self.problem.n}, {len(self.mesh)})")
-        return np.concatenate([Y.T.ravel(), q[list(self.problem.unknown)]])
-
-    def start(self, guess: BVPResult):
-        """(u0, lam0) from a solution (or guess) given as a BVPResult (its dense output at the mesh)."""
-        Y = np.asarray(guess.sol(self.mesh), float).reshape(self.problem.n, -1)
-        self.problem.check(Y[:, 0], _full_p(self.problem, guess.p))
-        return self.pack(Y, guess.p), float(guess.p[self.lam_index])
-
-    def unpack(self, u, lam):
-        """(Y (n, M + 1), full p) from u and lam."""
-        u = np.asarray(u, float)
-        if u.shape != (self.n_unknowns,):
-            raise InputError(f"{self.name}: u has shape {u.shape}", key="u", expected=f"({self.n_unknowns},)")
-        n, M = self.problem.n, len(self.mesh) - 1
-        q = self.p.copy()
-        q[list(self.problem.unknown)] = u[n * (M + 1):]
-        q[self.lam_index] = lam
-        return u[: n * (M + 1)].reshape(M + 1, n).T, q
-
-    # residual ------------------------------------------------------------------------
-    def _evaluate(self, u, lam):
-        key = (np.asarray(u, float).tobytes(), float(lam))
-        if key != self._cache_key:
-            if self.method == "multiple_shooting":
-                Y, q = self.unpack(u, lam)
-                self._ms.opts["budget"].used = 0          # the budget is per evaluation here
-                try:
-                    R, J, dl = self._ms.evaluate(np.asarray(u, float), q, extra_cols=[self.lam_index])
-                    out = (R, J, dl[:, 0])
-                except (_Failure, _BudgetSpent):
-                    nan = np.full(self.n_unknowns, np.nan)
-                    out = (nan, None, nan)
-            else:
-                out = self._collocation(u, lam)
-            self._cache_key, self._cache = key, out
-        return self._cache
-
-    def _collocation(self, u, lam):
-        prob = self.problem
-        Y, q = self.unpack(u, lam)
-        n, k, unk = prob.n, prob.k, list(prob.unknown)
-        s = self.mesh
-        h = np.diff(s)
-        M = h.size
-        F = prob.fv(s, Y, q)
-        Jn = prob.f_yv(s, Y, q)
-        Pn = prob.f_pv(s, Y, q)
-        ym = 0.5 * (Y[:, 1:] + Y[:, :-1]) - 0.125 * h * (F[:, 1:] - F[:, :-1])
-        sm = s[:-1] + 0.5 * h
-        Fm = prob.fv(sm, ym, q)
-        Jm = prob.f_yv(sm, ym, q)
-        Pm = prob.f_pv(sm, ym, q)
-        R = np.empty(self.n_unknowns)
-        R[: n * M] = (Y[:, 1:] - Y[:, :-1] - h / 6 * (F[:, :-1] + 4 * Fm + F[:, 1:])).T.ravel()
-        R[n * M:] = prob.bc(Y[:, 0], Y[:, -1], q)
-        eye = np.eye(n)[:, :, None]
-        Ji, Jj = Jn[:, :, :-1], Jn[:, :, 1:]
-        A = -eye - h / 6 * (Ji + 4 * np.einsum("abm,bcm->acm", Jm, 0.5 * eye + 0.125 * h * Ji))
-        B = eye - h / 6 * (Jj + 4 * np.einsum("abm,bcm->acm", Jm, 0.5 * eye - 0.125 * h * Jj))
-        dym_dp = -0.125 * h * (Pn[:, :, 1:] - Pn[:, :, :-1])
-        P = -h / 6 * (Pn[:, :, :-1] + 4 * (np.einsum("abm,bcm->acm", Jm, dym_dp) + Pm) + Pn[:, :, 1:])
-        # assemble (interval i: rows i n.., columns of y_i, y_{i+1}, p_u)
-        i, r, c = np.meshgrid(np.arange(M), np.arange(n), np.arange(n), indexing="ij")
-        rows = [i * n + r, i * n + r]
-        cols = [i * n + c, (i + 1) * n + c]
-        data = [A.transpose(2, 0, 1), B.transpose(2, 0, 1)]
-        if k:
-            i2, r2, c2 = np.meshgrid(np.arange(M), np.arange(n), np.arange(k), indexing="ij")
-            rows.append(i2 * n + r2)
-            cols.append(n * (M + 1) + c2)
-            data.append(P[:, unk, :].transpose(2, 0, 1))
-        Ga, Gb, Gp = prob.bc_jac(Y[:, 0], Y[:, -1], q)
-        m = n + k
-        br, bc_ = np.meshgrid(np.arange(m), np.arange(n), indexing="ij")
-        rows += [n * M + br, n * M + br]
-        cols += [bc_, n * M + bc_]
-        data += [Ga, Gb]
-        if k:
-            pr, pc = np.meshgrid(np.arange(m), np.arange(k), indexing="ij")
-            rows.append(n * M + pr)
-            cols.append(n * (M + 1) + pc)
-            data.append(Gp[:, unk])
-        J = sps.csc_matrix((np.concatenate([d.ravel() for d in data]),
-                            (np.concatenate([x.ravel() for x in rows]), np.concatenate([x.ravel() for x in cols]))),
-                           shape=(self.n_unknowns, self.n_unknowns))
-        lamc = self.lam_index
-        Fl = np.empty(self.n_unknowns)
-        Fl[: n * M] = P[:, lamc, :].T.ravel()
-        Fl[n * M:] = Gp[:, lamc]
-        return R, J, Fl
-
-    def F(self, u, lam):
-        return self._evaluate(u, lam)[0]
-
-    def F_u(self, u, lam):
-        return self._evaluate(u, lam)[1]
-
-    def F_lam(self, u, lam):
-        return self._evaluate(u, lam)[2]
-
-    # outputs -------------------------------------------------------------------------
-    def to_result(self, u, lam, *, residual_norm: float | None = None, iterations: int = 0) -> BVPResult:
-        """The BVPResult of a point (u, lam): node values, parameters and a dense output
-        (cubic Hermite with f at the nodes for collocation, the integrator's for shooting)."""
-        Y, q = self.unpack(u, lam)
-        if residual_norm is None:
-            residual_norm = float(np.linalg.norm(self.F(u, lam)))
-        if self.method == "multiple_shooting":
-            try:
-                self._ms.opts["budget"].used = 0
-                s, y, dense, _ = self._ms.dense(np.asarray(u, float), q)
-            except (_Failure, _BudgetSpent) as exc:
-                raise ConvergenceError(f"{self.name}: the trajectory through this point fails: {exc}") from None
-            return BVPResult(s, y, q, residual_norm, iterations, "multiple shooting", dense)
-        F = self.problem.fv(self.mesh, Y, q)
-        spline = CubicHermiteSpline(self.mesh, Y, F, axis=1)
-        return BVPResult(self.mesh.copy(), Y, q, residual_norm, iterations, "collocation (fixed mesh)", spline)
-
-    def output(self, fun, grad=None):
-        """Turn a boundary output fun(ya, yb, p) -> float into phi(u, lam), and, with
-        grad(ya, yb, p) -> (d/dya (n,), d/dyb (n,), d/dp (n_p,)), its gradient
-        (u, lam) -> (d phi/du (N,), d phi/dlam). Returns (phi, gradient or None)."""
-        n, M = self.problem.n, len(self.mesh) - 1
-        unk = list(self.problem.unknown)
-
-        def phi(u, lam):
-            Y, q = self.unpack(u, lam)
-            return float(fun(Y[:, 0], Y[:, -1], q))
-
-        if grad is None:
-            return phi, None
-
-        def gradient(u, lam):
-            Y, q = self.unpack(u, lam)
-            ga, gb, gp = (np.asarray(v, float).ravel() for v in grad(Y[:, 0], Y[:, -1], q))
-            if ga.shape != (n,) or gb.shape != (n,) or gp.shape != (self.problem.n_p,):
-                raise InputError(f"{self.name}: the output gradient has shapes {ga.shape}, {gb.shape}, {gp.shape}",
-                                 key="grad", expected=f"({n},), ({n},), ({self.problem.n_p},)")
-            g = np.zeros(self.n_unknowns)
-            g[:n] += ga
-            g[n * M: n * (M + 1)] += gb
-            g[n * (M + 1):] = gp[unk]
-            return g, float(gp[self.lam_index])
-
-        return phi, gradient
-
-
 # ----------------------------------------------------------------------------- helpers
 def on_unit_interval(problem: BVP, length_index: int, *, autonomous: bool = False, f_s=None) -> BVP:
     """The same BVP with a free length L = p[length_index]: s = a + L sigma, sigma in [0, 1].
@@ -973,3 +803,6 @@ def check_jacobians(problem: BVP, s: float, y, p=None, *, ya=None, yb=None, h: f
         out["f_p"] = rel(problem.f_p1(s, y, p), fd(lambda v: problem.f1(s, y, v), p))
         out["g_p"] = rel(Gp, fd(lambda v: problem.bc(ya, yb, v), p))
     return out
+
+
+from mechgen.runtime.collocation import Discretisation  # noqa: E402  (re-exported: it builds on this module)

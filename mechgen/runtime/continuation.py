@@ -3,11 +3,21 @@
 With x = (u, lam) and the unit tangent t (the null vector of [F_u, F_lam]), one step of
 length ds from an accepted point x_i is
 
-    predictor  x = x_i + ds t_i,
+    predictor  x = x_i + ds t_i + ds^2/2 (t_i - t_{i-1}) / (s_i - s_{i-1})  (the curvature from the
+               last two tangents; first order at the first step),
     corrector  Newton on  F(x) = 0,  t_i . (x - x_i) = ds   (the bordered system
                [[F_u, F_lam], [t_i^T]] dx = -[F, t_i . (x - x_i) - ds]),
     tangent    [[F_u, F_lam], [t_i^T]] t = (0, 1), normalised: t . t_i > 0 keeps the
                orientation, so the branch goes round a fold instead of turning back.
+
+The corrector evaluates the residual first and the Jacobian only when it takes another
+step; the tangent at the new point is solved with the last step's factorisation (the
+Jacobian one quadratically small step away, and the same row t_i). A system may bring its
+own linear algebra: ``evaluate(u, lam, jac)`` -> (F, J, F_lam) with J in any form, and
+``bordered(J, F_lam, row)`` -> a solver of the bordered system (a collocation
+:class:`Discretisation` condenses and keeps its sparsity pattern); and
+``arclength_weights`` W (the dot products above become t . W x: unknowns slaved to others,
+such as collocation stage values, weigh 0).
 
 The step grows (x ``grow``) after fast corrections, shrinks after slow ones, and is halved
 and retried when the corrector fails or the tangent turns more than ``max_turn``; below
@@ -98,8 +108,29 @@ class _Singular(Exception):
     pass
 
 
+_SOLVER_ERRORS = (np.linalg.LinAlgError, ValueError, RuntimeError, ZeroDivisionError)
+
+
+def _own(system, name):
+    """The system's optional method ``name`` (``evaluate``, ``bordered``) when it offers both."""
+    if callable(getattr(system, "evaluate", None)) and callable(getattr(system, "bordered", None)):
+        return getattr(system, name)
+    return None
+
+
 def _eval(system, u, lam, jac=True):
+    """(F, F_u, F_lam) at (u, lam); (F, None, None) without ``jac`` or where F is not finite.
+
+    A system with ``evaluate(u, lam, jac)`` and ``bordered(J, F_lam, row)`` (a
+    :class:`~mechgen.runtime.bvp.Discretisation`) gives F_u in its own form, for its own solver."""
+    evaluate = _own(system, "evaluate")
     with np.errstate(all="ignore"):
+        if evaluate is not None:
+            F, Fu, Fl = evaluate(u, lam, jac)
+            F = np.asarray(F, float).ravel()
+            if not jac or Fu is None or not np.all(np.isfinite(F)):
+                return F, None, None
+            return F, Fu, np.asarray(Fl, float).ravel()
         F = np.asarray(system.F(u, lam), float).ravel()
         if not jac:
             return F, None, None
@@ -112,8 +143,23 @@ def _eval(system, u, lam, jac=True):
     return F, Fu, Fl
 
 
-def _bordered_solve(Fu, Fl, row, rhs):
-    """Solve [[Fu, Fl], [row^T]] x = rhs (dense LU, or sparse LU when Fu is sparse)."""
+def _factor(system, Fu, Fl, row):
+    """A solver x = solve(rhs) of [[Fu, Fl], [row^T]] x = rhs: the system's own (``bordered``), or
+    SuperLU when Fu is sparse, or dense LU. Raises _Singular."""
+    own = _own(system, "bordered")
+    if own is not None:
+        try:
+            solve = own(Fu, Fl, row)
+        except _SOLVER_ERRORS as exc:
+            raise _Singular(str(exc)) from exc
+
+        def checked(rhs):
+            try:
+                return solve(rhs)
+            except _SOLVER_ERRORS as exc:
+                raise _Singular(str(exc)) from exc
+
+        return checked
     n = Fl.size
     if sps.issparse(Fu):
         A = sps.vstack([sps.hstack([Fu, sps.csc_matrix(Fl.reshape(n, 1))]),
@@ -121,9 +167,10 @@ def _bordered_solve(Fu, Fl, row, rhs):
         if not np.all(np.isfinite(A.data)):
             raise _Singular("the Jacobian is not finite")
         try:
-            x = spla.splu(A, permc_spec="MMD_AT_PLUS_A").solve(rhs)  # banded blocks + border: 8x less fill than COLAMD
+            lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A")  # banded blocks + border: 8x less fill than COLAMD
         except RuntimeError as exc:
             raise _Singular(str(exc)) from exc
+        solve = lu.solve
     else:
         A = np.vstack([np.hstack([Fu, Fl[:, None]]), row[None, :]])
         if not np.all(np.isfinite(A)):
@@ -136,49 +183,121 @@ def _bordered_solve(Fu, Fl, row, rhs):
             raise _Singular(str(exc)) from exc
         if np.min(np.abs(np.diag(lu[0]))) <= 1e-14 * max(np.abs(A).max(), 1e-300):
             raise _Singular("a zero pivot")
-        x = sla.lu_solve(lu, rhs, check_finite=False)
-    if not np.all(np.isfinite(x)):
-        raise _Singular("the solution of the bordered system is not finite")
-    return x
+
+        def solve(rhs):
+            return sla.lu_solve(lu, rhs, check_finite=False)
+
+    def finite(rhs):
+        x = solve(rhs)
+        if not np.all(np.isfinite(x)):
+            raise _Singular("the solution of the bordered system is not finite")
+        return x
+
+    return finite
 
 
-def _tangent(Fu, Fl, ref):
-    """Unit null vector of [Fu, Fl] with t . ref > 0."""
-    rhs = np.zeros(Fl.size + 1)
+class _Linearisation:
+    """F_u and F_lam at a point, with the bordered system's factorisation for ``row`` made on first use."""
+
+    def __init__(self, system, Fu, Fl, row):
+        self.system, self.Fu, self.Fl, self.row = system, Fu, Fl, row
+        self._solve = None
+
+    def solve(self, rhs, row=None):
+        if row is not None and row is not self.row and not np.array_equal(row, self.row):
+            return _factor(self.system, self.Fu, self.Fl, row)(rhs)
+        if self._solve is None:
+            self._solve = _factor(self.system, self.Fu, self.Fl, self.row)
+        return self._solve(rhs)
+
+
+def _linearise(system, x, row):
+    """The linearisation at x, where F is known to be finite (None when F_u cannot be evaluated there)."""
+    n = x.size - 1
+    if _own(system, "evaluate") is not None:
+        _, Fu, Fl = _eval(system, x[:n], x[n])
+    else:
+        with np.errstate(all="ignore"):
+            Fu = system.F_u(x[:n], x[n])
+            Fl = np.asarray(system.F_lam(x[:n], x[n]), float).ravel()
+        if Fu is not None and not sps.issparse(Fu):
+            Fu = np.atleast_2d(np.asarray(Fu, float))
+    return None if Fu is None else _Linearisation(system, Fu, Fl, row)
+
+
+def _weights(system, size: int):
+    """Weights of the arclength inner product (None: all 1): a discretisation's slaved unknowns weigh 0."""
+    w = getattr(system, "arclength_weights", None)
+    if w is None:
+        return None
+    w = np.asarray(w, float)
+    if w.shape != (size,) or np.any(w < 0) or not np.any(w > 0):
+        raise InputError(f"continuation: arclength weights of shape {w.shape}", key="arclength_weights",
+                         expected=f"{size} non-negative weights, not all zero")
+    return w
+
+
+def _row(w, t):
+    """The pseudo-arclength row W t."""
+    return t if w is None else w * t
+
+
+def _norm(w, x) -> float:
+    return float(np.sqrt(x @ _row(w, x)))
+
+
+def _tangent(lin, ref, w=None):
+    """Unit null vector (in the W-norm) of [F_u, F_lam] with t . ref > 0 (ref: the corrector's row W t_i)."""
+    rhs = np.zeros(lin.Fl.size + 1)
     rhs[-1] = 1.0
-    t = _bordered_solve(Fu, Fl, ref, rhs)
-    return t / np.linalg.norm(t)
+    t = lin.solve(rhs, row=ref)
+    return t / _norm(w, t)
 
 
 def _correct(system, x_pred, row, target, *, tol, max_iter, polish=False):
-    """Newton on F(x) = 0, row . x = target from x_pred. Returns (x, iterations, Fu, Fl) or None.
+    """Newton on F(x) = 0, row . x = target from x_pred. Returns (x, iterations, linearisation) or None.
 
-    With ``polish`` one more Newton step follows convergence (for folds, extrema and end
-    points, whose lam should be exact to rounding rather than to tol / |F_lam|)."""
+    The residual is evaluated first and the Jacobian only when another step is needed; the
+    returned linearisation is the last step's (its factorisation, with ``row``, serves the
+    tangent: the Jacobian one quadratically small step before x), or the one at x when the
+    predictor was already converged. With ``polish`` one more Newton step follows convergence
+    (for folds, extrema and end points, whose lam should be exact to rounding rather than to
+    tol / |F_lam|)."""
     x = np.array(x_pred, float)
     n = x.size - 1
     prev = np.inf
     done = False
+    lin = None
     for it in range(max_iter + 2):
-        F, Fu, Fl = _eval(system, x[:n], x[n])
+        F = _eval(system, x[:n], x[n], jac=False)[0]
         norm = float(np.linalg.norm(F))
-        if not np.isfinite(norm) or Fu is None or norm > 1e3 * prev + 1e3 * tol:
+        if not np.isfinite(norm) or norm > 1e3 * prev + 1e3 * tol:
             return None
         converged = norm <= tol and abs(row @ x - target) <= tol * max(1.0, abs(target))
         if done or (converged and not polish):
-            return (x, it, Fu, Fl) if converged or norm <= 1e3 * tol else None
+            if not (converged or norm <= 1e3 * tol):
+                return None
+            lin = lin or _linearise(system, x, row)
+            return None if lin is None else (x, it, lin)
         if converged:
             done = True
         elif it >= max_iter:
             return None
-        R = np.append(F, row @ x - target)
+        lin = _linearise(system, x, row)
+        if lin is None:
+            return None
         try:
-            dx = _bordered_solve(Fu, Fl, row, -R)
+            dx = lin.solve(-np.append(F, row @ x - target))
         except _Singular:
             return None
         x = x + dx
         prev = max(norm, tol)
     return None
+
+
+def _bordered_solve(Fu, Fl, row, rhs):
+    """Solve [[Fu, Fl], [row^T]] x = rhs (dense LU, or sparse LU when Fu is sparse)."""
+    return _factor(None, Fu, Fl, row)(rhs)
 
 
 # ----------------------------------------------------------------------------- driver
@@ -195,6 +314,11 @@ def _check_system(system, u, lam):
     if F.shape != (n,):
         raise InputError(f"continuation: F returned {F.size} values for {n} unknowns", key="F",
                          expected=f"{n} values (F: R^(n+1) -> R^n)")
+    if _own(system, "evaluate") is not None:  # the discretisation's own Jacobian and solver
+        if Fu is None:
+            raise InputError("continuation: the Jacobian at the starting point cannot be evaluated", key="u0",
+                             expected="a start where F, F_u and F_lam are finite")
+        return u
     shape = Fu.shape if Fu is not None else None
     if shape != (n, n):
         raise InputError(f"continuation: F_u has shape {shape}", key="F_u", expected=f"({n}, {n})")
@@ -227,6 +351,7 @@ def continuation(system, u0, lam0: float, *, ds: float = 0.05, ds_min: float = 1
         raise InputError(f"continuation: lam0 = {lam0} lies outside [{lam_min}, {lam_max}]", key="lam0",
                          expected="a start inside the lam range")
     n = u.size
+    w = _weights(system, n + 1)
     e_lam = np.zeros(n + 1)
     e_lam[-1] = 1.0
     got = _correct(system, np.append(u, lam0), e_lam, lam0, tol=tol, max_iter=4 * max_corrector)
@@ -235,11 +360,11 @@ def continuation(system, u0, lam0: float, *, ds: float = 0.05, ds_min: float = 1
         raise ConvergenceError(f"continuation of {getattr(system, 'name', 'F')}: the start (lam = {lam0:.6g}, "
                                f"||F|| = {np.linalg.norm(F):.3g}) could not be corrected onto the branch (Newton at "
                                "fixed lam failed: a bad start or a fold exactly at the start)")
-    x, _, Fu, Fl = got
+    x, _, lin = got
     t = None
     for ref in (e_lam, np.random.default_rng(0).standard_normal(n + 1)):
         try:
-            t = _tangent(Fu, Fl, ref)
+            t = _tangent(lin, ref, w)
             break
         except _Singular:
             continue
@@ -256,16 +381,20 @@ def continuation(system, u0, lam0: float, *, ds: float = 0.05, ds_min: float = 1
     step = ds
     while len(xs) < max_points:
         x_i, t_i = xs[-1], ts[-1]
-        got = _correct(system, x_i + step * t_i, t_i, t_i @ x_i + step, tol=tol, max_iter=max_corrector)
+        row = _row(w, t_i)
+        pred = x_i + step * t_i
+        if len(xs) > 1 and arc[-1] > arc[-2]:  # second order: x'' ~ (t_i - t_{i-1}) / (s_i - s_{i-1})
+            pred += 0.5 * step ** 2 / (arc[-1] - arc[-2]) * (t_i - ts[-2])
+        got = _correct(system, pred, row, row @ x_i + step, tol=tol, max_iter=max_corrector)
         ok = got is not None
         if ok:
-            x_new, iters, Fu, Fl = got
+            x_new, iters, lin = got
             try:
-                t_new = _tangent(Fu, Fl, t_i)
+                t_new = _tangent(lin, row, w)
             except _Singular:
                 ok = False
             else:
-                ok = t_new @ t_i >= cos_turn
+                ok = t_new @ row >= cos_turn
         if not ok:
             step *= 0.5
             if step < ds_min:
@@ -276,7 +405,7 @@ def continuation(system, u0, lam0: float, *, ds: float = 0.05, ds_min: float = 1
             continue
         # a fold between x_i and x_new?
         if locate_folds and t_i[n] * t_new[n] < 0:
-            fold = _locate_fold(system, x_i, t_i, step, tol=tol, max_corrector=max_corrector)
+            fold = _locate_fold(system, x_i, t_i, step, tol=tol, max_corrector=max_corrector, w=w)
             if fold is None:
                 lam_f = max(x_i[n], x_new[n]) if t_i[n] > 0 else min(x_i[n], x_new[n])
                 fold = Fold(x_new[:n].copy(), float(lam_f), len(xs) - 1, t_new, located=False)
@@ -292,14 +421,14 @@ def continuation(system, u0, lam0: float, *, ds: float = 0.05, ds_min: float = 1
             end = _correct(system, x_i + theta * (x_new - x_i), e_lam, bound, tol=tol, max_iter=max_corrector,
                            polish=True)
             if end is not None and (t_i[n] * t_new[n] > 0):
-                x_end, _, Fu, Fl = end
+                x_end, _, lin = end
                 try:
-                    t_end = _tangent(Fu, Fl, t_i)
+                    t_end = _tangent(lin, row, w)
                 except _Singular:
                     t_end = t_new
                 xs.append(x_end)
                 ts.append(t_end)
-                arc.append(arc[-1] + float(np.linalg.norm(x_end - x_i)))
+                arc.append(arc[-1] + _norm(w, x_end - x_i))
                 data.append(callback(x_end[:n].copy(), x_end[n]) if callback else None)
                 message = f"lam reached the bound {bound:.10g}"
             break
@@ -315,24 +444,25 @@ def continuation(system, u0, lam0: float, *, ds: float = 0.05, ds_min: float = 1
     return Branch(X[:, :n], X[:, n], np.array(arc), T, tuple(folds), tuple(data), status, message, system)
 
 
-def _segment_point(system, x_i, t_i, sigma, *, tol, max_corrector):
+def _segment_point(system, x_i, t_i, sigma, *, tol, max_corrector, w=None):
     """The corrected point at arclength parameter sigma on the segment from x_i, and its tangent."""
-    got = _correct(system, x_i + sigma * t_i, t_i, t_i @ x_i + sigma, tol=tol, max_iter=2 * max_corrector,
+    row = _row(w, t_i)
+    got = _correct(system, x_i + sigma * t_i, row, row @ x_i + sigma, tol=tol, max_iter=2 * max_corrector,
                    polish=True)
     if got is None:
         raise _Singular(f"no corrected point at sigma = {sigma:.6g}")
-    x, _, Fu, Fl = got
-    return x, _tangent(Fu, Fl, t_i)
+    x, _, lin = got
+    return x, _tangent(lin, row, w)
 
 
-def _locate_fold(system, x_i, t_i, step, *, tol, max_corrector):
+def _locate_fold(system, x_i, t_i, step, *, tol, max_corrector, w=None):
     """Zero of t_lam(sigma) on [0, step] (Brent); None when it cannot be bracketed."""
     cache = {}
 
     def tlam(sigma):
         if sigma == 0.0:
             return t_i[-1]
-        x, t = _segment_point(system, x_i, t_i, sigma, tol=tol, max_corrector=max_corrector)
+        x, t = _segment_point(system, x_i, t_i, sigma, tol=tol, max_corrector=max_corrector, w=w)
         cache[sigma] = (x, t)
         return t[-1]
 
@@ -343,18 +473,20 @@ def _locate_fold(system, x_i, t_i, step, *, tol, max_corrector):
             return None
         sigma = brentq(tlam, a, b, xtol=1e-14 * max(1.0, step), maxiter=100)
         return cache[sigma] if sigma in cache else _segment_point(system, x_i, t_i, sigma, tol=tol,
-                                                                  max_corrector=max_corrector)
+                                                                  max_corrector=max_corrector, w=w)
     except (_Singular, ValueError, RuntimeError):
         return None
 
 
 # ----------------------------------------------------------------------------- BVP continuation
 def continue_bvp(problem: BVP, guess: BVPResult, lam_index: int, *, method: str = "collocation", mesh=100,
-                 rtol_ivp: float = 1e-10, ivp_method: str = "DOP853", **options) -> Branch:
+                 stages: int | None = None, rtol_ivp: float = 1e-10, ivp_method: str = "DOP853",
+                 **options) -> Branch:
     """Continue a BVP in the fixed parameter p[lam_index], starting from ``guess`` (a
     BVPResult, e.g. from :func:`~mechgen.runtime.bvp.collocate`).
 
-    ``method`` is 'collocation' (fixed mesh; ``mesh`` an interval count or nodes) or
+    ``method`` is 'collocation' (Hermite-Simpson on a fixed mesh; ``mesh`` an interval count or
+    nodes), 'gauss' (``stages``-point Gauss-Legendre collocation, default 4: order 8) or
     'multiple_shooting' (``mesh`` the shooting nodes); ``options`` go to
     :func:`continuation`. ``branch.system`` is the :class:`Discretisation`; its
     ``to_result(u, lam)`` turns a branch point into a BVPResult.
@@ -362,10 +494,32 @@ def continue_bvp(problem: BVP, guess: BVPResult, lam_index: int, *, method: str 
     if not isinstance(guess, BVPResult):
         raise InputError(f"{problem.name}: continue_bvp needs a BVPResult to start from, got "
                          f"{type(guess).__name__}", key="guess", expected="a BVPResult")
-    disc = Discretisation(problem, lam_index, guess.p, mesh, method=method, rtol_ivp=rtol_ivp,
+    disc = Discretisation(problem, lam_index, guess.p, mesh, method=method, stages=stages, rtol_ivp=rtol_ivp,
                           ivp_method=ivp_method)
     u0, lam0 = disc.start(guess)
     return continuation(disc, u0, lam0, **options)
+
+
+def point_at(branch: Branch, lam: float, *, tol: float = 1e-10) -> np.ndarray:
+    """The branch's u at the parameter value ``lam``: the point of the first segment whose lam-range holds it,
+    interpolated linearly and corrected by Newton at fixed lam (polished). Raises ConvergenceError
+    when no segment holds lam or the correction fails."""
+    lam = float(lam)
+    system = branch.system
+    n = branch.u.shape[1]
+    e_lam = np.zeros(n + 1)
+    e_lam[-1] = 1.0
+    for i in range(len(branch.lam) - 1):
+        a, b = branch.lam[i], branch.lam[i + 1]
+        if min(a, b) <= lam <= max(a, b) and a != b:
+            theta = (lam - a) / (b - a)
+            guess = np.append(branch.u[i] + theta * (branch.u[i + 1] - branch.u[i]), lam)
+            got = _correct(system, guess, e_lam, lam, tol=tol, max_iter=20, polish=True)
+            if got is not None:
+                return got[0][:n]
+            raise ConvergenceError(f"point_at: Newton at lam = {lam:.10g} failed on segment {i}")
+    raise ConvergenceError(f"point_at: lam = {lam:.10g} is not on the branch ([{branch.lam.min():.6g}, "
+                           f"{branch.lam.max():.6g}])")
 
 
 # ----------------------------------------------------------------------------- extrema
@@ -394,6 +548,7 @@ def minimize_along_branch(branch: Branch, output: Callable, *, gradient: Callabl
         raise ConvergenceError(f"minimize_along_branch: the {kind}imum of the sampled output ({vals[j]:.6g}) is at "
                                f"an end of the branch (lam = {branch.lam[j]:.6g}); continue the branch further")
     tol = 1e-10 if tol is None else tol
+    w = _weights(system, n + 1)
     X = np.hstack([branch.u, branch.lam[:, None]])
     T = branch.tangents
     h = fd_step if fd_step is not None else 1e-5 * max(float(np.min(np.diff(branch.arclength)[j - 1:j + 1])), 1e-8)
@@ -401,7 +556,7 @@ def minimize_along_branch(branch: Branch, output: Callable, *, gradient: Callabl
     def point(i, sigma):
         if sigma == 0.0:
             return X[i], T[i]
-        return _segment_point(system, X[i], T[i], sigma, tol=tol, max_corrector=10)
+        return _segment_point(system, X[i], T[i], sigma, tol=tol, max_corrector=10, w=w)
 
     def slope(i, sigma):
         if gradient is not None:
@@ -413,7 +568,7 @@ def minimize_along_branch(branch: Branch, output: Callable, *, gradient: Callabl
         return (float(output(xp[:n], xp[n])) - float(output(xm[:n], xm[n]))) / (2 * h)
 
     for i in (j - 1, j):
-        length = float(T[i] @ (X[i + 1] - X[i]))
+        length = float(_row(w, T[i]) @ (X[i + 1] - X[i]))
         try:
             a, b = slope(i, 0.0), slope(i, length)
             if a * b > 0:

@@ -123,19 +123,16 @@ def steady_bvp(field_system) -> SteadyBVP:
 
     def accelerations(s_pts, y, p, with_jacobian: bool):
         """u_ss = -H^-1 r(u, u_s, 0) at every point (batched kernels), and optionally
-        d u_ss / d y = -H^-1 [r_u, r_us] at that u_ss."""
-        m = y.shape[1]
-        state = {"q": np.ascontiguousarray(y[:n].T), "v": np.ascontiguousarray(y[n:].T), "a": np.zeros((m, n)),
-                 "z": np.zeros((m, 0)), "t": np.reshape(np.asarray(s_pts, float), (m, 1)),
-                 "p": np.asarray(p, float)}
-        r = residual.evaluate(state)["r"].reshape(m, n)
-        H = tangent.evaluate(state)["r_a"].reshape(m, n, n)
-        acc = -np.linalg.solve(H, r[..., None])[..., 0]
+        d u_ss / d y = -H^-1 [r_u, r_us] at that u_ss (prepared kernel calls, the last
+        batches memoised: mechgen.runtime.steady_kernels)."""
+        impl = getattr(accelerations, "impl", None)
+        if impl is None:
+            from mechgen.runtime.steady_kernels import SteadyAccelerations
+
+            impl = accelerations.impl = SteadyAccelerations(residual, tangent, n)
         if not with_jacobian:
-            return acc, None
-        tan = tangent.evaluate({**state, "a": acc})  # r_q, r_v at the actual u_ss (H depends on u_s)
-        rhs = np.concatenate([tan["r_q"].reshape(m, n, n), tan["r_v"].reshape(m, n, n)], axis=2)
-        return acc, -np.linalg.solve(H, rhs)
+            return impl.accelerations(s_pts, y, p), None
+        return impl.jacobian(s_pts, y, p)
 
     def use(p) -> None:
         """Point the single-state kernels (shooting's hot path) at the parameters p."""
@@ -164,16 +161,31 @@ def steady_bvp(field_system) -> SteadyBVP:
         J[n:] = np.transpose(jac, (1, 2, 0))
         return L * J
 
-    def f_p(sigma, y, p):
-        """d f / d p by central differences (relative steps 1e-6), for continuation's F_lam."""
+    def f_p(sigma, y, p, cols=None):
+        """d f / d p (columns ``cols``, default all) for continuation's F_lam: f = L [u_s; u_ss],
+        d u_ss / d p_j = -H^-1 d r / d p_j at the actual u_ss (central differences of the residual,
+        relative steps 1e-6), plus [u_s; u_ss] for the length parameter."""
         p = np.asarray(p, float)
-        out = np.zeros((2 * n, len(p), y.shape[1]))
-        for j in range(len(p)):
-            step = 1e-6 * max(abs(p[j]), 1e-3)
-            up, down = p.copy(), p.copy()
-            up[j] += step
-            down[j] -= step
-            out[:, j] = (f(sigma, y, up) - f(sigma, y, down)) / (2 * step)
+        cols = range(len(p)) if cols is None else [int(j) for j in cols]
+        m = y.shape[1]
+        out = np.zeros((2 * n, len(cols), m))
+        if not len(cols):
+            return out
+        if m == 1:  # one state (shooting's variational equations): differences of f
+            for k, j in enumerate(cols):
+                step = 1e-6 * max(abs(p[j]), 1e-3)
+                up, down = p.copy(), p.copy()
+                up[j] += step
+                down[j] -= step
+                out[:, k] = (f(sigma, y, up) - f(sigma, y, down)) / (2 * step)
+            return out
+        sigma = np.asarray(sigma, float)
+        L = L_of(p)
+        accelerations(L * sigma, y, p, False)  # the memoised batch (and the implementation)
+        d_acc = accelerations.impl.parameter_derivatives(lambda q: L_of(q) * sigma, y, p, cols)
+        out[n:] = L * np.transpose(d_acc, (1, 2, 0))
+        if length_index is not None and length_index in cols:
+            out[:, list(cols).index(length_index)] += F(L * sigma, y, p)
         return out
 
     def g(ya, yb, p):

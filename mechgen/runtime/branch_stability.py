@@ -1,0 +1,42 @@
+"""Stability along a branch of steady states: the Galerkin linearisation about every point.
+
+For each point (u, lam) of a :class:`~mechgen.runtime.continuation.Branch` of a steady BVP
+(:func:`mechgen.runtime.continuation.continue_bvp` on a
+:class:`~mechgen.runtime.steady_bvp.SteadyBVP`), the steady state's jets at the
+discretisation's quadrature points give the linearised M, D, G, K
+(FieldSystem.linear(jets=...)), and :func:`mechgen.runtime.stability.stability` the
+eigenvalues of M q'' + (D + G) q' + K q = 0 and the verdict. The system's parameters are
+set to each point's and restored afterwards.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from mechgen.runtime.stability import StabilityResult, stability
+
+
+def _dense(A) -> np.ndarray:
+    return A.toarray() if hasattr(A, "toarray") else np.asarray(A, float)
+
+
+def stability_at(system, bvp, result) -> StabilityResult:
+    """Eigenvalues and verdict about one steady state ``result`` (a BVPResult of ``bvp``); the system's
+    parameters must already be the result's."""
+    disc = system.disc
+    mats = system.linear(jets=bvp.jets(result, disc.points, disc.jets))
+    return stability(_dense(mats["M"]), _dense(mats["D"]) + _dense(mats["G"]), _dense(mats["K"]))
+
+
+def stability_along(system, bvp, branch, results=None) -> list[StabilityResult]:
+    """The stability verdict at every point of ``branch`` (or of ``results``, BVPResults of its points)."""
+    if results is None:
+        results = [branch.system.to_result(u, lam) for u, lam in zip(branch.u, branch.lam)]
+    saved = np.array(system.params, float)
+    out = []
+    try:
+        for res in results:
+            system.params[...] = res.p
+            out.append(stability_at(system, bvp, res))
+    finally:
+        system.params[...] = saved
+    return out
