@@ -91,6 +91,20 @@ def lower_all(model: Model, eqs, kernels, *, cse: bool = True) -> list[KernelIR]
     return _with_whirl(model, [lower(eqs, k, cse=cse) for k in all_kernels(model) if k in kernels])
 
 
+def _constraint_kernel(model: Model, spec: Specialization, eqs, cse: bool) -> list[KernelIR]:
+    """The ``constraint`` kernel (g_j, g_jj) of a constrained continuum, beside its linear kernel (else none)."""
+    from mechgen.codegen.lower_lumped import lower_matrices
+    from mechgen.symbolic.constraint import constraint_matrices, constraint_of
+
+    g = constraint_of(model, spec)
+    if g is None:
+        return []
+    ir = lower_matrices(eqs.local, "constraint", "derivatives of the pointwise constraint g(jets) = 0",
+                        constraint_matrices(g, eqs.local, model), cse=cse)
+    ir.meta["field"] = {**field_meta(eqs), "constrained": True}
+    return [ir]
+
+
 def field_meta(eqs) -> dict:
     """What the runtime needs to know of a continuum: fields, jets, length, ends, parts, constraints."""
     state = set(eqs.local.q + eqs.local.v) | {eqs.local.t}
@@ -183,6 +197,8 @@ def _generate(model: Model, spec: Specialization, kernels: set, backend: str, cs
     report.seconds["derive"] = time.perf_counter() - clock
     clock = time.perf_counter()
     irs = [] if hamiltonian_only else lower_all(model, eqs, kernels, cse=cse)
+    if model.is_field and "linear" in kernels and not hamiltonian_only:
+        irs += _constraint_kernel(model, spec, eqs, cse)
     steady = [k for k in STEADY_KERNELS if k in kernels] if model.is_field else []
     if steady:
         from mechgen.symbolic.steady import derive_steady

@@ -209,7 +209,7 @@ def test_scene_inextensible_balloon(tmp_path):
 
 
 def test_scene_bad_form_and_inextensible_dynamics_are_refused(tmp_path, capsys):
-    """Unknown form, and the Lagrangian form (or stability) of an inextensible string: exit 2 with the key."""
+    """Unknown form, and the displacement form of an inextensible string (no strain energy): exit 2 with the key."""
     from mechgen.cli import main
 
     scene = tmp_path / "bad.toml"
@@ -218,7 +218,7 @@ def test_scene_bad_form_and_inextensible_dynamics_are_refused(tmp_path, capsys):
     assert "form" in capsys.readouterr().err
     scene.write_text(SCENE.format(lambda0=0.1, method="collocation", form="lagrangian"))
     assert main(["run", str(scene)]) == 2
-    assert "inextensible" in capsys.readouterr().err
+    assert "form = 'hamiltonian'" in capsys.readouterr().err
 
 
 def test_frequencies_scene_follows_fixed_eyelet_tension_in_beta(tmp_path):

@@ -55,6 +55,12 @@ def _meta(eqs: LumpedEquations) -> dict:
             "params": list(eqs.param_names), "kind": "field" if eqs.position else "lumped"}
 
 
+def lower_matrices(eqs: LumpedEquations, name: str, doc: str, mats: dict[str, sp.Matrix], *,
+                   cse: bool = True) -> KernelIR:
+    """A kernel of named matrices of the state (no acceleration input), e.g. a constraint's derivatives."""
+    return _matrix_kernel(eqs, name, doc, mats, accel=False, cse=cse)
+
+
 def lower_lumped(eqs: LumpedEquations, name: str, *, cse: bool = True) -> KernelIR:
     """Build the KernelIR of kernel ``name`` (one of :data:`LUMPED_KERNELS`)."""
     r = eqs.residual

@@ -16,18 +16,25 @@ lambda = |r_s| = |r_sigma| / l0 and the frame velocity e3 x r
     neo-Hookean  W = beta/3 (lambda^2/2 + 1/lambda),  tension p = W'(lambda) = beta/3 (lambda - lambda^-2),
     linear       W = beta/2 (lambda - 1)^2,           p = beta (lambda - 1).
 
-R is a linear air drag on the inertial velocity (zero by default: it then
-disappears from the generated code). Steady balloons solve
+    inextensible lambda = 1: no W; the constraint g = (lambda^2 - 1)/2 = 0 (model.constraint_density)
+                 with multiplier mu = l0 p.
+
+The complementary energy C(n) = l0 W*(|n|), W*(p) = integral of lambda(p) dp, of the
+tension vector n = p t (conjugate to r_sigma) gives the steady balloons in the
+tension-vector form r_sigma = l0 lambda(p) n / p, n_sigma = -l0 (x, y, 0) (steady
+``form = "hamiltonian"``; the only form for the inextensible law; lambda(p) of the
+neo-Hookean law by Cardano's formula). R is a linear air drag on the inertial
+velocity (zero by default: it then disappears from the generated code). Steady balloons solve
 (p r_s / lambda)_s + (x, y, 0) = drag e3 x r with r(0) = 0, r(l0) = (1, 0, h)
 (mechgen.symbolic.steady); small motions about one obey
 u_tt + 2 e3 x u_t - (A u_s)_s - diag(1, 1, 0) u = 0 with
 A = (p/lambda) I + (p' - p/lambda) t t^T, t = r_s/lambda, and u = 0 at both eyelets
-(Galerkin with sin(j pi sigma), N per component). Outputs: ``tension`` p,
+(Galerkin with sin(j pi sigma), N per component; the inextensible string's motions
+keep t . u_s = 0, A = p I, mechgen.runtime.constrained). Outputs: ``tension`` p,
 ``stretch`` lambda, ``radius`` sqrt(x^2 + y^2).
 """
 import sympy as sp
 
-from mechgen.errors import ModelError
 from mechgen.symbolic.field import fix
 from mechgen.symbolic.kinematics import frame_velocity
 from mechgen.symbolic.model import Model
@@ -57,11 +64,8 @@ def stretch(u, p):
 
 def strain_energy(lam, p):
     """W(lambda) per unit undeformed length."""
-    if p.law == "inextensible":
-        raise ModelError("the inextensible string has no strain energy (its tension is a constraint force): its "
-                         "steady balloons use the Hamiltonian form (steady form = 'hamiltonian'); for its "
-                         "dynamics use law = 'linear' with a large beta", file=__file__, key="law",
-                         expected="neo_hookean or linear for modes, stability and continuation with stability")
+    if p.law == "inextensible":  # no strain energy: the tension is the multiplier of the constraint below
+        return sp.Integer(0)
     if p.law == "neo_hookean":
         return p.beta / 3 * (lam**2 / 2 + 1 / lam)
     return p.beta / 2 * (lam - 1) ** 2
@@ -112,6 +116,12 @@ def complementary(u, n, p):
     return length(p) * complementary_energy(sp.sqrt(n.x**2 + n.y**2 + n.z**2), p)
 
 
+@model.constraint_density
+def inextensible(u, p):
+    """g = (lambda^2 - 1)/2 = 0 for the inextensible law (none otherwise); its multiplier is mu = l0 p."""
+    return (stretch(u, p) ** 2 - 1) / 2 if p.law == "inextensible" else 0
+
+
 @model.dissipation_density
 def dissipation(u, p):
     w = inertial_velocity(u)
@@ -127,3 +137,72 @@ def boundary(p):
 model.output("tension", lambda n: sp.sqrt(n.x**2 + n.y**2 + n.z**2), doc="p = |n| = W'(lambda)")
 model.output("stretch", stretch, doc="lambda = |r_s|")
 model.output("radius", lambda u: sp.sqrt(u.x**2 + u.y**2), doc="distance from the axis")
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Loop count: a number measured on a sampled steady balloon (numeric; the scene code stays generic), and starting
+# guesses for a balloon with a given loop count.
+def loop_count(u):
+    """The balloon's loop label (Sarangi et al.: single 1, one-and-a-half 1.5, double 2 ...), for planar balloons.
+
+    n_c = the sign changes of x(s) between the eyelets; loops = 1 if n_c = 0, else n_c + 1 when the last bulge
+    is complete (x_s < 0 at the rotating eyelet, i.e. the tension vector's Q(l0) < 0: |x| peaked before the
+    eyelet, since x(l0) = 1 > 0) and n_c + 1/2 otherwise (benchmarks/balloon_notes.md, section 4)."""
+    import numpy as np
+
+    x = np.asarray(u.x, float)[1:-1]
+    signs = np.sign(x[x != 0.0])
+    crossings = int(np.count_nonzero(signs[1:] != signs[:-1]))
+    if crossings == 0:
+        return 1.0
+    return crossings + (1.0 if float(np.asarray(u.x_s)[-1]) < 0.0 else 0.5)
+
+
+#: the tension levels (p_e scale) of the starting guesses tried, in order
+START_TENSIONS = (2.0, 5.0, 10.0)
+
+
+def loop_start(value, s, p):
+    """Starting guesses for a balloon with ``value`` loops: n_c = round(value + 1/2) - 1 axis crossings.
+
+    Each guess is the graph x(z) = z/h + a sin(k pi z/h), k = n_c + 1 (the sign of a makes the last bulge
+    positive), with a chosen so that the curve's length is l0 lambda_g: a uniformly stretched string at the
+    tension level p_g (lambda_g = 1 + p_g/beta), material points spaced evenly along it, and the tension
+    vector n = p_g t along its tangent t. One guess per p_g in START_TENSIONS."""
+    import numpy as np
+    from scipy.integrate import cumulative_trapezoid
+    from scipy.optimize import brentq
+
+    k = max(int(np.floor(float(value) + 0.5)), 1)
+    h, l0 = float(p.h), float(p.h) / (1.0 - float(p.lambda0))
+    sigma = np.asarray(s, float) / float(p.L)
+    zeta = np.linspace(0.0, 1.0, 4001)
+    cos = np.cos(k * np.pi * zeta)
+    for tension in START_TENSIONS:
+        target = l0 * (1.0 + tension / float(p.beta))
+
+        def excess(a):
+            return h * np.trapezoid(np.sqrt(1.0 + ((1.0 + a * k * np.pi * cos) / h) ** 2), zeta) - target
+
+        a = 0.0
+        if excess(0.0) < 0.0:
+            top = 1.0
+            while excess(top) < 0.0:
+                top *= 2.0
+            a = brentq(excess, 0.0, top, xtol=1e-12)
+        a *= (-1.0) ** (k - 1)
+        slope = (1.0 + a * k * np.pi * cos) / h  # dx/dz
+        arc = cumulative_trapezoid(h * np.sqrt(1.0 + slope**2), zeta, initial=0.0)
+        at = arc / arc[-1]
+        x = np.interp(sigma, at, zeta + a * np.sin(k * np.pi * zeta))
+        z = np.interp(sigma, at, h * zeta)
+        norm = np.sqrt(1.0 + slope**2)
+        tx, tz = np.interp(sigma, at, slope / norm), np.interp(sigma, at, 1.0 / norm)
+        stretch_ = arc[-1] / float(p.L)
+        zero = np.zeros_like(sigma)
+        yield {"u": {"x": x, "y": zero, "z": z}, "u_s": {"x": stretch_ * tx, "y": zero, "z": stretch_ * tz},
+               "n": {"x": tension * tx, "y": zero, "z": tension * tz}}
+
+
+model.shape_output("loops", loop_count, start=loop_start,
+                   doc="loop label: 1 + sign changes of x, less 1/2 when the last bulge is incomplete")

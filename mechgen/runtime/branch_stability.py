@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from mechgen.runtime.constrained import linear_about_bvp
 from mechgen.runtime.stability import StabilityResult, stability
 
 
@@ -22,8 +23,7 @@ def _dense(A) -> np.ndarray:
 def stability_at(system, bvp, result) -> StabilityResult:
     """Eigenvalues and verdict about one steady state ``result`` (a BVPResult of ``bvp``); the system's
     parameters must already be the result's."""
-    disc = system.disc
-    mats = system.linear(jets=bvp.jets(result, disc.points, disc.jets))
+    mats = linear_about_bvp(system, bvp, result)
     return stability(_dense(mats["M"]), _dense(mats["D"]) + _dense(mats["G"]), _dense(mats["K"]))
 
 

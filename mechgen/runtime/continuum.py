@@ -365,6 +365,11 @@ class FieldSystem:
     # -- the discretised system ---------------------------------------------
     def linear(self, q=None, v=None, z=None, t: float = 0.0, *, jets=None) -> dict:
         """M, D, G, K about the base state q (or its jets at the Gauss points) with zero acceleration."""
+        if "constraint" in self.kernels:
+            raise InputError(f"{self.meta.get('model')} holds a pointwise constraint (its multiplier is part of a "
+                             "steady state): small motions only about a boundary-value steady state",
+                             key="about", expected="modes or stability 'about' a steady analysis with "
+                             "form = 'hamiltonian' (mechgen.runtime.constrained)")
         return self._matrices("linear", ("M", "D", "G", "K"), q, v, None, t, jets)
 
     def tangent(self, q, v=None, a=None, z=None, t: float = 0.0) -> dict:

@@ -29,6 +29,8 @@ class ModelInfo:
     length: str | None = None
     parts: dict | None = None
     stress_form: bool = False
+    fields: tuple[str, ...] = ()
+    shape_outputs: tuple[str, ...] = ()
 
 
 def lookup_model(name: str) -> ModelInfo | None:
@@ -44,4 +46,5 @@ def lookup_model(name: str) -> ModelInfo | None:
         coords = tuple(f"{model.chain_spec.coordinate}_{i + 1}" for i in range(n))
     cont = model.continuum
     return ModelInfo(model.name, params, coords, model.output_names, cont is not None,
-                     cont.length if cont else None, dict(model.parts), model.complementary_fn is not None)
+                     cont.length if cont else None, dict(model.parts), model.complementary_fn is not None,
+                     model.field_names, tuple(o.name for o in getattr(model, "shape_outputs", ())))

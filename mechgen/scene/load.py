@@ -503,6 +503,106 @@ def _free_parameter(ctx: _Ctx, key: str, value: object) -> str:
     return value
 
 
+# --------------------------------------------------------------------------- branches of steady states
+
+BRANCH_DIRECTIONS = ("increasing", "decreasing", "both")
+
+
+def _param_values(ctx: _Ctx, key: str, value: object) -> dict[str, float]:
+    """{parameter: number}: a steady analysis's own values of numeric parameters (made free)."""
+    if not isinstance(value, dict) or not value:
+        raise _fail(ctx.file, key, f"value is {_show(value)}", "a table of numeric parameters, e.g. { lambda0 = 0.3 }")
+    out = {}
+    for name, number in value.items():
+        sub = _join(key, name)
+        info = _param_info(ctx.file, sub, ctx.model, name)
+        if _is_choice(info) or info.integer:
+            raise _fail(ctx.file, sub, f"parameter {_show(name)} is not a real number", "a numeric model parameter")
+        if name in ctx.swept:
+            raise _fail(ctx.file, sub, f"parameter {_show(name)} is swept", "a parameter the sweep does not set")
+        out[name] = _number(ctx, sub, number)
+        if info.below is not None and not out[name] < info.below:
+            raise _fail(ctx.file, sub, f"{name} = {out[name]!r} is not below {info.below!r}",
+                        f"a value below {info.below!r}")
+    return out
+
+
+def _shape_value(ctx: _Ctx, key: str, value: object) -> dict[str, float]:
+    """{shape_output: value}: a steady start with this value of a model-declared shape output (loops = 2)."""
+    known = tuple(getattr(ctx.model, "shape_outputs", ()))
+    expected = "a table with one entry, a shape output of the model = number: " + _listing(known)
+    if not isinstance(value, dict) or len(value) != 1:
+        raise _fail(ctx.file, key, f"value is {_show(value)}", expected)
+    (name, number), = value.items()
+    if name not in known:
+        raise _fail(ctx.file, _join(key, name), f"model '{ctx.model.name}' has no shape output {_show(name)}", expected)
+    return {name: _number(ctx, _join(key, name), number)}
+
+
+def _starts(ctx: _Ctx, key: str, value: object) -> str | list[str]:
+    """One earlier steady analysis, or an array of them (one branch each)."""
+    if not isinstance(value, list):
+        return _about(ctx, key, value)
+    if not value:
+        raise _fail(ctx.file, key, "empty array", "an array of earlier steady analyses")
+    names = [_about(ctx, f"{key}[{i}]", v) for i, v in enumerate(value, 1)]
+    for i, name in enumerate(names, 1):
+        if name in names[:i - 1]:
+            raise _fail(ctx.file, f"{key}[{i}]", f"start '{name}' is listed twice", "distinct steady analyses")
+    return names
+
+
+def _direction(ctx: _Ctx, key: str, value: object) -> str:
+    if not isinstance(value, str) or value not in BRANCH_DIRECTIONS:
+        raise _fail(ctx.file, key, f"unknown direction {_show(value)}", "one of: " + ", ".join(BRANCH_DIRECTIONS))
+    return value
+
+
+def _output_values(ctx: _Ctx, key: str, value: object) -> dict[str, float]:
+    """{output: number}: values whose crossings a branch locates (at = { p_e = 5.0 })."""
+    if not isinstance(value, dict) or not value:
+        raise _fail(ctx.file, key, f"value is {_show(value)}", "a table: output = number, e.g. { p_e = 5.0 }")
+    out = {}
+    for name, number in value.items():
+        if not is_identifier(name):
+            raise _fail(ctx.file, _join(key, name), f"{_show(name)} is not an output name", IDENTIFIER_RULE)
+        out[name] = _number(ctx, _join(key, name), number)
+    return out
+
+
+def _bounds(ctx: _Ctx, key: str, value: object) -> dict[str, tuple[float, float]]:
+    """{output: [low, high]}: a branch ends where an output leaves its range."""
+    expected = "a table: output = [low, high] with low < high, e.g. { p_e = [0, 12] }"
+    if not isinstance(value, dict) or not value:
+        raise _fail(ctx.file, key, f"value is {_show(value)}", expected)
+    out = {}
+    for name, pair in value.items():
+        sub = _join(key, name)
+        if not is_identifier(name):
+            raise _fail(ctx.file, sub, f"{_show(name)} is not an output name", IDENTIFIER_RULE)
+        if not isinstance(pair, list) or len(pair) != 2:
+            raise _fail(ctx.file, sub, f"value is {_show(pair)}", expected)
+        lo, hi = (_number(ctx, f"{sub}[{i}]", v) for i, v in enumerate(pair, 1))
+        if not lo < hi:
+            raise _fail(ctx.file, sub, f"the range [{lo!r}, {hi!r}] is empty", expected)
+        out[name] = (lo, hi)
+    return out
+
+
+def _check_branch_outputs(ctx: _Ctx, base: str, options: dict[str, Any]) -> None:
+    """Names in ``at`` and ``bounds``: aliases, <output>_<start|end|max|min>, <field>_s_<start|end>, shape outputs."""
+    if not getattr(ctx.model, "fields", ()):
+        return
+    known = set(options.get("aliases", {})) | set(getattr(ctx.model, "shape_outputs", ()))
+    known |= {f"{o}_{end}" for o in ctx.model.outputs for end in ("start", "end", "max", "min")}
+    known |= {f"{f}_s_{end}" for f in ctx.model.fields for end in ("start", "end")}
+    for key in ("at", "bounds"):
+        for name in options.get(key, {}):
+            if name not in known:
+                raise _fail(ctx.file, f"{base}.{key}.{name}", f"no output {_show(name)} on a branch",
+                            "an alias of this analysis or <output>_start/_end/_max/_min: " + _listing(sorted(known)))
+
+
 def _parameter(ctx: _Ctx, key: str, value: object) -> str:
     info = _param_info(ctx.file, key, ctx.model, value)
     if _is_choice(info) or info.integer:
@@ -677,6 +777,7 @@ SCHEMAS: dict[str, dict[str, tuple[Callable, Any]]] = {
     "steady": {"guess": (_coord_table, {}), "tol": (_positive, 1e-10), "max_iter": (_count, 50),
                "method": (_steady_method, _ABSENT), "bulge": (_modes_table, _ABSENT), "mesh": (_count, _ABSENT),
                "nodes": (_count, _ABSENT), "aliases": (_aliases, _ABSENT), "form": (_steady_form, _ABSENT),
+               "params": (_param_values, _ABSENT), "shape": (_shape_value, _ABSENT),
                "hold": (_hold, _ABSENT), "free": (_free_parameter, _ABSENT), "stability": (_bool, _ABSENT)},
     "simulate": {"t_end": (_positive, _REQUIRED), "method": (_method, "BDF"), "dt": (_positive, _ABSENT),
                  "rtol": (_positive, 1e-8), "atol": (_positive, 1e-10), "q0": (_coord_table, {}),
@@ -684,9 +785,11 @@ SCHEMAS: dict[str, dict[str, tuple[Callable, Any]]] = {
                  "outputs": (_outputs, _ALL_OUTPUTS), "series": (_bool, False), "samples": (_count, 201)},
     "sweep": {"over": (_over, _REQUIRED), "analysis": (_inner, _REQUIRED), "workers": (_workers, 0),
               "progress": (_bool, True)},
-    "continuation": {"about": (_about, _REQUIRED), "parameter": (_parameter, _REQUIRED), "stop": (_number, _REQUIRED),
+    "continuation": {"about": (_starts, _REQUIRED), "parameter": (_parameter, _REQUIRED), "stop": (_number, _REQUIRED),
                      "step": (_positive, 0.05), "max_points": (_count, 200), "mesh": (_count, 100),
-                     "stability": (_bool, True), "minimize": (_name, _ABSENT), "aliases": (_aliases, {})},
+                     "stability": (_bool, True), "minimize": (_name, _ABSENT), "aliases": (_aliases, {}),
+                     "direction": (_direction, _ABSENT), "bounds": (_bounds, _ABSENT),
+                     "at": (_output_values, _ABSENT), "eigenvalues": (_bool, False)},
     "campbell": {"over": (_speeds, _REQUIRED), "count": (_count, 8), "multiples": (_multiples, [1.0]),
                  "method": (_campbell_method, _ABSENT),
                  "about": (_about, _ABSENT), "at": (_coord_table, _ABSENT)},
@@ -747,6 +850,17 @@ def _cross_checks(ctx: _Ctx, base: str, kind: str, options: dict[str, Any]) -> N
         missing = "free" if "hold" in options else "hold"
         raise _fail(ctx.file, f"{base}.{missing}", f"'hold' and 'free' go together; '{missing}' is missing",
                     "hold = { output = value } with free = \"parameter\"")
+    if kind == "steady" and "shape" in options and "bulge" in options:
+        raise _fail(ctx.file, f"{base}.bulge", "'shape' takes its starting guesses from the model; 'bulge' would be "
+                    "ignored", "either shape or bulge")
+    if kind == "steady" and ("params" in options or "shape" in options) and options.get("method", "newton") == "newton":
+        raise _fail(ctx.file, f"{base}.method", "params and shape are for a boundary-value steady state",
+                    "method = shooting, multiple_shooting or collocation")
+    if kind == "continuation":
+        if isinstance(options["about"], list) and "minimize" in options:
+            raise _fail(ctx.file, f"{base}.minimize", "minimize follows one branch; 'about' lists several starts",
+                        "one start (about = \"name\") with minimize")
+        _check_branch_outputs(ctx, base, options)
     if kind == "steady" and ("hold" in options or options.get("stability") or "form" in options) \
             and options.get("method", "newton") == "newton":
         raise _fail(ctx.file, f"{base}.method", "hold, stability and form need a boundary-value steady state",
@@ -825,6 +939,8 @@ def load_scene(path: str, *, overrides: Sequence[str] = (), lookup_model: Callab
         inner = spec.options["analysis"] if spec.kind == "sweep" else spec
         if inner.kind == "steady" and inner.options.get("free") and inner.options["free"] not in free:
             free.append(inner.options["free"])
+        if inner.kind == "steady":
+            free += [n for n in inner.options.get("params", {}) if n not in free]
         if spec.kind == "continuation":
             name = spec.options["parameter"]
             below = getattr(model.params[name], "below", None)

@@ -39,6 +39,19 @@ class Output:
 
 
 @dataclass(frozen=True)
+class ShapeOutput:
+    """A number measured on a sampled steady state of a continuum (e.g. a balloon's loop count).
+
+    ``fn`` and ``start`` are plain numeric functions (nothing symbolic): see :meth:`Model.shape_output`.
+    """
+
+    name: str
+    fn: Callable
+    start: Callable | None = None
+    doc: str = ""
+
+
+@dataclass(frozen=True)
 class Continuum:
     """Scalar fields on s in [0, L], L the value of parameter ``length``."""
 
@@ -114,10 +127,12 @@ class Model:
         self.coordinate_names: list[str] = []
         self.internals: list[Internal] = []
         self.outputs: list[Output] = []
+        self.shape_outputs: list[ShapeOutput] = []
         self.kinetic_fn: Callable | None = None
         self.potential_fn: Callable | None = None
         self.dissipation_fn: Callable | None = None
         self.complementary_fn: Callable | None = None
+        self.constraint_fn: Callable | None = None
         self.forces_fn: Callable | None = None
         self.chain_spec: Chain | None = None
         self.site_kinetic_fn: Callable | None = None
@@ -155,6 +170,26 @@ class Model:
         """Declare a named output, a function of (q, v, z, p, t)."""
         self._claim(name, "output")
         self.outputs.append(Output(name, fn, unit, doc))
+
+    def shape_output(self, name: str, fn: Callable, *, start: Callable | None = None, doc: str = "") -> None:
+        """Declare a number measured on a steady state of a continuum, sampled along s (a balloon's loops).
+
+        ``fn`` is numeric and receives, by parameter name, any of ``s`` (the sample
+        positions on [0, L], an array), ``u`` (a :class:`Namespace` of arrays at
+        them: every field and its slope ``<field>_s``), ``out`` (the model's outputs
+        there) and ``p`` (the numeric parameter values); it returns a number.
+        ``steady`` and ``continuation`` report it for every steady state. The
+        optional ``start(value, s, p)`` gives starting guesses for a steady state
+        with that value of the measure: an iterable of dicts with ``u`` and ``u_s``
+        (field -> values at the positions s) and optionally ``n`` (field -> stress
+        resultants, for the Hamiltonian form); a scene asks for it with
+        ``shape = { name = value }``.
+        """
+        self._claim(name, "output")
+        if name in {o.name for o in self.shape_outputs}:
+            raise ModelError(f"output name {name!r} is already used in model {self.name}", file=self.file, key=name,
+                             expected="a name not yet declared")
+        self.shape_outputs.append(ShapeOutput(name, fn, start, doc))
 
     def chain(self, coordinate: str, *, sites: str, ends: str = "fixed") -> None:
         """Declare a lattice of identical sites; ``sites`` names a size parameter."""
@@ -226,6 +261,16 @@ class Model:
         the displacement form does not; a law without V (a constraint) declares C only.
         """
         self.complementary_fn = fn
+        return fn
+
+    def constraint_density(self, fn: Callable) -> Callable:
+        """Decorator (continuum): a pointwise constraint g(u, p) = 0 on the jets (an inextensible string:
+        (|r_s|^2 - 1)/2), held by a multiplier field mu(s) (the energy mu g). Returning 0 means none (a law
+        without it). Small motions about a steady state satisfy dg/dj . j' = 0 and feel the geometric
+        stiffness mu d2g/dj2 (mechgen.runtime.constrained); steady states use the Hamiltonian form, with
+        n = mu dg/du_s.
+        """
+        self.constraint_fn = fn
         return fn
 
     def weak_form(self, fn: Callable) -> Callable:

@@ -64,6 +64,12 @@ def derive_steady(model: Model, spec: Specialization) -> LumpedEquations:
     if model.weak_fn is not None or model.point_terms:
         raise ModelError(f"steady boundary value problems of {model.name}: weak forms and point terms are not "
                          "supported", file=model.file, key="steady", expected="energy densities only")
+    from mechgen.symbolic.constraint import constraint_of
+
+    if constraint_of(model, spec) is not None:
+        raise ModelError(f"the steady equations of {model.name} in displacement form: the model holds a pointwise "
+                         "constraint (no strain energy to invert)", file=model.file, key="form",
+                         expected="form = 'hamiltonian' (the stress form, from the complementary energy)")
     u, env, p_ns, free = _steady_env(model, spec)
     T = _density(model, model.kinetic_fn, "kinetic_density", env)
     V = _density(model, model.potential_fn, "potential_density", env)
