@@ -248,3 +248,25 @@ def test_frequencies_scene_follows_fixed_eyelet_tension_in_beta(tmp_path):
     l0 = brentq(lambda l: np.hypot(*reference.shoot(law, H, l, [6.0, 16.0])) - 17.5, 10.2, 10.6, xtol=1e-13)
     assert stiff[-1]["lambda0"] == pytest.approx(lambda0_of(l0), abs=1e-4)
     assert {p["verdict"] for p in out["vs_lambda0"]["branch"]} == {"stable"}
+
+
+def test_frequencies_scene_runs_the_inextensible_law(tmp_path):
+    """`--set law=inextensible`: the constrained string through the same scene; beta does not enter the
+    inextensible law, so the held balloon and its frequencies stay put along the vs-beta branch (to 1e-8), and
+    the start balloon is the elliptic one (p_e to 1e-6)."""
+    import json
+
+    from mechgen.cli import main
+
+    root = Path(__file__).resolve().parents[1]
+    target = tmp_path / "out.json"
+    assert main(["run", str(root / "scenes" / "balloon_frequencies.toml"), "--set", "law=inextensible",
+                 "--set", "lambda0=0.03", "--json", str(target)]) == 0
+    out = {a["name"]: a["outputs"] for a in json.loads(target.read_text())["analyses"]}
+    first, last = out["vs_beta"]["branch"][0], out["vs_beta"]["branch"][-1]
+    assert last["beta"] == pytest.approx(1e6)
+    np.testing.assert_allclose(last["frequencies"], first["frequencies"], rtol=1e-8)
+    assert last["lambda0"] == pytest.approx(first["lambda0"], abs=1e-10)
+    l0 = H / (1 - 0.03)
+    Q0, T = reference.shoot(reference.Law("inext"), H, l0, [6.0, 16.0])
+    assert out["start"]["p_e"] == pytest.approx(np.hypot(Q0, T), rel=1e-6)

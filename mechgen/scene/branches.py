@@ -280,7 +280,8 @@ def _follow(system, bvp, result, options: dict, aliases: dict):
     return branch_scan.follow(bvp.problem, result, index, direction=options.get("direction", towards),
                               inside=inside if bounds else None,
                               mesh=options.get("mesh", 100), ds=options.get("step", 0.05),
-                              ds_max=max(1.0, abs(stop - here) / 20), max_points=options.get("max_points", 200),
+                              ds_max=options.get("max_step", max(1.0, abs(stop - here) / 20)),
+                              max_points=options.get("max_points", 200),
                               **bound)
 
 

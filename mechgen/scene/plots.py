@@ -10,7 +10,8 @@
 * continuation: the branch diagram (an output against the parameter, points coloured by the
   stability verdict, shape outputs such as the loop count written where they change, folds,
   stability changes and the ``at`` crossings marked), the shapes of the ``at`` points (first field
-  against the last), and with ``eigenvalues`` their real and imaginary parts along the branch.
+  against the last), with ``eigenvalues`` their real and imaginary parts along the branch, and the
+  lowest frequencies against the parameter (a log axis when it spans decades: a beta sweep).
 """
 from __future__ import annotations
 
@@ -270,6 +271,29 @@ def _eigenvalues_along(plt, a: dict, path: Path, count: int = 4) -> bool:
     return True
 
 
+def _frequencies_along(plt, a: dict, path: Path) -> bool:
+    """The lowest frequencies of every branch point against the parameter (log axis over decades)."""
+    out = a["outputs"]
+    points = [p for p in out.get("branch", []) if p.get("frequencies")]
+    if not points:
+        return False
+    name = out.get("parameter") or next(iter(points[0]))
+    lam = [p[name] for p in points]
+    fig, ax = plt.subplots(figsize=(7, 5))
+    for k in range(max(len(p["frequencies"]) for p in points)):
+        ax.plot(lam, [p["frequencies"][k] if k < len(p["frequencies"]) else float("nan") for p in points], "-",
+                lw=1.0)
+    if min(lam) > 0 and max(lam) / min(lam) > 100:
+        ax.set_xscale("log")
+    ax.set_xlabel(name)
+    ax.set_ylabel("frequency")
+    ax.set_title(f"{a['name']}: the lowest frequencies along the branch", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return True
+
+
 def _continuation(plt, a: dict, path: Path) -> list[Path]:
     written = [path] if _branch(plt, a, path) else []
     out = a["outputs"]
@@ -284,6 +308,9 @@ def _continuation(plt, a: dict, path: Path) -> list[Path]:
     eig = path.with_name(path.stem + "_eigenvalues.png")
     if _eigenvalues_along(plt, a, eig):
         written.append(eig)
+    freq = path.with_name(path.stem + "_frequencies.png")
+    if _frequencies_along(plt, a, freq):
+        written.append(freq)
     return written
 
 
