@@ -40,8 +40,9 @@ More keys of ``continuation``:
 * ``at = { p_e = 5.0 }``: the points where an output crosses the value, located by
   Brent's method along the branch (mechgen.runtime.branch_scan.crossing): output
   ``at_<output>``, a list of {parameter, the output, the aliased outputs, the shape
-  outputs, ``verdict``} sorted by the parameter, and ``at_<output>_shapes`` (the
-  fields at 101 points of each, for plots);
+  outputs, ``verdict``, ``refinement``} sorted by the parameter (the verdict holds when
+  the model discretised with 2N and 4N terms agrees, else it is 'unconverged'), and
+  ``at_<output>_shapes`` (the fields at 101 points of each, for plots);
 * ``eigenvalues = true``: each branch point also reports its ``eigenvalues``.
 
 With stability, ``stability_changes`` lists where the verdict changes between
@@ -201,6 +202,18 @@ def _start_with_shape(system, bvp, options: dict, method: str):
                            "form = 'hamiltonian', or another value")
 
 
+def _refined_verdict(system, bvp, result) -> dict:
+    """The verdict at the scene's N checked on the model discretised with 2N and 4N terms (DESIGN.md: stability
+    of continua under refinement): ``verdict`` is the N verdict when 2N and 4N agree, else 'unconverged'
+    (balloons of three or more loops at N = 10: the in-plane sines converge slowly there, notes section 6);
+    ``refinement`` lists the three ({N, verdicts}) so that the trend shows."""
+    size = int(system.choices["N"])
+    sizes = [size, 2 * size, 4 * size]
+    verdicts = [_stability_about(system if k == size else system.refined(k), bvp, result)["verdict"] for k in sizes]
+    return {"verdict": verdicts[0] if len(set(verdicts)) == 1 else "unconverged",
+            "refinement": {"N": sizes, "verdicts": verdicts}}
+
+
 def run_steady_bvp(system, options: dict, context: dict) -> dict:
     """A steady state of a continuum with boundary values, by the BVP method the scene names."""
     if options.get("params"):
@@ -344,7 +357,7 @@ def _one_branch(system, start: dict, options: dict, label: str | None) -> dict:
                     lambda x: _values(system, bvp, disc.to_result(x[:-1], x[-1]), aliases, (key,))[key] - value)
                 res, rec = located(x, (key,))
                 if stability:
-                    rec["verdict"] = _stability_about(system, bvp, res)["verdict"]
+                    rec.update(_refined_verdict(system, bvp, res))
                 s = np.linspace(0.0, bvp.length_of(res), 101)
                 y = bvp.values(res, s)
                 found.append((rec, {f: [float(v) for v in y[j]] for j, f in enumerate(bvp.fields)}))
