@@ -93,6 +93,32 @@ class SteadyBVP:
         return {k: np.asarray(v).reshape(len(s)) for k, v in out.items() if not k.startswith("bc_")}
 
 
+def _differences(f, sigma, y, p, cols=None) -> np.ndarray:
+    """d f / d p_j (columns ``cols``, default all) by central differences, relative steps 1e-6: (2n, cols, m)."""
+    p = np.asarray(p, float)
+    cols = range(len(p)) if cols is None else [int(j) for j in cols]
+    out = np.zeros((np.shape(y)[0], len(cols), np.shape(y)[1]))
+    for k, j in enumerate(cols):
+        step = 1e-6 * max(abs(p[j]), 1e-3)
+        up, down = p.copy(), p.copy()
+        up[j] += step
+        down[j] -= step
+        out[:, k] = (f(sigma, y, up) - f(sigma, y, down)) / (2 * step)
+    return out
+
+
+def _end_conditions(start, end, size: int, n_p: int) -> tuple:
+    """g = y_i(0) - v (start) and y_i(1) - v (end) for the (index, value) pairs, and its Jacobians."""
+    eye = np.eye(size)
+    rows_a = np.vstack([eye[[i for i, _ in start]], np.zeros((len(end), size))])
+    rows_b = np.vstack([np.zeros((len(start), size)), eye[[i for i, _ in end]]])
+
+    def g(ya, yb, p):
+        return np.array([ya[i] - v for i, v in start] + [yb[i] - v for i, v in end])
+
+    return g, lambda ya, yb, p: rows_a, lambda ya, yb, p: rows_b, lambda ya, yb, p: np.zeros((size, n_p))
+
+
 def steady_bvp(field_system) -> SteadyBVP:
     """The BVP of ``field_system``'s steady state (kernels bvp_*); its parameters are the free ones."""
     st = field_system.steady_form()
@@ -115,7 +141,6 @@ def steady_bvp(field_system) -> SteadyBVP:
                          expected="n conditions per field pair: values or slopes at the two ends")
     start = [(i, v) for i, at, v in conditions if at == "start"]
     end = [(i, v) for i, at, v in conditions if at == "end"]
-    eye = np.eye(2 * n)
     residual, tangent = st.kernels["residual"], st.kernels["tangent"]
 
     def L_of(p):
@@ -172,13 +197,7 @@ def steady_bvp(field_system) -> SteadyBVP:
         if not len(cols):
             return out
         if m == 1:  # one state (shooting's variational equations): differences of f
-            for k, j in enumerate(cols):
-                step = 1e-6 * max(abs(p[j]), 1e-3)
-                up, down = p.copy(), p.copy()
-                up[j] += step
-                down[j] -= step
-                out[:, k] = (f(sigma, y, up) - f(sigma, y, down)) / (2 * step)
-            return out
+            return _differences(f, sigma, y, p, cols)
         sigma = np.asarray(sigma, float)
         L = L_of(p)
         accelerations(L * sigma, y, p, False)  # the memoised batch (and the implementation)
@@ -188,12 +207,7 @@ def steady_bvp(field_system) -> SteadyBVP:
             out[:, list(cols).index(length_index)] += F(L * sigma, y, p)
         return out
 
-    def g(ya, yb, p):
-        return np.array([ya[i] - v for i, v in start] + [yb[i] - v for i, v in end])
-
-    g_ya = lambda ya, yb, p: np.vstack([eye[[i for i, _ in start]], np.zeros((len(end), 2 * n))])  # noqa: E731
-    g_yb = lambda ya, yb, p: np.vstack([np.zeros((len(start), 2 * n)), eye[[i for i, _ in end]]])  # noqa: E731
-    g_p = lambda ya, yb, p: np.zeros((2 * n, len(names)))  # noqa: E731
+    g, g_ya, g_yb, g_p = _end_conditions(start, end, 2 * n, len(names))
     problem = BVP(f, f_y, g, g_ya, g_yb, (0.0, 1.0), 2 * n, n_p=len(names), f_p=f_p if names else None,
                   g_p=g_p if names else None, vectorized=True,
                   name=f"steady state of {field_system.meta.get('model')}")
@@ -249,23 +263,11 @@ def hamiltonian_bvp(field_system) -> SteadyBVP:
         L, st = state(sigma, y, p)
         return L * np.transpose(tangent.evaluate(st)["g_z"].reshape(-1, 2 * n, 2 * n), (1, 2, 0))
 
-    def f_p(sigma, y, p):
-        """d f / d p by central differences (relative steps 1e-6)."""
-        p = np.asarray(p, float)
-        out = np.zeros((2 * n, len(p), np.shape(y)[1]))
-        for j in range(len(p)):
-            step = 1e-6 * max(abs(p[j]), 1e-3)
-            up, down = p.copy(), p.copy()
-            up[j] += step
-            down[j] -= step
-            out[:, j] = (f(sigma, y, up) - f(sigma, y, down)) / (2 * step)
-        return out
+    def f_p(sigma, y, p, cols=None):
+        """d f / d p (columns ``cols``, default all) by central differences (relative steps 1e-6)."""
+        return _differences(f, sigma, y, p, cols)
 
-    eye = np.eye(2 * n)
-    g = lambda ya, yb, p: np.array([ya[i] - v for i, v in start] + [yb[i] - v for i, v in end])  # noqa: E731
-    g_ya = lambda ya, yb, p: np.vstack([eye[[i for i, _ in start]], np.zeros((len(end), 2 * n))])  # noqa: E731
-    g_yb = lambda ya, yb, p: np.vstack([np.zeros((len(start), 2 * n)), eye[[i for i, _ in end]]])  # noqa: E731
-    g_p = lambda ya, yb, p: np.zeros((2 * n, len(names)))  # noqa: E731
+    g, g_ya, g_yb, g_p = _end_conditions(start, end, 2 * n, len(names))
     problem = BVP(f, f_y, g, g_ya, g_yb, (0.0, 1.0), 2 * n, n_p=len(names), f_p=f_p if names else None,
                   g_p=g_p if names else None, vectorized=True,
                   name=f"steady state of {field_system.meta.get('model')} (Hamiltonian form)")
@@ -361,8 +363,15 @@ def holding(bvp: SteadyBVP, output: str, at: str, value: float, free: str) -> St
                              expected=", ".join(k for k in values if not k.startswith("bc_")))
         return float(np.ravel(values[output])[0])
 
+    last: dict = {}
+
     def d_out(y, p):
+        """(d out/dy, d out/dp) by central differences; the last pair is kept (g_ya, g_yb, g_p ask alike)."""
         y, p = np.asarray(y, float), np.asarray(p, float)
+        key = (y.tobytes(), p.tobytes())
+        if key in last:
+            return last[key]
+        last.clear()
         dy, dp = np.zeros(len(y)), np.zeros(len(p))
         for vec, grad in ((y, dy), (p, dp)):
             for j in range(len(vec)):
@@ -373,6 +382,7 @@ def holding(bvp: SteadyBVP, output: str, at: str, value: float, free: str) -> St
                 args = (up, p) if vec is y else (y, up)
                 back = (down, p) if vec is y else (y, down)
                 grad[j] = (out(*args) - out(*back)) / (2 * step)
+        last[key] = (dy, dp)
         return dy, dp
 
     end_y = (lambda ya, yb: ya) if at == "start" else (lambda ya, yb: yb)
