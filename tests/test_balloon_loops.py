@@ -201,6 +201,11 @@ aliases = {{ p_e = "tension_start" }}
     ("shape = { loops = 2 }", '"two"', "bounds = { p_e = 12.0 }", "analysis[2].bounds.p_e"),
     ("shape = { loops = 2 }", '"two"', "at = { p_x = 5.0 }", "analysis[2].at.p_x"),
     ("shape = { loops = 2 }", '"two"', "at = { p_e = \"five\" }", "analysis[2].at.p_e"),
+    ("shape = { loops = 2 }", '"two"', 'method = "rk4"', "analysis[2].method"),
+    ("shape = { loops = 2 }", '"two"', "max_step = -1.0", "analysis[2].max_step"),
+    ("hold = { p_e = 5.0 }", '"two"', "", "analysis[1].free"),
+    ("hold = { p_e = 5.0 }\nfree = \"law\"", '"two"', "", "analysis[1].free"),
+    ("stability = \"yes\"", '"two"', "", "analysis[1].stability"),
 ])
 def test_bad_keys_of_the_loop_and_branch_options_exit_2_naming_the_key(tmp_path, capsys, steady, about,
                                                                        continuation, key):

@@ -28,6 +28,10 @@ More keys of ``steady``:
 
 More keys of ``continuation``:
 
+* ``method = "collocation" | "gauss" | "multiple_shooting"`` (with ``mesh`` intervals or nodes;
+  ``stages`` for Gauss-Legendre collocation, default 4: order 8), ``step`` and ``max_step`` (the
+  first and largest arclength steps);
+
 * ``about = ["double", "triple"]``: several starts (earlier steady analyses), one
   branch each (the disconnected loop families of a balloon); every point, fold,
   crossing and change then carries ``start``, and ``status`` is per start;
@@ -292,7 +296,8 @@ def _follow(system, bvp, result, options: dict, aliases: dict):
                              key=f"bounds.{k}", expected="bounds that hold the start")
     return branch_scan.follow(bvp.problem, result, index, direction=options.get("direction", towards),
                               inside=inside if bounds else None,
-                              mesh=options.get("mesh", 100), ds=options.get("step", 0.05),
+                              mesh=options.get("mesh", 100), method=options.get("method", "collocation"),
+                              stages=options.get("stages"), ds=options.get("step", 0.05),
                               ds_max=options.get("max_step", max(1.0, abs(stop - here) / 20)),
                               max_points=options.get("max_points", 200),
                               **bound)

@@ -446,6 +446,13 @@ def _steady_method(ctx: _Ctx, key: str, value: object) -> str:
     return value
 
 
+def _branch_method(ctx: _Ctx, key: str, value: object) -> str:
+    methods = ("collocation", "gauss", "multiple_shooting")
+    if not isinstance(value, str) or value not in methods:
+        raise _fail(ctx.file, key, f"unknown continuation method {_show(value)}", "one of: " + ", ".join(methods))
+    return value
+
+
 def _steady_form(ctx: _Ctx, key: str, value: object) -> str:
     forms = ("lagrangian", "hamiltonian")
     if not isinstance(value, str) or value not in forms:
@@ -787,6 +794,7 @@ SCHEMAS: dict[str, dict[str, tuple[Callable, Any]]] = {
               "progress": (_bool, True)},
     "continuation": {"about": (_starts, _REQUIRED), "parameter": (_parameter, _REQUIRED), "stop": (_number, _REQUIRED),
                      "step": (_positive, 0.05), "max_step": (_positive, _ABSENT), "max_points": (_count, 200),
+                     "method": (_branch_method, _ABSENT), "stages": (_count, _ABSENT),
                      "mesh": (_count, 100),
                      "stability": (_bool, True), "minimize": (_name, _ABSENT), "aliases": (_aliases, {}),
                      "direction": (_direction, _ABSENT), "bounds": (_bounds, _ABSENT),
