@@ -37,6 +37,7 @@ from mechgen.symbolic.specialize import Specialization
 log = logging.getLogger("mechgen")
 BACKENDS = ("c", "numpy", "casadi")
 FIELD_KERNELS = ("residual", "tangent", "linear", "outputs")
+_FIELD_CHOICES = ("discretisation", "N", "quadrature", "constraints", "joints")
 #: kernels of a continuum's steady boundary value problem (mechgen.symbolic.steady)
 STEADY_KERNELS = ("bvp_residual", "bvp_tangent", "bvp_outputs")
 #: kernels of its Hamiltonian (stress) form, y = (u, n) (mechgen.symbolic.steady.derive_steady_hamiltonian)
@@ -92,17 +93,20 @@ def lower_all(model: Model, eqs, kernels, *, cse: bool = True) -> list[KernelIR]
 
 
 def _constraint_kernel(model: Model, spec: Specialization, eqs, cse: bool) -> list[KernelIR]:
-    """The ``constraint`` kernel (g_j, g_jj) of a constrained continuum, beside its linear kernel (else none)."""
+    """The ``constraint`` and ``strain`` kernels (g_j, g_jj) of a continuum that declares them, beside its linear one."""
     from mechgen.codegen.lower_lumped import lower_matrices
     from mechgen.symbolic.constraint import constraint_matrices, constraint_of
 
-    g = constraint_of(model, spec)
-    if g is None:
-        return []
-    ir = lower_matrices(eqs.local, "constraint", "derivatives of the pointwise constraint g(jets) = 0",
-                        constraint_matrices(g, eqs.local, model), cse=cse)
-    ir.meta["field"] = {**field_meta(eqs), "constrained": True}
-    return [ir]
+    irs = []
+    for name, fn, doc in (("constraint", model.constraint_fn, "the pointwise constraint g(jets) = 0"),
+                          ("strain", model.strain_fn, "the axial strain measure g(jets)")):
+        g = constraint_of(model, spec, fn)
+        if g is not None:
+            ir = lower_matrices(eqs.local, name, f"derivatives of {doc}", constraint_matrices(g, eqs.local, model),
+                                cse=cse)
+            ir.meta["field"] = field_meta(eqs)
+            irs.append(ir)
+    return irs
 
 
 def field_meta(eqs) -> dict:
@@ -267,8 +271,9 @@ def compile_model(model: Model, spec: Specialization, *, kernels=None, backend: 
                                                                     model.param(model.chain_spec.sites).default))
     if model.is_field:
         fixed = {k: v for k, v in spec.values.items() if model.param(k).is_numeric}
-        choices = {k: spec.values.get(k, model.param(k).default)
-                   for k in ("discretisation", "N", "quadrature", "constraints", "joints")}
+        choices = {k: spec.values.get(k, model.param(k).default) for k in
+                   ("discretisation", "N", "quadrature", "constraints", "joints",
+                    *(p.name for p in model.param_list if p.runtime and p.name not in _FIELD_CHOICES))}
         system = FieldSystem(loaded, meta, values, fixed, choices, report.backend)
     else:
         system = System(loaded, meta, values, sites or 0, report.backend)

@@ -13,6 +13,19 @@ basis at the Gauss points, and multiplier functions psi_k(s) = cos(k pi s / L),
 k = 0 .. m - 1 (m = the basis size N per field by default: a constraint on the slopes
 of sines lives in the cosines). The constraint is eliminated on the null space
 Z (orthonormal, from the SVD of B): the matrices returned are Z^T A Z, dense.
+
+A model whose strain energy depends on the slopes through a scalar strain g
+(``model.strain_density``: V = W(g, u), so V_jj = W_g g_jj + W_gg g_j g_j^T) may take its
+axial stiffness projected (runtime choice ``strain = "projected"``, a mixed Galerkin
+stiffness of the Hellinger-Reissner kind): with W_g and W_gg fitted pointwise from the
+linear kernel's V_jj on the jets g depends on,
+
+    K = K_V - sum w W_gg Phi^T g_j g_j^T Phi + B^T C^-1 B,    C_kk' = sum w psi_k psi_k' / W_gg,
+
+the tangential strain seen only through its projection on the cosines. As W_gg grows this
+tends to the constrained discretisation above instead of locking; for a moderately stiff
+string it converges faster in N than the pointwise stiffness (an in-plane sine series
+cannot follow nearly inextensional motions of a curved string).
 """
 from __future__ import annotations
 
@@ -28,9 +41,11 @@ def linear_about_bvp(system, bvp, result) -> dict:
     linearisation at its jets, on the constraint's null space when the model holds one."""
     disc = system.disc
     jets = bvp.jets(result, disc.points, disc.jets)
-    if "constraint" not in system.kernels:
-        return system.linear(jets=jets)
-    return constrained_linear(system, bvp, result, jets)
+    if "constraint" in system.kernels:
+        return constrained_linear(system, bvp, result, jets)
+    if system.choices.get("strain") == "projected":
+        return projected_strain_linear(system, jets)
+    return system.linear(jets=jets)
 
 
 def _reduce_rows(reduction, B: np.ndarray) -> np.ndarray:
@@ -71,12 +86,56 @@ def constrained_linear(system, bvp, result, jets: np.ndarray, multipliers: int |
     K_c = system.assembler.matrix(element_matrices(disc.tables, disc.weights, mu[..., None, None] * g_jj))
     K_c = red.matrix(K_c)
     dense["K"] = dense["K"] + (K_c.toarray() if hasattr(K_c, "toarray") else np.asarray(K_c))
-    m = int(multipliers or system.choices.get("N", 10))
-    rows = []
-    for k in range(m):
-        psi = np.cos(k * np.pi * disc.points / disc.length)
-        full = system.assembler.vector(element_vectors(disc.tables, disc.weights, psi[..., None] * g_j))
-        rows.append(np.asarray(full, float))
-    B = _reduce_rows(red, np.array(rows))
+    B = _multiplier_rows(system, g_j, int(multipliers or system.choices.get("N", 10)))
     Z = sla.null_space(B, rcond=1e-10)
     return {k: Z.T @ A @ Z for k, A in dense.items()}
+
+
+def _multiplier_rows(system, values: np.ndarray, m: int) -> np.ndarray:
+    """B_kl = sum_points w psi_k (values . Phi_l) over the reduced unknowns, psi_k = cos(k pi s / L), k < m."""
+    disc = system.disc
+    rows = [system.assembler.vector(element_vectors(disc.tables, disc.weights,
+                                                    np.cos(k * np.pi * disc.points / disc.length)[..., None] * values))
+            for k in range(m)]
+    return _reduce_rows(system.reduction, np.array(rows, float))
+
+
+def projected_strain_linear(system, jets: np.ndarray, multipliers: int | None = None) -> dict:
+    """M, D, G, K with the axial stiffness W_gg g_j g_j^T projected on the cosines (module docstring)."""
+    disc, red = system.disc, system.reduction
+    if "strain" not in system.kernels:
+        raise InputError(f"{system.meta.get('model')} declares no strain measure", key="strain",
+                         expected="strain = 'pointwise' (or a model with model.strain_density)")
+    if red.multiplier_rows is not None:
+        raise InputError("a projected strain takes its boundary conditions by elimination or penalty",
+                         key="constraints", expected="constraints = 'eliminate' or 'penalty'")
+    mats = system._matrices("linear", ("M", "D", "G", "K"), None, None, None, 0.0, jets)
+    dense = {k: v.toarray() if hasattr(v, "toarray") else np.asarray(v) for k, v in mats.items()}
+    na = len(disc.jets)
+    shape = disc.points.shape
+    V_jj = np.asarray(system._pointwise("linear", jets)["K"]).reshape(shape + (na, na))
+    local = system._pointwise("strain", jets)
+    g_j = np.asarray(local["g_j"]).reshape(shape + (na,))
+    g_jj = np.asarray(local["g_jj"]).reshape(shape + (na, na))
+    on = np.flatnonzero(np.any(g_j != 0, axis=tuple(range(len(shape)))))
+    block = np.ix_(on, on)
+    a = g_jj[(...,) + block].reshape(shape + (-1,))
+    b = (g_j[..., on, None] * g_j[..., None, on]).reshape(shape + (-1,))
+    v = V_jj[(...,) + block].reshape(shape + (-1,))
+    A = np.stack([a, b], axis=-1)  # V_jj = W_g g_jj + W_gg g_j g_j^T on the jets g depends on
+    coef = np.linalg.solve(np.einsum("...ki,...kj->...ij", A, A), np.einsum("...ki,...k->...i", A, v)[..., None])
+    misfit = np.abs(np.einsum("...ki,...i->...k", A, coef[..., 0]) - v).max() / max(np.abs(v).max(), 1e-300)
+    W_gg = coef[..., 1, 0]
+    if misfit > 1e-8 or not np.all(W_gg > 0):
+        raise InputError(f"the stiffness of {system.meta.get('model')} is not W(g) of its strain measure here "
+                         f"(misfit {misfit:.1e}, least W_gg {W_gg.min():.3g})", key="strain",
+                         expected="strain = 'pointwise'")
+    axial = W_gg[..., None, None] * g_j[..., :, None] * g_j[..., None, :]
+    K_ax = red.matrix(system.assembler.matrix(element_matrices(disc.tables, disc.weights, axial)))
+    m = int(multipliers or system.choices.get("N", 10))
+    B = _multiplier_rows(system, g_j, m)
+    psi = np.stack([np.cos(k * np.pi * disc.points / disc.length) for k in range(m)], axis=-1).reshape(-1, m)
+    C = (psi * (disc.weights / W_gg).reshape(-1, 1)).T @ psi
+    dense["K"] = dense["K"] - (K_ax.toarray() if hasattr(K_ax, "toarray") else np.asarray(K_ax)) \
+        + B.T @ np.linalg.solve(C, B)
+    return dense

@@ -8,6 +8,9 @@ geometric stiffness of the multiplier:
 
 The ``constraint`` kernel gives both at the Gauss points: g_j (jets) and g_jj
 (jets x jets), in the jets of the field's local equations (mechgen.symbolic.field).
+A model's axial strain measure (``model.strain_density``, a string's (lambda^2 - 1)/2)
+gets the same derivatives in the ``strain`` kernel: the Galerkin stiffness can then
+project the strain on a smaller space (mechgen.runtime.constrained, ``projected``).
 """
 from __future__ import annotations
 
@@ -20,13 +23,15 @@ from mechgen.symbolic.model import Model, as_expr, call_declared
 from mechgen.symbolic.specialize import Specialization, param_namespace
 
 
-def constraint_of(model: Model, spec: Specialization) -> sp.Expr | None:
-    """g(u, p) of the model under ``spec`` (None when it declares none or it is identically 0)."""
-    if model.constraint_fn is None or model.continuum is None:
+def constraint_of(model: Model, spec: Specialization, fn=None) -> sp.Expr | None:
+    """g(u, p) of the model's constraint (or of ``fn``: its strain measure) under ``spec``; None when it declares
+    none or it is identically 0."""
+    fn = model.constraint_fn if fn is None else fn
+    if fn is None or model.continuum is None:
         return None
     p_ns, _ = param_namespace(model, spec)
     u = Jets(model.field_names)
-    g = as_expr(call_declared(model.constraint_fn, u=u, p=p_ns, s=POSITION), "constraint_density", model)
+    g = as_expr(call_declared(fn, u=u, p=p_ns, s=POSITION), "constraint_density", model)
     if g == 0:
         return None
     if any(k > 1 or m > 0 for _, k, m in u.used):

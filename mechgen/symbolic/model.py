@@ -133,6 +133,7 @@ class Model:
         self.dissipation_fn: Callable | None = None
         self.complementary_fn: Callable | None = None
         self.constraint_fn: Callable | None = None
+        self.strain_fn: Callable | None = None
         self.forces_fn: Callable | None = None
         self.chain_spec: Chain | None = None
         self.site_kinetic_fn: Callable | None = None
@@ -271,6 +272,14 @@ class Model:
         n = mu dg/du_s.
         """
         self.constraint_fn = fn
+        return fn
+
+    def strain_density(self, fn: Callable) -> Callable:
+        """Decorator (continuum): the scalar strain measure g(u, p) through which the slopes enter the strain
+        energy (V = W(g, u): a string's stretch). With the runtime choice ``strain = "projected"`` the axial
+        stiffness W_gg g_j g_j^T is replaced by its projection on cos(k pi s/L) (a mixed, locking-free
+        Galerkin stiffness; mechgen.runtime.constrained). Returning 0 means none."""
+        self.strain_fn = fn
         return fn
 
     def weak_form(self, fn: Callable) -> Callable:
