@@ -103,13 +103,15 @@ def baseline_rtol(ref, rtol: float):
 
 
 def balloon_system(N: int = N_GALERKIN):
-    """The scene's balloon system (as ``mechgen run`` builds it) with N sines per component, and build info."""
+    """The scene's balloon system (as ``mechgen run`` builds it) with N sines per component and the baseline's
+    pointwise axial stiffness (the scene's projected one is a different, more accurate discretisation), and
+    build info."""
     from mechgen import models
     from mechgen.scene.info import lookup_model
     from mechgen.scene.load import load_scene
     from mechgen.scene.run import _system_for
 
-    scn = load_scene(str(SCENE), overrides=[f"N={N}"], lookup_model=lookup_model, model_names=models.names)
+    scn = load_scene(str(SCENE), overrides=[f"N={N}", "strain=pointwise"], lookup_model=lookup_model, model_names=models.names)
     model = models.get(scn.model)
     free = tuple(n for n in scn.free if model.param(n).is_numeric)
     kernels = ("bvp_outputs", "bvp_residual", "bvp_tangent", "linear")
