@@ -13,7 +13,7 @@ import pytest
 from mechgen.runtime.bvp import Discretisation, collocate
 from mechgen.runtime.continuation import continue_bvp, point_at
 from mechgen.runtime.stability import conservative_gyroscopic, stability
-from test_bvp import MESH, S, _bratu_guess, bratu, bratu_exact, bratu_theta, eigen_problem
+from test_bvp import MESH, S, _bratu_guess, bratu, bratu_exact, bratu_theta
 from test_continuation import LAM_C
 
 
@@ -73,23 +73,6 @@ def test_gauss_continuation_passes_the_bratu_fold():
     assert np.max(np.abs(lower(S) - bratu_exact(S, bratu_theta(3.0, upper=False)))) < 1e-10
     end = br.system.to_result(br.u[-1], br.lam[-1])
     assert np.max(np.abs(end(S) - bratu_exact(S, bratu_theta(2.0, upper=True)))) < 1e-8
-
-
-def test_gauss_continuation_with_an_unknown_parameter():
-    """y'' + p0 y = 0, y(0) = y(1) = 0, y'(0) = lam with p0 unknown: p0 = pi^2 along the branch."""
-    base = eigen_problem()
-    prob = type(base)(base.f, base.f_y, lambda ya, yb, p: np.array([ya[0], yb[0], ya[1] - p[1]]), base.g_ya,
-                      base.g_yb, (0.0, 1.0), 2, 2,
-                      lambda s, y, p: np.concatenate([base.f_p(s, y, p), np.zeros((2, 1) + np.shape(s))], axis=1),
-                      lambda ya, yb, p: np.array([[0.0, 0.0], [0.0, 0.0], [0.0, -1.0]]), unknown=(0,),
-                      vectorized=True)
-    start = collocate(prob, MESH, np.vstack([np.sin(3 * MESH) / 3, np.cos(3 * MESH)]), p=[7.0, 1.0], tol=1e-10)
-    br = continue_bvp(prob, start, 1, method="gauss", stages=4, mesh=10, ds=0.2, lam_max=3.0, max_points=30)
-    assert br.status == "lam_max" and br.lam[-1] == 3.0
-    for u, lam in zip(br.u, br.lam):
-        res = br.system.to_result(u, lam)
-        assert abs(res.p[0] - np.pi ** 2) < 1e-9
-        assert np.max(np.abs(res(S)[0] - lam * np.sin(np.pi * S) / np.pi)) < 1e-7
 
 
 def test_f_p_columns_on_request():

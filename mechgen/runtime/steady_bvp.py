@@ -119,15 +119,19 @@ def _end_conditions(start, end, size: int, n_p: int) -> tuple:
     return g, lambda ya, yb, p: rows_a, lambda ya, yb, p: rows_b, lambda ya, yb, p: np.zeros((size, n_p))
 
 
+def _layout(field_system) -> tuple:
+    """(fields, the free parameters' names, the length's index among them or None, the fixed length)."""
+    names = tuple(field_system.meta.get("params", []))
+    length = field_system.info["length"]
+    return (tuple(field_system.info["fields"]), names, names.index(length) if length in names else None,
+            field_system.value(length))
+
+
 def steady_bvp(field_system) -> SteadyBVP:
     """The BVP of ``field_system``'s steady state (kernels bvp_*); its parameters are the free ones."""
     st = field_system.steady_form()
-    fields = tuple(field_system.info["fields"])
+    fields, names, length_index, fixed_length = _layout(field_system)
     n = len(fields)
-    names = tuple(field_system.meta.get("params", []))
-    length_name = field_system.info["length"]
-    length_index = names.index(length_name) if length_name in names else None
-    fixed_length = field_system.value(length_name)
     bc = st.outputs(np.zeros(n), np.ones(n))  # boundary values depend on parameters only (unit slopes: finite)
     conditions = []
     for f, k, at in field_system.info["constraints"]:
@@ -226,12 +230,8 @@ def hamiltonian_bvp(field_system) -> SteadyBVP:
         raise InputError(f"the kernels of {field_system.meta.get('model')} were built without the Hamiltonian "
                          "steady form", key="form", expected="a model with a complementary_density and the "
                          "hbvp_rates, hbvp_rates_tangent and hbvp_outputs kernels")
-    fields = tuple(field_system.info["fields"])
+    fields, names, length_index, fixed_length = _layout(field_system)
     n = len(fields)
-    names = tuple(field_system.meta.get("params", []))
-    length_name = field_system.info["length"]
-    length_index = names.index(length_name) if length_name in names else None
-    fixed_length = field_system.value(length_name)
     params0 = np.array(field_system.params, float)
     reader = SteadyBVP(None, fields, fixed_length, SimpleNamespace(kernels=kernels), names, length_index, params0,
                        form="hamiltonian")

@@ -64,9 +64,9 @@ import numpy as np
 from mechgen import models
 from mechgen.errors import ConvergenceError, SceneError
 from mechgen.runtime import branch_scan
+from mechgen.runtime.branch_stability import stability_along
 from mechgen.runtime.constrained import linear_about_bvp
 from mechgen.runtime.continuation import minimize_along_branch
-from mechgen.runtime.stability import stability as solve_stability
 from mechgen.runtime.steady_bvp import hamiltonian_bvp, holding, solve_steady, steady_bvp, stress_guess
 from mechgen.symbolic.model import call_declared
 from mechgen.symbolic.params import Namespace
@@ -97,18 +97,15 @@ def linear_about_steady(system, steady: dict) -> dict:
     return linear_about_bvp(system, steady["_bvp"], steady["_result"])
 
 
-def _stability_about(system, bvp, result) -> dict:
-    """Verdict, lowest ten frequencies and the eigenvalues of the Galerkin linearisation about a steady state."""
-    saved = np.array(system.params, float)
-    try:
-        system.params[...] = result.p
-        mats = linear_about_steady(system, {"_bvp": bvp, "_result": result})
-    finally:
-        system.params[...] = saved
-    dense = {k: v.toarray() if hasattr(v, "toarray") else np.asarray(v) for k, v in mats.items()}
-    verdict = solve_stability(dense["M"], dense["D"] + dense["G"], dense["K"])
+def _reported(verdict) -> dict:
+    """Verdict, lowest ten frequencies and eigenvalues of a StabilityResult, as the scene reports them."""
     return {"verdict": verdict.verdict, "frequencies": [float(f) for f in verdict.frequencies[:10]],
             "eigenvalues": [[float(e.real), float(e.imag)] for e in verdict.eigenvalues]}
+
+
+def _stability_about(system, bvp, result) -> dict:
+    """The Galerkin linearisation's stability about one steady state (mechgen.runtime.branch_stability)."""
+    return _reported(stability_along(system, bvp, None, [result])[0])
 
 
 # ----------------------------------------------------------------------------- shape outputs, starts
@@ -259,7 +256,7 @@ def run_steady_bvp(system, options: dict, context: dict) -> dict:
 def _stability_along(system, bvp, results) -> list[dict]:
     """The stability of every steady state in ``results`` (one Galerkin eigenproblem each); the one place to
     swap for a batched runtime call."""
-    return [_stability_about(system, bvp, res) for res in results]
+    return [_reported(v) for v in stability_along(system, bvp, None, results)]
 
 
 def _record(name: str, lam: float, summary: dict, shapes: dict, aliases: dict, extra=()) -> dict:

@@ -440,17 +440,21 @@ def _method(ctx: _Ctx, key: str, value: object) -> str:
     return value
 
 
-def _steady_method(ctx: _Ctx, key: str, value: object) -> str:
-    if not isinstance(value, str) or value not in STEADY_METHODS:
-        raise _fail(ctx.file, key, f"unknown steady method {_show(value)}", "one of: " + ", ".join(STEADY_METHODS))
-    return value
+def _one_of(what: str, names: Sequence[str]) -> Callable:
+    """A validator of a string key whose value is one of ``names`` (``what`` names it in the message)."""
+    def check(ctx: _Ctx, key: str, value: object) -> str:
+        if not isinstance(value, str) or value not in names:
+            raise _fail(ctx.file, key, f"unknown {what} {_show(value)}", "one of: " + ", ".join(names))
+        return value
+
+    return check
 
 
-def _branch_method(ctx: _Ctx, key: str, value: object) -> str:
-    methods = ("collocation", "gauss", "multiple_shooting")
-    if not isinstance(value, str) or value not in methods:
-        raise _fail(ctx.file, key, f"unknown continuation method {_show(value)}", "one of: " + ", ".join(methods))
-    return value
+_steady_method = _one_of("steady method", STEADY_METHODS)
+_branch_method = _one_of("continuation method", ("collocation", "gauss", "multiple_shooting"))
+BRANCH_DIRECTIONS = ("increasing", "decreasing", "both")
+_direction = _one_of("direction", BRANCH_DIRECTIONS)
+_campbell_method = _one_of("campbell method", ("auto", "exact", "reduced"))
 
 
 def _steady_form(ctx: _Ctx, key: str, value: object) -> str:
@@ -512,7 +516,6 @@ def _free_parameter(ctx: _Ctx, key: str, value: object) -> str:
 
 # --------------------------------------------------------------------------- branches of steady states
 
-BRANCH_DIRECTIONS = ("increasing", "decreasing", "both")
 
 
 def _param_values(ctx: _Ctx, key: str, value: object) -> dict[str, float]:
@@ -557,12 +560,6 @@ def _starts(ctx: _Ctx, key: str, value: object) -> str | list[str]:
         if name in names[:i - 1]:
             raise _fail(ctx.file, f"{key}[{i}]", f"start '{name}' is listed twice", "distinct steady analyses")
     return names
-
-
-def _direction(ctx: _Ctx, key: str, value: object) -> str:
-    if not isinstance(value, str) or value not in BRANCH_DIRECTIONS:
-        raise _fail(ctx.file, key, f"unknown direction {_show(value)}", "one of: " + ", ".join(BRANCH_DIRECTIONS))
-    return value
 
 
 def _output_values(ctx: _Ctx, key: str, value: object) -> dict[str, float]:
@@ -740,13 +737,6 @@ def _speeds(ctx: _Ctx, key: str, value: object) -> dict[str, list]:
         raise _fail(ctx.file, _join(key, name), "campbell speeds must be two or more increasing numbers",
                     "increasing numbers, e.g. {start = 0, stop = 1000, num = 50}")
     return over
-
-
-def _campbell_method(ctx: _Ctx, key: str, value: object) -> str:
-    methods = ("auto", "exact", "reduced")
-    if not isinstance(value, str) or value not in methods:
-        raise _fail(ctx.file, key, f"unknown campbell method {_show(value)}", "one of: " + ", ".join(methods))
-    return value
 
 
 def _multiples(ctx: _Ctx, key: str, value: object) -> list[float]:
