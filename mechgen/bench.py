@@ -77,7 +77,7 @@ def numpy_stiffness(u: np.ndarray) -> np.ndarray:
 
 def _generated(n: int):
     from mechgen import models
-    from mechgen.compile import compile_model
+    from mechgen.pipeline import compile_model
     from mechgen.symbolic.specialize import specialize
 
     model = models.get("fpu_chain")
@@ -182,7 +182,7 @@ def kernel_rows(sizes, batch_n: int, batch: int, lambdify_max: int) -> list[dict
 def call_overhead() -> dict:
     """Prepared-call overhead of a small kernel: one call vs its share of a 10^6-state batch."""
     from mechgen import models
-    from mechgen.compile import compile_model
+    from mechgen.pipeline import compile_model
     from mechgen.symbolic.specialize import specialize
 
     model = models.get("laval_rotor")
@@ -216,7 +216,7 @@ def empty_cache():
 _FRESH_BUILD = """
 import json, sys, time
 start = time.perf_counter()
-import mechgen.compile, mechgen.models, mechgen.symbolic.specialize  # noqa: E401 (imports timed apart)
+import mechgen.pipeline, mechgen.models, mechgen.symbolic.specialize  # noqa: E401 (imports timed apart)
 from mechgen.bench import _generated
 from mechgen.codegen.build import STATS
 imported = time.perf_counter()
@@ -229,7 +229,7 @@ print(json.dumps({"seconds": time.perf_counter() - imported, "import_s": importe
 _FRESH_SCENE = """
 import json, sys, time
 start = time.perf_counter()
-import mechgen.compile, mechgen.models  # noqa: E401 (imports timed apart)
+import mechgen.pipeline, mechgen.models  # noqa: E401 (imports timed apart)
 from mechgen.codegen.build import STATS
 from mechgen.scene.run import run_scene
 imported = time.perf_counter()

@@ -122,7 +122,7 @@ def _times(fn, repeats: int, min_time: float = 0.0) -> list[float]:
 # -- work-precision --------------------------------------------------------------
 def _beam(bc: str, disc: str, size: int, backend: str):
     from mechgen import models
-    from mechgen.compile import compile_model
+    from mechgen.pipeline import compile_model
     from mechgen.symbolic.specialize import specialize
 
     model = models.get(MODEL)

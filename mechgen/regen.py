@@ -11,7 +11,7 @@ import tempfile
 from pathlib import Path
 
 from mechgen import models
-from mechgen.compile import all_kernels, derive, emit, lower_all
+from mechgen.pipeline import all_kernels, derive, emit, lower_all
 from mechgen.symbolic.specialize import all_free
 
 GENERATED = Path(__file__).resolve().parent / "generated"

@@ -7,7 +7,7 @@ from functools import lru_cache
 import numpy as np
 
 from mechgen import models
-from mechgen.compile import compile_model
+from mechgen.pipeline import compile_model
 from mechgen.runtime.mesh import Layout
 from mechgen.symbolic.specialize import specialize
 

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from mechgen import models
-from mechgen.compile import compile_model
+from mechgen.pipeline import compile_model
 from mechgen.runtime.continuation import continue_bvp
 from mechgen.runtime.stability import stability
 from mechgen.runtime.steady_bvp import solve_steady, steady_bvp

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from mechgen import models
-from mechgen.compile import compile_model
+from mechgen.pipeline import compile_model
 from mechgen.runtime.branch_stability import stability_along
 from mechgen.runtime.continuation import continue_bvp, minimize_along_branch, point_at
 from mechgen.runtime.steady_bvp import solve_steady, steady_bvp

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from mechgen import models
-from mechgen.compile import compile_model
+from mechgen.pipeline import compile_model
 from mechgen.errors import InputError
 from mechgen.runtime.constrained import linear_about_bvp
 from mechgen.runtime.stability import stability

@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 
 from mechgen import models
-from mechgen.compile import compile_model
+from mechgen.pipeline import compile_model
 from mechgen.errors import ConvergenceError
 from mechgen.runtime.steady_bvp import hamiltonian_bvp, solve_steady, steady_bvp
 from mechgen.symbolic.specialize import specialize

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from mechgen.compile import compile_model
+from mechgen.pipeline import compile_model
 from mechgen.runtime.pattern import affine_summary, interior
 from mechgen.symbolic.model import Model
 from mechgen.symbolic.params import Param

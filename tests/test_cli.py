@@ -101,7 +101,7 @@ def test_hostile_identifiers_are_rejected_at_declaration():
 
 
 def test_a_model_function_returning_text_is_not_parsed():
-    from mechgen.compile import derive
+    from mechgen.pipeline import derive
     from mechgen.symbolic.specialize import specialize
 
     model = Model("texty")

@@ -13,7 +13,7 @@ import pytest
 from scipy.optimize import brentq
 
 from mechgen import models
-from mechgen.compile import compile_model
+from mechgen.pipeline import compile_model
 from mechgen.errors import InputError
 from mechgen.runtime.discretise import UnderIntegrationWarning
 from mechgen.runtime.modes import modes

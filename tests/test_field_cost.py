@@ -10,7 +10,7 @@ import time
 import pytest
 
 from mechgen import models
-from mechgen.compile import derive, lower_all
+from mechgen.pipeline import derive, lower_all
 from mechgen.symbolic.specialize import specialize
 
 

@@ -6,7 +6,7 @@ ways, a finite-difference Jacobian of the generated residual, and closed forms.
 import numpy as np
 import pytest
 
-from mechgen.compile import compile_model
+from mechgen.pipeline import compile_model
 from mechgen.errors import ModelError
 from mechgen.symbolic.field import fix
 from mechgen.symbolic.model import Model

@@ -19,7 +19,7 @@ import pytest
 from scipy.optimize import brentq
 
 from mechgen import models
-from mechgen.compile import compile_model
+from mechgen.pipeline import compile_model
 from mechgen.scene.analyses import run_modes, run_stability
 from mechgen.symbolic.specialize import specialize
 

@@ -20,7 +20,7 @@ import pytest
 import scipy.linalg as sla
 
 from mechgen import models
-from mechgen.compile import compile_model
+from mechgen.pipeline import compile_model
 from mechgen.runtime.modes import modes
 from mechgen.symbolic.specialize import specialize
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from mechgen import models
-from mechgen.compile import compile_model
+from mechgen.pipeline import compile_model
 from mechgen.scene.analyses import run_stability
 from mechgen.symbolic.specialize import specialize
 

@@ -10,7 +10,7 @@ so for p != 0 one root pair has Re s > 0 with Im s != 0: flutter. With p = 0 it 
 import numpy as np
 import pytest
 
-from mechgen.compile import compile_model
+from mechgen.pipeline import compile_model
 from mechgen.scene.analyses import run_stability
 from mechgen.symbolic.model import Model
 from mechgen.symbolic.params import Param

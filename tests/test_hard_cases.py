@@ -7,7 +7,7 @@ import pytest
 import sympy as sp
 
 from mechgen import models
-from mechgen.compile import compile_model
+from mechgen.pipeline import compile_model
 from mechgen.errors import ConvergenceError, InputError, KernelError
 from mechgen.scene.analyses import run_modes, run_simulate, run_stability, run_steady
 from mechgen.symbolic.model import Model

@@ -12,7 +12,7 @@ With y = (x, v, s), y' = A y, the characteristic polynomial is
 import numpy as np
 import pytest
 
-from mechgen.compile import compile_model
+from mechgen.pipeline import compile_model
 from mechgen.scene.analyses import run_simulate, run_stability
 from mechgen.symbolic.model import Model
 from mechgen.symbolic.params import Param

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from mechgen import models
-from mechgen.compile import compile_model
+from mechgen.pipeline import compile_model
 from mechgen.runtime.integrate import leapfrog
 from mechgen.scene.analyses import run_modes, run_simulate, run_stability, run_steady
 from mechgen.symbolic.specialize import specialize

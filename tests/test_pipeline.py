@@ -4,10 +4,10 @@ import warnings
 import numpy as np
 import pytest
 
-import mechgen.compile as pipeline
+import mechgen.pipeline as pipeline
 from mechgen import models
 from mechgen.codegen import build
-from mechgen.compile import compile_model
+from mechgen.pipeline import compile_model
 from mechgen.scene.analyses import needs
 from mechgen.symbolic.specialize import specialize
 

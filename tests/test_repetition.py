@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from mechgen import models
-from mechgen.compile import compile_model, derive, lower_all
+from mechgen.pipeline import compile_model, derive, lower_all
 from mechgen.symbolic.specialize import specialize
 
 KERNELS = {"residual", "tangent", "linear", "force", "outputs"}
@@ -58,7 +58,7 @@ def test_large_chain_kernel_matches_vectorised_formula(backend):
 
 def test_generated_c_loops_instead_of_unrolling():
     """The emitted C of a chain has the same length for any N (a loop, never unrolled text)."""
-    from mechgen.compile import emit
+    from mechgen.pipeline import emit
 
     texts = {n: emit("c", _derive_and_lower(n)[0], model="fpu_chain", title="") for n in (8, 4096)}
     assert texts[8] == texts[4096]

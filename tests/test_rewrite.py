@@ -11,7 +11,7 @@ import sympy as sp
 
 from mechgen import models
 from mechgen.codegen.rewrite import _ops, horner, optimise, share_writes
-from mechgen.compile import compile_model
+from mechgen.pipeline import compile_model
 from mechgen.symbolic.specialize import specialize
 
 g0, g1, g2, g3, g4 = G = sp.symbols("g0:5", real=True)

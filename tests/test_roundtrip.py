@@ -9,7 +9,7 @@ import pytest
 import sympy as sp
 
 from mechgen import models
-from mechgen.compile import compile_model
+from mechgen.pipeline import compile_model
 from mechgen.symbolic.derive import derive_lumped
 from mechgen.symbolic.specialize import all_free, specialize
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from mechgen import models
-from mechgen.compile import compile_model
+from mechgen.pipeline import compile_model
 from mechgen.errors import InputError
 from mechgen.runtime.mesh import Layout
 from mechgen.runtime.sweep import sweep

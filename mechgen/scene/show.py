@@ -4,7 +4,7 @@ from __future__ import annotations
 import sympy as sp
 
 from mechgen import models
-from mechgen.compile import derive
+from mechgen.pipeline import derive
 from mechgen.symbolic.specialize import all_free
 
 

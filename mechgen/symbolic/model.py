@@ -16,7 +16,9 @@ A lattice model (:meth:`Model.chain`) declares instead one *site* and one
 from __future__ import annotations
 
 import inspect
+import sys
 from dataclasses import dataclass, replace
+from pathlib import Path
 
 import sympy as sp
 from typing import Callable
@@ -105,6 +107,13 @@ def call_declared(fn: Callable, **available: object) -> object:
     return fn(**{n: available[n] for n in names})
 
 
+def _caller_file() -> str | None:
+    """``__file__`` of the module that constructs a Model (None from an interactive session)."""
+    frame = sys._getframe(2)
+    file = frame.f_globals.get("__file__")
+    return str(Path(file).resolve()) if isinstance(file, str) and Path(file).is_file() else None
+
+
 class Model:
     """A mechanical model declared by its energies.
 
@@ -122,7 +131,9 @@ class Model:
     def __init__(self, name: str, doc: str = "", *, file: str | None = None) -> None:
         self.name = check_identifier(name, what="model")
         self.doc = (doc or "").strip()
-        self.file = file
+        #: the Python file that declares the model (keys the compile cache); taken from the caller's module
+        #: when not given, so a model file need not pass ``file=__file__``
+        self.file = file if file is not None else _caller_file()
         self.param_list: list[Param] = []
         self.coordinate_names: list[str] = []
         self.internals: list[Internal] = []
