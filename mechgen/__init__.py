@@ -1,11 +1,65 @@
-"""mechgen: energies and kinematics in, derived matrices and fast kernels out."""
+"""mechgen: energies and kinematics in, derived matrices and fast kernels out.
+
+The public names (DESIGN.md, "the user's three jobs"), importable from ``mechgen`` itself:
+
+* declaring a model: ``Model``, ``Param``, ``fix``;
+* finding one: ``load_model(name_or_path)``;
+* compiling it: ``compile(model, params=..., backend=...)`` -> an immutable compiled system
+  (``with_params(**values)`` gives a new one);
+* one function per analysis kind, each returning a ``Result``: ``modes``, ``stability``,
+  ``steady``, ``continuation``, ``simulate``, ``sweep``, ``campbell``;
+* ``run(scene)``: a scene file (or a dict of its contents), built on the same functions;
+* the errors: ``MechgenError`` and its kinds.
+
+Names are loaded on first use, so ``import mechgen`` stays cheap (no sympy until a model is
+declared or derived).
+"""
 from __future__ import annotations
+
+import importlib
 
 __version__ = "0.1.0"
 
+#: public name -> module that defines it
+_EXPORTS = {
+    "Model": "mechgen.symbolic.model",
+    "Param": "mechgen.symbolic.params",
+    "fix": "mechgen.symbolic.field",
+    "load_model": "mechgen.models",
+    "compile": "mechgen.api",
+    "Result": "mechgen.analyses.result",
+    "modes": "mechgen.analyses.public",
+    "stability": "mechgen.analyses.public",
+    "steady": "mechgen.analyses.public",
+    "continuation": "mechgen.analyses.public",
+    "simulate": "mechgen.analyses.public",
+    "sweep": "mechgen.analyses.public",
+    "campbell": "mechgen.analyses.public",
+    "MechgenError": "mechgen.errors",
+    "InputError": "mechgen.errors",
+    "SceneError": "mechgen.errors",
+    "ModelError": "mechgen.errors",
+    "ConvergenceError": "mechgen.errors",
+    "KernelError": "mechgen.errors",
+}
+
+__all__ = sorted([*_EXPORTS, "run"])
+
 
 def run(scene, **kwargs):
-    """Run a scene (path or dict) and return its results dict (see DESIGN.md)."""
+    """Run a scene (a path to a TOML file, or a dict of its contents) and return its results dict (DESIGN.md)."""
     from mechgen.scene.run import run_scene
 
     return run_scene(scene, **kwargs)
+
+
+def __getattr__(name: str):
+    if name not in _EXPORTS:
+        raise AttributeError(f"module 'mechgen' has no attribute {name!r}")
+    value = getattr(importlib.import_module(_EXPORTS[name]), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted([*globals(), *_EXPORTS])

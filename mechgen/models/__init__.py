@@ -115,3 +115,8 @@ def resolve(ref: str, *, base: str | Path | None = None) -> ModelSource:
 def get(ref: str, *, base: str | Path | None = None):
     """The :class:`~mechgen.symbolic.model.Model` a reference names (a built-in name, a path, module:attr)."""
     return resolve(ref, base=base).load()
+
+
+def load_model(ref: str, *, base: str | Path | None = None):
+    """Public: the Model a reference names (a built-in name, a path to a .py file, package.module:attribute)."""
+    return get(ref, base=base)
