@@ -1,4 +1,4 @@
-"""Command line: ``mechgen models | show MODEL | run SCENE | regen [--check] | bench``.
+"""Command line: ``mechgen models | show MODEL_OR_PATH | run SCENE | regen [--check] | bench``.
 
 Exit code 0 on success, 2 on bad input (one paragraph on stderr, no traceback),
 1 when a computation fails (convergence, kernel error) with its message.
@@ -18,9 +18,9 @@ from mechgen.errors import InputError, MechgenError
 def _parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="mechgen", description=__doc__.splitlines()[0])
     sub = ap.add_subparsers(dest="command", required=True)
-    sub.add_parser("models", help="list the built-in models")
+    sub.add_parser("models", help="list the built-in models and those installed packages register")
     show = sub.add_parser("show", help="print a model's derived equations and matrices")
-    show.add_argument("model")
+    show.add_argument("model", help="a model name, a path to a model file, or package.module:attribute")
     run = sub.add_parser("run", help="run a scene file")
     run.add_argument("scene")
     run.add_argument("--set", dest="overrides", action="append", default=[], metavar="NAME=VALUE")
@@ -67,10 +67,19 @@ def _cmd_run(args) -> int:
 
 
 def _cmd_models(_args) -> int:
+    """One line per model a scene can name: name, origin (built-in or the entry point's distribution), summary."""
     from mechgen import models
 
-    for name in models.names():
-        print(f"{name:18s} {models.get(name).summary()}")
+    rows = [(name, models.resolve(name)) for name in models.names()]
+    rows += sorted(models.entry_points().items())
+    wide = max(len(name) for name, _ in rows)
+    origin = max(len(source.origin) for _, source in rows)
+    for name, source in rows:
+        try:
+            summary = source.load().summary()
+        except InputError as exc:  # an installed package's broken model: say so, list the others
+            summary = f"(does not load: {exc.paragraph()})"
+        print(f"{name:{wide}s}  {source.origin:{origin}s}  {summary}")
     return 0
 
 

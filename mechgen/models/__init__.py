@@ -5,24 +5,35 @@ A model is named in a scene (``model = ...``) or in Python (:func:`mechgen.load_
 
 * a built-in name (``"laval_rotor"``: one module per model family in this package),
 * a path to a Python file (``"models/top.py"``, relative to the scene's folder or to ``base``),
-* ``"package.module:attribute"`` (``attribute`` defaults to ``model``).
+* ``"package.module:attribute"`` (``attribute`` defaults to ``model``),
+* the name of an entry point in the group ``mechgen.models`` of an installed distribution,
+  whose value is ``package.module:attribute``.
 
 :meth:`ModelSource.load` then imports the module and returns its
 :class:`~mechgen.symbolic.model.Model`. A model file is Python that the user chose to run;
-a scene stays pure data.
+a scene stays pure data. Errors while importing a model (a syntax error, an exception, a bad
+declaration) become a :class:`~mechgen.errors.ModelError` naming the file and the line.
 """
 from __future__ import annotations
 
 import importlib
 import importlib.util
+import re
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from mechgen.errors import InputError
+from mechgen.errors import InputError, ModelError
 
 BUILTIN = ("balloon_string", "euler_bernoulli_beam", "follower_column", "fpu_chain", "laval_rotor", "moving_string",
            "spinning_shaft", "rotating_string", "spring_pendulum", "timoshenko_beam")
 HERE = Path(__file__).resolve().parent
+#: the entry-point group installed packages register their models under (value ``module:attribute``)
+ENTRY_POINT_GROUP = "mechgen.models"
+_MODULE_REF = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*\Z")
+_ATTRIBUTE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
+EXPECTED_REF = ("a built-in model name, a path to a .py file, package.module:attribute or the name of an "
+                f"installed '{ENTRY_POINT_GROUP}' entry point")
 
 
 @dataclass(frozen=True)
@@ -42,20 +53,70 @@ class ModelSource:
     attribute: str = "model"
 
     def load(self):
-        """Import the declaring module and return its Model."""
+        """Import the declaring module and return its Model (``Model.source`` set to :attr:`key`)."""
         if self.module is not None:
-            module = importlib.import_module(self.module)
+            module = _guarded(lambda: importlib.import_module(self.module), self.file, self.key)
         else:
             module = _import_file(self.file)
-        model = getattr(module, self.attribute, None)
-        from mechgen.symbolic.model import Model
-
-        if not isinstance(model, Model):
-            raise InputError(f"{self.key} defines no Model called {self.attribute!r}", file=str(self.file or ""),
-                             key="model", expected=f"a module-level `{self.attribute} = Model(...)`")
+        model = _model_of(module, self)
         if model.file is None and self.file is not None:
             model.file = str(self.file)
+        model.source = self.key
         return model
+
+
+def _model_of(module, source: ModelSource):
+    """The module's Model: its attribute ``source.attribute``, else its only module-level Model."""
+    from mechgen.symbolic.model import Model
+
+    where = str(source.file or source.key)
+    model = getattr(module, source.attribute, None)
+    if isinstance(model, Model):
+        return model
+    found = {name: value for name, value in vars(module).items() if isinstance(value, Model)}
+    if model is None and source.attribute == "model" and len(found) == 1:
+        return next(iter(found.values()))
+    if model is not None:
+        message = f"{source.attribute!r} is a {type(model).__name__}, not a Model"
+    elif found:
+        message = f"the module defines no Model called {source.attribute!r} (it has {', '.join(sorted(found))})"
+    else:
+        message = "the module defines no Model"
+    raise ModelError(message, file=where, key=source.attribute,
+                     expected=f"a module-level `{source.attribute} = Model(...)` (mechgen.Model)")
+
+
+def _line_in(tb, file: str | None) -> int | None:
+    """The innermost line of traceback ``tb`` that lies in ``file``."""
+    line = None
+    while tb is not None:
+        if file is not None and Path(tb.tb_frame.f_code.co_filename) == Path(file):
+            line = tb.tb_lineno
+        tb = tb.tb_next
+    return line
+
+
+def _guarded(run, file: Path | None, key: str):
+    """``run()`` (an import), its errors turned into ModelErrors naming the model file and the line."""
+    where = str(file) if file is not None else key
+    try:
+        return run()
+    except SyntaxError as exc:
+        at = f"line {exc.lineno}: " if exc.lineno else ""
+        source = Path(exc.filename) if exc.filename else file
+        raise ModelError(f"{at}syntax error: {exc.msg}", file=str(source or where),
+                         expected="a model file that is valid Python") from None
+    except ModelError as exc:
+        line = _line_in(exc.__traceback__, str(file) if file else None)
+        at = f"line {line}: " if line else ""
+        raise ModelError(at + exc.message, file=where, key=exc.key, expected=exc.expected) from None
+    except InputError:
+        raise
+    except Exception as exc:  # the user's module raised while it was imported
+        line = _line_in(exc.__traceback__, str(file) if file else None)
+        at = f"line {line}: " if line else ""
+        raise ModelError(f"{at}importing the model raised {type(exc).__name__}: {exc}", file=where,
+                         expected="a model module that imports without errors") from None
 
 
 _FILE_MODULES: dict[tuple[str, bytes], object] = {}
@@ -71,7 +132,12 @@ def _import_file(path: Path):
         name = f"mechgen_user_{content_key(str(path).encode(), data)[:16]}"
         spec = importlib.util.spec_from_file_location(name, path)
         module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
+        sys.modules[name] = module  # as an import would (dataclasses, pickling and inspect look it up)
+        try:
+            _guarded(lambda: spec.loader.exec_module(module), path, str(path))
+        except BaseException:
+            sys.modules.pop(name, None)
+            raise
         _FILE_MODULES[memo] = module
     return _FILE_MODULES[memo]
 
@@ -81,35 +147,84 @@ def names() -> list[str]:
     return sorted(BUILTIN)
 
 
+def entry_points() -> dict[str, ModelSource]:
+    """Models that installed distributions register in the entry-point group ``mechgen.models``, by name.
+
+    A name a built-in model already has is left out (the built-in wins); nothing is imported.
+    """
+    from importlib.metadata import entry_points as installed
+
+    found: dict[str, ModelSource] = {}
+    for ep in sorted(installed(group=ENTRY_POINT_GROUP), key=lambda e: e.name):
+        if ep.name in BUILTIN or ep.name in found:
+            continue
+        dist = getattr(ep, "dist", None)
+        label = f"entry point of {dist.metadata['Name']} {dist.version}" if dist is not None else "entry point"
+        try:
+            source = _module_source(ep.value)
+        except InputError as exc:
+            source = ModelSource(ep.value, f"{label} (broken: {exc.message})", None)
+        else:
+            source = ModelSource(source.key, f"{label} ({source.key})", source.file, source.module, source.attribute)
+        found[ep.name] = source
+    return found
+
+
+def known() -> list[str]:
+    """Names a scene can use without a path: the built-ins and the installed entry points."""
+    return names() + sorted(entry_points())
+
+
+def _module_source(ref: str) -> ModelSource:
+    """``package.module:attribute`` as a source; the module is found, not imported."""
+    module, _, attribute = ref.partition(":")
+    attribute = attribute.strip() or "model"
+    module = module.strip()
+    if not _MODULE_REF.match(module) or not _ATTRIBUTE.match(attribute):
+        raise InputError(f"model reference {ref!r} is not package.module:attribute", key="model",
+                         expected="dotted Python names, then ':' and an attribute name")
+    try:
+        spec = importlib.util.find_spec(module)
+    except (ImportError, ValueError) as exc:
+        raise InputError(f"cannot find module {module!r} of model {ref!r} ({type(exc).__name__}: {exc})",
+                         key="model", expected="package.module:attribute of a module on the Python path") from None
+    if spec is None:
+        raise InputError(f"no module {module!r} for model {ref!r}", key="model",
+                         expected="package.module:attribute of a module on the Python path (PYTHONPATH)")
+    origin = Path(spec.origin) if spec.origin and spec.origin.endswith(".py") else None
+    return ModelSource(f"{module}:{attribute}", "module", origin, module=module, attribute=attribute)
+
+
+def is_path(ref: str) -> bool:
+    """Whether a reference names a file (ends in .py or holds a path separator)."""
+    return ref.endswith(".py") or "/" in ref or "\\" in ref
+
+
 def resolve(ref: str, *, base: str | Path | None = None) -> ModelSource:
-    """The :class:`ModelSource` a reference names (see the module doc); nothing is imported."""
+    """The :class:`ModelSource` a reference names (see the module doc); nothing is imported.
+
+    A relative path is taken from ``base`` (a scene's folder), else from the current directory.
+    """
     if not isinstance(ref, str) or not ref:
-        raise InputError(f"model reference {ref!r}", key="model",
-                         expected="a built-in name, a path to a .py file or package.module:attribute")
+        raise InputError(f"model reference {ref!r}", key="model", expected=EXPECTED_REF)
     if ref in BUILTIN:
         return ModelSource(ref, "built-in", HERE / f"{ref}.py", module=f"mechgen.models.{ref}")
-    if ref.endswith(".py") or "/" in ref or "\\" in ref:
-        path = Path(ref)
+    if is_path(ref):
+        path = Path(ref).expanduser()
         if not path.is_absolute() and base is not None:
             path = Path(base) / path
         path = path.resolve()
         if not path.is_file():
             raise InputError(f"model file {ref!r} does not exist (looked for {path})", key="model",
-                             expected="a path to a Python file, relative to the scene")
+                             expected="a path to a Python file, relative to the scene's folder")
         return ModelSource(str(path), "file", path)
     if ":" in ref:
-        module, _, attribute = ref.partition(":")
-        try:
-            spec = importlib.util.find_spec(module)
-        except (ImportError, ValueError):
-            spec = None
-        if spec is None:
-            raise InputError(f"no module {module!r} for model {ref!r}", key="model",
-                             expected="package.module:attribute of an importable module")
-        origin = Path(spec.origin) if spec.origin and spec.origin.endswith(".py") else None
-        return ModelSource(ref, "module", origin, module=module, attribute=attribute or "model")
-    raise InputError(f"unknown model {ref!r}", key="model", expected=f"one of {', '.join(names())}, "
-                     "a path to a .py file or package.module:attribute")
+        return _module_source(ref)
+    registered = entry_points().get(ref)
+    if registered is not None:
+        return registered
+    raise InputError(f"unknown model {ref!r}", key="model",
+                     expected=f"one of {', '.join(known())}; or a path to a .py file or package.module:attribute")
 
 
 def get(ref: str, *, base: str | Path | None = None):
@@ -118,5 +233,18 @@ def get(ref: str, *, base: str | Path | None = None):
 
 
 def load_model(ref: str, *, base: str | Path | None = None):
-    """Public: the Model a reference names (a built-in name, a path to a .py file, package.module:attribute)."""
+    """Public: the Model a reference names.
+
+    ``ref`` is a built-in name (``"laval_rotor"``), a path to a ``.py`` file (relative to ``base``,
+    else to the current directory), ``package.module:attribute`` or the name of an installed
+    ``mechgen.models`` entry point. Importing a model file runs it: name only files you trust.
+
+    Raises:
+        InputError: no such model; ModelError: the model's file fails to import or declares no Model
+            (the message names the file and, where Python gives one, the line).
+    """
     return get(ref, base=base)
+
+
+__all__ = ["BUILTIN", "ENTRY_POINT_GROUP", "ModelSource", "entry_points", "get", "is_path", "known", "load_model",
+           "names", "resolve"]

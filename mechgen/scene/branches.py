@@ -113,14 +113,19 @@ SHAPE_SAMPLES = 1001
 START_TOL = 1e-6  # the tolerance at which ``shape`` starts are tried (then refined to the analysis's tol)
 
 
+def _model_of(system):
+    """The system's Model, by its canonical reference (``meta["source"]``, set where scenes compile)."""
+    return models.get(system.meta.get("source") or system.meta["model"])
+
+
 def _shape_declarations(system) -> tuple:
     """The model's shape outputs (Model.shape_output)."""
-    return tuple(getattr(models.get(system.meta["model"]), "shape_outputs", ()))
+    return tuple(getattr(_model_of(system), "shape_outputs", ()))
 
 
 def _parameter_dict(system, p) -> dict:
     """Numeric parameter values: the model's defaults, the scene's fixed ones, the free ones from p."""
-    model = models.get(system.meta["model"])
+    model = _model_of(system)
     values = {prm.name: float(prm.default) for prm in model.param_list if prm.is_numeric}
     values.update({k: float(v) for k, v in getattr(system, "fixed", {}).items()})
     values.update(zip(system.meta.get("params", []), (float(v) for v in p)))
@@ -235,7 +240,7 @@ def run_steady_bvp(system, options: dict, context: dict) -> dict:
     if options.get("hold"):
         free = options["free"]
         solved = float(result.p[bvp.params.index(free)])
-        below = models.get(system.meta["model"]).param(free).below
+        below = _model_of(system).param(free).below
         if below is not None and not solved < below:
             raise ConvergenceError(f"steady state with {next(iter(options['hold']))} held: the solved {free} = "
                                    f"{solved:.6g} is not below {below:g} (no such state near the start; try "

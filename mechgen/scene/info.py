@@ -31,14 +31,24 @@ class ModelInfo:
     stress_form: bool = False
     fields: tuple[str, ...] = ()
     shape_outputs: tuple[str, ...] = ()
+    #: the canonical reference of the model (mechgen.models.resolve): what a scene's run compiles
+    key: str = ""
 
 
-def lookup_model(name: str) -> ModelInfo | None:
-    """ModelInfo of a built-in model, or None when there is no such model."""
+def lookup_model(ref: str, base=None) -> ModelInfo | None:
+    """ModelInfo of the model a scene names, or None when no model has that name.
+
+    ``ref`` is a built-in or entry-point name, a path (relative to ``base``, the scene's folder)
+    or ``package.module:attribute`` (:func:`mechgen.models.resolve`). A path or module that
+    does not exist, and a model file that fails to import, raise their InputError.
+    """
     try:
-        model = models.get(name)
+        source = models.resolve(ref, base=base)
     except InputError:
+        if models.is_path(ref) or ":" in ref:
+            raise
         return None
+    model = source.load()
     params = {p.name: ParamInfo(p.default, p.choices, p.integer, p.below) for p in model.param_list}
     coords = model.coordinates_all
     if model.is_lattice:
@@ -47,4 +57,4 @@ def lookup_model(name: str) -> ModelInfo | None:
     cont = model.continuum
     return ModelInfo(model.name, params, coords, model.output_names, cont is not None,
                      cont.length if cont else None, dict(model.parts), model.complementary_fn is not None,
-                     model.field_names, tuple(o.name for o in getattr(model, "shape_outputs", ())))
+                     model.field_names, tuple(o.name for o in getattr(model, "shape_outputs", ())), source.key)

@@ -17,6 +17,7 @@ import copy
 import itertools
 import json
 import math
+import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -91,6 +92,8 @@ class Scene:
     analyses: tuple[AnalysisSpec, ...]
     segments: tuple = ()
     parts: tuple = ()
+    #: the canonical reference of the model (a built-in name, an absolute file path, module:attribute)
+    source: str = ""
 
 
 @dataclass
@@ -201,9 +204,36 @@ def _string(file: str, key: str, value: object, expected: str = "a string") -> s
     return value
 
 
-def _top_level(file: str, data: dict, lookup_model: Callable[[str], Any],
-               model_names: Callable[[], list[str]]) -> tuple[str, Any, str]:
-    """Check top-level keys, title, model and backend; returns (title, model info, backend)."""
+_MODULE_REF = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*:([A-Za-z_][A-Za-z0-9_]*)?")
+_REGISTERED = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.\-]{0,99}")
+MODEL_FORMS = "a path to a .py file relative to the scene's folder, or package.module:attribute"
+
+
+def is_model_reference(name: str) -> bool:
+    """Whether a scene's ``model`` names a file (``models/top.py``) or ``package.module:attribute``."""
+    return len(name) <= 4096 and (name.endswith(".py") or "/" in name or "\\" in name
+                                  or _MODULE_REF.fullmatch(name) is not None)
+
+
+def _model_info(file: str, name: str, lookup_model: Callable[..., Any], base: Path | None):
+    """The looked-up model of a scene's ``model`` value (None: no such name)."""
+    if is_model_reference(name):
+        try:
+            return lookup_model(name, base=base)
+        except InputError as exc:
+            if exc.file:  # the model's own file is at fault: its message names it
+                raise
+            raise _fail(file, "model", exc.message, exc.expected) from None
+    return lookup_model(name) if _REGISTERED.fullmatch(name) else None
+
+
+def _top_level(file: str, data: dict, lookup_model: Callable[..., Any],
+               model_names: Callable[[], list[str]], base: Path | None = None) -> tuple[str, Any, str]:
+    """Check top-level keys, title, model and backend; returns (title, model info, backend).
+
+    ``model`` is a name ``lookup_model(name)`` knows, or a path / ``module:attribute`` given to
+    ``lookup_model(name, base=base)`` (``base``: the scene's folder).
+    """
     for key in data:
         if key not in TOP_KEYS:
             raise _fail(file, _part(key), f"unknown top-level key {_show(key)}", "one of: " + ", ".join(TOP_KEYS))
@@ -211,11 +241,13 @@ def _top_level(file: str, data: dict, lookup_model: Callable[[str], Any],
     if len(title) > MAX_TITLE:
         raise _fail(file, "title", f"title is {len(title)} characters long", f"at most {MAX_TITLE} characters")
     if "model" not in data:
-        raise _fail(file, "model", "the scene names no model", "model = one of: " + _listing(sorted(model_names())))
+        raise _fail(file, "model", "the scene names no model",
+                    "model = one of: " + _listing(sorted(model_names())) + "; or " + MODEL_FORMS)
     name = _string(file, "model", data["model"])
-    info = lookup_model(name) if is_identifier(name) else None
+    info = _model_info(file, name, lookup_model, base)
     if info is None:
-        raise _fail(file, "model", f"unknown model {_show(name)}", "one of: " + _listing(sorted(model_names())))
+        raise _fail(file, "model", f"unknown model {_show(name)}",
+                    "one of: " + _listing(sorted(model_names())) + "; or " + MODEL_FORMS)
     backend = _string(file, "backend", data.get("backend", "c"))
     if backend not in BACKENDS:
         raise _fail(file, "backend", f"unknown backend {_show(backend)}", "one of: " + ", ".join(BACKENDS))
@@ -902,14 +934,29 @@ def _analyses(ctx: _Ctx, data: dict) -> tuple[AnalysisSpec, ...]:
 
 # --------------------------------------------------------------------------- entry point
 
-def load_scene(path: str, *, overrides: Sequence[str] = (), lookup_model: Callable[[str], ModelInfo | None],
+def _plain(value: object) -> object:
+    """A Python scene value as TOML would give it: tuples as lists, numpy scalars as numbers."""
+    if isinstance(value, Mapping):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, os.PathLike):
+        return os.fspath(value)
+    return value
+
+
+def load_scene(path, *, overrides: Sequence[str] = (), lookup_model: Callable[..., ModelInfo | None],
                model_names: Callable[[], list[str]]) -> Scene:
-    """Load, validate and resolve a scene file.
+    """Load, validate and resolve a scene file, or a dict of a scene's contents.
 
     Args:
-        path: the scene TOML file.
+        path: the scene TOML file, or a mapping with the contents a TOML file would have
+            (messages name it ``<dict>``; a relative model path is taken from the current directory).
         overrides: ``name=value`` strings (``--set``); they replace [params] values.
-        lookup_model: model name -> :class:`ModelInfo`, or None when unknown.
+        lookup_model: model name -> :class:`ModelInfo`, or None when unknown; a path or
+            ``package.module:attribute`` comes with ``base=`` the scene's folder.
         model_names: the known model names (for messages).
 
     Returns:
@@ -919,9 +966,13 @@ def load_scene(path: str, *, overrides: Sequence[str] = (), lookup_model: Callab
         SceneError: the first problem found, naming the file, the key and what
             was expected.
     """
-    file = str(path)
-    data = _read(file)
-    title, model, backend = _top_level(file, data, lookup_model, model_names)
+    if isinstance(path, Mapping):
+        file, data, base = "<dict>", _plain(path), Path.cwd()
+    else:
+        file = str(path)
+        data = _read(file)
+        base = Path(file).resolve().parent
+    title, model, backend = _top_level(file, data, lookup_model, model_names, base)
     params, depends = _resolve_params(file, data, model, overrides)
     for name, info in model.params.items():
         below = getattr(info, "below", None)
@@ -952,4 +1003,5 @@ def load_scene(path: str, *, overrides: Sequence[str] = (), lookup_model: Callab
 
     segments, parts = load_layout(file, data, model, params)
     free += sorted({n for seg in segments for n in seg.values if n not in free})
-    return Scene(file, title, model.name, backend, params, tuple(free), active, analyses, segments, parts)
+    return Scene(file, title, model.name, backend, params, tuple(free), active, analyses, segments, parts,
+                 getattr(model, "key", "") or model.name)

@@ -10,6 +10,7 @@ import time
 from dataclasses import replace
 from functools import lru_cache
 from pathlib import Path
+from typing import Mapping
 
 import numpy as np
 
@@ -29,10 +30,14 @@ def _public(outputs: dict) -> dict:
 
 
 @lru_cache(maxsize=8)
-def _system_for(model_name: str, values: tuple, free: tuple, active, kernels: tuple, backend: str):
-    model = models.get(model_name)
+def _system_for(model_ref, values: tuple, free: tuple, active, kernels: tuple, backend: str):
+    """The compiled system; ``model_ref`` a Model (cached by identity: an edited model file loads as a new
+    Model) or a model reference. ``meta["source"]`` is the model's canonical reference (mechgen.models)."""
+    model = models.get(model_ref) if isinstance(model_ref, str) else model_ref
     spec = specialize(model, dict(values), free=free, active=active)
-    return compile_model(model, spec, kernels=set(kernels), backend=backend)
+    system, report = compile_model(model, spec, kernels=set(kernels), backend=backend)
+    system.meta["source"] = model.source or model.name
+    return system, report
 
 
 def _laid_out(system, layout: Layout | None):
@@ -44,12 +49,12 @@ def _laid_out(system, layout: Layout | None):
 
 def _sweep_point(task: tuple) -> dict:
     """Run the inner analysis of a sweep at one grid point (module level: picklable)."""
-    model_name, values, free, active, kernels, backend, kind, options, point, layout = task
-    system, _ = _system_for(model_name, values, free, active, kernels, backend)
-    model = models.get(model_name)
+    source, values, free, active, kernels, backend, kind, options, point, layout = task
+    model = models.get(source)  # the canonical reference: resolves in a worker process too
+    system, _ = _system_for(model, values, free, active, kernels, backend)
     sizes = {k: v for k, v in point.items() if not model.param(k).is_numeric}
     if sizes:
-        system, _ = _system_for(model_name, tuple(sorted({**dict(values), **sizes}.items())), free, active,
+        system, _ = _system_for(model, tuple(sorted({**dict(values), **sizes}.items())), free, active,
                                 kernels, backend)
     system = _laid_out(system, layout)
     system.params = np.array([float(point.get(n, dict(values).get(n, model.param(n).default)))
@@ -65,16 +70,17 @@ def _collect(grid: list[dict], results: list[dict]) -> dict:
 
 
 def run_scene(scene, *, overrides=(), backend: str | None = None) -> dict:
-    """Run every analysis of a scene file and return the results dict."""
-    scn = load_scene(str(scene), overrides=list(overrides), lookup_model=lookup_model, model_names=models.names)
-    model = models.get(scn.model)
+    """Run every analysis of a scene (a file, or a dict of its contents) and return the results dict."""
+    scn = load_scene(scene if isinstance(scene, Mapping) else str(scene), overrides=list(overrides),
+                     lookup_model=lookup_model, model_names=models.known)
+    model = models.get(scn.source)
     backend = backend or scn.backend
     internal = bool(model.internals)
     kernels = sorted(set().union(*(needs(a.kind, a.options, internal=internal) for a in scn.analyses)))
     free = tuple(n for n in scn.free if model.param(n).is_numeric)
     fixed = tuple(sorted((k, v) for k, v in scn.params.items()))
     started = time.perf_counter()
-    system, report = _system_for(scn.model, fixed, free, scn.active, tuple(kernels), backend)
+    system, report = _system_for(model, fixed, free, scn.active, tuple(kernels), backend)
     layout = Layout(scn.segments, scn.parts)
     system = _laid_out(system, layout)
     results = {"scene": Path(scn.path).name, "title": scn.title, "model": scn.model, "backend": report.backend,
@@ -85,7 +91,7 @@ def run_scene(scene, *, overrides=(), backend: str | None = None) -> dict:
         clock = time.perf_counter()
         if analysis.kind == "sweep":
             inner = analysis.options["analysis"]
-            tasks = [(scn.model, fixed, free, scn.active, tuple(kernels), backend, inner.kind, dict(inner.options),
+            tasks = [(scn.source, fixed, free, scn.active, tuple(kernels), backend, inner.kind, dict(inner.options),
                       point, layout) for point in analysis.options["grid"]]
             res = sweep(_sweep_point, tasks, workers=analysis.options.get("workers", 0),
                         progress=analysis.options.get("progress", True), desc=analysis.name)

@@ -48,10 +48,16 @@ def _field(eqs) -> list[str]:
 
 
 def show_model(name: str) -> str:
-    """Text of a model's parameters, derived residual and linear matrices (all parameters symbolic)."""
-    model = models.get(name)
+    """Text of a model's parameters, derived residual and linear matrices (all parameters symbolic).
+
+    ``name``: a built-in or entry-point name, a path to a model file (from the current directory)
+    or ``package.module:attribute`` (mechgen.models.resolve).
+    """
+    source = models.resolve(name)
+    model = source.load()
     eqs = derive(model, all_free(model))
-    lines = [f"model {model.name}: {model.summary()}", "parameters:"]
+    lines = [f"model {model.name}: {model.summary()}", f"from {source.origin}: {source.file or source.key}",
+             "parameters:"]
     lines += [f"  {p.name:10s} = {p.default!r:10} {p.unit:10s} {p.doc}" for p in model.param_list]
     lines.append("")
     lines += _field(eqs) if model.is_field else _lattice(eqs) if model.is_lattice else _lumped(eqs)

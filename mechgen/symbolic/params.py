@@ -68,11 +68,28 @@ class Param:
         return not self.is_choice and not self.size
 
 
+class UnknownEntry(AttributeError, KeyError):
+    """A name a :class:`Namespace` does not hold (``p.kk`` where no parameter kk is declared).
+
+    An AttributeError (and, for ``ns["kk"]``, a KeyError) that knows the namespace, the
+    name asked for and the names it holds, so that the caller of a declared function can
+    say which function asked for what (:func:`mechgen.symbolic.model.call_declared`).
+    """
+
+    def __init__(self, namespace: "Namespace", name: str) -> None:
+        self.namespace, self.name, self.known = namespace, name, namespace.names()
+        super().__init__(f"no entry {name!r}; known: {', '.join(self.known) or '(none)'}")
+
+    def __str__(self) -> str:
+        return self.args[0]
+
+
 class Namespace:
     """Attribute and index access to a fixed, ordered set of named values.
 
     ``ns.x`` and ``ns["x"]`` and ``ns[0]`` give the same entry; ``list(ns)``
-    iterates the values in declaration order.
+    iterates the values in declaration order. An unknown name raises
+    :class:`UnknownEntry`.
     """
 
     def __init__(self, items: dict[str, object]) -> None:
@@ -80,15 +97,20 @@ class Namespace:
         object.__setattr__(self, "_order", list(items))
 
     def __getattr__(self, name: str) -> object:
+        if name.startswith("_"):  # copy and pickle probe for dunders (and _items before it is set)
+            raise AttributeError(name)
         try:
             return self._items[name]
         except KeyError:
-            raise AttributeError(f"no entry {name!r}; known: {', '.join(self._order)}") from None
+            raise UnknownEntry(self, name) from None
 
     def __getitem__(self, key: int | str) -> object:
         if isinstance(key, int):
             return self._items[self._order[key]]
-        return self._items[key]
+        try:
+            return self._items[key]
+        except KeyError:
+            raise UnknownEntry(self, key) from None
 
     def __setattr__(self, name: str, value: object) -> None:
         raise AttributeError("namespaces are read-only")
