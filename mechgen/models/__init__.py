@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
+import os
 import re
 import sys
 from dataclasses import dataclass
@@ -185,6 +186,8 @@ def _module_source(ref: str) -> ModelSource:
                          expected="dotted Python names, then ':' and an attribute name")
     try:
         spec = importlib.util.find_spec(module)
+    except ModuleNotFoundError:  # a parent package is missing
+        spec = None
     except (ImportError, ValueError) as exc:
         raise InputError(f"cannot find module {module!r} of model {ref!r} ({type(exc).__name__}: {exc})",
                          key="model", expected="package.module:attribute of a module on the Python path") from None
@@ -203,8 +206,13 @@ def is_path(ref: str) -> bool:
 def resolve(ref: str, *, base: str | Path | None = None) -> ModelSource:
     """The :class:`ModelSource` a reference names (see the module doc); nothing is imported.
 
-    A relative path is taken from ``base`` (a scene's folder), else from the current directory.
+    A relative path is taken from ``base`` (a scene's folder), else from the current directory;
+    a :class:`pathlib.Path` is always a path.
     """
+    if isinstance(ref, os.PathLike):
+        ref = os.fspath(ref)
+        if not is_path(ref):
+            ref = os.path.join(".", ref)
     if not isinstance(ref, str) or not ref:
         raise InputError(f"model reference {ref!r}", key="model", expected=EXPECTED_REF)
     if ref in BUILTIN:
@@ -216,7 +224,8 @@ def resolve(ref: str, *, base: str | Path | None = None) -> ModelSource:
         path = path.resolve()
         if not path.is_file():
             raise InputError(f"model file {ref!r} does not exist (looked for {path})", key="model",
-                             expected="a path to a Python file, relative to the scene's folder")
+                             expected="a path to a Python file (a scene's model path is relative to the scene's "
+                             "folder; one given to mechgen show or load_model to the current directory)")
         return ModelSource(str(path), "file", path)
     if ":" in ref:
         return _module_source(ref)
@@ -227,12 +236,12 @@ def resolve(ref: str, *, base: str | Path | None = None) -> ModelSource:
                      expected=f"one of {', '.join(known())}; or a path to a .py file or package.module:attribute")
 
 
-def get(ref: str, *, base: str | Path | None = None):
+def get(ref: str | os.PathLike, *, base: str | Path | None = None):
     """The :class:`~mechgen.symbolic.model.Model` a reference names (a built-in name, a path, module:attr)."""
     return resolve(ref, base=base).load()
 
 
-def load_model(ref: str, *, base: str | Path | None = None):
+def load_model(ref: str | os.PathLike, *, base: str | Path | None = None):
     """Public: the Model a reference names.
 
     ``ref`` is a built-in name (``"laval_rotor"``), a path to a ``.py`` file (relative to ``base``,
