@@ -187,7 +187,7 @@ def _index_key(model: Model, spec: Specialization, kernels: set, backend: str, c
 
     if not model.file or not Path(model.file).is_file():
         return None
-    return content_key("index-1", _mechgen_sources_digest(), Path(model.file).read_bytes(), spec.key(),
+    return content_key("index-1", _mechgen_sources_digest(), Path(model.file).read_bytes(), model.name, spec.key(),
                        ",".join(sorted(kernels)), backend, str(cse))
 
 

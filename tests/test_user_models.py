@@ -260,6 +260,23 @@ def test_a_user_model_is_derived_once_and_cached_by_its_bytes(tmp_path):
     assert _derive_seconds(folder, cache) > 0.0
 
 
+def test_two_models_in_one_file_are_two_cache_entries(tmp_path):
+    """The cache is keyed by the file's bytes and the model's name: two Models in one file (same parameter
+    values, different energies) must not share kernels. soft: omega^2 = k/m, hard: omega^2 = 4 k/m."""
+    text = _oscillator(tmp_path / "unused.py").read_text()
+    two = text.replace("model", "soft") + "\n\n" + text.replace("model", "hard").replace(
+        '"user_oscillator"', '"hard_oscillator"').replace("p.k * q.x**2 / 2", "2 * p.k * q.x**2")
+    (tmp_path / "two.py").write_text(two)
+    got = {}
+    for name in ("soft", "hard"):
+        scene = {"model": f"{tmp_path / 'two.py'}:{name}", "analysis": [{"name": "free", "kind": "modes"}]}
+        got[name] = _outputs(mechgen.run(scene))["free"]["frequencies"]
+    assert got["soft"] == pytest.approx([math.sqrt(50.0 / M)], rel=1e-12)
+    assert got["hard"] == pytest.approx([math.sqrt(4 * 50.0 / M)], rel=1e-12)
+    with pytest.raises(ModelError, match="no Model called 'model' \\(it has hard, soft\\)"):
+        mechgen.load_model(tmp_path / "two.py")
+
+
 # ----------------------------------------------------------------------------- bad model files
 
 HEAD = "from mechgen import Model, Param\nmodel = Model(\"bad\")\n"
@@ -349,7 +366,7 @@ def test_declaration_errors_name_the_declaring_file():
         Param("lambda", 1.0)
     assert info.value.file == __file__
     model = Model("scripted")
-    assert model.file == __file__  # inferred: no file=__file__ needed
+    assert model.file is None  # built in a function: its file's bytes do not determine it, so no cache key
     with pytest.raises(ModelError, match="keyword") as info:
         model.coordinates("if")
     assert info.value.file == __file__

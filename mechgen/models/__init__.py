@@ -5,6 +5,7 @@ A model is named in a scene (``model = ...``) or in Python (:func:`mechgen.load_
 
 * a built-in name (``"laval_rotor"``: one module per model family in this package),
 * a path to a Python file (``"models/top.py"``, relative to the scene's folder or to ``base``),
+  optionally with ``:attribute`` for one of several Models in the file (``"models/two.py:soft"``),
 * ``"package.module:attribute"`` (``attribute`` defaults to ``model``),
 * the name of an entry point in the group ``mechgen.models`` of an installed distribution,
   whose value is ``package.module:attribute``.
@@ -33,6 +34,7 @@ HERE = Path(__file__).resolve().parent
 ENTRY_POINT_GROUP = "mechgen.models"
 _MODULE_REF = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*\Z")
 _ATTRIBUTE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
+_FILE_ATTRIBUTE = re.compile(r"\.py:([A-Za-z_][A-Za-z0-9_]*)\Z")
 EXPECTED_REF = ("a built-in model name, a path to a .py file, package.module:attribute or the name of an "
                 f"installed '{ENTRY_POINT_GROUP}' entry point")
 
@@ -162,7 +164,7 @@ def entry_points() -> dict[str, ModelSource]:
         dist = getattr(ep, "dist", None)
         label = f"entry point of {dist.metadata['Name']} {dist.version}" if dist is not None else "entry point"
         try:
-            source = _module_source(ep.value)
+            source = _module_source(f"{ep.module}:{ep.attr or 'model'}")
         except InputError as exc:
             source = ModelSource(ep.value, f"{label} (broken: {exc.message})", None)
         else:
@@ -217,6 +219,10 @@ def resolve(ref: str, *, base: str | Path | None = None) -> ModelSource:
         raise InputError(f"model reference {ref!r}", key="model", expected=EXPECTED_REF)
     if ref in BUILTIN:
         return ModelSource(ref, "built-in", HERE / f"{ref}.py", module=f"mechgen.models.{ref}")
+    attribute = "model"
+    in_file = _FILE_ATTRIBUTE.search(ref)
+    if in_file:  # models/two.py:soft, one of several Models in a file
+        ref, attribute = ref[:in_file.start() + 3], in_file.group(1)
     if is_path(ref):
         path = Path(ref).expanduser()
         if not path.is_absolute() and base is not None:
@@ -226,7 +232,8 @@ def resolve(ref: str, *, base: str | Path | None = None) -> ModelSource:
             raise InputError(f"model file {ref!r} does not exist (looked for {path})", key="model",
                              expected="a path to a Python file (a scene's model path is relative to the scene's "
                              "folder; one given to mechgen show or load_model to the current directory)")
-        return ModelSource(str(path), "file", path)
+        key = str(path) if attribute == "model" else f"{path}:{attribute}"
+        return ModelSource(key, "file", path, attribute=attribute)
     if ":" in ref:
         return _module_source(ref)
     registered = entry_points().get(ref)

@@ -201,8 +201,16 @@ def call_declared(fn: Callable, **available: object) -> object:
 
 
 def _caller_file() -> str | None:
-    """``__file__`` of the module that constructs a Model (None from an interactive session)."""
+    """``__file__`` of the module whose top level constructs a Model, else None.
+
+    The file's bytes key the compile cache, so only a model declared at module level takes it: one
+    built inside a function (a factory, a test) may depend on the function's arguments, which the
+    file's bytes do not show; it passes ``file=`` itself or is derived afresh. None as well from an
+    interactive session.
+    """
     frame = sys._getframe(2)
+    if frame.f_code.co_name != "<module>":
+        return None
     file = frame.f_globals.get("__file__")
     return str(Path(file).resolve()) if isinstance(file, str) and Path(file).is_file() else None
 
@@ -225,7 +233,7 @@ class Model:
         self.name = check_identifier(name, what="model")
         self.doc = (doc or "").strip()
         #: the Python file that declares the model (keys the compile cache); taken from the caller's module
-        #: when not given, so a model file need not pass ``file=__file__``
+        #: when not given and declared at its top level, so a model file need not pass ``file=__file__``
         self.file = file if file is not None else _caller_file()
         #: the canonical reference (mechgen.models.resolve) the model was loaded by; None when built in a script
         self.source: str | None = None
