@@ -7,11 +7,8 @@ starts with "_" are working data and never reach JSON.
 from __future__ import annotations
 
 import time
-from dataclasses import replace
 from functools import lru_cache
 from pathlib import Path
-
-import numpy as np
 
 from mechgen import models
 from mechgen.pipeline import compile_model
@@ -39,7 +36,7 @@ def _laid_out(system, layout: Layout | None):
     """The system with the scene's segments and parts (a copy; the cached system stays bare)."""
     if layout is None or not (layout.segments or layout.parts):
         return system
-    return replace(system, layout=layout, _cache={})
+    return system.with_layout(layout)
 
 
 def _sweep_point(task: tuple) -> dict:
@@ -51,9 +48,8 @@ def _sweep_point(task: tuple) -> dict:
     if sizes:
         system, _ = _system_for(model_name, tuple(sorted({**dict(values), **sizes}.items())), free, active,
                                 kernels, backend)
-    system = _laid_out(system, layout)
-    system.params = np.array([float(point.get(n, dict(values).get(n, model.param(n).default)))
-                              for n in system.meta.get("params", [])])
+    system = _laid_out(system, layout).with_param_vector(
+        [float(point.get(n, dict(values).get(n, model.param(n).default))) for n in system.meta.get("params", [])])
     return _public(RUNNERS[kind](system, options, {}))
 
 
