@@ -22,7 +22,6 @@ A FieldSystem is immutable like a System: :meth:`FieldSystem.with_params` and
 from __future__ import annotations
 
 from dataclasses import InitVar, dataclass, field, replace
-from types import MappingProxyType
 from typing import Callable
 
 import numpy as np
@@ -37,7 +36,7 @@ from mechgen.runtime.discretise import DISCRETISATIONS, GLOBAL, Discretisation, 
 from mechgen.runtime.elements import reference
 from mechgen.runtime.kernels import Kernel
 from mechgen.runtime.mesh import Layout, build_mesh
-from mechgen.runtime.system import (Memo, folded_parameter, frozen_vector, number, unknown_parameters)
+from mechgen.runtime.system import Memo, folded_parameter, frozen_vector, number, read_only, unknown_parameters
 
 
 #: the values a continuum's runtime choices take (others, such as a model's own runtime choices, are strings)
@@ -56,8 +55,8 @@ class FieldSystem:
     discretisation, N, quadrature, constraints (method), joints and the model's other
     runtime choices; ``fixed``: the numeric values folded into the kernels.
 
-    ``params`` is a read-only array; ``fixed``, ``choices`` and ``layout`` are read-only
-    too, and no attribute can be assigned after construction: :meth:`with_params` and
+    ``params`` is a read-only array; ``kernels``, ``meta``, ``fixed``, ``choices`` and
+    ``layout`` are read-only too, and no attribute can be assigned after construction: :meth:`with_params` and
     :meth:`with_layout` give new systems. The memo (discretisation, reduction, assembler,
     point tables, penalty, mass factor) holds pure functions of the frozen state: every key
     names what its value depends on (the length, and the parameter vector where the value
@@ -87,8 +86,10 @@ class FieldSystem:
     def __post_init__(self, _cache) -> None:
         params = frozen_vector(self.params)
         object.__setattr__(self, "params", params)
-        object.__setattr__(self, "fixed", MappingProxyType(dict(self.fixed)))
-        object.__setattr__(self, "choices", MappingProxyType(dict(self.choices)))
+        object.__setattr__(self, "kernels", read_only(self.kernels))
+        object.__setattr__(self, "meta", read_only(self.meta))
+        object.__setattr__(self, "fixed", read_only(self.fixed))
+        object.__setattr__(self, "choices", read_only(self.choices))
         object.__setattr__(self, "folded", tuple(self.folded))
         object.__setattr__(self, "_memo", Memo(256))
         object.__setattr__(self, "_pkey", params.tobytes())
@@ -108,7 +109,7 @@ class FieldSystem:
         return new
 
     def with_params(self, **values) -> "FieldSystem":
-        """A new system with these values (this one is unchanged).
+        """A new system with these values (this one is unchanged; itself when no value changes).
 
         Free numeric parameters give a new parameter vector with the same kernels; runtime
         choices (discretisation, N, quadrature, constraints, joints and the model's other
@@ -150,9 +151,23 @@ class FieldSystem:
         return {**{n: float(v) for n, v in zip(self.meta.get("params", []), self.params)}, **self.choices}
 
     def _key(self, *depends) -> tuple:
-        """A memo key: the discretisation's (length, and the parameters for timoshenko2) plus ``depends``."""
+        """A memo key: what the discretisation depends on (the length; for timoshenko2 the shear ratios phi of its
+        shape functions, not the whole parameter vector, so that a new spin speed reuses it) plus ``depends``."""
         length = self.value(self.info["length"])
-        return (length, self._pkey if self.choices["discretisation"] == "timoshenko2" else None, *depends)
+        if self.choices["discretisation"] != "timoshenko2":
+            return (length, None, *depends)
+        return (length, self._shear(length)[1].tobytes(), *depends)
+
+    def _shear(self, length: float) -> tuple[list, np.ndarray]:
+        """timoshenko2's shear pairs and ratios at this length and these parameters (memoised)."""
+        def make():
+            try:
+                return self._shear_ratios(build_mesh(self.layout, int(self.choices["N"]), length))
+            except ValueError as exc:
+                raise InputError(str(exc), key="discretisation",
+                                 expected="a discretisation that fits the model's energies") from None
+
+        return self._memo.get(("shear", length, self._pkey), make)
 
     # -- discretisation -------------------------------------------------------
     @property
@@ -170,7 +185,7 @@ class FieldSystem:
     @property
     def disc(self) -> Discretisation:
         """The discretisation at the current length (one per length; for timoshenko2, whose shape
-        functions hold EI / kGA, one per parameter vector)."""
+        functions hold EI / kGA, one per set of shear ratios phi = 12 EI / (kGA h^2))."""
         return self._memo.get(("disc", *self._key()), self._discretise)
 
     def _discretise(self) -> Discretisation:
@@ -184,7 +199,7 @@ class FieldSystem:
                 mesh = None
             else:
                 mesh = build_mesh(self.layout, int(self.choices["N"]), length)
-            shear = self._shear_ratios(mesh) if kind == "timoshenko2" else None
+            shear = self._shear(length) if kind == "timoshenko2" else None
             return discretise(kind, int(self.choices["N"]), length, self.info["fields"], jets,
                               quadrature=int(self.choices["quadrature"]),
                               constraints=[tuple(c) for c in self.info["constraints"]], mesh=mesh,

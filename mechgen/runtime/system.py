@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 from collections import OrderedDict
 from dataclasses import dataclass, field, replace
+from types import MappingProxyType
 from typing import Callable
 
 import numpy as np
@@ -53,6 +54,11 @@ class Memo:
 
     def __len__(self) -> int:
         return len(self._store)
+
+
+def read_only(mapping) -> MappingProxyType:
+    """A read-only view of a mapping (a view stays the same view)."""
+    return mapping if isinstance(mapping, MappingProxyType) else MappingProxyType(dict(mapping))
 
 
 def frozen_vector(values) -> np.ndarray:
@@ -92,7 +98,8 @@ class System:
     """Kernels plus numbers: the object every analysis works on. Immutable.
 
     ``params`` (the free parameters' values, in ``meta['params']`` order) is a read-only
-    array and no attribute can be assigned after construction; :meth:`with_params` gives a
+    array, ``kernels`` and ``meta`` are read-only mappings, and no attribute can be assigned
+    after construction; :meth:`with_params` gives a
     new system. ``patterns`` is a memo, a pure function of the frozen kernels and ``sites``:
     the CSR patterns of sparse outputs and the prepared single-state kernel calls
     (:class:`BoundKernel`, whose arrays are scratch space); systems that differ only in
@@ -112,6 +119,8 @@ class System:
     is_field = False
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "kernels", read_only(self.kernels))
+        object.__setattr__(self, "meta", read_only(self.meta))
         object.__setattr__(self, "params", frozen_vector(self.params))
         object.__setattr__(self, "sites", int(self.sites))
         object.__setattr__(self, "folded", tuple(self.folded))
@@ -132,7 +141,7 @@ class System:
         return new
 
     def with_params(self, **values) -> "System":
-        """A new system with these parameter values (this one is unchanged).
+        """A new system with these parameter values (this one is unchanged; itself when no value changes).
 
         Free numeric parameters give a new parameter vector with the same kernels; a chain's
         number of sites (``meta['sites_param']``) a new size; a name folded into the kernels at
