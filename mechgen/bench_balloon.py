@@ -127,10 +127,9 @@ class Mechgen:
     def __init__(self, system):
         from mechgen.runtime.steady_bvp import solve_steady, steady_bvp
 
-        self.system = system
-        self.bvp = steady_bvp(system)
+        self.system = system.with_params(lambda0=START)  # the scene's start value
+        self.bvp = steady_bvp(self.system)
         self.index = self.bvp.params.index("lambda0")
-        system.params[self.index] = START
         self.start = solve_steady(self.bvp, method="collocation", modes={"x": [2.0]})  # the scene's start
         self._steps: dict = {}
 
@@ -177,14 +176,9 @@ class Mechgen:
         from mechgen.runtime.continuation import point_at
 
         res = branch.system.to_result(point_at(branch, lam), lam)
-        system = self.system if N == int(self.system.choices["N"]) else self.system.refined(N)
-        saved = np.array(system.params, float)
-        system.params[...] = res.p
-        try:
-            stability_at(system, self.bvp, res)                     # tables built: untimed
-            seconds, out = _timed(lambda: stability_at(system, self.bvp, res))
-        finally:
-            system.params[...] = saved
+        system = (self.system if N == int(self.system.choices["N"]) else self.system.refined(N)).with_param_vector(res.p)
+        stability_at(system, self.bvp, res)                     # tables built: untimed
+        seconds, out = _timed(lambda: stability_at(system, self.bvp, res))
         return float(out.frequencies[0]), seconds
 
 

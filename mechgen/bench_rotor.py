@@ -167,34 +167,19 @@ def rotor_system(N: int, discretisation: str = "timoshenko2", *, fresh: bool = F
     return system, info
 
 
-def _omega_index(system) -> int:
-    return system.meta["params"].index("Omega")
-
-
 def mechgen_modes(system, speed: float, count: int = COUNT) -> dict:
     """mechgen's ``modes`` analysis at spin speed ``speed``: its outputs (frequencies, log_dec, whirl)."""
     from mechgen.scene.analyses import RUNNERS
 
-    i = _omega_index(system)
-    saved = float(system.params[i])
-    system.params[i] = speed
-    try:
-        return RUNNERS["modes"](system, {"count": count}, {})
-    finally:
-        system.params[i] = saved
+    return RUNNERS["modes"](system.with_params(Omega=speed), {"count": count}, {})
 
 
 def mechgen_damped_solve(system, speed: float, count: int = COUNT) -> dict:
     """The ``modes`` analysis without its mode-shape sampling: linear() + run_damped_modes (the eigen-solve)."""
     from mechgen.scene.whirl import run_damped_modes
 
-    i = _omega_index(system)
-    saved = float(system.params[i])
-    system.params[i] = speed
-    try:
-        return run_damped_modes(system, system.linear(np.zeros(system.n)), {"count": count})
-    finally:
-        system.params[i] = saved
+    at_speed = system.with_params(Omega=speed)
+    return run_damped_modes(at_speed, at_speed.linear(np.zeros(system.n)), {"count": count})
 
 
 def mechgen_campbell(system, speeds, multiples=(), method: str = "auto") -> dict:

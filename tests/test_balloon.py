@@ -43,10 +43,7 @@ def _compiled(law: str, drag: float = 0.0):
 def balloon(law: str, lambda0: float, beta: float = 100.0, N: int = 10):
     base = _compiled(law)
     system = replace(base, params=base.params.copy(), choices={**base.choices, "N": N}, _cache={})
-    names = system.meta["params"]
-    system.params[names.index("lambda0")] = lambda0
-    system.params[names.index("beta")] = beta
-    return system
+    return system.with_params(lambda0=lambda0, beta=beta)
 
 
 def l0_of(lambda0: float) -> float:
@@ -111,7 +108,7 @@ def on_branch(lambda0: float, N: int = 10):
     bound = {"lam_max": lambda0} if lambda0 > LAMBDA0_MIN else {"lam_min": lambda0, "direction": -1}
     branch = continue_bvp(bvp.problem, start, index, mesh=100, ds=0.05, max_points=400, **bound)
     assert branch.lam[-1] == pytest.approx(lambda0, abs=1e-12)
-    system.params[system.meta["params"].index("lambda0")] = lambda0
+    system = system.with_params(lambda0=lambda0)
     return system, bvp, branch.system.to_result(branch.u[-1], branch.lam[-1])
 
 
@@ -164,8 +161,7 @@ def test_drag_makes_the_balloon_leave_its_plane():
     the spin), and the steady state still solves by each method."""
     base = _compiled("neo_hookean", drag=0.2)
     system = replace(base, params=base.params.copy(), _cache={})
-    system.params[system.meta["params"].index("lambda0")] = LAMBDA0_MIN
-    system.params[system.meta["params"].index("beta")] = 100.0
+    system = system.with_params(lambda0=LAMBDA0_MIN, beta=100.0)
     bvp = steady_bvp(system)
     res = solve_steady(bvp, method="collocation", modes={"x": [2.0]})
     y = bvp.values(res, np.linspace(0, bvp.length, 101))[1]

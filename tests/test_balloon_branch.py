@@ -26,8 +26,7 @@ def test_parameter_derivatives_of_the_steady_form_match_central_differences():
     model = models.get("balloon_string")
     spec = specialize(model, {"law": "neo_hookean", "h": H}, free=("lambda0", "beta", "L"))
     system = compile_model(model, spec, kernels={"bvp_residual", "bvp_tangent", "bvp_outputs"}, backend="c")[0]
-    for name, value in (("lambda0", -0.2), ("beta", 100.0), ("L", 1.3)):
-        system.params[system.meta["params"].index(name)] = value
+    system = system.with_params(lambda0=-0.2, beta=100.0, L=1.3)
     bvp = steady_bvp(system)
     assert bvp.length_index == bvp.params.index("L")
     prob, p = bvp.problem, bvp.start
@@ -71,7 +70,7 @@ def test_gauss_branch_minimum_eyelet_tension_and_stability_against_the_reference
     verdicts = stability_along(system, bvp, branch)
     assert len(verdicts) == len(branch.lam) and {v.verdict for v in verdicts} == {"stable"}
     res = branch.system.to_result(point_at(branch, -0.2), -0.2)
-    system.params[system.meta["params"].index("lambda0")] = -0.2
+    system = system.with_params(lambda0=-0.2)
     ours = stability_along(system, bvp, None, results=[res])[0]
     _, _, freqs = reference.stability(law, *tension_vector(bvp, res, -0.2), l0_of(-0.2), N=10)
     np.testing.assert_allclose(ours.frequencies[:20], freqs[:20], rtol=1e-9)

@@ -40,9 +40,7 @@ def frequencies(law: str, N: int, beta: float = 0.0, guess=None):
     base = _compiled(law)
     system = replace(base, params=base.params.copy(), choices={**base.choices, "N": N}, _cache={})
     names = system.meta["params"]
-    system.params[names.index("lambda0")] = LAMBDA0
-    if "beta" in names:
-        system.params[names.index("beta")] = beta
+    system = system.with_params(lambda0=LAMBDA0, **({"beta": beta} if "beta" in names else {}))
     bvp = hamiltonian_bvp(system)
     res = solve_steady(bvp, method="collocation", guess=guess, modes=None if guess else {"x": [2.0]})
     mats = linear_about_bvp(system, bvp, res)
@@ -97,9 +95,7 @@ def test_projected_strain_reaches_the_inextensible_limit_without_locking():
         base = _compiled("linear")
         system = replace(base, params=base.params.copy(), choices={**base.choices, "N": 10, "strain": "projected"},
                          _cache={})
-        names = system.meta["params"]
-        system.params[names.index("lambda0")] = LAMBDA0
-        system.params[names.index("beta")] = beta
+        system = system.with_params(lambda0=LAMBDA0, beta=beta)
         bvp = hamiltonian_bvp(system)
         res = solve_steady(bvp, method="collocation", guess=balloon)
         mats = linear_about_bvp(system, bvp, res)

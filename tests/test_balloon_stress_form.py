@@ -47,10 +47,7 @@ def _compiled(law: str):
 def string(law: str, lambda0: float, beta: float = 100.0):
     system = _compiled(law)
     names = system.meta["params"]
-    system.params[names.index("lambda0")] = lambda0
-    if "beta" in names:
-        system.params[names.index("beta")] = beta
-    return system
+    return system.with_params(lambda0=lambda0, **({"beta": beta} if "beta" in names else {}))
 
 
 def lambda0_of(l0: float) -> float:

@@ -31,12 +31,10 @@ def circulatory_model() -> Model:
 def test_circulatory_force_flutters_with_closed_form_eigenvalues(backend):
     model = circulatory_model()
     system, _ = compile_model(model, specialize(model, {}, free=("P",)), kernels={"linear"}, backend=backend)
-    system.params = np.array([0.5])
-    out = run_stability(system, {}, {})
+    out = run_stability(system.with_params(P=0.5), {}, {})
     assert out["verdict"] == "flutter"
     expected = np.concatenate([np.sqrt(complex(-4.0, s * 0.5)) * np.array([1, -1]) for s in (1, -1)])
     found = np.array([complex(re, im) for re, im in out["eigenvalues"]])
     for lam in expected:
         assert np.min(np.abs(found - lam)) < 1e-12
-    system.params = np.array([0.0])
-    assert run_stability(system, {}, {})["verdict"] == "stable"
+    assert run_stability(system.with_params(P=0.0), {}, {})["verdict"] == "stable"

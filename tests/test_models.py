@@ -30,8 +30,7 @@ def laval():
 
 @pytest.mark.parametrize("omega_spin", np.linspace(0.0, 3000.0, 13))
 def test_laval_whirl_frequencies_match_closed_form(laval, omega_spin):
-    laval.params = np.array([omega_spin])
-    out = run_stability(laval, {}, {})
+    out = run_stability(laval.with_params(Omega=omega_spin), {}, {})
     assert out["verdict"] == "stable"
     expected = laval_whirl(omega_spin, **LAVAL)
     found = np.sort(np.repeat(out["frequencies"], 1))
@@ -43,8 +42,7 @@ def test_laval_gyroscopic_splitting_is_ip_omega_over_id(laval):
     """w_f - w_b = Ip Omega / Id exactly (the gyroscopic moment Ip Omega)."""
     w_t = np.sqrt(LAVAL["k_t"] / LAVAL["m"])
     for omega_spin in (100.0, 1000.0, 5000.0):
-        laval.params = np.array([omega_spin])
-        tilt = [f for f in run_stability(laval, {}, {})["frequencies"] if abs(f - w_t) > 1e-6 * w_t]
+        tilt = [f for f in run_stability(laval.with_params(Omega=omega_spin), {}, {})["frequencies"] if abs(f - w_t) > 1e-6 * w_t]
         assert max(tilt) - min(tilt) == pytest.approx(LAVAL["Ip"] * omega_spin / LAVAL["Id"], rel=1e-10)
 
 

@@ -42,7 +42,7 @@ def layout_of(model: dict, split: int = 1) -> Layout:
 
 
 def modes_at(system, speed: float, count: int = 8):
-    system.params[system.meta["params"].index("Omega")] = speed
+    system = system.with_params(Omega=speed)
     mats = system.linear(np.zeros(system.n))
     return damped_modes(mats["M"], mats["D"] + mats["G"], mats["K"], count)
 

@@ -5,8 +5,8 @@ For each point (u, lam) of a :class:`~mechgen.runtime.continuation.Branch` of a 
 :class:`~mechgen.runtime.steady_bvp.SteadyBVP`), the steady state's jets at the
 discretisation's quadrature points give the linearised M, D, G, K
 (FieldSystem.linear(jets=...)), and :func:`mechgen.runtime.stability.stability` the
-eigenvalues of M q'' + (D + G) q' + K q = 0 and the verdict. The system's parameters are
-set to each point's and restored afterwards.
+eigenvalues of M q'' + (D + G) q' + K q = 0 and the verdict, each with a system at that
+point's parameters (System.with_param_vector: the given system is never changed).
 """
 from __future__ import annotations
 
@@ -21,9 +21,9 @@ def _dense(A) -> np.ndarray:
 
 
 def stability_at(system, bvp, result) -> StabilityResult:
-    """Eigenvalues and verdict about one steady state ``result`` (a BVPResult of ``bvp``); the system's
-    parameters must already be the result's."""
-    mats = linear_about_bvp(system, bvp, result)
+    """Eigenvalues and verdict about one steady state ``result`` (a BVPResult of ``bvp``), with the result's
+    parameters (a system at them, when ``system``'s differ)."""
+    mats = linear_about_bvp(system.with_param_vector(result.p), bvp, result)
     return stability(_dense(mats["M"]), _dense(mats["D"]) + _dense(mats["G"]), _dense(mats["K"]))
 
 
@@ -31,12 +31,4 @@ def stability_along(system, bvp, branch, results=None) -> list[StabilityResult]:
     """The stability verdict at every point of ``branch`` (or of ``results``, BVPResults of its points)."""
     if results is None:
         results = [branch.system.to_result(u, lam) for u, lam in zip(branch.u, branch.lam)]
-    saved = np.array(system.params, float)
-    out = []
-    try:
-        for res in results:
-            system.params[...] = res.p
-            out.append(stability_at(system, bvp, res))
-    finally:
-        system.params[...] = saved
-    return out
+    return [stability_at(system, bvp, res) for res in results]

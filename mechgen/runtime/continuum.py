@@ -15,10 +15,14 @@ vector q, or given directly as data (``jets=``, shape (elements, points, jets)).
 The interface matches :class:`~mechgen.runtime.system.System` (``n``, ``m``,
 ``linear``, ``residual``, ``tangent``, ``outputs``, ``rhs``, ``jacobian``), so
 every analysis runs on it; :meth:`refined` gives the same model at another size.
+
+A FieldSystem is immutable like a System: :meth:`FieldSystem.with_params` and
+:meth:`FieldSystem.with_layout` give new ones.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import InitVar, dataclass, field, replace
+from typing import Callable
 
 import numpy as np
 import scipy.linalg as sla
@@ -28,19 +32,38 @@ import scipy.sparse.linalg as spla
 from mechgen.errors import InputError, KernelError
 from mechgen.runtime.assemble import Assembler, element_matrices, element_vectors, jets_at_points
 from mechgen.runtime.constrain import PENALTY_FACTOR, Reduction, binding, reduction
-from mechgen.runtime.discretise import GLOBAL, Discretisation, discretise
+from mechgen.runtime.discretise import DISCRETISATIONS, GLOBAL, Discretisation, discretise
 from mechgen.runtime.elements import reference
 from mechgen.runtime.kernels import Kernel
 from mechgen.runtime.mesh import Layout, build_mesh
+from mechgen.runtime.system import Memo, folded_parameter, frozen_vector, number, read_only, unknown_parameters
 
 
-@dataclass
+#: the values a continuum's runtime choices take (others, such as a model's own runtime choices, are strings)
+CHOICE_VALUES = {"discretisation": DISCRETISATIONS, "constraints": ("eliminate", "penalty", "multiplier"),
+                 "joints": ("assembly", "multiplier")}
+#: runtime choices that are sizes (integers >= 1)
+SIZE_CHOICES = ("N", "quadrature")
+
+
+@dataclass(frozen=True, eq=False)
 class FieldSystem:
-    """Kernels of a continuum's local piece, parameter values and the discretisation choices.
+    """Kernels of a continuum's local piece, parameter values and the discretisation choices. Immutable.
 
     ``info`` (from the kernel meta): fields, jets [[field, order]], length
     parameter, constraints [[field, order, 'start'|'end']]. ``choices``:
-    discretisation, N, quadrature, constraints (method).
+    discretisation, N, quadrature, constraints (method), joints and the model's other
+    runtime choices; ``fixed``: the numeric values folded into the kernels.
+
+    ``params`` is a read-only array; ``kernels``, ``meta``, ``fixed``, ``choices`` and
+    ``layout`` are read-only too, and no attribute can be assigned after construction: :meth:`with_params` and
+    :meth:`with_layout` give new systems. The memo (discretisation, reduction, assembler,
+    point tables, penalty, mass factor) holds pure functions of the frozen state: every key
+    names what its value depends on (the length, and the parameter vector where the value
+    depends on it), so that systems differing only in parameter values share it. ``_cache``
+    is accepted for compatibility and ignored: a system built by ``dataclasses.replace``
+    starts with its own memo. ``rebuild(system, values)``, given by the compile layer,
+    recompiles for names folded into the kernels (``fixed`` and ``folded``).
     """
 
     kernels: dict[str, Kernel]
@@ -50,11 +73,101 @@ class FieldSystem:
     choices: dict
     backend: str = "numpy"
     layout: Layout | None = None
-    _cache: dict = field(default_factory=dict, repr=False)
+    _cache: InitVar[dict | None] = None
+    rebuild: Callable | None = field(default=None, repr=False)
+    folded: tuple[str, ...] = ()
+    _memo: Memo = field(init=False, repr=False)
+    _pkey: bytes = field(init=False, repr=False)
 
     is_lattice = False
     is_field = True
     m = 0
+
+    def __post_init__(self, _cache) -> None:
+        params = frozen_vector(self.params)
+        object.__setattr__(self, "params", params)
+        object.__setattr__(self, "kernels", read_only(self.kernels))
+        object.__setattr__(self, "meta", read_only(self.meta))
+        object.__setattr__(self, "fixed", read_only(self.fixed))
+        object.__setattr__(self, "choices", read_only(self.choices))
+        object.__setattr__(self, "folded", tuple(self.folded))
+        object.__setattr__(self, "_memo", Memo(256))
+        object.__setattr__(self, "_pkey", params.tobytes())
+
+    # -- new systems ----------------------------------------------------------
+    def with_param_vector(self, params) -> "FieldSystem":
+        """The same kernels, choices and layout with another vector of free parameter values (the memo shared)."""
+        params = frozen_vector(params)
+        if params.shape != self.params.shape:
+            raise InputError(f"{len(params)} parameter values for the {len(self.params)} free parameters of "
+                             f"{self.meta.get('model')}", key="params",
+                             expected=f"values of {', '.join(self.meta.get('params', [])) or 'none'}")
+        if np.array_equal(params, self.params):
+            return self
+        new = replace(self, params=params)
+        object.__setattr__(new, "_memo", self._memo)
+        return new
+
+    def with_params(self, **values) -> "FieldSystem":
+        """A new system with these values (this one is unchanged; itself when no value changes).
+
+        Free numeric parameters give a new parameter vector with the same kernels; runtime
+        choices (discretisation, N, quadrature, constraints, joints and the model's other
+        ``Param(runtime=True)`` names) a system with those choices; a name folded into the
+        kernels at compile time (``fixed``, ``folded``) a recompiled system through
+        ``rebuild`` (InputError without one); any other name an InputError listing the known ones.
+        """
+        names = list(self.meta.get("params", []))
+        folded = [*self.fixed, *(k for k in self.folded if k not in self.fixed)]
+        unknown = [k for k in values if k not in names and k not in self.choices and k not in folded]
+        if unknown:
+            raise unknown_parameters(self.meta.get("model"), unknown, names + list(self.choices) + folded)
+        hit = [k for k in values if k in folded and k not in names and k not in self.choices]
+        if hit:
+            if self.rebuild is None:
+                raise folded_parameter(self.meta.get("model"), hit[0])
+            return self.rebuild(self, dict(values))
+        choices = {k: _choice(k, v) for k, v in values.items() if k in self.choices and k not in names}
+        out = self
+        if any(choices[k] != self.choices[k] for k in choices):
+            out = replace(self, choices={**self.choices, **choices})
+        params = np.array(self.params)
+        for name, value in values.items():
+            if name in names:
+                params[names.index(name)] = number(name, value)
+        return out.with_param_vector(params)
+
+    def with_layout(self, layout: Layout | None) -> "FieldSystem":
+        """The same kernels, parameters and choices with segments and parts ``layout`` (a new memo)."""
+        if layout is not None and not isinstance(layout, Layout):
+            raise InputError(f"layout is {type(layout).__name__}", key="layout",
+                             expected="a mechgen.runtime.mesh.Layout of segments and parts")
+        if layout == self.layout:
+            return self
+        return replace(self, layout=layout)
+
+    def param_values(self) -> dict:
+        """The free parameters' current values and the runtime choices, by name."""
+        return {**{n: float(v) for n, v in zip(self.meta.get("params", []), self.params)}, **self.choices}
+
+    def _key(self, *depends) -> tuple:
+        """A memo key: what the discretisation depends on (the length; for timoshenko2 the shear ratios phi of its
+        shape functions, not the whole parameter vector, so that a new spin speed reuses it) plus ``depends``."""
+        length = self.value(self.info["length"])
+        if self.choices["discretisation"] != "timoshenko2":
+            return (length, None, *depends)
+        return (length, self._shear(length)[1].tobytes(), *depends)
+
+    def _shear(self, length: float) -> tuple[list, np.ndarray]:
+        """timoshenko2's shear pairs and ratios at this length and these parameters (memoised)."""
+        def make():
+            try:
+                return self._shear_ratios(build_mesh(self.layout, int(self.choices["N"]), length))
+            except ValueError as exc:
+                raise InputError(str(exc), key="discretisation",
+                                 expected="a discretisation that fits the model's energies") from None
+
+        return self._memo.get(("shear", length, self._pkey), make)
 
     # -- discretisation -------------------------------------------------------
     @property
@@ -71,47 +184,51 @@ class FieldSystem:
 
     @property
     def disc(self) -> Discretisation:
-        """The discretisation at the current length (built once per length; for timoshenko2, whose shape
-        functions hold EI / kGA, once per parameter vector)."""
+        """The discretisation at the current length (one per length; for timoshenko2, whose shape
+        functions hold EI / kGA, one per set of shear ratios phi = 12 EI / (kGA h^2))."""
+        return self._memo.get(("disc", *self._key()), self._discretise)
+
+    def _discretise(self) -> Discretisation:
         length = self.value(self.info["length"])
-        key = ("disc", length, np.asarray(self.params, float).tobytes()
-               if self.choices["discretisation"] == "timoshenko2" else None)
-        if key not in self._cache:
-            self._cache.clear()
-            jets = tuple((f, int(k)) for f, k in self.info["jets"])
-            kind = self.choices["discretisation"]
-            try:
-                if kind in GLOBAL:
-                    if self.layout is not None and self.layout.segments:
-                        raise ValueError(f"segments need finite elements; {kind} is a global basis")
-                    mesh = None
-                else:
-                    mesh = build_mesh(self.layout, int(self.choices["N"]), length)
-                shear = self._shear_ratios(mesh) if kind == "timoshenko2" else None
-                self._cache[key] = discretise(kind, int(self.choices["N"]), length, self.info["fields"], jets,
-                                              quadrature=int(self.choices["quadrature"]),
-                                              constraints=[tuple(c) for c in self.info["constraints"]], mesh=mesh,
-                                              shear=shear, joints=self.choices.get("joints", "assembly"))
-            except ValueError as exc:
-                raise InputError(str(exc), key="discretisation",
-                                 expected="a discretisation that fits the model's energies") from None
-        return self._cache[key]
+        jets = tuple((f, int(k)) for f, k in self.info["jets"])
+        kind = self.choices["discretisation"]
+        try:
+            if kind in GLOBAL:
+                if self.layout is not None and self.layout.segments:
+                    raise ValueError(f"segments need finite elements; {kind} is a global basis")
+                mesh = None
+            else:
+                mesh = build_mesh(self.layout, int(self.choices["N"]), length)
+            shear = self._shear(length) if kind == "timoshenko2" else None
+            return discretise(kind, int(self.choices["N"]), length, self.info["fields"], jets,
+                              quadrature=int(self.choices["quadrature"]),
+                              constraints=[tuple(c) for c in self.info["constraints"]], mesh=mesh,
+                              shear=shear, joints=self.choices.get("joints", "assembly"))
+        except ValueError as exc:
+            raise InputError(str(exc), key="discretisation",
+                             expected="a discretisation that fits the model's energies") from None
+
+    def _reduction_key(self) -> tuple:
+        """The reduction depends on the discretisation, and on the parameters through multiplier joints."""
+        joints = self.choices.get("joints", "assembly") == "multiplier"
+        return self._key(self._pkey if joints else None)
 
     @property
     def reduction(self) -> Reduction:
         """x = Z q for the essential boundary conditions."""
+        return self._memo.get(("red", *self._reduction_key()), self._reduce)
+
+    def _reduce(self) -> Reduction:
         disc = self.disc
-        if "red" not in self._cache:
-            _, rows, scales = self._constraint_rows()
-            joints = self._joint_rows()
-            red = reduction(np.array(rows), np.array(scales), disc.ndof, self.choices["constraints"],
-                            sparse=not disc.is_global and not joints, joints=np.array(joints) if joints else None)
-            if red.penalty_rows is not None and disc.is_global:
-                raise InputError(f"penalty constraints with the global {disc.kind} basis couple every function "
-                                 "to the penalty and wreck the conditioning", key="constraints",
-                                 expected="'eliminate' for global bases (penalty with finite elements)")
-            self._cache["red"] = red
-        return self._cache["red"]
+        _, rows, scales = self._constraint_rows()
+        joints = self._joint_rows()
+        red = reduction(np.array(rows), np.array(scales), disc.ndof, self.choices["constraints"],
+                        sparse=not disc.is_global and not joints, joints=np.array(joints) if joints else None)
+        if red.penalty_rows is not None and disc.is_global:
+            raise InputError(f"penalty constraints with the global {disc.kind} basis couple every function "
+                             "to the penalty and wreck the conditioning", key="constraints",
+                             expected="'eliminate' for global bases (penalty with finite elements)")
+        return red
 
     def _constraint_rows(self) -> tuple[list, list, list]:
         """(field, order, end), dense row C_i and the jet's table magnitude of every essential condition."""
@@ -169,9 +286,7 @@ class FieldSystem:
     def assembler(self) -> Assembler:
         """Scatter into global dofs."""
         disc = self.disc
-        if "asm" not in self._cache:
-            self._cache["asm"] = Assembler(disc.dofs, disc.ndof, dense=disc.is_global)
-        return self._cache["asm"]
+        return self._memo.get(("asm", *self._key()), lambda: Assembler(disc.dofs, disc.ndof, dense=disc.is_global))
 
     @property
     def n(self) -> int:
@@ -190,7 +305,7 @@ class FieldSystem:
             factor = size / int(self.choices["N"])
             layout = replace(layout, segments=tuple(replace(seg, elements=max(1, round(seg.elements * factor)))
                                                     for seg in layout.segments))
-        return replace(self, choices={**self.choices, "N": int(size)}, layout=layout, _cache={})
+        return replace(self, choices={**self.choices, "N": int(size)}, layout=layout)
 
     # -- steady boundary value problem --------------------------------------------
     def steady_form(self):
@@ -206,7 +321,7 @@ class FieldSystem:
         if "residual" not in kernels:
             raise InputError(f"the kernels of {self.meta.get('model')} were built without the steady form",
                              key="kernels", expected="bvp_residual, bvp_tangent and bvp_outputs (a steady bvp analysis)")
-        return System(kernels, dict(kernels["residual"].spec["meta"]), np.array(self.params, float), 0, self.backend)
+        return System(kernels, dict(kernels["residual"].spec["meta"]), self.params, 0, self.backend)
 
     # -- segments and parts -----------------------------------------------------
     def _with(self, values: dict, prefix: str = "", what: str = "segment") -> np.ndarray:
@@ -307,11 +422,9 @@ class FieldSystem:
 
     def _point_table(self, x: float):
         """B_x (jets x dofs, CSR): the jets at s = x from the full dof vector."""
-        key = ("point", float(x))
-        if key not in self._cache:
-            disc = self.disc
-            self._cache[key] = sps.csr_matrix(np.array([disc.row(f, k, x) for f, k in disc.jets]))
-        return self._cache[key]
+        disc = self.disc
+        return self._memo.get(("point", *self._key(float(x))),
+                              lambda: sps.csr_matrix(np.array([disc.row(f, k, x) for f, k in disc.jets])))
 
     def _ends(self, kernel: str, states, t: float):
         """(B_x, local outputs) of every end term and placed part: states are full dof vectors (q, q', q'') or None."""
@@ -468,12 +581,13 @@ class FieldSystem:
         """alpha = PENALTY_FACTOR * max|diag K| of the unconstrained zero-state K (0 without penalty rows)."""
         if self.reduction.penalty_rows is None:
             return 0.0
-        if "alpha" not in self._cache:
+        def alpha() -> float:
             local = self._pointwise("linear", self._jets(None))
             ke = element_matrices(self.disc.tables, self.disc.weights, self._coeff(local["K"]))
             K = self.assembler.matrix(ke)
-            self._cache["alpha"] = PENALTY_FACTOR * max(float(np.abs(K.diagonal()).max()), 1e-300)
-        return self._cache["alpha"]
+            return PENALTY_FACTOR * max(float(np.abs(K.diagonal()).max()), 1e-300)
+
+        return self._memo.get(("alpha", *self._reduction_key(), self._pkey), alpha)
 
     def outputs(self, q, v=None, z=None, t: float = 0.0) -> dict[str, float]:
         """Energies: integrals of the kinetic and potential densities plus the end terms."""
@@ -502,11 +616,12 @@ class FieldSystem:
             raise InputError("time integration with Lagrange multipliers is a DAE (singular mass)",
                              key="constraints", expected="'eliminate' or 'penalty' for simulate")
         if self.info.get("constant_mass"):
-            if "mass" not in self._cache:
+            def factor():
                 M = self.tangent(np.zeros(self.n), t=t)["r_a"]
-                self._cache["mass"] = (spla.splu(sps.csc_matrix(M)).solve if sps.issparse(M)
-                                       else (lambda b, f=sla.cho_factor(M): sla.cho_solve(f, b)))
-            return self._cache["mass"](rhs)
+                return (spla.splu(sps.csc_matrix(M)).solve if sps.issparse(M)
+                        else (lambda b, f=sla.cho_factor(M): sla.cho_solve(f, b)))
+
+            return self._memo.get(("mass", *self._reduction_key(), self._pkey), factor)(rhs)
         M = self.tangent(q, v, t=t)["r_a"]
         return spla.spsolve(sps.csc_matrix(M), rhs) if sps.issparse(M) else sla.solve(M, rhs)
 
@@ -528,3 +643,16 @@ class FieldSystem:
         da = -self._mass_solve(q, v, t, np.hstack([dense(tan["r_q"]), dense(tan["r_v"])]))
         n = self.n
         return np.block([[np.zeros((n, n)), np.eye(n)], [da]])
+
+
+def _choice(name: str, value):
+    """A runtime choice's new value, validated where the runtime knows its values."""
+    if name in SIZE_CHOICES:
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or int(value) < 1:
+            raise InputError(f"{name} = {value!r} is not a size", key=name, expected="an integer >= 1")
+        return int(value)
+    allowed = CHOICE_VALUES.get(name)
+    if allowed is not None and value not in allowed:
+        raise InputError(f"{name} = {value!r} is not a choice the runtime knows", key=name,
+                         expected="one of: " + ", ".join(allowed))
+    return value

@@ -163,15 +163,18 @@ def steady_bvp(field_system) -> SteadyBVP:
             return impl.accelerations(s_pts, y, p), None
         return impl.jacobian(s_pts, y, p)
 
-    def use(p) -> None:
-        """Point the single-state kernels (shooting's hot path) at the parameters p."""
-        if not np.array_equal(st.params, p):
-            st.params[...] = p
+    at_params = [st]  # the steady form at the parameters of the last single-state call
+
+    def use(p):
+        """The steady form with the parameters p for the single-state kernels (shooting's hot path): the last
+        one again when p has not changed, else a new system sharing its kernels and prepared calls."""
+        if not np.array_equal(at_params[0].params, p):
+            at_params[0] = at_params[0].with_param_vector(p)
+        return at_params[0]
 
     def F(s_pts, y, p):
         if y.shape[1] == 1:  # one state (shooting): the prepared single-state kernels
-            use(p)
-            return st.rhs(float(np.ravel(s_pts)[0]), y[:, 0])[:, None]
+            return use(p).rhs(float(np.ravel(s_pts)[0]), y[:, 0])[:, None]
         acc, _ = accelerations(s_pts, y, p, False)
         return np.vstack([y[n:], acc.T])
 
@@ -182,8 +185,7 @@ def steady_bvp(field_system) -> SteadyBVP:
     def f_y(sigma, y, p):
         L = L_of(p)
         if y.shape[1] == 1:
-            use(p)
-            return L * st.jacobian(L * float(np.ravel(sigma)[0]), y[:, 0])[:, :, None]
+            return L * use(p).jacobian(L * float(np.ravel(sigma)[0]), y[:, 0])[:, :, None]
         _, jac = accelerations(L * np.asarray(sigma), y, p, True)
         J = np.zeros((2 * n, 2 * n, y.shape[1]))
         J[:n, n:] = np.eye(n)[:, :, None]

@@ -8,33 +8,182 @@ variables z (m), time t. Equations (see mechgen.symbolic.derive):
 First-order form x = (q, v, z): dq/dt = v, dv/dt = a = -M^-1 r(q, v, 0, z, t), dz/dt = g,
 with the exact Jacobian da/dx = -M^-1 dr/dx evaluated at the current a.
 Chain models have the same interface with sparse (CSR) matrices.
+
+Compiled systems are immutable (DESIGN.md): parameters, sizes and choices are fixed at
+construction, and a new value gives a new system (:meth:`System.with_params`).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import math
+from collections import OrderedDict
+from dataclasses import dataclass, field, replace
+from types import MappingProxyType
+from typing import Callable
 
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
-from mechgen.errors import KernelError
+from mechgen.errors import InputError, KernelError
 from mechgen.runtime.kernels import Kernel
 from mechgen.runtime.pattern import Pattern, build_pattern, extent
 
 
-@dataclass
+class Memo:
+    """A bounded memo of values that are pure functions of their key (and of the frozen structure of the
+    systems that share it): ``get(key, make)`` returns the value stored under ``key``, else ``make()``
+    stored there. The oldest entries are dropped beyond ``size``; an entry is never replaced by another
+    value, so dropping one only costs its recomputation."""
+
+    def __init__(self, size: int = 64) -> None:
+        self.size = size
+        self._store: OrderedDict = OrderedDict()
+
+    def get(self, key, make: Callable[[], object]):
+        """The value under ``key`` (made once by ``make``)."""
+        try:
+            value = self._store[key]
+        except KeyError:
+            value = self._store[key] = make()
+            if len(self._store) > self.size:
+                self._store.popitem(last=False)
+            return value
+        self._store.move_to_end(key)
+        return value
+
+    def __len__(self) -> int:
+        return len(self._store)
+
+
+def read_only(mapping) -> MappingProxyType:
+    """A read-only view of a mapping (a view stays the same view)."""
+    return mapping if isinstance(mapping, MappingProxyType) else MappingProxyType(dict(mapping))
+
+
+def frozen_vector(values) -> np.ndarray:
+    """A read-only float copy of a parameter vector (1-D)."""
+    out = np.array(values, dtype=float).reshape(-1)
+    out.flags.writeable = False
+    return out
+
+
+def number(name: str, value) -> float:
+    """A finite real parameter value, else InputError naming the parameter."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise InputError(f"parameter {name!r} = {value!r} is not a number", key=name, expected="a finite real number")
+    out = float(value)
+    if not math.isfinite(out):
+        raise InputError(f"parameter {name!r} = {value!r} is not finite", key=name, expected="a finite real number")
+    return out
+
+
+def unknown_parameters(model, unknown: list, known) -> InputError:
+    """The error for names that are no parameter of the compiled system."""
+    return InputError(f"unknown parameter{'s' if len(unknown) > 1 else ''} {', '.join(map(repr, unknown))} "
+                      f"for model {model}", key=unknown[0],
+                      expected="one of: " + (", ".join(sorted(known)) or "none"))
+
+
+def folded_parameter(model, name: str) -> InputError:
+    """The error for a name folded into the kernels at compile time when no rebuild is wired."""
+    return InputError(f"parameter {name!r} of model {model} was folded into the compiled kernels (a fixed value "
+                      "or a structural choice), and this system was built without a way to recompile",
+                      key=name, expected="a parameter kept free at compile time (mechgen.compile(..., free=[...])), "
+                      "or a system from mechgen.compile, which recompiles for it")
+
+
+@dataclass(frozen=True, eq=False)
 class System:
-    """Kernels plus numbers: the object every analysis works on."""
+    """Kernels plus numbers: the object every analysis works on. Immutable.
+
+    ``params`` (the free parameters' values, in ``meta['params']`` order) is a read-only
+    array, ``kernels`` and ``meta`` are read-only mappings, and no attribute can be assigned
+    after construction; :meth:`with_params` gives a
+    new system. ``patterns`` is a memo, a pure function of the frozen kernels and ``sites``:
+    the CSR patterns of sparse outputs and the prepared single-state kernel calls
+    (:class:`BoundKernel`, whose arrays are scratch space); systems that differ only in
+    their parameter values share it. ``rebuild(system, values)``, given by the compile
+    layer, recompiles for names folded into the kernels (``folded``).
+    """
 
     kernels: dict[str, Kernel]
     meta: dict
     params: np.ndarray
     sites: int = 0
     backend: str = "numpy"
-    patterns: dict = field(default_factory=dict)
+    rebuild: Callable | None = field(default=None, repr=False)
+    folded: tuple[str, ...] = ()
+    patterns: dict = field(init=False, repr=False)
 
     is_field = False
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "kernels", read_only(self.kernels))
+        object.__setattr__(self, "meta", read_only(self.meta))
+        object.__setattr__(self, "params", frozen_vector(self.params))
+        object.__setattr__(self, "sites", int(self.sites))
+        object.__setattr__(self, "folded", tuple(self.folded))
+        object.__setattr__(self, "patterns", {})
+
+    # -- new systems ----------------------------------------------------------
+    def with_param_vector(self, params) -> "System":
+        """The same kernels with another vector of free parameter values (``meta['params']`` order)."""
+        params = frozen_vector(params)
+        if params.shape != self.params.shape:
+            raise InputError(f"{len(params)} parameter values for the {len(self.params)} free parameters of "
+                             f"{self.meta.get('model')}", key="params",
+                             expected=f"values of {', '.join(self.meta.get('params', [])) or 'none'}")
+        if np.array_equal(params, self.params):
+            return self
+        new = replace(self, params=params)
+        object.__setattr__(new, "patterns", self.patterns)  # same kernels and sites: the same memo
+        return new
+
+    def with_params(self, **values) -> "System":
+        """A new system with these parameter values (this one is unchanged; itself when no value changes).
+
+        Free numeric parameters give a new parameter vector with the same kernels; a chain's
+        number of sites (``meta['sites_param']``) a new size; a name folded into the kernels at
+        compile time a recompiled system through ``rebuild`` (InputError without one); any other
+        name an InputError listing the known ones.
+        """
+        names = list(self.meta.get("params", []))
+        sites_param = self.meta.get("sites_param") if self.is_lattice else None
+        unknown = [k for k in values if k not in names and k != sites_param and k not in self.folded]
+        if unknown:
+            raise unknown_parameters(self.meta.get("model"), unknown,
+                                     names + list(self.folded) + ([sites_param] if sites_param else []))
+        folded = [k for k in values if k in self.folded]
+        if folded:
+            if self.rebuild is None:
+                raise folded_parameter(self.meta.get("model"), folded[0])
+            return self.rebuild(self, dict(values))
+        params = np.array(self.params)
+        for name, value in values.items():
+            if name in names:
+                params[names.index(name)] = number(name, value)
+        out = self.with_param_vector(params)
+        if sites_param in values:
+            sites = values[sites_param]
+            if isinstance(sites, bool) or not isinstance(sites, (int, np.integer)) or int(sites) < 1:
+                raise InputError(f"parameter {sites_param!r} = {sites!r} is not a number of sites", key=sites_param,
+                                 expected="an integer >= 1")
+            if int(sites) != out.sites:
+                out = replace(out, sites=int(sites))  # a fresh memo: patterns depend on the size
+        return out
+
+    def with_layout(self, layout) -> "System":
+        """Segments and parts belong to continua; a lumped or chain system has none."""
+        raise InputError(f"model {self.meta.get('model')} is not a continuum", key="segments",
+                         expected="segments and parts only for continua")
+
+    def param_values(self) -> dict:
+        """The current values of the free parameters (and a chain's number of sites) by name."""
+        out = {n: float(v) for n, v in zip(self.meta.get("params", []), self.params)}
+        if self.is_lattice and self.meta.get("sites_param"):
+            out[self.meta["sites_param"]] = self.sites
+        return out
 
     # -- shape --------------------------------------------------------------
     @property
@@ -76,11 +225,14 @@ class System:
 
     # -- evaluation -----------------------------------------------------------
     def bound(self, kernel: str) -> "BoundKernel":
-        """A prepared single-state evaluator of ``kernel`` (inputs and outputs allocated once)."""
+        """A prepared single-state evaluator of ``kernel`` (inputs and outputs allocated once, shared with the
+        systems of other parameter values: it is pointed at this system's parameters on every call)."""
         key = ("bound", kernel)
         if key not in self.patterns:
             self.patterns[key] = BoundKernel(self, kernel)
-        return self.patterns[key]
+        bound = self.patterns[key]
+        bound.use(self.params)
+        return bound
 
     def call(self, kernel: str, **state) -> dict:
         """Evaluate ``kernel`` at a state (missing state entries are zero)."""
@@ -208,7 +360,9 @@ class BoundKernel:
 
     ``evaluate(q=..., v=...)`` copies the given state into the kernel's input
     arrays (absent entries are zero), calls the kernel and returns its output
-    arrays (views that the next call overwrites; copy to keep them).
+    arrays (views that the next call overwrites; copy to keep them). The
+    parameter input is a private copy of the (read-only) parameter vector last
+    given to :meth:`use`.
     """
 
     def __init__(self, system: System, kernel: str) -> None:
@@ -218,19 +372,24 @@ class BoundKernel:
         for port in k.spec["inputs"]:
             name = port["name"]
             if name == "p":
-                self.inputs[name] = np.ascontiguousarray(system.params, dtype=float)
+                self.inputs[name] = np.array(system.params, dtype=float)
             elif port["integer"]:
                 self.inputs[name] = system.pattern(kernel).slots[name]
             else:
                 self.inputs[name] = np.zeros(extent(port["extent"], sizes))
         self.outputs = {p["name"]: np.zeros(extent(p["extent"], sizes)) for p in k.spec["outputs"]}
-        self._system = system
+        self._params = system.params
         self._call = k.bind(self.inputs, self.outputs, sizes)
+
+    def use(self, params: np.ndarray) -> None:
+        """Evaluate with the parameter vector ``params`` from now on (a copy when it is another array)."""
+        if params is not self._params:
+            if "p" in self.inputs:
+                self.inputs["p"][...] = params
+            self._params = params
 
     def evaluate(self, **state) -> dict[str, np.ndarray]:
         """Outputs at ``state`` (q, v, a, z as arrays, t as a number)."""
-        if self.inputs.get("p") is not None and self.inputs["p"] is not self._system.params:
-            self.inputs["p"][...] = self._system.params
         for name, arr in self.inputs.items():
             if name in ("p",) or name.startswith("slots"):
                 continue

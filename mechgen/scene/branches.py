@@ -57,7 +57,6 @@ consecutive points, located by bisection along the branch to 1e-9 of the segment
 """
 from __future__ import annotations
 
-from dataclasses import replace
 
 import numpy as np
 
@@ -151,15 +150,13 @@ def _shapes(system, bvp, result) -> dict:
 
 
 def _with_params(system, values: dict):
-    """A copy of the system with some free parameters set (``steady``'s ``params``)."""
+    """A new system with some free parameters set (``steady``'s ``params``; the given one is unchanged)."""
     names = list(system.meta.get("params", []))
-    params = np.array(system.params, float)
-    for name, value in values.items():
+    for name in values:
         if name not in names:
             raise SceneError(f"parameter {name!r} is not free in the compiled kernels", key=f"params.{name}",
                              expected="a parameter the scene leaves free: " + ", ".join(names))
-        params[names.index(name)] = float(value)
-    return replace(system, params=params, _cache={})
+    return system.with_params(**{name: float(value) for name, value in values.items()})
 
 
 def _start_with_shape(system, bvp, options: dict, method: str):
@@ -378,11 +375,7 @@ def run_continuation(system, options: dict, context: dict) -> dict:
     about = options["about"]
     starts = about if isinstance(about, list) else [about]
     name, aliases = options["parameter"], options.get("aliases", {})
-    saved = np.array(system.params, float)
-    try:
-        branches = [_one_branch(system, context[s], options, s if isinstance(about, list) else None) for s in starts]
-    finally:
-        system.params[...] = saved
+    branches = [_one_branch(system, context[s], options, s if isinstance(about, list) else None) for s in starts]
     out = {"parameter": name, "shape_outputs": [d.name for d in _shape_declarations(system)],
            "branch": [p for b in branches for p in b["points"]],
            "status": branches[0]["status"] if len(branches) == 1 else

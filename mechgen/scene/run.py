@@ -7,12 +7,9 @@ starts with "_" are working data and never reach JSON.
 from __future__ import annotations
 
 import time
-from dataclasses import replace
 from functools import lru_cache
 from pathlib import Path
 from typing import Mapping
-
-import numpy as np
 
 from mechgen import models
 from mechgen.pipeline import compile_model
@@ -44,7 +41,7 @@ def _laid_out(system, layout: Layout | None):
     """The system with the scene's segments and parts (a copy; the cached system stays bare)."""
     if layout is None or not (layout.segments or layout.parts):
         return system
-    return replace(system, layout=layout, _cache={})
+    return system.with_layout(layout)
 
 
 def _sweep_point(task: tuple) -> dict:
@@ -56,9 +53,8 @@ def _sweep_point(task: tuple) -> dict:
     if sizes:
         system, _ = _system_for(model, tuple(sorted({**dict(values), **sizes}.items())), free, active,
                                 kernels, backend)
-    system = _laid_out(system, layout)
-    system.params = np.array([float(point.get(n, dict(values).get(n, model.param(n).default)))
-                              for n in system.meta.get("params", [])])
+    system = _laid_out(system, layout).with_param_vector(
+        [float(point.get(n, dict(values).get(n, model.param(n).default))) for n in system.meta.get("params", [])])
     return _public(RUNNERS[kind](system, options, {}))
 
 

@@ -106,13 +106,10 @@ def run_campbell(system, options: dict, context: dict) -> dict:
     if stations is None:
         raise SceneError("a campbell diagram tracks whirl at nodal values; substructures joined by multipliers have "
                          "none", key="joints", expected="joints = 'assembly' for campbell (the same frequencies)")
-    index = system.meta["params"].index(name)
     q = operating_point(system, options, context)
-    saved = float(system.params[index])
 
     def assembled(speed: float) -> dict:
-        system.params[index] = speed
-        mats = system.linear(q)
+        mats = system.with_params(**{name: speed}).linear(q)
         return {"M": mats["M"], "D": mats["D"], "G": mats["G"], "K": mats["K"]}
 
     def assembled_at(speed: float) -> dict:
@@ -121,15 +118,12 @@ def run_campbell(system, options: dict, context: dict) -> dict:
 
     count = int(options.get("count", 8))
     sparse = system.n > SPARSE_N
-    try:
-        # matrices polynomial in the speed (a rotor's G = Omega G1): four assemblies, then sparse adds
-        poly = fit_speed_polynomial(assembled, speeds[0], speeds[-1]) if len(speeds) > 4 else None
-        matrices_at = assembled_at if poly is None else poly.combined({"M": ("M",), "C": ("D", "G"), "K": ("K",)})
-        res = campbell(matrices_at, speeds, count, x_index=stations[0], y_index=stations[1], sparse=sparse,
-                       method=options.get("method", "auto"))
-        crit = critical_speeds(res, options.get("multiples", [1.0]), refine=matrices_at, sparse=sparse)
-    finally:
-        system.params[index] = saved
+    # matrices polynomial in the speed (a rotor's G = Omega G1): four assemblies, then sparse adds
+    poly = fit_speed_polynomial(assembled, speeds[0], speeds[-1]) if len(speeds) > 4 else None
+    matrices_at = assembled_at if poly is None else poly.combined({"M": ("M",), "C": ("D", "G"), "K": ("K",)})
+    res = campbell(matrices_at, speeds, count, x_index=stations[0], y_index=stations[1], sparse=sparse,
+                   method=options.get("method", "auto"))
+    crit = critical_speeds(res, options.get("multiples", [1.0]), refine=matrices_at, sparse=sparse)
     freqs = np.asarray(res.frequencies)
     return {"speeds": [float(w) for w in res.speeds], "frequencies": [[float(f) for f in row] for row in freqs],
             "whirl": [list(row) for row in res.whirl], "log_dec": [[float(d) for d in row] for row in res.log_dec],
