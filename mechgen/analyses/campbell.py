@@ -1,84 +1,61 @@
-"""Damped (gyroscopic) modes and Campbell diagrams of a scene's system: the rotordynamics analyses.
+"""``campbell``: a Campbell diagram, the damped modes over a range of one parameter (the spin speed).
 
-``modes`` of a system with gyroscopic or damping terms (or a non-symmetric
-stiffness) solves M q'' + (D + G) q' + K q = 0 instead of the symmetric problem
-and reports the damped natural frequencies wd = Im s (ascending), the
-eigenvalues s, logarithmic decrements and, for a model that declares a whirl
-pair (Model.whirl_pair), each mode's whirl. ``campbell`` does so over a range of
-one parameter (the spin speed), tracking the modes across speeds
-(mechgen.runtime.campbell), and finds critical speeds where a whirl frequency
-crosses a multiple of the speed.
+The modes are tracked across speeds (mechgen.runtime.campbell) and critical speeds are found where a
+whirl frequency crosses a multiple of the speed. Scene keys: ``over`` (one numeric parameter with two
+or more increasing values), ``count`` (modes, default 8), ``multiples`` (of the speed, default [1]),
+``method`` (auto, exact, reduced), ``about`` and ``at`` (the operating point). Outputs: ``speeds``,
+``frequencies`` and ``whirl`` and ``log_dec`` (one row per speed), ``critical_speeds``, ``parameter``,
+``method`` and ``exact_solves``.
 """
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
-from mechgen.errors import InputError, SceneError
+from mechgen.analyses import schema, summary
+from mechgen.analyses.operating_point import operating_point
+from mechgen.analyses.registry import AnalysisKind, register
+from mechgen.analyses.schema import REQUIRED, Option
+from mechgen.analyses.whirl import SPARSE_N, whirl_stations
+from mechgen.errors import SceneError
 from mechgen.runtime.campbell import campbell, critical_speeds, fit_speed_polynomial
-from mechgen.runtime.damped import damped_modes, whirl
-
-#: above this many unknowns a damped-modes analysis with a ``count`` uses sparse shift-invert
-SPARSE_N = 100
+from mechgen.scene.values import fail, is_choice, join, param_info, type_name
 
 
-def is_gyroscopic(mats: dict) -> bool:
-    """True when D or G has a nonzero entry or K is not symmetric (the symmetric eigenproblem would be wrong)."""
-    dense = {k: v.toarray() if hasattr(v, "toarray") else np.asarray(v) for k, v in mats.items()}
-    K = dense["K"]
-    scale = max(np.abs(K).max(), 1e-300)
-    return bool(np.any(dense["D"]) or np.any(dense["G"]) or np.abs(K - K.T).max() > 1e-12 * scale)
+def _speeds(ctx, key: str, value: object) -> dict[str, list]:
+    """A campbell range: one numeric parameter (the spin speed) with increasing values."""
+    over = schema.over(ctx, key, value)
+    if len(over) != 1:
+        raise fail(ctx.file, key, f"a campbell diagram runs over one parameter, got {len(over)}",
+                   "one entry: Omega = {start, stop, num} or an array")
+    (name, values), = over.items()
+    if is_choice(param_info(ctx.file, key, ctx.model, name)) or len(values) < 2 or np.any(np.diff(values) <= 0):
+        raise fail(ctx.file, join(key, name), "campbell speeds must be two or more increasing numbers",
+                   "increasing numbers, e.g. {start = 0, stop = 1000, num = 50}")
+    return over
 
 
-def whirl_stations(system) -> tuple[np.ndarray, np.ndarray] | None:
-    """Indices (into the unknowns) of the x and y displacements whose orbits classify whirl, or None
-    (no whirl pair, or unknowns that are not a selection of nodal values)."""
-    pair = system.meta.get("whirl")
-    if not pair:
-        return None
-    if system.is_field:
-        return system.nodal_indices(pair)
-    names = system.coordinates
-    return np.array([names.index(pair[0])]), np.array([names.index(pair[1])])
+def _multiples(ctx, key: str, value: object) -> list[float]:
+    if not isinstance(value, list) or not value:
+        raise fail(ctx.file, key, f"value is {type_name(value)}", "a non-empty array of positive numbers")
+    return [schema.positive(ctx, f"{key}[{i}]", v) for i, v in enumerate(value, 1)]
 
 
-def run_damped_modes(system, mats: dict, options: dict) -> dict:
-    """Damped modes about the operating point: frequencies (wd, rad/s), eigenvalues, log_dec, whirl."""
-    count = options.get("count")
-    massless = np.flatnonzero(np.asarray(mats["M"].diagonal()) <= 0)
-    if len(massless) and not getattr(system, "has_multipliers", False):
-        names = ", ".join(system.coordinates[i] for i in massless[:5])
-        raise InputError(f"the mass matrix is singular: unknowns {names} carry no inertia", key="M",
-                         expected="a positive definite mass matrix (every coordinate with inertia)")
-    sparse = bool(count) and system.n > SPARSE_N and hasattr(mats["M"], "toarray")
-    res = damped_modes(mats["M"], mats["D"] + mats["G"], mats["K"], count, sparse=sparse)
-    out = {"frequencies": [float(w) for w in res.wd],
-           "eigenvalues": [[float(s.real), float(s.imag)] for s in res.eigenvalues],
-           "log_dec": [float(d) for d in res.log_dec], "_shapes": res.shapes}
-    pair = system.meta.get("whirl")
-    if pair:
-        stations = whirl_stations(system)
-        shapes = res.shapes
-        if stations is None:  # unknowns are no selection of nodal values: observe them through x = Z q
-            shapes = system.nodal_rows(pair) @ shapes
-            half = shapes.shape[0] // 2
-            stations = (np.arange(half), half + np.arange(half))
-        out["whirl"] = _paired(whirl(shapes, *stations), res.wd)
-    return out
+SCHEMA = {"over": Option(_speeds, REQUIRED, "a table: parameter = [values] or {start, stop, num}"),
+          "count": Option(schema.count, 8), "multiples": Option(_multiples, [1.0]),
+          "method": Option(schema.one_of("campbell method", ("auto", "exact", "reduced"))),
+          "about": Option(schema.about), "at": Option(schema.coordinate_table)}
 
 
-def _paired(labels: list[str], wd: np.ndarray, rtol: float = 1e-6) -> list[str]:
-    """Whirl of repeated frequencies (an isotropic rotor at rest): the eigenvectors of a double frequency are
-    an arbitrary basis of a plane that holds one backward and one forward circular whirl, so such a pair is
-    labelled (backward, forward), the order a Campbell diagram gives as the spin grows from zero."""
-    out = list(labels)
-    i = 0
-    while i + 1 < len(out):
-        if abs(wd[i + 1] - wd[i]) <= rtol * abs(wd[i]):
-            out[i], out[i + 1] = "backward", "forward"
-            i += 2
-        else:
-            i += 1
-    return out
+def needs(options: dict, *, internal: bool) -> set[str]:
+    """M, D, G, K: the linear kernel."""
+    return {"linear"}
+
+
+def frees(options: dict) -> list[str]:
+    """The speed parameter: free in the kernels."""
+    return list(options["over"])
 
 
 def _speed_parameter(system, options: dict) -> tuple[str, list[float]]:
@@ -96,8 +73,6 @@ def run_campbell(system, options: dict, context: dict) -> dict:
     (fit_speed_polynomial: three or four assemblies); when it holds, no further assembly is needed and
     the Campbell runs on the reduced basis (mechgen.runtime.campbell), else it assembles at every speed.
     ``options['method'] = 'exact'`` forces full-size solves at every speed."""
-    from mechgen.scene.analyses import operating_point
-
     name, speeds = _speed_parameter(system, options)
     if not system.meta.get("whirl"):
         raise SceneError(f"model {system.meta.get('model')} declares no whirl pair", key="kind",
@@ -137,3 +112,39 @@ def run_campbell(system, options: dict, context: dict) -> dict:
                                  "speed": float(c["speed"]), "frequency": float(c["frequency"]), "whirl": c["whirl"]}
                                 for c in crit],
             "parameter": name, "method": res.method, "exact_solves": int(res.exact_solves)}
+
+
+def summary_lines(outputs: dict) -> list[str]:
+    """The default lines without the per-speed eigenvalues and log decrements."""
+    return summary.output_lines(outputs, skip=("eigenvalues", "log_dec"))
+
+
+def plot(plt, a: dict, path: Path) -> list[Path]:
+    """Tracked whirl frequencies against spin speed (forward solid, backward dashed), multiples of the
+    speed as excitation lines and the critical speeds where they cross."""
+    out = a["outputs"]
+    speeds, freqs = out["speeds"], list(zip(*out["frequencies"]))
+    whirls = list(zip(*out["whirl"]))
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    for k, (curve, labels) in enumerate(zip(freqs, whirls)):
+        forward = labels[len(labels) // 2] == "forward"
+        ax.plot(speeds, curve, "-" if forward else "--", color=f"C{k % 10}", lw=1.2,
+                label=f"mode {k + 1} ({'F' if forward else 'B'})")
+    top = max(max(c) for c in freqs)
+    for r in sorted({c["multiple"] for c in out.get("critical_speeds", [])} or {1.0}):
+        reach = min(speeds[-1], top / r)
+        ax.plot([0, reach], [0, r * reach], "k:", lw=1)
+        ax.annotate(f"{r:g}x", (reach, r * reach), fontsize=7)
+    for c in out.get("critical_speeds", []):
+        ax.plot(c["speed"], c["frequency"], "kx", ms=6)
+    ax.set_xlabel(f"{out.get('parameter', 'speed')} (rad/s)")
+    ax.set_ylabel("damped natural frequency (rad/s)")
+    ax.set_title(f"{a['name']}: Campbell diagram (solid forward, dashed backward; x critical speeds)", fontsize=9)
+    ax.legend(fontsize=7, ncol=2, loc="upper left")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return [path]
+
+
+register(AnalysisKind("campbell", SCHEMA, run_campbell, needs, summary_lines, frees=frees, plot=plot))

@@ -1,11 +1,5 @@
-"""Steady states of continua as boundary value problems, and branches of them (the scene's face).
+"""``continuation``: branches of a continuum's steady states (boundary value problems in s).
 
-``steady`` of a continuum whose boundary conditions carry values (a string
-between two eyelets) solves the steady equations in s (mechgen.runtime.steady_bvp)
-by shooting, multiple shooting or collocation and reports every model output
-at the ends and its extremes along s (``tension_start``, ``radius_max`` ...), the
-fields' slopes at the ends (``x_s_start`` ...),
-the shape (``s``, ``deflection``) and ``iterations`` / ``residual_norm``.
 ``continuation`` follows such a steady state in one parameter by pseudo-arclength
 (mechgen.runtime.continuation), through turning points, with the stability verdict
 of the Galerkin linearisation about every point; it reports ``branch`` (one entry
@@ -13,18 +7,11 @@ per point: the parameter, the outputs, ``verdict``), ``folds`` and, with
 ``minimize``, the least value of an output along the branch (``<output>_min`` and
 ``<parameter>_at_<output>_min``). ``aliases`` report outputs under the scene's names.
 
-Shape outputs. A model may declare numbers measured on a sampled steady state
-(``Model.shape_output``: the balloon's ``loops``); ``steady`` reports them, and so
-does every point of a branch, fold, crossing and stability change.
+Shape outputs (mechgen.analyses.bvp_states: the balloon's ``loops``) are reported at every point
+of a branch, fold, crossing and stability change.
 
-More keys of ``steady``:
-
-* ``params = { lambda0 = 0.3 }``: this analysis's own values of numeric parameters
-  (made free in the kernels), e.g. a start where a multi-loop balloon exists;
-* ``shape = { loops = 2 }``: a start with this value of a shape output, from the
-  starting guesses the model declares with it (each is solved by the analysis's
-  method and form; the first whose measure equals the value is kept, else a
-  ConvergenceError lists what the guesses gave).
+Keys: ``about`` (an earlier steady analysis), ``parameter``, ``stop``, ``max_points``,
+``stability`` (default true), ``minimize`` (an output), ``aliases``.
 
 More keys of ``continuation``:
 
@@ -55,153 +42,131 @@ consecutive points, located by bisection along the branch to 1e-9 of the segment
 ``from``, ``to``}. ``aliases`` may also name an analysis output:
 ``balloons_at_tension = "at_p_e"``.
 """
+
 from __future__ import annotations
 
-from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 
-from mechgen import models
-from mechgen.errors import ConvergenceError, SceneError
+from mechgen.analyses import figures, schema, summary
+from mechgen.analyses.bvp_states import (bvp_summary, shape_declarations, shape_values, stability_about,
+                                         stability_of_each)
+from mechgen.analyses.registry import AnalysisKind, register
+from mechgen.analyses.schema import REQUIRED, Option
+from mechgen.errors import SceneError
 from mechgen.runtime import branch_scan
-from mechgen.runtime.branch_stability import stability_along
-from mechgen.runtime.constrained import linear_about_bvp
 from mechgen.runtime.continuation import minimize_along_branch
-from mechgen.runtime.steady_bvp import hamiltonian_bvp, holding, solve_steady, steady_bvp, stress_guess
-from mechgen.symbolic.model import call_declared
-from mechgen.symbolic.params import Namespace
+from mechgen.scene.expr import is_identifier
+from mechgen.scene.values import IDENTIFIER_RULE, fail, is_choice, join, listing, param_info, show
 
-SAMPLES = 201
+METHODS = ("collocation", "gauss", "multiple_shooting")
+DIRECTIONS = ("increasing", "decreasing", "both")
 
 
-def _summary(bvp, result, aliases: dict) -> dict:
-    """Outputs at the ends and their extremes along s (sampled at SAMPLES points), aliased."""
-    s = np.linspace(0.0, bvp.length_of(result), SAMPLES)
+# --------------------------------------------------------------------------- schema
+
+def _starts(ctx, key: str, value: object) -> str | list[str]:
+    """One earlier steady analysis, or an array of them (one branch each)."""
+    if not isinstance(value, list):
+        return schema.about(ctx, key, value)
+    if not value:
+        raise fail(ctx.file, key, "empty array", "an array of earlier steady analyses")
+    names = [schema.about(ctx, f"{key}[{i}]", v) for i, v in enumerate(value, 1)]
+    for i, name in enumerate(names, 1):
+        if name in names[:i - 1]:
+            raise fail(ctx.file, f"{key}[{i}]", f"start '{name}' is listed twice", "distinct steady analyses")
+    return names
+
+
+def _output_values(ctx, key: str, value: object) -> dict[str, float]:
+    """{output: number}: values whose crossings a branch locates (at = { p_e = 5.0 })."""
+    if not isinstance(value, dict) or not value:
+        raise fail(ctx.file, key, f"value is {show(value)}", "a table: output = number, e.g. { p_e = 5.0 }")
     out = {}
-    for name, values in bvp.outputs(result, s).items():
-        if name in ("potential_density", "hamiltonian"):
-            continue
-        out.update({f"{name}_start": float(values[0]), f"{name}_end": float(values[-1]),
-                    f"{name}_max": float(values.max()), f"{name}_min": float(values.min())})
-    ends = bvp.values(result, np.array([s[0], s[-1]]))
-    for i, f in enumerate(bvp.fields):
-        out[f"{f}_s_start"], out[f"{f}_s_end"] = float(ends[bvp.n + i, 0]), float(ends[bvp.n + i, 1])
-    for alias, target in aliases.items():
-        if target in out:
-            out[alias] = out[target]
+    for name, number in value.items():
+        if not is_identifier(name):
+            raise fail(ctx.file, join(key, name), f"{show(name)} is not an output name", IDENTIFIER_RULE)
+        out[name] = schema.number(ctx, join(key, name), number)
     return out
 
 
-def linear_about_steady(system, steady: dict) -> dict:
-    """M, D, G, K of the model's discretisation about a boundary-value steady state (its jets at the points)."""
-    return linear_about_bvp(system, steady["_bvp"], steady["_result"])
+def _bounds(ctx, key: str, value: object) -> dict[str, tuple[float, float]]:
+    """{output: [low, high]}: a branch ends where an output leaves its range."""
+    expected = "a table: output = [low, high] with low < high, e.g. { p_e = [0, 12] }"
+    if not isinstance(value, dict) or not value:
+        raise fail(ctx.file, key, f"value is {show(value)}", expected)
+    out = {}
+    for name, pair in value.items():
+        sub = join(key, name)
+        if not is_identifier(name):
+            raise fail(ctx.file, sub, f"{show(name)} is not an output name", IDENTIFIER_RULE)
+        if not isinstance(pair, list) or len(pair) != 2:
+            raise fail(ctx.file, sub, f"value is {show(pair)}", expected)
+        lo, hi = (schema.number(ctx, f"{sub}[{i}]", v) for i, v in enumerate(pair, 1))
+        if not lo < hi:
+            raise fail(ctx.file, sub, f"the range [{lo!r}, {hi!r}] is empty", expected)
+        out[name] = (lo, hi)
+    return out
 
 
-def _reported(verdict) -> dict:
-    """Verdict, lowest ten frequencies and eigenvalues of a StabilityResult, as the scene reports them."""
-    return {"verdict": verdict.verdict, "frequencies": [float(f) for f in verdict.frequencies[:10]],
-            "eigenvalues": [[float(e.real), float(e.imag)] for e in verdict.eigenvalues]}
+def _parameter(ctx, key: str, value: object) -> str:
+    info = param_info(ctx.file, key, ctx.model, value)
+    if is_choice(info) or info.integer:
+        raise fail(ctx.file, key, f"parameter {show(value)} is not a real number", "a numeric model parameter")
+    schema.check_not_derived(ctx, key, value)
+    ctx.swept = (value,)
+    return value
 
 
-def _stability_about(system, bvp, result) -> dict:
-    """The Galerkin linearisation's stability about one steady state (mechgen.runtime.branch_stability)."""
-    return _reported(stability_along(system, bvp, None, [result])[0])
+SCHEMA = {"about": Option(_starts, REQUIRED), "parameter": Option(_parameter, REQUIRED),
+          "stop": Option(schema.number, REQUIRED), "step": Option(schema.positive, 0.05),
+          "max_step": Option(schema.positive), "max_points": Option(schema.count, 200),
+          "method": Option(schema.one_of("continuation method", METHODS)), "stages": Option(schema.count),
+          "mesh": Option(schema.count, 100), "stability": Option(schema.boolean, True),
+          "minimize": Option(schema.name), "aliases": Option(schema.aliases, {}),
+          "direction": Option(schema.one_of("direction", DIRECTIONS)), "bounds": Option(_bounds),
+          "at": Option(_output_values), "eigenvalues": Option(schema.boolean, False)}
 
 
-# ----------------------------------------------------------------------------- shape outputs, starts
-SHAPE_SAMPLES = 1001
-START_TOL = 1e-6  # the tolerance at which ``shape`` starts are tried (then refined to the analysis's tol)
+def _check_branch_outputs(ctx, base: str, options: dict) -> None:
+    """Names in ``at`` and ``bounds``: aliases, <output>_<start|end|max|min>, <field>_s_<start|end>, shape outputs."""
+    if not getattr(ctx.model, "fields", ()):
+        return
+    known = set(options.get("aliases", {})) | set(getattr(ctx.model, "shape_outputs", ()))
+    known |= {f"{o}_{end}" for o in ctx.model.outputs for end in ("start", "end", "max", "min")}
+    known |= {f"{f}_s_{end}" for f in ctx.model.fields for end in ("start", "end")}
+    for key in ("at", "bounds"):
+        for name in options.get(key, {}):
+            if name not in known:
+                raise fail(ctx.file, f"{base}.{key}.{name}", f"no output {show(name)} on a branch",
+                           "an alias of this analysis or <output>_start/_end/_max/_min: " + listing(sorted(known)))
 
 
-def _shape_declarations(system) -> tuple:
-    """The model's shape outputs (Model.shape_output)."""
-    return tuple(getattr(models.get(system.meta["model"]), "shape_outputs", ()))
+def check(ctx, base: str, options: dict) -> None:
+    """minimize follows one start; ``at`` and ``bounds`` name branch outputs; ``stop`` below the parameter's bound."""
+    if isinstance(options["about"], list) and "minimize" in options:
+        raise fail(ctx.file, f"{base}.minimize", "minimize follows one branch; 'about' lists several starts",
+                   "one start (about = \"name\") with minimize")
+    _check_branch_outputs(ctx, base, options)
+    name = options["parameter"]
+    below = getattr(ctx.model.params[name], "below", None)
+    if below is not None and not options["stop"] < below:
+        raise fail(ctx.file, f"{base}.stop", f"stop {options['stop']!r} is not below {below!r}, the bound of "
+                   f"parameter '{name}'", f"a value below {below!r}")
 
 
-def _parameter_dict(system, p) -> dict:
-    """Numeric parameter values: the model's defaults, the scene's fixed ones, the free ones from p."""
-    model = models.get(system.meta["model"])
-    values = {prm.name: float(prm.default) for prm in model.param_list if prm.is_numeric}
-    values.update({k: float(v) for k, v in getattr(system, "fixed", {}).items()})
-    values.update(zip(system.meta.get("params", []), (float(v) for v in p)))
-    return values
+def frees(options: dict) -> list[str]:
+    """The continuation parameter: free in the kernels."""
+    return [options["parameter"]]
 
 
-def _parameter_values(system, p) -> Namespace:
-    return Namespace(_parameter_dict(system, p))
+def needs(options: dict, *, internal: bool) -> set[str]:
+    """The linear kernel for the stability along the branch (its steady start brings the BVP kernels)."""
+    return {"linear"} if options.get("stability", True) else set()
 
 
-def _shapes(system, bvp, result) -> dict:
-    """Every shape output of the model on a steady state (sampled at SHAPE_SAMPLES points)."""
-    declared = _shape_declarations(system)
-    if not declared:
-        return {}
-    s = np.linspace(0.0, bvp.length_of(result), SHAPE_SAMPLES)
-    y = bvp.values(result, s)
-    u = Namespace({**{f: y[i] for i, f in enumerate(bvp.fields)},
-                   **{f"{f}_s": y[bvp.n + i] for i, f in enumerate(bvp.fields)}})
-    out = Namespace(bvp.outputs(result, s))
-    p = _parameter_values(system, result.p)
-    return {d.name: float(call_declared(d.fn, s=s, u=u, out=out, p=p)) for d in declared}
-
-
-def _with_params(system, values: dict):
-    """A copy of the system with some free parameters set (``steady``'s ``params``)."""
-    names = list(system.meta.get("params", []))
-    params = np.array(system.params, float)
-    for name, value in values.items():
-        if name not in names:
-            raise SceneError(f"parameter {name!r} is not free in the compiled kernels", key=f"params.{name}",
-                             expected="a parameter the scene leaves free: " + ", ".join(names))
-        params[names.index(name)] = float(value)
-    return replace(system, params=params, _cache={})
-
-
-def _start_with_shape(system, bvp, options: dict, method: str):
-    """A steady state whose shape output equals the requested value, from the model's starting guesses."""
-    (name, value), = options["shape"].items()
-    declared = {d.name: d for d in _shape_declarations(system)}
-    if name not in declared or declared[name].start is None:
-        with_start = [n for n, d in declared.items() if d.start is not None]
-        raise SceneError(f"model {system.meta['model']} declares no starting guesses for {name!r}",
-                         key=f"shape.{name}", expected="one of: " + (", ".join(with_start) or "(none)"))
-    mesh = options.get("mesh", 200)
-    sigma = np.linspace(0.0, 1.0, mesh + 1)
-    L = bvp.start[bvp.length_index] if bvp.length_index is not None else bvp.length
-    p = _parameter_values(system, bvp.start)
-    tol = options.get("tol", 1e-10)
-    gave = []
-    for guess in call_declared(declared[name].start, value=float(value), s=L * sigma, p=p):
-        u = np.array([np.broadcast_to(np.asarray(guess["u"][f], float), sigma.shape) for f in bvp.fields])
-        du = np.array([np.broadcast_to(np.asarray(guess["u_s"][f], float), sigma.shape) for f in bvp.fields])
-        if bvp.form == "hamiltonian":
-            Y = np.vstack([u, [guess["n"][f] for f in bvp.fields]]) if "n" in guess else \
-                stress_guess(bvp, sigma, np.vstack([u, du]))
-        else:
-            Y = np.vstack([u, du])
-
-        def interpolate(at, Y=Y):
-            return np.array([np.interp(np.asarray(at, float), sigma, row) for row in Y])
-
-        try:  # a loose tolerance first: failures are cheap, and the measure is decided by then
-            result = solve_steady(bvp, method=method, guess=interpolate, mesh=mesh, nodes=options.get("nodes", 20),
-                                  tol=max(tol, START_TOL))
-        except ConvergenceError as exc:
-            gave.append(f"no convergence ({str(exc).split(':')[0]})")
-            continue
-        got = _shapes(system, bvp, result)[name]
-        if abs(got - float(value)) <= 1e-9 * max(1.0, abs(float(value))):
-            if tol < START_TOL:
-                result = solve_steady(bvp, method=method, guess=result, mesh=mesh, nodes=options.get("nodes", 20),
-                                      tol=tol)
-            return result
-        gave.append(f"{name} = {got:g}")
-    where = ", ".join(f"{k} = {v:g}" for k, v in _parameter_dict(system, bvp.start).items())
-    raise ConvergenceError(f"steady: no state with {name} = {float(value):g} from the {len(gave)} starting guesses "
-                           f"of model {system.meta['model']} by {method} ({bvp.form} form, {where}): they gave "
-                           f"{'; '.join(gave)}. Try another start (params), method = 'collocation' with "
-                           "form = 'hamiltonian', or another value")
-
+# --------------------------------------------------------------------------- the branch
 
 def _refined_verdict(system, bvp, result) -> dict:
     """The verdict at the scene's N checked on the model discretised with 2N and 4N terms (DESIGN.md: stability
@@ -210,53 +175,10 @@ def _refined_verdict(system, bvp, result) -> dict:
     ``refinement`` lists the three ({N, verdicts}) so that the trend shows."""
     size = int(system.choices["N"])
     sizes = [size, 2 * size, 4 * size]
-    verdicts = [_stability_about(system if k == size else system.refined(k), bvp, result)["verdict"] for k in sizes]
+    verdicts = [stability_about(system if k == size else system.refined(k), bvp, result)["verdict"] for k in sizes]
     return {"verdict": verdicts[0] if len(set(verdicts)) == 1 else "unconverged",
             "refinement": {"N": sizes, "verdicts": verdicts}}
 
-
-def run_steady_bvp(system, options: dict, context: dict) -> dict:
-    """A steady state of a continuum with boundary values, by the BVP method the scene names."""
-    if options.get("params"):
-        system = _with_params(system, options["params"])
-    bvp = hamiltonian_bvp(system) if options.get("form") == "hamiltonian" else steady_bvp(system)
-    aliases = options.get("aliases", {})
-    if options.get("hold"):
-        (name, value), = options["hold"].items()
-        output, at = aliases.get(name, name).rsplit("_", 1)
-        bvp = holding(bvp, output, at, float(value), options["free"])
-    method = "collocation" if options.get("method", "newton") == "newton" else options["method"]
-    if options.get("shape"):
-        result = _start_with_shape(system, bvp, options, method)
-    else:
-        result = solve_steady(bvp, method=method, modes=options.get("bulge"), mesh=options.get("mesh", 200),
-                              nodes=options.get("nodes", 20), tol=options.get("tol", 1e-10))
-    out = {"method": method, "iterations": int(result.iterations), "residual_norm": float(result.residual_norm)}
-    if options.get("hold"):
-        free = options["free"]
-        solved = float(result.p[bvp.params.index(free)])
-        below = models.get(system.meta["model"]).param(free).below
-        if below is not None and not solved < below:
-            raise ConvergenceError(f"steady state with {next(iter(options['hold']))} held: the solved {free} = "
-                                   f"{solved:.6g} is not below {below:g} (no such state near the start; try "
-                                   f"another start value of {free} or another bulge)")
-        out[free] = solved
-    out.update(_summary(bvp, result, aliases))
-    out.update(_shapes(system, bvp, result))
-    if options.get("stability"):
-        out.update(_stability_about(system, bvp, result))
-    s = np.linspace(0.0, bvp.length_of(result), 101)
-    y = bvp.values(result, s)
-    out["s"] = [float(v) for v in s]
-    out["deflection"] = {f: [float(v) for v in y[i]] for i, f in enumerate(bvp.fields)}
-    out["_bvp"], out["_result"] = bvp, result
-    return out
-
-
-def _stability_along(system, bvp, results) -> list[dict]:
-    """The stability of every steady state in ``results`` (one Galerkin eigenproblem each); the one place to
-    swap for a batched runtime call."""
-    return [_reported(v) for v in stability_along(system, bvp, None, results)]
 
 
 def _record(name: str, lam: float, summary: dict, shapes: dict, aliases: dict, extra=()) -> dict:
@@ -267,9 +189,9 @@ def _record(name: str, lam: float, summary: dict, shapes: dict, aliases: dict, e
 
 def _values(system, bvp, result, aliases: dict, names=()) -> dict:
     """The summary of a steady state, with the shape outputs when ``names`` asks for one of them."""
-    out = _summary(bvp, result, aliases)
+    out = bvp_summary(bvp, result, aliases)
     if any(n not in out for n in names):
-        out.update(_shapes(system, bvp, result))
+        out.update(shape_values(system, bvp, result))
     return out
 
 
@@ -313,13 +235,13 @@ def _one_branch(system, start: dict, options: dict, label: str | None) -> dict:
     bvp, result = start["_bvp"], start["_result"]
     name, aliases = options["parameter"], options.get("aliases", {})
     stability = options.get("stability", True)
-    _check_names(options, {**_summary(bvp, result, aliases), **_shapes(system, bvp, result)})
+    _check_names(options, {**bvp_summary(bvp, result, aliases), **shape_values(system, bvp, result)})
     branch = _follow(system, bvp, result, options, aliases)
     disc = branch.system
     tag = {"start": label} if label else {}
     results = [disc.to_result(u, lam) for u, lam in zip(branch.u, branch.lam)]
-    summaries = [{**_summary(bvp, res, aliases), **_shapes(system, bvp, res)} for res in results]
-    stab = _stability_along(system, bvp, results) if stability else [{}] * len(results)
+    summaries = [{**bvp_summary(bvp, res, aliases), **shape_values(system, bvp, res)} for res in results]
+    stab = stability_of_each(system, bvp, results) if stability else [{}] * len(results)
     points = []
     for lam, res, summary, st in zip(branch.lam, results, summaries, stab):
         point = {**tag, name: float(lam), **{bvp.params[i]: float(res.p[i]) for i in bvp.problem.unknown},
@@ -332,17 +254,17 @@ def _one_branch(system, start: dict, options: dict, label: str | None) -> dict:
 
     def located(x, extra=()):
         res = disc.to_result(x[:-1], x[-1])
-        return res, {**tag, **_record(name, x[-1], _summary(bvp, res, aliases), _shapes(system, bvp, res), aliases,
-                                      extra)}
+        return res, {**tag, **_record(name, x[-1], bvp_summary(bvp, res, aliases), shape_values(system, bvp, res),
+                                      aliases, extra)}
 
     X = np.hstack([branch.u, branch.lam[:, None]])
-    shaped = [d.name for d in _shape_declarations(system)]
+    shaped = [d.name for d in shape_declarations(system)]
     out = {"points": points, "status": branch.status,
            "folds": [{**tag, name: float(f.lam), **_values(system, bvp, disc.to_result(f.u, f.lam), aliases, shaped)}
                      for f in branch.folds], "stability_changes": [], "at": {}, "branch": branch}
     if stability:
         def verdict(x):
-            return _stability_about(system, bvp, disc.to_result(x[:-1], x[-1]))["verdict"]
+            return stability_about(system, bvp, disc.to_result(x[:-1], x[-1]))["verdict"]
 
         for i in range(len(points) - 1):
             a, b = points[i]["verdict"], points[i + 1]["verdict"]
@@ -378,7 +300,7 @@ def run_continuation(system, options: dict, context: dict) -> dict:
         branches = [_one_branch(system, context[s], options, s if isinstance(about, list) else None) for s in starts]
     finally:
         system.params[...] = saved
-    out = {"parameter": name, "shape_outputs": [d.name for d in _shape_declarations(system)],
+    out = {"parameter": name, "shape_outputs": [d.name for d in shape_declarations(system)],
            "branch": [p for b in branches for p in b["points"]],
            "status": branches[0]["status"] if len(branches) == 1 else
            {s: b["status"] for s, b in zip(starts, branches)},
@@ -395,7 +317,7 @@ def run_continuation(system, options: dict, context: dict) -> dict:
         bvp, branch = context[starts[0]]["_bvp"], branches[0]["branch"]
 
         def value(u, lam):
-            return _summary(bvp, branch.system.to_result(u, lam), aliases)[target]
+            return bvp_summary(bvp, branch.system.to_result(u, lam), aliases)[target]
 
         best = minimize_along_branch(branch, value, kind="min")
         out[f"{target}_min"] = float(best.value)
@@ -404,3 +326,151 @@ def run_continuation(system, options: dict, context: dict) -> dict:
         if target in out and alias not in out:
             out[alias] = out[target]
     return out
+
+
+# --------------------------------------------------------------------------- plots
+
+_POINT_KEYS = ("start", "verdict", "frequencies", "eigenvalues")
+
+
+def _branch_axes(out: dict) -> tuple[str, str, list[str]]:
+    """(parameter, the output drawn against it, the shape outputs written on the diagram) of a continuation:
+    the output of ``at``, else the minimized one, else the first number reported per point."""
+    points = out["branch"]
+    name = out.get("parameter") or next(iter(points[0]))
+    at = [k[3:] for k in out if k.startswith("at_") and not k.endswith("_shapes")]
+    minimized = [k[:-4] for k in out if k.endswith("_min") and f"{name}_at_{k[:-4]}_min" in out]
+    numeric = [k for k, v in points[0].items() if k not in _POINT_KEYS and k != name and isinstance(v, float)]
+    return name, (at or minimized or numeric)[0], list(out.get("shape_outputs", []))
+
+
+def _families(points: list) -> list[list[dict]]:
+    """The branch's points split by start (one list per branch, in order)."""
+    groups: dict = {}
+    for p in points:
+        groups.setdefault(p.get("start"), []).append(p)
+    return list(groups.values())
+
+
+def _branch(plt, a: dict, path: Path) -> bool:
+    """p_e (or another output) against the parameter: verdict colours, loop counts, folds, changes, crossings."""
+    out = a["outputs"]
+    if not out.get("branch"):
+        return False
+    colours = figures.VERDICT_COLOURS
+    name, output, shapes = _branch_axes(out)
+    fig, ax = plt.subplots(figsize=(7, 5))
+    for family in _families(out["branch"]):
+        lam = [p[name] for p in family]
+        val = [p.get(output, float("nan")) for p in family]
+        ax.plot(lam, val, "-", color="0.75", lw=0.8, zorder=1)
+        for verdict in colours:
+            sel = [i for i, p in enumerate(family) if p.get("verdict", "stable") == verdict]
+            if sel:
+                ax.plot([lam[i] for i in sel], [val[i] for i in sel], ".", ms=3, color=colours[verdict], zorder=2)
+        for key in shapes:
+            last = None
+            for i, p in enumerate(family):
+                if p.get(key) != last:
+                    last = p.get(key)
+                    ax.annotate(f"{key} {last:g}", (lam[i], val[i]), fontsize=7, xytext=(4, 4),
+                                textcoords="offset points", color="tab:green")
+    for fold in out.get("folds", []):
+        ax.plot(fold[name], fold.get(output, float("nan")), "x", color="tab:purple", ms=7)
+    for change in out.get("stability_changes", []):
+        ax.plot(change[name], change.get(output, float("nan")), "d", color="tab:orange", ms=6, mfc="none")
+    for key in [k[3:] for k in out if k.startswith("at_") and not k.endswith("_shapes")]:
+        for p in out[f"at_{key}"]:
+            ax.plot(p[name], p[key], "o", ms=8, mfc="none", color="tab:green")
+    handles = [plt.Line2D([], [], ls="", marker=".", color=c, label=v) for v, c in colours.items()]
+    handles += [plt.Line2D([], [], ls="", marker="x", color="tab:purple", label="fold"),
+                plt.Line2D([], [], ls="", marker="d", mfc="none", color="tab:orange", label="stability change"),
+                plt.Line2D([], [], ls="", marker="o", mfc="none", color="tab:green", label="at")]
+    ax.legend(handles=handles, fontsize=7, loc="best")
+    ax.set_xlabel(name)
+    ax.set_ylabel(output)
+    ax.set_title(f"{a['name']}: {output} against {name}", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return True
+
+
+def _eigenvalues_along(plt, a: dict, path: Path, count: int = 4) -> bool:
+    """Real and imaginary parts of the eigenvalues with the smallest |Im| (Im >= 0) at every branch point."""
+    points = a["outputs"]["branch"]
+    if not points or "eigenvalues" not in points[0]:
+        return False
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+    for i, p in enumerate(points):
+        ev = sorted((e for e in p["eigenvalues"] if e[1] >= 0), key=lambda e: (abs(e[1]), -e[0]))[:count]
+        colour = figures.VERDICT_COLOURS.get(p.get("verdict"), "k")
+        top.plot([i] * len(ev), [e[0] for e in ev], ".", ms=3, color=colour)
+        bottom.plot([i] * len(ev), [e[1] for e in ev], ".", ms=3, color=colour)
+    for i in range(len(points) - 1):
+        if points[i].get("verdict") != points[i + 1].get("verdict"):
+            for ax in (top, bottom):
+                ax.axvline(i + 0.5, color="0.6", lw=0.6, ls="--")
+    name = a["outputs"].get("parameter", "parameter")
+    ticks = list(range(0, len(points), max(1, len(points) // 8)))
+    bottom.set_xticks(ticks, [f"{points[i][name]:.3g}" for i in ticks])
+    top.axhline(0.0, color="0.6", lw=0.5)
+    top.set_ylabel("Re mu")
+    bottom.set_ylabel("Im mu")
+    bottom.set_xlabel(f"branch points in order ({name} marked)")
+    top.set_title(f"{a['name']}: the {count} eigenvalues with the smallest Im >= 0 (colour: verdict)", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return True
+
+
+def _frequencies_along(plt, a: dict, path: Path) -> bool:
+    """The lowest frequencies of every branch point against the parameter (log axis over decades)."""
+    out = a["outputs"]
+    points = [p for p in out.get("branch", []) if p.get("frequencies")]
+    if not points:
+        return False
+    name = out.get("parameter") or next(iter(points[0]))
+    lam = [p[name] for p in points]
+    fig, ax = plt.subplots(figsize=(7, 5))
+    for k in range(max(len(p["frequencies"]) for p in points)):
+        ax.plot(lam, [p["frequencies"][k] if k < len(p["frequencies"]) else float("nan") for p in points], "-",
+                lw=1.0)
+    if min(lam) > 0 and max(lam) / min(lam) > 100:
+        ax.set_xscale("log")
+    ax.set_xlabel(name)
+    ax.set_ylabel("frequency")
+    ax.set_title(f"{a['name']}: the lowest frequencies along the branch", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return True
+
+
+def plot(plt, a: dict, path: Path) -> list[Path]:
+    """The branch diagram (an output against the parameter, points coloured by the stability verdict, shape
+    outputs such as the loop count written where they change, folds, stability changes and the ``at``
+    crossings marked), the shapes of the ``at`` points (first field against the last), with ``eigenvalues``
+    their real and imaginary parts along the branch, and the lowest frequencies against the parameter."""
+    written = [path] if _branch(plt, a, path) else []
+    out = a["outputs"]
+    name = out.get("parameter", "parameter")
+    for key in [k[3:] for k in out if k.startswith("at_") and not k.endswith("_shapes")]:
+        labels = [f"{name} = {p[name]:.4g}" + (f", loops {p['loops']:g}" if "loops" in p else "")
+                  + (f", {p['verdict']}" if "verdict" in p else "") for p in out[f"at_{key}"]]
+        shapes = path.with_name(f"{path.stem}_at_{key}.png")
+        if figures.curves(plt, f"{a['name']}: steady states at {key} = {out[f'at_{key}'][0][key]:.4g}"
+                          if labels else "", list(zip(labels, out.get(f"at_{key}_shapes", []))), shapes):
+            written.append(shapes)
+    eig = path.with_name(path.stem + "_eigenvalues.png")
+    if _eigenvalues_along(plt, a, eig):
+        written.append(eig)
+    freq = path.with_name(path.stem + "_frequencies.png")
+    if _frequencies_along(plt, a, freq):
+        written.append(freq)
+    return written
+
+
+register(AnalysisKind("continuation", SCHEMA, run_continuation, needs, summary.lines, check=check, frees=frees,
+                      plot=plot))

@@ -1,0 +1,33 @@
+"""A compiled system's parameter values by name, and a system with other values of its free ones."""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from mechgen import models
+from mechgen.errors import SceneError
+
+
+def parameter_dict(system, p) -> dict:
+    """Numeric parameter values: the model's defaults, the scene's fixed ones, the free ones from p."""
+    model = models.get(system.meta["model"])
+    values = {prm.name: float(prm.default) for prm in model.param_list if prm.is_numeric}
+    values.update({k: float(v) for k, v in getattr(system, "fixed", {}).items()})
+    values.update(zip(system.meta.get("params", []), (float(v) for v in p)))
+    return values
+
+
+def with_free_params(system, values: dict, key: str = "params"):
+    """A copy of the system with some free parameters set (``steady``'s ``params``, a sweep's point);
+    the system given is left as it was."""
+    names = list(system.meta.get("params", []))
+    params = np.array(system.params, float)
+    for name, value in values.items():
+        if name not in names:
+            raise SceneError(f"parameter {name!r} is not free in the compiled kernels", key=f"{key}.{name}",
+                             expected="a parameter the scene leaves free: " + ", ".join(names))
+        params[names.index(name)] = float(value)
+    if system.is_field:
+        return replace(system, params=params, _cache={})
+    return replace(system, params=params, patterns={})
