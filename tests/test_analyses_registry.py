@@ -203,3 +203,37 @@ def test_result_plot_writes_the_kinds_figure(tmp_path):
     _, system = _scene(ROOT / "scenes" / "laval_rotor.toml")
     assert mechgen.stability(system, name="whirl").plot(tmp_path) == [tmp_path / "whirl.png"]
     assert (tmp_path / "whirl.png").stat().st_size > 0
+
+
+def test_a_kind_registered_at_run_time_runs_through_the_scene_the_summary_and_the_python_api(tmp_path):
+    """What adding a kind takes: an AnalysisKind registered; the loader, run_scene, the summary and the Python
+    API then know it without naming it. The toy kind reports the number of unknowns and M's trace, compared
+    with the spring pendulum's M = diag(m, m r^2) at r = ``r``."""
+    from mechgen.analyses import schema, summary
+    from mechgen.scene.report import summary as scene_summary
+
+    def run(system, options, context):
+        mats = system.linear(np.array([options["r"], 0.0]))
+        return {"unknowns": system.n, "mass_trace": float(np.trace(mats["M"]))}
+
+    kind = registry.AnalysisKind("mass_trace", {"r": schema.Option(schema.positive, 1.0)}, run,
+                                 lambda options, *, internal: {"linear"}, summary.lines)
+    registry.register(kind)
+    try:
+        assert registry.kinds()[-1] == "mass_trace"
+        scene = tmp_path / "toy.toml"
+        scene.write_text('model = "spring_pendulum"\n[params]\nm = 2.0\n[[analysis]]\nname = "toy"\n'
+                         'kind = "mass_trace"\nr = 1.5\n')
+        results = run_scene(scene)
+        assert _entry(results, "toy")["outputs"] == {"unknowns": 2, "mass_trace": pytest.approx(2.0 + 2.0 * 1.5**2)}
+        assert "[mass_trace] toy" in scene_summary(results) and "    unknowns: 2" in scene_summary(results)
+        _, system = _scene(scene)
+        from mechgen.analyses.public import analysis
+
+        assert analysis("mass_trace", system, r=1.5, name="toy").outputs == _entry(results, "toy")["outputs"]
+        scene.write_text(scene.read_text() + "bogus = 1\n")
+        with pytest.raises(InputError, match="unknown key 'bogus' for a mass_trace analysis"):
+            run_scene(scene)
+    finally:
+        registry.unregister("mass_trace")
+    assert registry.kinds() == KINDS

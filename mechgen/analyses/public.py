@@ -19,7 +19,7 @@ from mechgen.analyses.result import Result, run_analysis
 from mechgen.analyses.schema import OptionContext, validate
 from mechgen.errors import InputError
 
-__all__ = ["campbell", "continuation", "modes", "simulate", "stability", "steady", "sweep"]
+__all__ = ["analysis", "campbell", "continuation", "modes", "simulate", "stability", "steady", "sweep"]
 
 
 def _model_info(system):
@@ -74,6 +74,13 @@ def _run(kind: str, system, options: dict, name: str | None) -> Result:
     checked = validate(ctx, kind, get(kind), table)
     context = {n: r.state for n, r in earlier.items()}
     return run_analysis(name or kind, kind, system, checked, context)
+
+
+def analysis(kind: str, system, *, name: str | None = None, **options) -> Result:
+    """Any registered kind by name (``analysis("modes", system, count=4)`` is ``modes(system, count=4)``):
+    a kind added to the registry is callable here without a function of its own."""
+    get(kind)
+    return _run(kind, system, options, name)
 
 
 def modes(system, *, name: str | None = None, **options) -> Result:

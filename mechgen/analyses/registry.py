@@ -72,6 +72,13 @@ def register(kind: AnalysisKind) -> AnalysisKind:
     return kind
 
 
+def unregister(name: str) -> None:
+    """Remove a kind registered at run time (a plugin's or a test's); the built-in ones stay."""
+    if any(m.rsplit(".", 1)[1] == name for m in MODULES):
+        raise ValueError(f"analysis kind {name!r} is built in")
+    _KINDS.pop(name, None)
+
+
 def _load() -> None:
     global _loaded
     if not _loaded:
