@@ -13,7 +13,6 @@ from __future__ import annotations
 
 from typing import Any, Mapping
 
-from mechgen.analyses.parameters import parameter_dict
 from mechgen.analyses.registry import get, kinds
 from mechgen.analyses.result import Result, run_analysis
 from mechgen.analyses.schema import OptionContext, validate
@@ -38,9 +37,17 @@ def _context(system, function: str, earlier: Mapping[str, Result]) -> OptionCont
     info = _model_info(system)
     coordinates = tuple(info.coordinates) if system.is_field else tuple(system.coordinates)
     active = None if set(coordinates) == set(info.coordinates) else coordinates
-    return OptionContext(file=None, model=info, params=parameter_dict(system, system.params), depends={},
+    return OptionContext(file=None, model=info, params=_known_values(system), depends={},
                          coordinates=coordinates, active=active, all_names=tuple(earlier),
                          earlier={n: r.kind for n, r in earlier.items()}, current=function)
+
+
+def _known_values(system) -> dict:
+    """The parameter values the system itself records (its free ones, a continuum's fixed ones), for
+    expression strings in options; a value folded into the kernels and not recorded is not guessed."""
+    values = {k: float(v) for k, v in getattr(system, "fixed", {}).items()}
+    values.update(zip(system.meta.get("params", []), (float(v) for v in system.params)))
+    return values
 
 
 def _check_keys(function: str, kind: str, options: Mapping[str, Any]) -> None:
@@ -152,8 +159,10 @@ def sweep(system, analysis: str = "modes", grid: Mapping[str, Any] | None = None
 
     ``grid`` maps each parameter (free in the kernels) to its values or {start, stop, num}; several
     parameters give their cartesian product, the first outermost. Each point runs on a new system
-    with the point's values (``system`` is not changed). Outputs: ``grid`` (the points) and one list
-    per output of the inner analysis.
+    with the point's values (``system`` is not changed). ``workers`` > 1 runs points in local
+    processes (the system must then pickle; a scene's sweep compiles in each process instead);
+    ``progress`` draws a bar on stderr (off by default here, on in scenes). Outputs: ``grid`` (the
+    points) and one list per output of the inner analysis.
     """
     if grid is None:
         raise InputError("sweep() needs a grid", key="grid", expected="grid = {parameter: [values]}")

@@ -45,7 +45,6 @@ class AnalysisKind:
         summary: ``outputs -> [line]``: the text summary's lines for these outputs.
         plot: ``(plt, entry, path) -> [written paths]`` for a scene-JSON entry, or None (nothing to plot).
         sweepable: whether a sweep may repeat this kind over a grid.
-        builds_on: the option that names an earlier analysis whose outputs this one needs (``about``).
     """
 
     name: str
@@ -57,7 +56,6 @@ class AnalysisKind:
     frees: Callable[[Mapping[str, Any]], list[str]] = no_free
     plot: Callable | None = None
     sweepable: bool = False
-    builds_on: str | None = "about"
 
 
 _KINDS: dict[str, AnalysisKind] = {}

@@ -167,4 +167,4 @@ def plot(plt, a: dict, path: Path) -> list[Path]:
 
 
 register(AnalysisKind("simulate", SCHEMA, run_simulate, needs, summary.lines, check=check, plot=plot,
-                      sweepable=True, builds_on=None))
+                      sweepable=True))

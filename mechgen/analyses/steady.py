@@ -316,4 +316,4 @@ def plot(plt, a: dict, path: Path) -> list[Path]:
 
 
 register(AnalysisKind("steady", SCHEMA, run_steady, needs, summary.lines, check=check, frees=frees, plot=plot,
-                      sweepable=True, builds_on=None))
+                      sweepable=True))

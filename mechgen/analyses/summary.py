@@ -16,7 +16,7 @@ def fmt(value, width: int = 8, depth: int = 0) -> str:
         if depth >= 2:
             return f"[...] ({len(value)})"
         shown = ", ".join(fmt(v, width, depth + 1) for v in value[:width])
-        return f"[{shown}{', ...' if len(value) > width else ''}] ({len(value)})" if len(value) > width else f"[{shown}]"
+        return f"[{shown}, ...] ({len(value)})" if len(value) > width else f"[{shown}]"
     if isinstance(value, dict):
         if depth >= 2:
             return "{" + ", ".join(str(k) for k in list(value)[:width]) + "}"

@@ -123,5 +123,4 @@ def plot(plt, a: dict, path: Path) -> list[Path]:
     return [path]
 
 
-register(AnalysisKind("sweep", SCHEMA, run_sweep, needs, summary_lines, check=check, frees=frees, plot=plot,
-                      builds_on=None))
+register(AnalysisKind("sweep", SCHEMA, run_sweep, needs, summary_lines, check=check, frees=frees, plot=plot))
