@@ -17,7 +17,7 @@ Steps, all in one process, BLAS limited to one thread for both tools (threadpool
    to ``TOL`` = 1e-6 relative at 0 and 1000 rad/s, and every lateral curve of ROSS's Campbell diagram
    is matched at every speed by one of mechgen's eight curves to ``TOL``. Otherwise the benchmark raises:
    it must compare equal computations.
-2. **Campbell timing.** mechgen's campbell analysis (``mechgen.scene.whirl.run_campbell``: 50 speeds over
+2. **Campbell timing.** mechgen's campbell analysis (``mechgen.analyses.campbell.run_campbell``: 50 speeds over
    0..1000 rad/s, 8 curves) against ``rotor.run_campbell(np.linspace(0, 1000, 50), frequencies=8)``,
    median of 3, interleaved (ROSS, mechgen, ROSS, mechgen ...), ROSS's ``run_modal`` lru_cache cleared
    before every run. ROSS's Campbell tracks its modes and computes no critical speeds, so the matched
@@ -169,14 +169,14 @@ def rotor_system(N: int, discretisation: str = "timoshenko2", *, fresh: bool = F
 
 def mechgen_modes(system, speed: float, count: int = COUNT) -> dict:
     """mechgen's ``modes`` analysis at spin speed ``speed``: its outputs (frequencies, log_dec, whirl)."""
-    from mechgen.scene.analyses import RUNNERS
+    from mechgen.analyses.modes import run_modes
 
-    return RUNNERS["modes"](system.with_params(Omega=speed), {"count": count}, {})
+    return run_modes(system.with_params(Omega=speed), {"count": count}, {})
 
 
 def mechgen_damped_solve(system, speed: float, count: int = COUNT) -> dict:
     """The ``modes`` analysis without its mode-shape sampling: linear() + run_damped_modes (the eigen-solve)."""
-    from mechgen.scene.whirl import run_damped_modes
+    from mechgen.analyses.whirl import run_damped_modes
 
     at_speed = system.with_params(Omega=speed)
     return run_damped_modes(at_speed, at_speed.linear(np.zeros(system.n)), {"count": count})
@@ -185,7 +185,7 @@ def mechgen_damped_solve(system, speed: float, count: int = COUNT) -> dict:
 def mechgen_campbell(system, speeds, multiples=(), method: str = "auto") -> dict:
     """mechgen's ``campbell`` analysis (the scene runner) over ``speeds``, 8 curves (``method``: see
     mechgen.runtime.campbell.campbell; 'auto' is the scene's)."""
-    from mechgen.scene.whirl import run_campbell
+    from mechgen.analyses.campbell import run_campbell
 
     return run_campbell(system, {"over": {"Omega": list(speeds)}, "count": COUNT, "multiples": list(multiples),
                                  "method": method}, {})

@@ -108,7 +108,7 @@ def test_static_deflection_under_uniform_load():
 
     The exact deflection is a quartic, which quintic elements represent exactly.
     """
-    from mechgen.scene.analyses import run_steady
+    from mechgen.analyses.steady import run_steady
 
     model = models.get("euler_bernoulli_beam")
     spec = specialize(model, {"discretisation": "quintic", "N": 2, "q": 3.0, "EI": 2.0, "L": 1.5})
@@ -153,7 +153,7 @@ def test_under_integration_warns():
 ])
 def test_reactions_and_deflection_under_uniform_load(bc, reactions, peak):
     """Support forces (x q L) and moments (x q L^2), peak deflection (x q L^4 / EI): beam-table closed forms."""
-    from mechgen.scene.analyses import run_steady
+    from mechgen.analyses.steady import run_steady
 
     q, L, EI = 2.0, 1.5, 3.0
     model = models.get("euler_bernoulli_beam")
@@ -173,7 +173,7 @@ def test_free_vibration_in_the_first_mode_returns_after_one_period():
     omega_1 = 1.8751^2 sqrt(EI / rhoA L^4); quintic elements (N = 2) are within 1e-7 of it.
     """
     from mechgen.runtime.integrate import integrate_first_order
-    from mechgen.scene.analyses import initial_state, run_simulate
+    from mechgen.analyses.simulate import initial_state, run_simulate
 
     model = models.get("euler_bernoulli_beam")
     spec = specialize(model, {"discretisation": "quintic", "N": 2, "bc": "clamped-free"})
@@ -200,7 +200,7 @@ def test_lagrange_multipliers_match_elimination(disc, size):
 
 def test_multipliers_are_the_reactions():
     """Clamped-free under uniform q: the multipliers solved by Newton are R = q L and M = q L^2 / 2."""
-    from mechgen.scene.analyses import run_steady
+    from mechgen.analyses.steady import run_steady
 
     model = models.get("euler_bernoulli_beam")
     spec = specialize(model, {"discretisation": "quintic", "N": 4, "q": 2.0, "bc": "clamped-free",

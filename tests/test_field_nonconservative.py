@@ -20,7 +20,8 @@ from scipy.optimize import brentq
 
 from mechgen import models
 from mechgen.pipeline import compile_model
-from mechgen.scene.analyses import run_modes, run_stability
+from mechgen.analyses.modes import run_modes
+from mechgen.analyses.stability import run_stability
 from mechgen.symbolic.specialize import specialize
 
 

@@ -12,7 +12,7 @@ import pytest
 
 from mechgen import models
 from mechgen.pipeline import compile_model
-from mechgen.scene.analyses import run_stability
+from mechgen.analyses.stability import run_stability
 from mechgen.symbolic.specialize import specialize
 
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from mechgen.pipeline import compile_model
-from mechgen.scene.analyses import run_stability
+from mechgen.analyses.stability import run_stability
 from mechgen.symbolic.model import Model
 from mechgen.symbolic.params import Param
 from mechgen.symbolic.specialize import specialize

@@ -9,7 +9,10 @@ import sympy as sp
 from mechgen import models
 from mechgen.pipeline import compile_model
 from mechgen.errors import ConvergenceError, InputError, KernelError
-from mechgen.scene.analyses import run_modes, run_simulate, run_stability, run_steady
+from mechgen.analyses.modes import run_modes
+from mechgen.analyses.simulate import run_simulate
+from mechgen.analyses.stability import run_stability
+from mechgen.analyses.steady import run_steady
 from mechgen.symbolic.model import Model
 from mechgen.symbolic.params import Param
 from mechgen.symbolic.specialize import specialize

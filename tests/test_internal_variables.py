@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from mechgen.pipeline import compile_model
-from mechgen.scene.analyses import run_simulate, run_stability
+from mechgen.analyses.simulate import run_simulate
+from mechgen.analyses.stability import run_stability
 from mechgen.symbolic.model import Model
 from mechgen.symbolic.params import Param
 from mechgen.symbolic.specialize import specialize

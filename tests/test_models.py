@@ -5,7 +5,10 @@ import pytest
 from mechgen import models
 from mechgen.pipeline import compile_model
 from mechgen.runtime.integrate import leapfrog
-from mechgen.scene.analyses import run_modes, run_simulate, run_stability, run_steady
+from mechgen.analyses.modes import run_modes
+from mechgen.analyses.simulate import run_simulate
+from mechgen.analyses.stability import run_stability
+from mechgen.analyses.steady import run_steady
 from mechgen.symbolic.specialize import specialize
 
 LAVAL = {"m": 10.0, "Ip": 0.2, "Id": 0.1, "k_t": 4.0e5, "k_r": 2.0e4}

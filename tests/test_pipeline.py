@@ -8,7 +8,7 @@ import mechgen.pipeline as pipeline
 from mechgen import models
 from mechgen.codegen import build
 from mechgen.pipeline import compile_model
-from mechgen.scene.analyses import needs
+from mechgen.analyses.registry import needs
 from mechgen.symbolic.specialize import specialize
 
 

@@ -20,24 +20,23 @@ from __future__ import annotations
 from typing import Any
 
 from mechgen.runtime.mesh import Part, Segment
-from mechgen.scene.load import (NUMBER, _evaluate, _expression, _fail, _finite, _is_number, _join, _listing,
-                                _show, _type_name)
+from mechgen.scene.values import NUMBER, evaluate, expression, fail, finite, is_number, join, listing, show, type_name
 
 DISCRETISATION_PARAMS = ("discretisation", "N", "quadrature", "constraints")
 
 
 def _number(file: str, key: str, value: object, params: dict) -> float:
-    if _is_number(value):
-        return float(_finite(file, key, value))
+    if is_number(value):
+        return float(finite(file, key, value))
     if isinstance(value, str):
-        return float(_evaluate(file, key, _expression(file, key, value), params))
-    raise _fail(file, key, f"value is {_type_name(value)}", NUMBER)
+        return float(evaluate(file, key, expression(file, key, value), params))
+    raise fail(file, key, f"value is {type_name(value)}", NUMBER)
 
 
 def _tables(file: str, data: dict, name: str) -> list:
     entries = data.get(name, [])
     if not isinstance(entries, list) or not all(isinstance(e, dict) for e in entries):
-        raise _fail(file, name, f"{name} is {_type_name(entries)}", f"[[{name}]] tables")
+        raise fail(file, name, f"{name} is {type_name(entries)}", f"[[{name}]] tables")
     return entries
 
 
@@ -50,22 +49,22 @@ def _segments(file: str, data: dict, model: Any, params: dict) -> tuple[Segment,
         base = f"segments[{i}]"
         for required in ("length", "elements"):
             if required not in table:
-                raise _fail(file, _join(base, required), f"missing key '{required}'",
+                raise fail(file, join(base, required), f"missing key '{required}'",
                             "a length > 0 (m)" if required == "length" else "an integer >= 1")
         length = _number(file, f"{base}.length", table["length"], params)
         if not length > 0:
-            raise _fail(file, f"{base}.length", f"length {length!r} is not positive", "a length > 0")
+            raise fail(file, f"{base}.length", f"length {length!r} is not positive", "a length > 0")
         elements = table["elements"]
         if not (isinstance(elements, int) and not isinstance(elements, bool)) or not 1 <= elements <= 100_000:
-            raise _fail(file, f"{base}.elements", f"elements is {_show(elements)}", "an integer from 1 to 100000")
+            raise fail(file, f"{base}.elements", f"elements is {show(elements)}", "an integer from 1 to 100000")
         values = {}
         for name, value in table.items():
             if name in ("length", "elements"):
                 continue
             if name not in numeric:
-                raise _fail(file, _join(base, name), f"unknown segment key {_show(name)}",
-                            "length, elements or a numeric model parameter: " + _listing(numeric))
-            values[name] = _number(file, _join(base, name), value, params)
+                raise fail(file, join(base, name), f"unknown segment key {show(name)}",
+                            "length, elements or a numeric model parameter: " + listing(numeric))
+            values[name] = _number(file, join(base, name), value, params)
         out.append(Segment(length, elements, values))
     return tuple(out)
 
@@ -81,19 +80,19 @@ def _parts(file: str, data: dict, model: Any, params: dict) -> tuple[Part, ...]:
         base = f"parts[{i}]"
         kind = table.get("kind")
         if kind not in kinds:
-            raise _fail(file, f"{base}.kind", f"unknown part kind {_show(kind)} for model '{model.name}'",
-                        "one of: " + _listing(sorted(kinds)))
+            raise fail(file, f"{base}.kind", f"unknown part kind {show(kind)} for model '{model.name}'",
+                        "one of: " + listing(sorted(kinds)))
         if "at" not in table:
-            raise _fail(file, f"{base}.at", "missing key 'at'", "the part's position s (m)")
+            raise fail(file, f"{base}.at", "missing key 'at'", "the part's position s (m)")
         at = _number(file, f"{base}.at", table["at"], params)
         values = {}
         for name, value in table.items():
             if name in ("kind", "at"):
                 continue
             if name not in kinds[kind]:
-                raise _fail(file, _join(base, name), f"unknown key {_show(name)} for a {kind}",
-                            "kind, at or a parameter of the part: " + _listing(list(kinds[kind])))
-            values[name] = _number(file, _join(base, name), value, params)
+                raise fail(file, join(base, name), f"unknown key {show(name)} for a {kind}",
+                            "kind, at or a parameter of the part: " + listing(list(kinds[kind])))
+            values[name] = _number(file, join(base, name), value, params)
         out.append(Part(kind, at, values))
     return tuple(out)
 
@@ -102,5 +101,5 @@ def load_layout(file: str, data: dict, model: Any, params: dict) -> tuple[tuple[
     """Validated segments and parts of a scene (both empty when it has none)."""
     if ("segments" in data or "parts" in data) and not getattr(model, "continuum", False):
         key = "segments" if "segments" in data else "parts"
-        raise _fail(file, key, f"model '{model.name}' is not a continuum", "segments and parts only for continua")
+        raise fail(file, key, f"model '{model.name}' is not a continuum", "segments and parts only for continua")
     return _segments(file, data, model, params), _parts(file, data, model, params)

@@ -10,72 +10,51 @@ list positions are 1-based) and what would have been accepted.
 
 No user text is evaluated: expressions go through :mod:`mechgen.scene.expr`,
 names are checked against the model or :func:`~mechgen.scene.expr.is_identifier`.
+Each analysis's keys are checked by its kind's schema (mechgen.analyses.registry); this module
+names no kind.
 """
 from __future__ import annotations
 
-import copy
-import itertools
-import json
-import math
 import os
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Mapping, Protocol, Sequence
-
-import numpy as np
+from typing import Any, Callable, Mapping, Sequence
 
 try:
     import tomllib
 except ImportError:  # pragma: no cover - Python 3.10
     import tomli as tomllib  # type: ignore[no-redef]
 
-from mechgen.errors import InputError, SceneError
-from mechgen.scene.expr import CONSTANTS, Expression, is_identifier, parse_expression
+from mechgen.errors import InputError
+from mechgen.analyses.registry import get as get_kind
+from mechgen.analyses.registry import kinds as analysis_kinds
+from mechgen.analyses.schema import AnalysisSpec, OptionContext, analysis_kind, validate
+from mechgen.scene.expr import CONSTANTS, Expression, is_identifier
+from mechgen.scene.layout import load_layout
+from mechgen.scene.values import IDENTIFIER_RULE, NUMBER, ModelInfo, ParamInfo
+# the value checks under the names this module has always used
+from mechgen.scene.values import choice_value as _choice_value
+from mechgen.scene.values import evaluate as _evaluate
+from mechgen.scene.values import expression as _expression
+from mechgen.scene.values import fail as _fail
+from mechgen.scene.values import finish as _finish
+from mechgen.scene.values import finite as _finite
+from mechgen.scene.values import is_choice as _is_choice
+from mechgen.scene.values import is_number as _is_number
+from mechgen.scene.values import join as _join
+from mechgen.scene.values import listing as _listing
+from mechgen.scene.values import param_info as _param_info
+from mechgen.scene.values import part as _part
+from mechgen.scene.values import show as _show
+from mechgen.scene.values import type_name as _type_name
 
-KINDS = ("modes", "stability", "steady", "simulate", "sweep", "campbell", "continuation")
-STEADY_METHODS = ("newton", "shooting", "multiple_shooting", "collocation")
+__all__ = ["AnalysisSpec", "ModelInfo", "ParamInfo", "Scene", "load_scene", "IDENTIFIER_RULE", "NUMBER"]
+
 BACKENDS = ("c", "numpy", "casadi")
-METHODS = ("BDF", "Radau", "LSODA", "RK45", "DOP853", "leapfrog")
 TOP_KEYS = ("title", "model", "backend", "free", "params", "coordinates", "analysis", "segments", "parts")
 MAX_SCENE_BYTES = 10 * 1024 * 1024
-MAX_GRID = 1_000_000
 MAX_TITLE = 500
-IDENTIFIER_RULE = ("an identifier: ASCII letters, digits and underscores, not starting with a digit or '__', "
-                   "at most 64 characters, not a Python keyword")
-NUMBER = "a number or an expression string"
-
-
-class ParamInfo(Protocol):
-    """What the loader needs to know about one model parameter."""
-
-    default: float | str
-    choices: tuple[str, ...] | None
-    integer: bool
-
-
-class ModelInfo(Protocol):
-    """Names of a model's parameters, coordinates and outputs."""
-
-    name: str
-    params: Mapping[str, ParamInfo]
-    coordinates: tuple[str, ...]
-    outputs: tuple[str, ...]
-
-
-@dataclass(frozen=True)
-class AnalysisSpec:
-    """One validated analysis: defaults filled, expressions evaluated to floats.
-
-    For ``sweep``, ``options["analysis"]`` is the inner :class:`AnalysisSpec`
-    (named like its parent), ``options["over"]`` maps each swept parameter to
-    its list of values and ``options["grid"]`` is the cartesian product of
-    ``over`` (first parameter outermost) as a list of dicts.
-    """
-
-    name: str
-    kind: str
-    options: Mapping[str, Any]
 
 
 @dataclass(frozen=True)
@@ -95,84 +74,6 @@ class Scene:
     #: the canonical reference of the model (a built-in name, an absolute file path, module:attribute)
     source: str = ""
 
-
-@dataclass
-class _Ctx:
-    """Working state while validating analyses."""
-
-    file: str
-    model: ModelInfo
-    params: dict[str, float | int | str]
-    depends: dict[str, tuple[str, ...]]
-    coordinates: tuple[str, ...]
-    active: tuple[str, ...] | None
-    all_names: tuple[str, ...] = ()
-    earlier: dict[str, str] = field(default_factory=dict)
-    current: str = ""
-    swept: tuple[str, ...] = ()
-
-
-# --------------------------------------------------------------------------- helpers
-
-_PLAIN_KEY = re.compile(r"[A-Za-z0-9_\-]{1,64}")
-
-
-def _part(name: object) -> str:
-    """A key segment safe to print: plain names as is, anything else JSON-quoted and shortened."""
-    text = str(name)
-    if _PLAIN_KEY.fullmatch(text):
-        return text
-    quoted = json.dumps(text)
-    return quoted if len(quoted) <= 40 else quoted[:36] + '..."'
-
-
-def _show(value: object) -> str:
-    """A short single-line rendering of a user value for messages."""
-    text = repr(value)
-    return text if len(text) <= 60 else text[:56] + "..."
-
-
-def _join(key: str | None, name: object) -> str:
-    return f"{key}.{_part(name)}" if key else _part(name)
-
-
-def _fail(file: str | None, key: str | None, message: str, expected: str | None = None) -> SceneError:
-    return SceneError(message, file=file, key=key, expected=expected)
-
-
-def _listing(names: Sequence[str]) -> str:
-    return ", ".join(names) if names else "(none)"
-
-
-def _type_name(value: object) -> str:
-    return {bool: "a boolean", int: "an integer", float: "a float", str: "a string", list: "an array",
-            dict: "a table"}.get(type(value), type(value).__name__)
-
-
-def _is_number(value: object) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
-
-
-def _finite(file: str | None, key: str, value: int | float) -> float | int:
-    if isinstance(value, float) and not math.isfinite(value):
-        raise _fail(file, key, f"value {value} is not finite", "a finite number")
-    return value
-
-
-def _expression(file: str | None, key: str, text: str) -> Expression:
-    try:
-        return parse_expression(text, file=file, key=key)
-    except SceneError:
-        raise
-    except InputError as exc:
-        raise _fail(file, key, exc.message, exc.expected) from None
-
-
-def _evaluate(file: str | None, key: str, expr: Expression, values: Mapping[str, Any]) -> float:
-    try:
-        return expr.evaluate(values)
-    except InputError as exc:
-        raise _fail(file, key, exc.message, exc.expected) from None
 
 
 # --------------------------------------------------------------------------- file and top level
@@ -256,27 +157,6 @@ def _top_level(file: str, data: dict, lookup_model: Callable[..., Any],
 
 # --------------------------------------------------------------------------- parameters
 
-def _is_choice(info: ParamInfo) -> bool:
-    return info.choices is not None or isinstance(info.default, str)
-
-
-def _param_info(file: str | None, key: str, model: ModelInfo, name: object) -> ParamInfo:
-    if not isinstance(name, str) or name not in model.params:
-        raise _fail(file, key, f"model '{model.name}' has no parameter {_show(name)}",
-                    "one of the model's parameters: " + _listing(list(model.params)))
-    return model.params[name]
-
-
-def _choice_value(file: str | None, key: str, info: ParamInfo, value: object) -> str:
-    allowed = f"one of: {_listing(list(info.choices))}" if info.choices is not None else IDENTIFIER_RULE
-    if not isinstance(value, str):
-        raise _fail(file, key, f"this parameter is a choice, got {_type_name(value)}", f"a string, {allowed}")
-    ok = value in info.choices if info.choices is not None else is_identifier(value)
-    if not ok:
-        raise _fail(file, key, f"{_show(value)} is not an allowed choice", allowed)
-    return value
-
-
 def _raw_value(file: str | None, key: str, info: ParamInfo, value: object) -> Any:
     """A parameter value as given: a number, an :class:`Expression` or a choice string."""
     if _is_choice(info):
@@ -324,14 +204,6 @@ def _scene_params(file: str, data: dict, model: ModelInfo) -> dict:
         info = _param_info(file, key, model, name)
         raw[name] = (_raw_value(file, key, info, value), file, key)
     return raw
-
-
-def _finish(file: str | None, key: str, info: ParamInfo, value: float) -> float | int:
-    if not info.integer:
-        return float(value)
-    if not float(value).is_integer():
-        raise _fail(file, key, f"value {value!r} is not an integer", "an integer value")
-    return int(value)
 
 
 class _Resolver:
@@ -421,484 +293,7 @@ def _active(file: str, data: dict, model: ModelInfo) -> tuple[str, ...] | None:
     return tuple(c for c in model.coordinates if c in names)
 
 
-# --------------------------------------------------------------------------- option validators
-
-def _number(ctx: _Ctx, key: str, value: object) -> float:
-    """A number or an expression of the resolved parameters."""
-    if _is_number(value):
-        return float(_finite(ctx.file, key, value))
-    if not isinstance(value, str):
-        raise _fail(ctx.file, key, f"value is {_type_name(value)}", NUMBER)
-    expr = _expression(ctx.file, key, value)
-    for name in expr.names:
-        if name in ctx.swept:
-            raise _fail(ctx.file, key, f"expression uses swept parameter '{name}', whose value changes "
-                        "across the grid", "an expression of parameters that are not swept")
-    return _evaluate(ctx.file, key, expr, ctx.params)
-
-
-def _positive(ctx: _Ctx, key: str, value: object) -> float:
-    number = _number(ctx, key, value)
-    if number <= 0:
-        raise _fail(ctx.file, key, f"value {number!r} is not positive", "a number > 0")
-    return number
-
-
-def _int_at_least(ctx: _Ctx, key: str, value: object, low: int) -> int:
-    if not isinstance(value, int) or isinstance(value, bool):
-        raise _fail(ctx.file, key, f"value is {_type_name(value)}", f"an integer >= {low}")
-    if value < low:
-        raise _fail(ctx.file, key, f"value {value} is below {low}", f"an integer >= {low}")
-    return value
-
-
-def _count(ctx: _Ctx, key: str, value: object) -> int:
-    return _int_at_least(ctx, key, value, 1)
-
-
-def _workers(ctx: _Ctx, key: str, value: object) -> int:
-    return _int_at_least(ctx, key, value, 0)
-
-
-def _bool(ctx: _Ctx, key: str, value: object) -> bool:
-    if not isinstance(value, bool):
-        raise _fail(ctx.file, key, f"value is {_type_name(value)}", "true or false")
-    return value
-
-
-def _method(ctx: _Ctx, key: str, value: object) -> str:
-    if not isinstance(value, str) or value not in METHODS:
-        raise _fail(ctx.file, key, f"unknown method {_show(value)}", "one of: " + ", ".join(METHODS))
-    return value
-
-
-def _one_of(what: str, names: Sequence[str]) -> Callable:
-    """A validator of a string key whose value is one of ``names`` (``what`` names it in the message)."""
-    def check(ctx: _Ctx, key: str, value: object) -> str:
-        if not isinstance(value, str) or value not in names:
-            raise _fail(ctx.file, key, f"unknown {what} {_show(value)}", "one of: " + ", ".join(names))
-        return value
-
-    return check
-
-
-_steady_method = _one_of("steady method", STEADY_METHODS)
-_branch_method = _one_of("continuation method", ("collocation", "gauss", "multiple_shooting"))
-BRANCH_DIRECTIONS = ("increasing", "decreasing", "both")
-_direction = _one_of("direction", BRANCH_DIRECTIONS)
-_campbell_method = _one_of("campbell method", ("auto", "exact", "reduced"))
-
-
-def _steady_form(ctx: _Ctx, key: str, value: object) -> str:
-    forms = ("lagrangian", "hamiltonian")
-    if not isinstance(value, str) or value not in forms:
-        raise _fail(ctx.file, key, f"unknown steady form {_show(value)}", "one of: " + ", ".join(forms))
-    if value == "hamiltonian" and not ctx.model.stress_form:
-        raise _fail(ctx.file, key, f"model {ctx.model.name} declares no complementary energy density",
-                    "form = 'lagrangian' (the Hamiltonian form needs @model.complementary_density)")
-    return value
-
-
-def _modes_table(ctx: _Ctx, key: str, value: object) -> dict[str, list[float]]:
-    """{field: [a_1, a_2, ...]}: sine amplitudes added to a boundary-value problem's initial guess."""
-    if not isinstance(value, dict):
-        raise _fail(ctx.file, key, f"value is {_type_name(value)}", "a table: field = [amplitudes of sin(j pi s/L)]")
-    out = {}
-    for name, amps in value.items():
-        sub = _join(key, name)
-        if not is_identifier(name):
-            raise _fail(ctx.file, sub, f"{_show(name)} is not a field name", IDENTIFIER_RULE)
-        if not isinstance(amps, list) or not amps:
-            raise _fail(ctx.file, sub, f"value is {_type_name(amps)}", "an array of numbers")
-        out[name] = [_number(ctx, f"{sub}[{i}]", a) for i, a in enumerate(amps, 1)]
-    return out
-
-
-def _aliases(ctx: _Ctx, key: str, value: object) -> dict[str, str]:
-    """{new_name: output_name}: report an output (e.g. tension_start) under a name of the scene's choosing."""
-    if not isinstance(value, dict):
-        raise _fail(ctx.file, key, f"value is {_type_name(value)}", "a table: name = \"output_name\"")
-    for name, target in value.items():
-        if not is_identifier(name) or not isinstance(target, str) or not is_identifier(target):
-            raise _fail(ctx.file, _join(key, name), f"alias {_show(name)} = {_show(target)}",
-                        "identifiers on both sides: name = \"output_name\"")
-    return dict(value)
-
-
-def _hold(ctx: _Ctx, key: str, value: object) -> dict[str, float]:
-    """{output_end: value}: one output at an end of a steady BVP held fixed (e.g. p_e = 17.5)."""
-    if not isinstance(value, dict) or len(value) != 1:
-        raise _fail(ctx.file, key, f"value is {_show(value)}", "a table with one entry: output = number, e.g. "
-                    "{ tension_start = 17.5 } (or an alias)")
-    (name, number), = value.items()
-    if not is_identifier(name):
-        raise _fail(ctx.file, _join(key, name), f"{_show(name)} is not an output name", IDENTIFIER_RULE)
-    return {name: _number(ctx, _join(key, name), number)}
-
-
-def _free_parameter(ctx: _Ctx, key: str, value: object) -> str:
-    """A numeric parameter a steady BVP solves for (with ``hold``)."""
-    info = _param_info(ctx.file, key, ctx.model, value)
-    if _is_choice(info) or info.integer:
-        raise _fail(ctx.file, key, f"parameter {_show(value)} is not a real number", "a numeric model parameter")
-    if value in ctx.swept:
-        raise _fail(ctx.file, key, f"parameter {_show(value)} is swept", "a parameter the sweep does not set")
-    return value
-
-
-# --------------------------------------------------------------------------- branches of steady states
-
-
-
-def _param_values(ctx: _Ctx, key: str, value: object) -> dict[str, float]:
-    """{parameter: number}: a steady analysis's own values of numeric parameters (made free)."""
-    if not isinstance(value, dict) or not value:
-        raise _fail(ctx.file, key, f"value is {_show(value)}", "a table of numeric parameters, e.g. { lambda0 = 0.3 }")
-    out = {}
-    for name, number in value.items():
-        sub = _join(key, name)
-        info = _param_info(ctx.file, sub, ctx.model, name)
-        if _is_choice(info) or info.integer:
-            raise _fail(ctx.file, sub, f"parameter {_show(name)} is not a real number", "a numeric model parameter")
-        if name in ctx.swept:
-            raise _fail(ctx.file, sub, f"parameter {_show(name)} is swept", "a parameter the sweep does not set")
-        out[name] = _number(ctx, sub, number)
-        if info.below is not None and not out[name] < info.below:
-            raise _fail(ctx.file, sub, f"{name} = {out[name]!r} is not below {info.below!r}",
-                        f"a value below {info.below!r}")
-    return out
-
-
-def _shape_value(ctx: _Ctx, key: str, value: object) -> dict[str, float]:
-    """{shape_output: value}: a steady start with this value of a model-declared shape output (loops = 2)."""
-    known = tuple(getattr(ctx.model, "shape_outputs", ()))
-    expected = "a table with one entry, a shape output of the model = number: " + _listing(known)
-    if not isinstance(value, dict) or len(value) != 1:
-        raise _fail(ctx.file, key, f"value is {_show(value)}", expected)
-    (name, number), = value.items()
-    if name not in known:
-        raise _fail(ctx.file, _join(key, name), f"model '{ctx.model.name}' has no shape output {_show(name)}", expected)
-    return {name: _number(ctx, _join(key, name), number)}
-
-
-def _starts(ctx: _Ctx, key: str, value: object) -> str | list[str]:
-    """One earlier steady analysis, or an array of them (one branch each)."""
-    if not isinstance(value, list):
-        return _about(ctx, key, value)
-    if not value:
-        raise _fail(ctx.file, key, "empty array", "an array of earlier steady analyses")
-    names = [_about(ctx, f"{key}[{i}]", v) for i, v in enumerate(value, 1)]
-    for i, name in enumerate(names, 1):
-        if name in names[:i - 1]:
-            raise _fail(ctx.file, f"{key}[{i}]", f"start '{name}' is listed twice", "distinct steady analyses")
-    return names
-
-
-def _output_values(ctx: _Ctx, key: str, value: object) -> dict[str, float]:
-    """{output: number}: values whose crossings a branch locates (at = { p_e = 5.0 })."""
-    if not isinstance(value, dict) or not value:
-        raise _fail(ctx.file, key, f"value is {_show(value)}", "a table: output = number, e.g. { p_e = 5.0 }")
-    out = {}
-    for name, number in value.items():
-        if not is_identifier(name):
-            raise _fail(ctx.file, _join(key, name), f"{_show(name)} is not an output name", IDENTIFIER_RULE)
-        out[name] = _number(ctx, _join(key, name), number)
-    return out
-
-
-def _bounds(ctx: _Ctx, key: str, value: object) -> dict[str, tuple[float, float]]:
-    """{output: [low, high]}: a branch ends where an output leaves its range."""
-    expected = "a table: output = [low, high] with low < high, e.g. { p_e = [0, 12] }"
-    if not isinstance(value, dict) or not value:
-        raise _fail(ctx.file, key, f"value is {_show(value)}", expected)
-    out = {}
-    for name, pair in value.items():
-        sub = _join(key, name)
-        if not is_identifier(name):
-            raise _fail(ctx.file, sub, f"{_show(name)} is not an output name", IDENTIFIER_RULE)
-        if not isinstance(pair, list) or len(pair) != 2:
-            raise _fail(ctx.file, sub, f"value is {_show(pair)}", expected)
-        lo, hi = (_number(ctx, f"{sub}[{i}]", v) for i, v in enumerate(pair, 1))
-        if not lo < hi:
-            raise _fail(ctx.file, sub, f"the range [{lo!r}, {hi!r}] is empty", expected)
-        out[name] = (lo, hi)
-    return out
-
-
-def _check_branch_outputs(ctx: _Ctx, base: str, options: dict[str, Any]) -> None:
-    """Names in ``at`` and ``bounds``: aliases, <output>_<start|end|max|min>, <field>_s_<start|end>, shape outputs."""
-    if not getattr(ctx.model, "fields", ()):
-        return
-    known = set(options.get("aliases", {})) | set(getattr(ctx.model, "shape_outputs", ()))
-    known |= {f"{o}_{end}" for o in ctx.model.outputs for end in ("start", "end", "max", "min")}
-    known |= {f"{f}_s_{end}" for f in ctx.model.fields for end in ("start", "end")}
-    for key in ("at", "bounds"):
-        for name in options.get(key, {}):
-            if name not in known:
-                raise _fail(ctx.file, f"{base}.{key}.{name}", f"no output {_show(name)} on a branch",
-                            "an alias of this analysis or <output>_start/_end/_max/_min: " + _listing(sorted(known)))
-
-
-def _parameter(ctx: _Ctx, key: str, value: object) -> str:
-    info = _param_info(ctx.file, key, ctx.model, value)
-    if _is_choice(info) or info.integer:
-        raise _fail(ctx.file, key, f"parameter {_show(value)} is not a real number", "a numeric model parameter")
-    _check_not_derived(ctx, key, value)
-    ctx.swept = (value,)
-    return value
-
-
-def _name(ctx: _Ctx, key: str, value: object) -> str:
-    if not isinstance(value, str) or not is_identifier(value):
-        raise _fail(ctx.file, key, f"value is {_show(value)}", IDENTIFIER_RULE)
-    return value
-
-
-def _coord_table(ctx: _Ctx, key: str, value: object) -> dict[str, float]:
-    """A table coordinate name -> number or expression."""
-    if not isinstance(value, dict):
-        raise _fail(ctx.file, key, f"value is {_type_name(value)}", "a table of coordinate = value")
-    out: dict[str, float] = {}
-    for name, item in value.items():
-        sub = _join(key, name)
-        if not isinstance(name, str) or name not in ctx.coordinates:
-            frozen = ctx.active is not None and name in ctx.model.coordinates
-            which = "active coordinates" if ctx.active is not None else "model's coordinates"
-            what = f"coordinate '{name}' is not active" if frozen else f"unknown coordinate {_show(name)}"
-            raise _fail(ctx.file, sub, what, f"one of the {which}: " + _listing(ctx.coordinates))
-        out[name] = _number(ctx, sub, item)
-    return out
-
-
-def _about(ctx: _Ctx, key: str, value: object) -> str:
-    """Name of an earlier ``steady`` analysis."""
-    steady = [n for n, k in ctx.earlier.items() if k == "steady"]
-    expected = "the name of an earlier steady analysis: " + _listing(steady)
-    if ctx.swept:
-        raise _fail(ctx.file, key, "'about' is not available inside a sweep", "no 'about' key")
-    if not isinstance(value, str):
-        raise _fail(ctx.file, key, f"value is {_type_name(value)}", expected)
-    if value in ctx.earlier and ctx.earlier[value] != "steady":
-        raise _fail(ctx.file, key, f"analysis '{value}' is a {ctx.earlier[value]} analysis, not steady", expected)
-    if value not in ctx.earlier:
-        later = value in ctx.all_names
-        what = f"analysis '{value}' comes later in the scene" if later else f"no analysis named {_show(value)}"
-        raise _fail(ctx.file, key, what, expected)
-    return value
-
-
-def _outputs(ctx: _Ctx, key: str, value: object) -> list[str]:
-    known = ctx.model.outputs
-    if not isinstance(value, list):
-        raise _fail(ctx.file, key, f"value is {_type_name(value)}", "an array of output names: " + _listing(known))
-    names: list[str] = []
-    for i, name in enumerate(value, 1):
-        if not isinstance(name, str) or name not in known:
-            raise _fail(ctx.file, f"{key}[{i}]", f"unknown output {_show(name)}",
-                        "one of the model's outputs: " + _listing(known))
-        if name not in names:
-            names.append(name)
-    return names
-
-
-# --------------------------------------------------------------------------- sweeps
-
-def _range(ctx: _Ctx, key: str, table: dict) -> list[float]:
-    """{start, stop, num} -> evenly spaced values."""
-    for name in table:
-        if name not in ("start", "stop", "num"):
-            raise _fail(ctx.file, _join(key, name), f"unknown key {_show(name)}", "start, stop, num")
-    for name in ("start", "stop", "num"):
-        if name not in table:
-            raise _fail(ctx.file, _join(key, name), f"missing key '{name}'", "a table {start, stop, num}")
-    start, stop = _number(ctx, f"{key}.start", table["start"]), _number(ctx, f"{key}.stop", table["stop"])
-    num = _int_at_least(ctx, f"{key}.num", table["num"], 1)
-    if num > MAX_GRID:
-        raise _fail(ctx.file, f"{key}.num", f"num {num} is too large", f"at most {MAX_GRID}")
-    return [float(v) for v in np.linspace(start, stop, num)]
-
-
-def _sweep_values(ctx: _Ctx, key: str, name: str, value: object) -> list[float | int]:
-    info = _param_info(ctx.file, key, ctx.model, name)
-    if _is_choice(info):
-        if not isinstance(value, list) or not value:
-            raise _fail(ctx.file, key, f"value is {_type_name(value)}", "a non-empty array of choices")
-        return [_choice_value(ctx.file, f"{key}[{i}]", info, v) for i, v in enumerate(value, 1)]
-    if isinstance(value, dict):
-        values = _range(ctx, key, value)
-    elif isinstance(value, list) and value:
-        values = [_number(ctx, f"{key}[{i}]", v) for i, v in enumerate(value, 1)]
-    else:
-        what = "empty array" if value == [] else f"value is {_type_name(value)}"
-        raise _fail(ctx.file, key, what, "a non-empty array of numbers or a table {start, stop, num}")
-    return [_finish(ctx.file, key, info, v) for v in values]
-
-
-def _check_not_derived(ctx: _Ctx, key: str, name: str) -> None:
-    """A swept parameter may not feed another parameter's expression (it would go stale)."""
-    for other, uses in ctx.depends.items():
-        if name in uses:
-            raise _fail(ctx.file, key, f"parameter '{other}' is computed from '{name}', so sweeping '{name}' "
-                        f"would leave '{other}' at its scene value", "a parameter no expression depends on")
-
-
-def _over(ctx: _Ctx, key: str, value: object) -> dict[str, list]:
-    if not isinstance(value, dict) or not value:
-        raise _fail(ctx.file, key, f"value is {_type_name(value)}" if not isinstance(value, dict) else "empty table",
-                    "a table: parameter = [values] or {start, stop, num}")
-    over = {}
-    for name, item in value.items():
-        sub = _join(key, name)
-        over[name] = _sweep_values(ctx, sub, name, item)
-        _check_not_derived(ctx, sub, name)
-    size = math.prod(len(v) for v in over.values())
-    if size > MAX_GRID:
-        raise _fail(ctx.file, key, f"the grid has {size} points", f"at most {MAX_GRID} points")
-    ctx.swept = tuple(over)
-    return over
-
-
-def _speeds(ctx: _Ctx, key: str, value: object) -> dict[str, list]:
-    """A campbell range: one numeric parameter (the spin speed) with increasing values."""
-    over = _over(ctx, key, value)
-    if len(over) != 1:
-        raise _fail(ctx.file, key, f"a campbell diagram runs over one parameter, got {len(over)}",
-                    "one entry: Omega = {start, stop, num} or an array")
-    (name, values), = over.items()
-    if _is_choice(_param_info(ctx.file, key, ctx.model, name)) or len(values) < 2 or np.any(np.diff(values) <= 0):
-        raise _fail(ctx.file, _join(key, name), "campbell speeds must be two or more increasing numbers",
-                    "increasing numbers, e.g. {start = 0, stop = 1000, num = 50}")
-    return over
-
-
-def _multiples(ctx: _Ctx, key: str, value: object) -> list[float]:
-    if not isinstance(value, list) or not value:
-        raise _fail(ctx.file, key, f"value is {_type_name(value)}", "a non-empty array of positive numbers")
-    return [_positive(ctx, f"{key}[{i}]", v) for i, v in enumerate(value, 1)]
-
-
-def _inner(ctx: _Ctx, key: str, value: object) -> AnalysisSpec:
-    """The analysis a sweep repeats: a table with ``kind`` (not sweep) and that kind's keys."""
-    inner_kinds = [k for k in KINDS if k not in ("sweep", "campbell", "continuation")]
-    if not isinstance(value, dict):
-        raise _fail(ctx.file, key, f"value is {_type_name(value)}", "a table with kind and its options")
-    kind = _kind(ctx, key, value, inner_kinds)
-    options = _options(ctx, key, kind, {k: v for k, v in value.items() if k != "kind"})
-    return AnalysisSpec(ctx.current, kind, options)
-
-
-def _grid(over: Mapping[str, list]) -> list[dict[str, float | int]]:
-    names = list(over)
-    return [dict(zip(names, combo)) for combo in itertools.product(*(over[n] for n in names))]
-
-
-# --------------------------------------------------------------------------- analyses
-
-_REQUIRED = object()
-_ABSENT = object()
-_ALL_OUTPUTS = object()
-
-_LINEAR = {"about": (_about, _ABSENT), "at": (_coord_table, _ABSENT), "count": (_count, _ABSENT)}
-SCHEMAS: dict[str, dict[str, tuple[Callable, Any]]] = {
-    "modes": dict(_LINEAR),
-    "stability": {**_LINEAR, "tolerance": (_positive, 1e-8), "refine": (_bool, True),
-                  "refine_rtol": (_positive, 1e-2)},
-    "steady": {"guess": (_coord_table, {}), "tol": (_positive, 1e-10), "max_iter": (_count, 50),
-               "method": (_steady_method, _ABSENT), "bulge": (_modes_table, _ABSENT), "mesh": (_count, _ABSENT),
-               "nodes": (_count, _ABSENT), "aliases": (_aliases, _ABSENT), "form": (_steady_form, _ABSENT),
-               "params": (_param_values, _ABSENT), "shape": (_shape_value, _ABSENT),
-               "hold": (_hold, _ABSENT), "free": (_free_parameter, _ABSENT), "stability": (_bool, _ABSENT)},
-    "simulate": {"t_end": (_positive, _REQUIRED), "method": (_method, "BDF"), "dt": (_positive, _ABSENT),
-                 "rtol": (_positive, 1e-8), "atol": (_positive, 1e-10), "q0": (_coord_table, {}),
-                 "v0": (_coord_table, {}), "initial_mode": (_count, _ABSENT), "amplitude": (_number, 1.0),
-                 "outputs": (_outputs, _ALL_OUTPUTS), "series": (_bool, False), "samples": (_count, 201)},
-    "sweep": {"over": (_over, _REQUIRED), "analysis": (_inner, _REQUIRED), "workers": (_workers, 0),
-              "progress": (_bool, True)},
-    "continuation": {"about": (_starts, _REQUIRED), "parameter": (_parameter, _REQUIRED), "stop": (_number, _REQUIRED),
-                     "step": (_positive, 0.05), "max_step": (_positive, _ABSENT), "max_points": (_count, 200),
-                     "method": (_branch_method, _ABSENT), "stages": (_count, _ABSENT),
-                     "mesh": (_count, 100),
-                     "stability": (_bool, True), "minimize": (_name, _ABSENT), "aliases": (_aliases, {}),
-                     "direction": (_direction, _ABSENT), "bounds": (_bounds, _ABSENT),
-                     "at": (_output_values, _ABSENT), "eigenvalues": (_bool, False)},
-    "campbell": {"over": (_speeds, _REQUIRED), "count": (_count, 8), "multiples": (_multiples, [1.0]),
-                 "method": (_campbell_method, _ABSENT),
-                 "about": (_about, _ABSENT), "at": (_coord_table, _ABSENT)},
-}
-
-
-def _kind(ctx: _Ctx, base: str, table: dict, kinds: Sequence[str]) -> str:
-    key = f"{base}.kind"
-    expected = "one of: " + ", ".join(kinds)
-    if "kind" not in table:
-        raise _fail(ctx.file, key, "missing key 'kind'", expected)
-    kind = table["kind"]
-    if not isinstance(kind, str) or kind not in kinds:
-        raise _fail(ctx.file, key, f"unknown analysis kind {_show(kind)}", expected)
-    return kind
-
-
-def _options(ctx: _Ctx, base: str, kind: str, table: dict) -> dict[str, Any]:
-    """Validate a kind's keys, fill defaults and run the cross-key checks."""
-    schema = SCHEMAS[kind]
-    for name in table:
-        if name not in schema:
-            raise _fail(ctx.file, _join(base, name), f"unknown key {_show(name)} for a {kind} analysis",
-                        "one of: " + ", ".join(schema))
-    options: dict[str, Any] = {}
-    for name, (check, default) in schema.items():
-        if name in table:
-            options[name] = check(ctx, f"{base}.{name}", table[name])
-        elif default is _REQUIRED:
-            raise _fail(ctx.file, f"{base}.{name}", f"missing required key '{name}' for a {kind} analysis",
-                        _describe(name))
-        elif default is _ALL_OUTPUTS:
-            options[name] = list(ctx.model.outputs)
-        elif default is not _ABSENT:
-            options[name] = copy.deepcopy(default)
-    _cross_checks(ctx, base, kind, options)
-    return options
-
-
-def _describe(name: str) -> str:
-    return {"t_end": "a number > 0 (or an expression)", "over": "a table: parameter = [values] or {start, stop, num}",
-            "analysis": "a table with kind and its options", "dt": "a number > 0 (or an expression)"}.get(name, "a value")
-
-
-def _cross_checks(ctx: _Ctx, base: str, kind: str, options: dict[str, Any]) -> None:
-    if kind == "simulate":
-        if options["method"] == "leapfrog" and "dt" not in options:
-            raise _fail(ctx.file, f"{base}.dt", "method 'leapfrog' needs a time step dt", _describe("dt"))
-        if "dt" in options and options["dt"] > options["t_end"]:
-            raise _fail(ctx.file, f"{base}.dt", f"dt {options['dt']!r} exceeds t_end {options['t_end']!r}",
-                        "a time step no larger than t_end")
-        if options.get("initial_mode", 0) > len(ctx.coordinates):
-            raise _fail(ctx.file, f"{base}.initial_mode", f"initial_mode {options['initial_mode']} exceeds the "
-                        f"{len(ctx.coordinates)} coordinates", f"an integer from 1 to {len(ctx.coordinates)}")
-    if kind == "sweep":
-        options["grid"] = _grid(options["over"])
-    if kind == "steady" and ("hold" in options) != ("free" in options):
-        missing = "free" if "hold" in options else "hold"
-        raise _fail(ctx.file, f"{base}.{missing}", f"'hold' and 'free' go together; '{missing}' is missing",
-                    "hold = { output = value } with free = \"parameter\"")
-    if kind == "steady" and "shape" in options and "bulge" in options:
-        raise _fail(ctx.file, f"{base}.bulge", "'shape' takes its starting guesses from the model; 'bulge' would be "
-                    "ignored", "either shape or bulge")
-    if kind == "steady" and ("params" in options or "shape" in options) and options.get("method", "newton") == "newton":
-        raise _fail(ctx.file, f"{base}.method", "params and shape are for a boundary-value steady state",
-                    "method = shooting, multiple_shooting or collocation")
-    if kind == "continuation":
-        if isinstance(options["about"], list) and "minimize" in options:
-            raise _fail(ctx.file, f"{base}.minimize", "minimize follows one branch; 'about' lists several starts",
-                        "one start (about = \"name\") with minimize")
-        _check_branch_outputs(ctx, base, options)
-    if kind == "steady" and ("hold" in options or options.get("stability") or "form" in options) \
-            and options.get("method", "newton") == "newton":
-        raise _fail(ctx.file, f"{base}.method", "hold, stability and form need a boundary-value steady state",
-                    "method = shooting, multiple_shooting or collocation")
-
-
-def _analysis_name(ctx: _Ctx, base: str, table: dict) -> str:
+def _analysis_name(ctx: OptionContext, base: str, table: dict) -> str:
     key = f"{base}.name"
     if "name" not in table:
         raise _fail(ctx.file, key, "missing key 'name'", IDENTIFIER_RULE)
@@ -910,20 +305,20 @@ def _analysis_name(ctx: _Ctx, base: str, table: dict) -> str:
     return name
 
 
-def _analysis(ctx: _Ctx, index: int, table: object) -> AnalysisSpec:
+def _analysis(ctx: OptionContext, index: int, table: object) -> AnalysisSpec:
     base = f"analysis[{index}]"
     if not isinstance(table, dict):
         raise _fail(ctx.file, base, f"analysis entry is {_type_name(table)}", "an [[analysis]] table")
     name = _analysis_name(ctx, base, table)
-    kind = _kind(ctx, base, table, KINDS)
+    kind = analysis_kind(ctx, base, table, analysis_kinds())
     ctx.current, ctx.swept = name, ()
-    options = _options(ctx, base, kind, {k: v for k, v in table.items() if k not in ("name", "kind")})
+    options = validate(ctx, base, get_kind(kind), {k: v for k, v in table.items() if k not in ("name", "kind")})
     ctx.swept = ()
     ctx.earlier[name] = kind
     return AnalysisSpec(name, kind, options)
 
 
-def _analyses(ctx: _Ctx, data: dict) -> tuple[AnalysisSpec, ...]:
+def _analyses(ctx: OptionContext, data: dict) -> tuple[AnalysisSpec, ...]:
     entries = data.get("analysis")
     if not isinstance(entries, list) or not entries:
         what = "the scene has no analysis" if entries is None else f"analysis is {_type_name(entries)}"
@@ -940,7 +335,7 @@ def _plain(value: object) -> object:
         return {k: _plain(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
         return [_plain(v) for v in value]
-    if isinstance(value, np.generic):
+    if hasattr(value, "item") and type(value).__module__ == "numpy":
         return value.item()
     if isinstance(value, os.PathLike):
         return os.fspath(value)
@@ -981,26 +376,10 @@ def load_scene(path, *, overrides: Sequence[str] = (), lookup_model: Callable[..
                         f"a value below {below!r}")
     free = _free(file, data, model)
     active = _active(file, data, model)
-    ctx = _Ctx(file, model, params, depends, active or tuple(model.coordinates), active)
+    ctx = OptionContext(file, model, params, depends, active or tuple(model.coordinates), active)
     analyses = _analyses(ctx, data)
-    for index, spec in enumerate(analyses, 1):
-        if spec.kind in ("sweep", "campbell"):
-            free += [n for n in spec.options["over"] if n not in free]
-        inner = spec.options["analysis"] if spec.kind == "sweep" else spec
-        if inner.kind == "steady" and inner.options.get("free") and inner.options["free"] not in free:
-            free.append(inner.options["free"])
-        if inner.kind == "steady":
-            free += [n for n in inner.options.get("params", {}) if n not in free]
-        if spec.kind == "continuation":
-            name = spec.options["parameter"]
-            below = getattr(model.params[name], "below", None)
-            if below is not None and not spec.options["stop"] < below:
-                raise _fail(file, f"analysis[{index}].stop", f"stop {spec.options['stop']!r} is not below "
-                            f"{below!r}, the bound of parameter '{name}'", f"a value below {below!r}")
-            if name not in free:
-                free.append(name)
-    from mechgen.scene.layout import load_layout
-
+    for spec in analyses:
+        free += [n for n in get_kind(spec.kind).frees(spec.options) if n not in free]
     segments, parts = load_layout(file, data, model, params)
     free += sorted({n for seg in segments for n in seg.values if n not in free})
     return Scene(file, title, model.name, backend, params, tuple(free), active, analyses, segments, parts,

@@ -1,21 +1,7 @@
-"""A readable text summary of scene results."""
+"""A readable text summary of scene results (each analysis's lines come from its kind)."""
 from __future__ import annotations
 
-
-def _fmt(value, width: int = 8, depth: int = 0) -> str:
-    """One line: numbers to 6 digits, lists cut at ``width`` items, nesting below two levels only sized."""
-    if isinstance(value, float):
-        return f"{value:.6g}"
-    if isinstance(value, list):
-        if depth >= 2:
-            return f"[...] ({len(value)})"
-        shown = ", ".join(_fmt(v, width, depth + 1) for v in value[:width])
-        return f"[{shown}{', ...' if len(value) > width else ''}] ({len(value)})" if len(value) > width else f"[{shown}]"
-    if isinstance(value, dict):
-        if depth >= 2:
-            return "{" + ", ".join(str(k) for k in list(value)[:width]) + "}"
-        return "{" + ", ".join(f"{k}: {_fmt(v, width, depth + 1)}" for k, v in list(value.items())[:width]) + "}"
-    return str(value)
+from mechgen.analyses.registry import get
 
 
 def summary(results: dict) -> str:
@@ -27,13 +13,5 @@ def summary(results: dict) -> str:
              "kernels: " + ", ".join(f"{k} ({v['ops']} ops)" for k, v in build.get("kernels", {}).items())]
     for a in results["analyses"]:
         lines.append(f"[{a['kind']}] {a['name']} ({a['seconds']:.3f} s)")
-        for key, value in a["outputs"].items():
-            if key in ("t", "energy_series", "grid", "s", "shapes") or (a["kind"] in ("sweep", "campbell")
-                                                                      and key in ("eigenvalues", "log_dec")):
-                continue
-            lines.append(f"    {key}: {_fmt(value, width=4 if a['kind'] == 'sweep' else 8)}")
-        if a["kind"] == "sweep":
-            grid = a["outputs"].get("grid", [])
-            if grid:
-                lines.append(f"    grid: {len(grid)} points from {grid[0]} to {grid[-1]}")
+        lines += get(a["kind"]).summary(a["outputs"])
     return "\n".join(lines)

@@ -7,23 +7,20 @@ starts with "_" are working data and never reach JSON.
 from __future__ import annotations
 
 import time
-from functools import lru_cache
+from functools import lru_cache, partial
 from pathlib import Path
 from typing import Mapping
 
 from mechgen import models
 from mechgen.pipeline import compile_model
 from mechgen.errors import InputError
+from mechgen.analyses.context import NAME, POINTS, PointRunner, public
+from mechgen.analyses.registry import get
+from mechgen.analyses.result import run_analysis
 from mechgen.runtime.mesh import Layout
-from mechgen.runtime.sweep import sweep
-from mechgen.scene.analyses import RUNNERS, needs
 from mechgen.scene.info import lookup_model
 from mechgen.scene.load import load_scene
 from mechgen.symbolic.specialize import specialize
-
-
-def _public(outputs: dict) -> dict:
-    return {k: v for k, v in outputs.items() if not k.startswith("_")}
 
 
 @lru_cache(maxsize=8)
@@ -55,14 +52,12 @@ def _sweep_point(task: tuple) -> dict:
                                 kernels, backend)
     system = _laid_out(system, layout).with_param_vector(
         [float(point.get(n, dict(values).get(n, model.param(n).default))) for n in system.meta.get("params", [])])
-    return _public(RUNNERS[kind](system, options, {}))
+    return public(get(kind).run(system, options, {}))
 
 
-def _collect(grid: list[dict], results: list[dict]) -> dict:
-    out: dict = {"grid": grid}
-    for key in results[0] if results else []:
-        out[key] = [r.get(key) for r in results]
-    return out
+def _point_task(scene: tuple, layout, kind: str, options: dict, point: dict) -> tuple:
+    """The task _sweep_point takes: the scene's compile inputs, the analysis, the point and the layout."""
+    return (*scene, kind, options, point, layout)
 
 
 def run_scene(scene, *, overrides=(), backend: str | None = None) -> dict:
@@ -72,7 +67,7 @@ def run_scene(scene, *, overrides=(), backend: str | None = None) -> dict:
     model = models.get(scn.source)
     backend = backend or scn.backend
     internal = bool(model.internals)
-    kernels = sorted(set().union(*(needs(a.kind, a.options, internal=internal) for a in scn.analyses)))
+    kernels = sorted(set().union(*(get(a.kind).needs(a.options, internal=internal) for a in scn.analyses)))
     free = tuple(n for n in scn.free if model.param(n).is_numeric)
     fixed = tuple(sorted((k, v) for k, v in scn.params.items()))
     started = time.perf_counter()
@@ -82,21 +77,13 @@ def run_scene(scene, *, overrides=(), backend: str | None = None) -> dict:
     results = {"scene": Path(scn.path).name, "title": scn.title, "model": scn.model, "backend": report.backend,
                "params": dict(scn.params), "build": report.to_json(), "analyses": []}
     results["build"]["seconds_total"] = time.perf_counter() - started
-    context: dict = {}
+    scene_inputs = (scn.source, fixed, free, scn.active, tuple(kernels), backend)
+    context: dict = {POINTS: PointRunner(_sweep_point, partial(_point_task, scene_inputs, layout))}
     for analysis in scn.analyses:
-        clock = time.perf_counter()
-        if analysis.kind == "sweep":
-            inner = analysis.options["analysis"]
-            tasks = [(scn.source, fixed, free, scn.active, tuple(kernels), backend, inner.kind, dict(inner.options),
-                      point, layout) for point in analysis.options["grid"]]
-            res = sweep(_sweep_point, tasks, workers=analysis.options.get("workers", 0),
-                        progress=analysis.options.get("progress", True), desc=analysis.name)
-            outputs = _collect(analysis.options["grid"], res)
-        else:
-            outputs = RUNNERS[analysis.kind](system, dict(analysis.options), context)
-        context[analysis.name] = outputs
-        results["analyses"].append({"name": analysis.name, "kind": analysis.kind, "outputs": _public(outputs),
-                                    "seconds": time.perf_counter() - clock})
+        context[NAME] = analysis.name
+        result = run_analysis(analysis.name, analysis.kind, system, dict(analysis.options), context)
+        context[analysis.name] = result.state
+        results["analyses"].append(result.to_json())
     return results
 
 

@@ -1,0 +1,144 @@
+"""``campbell``: a Campbell diagram, the damped modes over a range of one parameter (the spin speed).
+
+The modes are tracked across speeds (mechgen.runtime.campbell) and critical speeds are found where a
+whirl frequency crosses a multiple of the speed. Scene keys: ``over`` (one numeric parameter with two
+or more increasing values), ``count`` (modes, default 8), ``multiples`` (of the speed, default [1]),
+``method`` (auto, exact, reduced), ``about`` and ``at`` (the operating point). Outputs: ``speeds``,
+``frequencies`` and ``whirl`` and ``log_dec`` (one row per speed), ``critical_speeds``, ``parameter``,
+``method`` and ``exact_solves``.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from mechgen.analyses import schema, summary
+from mechgen.analyses.operating_point import operating_point
+from mechgen.analyses.registry import AnalysisKind, register
+from mechgen.analyses.schema import REQUIRED, Option
+from mechgen.analyses.whirl import SPARSE_N, whirl_stations
+from mechgen.errors import SceneError
+from mechgen.runtime.campbell import campbell, critical_speeds, fit_speed_polynomial
+from mechgen.scene.values import fail, is_choice, join, param_info, type_name
+
+
+def _speeds(ctx, key: str, value: object) -> dict[str, list]:
+    """A campbell range: one numeric parameter (the spin speed) with increasing values."""
+    over = schema.over(ctx, key, value)
+    if len(over) != 1:
+        raise fail(ctx.file, key, f"a campbell diagram runs over one parameter, got {len(over)}",
+                   "one entry: Omega = {start, stop, num} or an array")
+    (name, values), = over.items()
+    if is_choice(param_info(ctx.file, key, ctx.model, name)) or len(values) < 2 or np.any(np.diff(values) <= 0):
+        raise fail(ctx.file, join(key, name), "campbell speeds must be two or more increasing numbers",
+                   "increasing numbers, e.g. {start = 0, stop = 1000, num = 50}")
+    return over
+
+
+def _multiples(ctx, key: str, value: object) -> list[float]:
+    if not isinstance(value, list) or not value:
+        raise fail(ctx.file, key, f"value is {type_name(value)}", "a non-empty array of positive numbers")
+    return [schema.positive(ctx, f"{key}[{i}]", v) for i, v in enumerate(value, 1)]
+
+
+SCHEMA = {"over": Option(_speeds, REQUIRED, "a table: parameter = [values] or {start, stop, num}"),
+          "count": Option(schema.count, 8), "multiples": Option(_multiples, [1.0]),
+          "method": Option(schema.one_of("campbell method", ("auto", "exact", "reduced"))),
+          "about": Option(schema.about), "at": Option(schema.coordinate_table)}
+
+
+def needs(options: dict, *, internal: bool) -> set[str]:
+    """M, D, G, K: the linear kernel."""
+    return {"linear"}
+
+
+def frees(options: dict) -> list[str]:
+    """The speed parameter: free in the kernels."""
+    return list(options["over"])
+
+
+def _speed_parameter(system, options: dict) -> tuple[str, list[float]]:
+    (name, values), = options["over"].items()
+    if name not in system.meta.get("params", []):
+        raise SceneError(f"campbell over {name!r}, which the compiled kernels fold as a constant",
+                         key="over", expected="a numeric model parameter (kept free by the scene)")
+    return name, [float(v) for v in values]
+
+
+def run_campbell(system, options: dict, context: dict) -> dict:
+    """Campbell diagram: tracked damped frequencies over the speed range, whirl, log_dec, critical speeds.
+
+    With more than four speeds the matrices are tested for a polynomial dependence on the speed
+    (fit_speed_polynomial: three or four assemblies); when it holds, no further assembly is needed and
+    the Campbell runs on the reduced basis (mechgen.runtime.campbell), else it assembles at every speed.
+    ``options['method'] = 'exact'`` forces full-size solves at every speed."""
+    name, speeds = _speed_parameter(system, options)
+    if not system.meta.get("whirl"):
+        raise SceneError(f"model {system.meta.get('model')} declares no whirl pair", key="kind",
+                         expected="a model with Model.whirl_pair (a rotor) for a campbell analysis")
+    stations = whirl_stations(system)
+    if stations is None:
+        raise SceneError("a campbell diagram tracks whirl at nodal values; substructures joined by multipliers have "
+                         "none", key="joints", expected="joints = 'assembly' for campbell (the same frequencies)")
+    q = operating_point(system, options, context)
+
+    def assembled(speed: float) -> dict:
+        mats = system.with_params(**{name: speed}).linear(q)
+        return {"M": mats["M"], "D": mats["D"], "G": mats["G"], "K": mats["K"]}
+
+    def assembled_at(speed: float) -> dict:
+        mats = assembled(speed)
+        return {"M": mats["M"], "C": mats["D"] + mats["G"], "K": mats["K"]}
+
+    count = int(options.get("count", 8))
+    sparse = system.n > SPARSE_N
+    # matrices polynomial in the speed (a rotor's G = Omega G1): four assemblies, then sparse adds
+    poly = fit_speed_polynomial(assembled, speeds[0], speeds[-1]) if len(speeds) > 4 else None
+    matrices_at = assembled_at if poly is None else poly.combined({"M": ("M",), "C": ("D", "G"), "K": ("K",)})
+    res = campbell(matrices_at, speeds, count, x_index=stations[0], y_index=stations[1], sparse=sparse,
+                   method=options.get("method", "auto"))
+    crit = critical_speeds(res, options.get("multiples", [1.0]), refine=matrices_at, sparse=sparse)
+    freqs = np.asarray(res.frequencies)
+    return {"speeds": [float(w) for w in res.speeds], "frequencies": [[float(f) for f in row] for row in freqs],
+            "whirl": [list(row) for row in res.whirl], "log_dec": [[float(d) for d in row] for row in res.log_dec],
+            "critical_speeds": [{"mode": int(c["mode"]) + 1, "multiple": float(c["multiple"]),
+                                 "speed": float(c["speed"]), "frequency": float(c["frequency"]), "whirl": c["whirl"]}
+                                for c in crit],
+            "parameter": name, "method": res.method, "exact_solves": int(res.exact_solves)}
+
+
+def summary_lines(outputs: dict) -> list[str]:
+    """The default lines without the per-speed eigenvalues and log decrements."""
+    return summary.output_lines(outputs, skip=("eigenvalues", "log_dec"))
+
+
+def plot(plt, a: dict, path: Path) -> list[Path]:
+    """Tracked whirl frequencies against spin speed (forward solid, backward dashed), multiples of the
+    speed as excitation lines and the critical speeds where they cross."""
+    out = a["outputs"]
+    speeds, freqs = out["speeds"], list(zip(*out["frequencies"]))
+    whirls = list(zip(*out["whirl"]))
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    for k, (curve, labels) in enumerate(zip(freqs, whirls)):
+        forward = labels[len(labels) // 2] == "forward"
+        ax.plot(speeds, curve, "-" if forward else "--", color=f"C{k % 10}", lw=1.2,
+                label=f"mode {k + 1} ({'F' if forward else 'B'})")
+    top = max(max(c) for c in freqs)
+    for r in sorted({c["multiple"] for c in out.get("critical_speeds", [])} or {1.0}):
+        reach = min(speeds[-1], top / r)
+        ax.plot([0, reach], [0, r * reach], "k:", lw=1)
+        ax.annotate(f"{r:g}x", (reach, r * reach), fontsize=7)
+    for c in out.get("critical_speeds", []):
+        ax.plot(c["speed"], c["frequency"], "kx", ms=6)
+    ax.set_xlabel(f"{out.get('parameter', 'speed')} (rad/s)")
+    ax.set_ylabel("damped natural frequency (rad/s)")
+    ax.set_title(f"{a['name']}: Campbell diagram (solid forward, dashed backward; x critical speeds)", fontsize=9)
+    ax.legend(fontsize=7, ncol=2, loc="upper left")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return [path]
+
+
+register(AnalysisKind("campbell", SCHEMA, run_campbell, needs, summary_lines, frees=frees, plot=plot))

@@ -1,0 +1,34 @@
+"""The context an analysis runs in (the runner's third argument).
+
+A mapping from the names of the analyses run before it to their outputs (working entries ``_q``,
+``_bvp`` ... included), so that ``about = "name"`` finds its steady state. A scene's run also
+stores, under :data:`POINTS`, a :class:`PointRunner`: how an analysis is run at another parameter
+point of the scene (a sweep's grid point, compiled again when the point sets a size). Analysis
+names are identifiers that do not start with ``__``, so these keys cannot clash with one.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Callable
+
+#: context key of the scene's PointRunner
+POINTS = "__points__"
+#: context key of the running analysis's name (progress bars)
+NAME = "__name__"
+
+
+@dataclass(frozen=True)
+class PointRunner:
+    """``evaluate(task(kind, options, point))`` -> the public outputs of ``kind`` at ``point``.
+
+    ``evaluate`` is a module-level function and tasks are plain data, so that points can run in
+    other processes.
+    """
+
+    evaluate: Callable[[Any], dict]
+    task: Callable[[str, dict, dict], Any]
+
+
+def public(outputs: dict) -> dict:
+    """The outputs without working entries (names starting with ``_``)."""
+    return {k: v for k, v in outputs.items() if not k.startswith("_")}

@@ -1,0 +1,175 @@
+"""One Python function per analysis kind: ``mechgen.modes(system, count=4)`` ... each returning a Result.
+
+Every function takes a compiled system (``mechgen.compile``) and the options of its kind under
+the names a scene uses for them (the same checks and defaults: a bad name raises an InputError
+naming the function, the key and the accepted keys; a bad value one naming ``<function>.<key>``).
+An analysis that builds on another takes that one's Result where a scene takes its name
+(``about=steady_result``). ``name=`` names the Result (default: the kind).
+
+The functions are those of ``mechgen.run(scene)``: a scene's analysis and the same call here give
+the same outputs, and ``Result.to_json()`` is the scene JSON's entry.
+"""
+from __future__ import annotations
+
+from typing import Any, Mapping
+
+from mechgen.analyses.registry import get, kinds
+from mechgen.analyses.result import Result, run_analysis
+from mechgen.analyses.schema import OptionContext, validate
+from mechgen.errors import InputError
+
+__all__ = ["analysis", "campbell", "continuation", "modes", "simulate", "stability", "steady", "sweep"]
+
+
+def _model_info(system):
+    from mechgen.scene.info import lookup_model
+
+    name = system.meta.get("model")
+    info = lookup_model(name) if name else None
+    if info is None:
+        raise InputError(f"the system's model {name!r} is not one mechgen can look up", key="system",
+                         expected="a system compiled by mechgen.compile")
+    return info
+
+
+def _context(system, function: str, earlier: Mapping[str, Result]) -> OptionContext:
+    """The checks' view of a compiled system: its model's names, its coordinates and parameter values."""
+    info = _model_info(system)
+    coordinates = tuple(info.coordinates) if system.is_field else tuple(system.coordinates)
+    active = None if set(coordinates) == set(info.coordinates) else coordinates
+    return OptionContext(file=None, model=info, params=_known_values(system), depends={},
+                         coordinates=coordinates, active=active, all_names=tuple(earlier),
+                         earlier={n: r.kind for n, r in earlier.items()}, current=function)
+
+
+def _known_values(system) -> dict:
+    """The parameter values the system itself records (its free ones, a continuum's fixed ones), for
+    expression strings in options; a value folded into the kernels and not recorded is not guessed."""
+    values = {k: float(v) for k, v in getattr(system, "fixed", {}).items()}
+    values.update(zip(system.meta.get("params", []), (float(v) for v in system.params)))
+    return values
+
+
+def _check_keys(function: str, kind: str, options: Mapping[str, Any]) -> None:
+    schema = get(kind).schema
+    for key in options:
+        if key not in schema:
+            raise InputError(f"{function}() got an unknown option {key!r}", key=key,
+                             expected=f"one of the {function}() options: " + ", ".join(schema))
+
+
+def _named(value, earlier: dict):
+    """An option's value as a scene would hold it: a Result (or a list of them) given for an option that names
+    an earlier analysis becomes its name (names); arrays and tuples become lists, numpy numbers Python ones."""
+    if isinstance(value, Result):
+        earlier[value.name] = value
+        return value.name
+    if isinstance(value, Mapping):
+        return {k: _named(v, earlier) for k, v in value.items()}
+    if isinstance(value, (list, tuple)) or hasattr(value, "tolist"):
+        value = value.tolist() if hasattr(value, "tolist") else list(value)
+        return [_named(v, earlier) for v in value] if isinstance(value, list) else value
+    return value
+
+
+def _run(kind: str, system, options: dict, name: str | None) -> Result:
+    """Check ``options`` through the kind's schema, run it, return its Result."""
+    _check_keys(kind, kind, options)
+    earlier: dict[str, Result] = {}
+    table = {key: _named(value, earlier) for key, value in options.items()}
+    ctx = _context(system, kind, earlier)
+    checked = validate(ctx, kind, get(kind), table)
+    context = {n: r.state for n, r in earlier.items()}
+    return run_analysis(name or kind, kind, system, checked, context)
+
+
+def analysis(kind: str, system, *, name: str | None = None, **options) -> Result:
+    """Any registered kind by name (``analysis("modes", system, count=4)`` is ``modes(system, count=4)``):
+    a kind added to the registry is callable here without a function of its own."""
+    get(kind)
+    return _run(kind, system, options, name)
+
+
+def modes(system, *, name: str | None = None, **options) -> Result:
+    """Natural frequencies (and a continuum's mode shapes) about an operating point.
+
+    Options (scene keys of ``kind = "modes"``): ``about`` (a steady Result), ``at`` ({coordinate:
+    value}), ``count``. Outputs: ``frequencies`` (ascending, rad/s or the model's unit); with
+    damping or gyroscopic terms, and for rotors, the damped modes (``eigenvalues``, ``log_dec``,
+    ``whirl``).
+    """
+    return _run("modes", system, options, name)
+
+
+def stability(system, *, name: str | None = None, **options) -> Result:
+    """Eigenvalues of M q'' + (D + G) q' + K q = 0 and the verdict (stable, divergence, flutter, unconverged).
+
+    Options: ``about``, ``at``, ``count``, ``tolerance``, ``refine``, ``refine_rtol``. Outputs:
+    ``eigenvalues`` ([re, im] pairs), ``verdict``, ``frequencies``, ``growth_rate``.
+    """
+    return _run("stability", system, options, name)
+
+
+def steady(system, *, name: str | None = None, **options) -> Result:
+    """An equilibrium (Newton), or a continuum's steady state as a boundary value problem (``method``).
+
+    Options: ``guess``, ``tol``, ``max_iter``, ``method``, ``mesh``, ``nodes``, ``bulge``, ``form``,
+    ``aliases``, ``stability``, ``hold`` with ``free``, ``params``, ``shape``. Outputs:
+    ``iterations``, ``residual_norm``, ``coordinates`` (lumped), the model's outputs. The Result can
+    be given as ``about=`` to modes, stability, campbell and continuation.
+    """
+    return _run("steady", system, options, name)
+
+
+def simulate(system, *, name: str | None = None, **options) -> Result:
+    """The time response from ``q0``, ``v0`` (or ``initial_mode``) to ``t_end`` (required).
+
+    Options: ``t_end``, ``method``, ``dt``, ``rtol``, ``atol``, ``q0``, ``v0``, ``initial_mode``,
+    ``amplitude``, ``outputs``, ``series``, ``samples``. Outputs: the model's outputs at ``t_end``,
+    ``energy_drift``, ``t_end`` (and ``t``, ``energy_series`` with ``series=True``).
+    """
+    return _run("simulate", system, options, name)
+
+
+def campbell(system, *, name: str | None = None, **options) -> Result:
+    """A Campbell diagram over ``over = {"Omega": [speeds]}`` (a parameter left free in the kernels).
+
+    Options: ``over`` (required; values or {start, stop, num}), ``count``, ``multiples``, ``method``,
+    ``about``, ``at``. Outputs: ``speeds``, ``frequencies``, ``whirl``, ``log_dec`` (one row per speed),
+    ``critical_speeds``.
+    """
+    return _run("campbell", system, options, name)
+
+
+def continuation(system, about, *, name: str | None = None, **options) -> Result:
+    """The branch of steady states through ``about`` (a steady Result of a continuum, or a list of them)
+    as ``parameter`` goes to ``stop``.
+
+    Options: ``parameter`` and ``stop`` (required), ``step``, ``max_step``, ``max_points``, ``method``,
+    ``stages``, ``mesh``, ``stability``, ``minimize``, ``aliases``, ``direction``, ``bounds``, ``at``,
+    ``eigenvalues``. Outputs: ``branch`` (points with the parameter, outputs and ``verdict``), ``folds``,
+    ``status``, ``points`` ...
+    """
+    return _run("continuation", system, {"about": about, **options}, name)
+
+
+def sweep(system, analysis: str = "modes", grid: Mapping[str, Any] | None = None, *, name: str | None = None,
+          workers: int = 0, progress: bool = False, **inner_options) -> Result:
+    """``analysis`` (modes, stability, steady or simulate, with ``inner_options``) at every point of ``grid``.
+
+    ``grid`` maps each parameter (free in the kernels) to its values or {start, stop, num}; several
+    parameters give their cartesian product, the first outermost. Each point runs on a new system
+    with the point's values (``system`` is not changed). ``workers`` > 1 runs points in local
+    processes (the system must then pickle; a scene's sweep compiles in each process instead);
+    ``progress`` draws a bar on stderr (off by default here, on in scenes). Outputs: ``grid`` (the
+    points) and one list per output of the inner analysis.
+    """
+    if grid is None:
+        raise InputError("sweep() needs a grid", key="grid", expected="grid = {parameter: [values]}")
+    if analysis not in [k for k in kinds() if get(k).sweepable]:
+        raise InputError(f"sweep() cannot repeat {analysis!r}", key="analysis",
+                         expected="one of: " + ", ".join(k for k in kinds() if get(k).sweepable))
+    _check_keys("sweep", analysis, inner_options)
+    table = {"over": grid, "analysis": {"kind": analysis, **inner_options}, "workers": workers,
+             "progress": progress}
+    return _run("sweep", system, table, name)

@@ -1,0 +1,105 @@
+"""The analysis kinds: one :class:`AnalysisKind` record per kind, registered by the kind's module.
+
+The scene loader, ``run_scene``, the text summary, the plots and the Python API find a kind here
+and never name one. Adding a kind: write ``mechgen/analyses/<kind>.py`` ending in
+``register(AnalysisKind(...))`` and add its module to :data:`MODULES` (the registration line).
+"""
+from __future__ import annotations
+
+import importlib
+from dataclasses import dataclass
+from typing import Any, Callable, Mapping
+
+from mechgen.errors import InputError
+
+#: the modules that register a kind, in the order kinds are listed (scene messages, ``kinds()``)
+MODULES = (
+    "mechgen.analyses.modes",
+    "mechgen.analyses.stability",
+    "mechgen.analyses.steady",
+    "mechgen.analyses.simulate",
+    "mechgen.analyses.sweep",
+    "mechgen.analyses.campbell",
+    "mechgen.analyses.continuation",
+)
+
+
+def no_free(options: Mapping[str, Any]) -> list[str]:
+    """The parameters of a kind that keeps none free in the kernels."""
+    return []
+
+
+@dataclass(frozen=True)
+class AnalysisKind:
+    """Everything mechgen knows about one analysis kind.
+
+    Attributes:
+        name: the scene's ``kind`` and the Python function's name.
+        schema: option name -> :class:`mechgen.analyses.schema.Option` (checks and defaults).
+        run: ``(system, options, context) -> outputs``; ``context`` maps earlier analyses' names to
+            their outputs (see :mod:`mechgen.analyses.context`). Output names starting with ``_`` are
+            working data (kept for later analyses, never in JSON).
+        needs: ``(options, *, internal) -> set`` of kernel names the system must have.
+        check: ``(ctx, base, options)``: cross-key checks after each option's own, or None.
+        frees: ``options -> [parameter]``: parameters the analysis sets, so kept free in the kernels.
+        summary: ``outputs -> [line]``: the text summary's lines for these outputs.
+        plot: ``(plt, entry, path) -> [written paths]`` for a scene-JSON entry, or None (nothing to plot).
+        sweepable: whether a sweep may repeat this kind over a grid.
+    """
+
+    name: str
+    schema: Mapping[str, Any]
+    run: Callable[..., dict]
+    needs: Callable[..., set]
+    summary: Callable[[dict], list[str]]
+    check: Callable | None = None
+    frees: Callable[[Mapping[str, Any]], list[str]] = no_free
+    plot: Callable | None = None
+    sweepable: bool = False
+
+
+_KINDS: dict[str, AnalysisKind] = {}
+_loaded = False
+
+
+def register(kind: AnalysisKind) -> AnalysisKind:
+    """Add a kind (called once, at the end of the kind's module)."""
+    if kind.name in _KINDS and _KINDS[kind.name] is not kind:
+        raise ValueError(f"analysis kind {kind.name!r} is registered twice")
+    _KINDS[kind.name] = kind
+    return kind
+
+
+def unregister(name: str) -> None:
+    """Remove a kind registered at run time (a plugin's or a test's); the built-in ones stay."""
+    if any(m.rsplit(".", 1)[1] == name for m in MODULES):
+        raise ValueError(f"analysis kind {name!r} is built in")
+    _KINDS.pop(name, None)
+
+
+def _load() -> None:
+    global _loaded
+    if not _loaded:
+        for module in MODULES:
+            importlib.import_module(module)
+        _loaded = True
+
+
+def kinds() -> tuple[str, ...]:
+    """The registered kinds' names, in the order of :data:`MODULES`."""
+    _load()
+    order = [m.rsplit(".", 1)[1] for m in MODULES]
+    return tuple(sorted(_KINDS, key=lambda k: order.index(k) if k in order else len(order)))
+
+
+def get(name: str) -> AnalysisKind:
+    """The kind called ``name``; an InputError listing the kinds when there is none."""
+    _load()
+    if name not in _KINDS:
+        raise InputError(f"unknown analysis kind {name!r}", key="kind", expected="one of: " + ", ".join(kinds()))
+    return _KINDS[name]
+
+
+def needs(kind: str, options: Mapping[str, Any], *, internal: bool) -> set[str]:
+    """The kernels an analysis of ``kind`` with ``options`` needs (``internal``: the model has internal variables)."""
+    return get(kind).needs(options, internal=internal)

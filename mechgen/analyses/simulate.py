@@ -1,0 +1,170 @@
+"""``simulate``: the time response from an initial state.
+
+Scene keys: ``t_end`` (required), ``method`` (BDF, Radau, LSODA, RK45, DOP853, or ``leapfrog`` with a
+step ``dt``), ``rtol``, ``atol``, ``q0`` / ``v0`` (tables of coordinates), ``initial_mode`` with
+``amplitude`` (start from a linear mode), ``outputs`` (which model outputs to report), ``series``
+(also report ``t`` and ``energy_series``), ``samples``. Outputs: the model's outputs at ``t_end``,
+``energy_drift``, ``t_end``; a fixed-end chain also ``mode_energies``.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from mechgen.analyses import schema, summary
+from mechgen.analyses.operating_point import vector
+from mechgen.analyses.registry import AnalysisKind, register
+from mechgen.analyses.schema import ABSENT, ALL_OUTPUTS, REQUIRED, Option
+from mechgen.errors import SceneError
+from mechgen.runtime.integrate import integrate_first_order, leapfrog
+from mechgen.runtime.modes import modes as solve_modes
+from mechgen.scene.values import fail, listing, show, type_name
+
+METHODS = ("BDF", "Radau", "LSODA", "RK45", "DOP853", "leapfrog")
+STEP = "a number > 0 (or an expression)"
+
+
+def _outputs(ctx, key: str, value: object) -> list[str]:
+    known = ctx.model.outputs
+    if not isinstance(value, list):
+        raise fail(ctx.file, key, f"value is {type_name(value)}", "an array of output names: " + listing(known))
+    names: list[str] = []
+    for i, name in enumerate(value, 1):
+        if not isinstance(name, str) or name not in known:
+            raise fail(ctx.file, f"{key}[{i}]", f"unknown output {show(name)}",
+                       "one of the model's outputs: " + listing(known))
+        if name not in names:
+            names.append(name)
+    return names
+
+
+def _method(ctx, key: str, value: object) -> str:
+    if not isinstance(value, str) or value not in METHODS:
+        raise fail(ctx.file, key, f"unknown method {show(value)}", "one of: " + ", ".join(METHODS))
+    return value
+
+
+SCHEMA = {"t_end": Option(schema.positive, REQUIRED, STEP), "method": Option(_method, "BDF"),
+          "dt": Option(schema.positive, ABSENT), "rtol": Option(schema.positive, 1e-8),
+          "atol": Option(schema.positive, 1e-10), "q0": Option(schema.coordinate_table, {}),
+          "v0": Option(schema.coordinate_table, {}), "initial_mode": Option(schema.count),
+          "amplitude": Option(schema.number, 1.0), "outputs": Option(_outputs, ALL_OUTPUTS),
+          "series": Option(schema.boolean, False), "samples": Option(schema.count, 201)}
+
+
+def check(ctx, base: str, options: dict) -> None:
+    """leapfrog needs dt; dt <= t_end; initial_mode within the coordinates."""
+    if options["method"] == "leapfrog" and "dt" not in options:
+        raise fail(ctx.file, f"{base}.dt", "method 'leapfrog' needs a time step dt", STEP)
+    if "dt" in options and options["dt"] > options["t_end"]:
+        raise fail(ctx.file, f"{base}.dt", f"dt {options['dt']!r} exceeds t_end {options['t_end']!r}",
+                   "a time step no larger than t_end")
+    if options.get("initial_mode", 0) > len(ctx.coordinates):
+        raise fail(ctx.file, f"{base}.initial_mode", f"initial_mode {options['initial_mode']} exceeds the "
+                   f"{len(ctx.coordinates)} coordinates", f"an integer from 1 to {len(ctx.coordinates)}")
+
+
+def needs(options: dict, *, internal: bool) -> set[str]:
+    """Residual, tangent and outputs (force and M for leapfrog; M, K for an initial mode)."""
+    if options.get("method") == "leapfrog":
+        return {"force", "outputs", "linear"}
+    start = {"linear"} if options.get("initial_mode") else set()
+    return {"residual", "tangent", "outputs"} | start | ({"rates", "rates_tangent"} if internal else set())
+
+
+def initial_state(system, options: dict) -> tuple[np.ndarray, np.ndarray]:
+    """(q0, v0) from the options: tables of coordinates, or a linear mode times an amplitude."""
+    q0, v0 = vector(system, options.get("q0")), vector(system, options.get("v0"))
+    if options.get("initial_mode"):
+        k = int(options["initial_mode"])
+        if k > system.n:
+            raise SceneError(f"initial_mode {k} exceeds the {system.n} degrees of freedom", key="initial_mode",
+                             expected=f"an integer from 1 to {system.n}")
+        mats = system.linear(np.zeros(system.n))
+        shapes = solve_modes(mats["M"], mats["K"]).shapes
+        shape = shapes[:, k - 1] / np.max(np.abs(shapes[:, k - 1]))
+        q0 = q0 + options.get("amplitude", 1.0) * shape * np.sign(shape[np.argmax(np.abs(shape))])
+    return q0, v0
+
+
+def mode_energies(system, q: np.ndarray, v: np.ndarray, count: int = 8) -> list[float]:
+    """Harmonic energies E_k = (P_k^2 + omega_k^2 Q_k^2)/2 of a fixed-end chain (FPU's observable).
+
+    Q_k = sqrt(2/(N+1)) sum_n q_n sin(n k pi/(N+1)); omega_k from the linear stiffness.
+    """
+    n = system.n
+    idx = np.arange(1, n + 1)
+    k = np.arange(1, min(count, n) + 1)
+    S = np.sqrt(2.0 / (n + 1)) * np.sin(np.outer(k, idx) * np.pi / (n + 1))
+    mats = system.linear(np.zeros(n))
+    omega2 = np.einsum("ki,ij,kj->k", S, mats["K"].toarray(), S)
+    Q, P = S @ q, S @ v
+    return [float(e) for e in 0.5 * (P**2 + omega2 * Q**2)]
+
+
+def run_simulate(system, options: dict, context: dict) -> dict:
+    """Time response; reports the model's outputs at t_end and the energy drift."""
+    q0, v0 = initial_state(system, options)
+    t_end = float(options["t_end"])
+    energy = lambda q, v: system.outputs(q, v)["energy"]  # noqa: E731
+    if options.get("method") == "leapfrog":
+        dt = float(options["dt"])
+        steps = int(round(t_end / dt))
+        mats = system.linear(np.zeros(system.n))
+        M = mats["M"]
+        minv = 1.0 / (M.diagonal() if hasattr(M, "diagonal") else np.diag(M))
+        traj = leapfrog(lambda q: system.force(q) * minv, q0, v0, dt, steps,
+                        record_every=max(1, steps // 1000), energy=energy)
+        q_end, v_end, ts, energies = traj.q[-1], traj.v[-1], traj.t, np.asarray(traj.energy)
+        z_end = None
+    else:
+        x0 = np.concatenate([q0, v0, np.zeros(system.m)])
+        n_out = int(options.get("samples", 201))
+        t_eval = np.linspace(0.0, t_end, n_out)
+        traj = integrate_first_order(system.rhs, x0, t_end, jac=system.jacobian, method=options.get("method", "BDF"),
+                                     rtol=options.get("rtol", 1e-8), atol=options.get("atol", 1e-10), t_eval=t_eval)
+        xs = traj.x if traj.x.shape[0] == len(traj.t) else traj.x.T
+        n = system.n
+        q_end, v_end, z_end = xs[-1, :n], xs[-1, n:2 * n], xs[-1, 2 * n:]
+        ts = traj.t
+        energies = np.array([system.outputs(x[:n], x[n:2 * n], x[2 * n:] if system.m else None)["energy"]
+                             for x in xs])
+    out = system.outputs(q_end, v_end, z_end if system.m else None)
+    wanted = options.get("outputs")
+    if wanted:
+        out = {k: v for k, v in out.items() if k in wanted}
+    e0 = energies[0]
+    out["energy_drift"] = float(np.max(np.abs(energies - e0)) / max(abs(e0), 1e-300))
+    out["t_end"] = t_end
+    if system.is_lattice and system.meta.get("ends") == "fixed":
+        out["mode_energies"] = mode_energies(system, q_end, v_end)
+    if options.get("series"):
+        out["t"] = [float(t) for t in ts]
+        out["energy_series"] = [float(e) for e in energies]
+    return out
+
+
+def plot(plt, a: dict, path: Path) -> list[Path]:
+    """Energy against time (``series = true``), else a chain's final mode energies; nothing otherwise."""
+    out = a["outputs"]
+    if "energy_series" not in out and "mode_energies" not in out:
+        return []
+    fig, ax = plt.subplots(figsize=(6, 4))
+    if "energy_series" in out:
+        ax.plot(out["t"], out["energy_series"])
+        ax.set_xlabel("t")
+        ax.set_ylabel("energy")
+    else:
+        ax.bar(range(1, len(out["mode_energies"]) + 1), out["mode_energies"])
+        ax.set_xlabel("mode k")
+        ax.set_ylabel("E_k at t_end")
+    ax.set_title(a["name"])
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return [path]
+
+
+register(AnalysisKind("simulate", SCHEMA, run_simulate, needs, summary.lines, check=check, plot=plot,
+                      sweepable=True))

@@ -1,0 +1,126 @@
+"""``sweep``: another analysis repeated over a grid of parameter values.
+
+Scene keys: ``over`` (parameter = [values] or {start, stop, num}; several parameters give their
+cartesian product, the first outermost), ``analysis`` (a table with the inner ``kind``: modes,
+stability, steady or simulate, and its keys), ``workers`` (local processes; 0 or 1: serial) and
+``progress``. Outputs: ``grid`` (the points, a list of {parameter: value}) plus one list per output
+of the inner analysis, in grid order.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+from mechgen.analyses import figures, schema, summary
+from mechgen.analyses.context import NAME, POINTS, PointRunner, public
+from mechgen.analyses.parameters import with_free_params
+from mechgen.analyses.registry import AnalysisKind, get, kinds, register
+from mechgen.analyses.schema import REQUIRED, AnalysisSpec, Option
+from mechgen.runtime.sweep import sweep
+from mechgen.scene.values import fail, type_name
+
+
+def _inner(ctx, key: str, value: object) -> AnalysisSpec:
+    """The analysis a sweep repeats: a table with ``kind`` (a sweepable kind) and that kind's keys."""
+    inner_kinds = [k for k in kinds() if get(k).sweepable]
+    if not isinstance(value, dict):
+        raise fail(ctx.file, key, f"value is {type_name(value)}", "a table with kind and its options")
+    kind = schema.analysis_kind(ctx, key, value, inner_kinds)
+    options = schema.validate(ctx, key, get(kind), {k: v for k, v in value.items() if k != "kind"})
+    return AnalysisSpec(ctx.current, kind, options)
+
+
+def _workers(ctx, key: str, value: object) -> int:
+    return schema.int_at_least(ctx, key, value, 0)
+
+
+SCHEMA = {"over": Option(schema.over, REQUIRED, "a table: parameter = [values] or {start, stop, num}"),
+          "analysis": Option(_inner, REQUIRED, "a table with kind and its options"),
+          "workers": Option(_workers, 0), "progress": Option(schema.boolean, True)}
+
+
+def check(ctx, base: str, options: dict) -> None:
+    """Adds ``grid``: the cartesian product of ``over``."""
+    options["grid"] = schema.grid(options["over"])
+
+
+def frees(options: dict) -> list[str]:
+    """The swept parameters, and those the inner analysis keeps free."""
+    names = list(options["over"])
+    inner = options["analysis"]
+    return names + [n for n in get(inner.kind).frees(inner.options) if n not in names]
+
+
+def needs(options: dict, *, internal: bool) -> set[str]:
+    """The inner analysis's kernels."""
+    inner = options["analysis"]
+    return get(inner.kind).needs(inner.options, internal=internal)
+
+
+def _at_point(task: tuple) -> dict:
+    """The inner analysis at one point on a copy of the system with the point's parameter values."""
+    system, kind, options, point = task
+    return public(get(kind).run(with_free_params(system, point, key="grid"), options, {}))
+
+
+def collect(grid: list[dict], results: list[dict]) -> dict:
+    """{"grid": grid, output: [value at each point]} (the outputs of the first point)."""
+    out: dict = {"grid": grid}
+    for key in results[0] if results else []:
+        out[key] = [r.get(key) for r in results]
+    return out
+
+
+def run_sweep(system, options: dict, context: dict) -> dict:
+    """The inner analysis at every grid point (mechgen.runtime.sweep: serial, or ``workers`` processes).
+
+    A scene's run gives the points through ``context[POINTS]`` (compiled again where a point sets a
+    size); otherwise each point runs on a copy of ``system`` with the point's free parameters set.
+    """
+    inner = options["analysis"]
+    points = context.get(POINTS) or PointRunner(_at_point, lambda kind, opts, point: (system, kind, opts, point))
+    tasks = [points.task(inner.kind, dict(inner.options), point) for point in options["grid"]]
+    results = sweep(points.evaluate, tasks, workers=options.get("workers", 0), progress=options.get("progress", True),
+                    desc=context.get(NAME, "sweep"))
+    return collect(options["grid"], results)
+
+
+def summary_lines(outputs: dict) -> list[str]:
+    """Each output's list cut at 4 points (no eigenvalues or log decrements), then the grid's extent."""
+    lines = summary.output_lines(outputs, skip=("eigenvalues", "log_dec"), width=4)
+    grid = outputs.get("grid", [])
+    if grid:
+        lines.append(f"    grid: {len(grid)} points from {grid[0]} to {grid[-1]}")
+    return lines
+
+
+def plot(plt, a: dict, path: Path) -> list[Path]:
+    """Frequencies against the swept parameter (a Campbell diagram when it is the spin speed Omega); with
+    stability results, the verdicts as colours and the growth rates in a second panel."""
+    grid = a["outputs"]["grid"]
+    name = next(iter(grid[0])) if grid else "parameter"
+    x = [g[name] for g in grid]
+    growth = a["outputs"].get("growth_rate")
+    fig, axes = plt.subplots(2 if growth else 1, 1, figsize=(6, 6 if growth else 4), squeeze=False, sharex=True)
+    ax = axes[0, 0]
+    verdicts = a["outputs"].get("verdict") or ["stable"] * len(x)
+    colours = figures.VERDICT_COLOURS
+    for xi, freqs, verdict in zip(x, a["outputs"].get("frequencies", []), verdicts):
+        ax.plot([xi] * len(freqs), freqs, ".", color=colours.get(verdict, "k"), ms=3)
+    if name == "Omega" and x and isinstance(x[0], (int, float)):
+        ax.plot([min(x), max(x)], [min(x), max(x)], "r--", lw=1, label="1x (synchronous)")
+        ax.legend(loc="upper left")
+    ax.set_ylabel("frequency")
+    ax.set_title(f"{a['name']}: frequencies vs {name}" + (" (red: flutter, blue: divergence, orange: unconverged)"
+                                                          if growth else ""), fontsize=9)
+    if growth:
+        axes[1, 0].plot(x, growth, "o-", ms=3)
+        axes[1, 0].axhline(0.0, color="0.6", lw=0.5)
+        axes[1, 0].set_ylabel("growth rate max Re s")
+    axes[-1, 0].set_xlabel(name)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return [path]
+
+
+register(AnalysisKind("sweep", SCHEMA, run_sweep, needs, summary_lines, check=check, frees=frees, plot=plot))
