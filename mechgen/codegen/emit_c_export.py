@@ -10,9 +10,9 @@ module adds, for model ``M`` and kernel ``K``:
 * for a kernel with sparse (CSR) outputs, ``long M_K_nnz(long sites)`` and
   ``int M_K_pattern(long sites, long *indptr, long *indices, long *slots0, ...)``: the CSR
   pattern (sites x sites) and the slot tables the kernel reads, computed in C from the
-  kernel's loop recipe exactly as :func:`mechgen.runtime.pattern.build_pattern` does; the
-  affine summaries it writes are all zero (no affine run: the kernel addresses the CSR data
-  through the slot table, which is always valid).
+  kernel's loop recipe exactly as :func:`mechgen.runtime.pattern.build_pattern` does, with
+  the affine summaries of :func:`mechgen.runtime.pattern.affine_summary` (all zeros would
+  also be valid: the kernel then addresses the CSR data through the slot table alone).
 
 Free text (model doc, parameter docs, choice values) reaches the files only through
 :func:`mechgen.codegen.escape.c_comment`; names are validated identifiers.
@@ -93,8 +93,8 @@ def _input_doc(ir: KernelIR, p: Port, facts: ExportFacts, prefix: str) -> list[s
             lines.append(f"    p[{i}] {n}{f' [{unit}]' if unit else ''}{': ' + doc if doc else ''}")
         return lines
     if p.name.endswith("_affine"):
-        return [head + "affine summary of a slot table (long); all zeros is valid: "
-                f"{prefix}_pattern writes zeros"]
+        return [head + f"affine summary of a slot table (long), filled by {prefix}_pattern "
+                "(all zeros is also valid: the kernel then uses the slot table alone)"]
     if p.name.startswith("slots"):
         return [head + f"slot table (long) of loop block {p.name[5:]}, filled by "
                 f"{prefix}_pattern"]
@@ -137,8 +137,13 @@ def _pattern_context(ir: KernelIR, prefix: str) -> dict | None:
         for ext in (b.loop.count, b.loop.sites):
             if any(name != "sites" for name, _ in ext.terms):
                 raise ValueError(f"kernel {ir.name}: loop extent {ext} depends on more than the sites")
-        aff = next(p for p in ir.inputs if p.name == affine)
-        blocks.append({"slot": slot, "affine": affine, "affine_len": aff.extent.const,
+        stored = []
+        for port in ir.stored_ports(i):
+            outgoing = sorted({j_out for _, j_out in b.carried_entries(port)})
+            entries = b.port_entries(port)
+            stored.append({"nentries": len(entries), "entries": ", ".join(map(str, entries)),
+                           "noutgoing": len(outgoing), "outgoing": ", ".join(map(str, outgoing))})
+        blocks.append({"slot": slot, "affine": affine, "offsets": list(b.offset_range()), "stored": stored,
                        "count": [b.loop.count.const, sum(c for _, c in b.loop.count.terms)],
                        "sites": [b.loop.sites.const, sum(c for _, c in b.loop.sites.terms)],
                        "periodic": int(b.loop.boundary == "periodic"), "width": len(b.entries),
