@@ -105,6 +105,7 @@ def write_atomically(out: Path, contents: dict) -> list[Path]:
         for name, data in contents.items():
             (tmp / name).write_bytes(data if isinstance(data, bytes) else data.encode("utf-8"))
             os.chmod(tmp / name, 0o644)
+        check_out_dir(out, list(contents))  # again, with every name: nothing is moved unless all can be
         if not out.exists():
             os.chmod(tmp, 0o755)
             os.rename(tmp, out)
@@ -165,11 +166,12 @@ def _facts(model, spec):
 
 # --------------------------------------------------------------------------- casadi
 
-def _entry_names(ir, port) -> list[str] | None:
+def _entry_names(ir, port, sites: int | None) -> list[str] | None:
+    """Names of a port's entries: coordinates (a chain's ``u_1 .. u_N``), their rates, parameters ..."""
     meta = ir.meta
     coords = list(meta.get("coordinates", []))
-    if meta.get("kind") == "lattice" and port.name in ("q", "v", "a"):
-        return None
+    if meta.get("kind") == "lattice":
+        coords = [f"{coords[0]}_{e + 1}" for e in range(sites)]
     table = {"q": coords, "v": [f"d({c})/dt" for c in coords], "a": [f"d2({c})/dt2" for c in coords],
              "z": list(meta.get("internal", [])), "t": ["t"], "s": ["s"], "p": list(meta.get("params", []))}
     return table.get(port.name)
@@ -205,7 +207,7 @@ def _casadi_files(model, spec, irs) -> dict:
             fname = f"{renamed.name}.casadi"
             fn.save(str(Path(work) / fname))
             files[fname] = (Path(work) / fname).read_bytes()
-            ins = [{"name": p.name, "length": p.extent.evaluate(sizes), "entries": _entry_names(ir, p)} for p in ir.inputs if not p.integer]
+            ins = [{"name": p.name, "length": p.extent.evaluate(sizes), "entries": _entry_names(ir, p, sites)} for p in ir.inputs if not p.integer]
             outs = []
             for p in ir.outputs:
                 o = {"name": p.name, "length": p.extent.evaluate(sizes), "shape": list(p.shape) if p.shape else None,

@@ -8,6 +8,7 @@ The C files are compiled warning-free (``-std=c99 -Wall -Wextra -pedantic -Werro
 a driver the test writes, run, and their printed outputs compared to 1e-12.
 """
 import json
+import os
 import re
 import shlex
 import shutil
@@ -22,6 +23,7 @@ import scipy.sparse as sps
 from mechgen import models
 from mechgen.cli import main
 from mechgen.codegen.escape import c_comment, py_docstring
+from mechgen.errors import InputError
 from mechgen.pipeline import compile_model
 from mechgen.symbolic.specialize import specialize
 
@@ -305,6 +307,7 @@ def test_casadi_export_of_a_chain_carries_its_pattern(tmp_path):
     folder = _export(tmp_path, "fpu_chain", "casadi", "--set", "N=6", "--kernels", "stiffness,force")
     manifest = json.loads((folder / "fpu_chain.json").read_text())
     assert manifest["sites"] == 6
+    assert manifest["kernels"]["force"]["inputs"][0]["entries"] == [f"u_{i}" for i in range(1, 7)]
     k = manifest["kernels"]["stiffness"]
     fn = ca.Function.load(str(folder / k["file"]))
     _, system = _numpy_system("fpu_chain", {"N": 6})
@@ -352,6 +355,22 @@ def test_out_naming_a_file_exits_2_before_deriving(tmp_path, capsys, monkeypatch
     assert sorted(p.name for p in blocked.iterdir()) == ["laval_rotor.h"]
 
 
+def test_out_in_a_read_only_folder_exits_2(tmp_path, capsys, monkeypatch):
+    import mechgen.export as export
+
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(0o555)
+    if os.geteuid() == 0:  # permissions do not bind root: let the folder report itself read-only
+        real = os.access
+        monkeypatch.setattr(export.os, "access", lambda p, mode: real(p, mode) and Path(p) != locked)
+    try:
+        assert main(["export", "laval_rotor", "--backend", "c", "--out", str(locked / "out")]) == 2
+        assert "not writable" in capsys.readouterr().err and list(locked.iterdir()) == []
+    finally:
+        locked.chmod(0o755)
+
+
 def test_a_failure_while_writing_leaves_nothing_half_written(tmp_path, monkeypatch):
     import mechgen.export as export
 
@@ -369,6 +388,13 @@ def test_a_failure_while_writing_leaves_nothing_half_written(tmp_path, monkeypat
     with pytest.raises(OSError):
         export.write_atomically(out, {"a.h": "x", "a.c": "y"})
     assert list(tmp_path.iterdir()) == []
+    monkeypatch.undo()
+    out.mkdir()
+    (out / "a.h").write_text("old")
+    (out / "a.c").mkdir()  # in the way of the second file: the first is not replaced either
+    with pytest.raises(InputError):
+        export.write_atomically(out, {"a.h": "new", "a.c": "y"})
+    assert (out / "a.h").read_text() == "old" and sorted(p.name for p in tmp_path.iterdir()) == ["out"]
 
 
 # --------------------------------------------------------------------------- hostile text

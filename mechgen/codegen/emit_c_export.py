@@ -159,7 +159,11 @@ def _kernel(ir: KernelIR, facts: ExportFacts) -> dict:
     args += [f"double *out_{p.name}" for p in ir.outputs]
     ins = [f"(const double *)(const void *)in_{p.name}" if p.integer else f"in_{p.name}" for p in ir.inputs]
     doc = [f"{prefix}: {c_comment(ir.doc)}"]
-    if ir.meta.get("kind") == "field":
+    if "_at_" in ir.name:
+        at = ir.name.split("_at_", 1)[1]
+        doc.append(f"point term of '{at}' (an end or a part of the continuum): evaluate it at the point where "
+                   f"'{at}' sits (nbatch such points) and add it to the discretised equations there")
+    elif ir.meta.get("kind") == "field":
         doc.append("pointwise kernel of a continuum: one state per point (nbatch points, e.g. quadrature points)")
     doc.append("inputs (state ports: nbatch x length, row-major):")
     doc += ["  " + line for p in ir.inputs for line in _input_doc(ir, p, facts, prefix)]
