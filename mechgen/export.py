@@ -19,6 +19,7 @@ folder beside it and moved into place only when all of them are complete.
 """
 from __future__ import annotations
 
+import importlib.util
 import json
 import math
 import os
@@ -31,6 +32,11 @@ from mechgen import __version__
 from mechgen.errors import InputError
 
 EXPORT_BACKENDS = ("c", "casadi")
+#: how the CasADi manifest's ports read (also stated in the manifest itself)
+LAYOUT = ("Each Function takes the kernel's inputs in the order listed (column vectors; 'entries' names each entry) "
+          "and returns its outputs in the order listed: a dense output of shape [rows, cols] is the row-major "
+          "flat vector (ca.reshape(out, cols, rows).T is the matrix), a sparse output is the CSR data of "
+          "'pattern'. A pointwise kernel of a continuum is one point: .map(n) evaluates n points.")
 
 
 def _fail(key: str, message: str, expected: str | None = None) -> InputError:
@@ -191,7 +197,7 @@ def _casadi_files(model, spec, irs) -> dict:
     manifest = {"model": model.name, "mechgen": __version__, "backend": "casadi", "doc": model.doc,
                 "specialisation": spec.key(), "fixed": _fixed(model, spec),
                 "free_params": [p for p in spec.free], "kind": irs[0].meta.get("kind") if irs else None,
-                "sites": sites, "kernels": {}}
+                "sites": sites, "layout": LAYOUT, "kernels": {}}
     with tempfile.TemporaryDirectory(prefix="mechgen-export-") as work:
         path = Path(work) / f"mg_export_{model.name}.py"
         path.write_text(text, encoding="utf-8")
@@ -207,7 +213,8 @@ def _casadi_files(model, spec, irs) -> dict:
             fname = f"{renamed.name}.casadi"
             fn.save(str(Path(work) / fname))
             files[fname] = (Path(work) / fname).read_bytes()
-            ins = [{"name": p.name, "length": p.extent.evaluate(sizes), "entries": _entry_names(ir, p, sites)} for p in ir.inputs if not p.integer]
+            ins = [{"name": p.name, "length": p.extent.evaluate(sizes), "entries": _entry_names(ir, p, sites)}
+                   for p in ir.inputs if not p.integer]
             outs = []
             for p in ir.outputs:
                 o = {"name": p.name, "length": p.extent.evaluate(sizes), "shape": list(p.shape) if p.shape else None,
@@ -242,6 +249,9 @@ def export_model(ref, backend: str, out, *, sets=(), kernels=None) -> list[Path]
 
     if backend not in EXPORT_BACKENDS:
         raise _fail("--backend", f"unknown export backend {backend!r}", "one of: " + ", ".join(EXPORT_BACKENDS))
+    if backend == "casadi" and importlib.util.find_spec("casadi") is None:
+        raise _fail("--backend", "the casadi backend needs the casadi package, which is not installed",
+                    "backend c, or casadi installed (pip install casadi)")
     model = ref if hasattr(ref, "param_list") else models.load_model(str(ref))
     out = Path(out)
     values = parse_sets(model, list(sets))
