@@ -61,6 +61,9 @@ def parse_sets(model, items) -> dict:
         if name not in names:
             raise _fail(key, f"model {model.name} has no parameter {name!r}", "one of: " + ", ".join(names))
         prm = model.param(name)
+        if name in model.part_params():
+            raise _fail(key, f"{name} is a parameter of a part kind, which stays a kernel input (its value "
+                        "differs from part to part)", "a parameter that is not a part's")
         if prm.is_choice:
             if text not in prm.choices:
                 raise _fail(key, f"{text!r} is not an allowed choice", "one of: " + ", ".join(prm.choices))

@@ -334,6 +334,9 @@ def test_casadi_export_of_a_chain_carries_its_pattern(tmp_path):
     (["laval_rotor", "--set", "m"], "--set m"),
     (["fpu_chain", "--set", "N=2.5"], "--set N"),
     (["laval_rotor", "--kernels", "linear,bogus"], "--kernels"),
+    (["laval_rotor", "--kernels", ","], "--kernels"),
+    (["euler_bernoulli_beam", "--set", "bc=no-such-end"], "--set bc"),
+    (["spinning_shaft", "--set", "disk_m=2"], "--set disk_m"),
     (["laval_rotor", "--backend", "numpy"], "--backend"),
 ])
 def test_bad_export_input_exits_2_and_writes_nothing(tmp_path, capsys, argv, key):
