@@ -1,4 +1,4 @@
-"""Command line: ``mechgen models | show MODEL_OR_PATH | run SCENE | regen [--check] | bench``.
+"""Command line: ``mechgen models | show MODEL_OR_PATH | run SCENE | regen [--check] | bench | export MODEL_OR_PATH``.
 
 Exit code 0 on success, 2 on bad input (one paragraph on stderr, no traceback),
 1 when a computation fails (convergence, kernel error) with its message.
@@ -33,6 +33,13 @@ def _parser() -> argparse.ArgumentParser:
     bench.add_argument("models", nargs="*", help="suites: fpu, beam, rotor, balloon (default: all)")
     bench.add_argument("--out", default="bench-out")
     bench.add_argument("--quick", action="store_true")
+    export = sub.add_parser("export", help="write a model's kernels as standalone C or CasADi Functions")
+    export.add_argument("model", help="a built-in name, a path to a model file, or package.module:attribute")
+    export.add_argument("--backend", required=True, help="c (header and source) or casadi (Function.save files)")
+    export.add_argument("--out", dest="out_dir", required=True, metavar="DIR", help="folder to write into")
+    export.add_argument("--set", dest="overrides", action="append", default=[], metavar="NAME=VALUE",
+                        help="fold a parameter value into the code (others stay inputs)")
+    export.add_argument("--kernels", default=None, metavar="K1,K2", help="kernels to export (default: all)")
     return ap
 
 
@@ -109,7 +116,17 @@ def _cmd_bench(args) -> int:
     return 0
 
 
-COMMANDS = {"run": _cmd_run, "models": _cmd_models, "show": _cmd_show, "regen": _cmd_regen, "bench": _cmd_bench}
+def _cmd_export(args) -> int:
+    from mechgen.export import export_model
+
+    for path in export_model(args.model, args.backend, Path(args.out_dir), sets=args.overrides,
+                             kernels=args.kernels):
+        print(f"wrote {path}")
+    return 0
+
+
+COMMANDS = {"run": _cmd_run, "models": _cmd_models, "show": _cmd_show, "regen": _cmd_regen, "bench": _cmd_bench,
+            "export": _cmd_export}
 
 
 def main(argv: list[str] | None = None) -> int:
