@@ -50,9 +50,10 @@ SUITES = tuple(REGISTRY)
 
 
 def suite_lines() -> list[str]:
-    """One line per suite: its name and what it measures (``mechgen bench --list``)."""
+    """One line per suite: its name, what it measures and the reports it writes (``mechgen bench --list``)."""
     width = max(len(name) for name in REGISTRY)
-    return [f"{s.name:{width}s}  {s.summary}" for s in REGISTRY.values()]
+    return [f"{s.name:{width}s}  {s.summary}" + (f" -> {', '.join(s.writes)}" if s.writes else "")
+            for s in REGISTRY.values()]
 
 
 def run_benchmarks(models_: list[str] | None = None, *, out: Path, quick: bool = False) -> dict:
