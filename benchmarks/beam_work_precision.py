@@ -6,7 +6,7 @@ Run: ``python benchmarks/beam_work_precision.py --out bench-out [--quick]`` (nee
 import argparse
 from pathlib import Path
 
-from mechgen.bench_field import run_field_benchmarks
+from mechgen.bench.beam import run_field_benchmarks
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])

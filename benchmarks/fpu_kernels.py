@@ -5,7 +5,7 @@ Run: ``python benchmarks/fpu_kernels.py --out bench-out [--quick]`` (same as ``m
 import argparse
 from pathlib import Path
 
-from mechgen.bench import run_fpu_benchmarks
+from mechgen.bench.fpu import run_fpu_benchmarks
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])

@@ -31,6 +31,7 @@ def _parser() -> argparse.ArgumentParser:
     regen.add_argument("--check", action="store_true", help="fail if mechgen/generated is stale")
     bench = sub.add_parser("bench", help="run the benchmarks")
     bench.add_argument("models", nargs="*", help="suites: fpu, beam, rotor, balloon (default: all)")
+    bench.add_argument("--list", dest="list_suites", action="store_true", help="name the suites and exit")
     bench.add_argument("--out", default="bench-out")
     bench.add_argument("--quick", action="store_true")
     export = sub.add_parser("export", help="write a model's kernels as standalone C or CasADi Functions")
@@ -110,8 +111,11 @@ def _cmd_regen(args) -> int:
 
 
 def _cmd_bench(args) -> int:
-    from mechgen.bench import run_benchmarks
+    from mechgen.bench import run_benchmarks, suite_lines
 
+    if args.list_suites:
+        print("\n".join(suite_lines()))
+        return 0
     run_benchmarks(args.models, out=Path(args.out), quick=args.quick)
     return 0
 

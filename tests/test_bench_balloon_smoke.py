@@ -7,7 +7,7 @@ import json
 
 import pytest
 
-from mechgen.bench_balloon import POINTS, STOP, run_balloon_benchmarks
+from mechgen.bench.balloon import POINTS, STOP, run_balloon_benchmarks
 
 
 @pytest.mark.slow

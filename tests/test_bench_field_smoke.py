@@ -8,7 +8,7 @@ import csv
 import importlib.util
 import json
 
-from mechgen.bench_field import run_field_benchmarks
+from mechgen.bench.beam import run_field_benchmarks
 
 
 def test_quick_field_benchmark_writes_reports(tmp_path, capsys):

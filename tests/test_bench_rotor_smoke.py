@@ -7,7 +7,7 @@ import json
 
 import pytest
 
-from mechgen.bench_rotor import COUNT, TOL, run_rotor_benchmarks
+from mechgen.bench.rotor import COUNT, TOL, run_rotor_benchmarks
 
 HAVE_ROSS = importlib.util.find_spec("ross") is not None
 

@@ -19,6 +19,8 @@ lambda = |r_s| = |r_sigma| / l0 and the frame velocity e3 x r
     inextensible lambda = 1: no W; the constraint g = (lambda^2 - 1)/2 = 0 (model.constraint_density)
                  with multiplier mu = l0 p.
 
+(the string laws of mechgen.symbolic.materials with stiffness beta).
+
 The complementary energy C(n) = l0 W*(|n|), W*(p) = integral of lambda(p) dp, of the
 tension vector n = p t (conjugate to r_sigma) gives the steady balloons in the
 tension-vector form r_sigma = l0 lambda(p) n / p, n_sigma = -l0 (x, y, 0) (steady
@@ -34,12 +36,15 @@ keep t . u_s = 0, A = p I, mechgen.runtime.constrained; with ``strain = "project
 extensible laws' axial stiffness p' t t^T is seen through cos(k pi sigma) as well, the
 strain measure being g = (lambda^2 - 1)/2: N = 10 then converges about ten times better).
 Outputs: ``tension`` p,
-``stretch`` lambda, ``radius`` sqrt(x^2 + y^2).
+``stretch`` lambda, ``radius`` sqrt(x^2 + y^2); the shape output ``loops`` with its starting guesses
+(``shape = { loops = 2 }``) comes from mechgen.runtime.guesses.
 """
 import sympy as sp
 
+from mechgen.runtime import guesses
 from mechgen.symbolic.field import fix
 from mechgen.symbolic.kinematics import frame_velocity
+from mechgen.symbolic.materials import green_strain, string_law
 from mechgen.symbolic.model import Model
 from mechgen.symbolic.params import Param
 
@@ -67,36 +72,25 @@ def stretch(u, p):
     return sp.sqrt(u.x_s**2 + u.y_s**2 + u.z_s**2) / length(p)
 
 
+def law(p):
+    """The string's constitutive law, by the scene's ``law`` (mechgen.symbolic.materials), stiffness beta."""
+    return string_law(p.law, stiffness=p.beta)
+
+
 def strain_energy(lam, p):
-    """W(lambda) per unit undeformed length."""
-    if p.law == "inextensible":  # no strain energy: the tension is the multiplier of the constraint below
-        return sp.Integer(0)
-    if p.law == "neo_hookean":
-        return p.beta / 3 * (lam**2 / 2 + 1 / lam)
-    return p.beta / 2 * (lam - 1) ** 2
+    """W(lambda) per unit undeformed length (0 for the inextensible law: its tension is the constraint's
+    multiplier)."""
+    return law(p).energy(lam)
 
 
 def stretch_of_tension(t, p):
-    """lambda(p), the inverse of the law: neo-Hookean lambda^3 - (3p/beta) lambda^2 - 1 = 0 by Cardano's
-    formula, lambda = q + cbrt(S) + cbrt(q^6 / S), q = p/beta, S = 1/2 + q^3 + sqrt(1/4 + q^3) (the second
-    root written without cancellation; real for q^3 > -1/4); linear 1 + p/beta; inextensible 1."""
-    if p.law == "inextensible":
-        return sp.Integer(1)
-    if p.law == "linear":
-        return 1 + t / p.beta
-    q = t / p.beta
-    S = sp.Rational(1, 2) + q**3 + sp.sqrt(sp.Rational(1, 4) + q**3)
-    return q + sp.cbrt(S) + sp.cbrt(q**6 / S)
+    """lambda(p), the inverse of the law (neo-Hookean by Cardano's formula)."""
+    return law(p).stretch(t)
 
 
 def complementary_energy(t, p):
     """W*(p) = p lambda(p) - W(lambda(p)) = integral of lambda dp: per unit undeformed length, up to a constant."""
-    if p.law == "inextensible":
-        return t
-    if p.law == "linear":
-        return t + t**2 / (2 * p.beta)
-    lam = stretch_of_tension(t, p)
-    return t * lam - strain_energy(lam, p)
+    return law(p).complementary(t)
 
 
 def inertial_velocity(u):
@@ -124,13 +118,13 @@ def complementary(u, n, p):
 @model.constraint_density
 def inextensible(u, p):
     """g = (lambda^2 - 1)/2 = 0 for the inextensible law (none otherwise); its multiplier is mu = l0 p."""
-    return (stretch(u, p) ** 2 - 1) / 2 if p.law == "inextensible" else 0
+    return law(p).constraint(stretch(u, p))
 
 
 @model.strain_density
 def axial_strain(u, p):
     """g = (lambda^2 - 1)/2, the strain measure of the extensible laws (for strain = "projected")."""
-    return (stretch(u, p) ** 2 - 1) / 2 if p.law != "inextensible" else 0
+    return 0 if law(p).inextensible else green_strain(stretch(u, p))
 
 
 @model.dissipation_density
@@ -150,69 +144,18 @@ model.output("stretch", stretch, doc="lambda = |r_s|")
 model.output("radius", lambda u: sp.sqrt(u.x**2 + u.y**2), doc="distance from the axis")
 
 
-# ---------------------------------------------------------------------------------------------------------------
-# Loop count: a number measured on a sampled steady balloon (numeric; the scene code stays generic), and starting
-# guesses for a balloon with a given loop count.
-def loop_count(u):
-    """The balloon's loop label (Sarangi et al.: single 1, one-and-a-half 1.5, double 2 ...), for planar balloons.
-
-    n_c = the sign changes of x(s) between the eyelets; loops = 1 if n_c = 0, else n_c + 1 when the last bulge
-    is complete (x_s < 0 at the rotating eyelet, i.e. the tension vector's Q(l0) < 0: |x| peaked before the
-    eyelet, since x(l0) = 1 > 0) and n_c + 1/2 otherwise (benchmarks/balloon_notes.md, section 4)."""
-    import numpy as np
-
-    x = np.asarray(u.x, float)[1:-1]
-    signs = np.sign(x[x != 0.0])
-    crossings = int(np.count_nonzero(signs[1:] != signs[:-1]))
-    if crossings == 0:
-        return 1.0
-    return crossings + (1.0 if float(np.asarray(u.x_s)[-1]) < 0.0 else 0.5)
-
+# Loop count and starting guesses for a balloon with a given loop count: numeric, in mechgen.runtime.guesses.
+loop_count = guesses.loop_count
 
 #: the tension levels (p_e scale) of the starting guesses tried, in order
 START_TENSIONS = (2.0, 5.0, 10.0)
 
 
 def loop_start(value, s, p):
-    """Starting guesses for a balloon with ``value`` loops: n_c = round(value + 1/2) - 1 axis crossings.
-
-    Each guess is the graph x(z) = z/h + a sin(k pi z/h), k = n_c + 1 (the sign of a makes the last bulge
-    positive), with a chosen so that the curve's length is l0 lambda_g: a uniformly stretched string at the
-    tension level p_g (lambda_g = 1 + p_g/beta), material points spaced evenly along it, and the tension
-    vector n = p_g t along its tangent t. One guess per p_g in START_TENSIONS."""
-    import numpy as np
-    from scipy.integrate import cumulative_trapezoid
-    from scipy.optimize import brentq
-
-    k = max(int(np.floor(float(value) + 0.5)), 1)
-    h, l0 = float(p.h), float(p.h) / (1.0 - float(p.lambda0))
-    sigma = np.asarray(s, float) / float(p.L)
-    zeta = np.linspace(0.0, 1.0, 4001)
-    cos = np.cos(k * np.pi * zeta)
-    for tension in START_TENSIONS:
-        target = l0 * (1.0 + tension / float(p.beta))
-
-        def excess(a):
-            return h * np.trapezoid(np.sqrt(1.0 + ((1.0 + a * k * np.pi * cos) / h) ** 2), zeta) - target
-
-        a = 0.0
-        if excess(0.0) < 0.0:
-            top = 1.0
-            while excess(top) < 0.0:
-                top *= 2.0
-            a = brentq(excess, 0.0, top, xtol=1e-12)
-        a *= (-1.0) ** (k - 1)
-        slope = (1.0 + a * k * np.pi * cos) / h  # dx/dz
-        arc = cumulative_trapezoid(h * np.sqrt(1.0 + slope**2), zeta, initial=0.0)
-        at = arc / arc[-1]
-        x = np.interp(sigma, at, zeta + a * np.sin(k * np.pi * zeta))
-        z = np.interp(sigma, at, h * zeta)
-        norm = np.sqrt(1.0 + slope**2)
-        tx, tz = np.interp(sigma, at, slope / norm), np.interp(sigma, at, 1.0 / norm)
-        stretch_ = arc[-1] / float(p.L)
-        zero = np.zeros_like(sigma)
-        yield {"u": {"x": x, "y": zero, "z": z}, "u_s": {"x": stretch_ * tx, "y": zero, "z": stretch_ * tz},
-               "n": {"x": tension * tx, "y": zero, "z": tension * tz}}
+    """Starting guesses for a balloon with ``value`` loops (mechgen.runtime.guesses.sine_loop_guesses: the
+    string from the guide eyelet to (1, 0, h), undeformed length l0, one guess per level of START_TENSIONS)."""
+    return guesses.sine_loop_guesses(value, s, height=p.h, length=length(p), domain=p.L, stiffness=p.beta,
+                                     tensions=START_TENSIONS)
 
 
 model.shape_output("loops", loop_count, start=loop_start,

@@ -1,4 +1,5 @@
-"""Balloon benchmark (issue #4): the single-loop branch with stability, mechgen against a hand-written scipy baseline.
+"""``mechgen bench balloon`` (issue #4): the single-loop branch with stability, mechgen against a hand-written scipy
+baseline.
 
 The computation is that of ``scenes/balloon_branches.toml`` (neo-Hookean string, h = 10, beta = 100): the
 single-loop branch of steady balloons in lambda0 from -0.5 to 0.27 by pseudo-arclength continuation, about
@@ -35,18 +36,15 @@ from __future__ import annotations
 
 import contextlib
 import importlib.util
-import json
 import os
-import platform
 import statistics
-import time
 from pathlib import Path
 
 import numpy as np
 
-from mechgen.bench_rotor import _blas_info, blas_threads
+from mechgen.bench.common import ROOT, blas_info, blas_threads, environment, write_json, write_text
+from mechgen.bench.common import timed as _timed  # the local name the suite's steps use
 
-ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "scenes" / "balloon_branches.toml"
 BASELINE = ROOT / "benchmarks" / "balloon_handwritten.py"
 H = 10.0
@@ -68,12 +66,6 @@ GALERKIN = (5, 10, 15, 20)
 
 
 # -- helpers ------------------------------------------------------------------------------------------------
-def _timed(fn):
-    start = time.perf_counter()
-    out = fn()
-    return time.perf_counter() - start, out
-
-
 def _label(config) -> str:
     scheme, stages, mesh = config
     return f"Hermite-Simpson, M = {mesh}" if scheme == "collocation" else f"Gauss s = {stages}, M = {mesh}"
@@ -348,16 +340,13 @@ def report_markdown(res: dict) -> str:
 # -- entry point ----------------------------------------------------------------------------------------------
 def run_balloon_benchmarks(out: Path, quick: bool = False) -> dict:
     """Run the balloon benchmark; write ``out/balloon_branch.json`` and ``.md``; return the results."""
-    import scipy
-
     out = Path(out)
-    env = {"python": platform.python_version(), "numpy": np.__version__, "scipy": scipy.__version__,
-           "cpu_count": os.cpu_count(), "machine": platform.machine(), "loadavg_before": list(os.getloadavg())}
+    env = environment()
     res: dict = {"quick": quick, "environment": env, "points": POINTS, "default": _label(DEFAULT)}
     ref = load_baseline()
     with blas_threads(1) as nthreads:
         res["blas_threads"] = nthreads if nthreads is not None else "unlimited (threadpoolctl missing)"
-        res["blas"] = _blas_info()
+        res["blas"] = blas_info()
         system, res["build"] = balloon_system()
         mech = Mechgen(system)
         for config in (DEFAULT, REFERENCE):
@@ -392,10 +381,9 @@ def run_balloon_benchmarks(out: Path, quick: bool = False) -> dict:
                                "ratio_per_point": match["per_point_s"] / h["mechgen"]["per_point_median_s"]}
         res["headline"] = h
     env["loadavg_after"] = list(os.getloadavg())
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "balloon_branch.json").write_text(json.dumps(res, indent=1, default=float) + "\n")
+    write_json(out / "balloon_branch.json", res, indent=1)
     table = report_markdown(res)
-    (out / "balloon_branch.md").write_text(table + "\n")
+    write_text(out / "balloon_branch.md", table + "\n")
     print(table)
     print(f"\nwrote {out / 'balloon_branch.json'}, {out / 'balloon_branch.md'}")
     return res

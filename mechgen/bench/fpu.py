@@ -1,4 +1,4 @@
-"""``mechgen bench``: speed of generated kernels against hand-written and library baselines.
+"""``mechgen bench fpu``: speed of generated kernels against hand-written and library baselines.
 
 FPU chain (bond force f(r) = gamma r + alpha r^2 + beta r^3, fixed ends): the force
 F = -dV/du and its sparse (tridiagonal) stiffness K = dF/du... as CSR data, at N = 64,
@@ -18,41 +18,18 @@ against each other before timing.
 """
 from __future__ import annotations
 
-import csv
-import json
-import os
-import subprocess
-import sys
-import tempfile
 import time
-from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 
+from mechgen.bench.common import ROOT, best_time, empty_cache, in_fresh_process, write_csv, write_json, write_text
+
+__all__ = ["best_time", "empty_cache", "numpy_force", "numpy_stiffness", "fpu_system", "kernel_rows",
+           "call_overhead", "build_times", "scene_start", "report_markdown", "run_fpu_benchmarks"]
+
 GAMMA, ALPHA, BETA = 1.0, 0.25, 0.1
-HAND_C = Path(__file__).resolve().parents[1] / "benchmarks" / "hand_fpu.c"
-
-
-def best_time(fn, *, min_time: float = 0.1, repeats: int = 5) -> float:
-    """Best over ``repeats`` of the mean time of enough calls to last ``min_time`` seconds."""
-    fn()
-    number, elapsed = 1, 0.0
-    while True:
-        start = time.perf_counter()
-        for _ in range(number):
-            fn()
-        elapsed = time.perf_counter() - start
-        if elapsed >= min_time:
-            break
-        number *= 2 if elapsed <= 0 else max(2, int(min_time / max(elapsed, 1e-9)))
-    best = elapsed / number
-    for _ in range(repeats - 1):
-        start = time.perf_counter()
-        for _ in range(number):
-            fn()
-        best = min(best, (time.perf_counter() - start) / number)
-    return best
+HAND_C = ROOT / "benchmarks" / "hand_fpu.c"
 
 
 def numpy_force(u: np.ndarray) -> np.ndarray:
@@ -75,7 +52,8 @@ def numpy_stiffness(u: np.ndarray) -> np.ndarray:
     return data
 
 
-def _generated(n: int):
+def fpu_system(n: int):
+    """The FPU chain of n sites compiled to C with its force and stiffness kernels: (system, build report)."""
     from mechgen import models
     from mechgen.pipeline import compile_model
     from mechgen.symbolic.specialize import specialize
@@ -140,7 +118,7 @@ def kernel_rows(sizes, batch_n: int, batch: int, lambdify_max: int) -> list[dict
     rows: list = []
     rng = np.random.default_rng(0)
     for n, nb in [(n, 1) for n in sizes] + [(batch_n, batch)]:
-        system, _ = _generated(n)
+        system, _ = fpu_system(n)
         u = np.ascontiguousarray(rng.normal(scale=0.1, size=(nb, n)))
         u1 = u[0].copy()
         f_gen, f_hand = np.zeros((nb, n)), np.zeros((nb, n))
@@ -198,29 +176,14 @@ def call_overhead() -> dict:
             "overhead_ns": (single - per_state) * 1e9}
 
 
-@contextmanager
-def empty_cache():
-    """Point $MECHGEN_CACHE at a fresh temporary directory for the duration (first-run timings)."""
-    old = os.environ.get("MECHGEN_CACHE")
-    with tempfile.TemporaryDirectory() as tmp:
-        os.environ["MECHGEN_CACHE"] = tmp
-        try:
-            yield
-        finally:
-            if old is None:
-                os.environ.pop("MECHGEN_CACHE", None)
-            else:
-                os.environ["MECHGEN_CACHE"] = old
-
-
 _FRESH_BUILD = """
 import json, sys, time
 start = time.perf_counter()
 import mechgen.pipeline, mechgen.models, mechgen.symbolic.specialize  # noqa: E401 (imports timed apart)
-from mechgen.bench import _generated
+from mechgen.bench.fpu import fpu_system
 from mechgen.codegen.build import STATS
 imported = time.perf_counter()
-_, report = _generated(int(sys.argv[1]))
+_, report = fpu_system(int(sys.argv[1]))
 print(json.dumps({"seconds": time.perf_counter() - imported, "import_s": imported - start,
                   "compiled": STATS["miss"] > 0, "cached": report.cached,
                   **{f"{k}_s": v for k, v in report.seconds.items()}}))
@@ -238,13 +201,6 @@ print(json.dumps({"seconds": seconds, "import_s": imported - start, "compiled": 
 """
 
 
-def _in_fresh_process(code: str, arg: str) -> dict:
-    """Run ``code`` in a new interpreter (cold imports and sympy caches, the current $MECHGEN_CACHE)."""
-    done = subprocess.run([sys.executable, "-c", code, arg], capture_output=True, text=True, check=True,
-                          env=os.environ.copy(), cwd=Path(__file__).resolve().parents[1])
-    return json.loads(done.stdout.strip().splitlines()[-1])
-
-
 def build_times(sizes) -> list[dict]:
     """Derivation + generation + compile of the FPU kernels, first run (empty cache) and cached, for each N.
 
@@ -257,7 +213,7 @@ def build_times(sizes) -> list[dict]:
     for n in sizes:
         with empty_cache():
             for label in ("first", "cached"):
-                rows.append({"N": n, "run": label, **_in_fresh_process(_FRESH_BUILD, str(n))})
+                rows.append({"N": n, "run": label, **in_fresh_process(_FRESH_BUILD, str(n))})
     return rows
 
 
@@ -266,7 +222,7 @@ def scene_start(scene: Path) -> dict:
     out = {}
     with empty_cache():
         for label in ("first", "cached"):
-            out[label] = _in_fresh_process(_FRESH_SCENE, str(scene))["seconds"]
+            out[label] = in_fresh_process(_FRESH_SCENE, str(scene))["seconds"]
     return out
 
 
@@ -313,41 +269,6 @@ def report_markdown(rows, overhead, builds, start) -> str:
     return "\n".join(lines)
 
 
-SUITES = ("fpu", "beam", "rotor", "balloon")
-
-
-def run_benchmarks(models_: list[str] | None = None, *, out: Path, quick: bool = False) -> dict:
-    """Run the benchmark suites named in ``models_`` (default: all of :data:`SUITES`).
-
-    ``fpu``: FPU chain kernels, writes ``out/fpu_kernels.{csv,json,md}``; ``beam``: the
-    continua work-precision and assembly study (:mod:`mechgen.bench_field`); ``rotor``: Campbell
-    diagrams against ROSS (:mod:`mechgen.bench_rotor`); ``balloon``: the ballooning string's
-    branch with stability against a hand-written scipy baseline (:mod:`mechgen.bench_balloon`).
-    """
-    from mechgen.errors import InputError
-
-    chosen = list(models_ or SUITES)
-    unknown = [m for m in chosen if m not in SUITES]
-    if unknown:
-        raise InputError(f"unknown benchmark {unknown[0]!r}", key="bench", expected=f"one of {', '.join(SUITES)}")
-    results = {}
-    if "fpu" in chosen:
-        results["fpu"] = run_fpu_benchmarks(out=out, quick=quick)
-    if "beam" in chosen:
-        from mechgen.bench_field import run_field_benchmarks
-
-        results["beam"] = run_field_benchmarks(out, quick=quick)
-    if "rotor" in chosen:
-        from mechgen.bench_rotor import run_rotor_benchmarks
-
-        results["rotor"] = run_rotor_benchmarks(out, quick=quick)
-    if "balloon" in chosen:
-        from mechgen.bench_balloon import run_balloon_benchmarks
-
-        results["balloon"] = run_balloon_benchmarks(out, quick=quick)
-    return results
-
-
 def run_fpu_benchmarks(*, out: Path, quick: bool = False) -> dict:
     """Run the FPU benchmark and write ``out/fpu_kernels.{csv,json,md}``."""
     sizes = (64, 256) if quick else (64, 1024, 16384)
@@ -355,16 +276,13 @@ def run_fpu_benchmarks(*, out: Path, quick: bool = False) -> dict:
     rows = kernel_rows(sizes, batch[0], batch[1], lambdify_max=256 if quick else 1024)
     overhead = call_overhead()
     builds = build_times((8, 100_000) if not quick else (8, 1000))
-    start = scene_start(Path(__file__).resolve().parents[1] / "scenes" / "spring_pendulum.toml")
-    out.mkdir(parents=True, exist_ok=True)
-    with open(out / "fpu_kernels.csv", "w", newline="") as fh:
-        writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        writer.writeheader()
-        writer.writerows(rows)
+    start = scene_start(ROOT / "scenes" / "spring_pendulum.toml")
+    out = Path(out)
+    write_csv(out / "fpu_kernels.csv", rows)
     result = {"kernels": rows, "call_overhead": overhead, "builds": builds, "scene_start": start}
-    (out / "fpu_kernels.json").write_text(json.dumps(result, indent=2, default=float))
+    write_json(out / "fpu_kernels.json", result)
     table = report_markdown(rows, overhead, builds, start)
-    (out / "fpu_kernels.md").write_text(table + "\n")
+    write_text(out / "fpu_kernels.md", table + "\n")
     print(table)
     print(f"\nwrote {out / 'fpu_kernels.csv'}, {out / 'fpu_kernels.json'}, {out / 'fpu_kernels.md'}")
     return result

@@ -1,4 +1,4 @@
-"""Rotor benchmark (issue #5): Campbell diagrams of ROSS's example rotor, mechgen against ROSS.
+"""``mechgen bench rotor`` (issue #5): Campbell diagrams of ROSS's example rotor, mechgen against ROSS.
 
 The rotor is ROSS's documented example (``ross.rotor_example()``: 1.5 m solid steel shaft, D = 0.05 m,
 two disks from geometry at s = 0.5 and 1.0 m, bearings kxx = 1e6, kyy = 0.8e6 N/m at both ends, no
@@ -53,19 +53,18 @@ from __future__ import annotations
 import contextlib
 import cProfile
 import io
-import json
 import os
-import platform
 import pstats
 import statistics
 import sys
-import time
 import warnings
 from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
+from mechgen.bench.common import ROOT, blas_info, blas_threads, environment, write_json, write_text
+from mechgen.bench.common import timed as _timed  # the local name the suite's steps use
+
 SCENE = ROOT / "scenes" / "ross_example_rotor.toml"
 COUNT = 8
 SPLIT = 8                 # every ROSS element split in 8: N = 48
@@ -105,32 +104,6 @@ def import_ross():
         return ross, None
     except Exception as exc:  # noqa: BLE001 (any failure to import means: skip ROSS)
         return None, f"{type(exc).__name__}: {exc}"
-
-
-@contextlib.contextmanager
-def blas_threads(n: int = 1):
-    """Limit BLAS/OpenMP threads of both tools alike (threadpoolctl, when installed)."""
-    try:
-        from threadpoolctl import threadpool_limits
-    except ImportError:
-        yield None
-        return
-    with threadpool_limits(limits=n):
-        yield n
-
-
-def _blas_info() -> list:
-    try:
-        from threadpoolctl import threadpool_info
-    except ImportError:
-        return []
-    return [{"api": i.get("internal_api"), "num_threads": i.get("num_threads")} for i in threadpool_info()]
-
-
-def _timed(fn):
-    start = time.perf_counter()
-    out = fn()
-    return time.perf_counter() - start, out
 
 
 def _summary(times: list[float]) -> dict:
@@ -529,19 +502,15 @@ def report_markdown(res: dict) -> str:
 # -- entry point ----------------------------------------------------------------------------------------------
 def run_rotor_benchmarks(out: Path, quick: bool = False) -> dict:
     """Run the rotor benchmark; write ``out/rotor_campbell.json`` and ``out/rotor_campbell.md``; return the results."""
-    import scipy
-
     out = Path(out)
     repeats = 1 if quick else 3
     speeds = speeds_of(10 if quick else 50)
     rs, skipped = import_ross()
-    env = {"python": platform.python_version(), "numpy": np.__version__, "scipy": scipy.__version__,
-           "ross": getattr(rs, "__version__", None), "cpu_count": os.cpu_count(), "machine": platform.machine(),
-           "loadavg_before": list(os.getloadavg())}
+    env = environment(ross=getattr(rs, "__version__", None))
     res: dict = {"quick": quick, "environment": env, "ross_skipped": skipped}
     with blas_threads(1) as nthreads:
         res["blas_threads"] = nthreads if nthreads is not None else "unlimited (threadpoolctl missing)"
-        res["blas"] = _blas_info()
+        res["blas"] = blas_info()
         system, info = rotor_system(6 * SPLIT, fresh=True)
         info["unknowns"] = system.n
         res["build"] = info
@@ -565,10 +534,9 @@ def run_rotor_benchmarks(out: Path, quick: bool = False) -> dict:
                         "frequencies": [res["accuracy"]["rows"][k]["ross"] for k in range(2)]}
         res["work_precision"] = work_precision(repeats, quick, ross_row)
     env["loadavg_after"] = list(os.getloadavg())
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "rotor_campbell.json").write_text(json.dumps(res, indent=1, default=float) + "\n")
+    write_json(out / "rotor_campbell.json", res, indent=1)
     table = report_markdown(res)
-    (out / "rotor_campbell.md").write_text(table + "\n")
+    write_text(out / "rotor_campbell.md", table + "\n")
     print(table)
     print(f"\nwrote {out / 'rotor_campbell.json'}, {out / 'rotor_campbell.md'}")
     return res

@@ -1,4 +1,5 @@
-"""Continua benchmarks: work against precision on the clamped-free beam, and assembly speed against scikit-fem.
+"""``mechgen bench beam`` (continua): work against precision on the clamped-free beam, and assembly speed against
+scikit-fem.
 
 1. **Work-precision.** Euler-Bernoulli beam, EI = rhoA = L = 1, clamped at s = 0
    and free at s = L. Exact frequencies omega_n = (beta_n L)^2 with beta_n L the
@@ -33,15 +34,14 @@ machine. Entry point: :func:`run_field_benchmarks`.
 """
 from __future__ import annotations
 
-import csv
-import json
 import platform
 import statistics
-import time
 import warnings
 from pathlib import Path
 
 import numpy as np
+
+from mechgen.bench.common import loglog_plot, repeat_times, write_csv, write_json, write_text
 
 MODEL = "euler_bernoulli_beam"
 COUNT = 5
@@ -100,25 +100,6 @@ def _lowest_frequencies(M, K, fixed=(0, 1), count: int = COUNT) -> np.ndarray:
     return np.sqrt(np.sort(lam))
 
 
-# -- timing ----------------------------------------------------------------------
-def _times(fn, repeats: int, min_time: float = 0.0) -> list[float]:
-    """Per-call seconds of ``repeats`` timed runs (after one untimed warm-up); a run loops to last ``min_time``."""
-    fn()
-    number = 1
-    if min_time > 0:
-        start = time.perf_counter()
-        fn()
-        once = max(time.perf_counter() - start, 1e-7)
-        number = max(1, int(min_time / once))
-    out = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        for _ in range(number):
-            fn()
-        out.append((time.perf_counter() - start) / number)
-    return out
-
-
 # -- work-precision --------------------------------------------------------------
 def _beam(bc: str, disc: str, size: int, backend: str):
     from mechgen import models
@@ -149,7 +130,7 @@ def work_precision(ladders: dict, *, repeats: int = 5, backend: str = "c") -> li
 
             freqs = solve()
             err = float(np.max(np.abs(freqs / exact - 1.0)))
-            times = _times(solve, repeats)
+            times = repeat_times(solve, repeats)
             rows.append({"discretisation": disc, "size": int(size), "unknowns": int(system.n),
                          "max_rel_error": err, "seconds": min(times), "median_seconds": statistics.median(times),
                          "backend": report.backend})
@@ -158,14 +139,10 @@ def work_precision(ladders: dict, *, repeats: int = 5, backend: str = "c") -> li
 
 def _write_work_precision(rows: list[dict], out: Path, exact: np.ndarray) -> list[Path]:
     files = [out / "beam_work_precision.csv", out / "beam_work_precision.md"]
-    with files[0].open("w", newline="") as fh:
-        writer = csv.writer(fh)
-        writer.writerow(["discretisation", "size", "unknowns", "max_rel_error", "seconds", "median_seconds",
-                         "backend"])
-        for r in rows:
-            writer.writerow([r["discretisation"], r["size"], r["unknowns"], f"{r['max_rel_error']:.6e}",
-                             f"{r['seconds']:.6e}", f"{r['median_seconds']:.6e}", r["backend"]])
-    files[1].write_text(work_precision_markdown(rows, exact))
+    write_csv(files[0], ([r["discretisation"], r["size"], r["unknowns"], f"{r['max_rel_error']:.6e}",
+                          f"{r['seconds']:.6e}", f"{r['median_seconds']:.6e}", r["backend"]] for r in rows),
+              header=["discretisation", "size", "unknowns", "max_rel_error", "seconds", "median_seconds", "backend"])
+    write_text(files[1], work_precision_markdown(rows, exact))
     png = out / "beam_work_precision.png"
     if _plot_work_precision(rows, png):
         files.append(png)
@@ -190,30 +167,11 @@ def work_precision_markdown(rows: list[dict], exact: np.ndarray) -> str:
 
 def _plot_work_precision(rows: list[dict], path: Path) -> bool:
     """Error against time, log-log, one line per discretisation (False when matplotlib is missing)."""
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        return False
-    fig, ax = plt.subplots(figsize=(7, 5))
-    for disc in dict.fromkeys(r["discretisation"] for r in rows):
-        sel = [r for r in rows if r["discretisation"] == disc]
-        t = [r["seconds"] for r in sel]
-        e = [max(r["max_rel_error"], PLOT_FLOOR) for r in sel]
-        ax.loglog(t, e, "o-", label=disc)
-        for r, ti, ei in zip(sel, t, e):
-            ax.annotate(str(r["size"]), (ti, ei), textcoords="offset points", xytext=(4, 3), fontsize=7)
-    ax.set_xlabel("full solve wall time [s] (warm compile + linear() + modes(5))")
-    ax.set_ylabel("max relative error, first five frequencies")
-    ax.set_title("Clamped-free Euler-Bernoulli beam: work-precision")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend()
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return True
+    series = {disc: [(r["seconds"], r["max_rel_error"], r["size"]) for r in rows if r["discretisation"] == disc]
+              for disc in dict.fromkeys(r["discretisation"] for r in rows)}
+    return loglog_plot(path, series, xlabel="full solve wall time [s] (warm compile + linear() + modes(5))",
+                       ylabel="max relative error, first five frequencies",
+                       title="Clamped-free Euler-Bernoulli beam: work-precision", floor=PLOT_FLOOR)
 
 
 # -- assembly against scikit-fem ----------------------------------------------------
@@ -281,14 +239,14 @@ def assembly_comparison(elements: int = ASSEMBLY_ELEMENTS, *, repeats: int = 7, 
     if result["checks"]["mechgen_vs_closed_form"] > 1e-12:
         raise AssertionError(f"mechgen's Hermite matrices deviate from the closed form: {result['checks']}")
     t = result["seconds"]
-    t["mechgen linear()"] = min(_times(system.linear, repeats, min_time))
-    t["mechgen refined(N).linear()"] = min(_times(lambda: system.refined(elements).linear(), repeats, min_time))
+    t["mechgen linear()"] = min(repeat_times(system.linear, repeats, min_time))
+    t["mechgen refined(N).linear()"] = min(repeat_times(lambda: system.refined(elements).linear(), repeats, min_time))
     only = _assembly_only(system)
     if only is not None:
         check = only()
         if max(_relative(check["M"], Mx), _relative(check["K"], Kx)) > 1e-12:
             raise AssertionError("assembly-only M/K differ from linear()'s")
-        t["mechgen assembly only (M, K)"] = min(_times(only, repeats, min_time))
+        t["mechgen assembly only (M, K)"] = min(repeat_times(only, repeats, min_time))
     skfem, version = _skfem()
     result["skfem_version"] = version if skfem is not None else None
     if skfem is None:
@@ -309,8 +267,8 @@ def assembly_comparison(elements: int = ASSEMBLY_ELEMENTS, *, repeats: int = 7, 
     # is still recognisable well inside 1e-3.
     if result["checks"]["mechgen_vs_skfem"] > 1e-3:
         raise AssertionError(f"mechgen and scikit-fem assemble different operators: {result['checks']}")
-    t["skfem asm(M)+asm(K)"] = min(_times(built, repeats, min_time))
-    t["skfem MeshLine+Basis+asm"] = min(_times(scratch, repeats, min_time))
+    t["skfem asm(M)+asm(K)"] = min(repeat_times(built, repeats, min_time))
+    t["skfem MeshLine+Basis+asm"] = min(repeat_times(scratch, repeats, min_time))
     r = result["ratios"]
     r["linear() / asm"] = t["mechgen linear()"] / t["skfem asm(M)+asm(K)"]
     r["refined(N).linear() / MeshLine+Basis+asm"] = t["mechgen refined(N).linear()"] / t["skfem MeshLine+Basis+asm"]
@@ -349,8 +307,8 @@ def run_field_benchmarks(out: Path, quick: bool = False) -> dict:
         rows = work_precision(QUICK_LADDERS if quick else LADDERS, repeats=2 if quick else 5)
         assembly = assembly_comparison(ASSEMBLY_ELEMENTS, repeats=3 if quick else 7, min_time=0.0 if quick else 0.05)
     files = _write_work_precision(rows, out, exact)
-    (out / "beam_assembly.json").write_text(json.dumps(assembly, indent=2) + "\n")
-    (out / "beam_assembly.md").write_text(assembly_markdown(assembly))
+    write_json(out / "beam_assembly.json", assembly)
+    write_text(out / "beam_assembly.md", assembly_markdown(assembly))
     files += [out / "beam_assembly.json", out / "beam_assembly.md"]
     print(work_precision_markdown(rows, exact))
     print(assembly_markdown(assembly))

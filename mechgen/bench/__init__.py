@@ -1,0 +1,85 @@
+"""``mechgen bench``: the benchmark suites and their registry.
+
+One module per suite (``mechgen.bench.<module>``, each with its entry point ``run_<...>_benchmarks(out=...,
+quick=...)`` writing its reports into ``out``), the helpers they share in :mod:`mechgen.bench.common`.
+A suite is added by writing its module and one :class:`Suite` line in :data:`REGISTRY`; ``mechgen bench
+--list`` names them. Importing this package loads no suite (and neither numpy nor sympy).
+"""
+from __future__ import annotations
+
+import importlib
+from dataclasses import dataclass
+from pathlib import Path
+
+
+@dataclass(frozen=True)
+class Suite:
+    """A benchmark suite: its name on the command line, the module and function that run it, what it measures
+    and the reports it writes into the output folder."""
+
+    name: str
+    module: str
+    function: str
+    summary: str
+    writes: tuple[str, ...] = ()
+
+    def run(self, out: Path, quick: bool = False) -> dict:
+        """Run the suite (importing its module now) and return its results."""
+        return getattr(importlib.import_module(self.module), self.function)(out=Path(out), quick=quick)
+
+
+#: the suites, in the order ``mechgen bench`` runs them
+REGISTRY: dict[str, Suite] = {s.name: s for s in (
+    Suite("fpu", "mechgen.bench.fpu", "run_fpu_benchmarks",
+          "FPU chain kernels: generated C against hand C, numpy, sympy.lambdify, CasADi; call overhead, build and "
+          "scene start times", ("fpu_kernels.csv", "fpu_kernels.json", "fpu_kernels.md")),
+    Suite("beam", "mechgen.bench.beam", "run_field_benchmarks",
+          "clamped-free beam: work against precision of four discretisations, assembly against scikit-fem",
+          ("beam_work_precision.csv", "beam_work_precision.md", "beam_work_precision.png", "beam_assembly.json",
+           "beam_assembly.md")),
+    Suite("rotor", "mechgen.bench.rotor", "run_rotor_benchmarks",
+          "Campbell diagrams of ROSS's example rotor, mechgen against ROSS", ("rotor_campbell.json",
+                                                                              "rotor_campbell.md")),
+    Suite("balloon", "mechgen.bench.balloon", "run_balloon_benchmarks",
+          "the ballooning string's branch with stability against a hand-written scipy baseline",
+          ("balloon_branch.json", "balloon_branch.md")),
+)}
+
+#: the suite names (``mechgen bench`` with none runs them all)
+SUITES = tuple(REGISTRY)
+
+
+def suite_lines() -> list[str]:
+    """One line per suite: its name, what it measures and the reports it writes (``mechgen bench --list``)."""
+    width = max(len(name) for name in REGISTRY)
+    return [f"{s.name:{width}s}  {s.summary}" + (f" -> {', '.join(s.writes)}" if s.writes else "")
+            for s in REGISTRY.values()]
+
+
+def run_benchmarks(models_: list[str] | None = None, *, out: Path, quick: bool = False) -> dict:
+    """Run the benchmark suites named in ``models_`` (default: all of :data:`SUITES`), in registry order.
+
+    ``fpu``: FPU chain kernels, writes ``out/fpu_kernels.{csv,json,md}``; ``beam``: the continua
+    work-precision and assembly study (:mod:`mechgen.bench.beam`); ``rotor``: Campbell diagrams against ROSS
+    (:mod:`mechgen.bench.rotor`); ``balloon``: the ballooning string's branch with stability against a
+    hand-written scipy baseline (:mod:`mechgen.bench.balloon`). Returns {suite: its results}.
+    """
+    from mechgen.errors import InputError
+
+    chosen = list(models_ or SUITES)
+    unknown = [m for m in chosen if m not in REGISTRY]
+    if unknown:
+        raise InputError(f"unknown benchmark {unknown[0]!r}", key="bench", expected=f"one of {', '.join(SUITES)}")
+    return {name: suite.run(out, quick=quick) for name, suite in REGISTRY.items() if name in chosen}
+
+
+def __getattr__(name: str):
+    """The FPU suite's public names, as ``mechgen.bench`` gave them before the suites had modules of their own
+    (``best_time``, ``run_fpu_benchmarks``, ``kernel_rows`` ...): loaded on first use."""
+    if name.startswith("_"):
+        raise AttributeError(f"module 'mechgen.bench' has no attribute {name!r}")
+    fpu = importlib.import_module("mechgen.bench.fpu")
+    try:
+        return getattr(fpu, name)
+    except AttributeError:
+        raise AttributeError(f"module 'mechgen.bench' has no attribute {name!r}") from None
