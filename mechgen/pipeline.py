@@ -265,6 +265,7 @@ def compile_model(model: Model, spec: Specialization, *, kernels=None, backend: 
         report.seconds["build"] = time.perf_counter() - clock
     report.kernels = {name: {"ops": s["ops"]} for name, s in specs.items()}
     meta = dict(next(iter(specs.values()))["meta"]) if specs else {}
+    meta["source"] = model.source or model.name  # the canonical reference (mechgen.models.resolve)
     values = np.array([float(spec_value(model, spec, n)) for n in meta.get("params", [])])
     if model.is_lattice:
         sites = int(sites if sites is not None else spec.values.get(model.chain_spec.sites,

@@ -29,9 +29,7 @@ def _system_for(model_ref, values: tuple, free: tuple, active, kernels: tuple, b
     Model) or a model reference. ``meta["source"]`` is the model's canonical reference (mechgen.models)."""
     model = models.get(model_ref) if isinstance(model_ref, str) else model_ref
     spec = specialize(model, dict(values), free=free, active=active)
-    system, report = compile_model(model, spec, kernels=set(kernels), backend=backend)
-    system.meta["source"] = model.source or model.name
-    return system, report
+    return compile_model(model, spec, kernels=set(kernels), backend=backend)
 
 
 def _laid_out(system, layout: Layout | None):
