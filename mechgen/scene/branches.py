@@ -68,8 +68,7 @@ from mechgen.runtime.branch_stability import stability_along
 from mechgen.runtime.constrained import linear_about_bvp
 from mechgen.runtime.continuation import minimize_along_branch
 from mechgen.runtime.steady_bvp import hamiltonian_bvp, holding, solve_steady, steady_bvp, stress_guess
-from mechgen.symbolic.model import call_declared
-from mechgen.symbolic.params import Namespace
+from mechgen.scene.info import model_info
 
 SAMPLES = 201
 
@@ -114,20 +113,24 @@ START_TOL = 1e-6  # the tolerance at which ``shape`` starts are tried (then refi
 
 
 def _shape_declarations(system) -> tuple:
-    """The model's shape outputs (Model.shape_output)."""
+    """The model's shape outputs (Model.shape_output); the model is imported only when it declares some."""
+    if not model_info(system.meta["model"]).shape_outputs:
+        return ()
     return tuple(getattr(models.get(system.meta["model"]), "shape_outputs", ()))
 
 
 def _parameter_dict(system, p) -> dict:
     """Numeric parameter values: the model's defaults, the scene's fixed ones, the free ones from p."""
-    model = models.get(system.meta["model"])
-    values = {prm.name: float(prm.default) for prm in model.param_list if prm.is_numeric}
+    info = model_info(system.meta["model"])
+    values = {name: float(prm.default) for name, prm in info.params.items() if prm.numeric}
     values.update({k: float(v) for k, v in getattr(system, "fixed", {}).items()})
     values.update(zip(system.meta.get("params", []), (float(v) for v in p)))
     return values
 
 
-def _parameter_values(system, p) -> Namespace:
+def _parameter_values(system, p):
+    from mechgen.symbolic.params import Namespace  # declared model code needs the model's own types
+
     return Namespace(_parameter_dict(system, p))
 
 
@@ -136,6 +139,9 @@ def _shapes(system, bvp, result) -> dict:
     declared = _shape_declarations(system)
     if not declared:
         return {}
+    from mechgen.symbolic.model import call_declared
+    from mechgen.symbolic.params import Namespace
+
     s = np.linspace(0.0, bvp.length_of(result), SHAPE_SAMPLES)
     y = bvp.values(result, s)
     u = Namespace({**{f: y[i] for i, f in enumerate(bvp.fields)},
@@ -159,6 +165,8 @@ def _with_params(system, values: dict):
 
 def _start_with_shape(system, bvp, options: dict, method: str):
     """A steady state whose shape output equals the requested value, from the model's starting guesses."""
+    from mechgen.symbolic.model import call_declared
+
     (name, value), = options["shape"].items()
     declared = {d.name: d for d in _shape_declarations(system)}
     if name not in declared or declared[name].start is None:
@@ -235,7 +243,7 @@ def run_steady_bvp(system, options: dict, context: dict) -> dict:
     if options.get("hold"):
         free = options["free"]
         solved = float(result.p[bvp.params.index(free)])
-        below = models.get(system.meta["model"]).param(free).below
+        below = model_info(system.meta["model"]).param(free).below
         if below is not None and not solved < below:
             raise ConvergenceError(f"steady state with {next(iter(options['hold']))} held: the solved {free} = "
                                    f"{solved:.6g} is not below {below:g} (no such state near the start; try "

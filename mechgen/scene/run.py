@@ -14,14 +14,14 @@ from pathlib import Path
 import numpy as np
 
 from mechgen import models
-from mechgen.pipeline import compile_model
+from mechgen.pipeline import compile_request
 from mechgen.errors import InputError
 from mechgen.runtime.mesh import Layout
 from mechgen.runtime.sweep import sweep
-from mechgen.scene.analyses import RUNNERS, needs
-from mechgen.scene.info import lookup_model
+from mechgen.scene.analyses import RUNNERS
+from mechgen.scene.info import lookup_model, model_info
 from mechgen.scene.load import load_scene
-from mechgen.symbolic.specialize import specialize
+from mechgen.scene.plan import derive_with, plan_scene, point_request
 
 
 def _public(outputs: dict) -> dict:
@@ -29,10 +29,9 @@ def _public(outputs: dict) -> dict:
 
 
 @lru_cache(maxsize=8)
-def _system_for(model_name: str, values: tuple, free: tuple, active, kernels: tuple, backend: str):
-    model = models.get(model_name)
-    spec = specialize(model, dict(values), free=free, active=active)
-    return compile_model(model, spec, kernels=set(kernels), backend=backend)
+def _system_for(source_key: str, request):
+    """The compiled system of a request (mechgen.scene.plan); the model is imported only to derive."""
+    return compile_request(request, derive_with(models.resolve(source_key), request))
 
 
 def _laid_out(system, layout: Layout | None):
@@ -44,15 +43,11 @@ def _laid_out(system, layout: Layout | None):
 
 def _sweep_point(task: tuple) -> dict:
     """Run the inner analysis of a sweep at one grid point (module level: picklable)."""
-    model_name, values, free, active, kernels, backend, kind, options, point, layout = task
-    system, _ = _system_for(model_name, values, free, active, kernels, backend)
-    model = models.get(model_name)
-    sizes = {k: v for k, v in point.items() if not model.param(k).is_numeric}
-    if sizes:
-        system, _ = _system_for(model_name, tuple(sorted({**dict(values), **sizes}.items())), free, active,
-                                kernels, backend)
+    source_key, request, values, kind, options, point, layout = task
+    info = model_info(source_key)
+    system, _ = _system_for(source_key, point_request(request, info, point) or request)
     system = _laid_out(system, layout)
-    system.params = np.array([float(point.get(n, dict(values).get(n, model.param(n).default)))
+    system.params = np.array([float(point.get(n, dict(values).get(n, info.param(n).default)))
                               for n in system.meta.get("params", [])])
     return _public(RUNNERS[kind](system, options, {}))
 
@@ -67,14 +62,10 @@ def _collect(grid: list[dict], results: list[dict]) -> dict:
 def run_scene(scene, *, overrides=(), backend: str | None = None) -> dict:
     """Run every analysis of a scene file and return the results dict."""
     scn = load_scene(str(scene), overrides=list(overrides), lookup_model=lookup_model, model_names=models.names)
-    model = models.get(scn.model)
-    backend = backend or scn.backend
-    internal = bool(model.internals)
-    kernels = sorted(set().union(*(needs(a.kind, a.options, internal=internal) for a in scn.analyses)))
-    free = tuple(n for n in scn.free if model.param(n).is_numeric)
+    plan = plan_scene(scn, backend=backend)
     fixed = tuple(sorted((k, v) for k, v in scn.params.items()))
     started = time.perf_counter()
-    system, report = _system_for(scn.model, fixed, free, scn.active, tuple(kernels), backend)
+    system, report = _system_for(plan.source.key, plan.main)
     layout = Layout(scn.segments, scn.parts)
     system = _laid_out(system, layout)
     results = {"scene": Path(scn.path).name, "title": scn.title, "model": scn.model, "backend": report.backend,
@@ -85,8 +76,8 @@ def run_scene(scene, *, overrides=(), backend: str | None = None) -> dict:
         clock = time.perf_counter()
         if analysis.kind == "sweep":
             inner = analysis.options["analysis"]
-            tasks = [(scn.model, fixed, free, scn.active, tuple(kernels), backend, inner.kind, dict(inner.options),
-                      point, layout) for point in analysis.options["grid"]]
+            tasks = [(plan.source.key, plan.main, fixed, inner.kind, dict(inner.options), point, layout)
+                     for point in analysis.options["grid"]]
             res = sweep(_sweep_point, tasks, workers=analysis.options.get("workers", 0),
                         progress=analysis.options.get("progress", True), desc=analysis.name)
             outputs = _collect(analysis.options["grid"], res)
