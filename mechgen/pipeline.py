@@ -331,8 +331,9 @@ def committed_document(request: CompileRequest, key: str, generated: dict, text_
     import hashlib
 
     doc = {"format": REQUEST_FORMAT, "key": key, "request": request.describe(), "text": text_name,
-           "sha256": hashlib.sha256(generated["text"].encode("utf-8")).hexdigest(), "specs": generated["specs"]}
-    return json.dumps(doc, indent=1, sort_keys=True) + "\n"
+           "sha256": hashlib.sha256(generated["text"].encode("utf-8")).hexdigest(),
+           "kernels": list(generated["specs"]), "specs": generated["specs"]}
+    return json.dumps(doc, indent=1) + "\n"
 
 
 def read_committed(model: str, key: str, backend: str, root: Path = GENERATED) -> dict | None:
@@ -349,7 +350,7 @@ def read_committed(model: str, key: str, backend: str, root: Path = GENERATED) -
         return None
     if hashlib.sha256(text.encode("utf-8")).hexdigest() != doc.get("sha256"):
         return None
-    return {"text": text, "specs": doc["specs"]}
+    return {"text": text, "specs": {name: doc["specs"][name] for name in doc["kernels"]}}
 
 
 def generated_text(request: CompileRequest, derive_with: Callable[[], tuple], report: BuildReport) -> dict:

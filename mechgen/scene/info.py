@@ -25,7 +25,7 @@ from mechgen import models
 from mechgen.errors import InputError
 
 #: version of the JSON layout of a ModelInfo (part of its cache key)
-INFO_SCHEMA = "model-info-1"
+INFO_SCHEMA = "model-info-2"
 GENERATED = Path(__file__).resolve().parent.parent / "generated"
 
 
@@ -83,6 +83,9 @@ class ModelInfo:
         """JSON form (see :func:`info_from_json`)."""
         data = asdict(self)
         data.pop("file")
+        # orders matter (free names and parts follow the declaration): pairs, not objects that sort_keys reorders
+        data["params"] = [[k, v] for k, v in data["params"].items()]
+        data["parts"] = None if self.parts is None else [[k, list(v)] for k, v in self.parts.items()]
         return data
 
 
@@ -110,8 +113,8 @@ def info_from_json(data: dict, *, file: str | None = None) -> ModelInfo:
         return tuple(v) if v is not None else None
 
     params = {k: ParamInfo(v["default"], tup(v["choices"]), v["integer"], v["below"], v["numeric"], v["runtime"])
-              for k, v in data["params"].items()}
-    parts = {k: tuple(v) for k, v in data["parts"].items()} if data.get("parts") is not None else None
+              for k, v in data["params"]}
+    parts = {k: tuple(v) for k, v in data["parts"]} if data.get("parts") is not None else None
     return ModelInfo(data["name"], params, tuple(data["coordinates"]), tuple(data["outputs"]), data["continuum"],
                      data["length"], parts, data["stress_form"], tuple(data["fields"]), tuple(data["shape_outputs"]),
                      data["internals"], tup(data["chain"]), tuple(data["coordinates_all"]),
