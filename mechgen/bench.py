@@ -313,7 +313,7 @@ def report_markdown(rows, overhead, builds, start) -> str:
     return "\n".join(lines)
 
 
-SUITES = ("fpu", "beam", "rotor", "balloon")
+SUITES = ("fpu", "beam", "rotor", "balloon", "startup")
 
 
 def run_benchmarks(models_: list[str] | None = None, *, out: Path, quick: bool = False) -> dict:
@@ -345,6 +345,10 @@ def run_benchmarks(models_: list[str] | None = None, *, out: Path, quick: bool =
         from mechgen.bench_balloon import run_balloon_benchmarks
 
         results["balloon"] = run_balloon_benchmarks(out, quick=quick)
+    if "startup" in chosen:  # whole-process start of a cached scene (mechgen.bench_startup)
+        from mechgen.bench_startup import run_startup_benchmarks
+
+        results["startup"] = run_startup_benchmarks(out, quick=quick)
     return results
 
 

@@ -336,11 +336,12 @@ def committed_document(request: CompileRequest, key: str, generated: dict, text_
     return json.dumps(doc, indent=1) + "\n"
 
 
-def read_committed(model: str, key: str, backend: str, root: Path = GENERATED) -> dict | None:
-    """{'text', 'specs'} of a request from mechgen/generated/ when its full key and text digest match, else None."""
+def read_committed(model: str, key: str, backend: str, root: Path | None = None) -> dict | None:
+    """{'text', 'specs'} of a request from mechgen/generated/ (or ``root``) when its full key and text digest
+    match, else None."""
     import hashlib
 
-    text_path, json_path = committed_paths(model, key, backend, root)
+    text_path, json_path = committed_paths(model, key, backend, GENERATED if root is None else root)
     try:
         doc = json.loads(json_path.read_text(encoding="utf-8"))
         if doc.get("key") != key or doc.get("text") != text_path.name:
