@@ -74,7 +74,12 @@ def fresh(source, request) -> dict:
     """{'text', 'specs'} of a request, derived now (never from a cache)."""
     from mechgen.scene.plan import derive_with
 
+    from mechgen.errors import MechgenError
+
     model, spec = derive_with(source, request)()
+    if spec.key() != request.spec_text():
+        raise MechgenError(f"internal: the planned request of {request.model} ({request.spec_text()}) does not "
+                           f"match the model's specialisation ({spec.key()})")
     return generate(model, spec, request.kernels, request.backend, request.cse)
 
 
