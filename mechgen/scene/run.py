@@ -14,14 +14,14 @@ from pathlib import Path
 import numpy as np
 
 from mechgen import models
-from mechgen.pipeline import compile_request
+from mechgen.pipeline import compile_request, file_digest
 from mechgen.errors import InputError
 from mechgen.runtime.mesh import Layout
 from mechgen.runtime.sweep import sweep
 from mechgen.scene.analyses import RUNNERS
 from mechgen.scene.info import lookup_model, model_info
 from mechgen.scene.load import load_scene
-from mechgen.scene.plan import derive_with, plan_scene, point_request
+from mechgen.scene.plan import derive_with, plan_scene, point_request, request_for
 
 
 def _public(outputs: dict) -> dict:
@@ -29,9 +29,18 @@ def _public(outputs: dict) -> dict:
 
 
 @lru_cache(maxsize=8)
-def _system_for(source_key: str, request):
+def _system_of(source_key: str, request):
     """The compiled system of a request (mechgen.scene.plan); the model is imported only to derive."""
     return compile_request(request, derive_with(models.resolve(source_key), request))
+
+
+@lru_cache(maxsize=8)
+def _system_for(model_name: str, values: tuple, free: tuple, active, kernels: tuple, backend: str):
+    """The compiled system of scene values (the benchmarks' entry; a scene run plans with plan_scene)."""
+    source = models.resolve(model_name)
+    request = request_for(model_info(source.key), file_digest(source.file), dict(values), free=free, active=active,
+                          kernels=kernels, backend=backend)
+    return compile_request(request, derive_with(source, request))
 
 
 def _laid_out(system, layout: Layout | None):
@@ -45,7 +54,7 @@ def _sweep_point(task: tuple) -> dict:
     """Run the inner analysis of a sweep at one grid point (module level: picklable)."""
     source_key, request, values, kind, options, point, layout = task
     info = model_info(source_key)
-    system, _ = _system_for(source_key, point_request(request, info, point) or request)
+    system, _ = _system_of(source_key, point_request(request, info, point) or request)
     system = _laid_out(system, layout)
     system.params = np.array([float(point.get(n, dict(values).get(n, info.param(n).default)))
                               for n in system.meta.get("params", [])])
@@ -65,7 +74,7 @@ def run_scene(scene, *, overrides=(), backend: str | None = None) -> dict:
     plan = plan_scene(scn, backend=backend)
     fixed = tuple(sorted((k, v) for k, v in scn.params.items()))
     started = time.perf_counter()
-    system, report = _system_for(plan.source.key, plan.main)
+    system, report = _system_of(plan.source.key, plan.main)
     layout = Layout(scn.segments, scn.parts)
     system = _laid_out(system, layout)
     results = {"scene": Path(scn.path).name, "title": scn.title, "model": scn.model, "backend": report.backend,
