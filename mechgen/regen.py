@@ -30,7 +30,7 @@ import tempfile
 from pathlib import Path
 
 from mechgen import models
-from mechgen.pipeline import GENERATED, SUFFIXES, committed_document, committed_paths, generate, read_committed
+from mechgen.pipeline import GENERATED, committed_document, committed_paths, generate, read_committed
 
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
 CHECK_FORMAT = "regen-check-1"
@@ -241,6 +241,3 @@ def numeric_difference(committed: dict, fresh_: dict, backend: str, *, sites: in
                 err = float(np.nanmax(np.abs(x - y))) if x.size else 0.0
                 return f"kernel {name} output {port} differs by {err:.3g} at seeded random inputs"
     return None
-
-
-__all__ = ["regen", "write_generated", "check_generated", "planned_requests", "compare_generated", "SUFFIXES"]

@@ -11,7 +11,7 @@ import pytest
 
 from mechgen import models
 from mechgen.pipeline import GENERATED, committed_paths, read_committed, request_of
-from mechgen.regen import planned_requests, shipped_scenes
+from mechgen.regen import planned_requests
 from mechgen.scene.info import cached_info, info_from_json, info_of_model, model_info
 from mechgen.scene.plan import derive_with
 

@@ -177,8 +177,8 @@ def source_info(source: models.ModelSource) -> ModelInfo:
 
 
 @lru_cache(maxsize=64)
-def _model_info(ref: str, base: str | None, stamp: tuple) -> ModelInfo:
-    return source_info(models.resolve(ref, base=base))
+def _model_info(key: str, stamp: tuple) -> ModelInfo:
+    return source_info(models.resolve(key))
 
 
 def model_info(ref: str, *, base: str | Path | None = None) -> ModelInfo:
@@ -194,7 +194,7 @@ def model_info(ref: str, *, base: str | Path | None = None) -> ModelInfo:
             stamp = (st.st_mtime_ns, st.st_size)
         except OSError:
             pass
-    return _model_info(source.key, None, stamp)
+    return _model_info(source.key, stamp)
 
 
 def lookup_model(name: str) -> ModelInfo | None:
