@@ -12,27 +12,19 @@ import logging
 import time
 import warnings
 from dataclasses import dataclass, field, replace
-from functools import lru_cache
 from pathlib import Path
+from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
-from mechgen.codegen.emit_c import emit_c
-from mechgen.codegen.emit_casadi import emit_casadi
-from mechgen.codegen.emit_numpy import emit_numpy
-from mechgen.codegen.ir import KernelIR
-from mechgen.codegen.lower_lattice import LATTICE_KERNELS, lower_lattice
-from mechgen.codegen.lower_lumped import LUMPED_KERNELS, lower_lumped
-from mechgen.codegen.spec import kernel_spec
-from mechgen.errors import CompilerUnavailable, InputError
+from mechgen.errors import CompilerUnavailable, InputError, MechgenError
 from mechgen.runtime.kernels import c_kernels, casadi_kernels, load_module, numpy_kernels
-from mechgen.runtime.continuum import FieldSystem
 from mechgen.runtime.system import System
-from mechgen.symbolic.derive import derive_lumped
-from mechgen.symbolic.field import derive_field
-from mechgen.symbolic.lattice import derive_lattice
-from mechgen.symbolic.model import Model
-from mechgen.symbolic.specialize import Specialization
+
+if TYPE_CHECKING:  # the symbolic side is imported only where text is derived (a cached run never needs it)
+    from mechgen.codegen.ir import KernelIR
+    from mechgen.symbolic.model import Model
+    from mechgen.symbolic.specialize import Specialization
 
 log = logging.getLogger("mechgen")
 BACKENDS = ("c", "numpy", "casadi")
@@ -42,25 +34,127 @@ _FIELD_CHOICES = ("discretisation", "N", "quadrature", "constraints", "joints")
 STEADY_KERNELS = ("bvp_residual", "bvp_tangent", "bvp_outputs")
 #: kernels of its Hamiltonian (stress) form, y = (u, n) (mechgen.symbolic.steady.derive_steady_hamiltonian)
 HAMILTONIAN_KERNELS = ("hbvp_rates", "hbvp_rates_tangent", "hbvp_outputs")
+#: version of the request key (bump when what a key covers changes)
+REQUEST_FORMAT = "request-1"
+#: the committed layer of generated text for the built-in models (written by ``mechgen regen``, read-only)
+GENERATED = Path(__file__).resolve().parent / "generated"
+#: file suffix of a generated text in mechgen/generated/, by backend
+SUFFIXES = {"c": ".c", "numpy": ".numpy.py", "casadi": ".casadi.py"}
 _warned_no_compiler = False
 
 
 @dataclass
 class BuildReport:
-    """What a compilation did: kernels, operation counts, stage times (s), cache use."""
+    """What a compilation did: kernels, operation counts, stage times (s), cache use.
+
+    ``origin`` says where the generated text came from: ``"derived"`` (derived and emitted now),
+    ``"cache"`` (the user compile cache) or ``"generated"`` (the committed mechgen/generated/).
+    """
 
     backend: str
     kernels: dict = field(default_factory=dict)
     seconds: dict = field(default_factory=dict)
     cached: bool = False
+    origin: str = "derived"
 
     def to_json(self) -> dict:
         """JSON form for results."""
-        return {"backend": self.backend, "kernels": self.kernels, "seconds": self.seconds, "cached": self.cached}
+        return {"backend": self.backend, "kernels": self.kernels, "seconds": self.seconds, "cached": self.cached,
+                "origin": self.origin}
+
+
+@dataclass(frozen=True)
+class CompileRequest:
+    """Everything that determines a compiled system, known without importing the model or sympy.
+
+    Attributes:
+        model: the model's name (Model.name; its folder in mechgen/generated/).
+        digest: sha256 of the model file's bytes ("" when unknown: nothing is cached).
+        values: ``((name, value), ...)`` sorted by name: every parameter that is not free, defaults
+            filled in (sizes, choices and runtime choices included).
+        free: the free numeric parameters in declaration order (part parameters included).
+        active: the active coordinates in declaration order, or None for all.
+        kernels: the kernel names, sorted.
+        backend, cse: code generation options.
+        runtime: names of runtime-only choices (Param.runtime): in ``values``, not in :meth:`key`.
+        free_values: ``((name, start value), ...)`` of the free parameters, in ``free`` order.
+        kind: ``"lumped"``, ``"field"`` or ``"lattice"``.
+        numeric: names of the numeric parameters (the continuum's fixed values).
+        sites: a lattice's sites parameter.
+        source: the model's canonical reference (mechgen.models.resolve), recorded in the system's
+            meta so that analyses find the Model again in any process; not in :meth:`key` (the same
+            model at another path makes the same kernels).
+
+    Equality covers every field (a cached system is found by it); :meth:`key` covers only what
+    shapes generated text, so starting values and runtime choices reuse the same kernels.
+    """
+
+    model: str
+    digest: str
+    values: tuple
+    free: tuple
+    active: tuple | None
+    kernels: tuple
+    backend: str = "c"
+    cse: bool = True
+    runtime: tuple = ()
+    free_values: tuple = ()
+    kind: str = "lumped"
+    numeric: tuple = ()
+    sites: str | None = None
+    source: str = ""
+
+    def spec_text(self) -> str:
+        """The specialisation's canonical text (equal to Specialization.key() of the same specialisation)."""
+        vals = ",".join(f"{k}={v!r}" for k, v in sorted(self.values) if k not in self.runtime)
+        return f"values[{vals}] free[{','.join(self.free)}] active[{','.join(self.active or ())}]"
+
+    def key(self) -> str | None:
+        """Content key of the generated text: mechgen's sources, the model file and name, the specialisation,
+        kernels, backend and cse (None when the model file is unknown)."""
+        from mechgen.codegen.cache import content_key, sources_digest
+
+        if not self.digest:
+            return None
+        return content_key(REQUEST_FORMAT, sources_digest(), self.digest, self.model, self.spec_text(),
+                           ",".join(self.kernels), self.backend, str(self.cse))
+
+    def with_backend(self, backend: str) -> "CompileRequest":
+        """The same request for another backend."""
+        return replace(self, backend=backend)
+
+    def describe(self) -> dict:
+        """A JSON description (stored beside committed text, for readers and ``regen --check`` messages)."""
+        return {"model": self.model, "spec": self.spec_text(), "kernels": list(self.kernels),
+                "backend": self.backend, "cse": self.cse}
+
+
+def file_digest(path) -> str:
+    """sha256 of a model file's bytes, "" when there is no such file."""
+    from mechgen.codegen.cache import file_sha256
+
+    if not path or not Path(path).is_file():
+        return ""
+    return file_sha256(Path(path))
+
+
+def request_of(model: Model, spec: Specialization, *, kernels=None, backend: str = "c",
+               cse: bool = True) -> CompileRequest:
+    """The :class:`CompileRequest` of a model and a specialisation."""
+    kind = "field" if model.is_field else "lattice" if model.is_lattice else "lumped"
+    free_values = tuple((n, spec.free_values.get(n, model.param(n).default)) for n in spec.free)
+    return CompileRequest(model.name, file_digest(model.file), tuple(sorted(spec.values.items())), tuple(spec.free),
+                          None if spec.active is None else tuple(spec.active),
+                          tuple(sorted(set(kernels or all_kernels(model)))), backend, cse, tuple(spec.runtime),
+                          free_values, kind, tuple(p.name for p in model.param_list if p.is_numeric),
+                          model.chain_spec.sites if model.is_lattice else None, model.source or model.name)
 
 
 def all_kernels(model: Model) -> tuple[str, ...]:
     """Every kernel a model can have."""
+    from mechgen.codegen.lower_lattice import LATTICE_KERNELS
+    from mechgen.codegen.lower_lumped import LUMPED_KERNELS
+
     if model.is_lattice:
         return LATTICE_KERNELS
     if model.is_field:
@@ -73,12 +167,23 @@ def all_kernels(model: Model) -> tuple[str, ...]:
 def derive(model: Model, spec: Specialization):
     """Derived equations (lumped or lattice) of a specialisation."""
     if model.is_field:
+        from mechgen.symbolic.field import derive_field
+
         return derive_field(model, spec)
-    return derive_lattice(model, spec) if model.is_lattice else derive_lumped(model, spec)
+    if model.is_lattice:
+        from mechgen.symbolic.lattice import derive_lattice
+
+        return derive_lattice(model, spec)
+    from mechgen.symbolic.derive import derive_lumped
+
+    return derive_lumped(model, spec)
 
 
 def lower_all(model: Model, eqs, kernels, *, cse: bool = True) -> list[KernelIR]:
     """KernelIRs of the requested kernels, in canonical order."""
+    from mechgen.codegen.lower_lattice import lower_lattice
+    from mechgen.codegen.lower_lumped import lower_lumped
+
     if model.is_field:
         wanted = [k for k in all_kernels(model) if k in kernels]
         irs = [lower_lumped(eqs.local, k, cse=cse) for k in wanted]
@@ -136,7 +241,13 @@ def _with_whirl(model: Model, irs: list[KernelIR]) -> list[KernelIR]:
 
 def emit(backend: str, irs: list[KernelIR], *, model: str, title: str) -> str:
     """Source text of one backend."""
-    return {"c": emit_c, "numpy": emit_numpy, "casadi": emit_casadi}[backend](irs, model=model, title=title)
+    if backend == "c":
+        from mechgen.codegen.emit_c import emit_c as emitter
+    elif backend == "numpy":
+        from mechgen.codegen.emit_numpy import emit_numpy as emitter
+    else:
+        from mechgen.codegen.emit_casadi import emit_casadi as emitter
+    return emitter(irs, model=model, title=title)
 
 
 def _store_text(kind: str, key: str, filename: str, text: str) -> tuple[Path, bool]:
@@ -170,30 +281,14 @@ def _load(backend: str, text: str, specs: dict, key: str, report: BuildReport):
     return numpy_kernels(module) if backend == "numpy" else casadi_kernels(module, specs)
 
 
-@lru_cache(maxsize=1)
-def _mechgen_sources_digest() -> str:
-    """Digest of the sources that shape generated code (symbolic, codegen, templates)."""
-    from mechgen.codegen.cache import content_key
+def generate(model: Model, spec: Specialization, kernels, backend: str, cse: bool = True,
+             report: BuildReport | None = None) -> dict:
+    """derive -> lower -> emit; returns {'text', 'specs'} (timed into ``report`` when given)."""
+    from mechgen.codegen.lower_lumped import lower_lumped
+    from mechgen.codegen.spec import kernel_spec
 
-    root = Path(__file__).resolve().parent
-    files = sorted(p for sub in ("symbolic", "codegen") for p in (root / sub).rglob("*")
-                   if p.is_file() and p.suffix in (".py", ".j2"))
-    return content_key(*(f"{p.relative_to(root)}\n".encode() + p.read_bytes() for p in files))
-
-
-def _index_key(model: Model, spec: Specialization, kernels: set, backend: str, cse: bool) -> str | None:
-    """Key of the index entry mapping a compile request to its generated text (None: not cacheable)."""
-    from mechgen.codegen.cache import content_key
-
-    if not model.file or not Path(model.file).is_file():
-        return None
-    return content_key("index-1", _mechgen_sources_digest(), Path(model.file).read_bytes(), model.name, spec.key(),
-                       ",".join(sorted(kernels)), backend, str(cse))
-
-
-def _generate(model: Model, spec: Specialization, kernels: set, backend: str, cse: bool,
-              report: BuildReport) -> dict:
-    """derive -> lower -> emit; returns {'text', 'specs'} (timed into ``report``)."""
+    report = report if report is not None else BuildReport(backend)
+    kernels = set(kernels)
     clock = time.perf_counter()
     hamiltonian_only = model.is_field and set(kernels) <= set(HAMILTONIAN_KERNELS)
     # a steady state in stress form needs no dynamics (an inextensible string has no strain energy)
@@ -214,9 +309,7 @@ def _generate(model: Model, spec: Specialization, kernels: set, backend: str, cs
             irs.append(_with_whirl(model, [ir])[0])
     hamiltonian = [k for k in HAMILTONIAN_KERNELS if k in kernels] if model.is_field else []
     if hamiltonian:
-        from mechgen.symbolic.steady import derive_steady_hamiltonian
-
-        from mechgen.symbolic.steady import steady_field_meta
+        from mechgen.symbolic.steady import derive_steady_hamiltonian, steady_field_meta
 
         form = derive_steady_hamiltonian(model, spec)
         meta = steady_field_meta(model, spec) if eqs is None else field_meta(eqs)
@@ -231,55 +324,117 @@ def _generate(model: Model, spec: Specialization, kernels: set, backend: str, cs
     return {"text": text, "specs": {ir.name: kernel_spec(ir) for ir in irs}}
 
 
-def _generated(model: Model, spec: Specialization, kernels: set, backend: str, cse: bool,
-               report: BuildReport) -> dict:
-    """The generated text and specs, from the index cache when this exact request was seen before."""
+# ----------------------------------------------------------------------------- the committed layer
+def committed_paths(model: str, key: str, backend: str, root: Path = GENERATED) -> tuple[Path, Path]:
+    """(text file, its JSON) of a request in mechgen/generated/: ``<model>/<key[:16]><suffix>`` and ``.json``."""
+    return root / model / f"{key[:16]}{SUFFIXES[backend]}", root / model / f"{key[:16]}.{backend}.json"
+
+
+def committed_document(request: CompileRequest, key: str, generated: dict, text_name: str) -> str:
+    """The JSON beside a committed text: its full key, the request, the text's sha256 and the kernel specs."""
+    import hashlib
+
+    doc = {"format": REQUEST_FORMAT, "key": key, "request": request.describe(), "text": text_name,
+           "sha256": hashlib.sha256(generated["text"].encode("utf-8")).hexdigest(),
+           "kernels": list(generated["specs"]), "specs": generated["specs"]}
+    return json.dumps(doc, indent=1) + "\n"
+
+
+def read_committed(model: str, key: str, backend: str, root: Path | None = None) -> dict | None:
+    """{'text', 'specs'} of a request from mechgen/generated/ (or ``root``) when its full key and text digest
+    match, else None."""
+    import hashlib
+
+    text_path, json_path = committed_paths(model, key, backend, GENERATED if root is None else root)
+    try:
+        doc = json.loads(json_path.read_text(encoding="utf-8"))
+        if doc.get("key") != key or doc.get("text") != text_path.name:
+            return None
+        text = text_path.read_bytes().decode("utf-8")
+    except (OSError, ValueError):
+        return None
+    if hashlib.sha256(text.encode("utf-8")).hexdigest() != doc.get("sha256"):
+        return None
+    return {"text": text, "specs": {name: doc["specs"][name] for name in doc["kernels"]}}
+
+
+def generated_text(request: CompileRequest, derive_with: Callable[[], tuple], report: BuildReport) -> dict:
+    """The generated text and specs of a request: user cache index -> mechgen/generated/ -> derived (and stored).
+
+    ``derive_with()`` gives ``(model, spec)``; it is called only when neither cache holds the request.
+    """
     from mechgen.codegen.cache import get_or_create, lookup
 
-    key = _index_key(model, spec, kernels, backend, cse)
-    entry = lookup("index", key) if key else None
-    if entry is not None:
-        report.seconds.update(derive=0.0, lower=0.0, emit=0.0)
-        return json.loads((entry / "generated.json").read_text())
-    result = _generate(model, spec, kernels, backend, cse, report)
-    if key:
+    key = request.key()
+    if key is not None:
+        entry = lookup("index", key)
+        if entry is not None:
+            report.seconds.update(derive=0.0, lower=0.0, emit=0.0)
+            report.origin = "cache"
+            return json.loads((entry / "generated.json").read_text())
+        found = read_committed(request.model, key, request.backend)
+        if found is not None:
+            report.seconds.update(derive=0.0, lower=0.0, emit=0.0)
+            report.origin = "generated"
+            return found
+    model, spec = derive_with()
+    if spec.key() != request.spec_text():
+        raise MechgenError(f"internal: the compile request of {request.model} ({request.spec_text()}) does not "
+                           f"match the model's specialisation ({spec.key()})")
+    result = generate(model, spec, request.kernels, request.backend, request.cse, report)
+    report.origin = "derived"
+    if key is not None:
         get_or_create("index", key, lambda folder: (folder / "generated.json").write_text(json.dumps(result)))
     return result
 
 
-def compile_model(model: Model, spec: Specialization, *, kernels=None, backend: str = "c", cse: bool = True,
-                  sites: int | None = None) -> tuple[System, BuildReport]:
-    """Derive, generate, build and load the kernels a set of analyses needs."""
+def compile_request(request: CompileRequest, derive_with: Callable[[], tuple], *,
+                    sites: int | None = None) -> tuple[System, BuildReport]:
+    """Build and load the kernels of a request (deriving them only when no cache holds them).
+
+    ``derive_with()`` returns ``(model, spec)`` and is called only on a cache miss, so a cached
+    request never imports the model or sympy.
+    """
     from mechgen.codegen.cache import content_key
 
-    if backend not in BACKENDS:
-        raise InputError(f"unknown backend {backend!r}", key="backend", expected=", ".join(BACKENDS))
-    kernels = set(kernels or all_kernels(model))
-    report = BuildReport(backend)
+    if request.backend not in BACKENDS:
+        raise InputError(f"unknown backend {request.backend!r}", key="backend", expected=", ".join(BACKENDS))
+    report = BuildReport(request.backend)
     loaded = None
     while loaded is None:
-        generated = _generated(model, spec, kernels, report.backend, cse, report)
+        generated = generated_text(request.with_backend(report.backend), derive_with, report)
         text, specs = generated["text"], generated["specs"]
         clock = time.perf_counter()
         loaded = _load(report.backend, text, specs, content_key(report.backend, text), report)
         report.seconds["build"] = time.perf_counter() - clock
     report.kernels = {name: {"ops": s["ops"]} for name, s in specs.items()}
     meta = dict(next(iter(specs.values()))["meta"]) if specs else {}
-    meta["source"] = model.source or model.name  # the canonical reference (mechgen.models.resolve)
-    values = np.array([float(spec_value(model, spec, n)) for n in meta.get("params", [])])
-    if model.is_lattice:
-        sites = int(sites if sites is not None else spec.values.get(model.chain_spec.sites,
-                                                                    model.param(model.chain_spec.sites).default))
-    if model.is_field:
-        fixed = {k: v for k, v in spec.values.items() if model.param(k).is_numeric}
-        choices = {k: spec.values.get(k, model.param(k).default) for k in
-                   ("discretisation", "N", "quadrature", "constraints", "joints",
-                    *(p.name for p in model.param_list if p.runtime and p.name not in _FIELD_CHOICES))}
-        system = FieldSystem(loaded, meta, values, fixed, choices, report.backend)
+    meta["source"] = request.source or request.model  # the canonical reference (mechgen.models.resolve)
+    starts = dict(request.free_values)
+    values = dict(request.values)
+    params = np.array([float(starts[n]) for n in meta.get("params", [])])
+    if request.kind == "lattice":
+        sites = int(sites if sites is not None else values[request.sites])
+    if request.kind == "field":
+        from mechgen.runtime.continuum import FieldSystem
+
+        fixed = {k: v for k, v in values.items() if k in request.numeric}
+        names = (*_FIELD_CHOICES, *(n for n in request.runtime if n not in _FIELD_CHOICES))
+        choices = {k: values[k] for k in names if k in values}
+        system = FieldSystem(loaded, meta, params, fixed, choices, report.backend)
     else:
-        system = System(loaded, meta, values, sites or 0, report.backend)
-    log.info("built %s [%s]: %s", model.name, report.backend, report.seconds)
+        system = System(loaded, meta, params, sites or 0, report.backend)
+    log.info("built %s [%s, %s]: %s", request.model, report.backend, report.origin, report.seconds)
     return system, report
+
+
+def compile_model(model: Model, spec: Specialization, *, kernels=None, backend: str = "c", cse: bool = True,
+                  sites: int | None = None) -> tuple[System, BuildReport]:
+    """Derive, generate, build and load the kernels a set of analyses needs."""
+    if backend not in BACKENDS:
+        raise InputError(f"unknown backend {backend!r}", key="backend", expected=", ".join(BACKENDS))
+    request = request_of(model, spec, kernels=kernels, backend=backend, cse=cse)
+    return compile_request(request, lambda: (model, spec), sites=sites)
 
 
 def spec_value(model: Model, spec: Specialization, name: str) -> float:

@@ -10,10 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from mechgen.analyses.parameters import model_of, parameter_dict
+from mechgen.analyses.parameters import info_of, model_of, parameter_dict
 from mechgen.runtime.branch_stability import stability_along
-from mechgen.symbolic.model import call_declared
-from mechgen.symbolic.params import Namespace
 
 SAMPLES = 201
 SHAPE_SAMPLES = 1001
@@ -56,11 +54,15 @@ def stability_of_each(system, bvp, results) -> list[dict]:
 
 def shape_declarations(system) -> tuple:
     """The model's shape outputs (Model.shape_output)."""
+    if not info_of(system).shape_outputs:
+        return ()
     return tuple(getattr(model_of(system), "shape_outputs", ()))
 
 
-def parameter_namespace(system, p) -> Namespace:
+def parameter_namespace(system, p):
     """The parameter values as a model's declared functions read them (``p.lambda0``)."""
+    from mechgen.symbolic.params import Namespace  # declared model code reads the model's own types
+
     return Namespace(parameter_dict(system, p))
 
 
@@ -71,6 +73,9 @@ def shape_values(system, bvp, result) -> dict:
         return {}
     s = np.linspace(0.0, bvp.length_of(result), SHAPE_SAMPLES)
     y = bvp.values(result, s)
+    from mechgen.symbolic.model import call_declared
+    from mechgen.symbolic.params import Namespace
+
     u = Namespace({**{f: y[i] for i, f in enumerate(bvp.fields)},
                    **{f"{f}_s": y[bvp.n + i] for i, f in enumerate(bvp.fields)}})
     out = Namespace(bvp.outputs(result, s))

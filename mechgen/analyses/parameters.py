@@ -6,14 +6,21 @@ from mechgen.errors import SceneError
 
 
 def model_of(system):
-    """The system's Model, by its canonical reference (``meta["source"]``, set where scenes compile)."""
+    """The system's Model, by its canonical reference (``meta["source"]``, set by the pipeline); imports it."""
     return models.get(system.meta.get("source") or system.meta["model"])
+
+
+def info_of(system):
+    """The system's model facts (mechgen.scene.info.ModelInfo), from the caches: no import of the model."""
+    from mechgen.scene.info import model_info
+
+    return model_info(system.meta.get("source") or system.meta["model"])
 
 
 def parameter_dict(system, p) -> dict:
     """Numeric parameter values: the model's defaults, the scene's fixed ones, the free ones from p."""
-    model = model_of(system)
-    values = {prm.name: float(prm.default) for prm in model.param_list if prm.is_numeric}
+    info = info_of(system)
+    values = {name: float(prm.default) for name, prm in info.params.items() if prm.numeric}
     values.update({k: float(v) for k, v in getattr(system, "fixed", {}).items()})
     values.update(zip(system.meta.get("params", []), (float(v) for v in p)))
     return values

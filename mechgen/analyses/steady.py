@@ -28,7 +28,7 @@ from mechgen.analyses.bvp_states import (bvp_summary, parameter_namespace, shape
                                          stability_about)
 from mechgen.analyses.fields import field_shapes
 from mechgen.analyses.operating_point import vector
-from mechgen.analyses.parameters import model_of, parameter_dict, with_free_params
+from mechgen.analyses.parameters import info_of, parameter_dict, with_free_params
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import Option
 from mechgen.errors import ConvergenceError, SceneError
@@ -36,7 +36,6 @@ from mechgen.runtime.newton import newton
 from mechgen.runtime.steady_bvp import hamiltonian_bvp, holding, solve_steady, steady_bvp, stress_guess
 from mechgen.scene.expr import is_identifier
 from mechgen.scene.values import IDENTIFIER_RULE, fail, is_choice, join, listing, param_info, show, type_name
-from mechgen.symbolic.model import call_declared
 
 METHODS = ("newton", "shooting", "multiple_shooting", "collocation")
 START_TOL = 1e-6  # the tolerance at which ``shape`` starts are tried (then refined to the analysis's tol)
@@ -229,6 +228,8 @@ def _start_with_shape(system, bvp, options: dict, method: str):
     p = parameter_namespace(system, bvp.start)
     tol = options.get("tol", 1e-10)
     gave = []
+    from mechgen.symbolic.model import call_declared
+
     for guess in call_declared(declared[name].start, value=float(value), s=L * sigma, p=p):
         u = np.array([np.broadcast_to(np.asarray(guess["u"][f], float), sigma.shape) for f in bvp.fields])
         du = np.array([np.broadcast_to(np.asarray(guess["u_s"][f], float), sigma.shape) for f in bvp.fields])
@@ -281,7 +282,7 @@ def run_steady_bvp(system, options: dict, context: dict) -> dict:
     if options.get("hold"):
         free = options["free"]
         solved = float(result.p[bvp.params.index(free)])
-        below = model_of(system).param(free).below
+        below = info_of(system).param(free).below
         if below is not None and not solved < below:
             raise ConvergenceError(f"steady state with {next(iter(options['hold']))} held: the solved {free} = "
                                    f"{solved:.6g} is not below {below:g} (no such state near the start; try "

@@ -43,6 +43,9 @@ REGISTRY: dict[str, Suite] = {s.name: s for s in (
     Suite("balloon", "mechgen.bench.balloon", "run_balloon_benchmarks",
           "the ballooning string's branch with stability against a hand-written scipy baseline",
           ("balloon_branch.json", "balloon_branch.md")),
+    Suite("startup", "mechgen.bench.startup", "run_startup_benchmarks",
+          "whole-process start of a cached scene (laval_rotor, beam_modes): median wall time and import share",
+          ("startup.json", "startup.md")),
 )}
 
 #: the suite names (``mechgen bench`` with none runs them all)

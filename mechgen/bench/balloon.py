@@ -101,13 +101,13 @@ def balloon_system(N: int = N_GALERKIN):
     from mechgen import models
     from mechgen.scene.info import lookup_model
     from mechgen.scene.load import load_scene
-    from mechgen.scene.run import _system_for
+    from mechgen.scene.run import system_for
 
     scn = load_scene(str(SCENE), overrides=[f"N={N}", "strain=pointwise"], lookup_model=lookup_model, model_names=models.names)
     model = models.get(scn.model)
     free = tuple(n for n in scn.free if model.param(n).is_numeric)
     kernels = ("bvp_outputs", "bvp_residual", "bvp_tangent", "linear")
-    seconds, (system, report) = _timed(lambda: _system_for(scn.model, tuple(sorted(scn.params.items())), free,
+    seconds, (system, report) = _timed(lambda: system_for(scn.model, tuple(sorted(scn.params.items())), free,
                                                            scn.active, kernels, scn.backend))
     return system, {"N": N, "compile_s": seconds, "backend": report.backend, "params": list(system.meta["params"])}
 

@@ -125,18 +125,17 @@ def rotor_system(N: int, discretisation: str = "timoshenko2", *, fresh: bool = F
     from mechgen.runtime.mesh import Layout
     from mechgen.scene.info import lookup_model
     from mechgen.scene.load import load_scene
-    from mechgen.scene.run import _laid_out, _system_for
+    from mechgen.scene.run import laid_out, system_for
 
     scn = load_scene(str(SCENE), overrides=[f"N={N}", f"discretisation={discretisation}"],
                      lookup_model=lookup_model, model_names=models.names)
     model = models.get(scn.model)
     free = tuple(n for n in scn.free if model.param(n).is_numeric)
-    build = _system_for.__wrapped__ if fresh else _system_for
-    seconds, (system, report) = _timed(lambda: build(scn.model, tuple(sorted(scn.params.items())), free,
-                                                     scn.active, ("linear",), scn.backend))
+    seconds, (system, report) = _timed(lambda: system_for(scn.model, tuple(sorted(scn.params.items())), free,
+                                                          scn.active, ("linear",), scn.backend, fresh=fresh))
     info = {"N": N, "discretisation": discretisation, "unknowns": None, "compile_s": seconds,
             "compile_cache_hit": bool(report.cached), "backend": report.backend}
-    system = _laid_out(system, Layout(scn.segments, scn.parts))
+    system = laid_out(system, Layout(scn.segments, scn.parts))
     return system, info
 
 

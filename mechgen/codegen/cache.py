@@ -289,3 +289,22 @@ def get_or_create(kind: str, key: str, fill: Callable[[Path], None]) -> tuple[Pa
     if entry is not None:
         return entry, False
     return publish(kind, key, fill), True
+
+
+def sources_digest() -> str:
+    """Digest of the mechgen sources that shape generated code and model facts (symbolic, codegen, templates).
+
+    Part of every key of generated text (user cache and mechgen/generated/): an edit to one of these
+    files makes every earlier generation a miss. Memoised per process.
+    """
+    global _SOURCES_DIGEST
+    if _SOURCES_DIGEST is None:
+        root = Path(__file__).resolve().parent.parent
+        files = sorted(p for sub in ("symbolic", "codegen") for p in (root / sub).rglob("*")
+                       if p.is_file() and p.suffix in (".py", ".j2") and "__pycache__" not in p.parts)
+        _SOURCES_DIGEST = content_key(*(f"{p.relative_to(root).as_posix()}\n".encode() + p.read_bytes()
+                                        for p in files))
+    return _SOURCES_DIGEST
+
+
+_SOURCES_DIGEST: str | None = None

@@ -15,7 +15,6 @@ from functools import lru_cache
 
 import numpy as np
 from numpy.polynomial import legendre as Leg
-from scipy.optimize import brentq
 
 END_ORDERS = {"clamped": (0, 1), "pinned": (0, 2), "free": (2, 3)}
 
@@ -81,6 +80,8 @@ def beam_roots(n: int, length: float, ends: tuple[str, str]) -> tuple[tuple[floa
         if len(roots) == n:
             break
         if f0 == 0.0 or f0 * f1 < 0:
+            from scipy.optimize import brentq  # loaded on use (startup)
+
             beta = b0 if f0 == 0.0 else brentq(det, b0, b1, xtol=1e-15 / length, rtol=1e-15)
             _, _, vt = np.linalg.svd(_boundary_matrix(beta, length, ends))
             roots.append(beta)

@@ -24,7 +24,6 @@ from dataclasses import replace
 import numpy as np
 import scipy.sparse as sps
 import scipy.sparse.linalg as spla
-from scipy.optimize import brentq
 
 from mechgen.errors import ConvergenceError, InputError
 from mechgen.runtime.continuation import Branch, continue_bvp
@@ -172,6 +171,8 @@ def crossing(system, xa, xb, g, *, xtol: float = 1e-12) -> np.ndarray:
         x = point_between(system, xa, xb, theta)
         cache[theta] = x
         return float(g(x))
+
+    from scipy.optimize import brentq  # loaded on use (startup)
 
     theta = brentq(value, 0.0, 1.0, xtol=xtol, maxiter=100)
     return cache[theta] if theta in cache else point_between(system, xa, xb, theta)

@@ -52,7 +52,6 @@ from typing import Callable
 import numpy as np
 import scipy.sparse as sps
 import scipy.sparse.linalg as spla
-from scipy.integrate import solve_bvp, solve_ivp
 
 from mechgen.errors import ConvergenceError, InputError
 
@@ -378,6 +377,8 @@ def _flow(problem: BVP, s0, s1, y0, p, cols, *, rtol, atol, method, budget, blow
     try:
         with warnings.catch_warnings(), np.errstate(all="ignore"):
             warnings.simplefilter("ignore", RuntimeWarning)
+            from scipy.integrate import solve_ivp  # loaded on use (startup)
+
             sol = solve_ivp(rhs, (s0, s1), z0, method=method, rtol=rtol, atol=atol, dense_output=dense, **kwargs)
     except (ValueError, np.linalg.LinAlgError, ZeroDivisionError, OverflowError) as exc:
         raise _Failure(f"the integrator failed ({exc})") from exc
@@ -724,6 +725,8 @@ def collocate(problem: BVP, mesh, guess, *, p=None, tol: float = 1e-8, bc_tol: f
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         try:
+            from scipy.integrate import solve_bvp  # loaded on use (startup)
+
             sol = solve_bvp(fun, bc, mesh, Y, fun_jac=fun_jac, bc_jac=bc_jac, tol=tol,
                             bc_tol=tol if bc_tol is None else bc_tol, max_nodes=max_nodes, **kwargs)
         except (ValueError, np.linalg.LinAlgError) as exc:

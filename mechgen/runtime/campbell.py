@@ -42,7 +42,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.linalg as sla
-from scipy.optimize import linear_sum_assignment
 
 from mechgen.errors import InputError
 from mechgen.runtime.damped import (DampedModes, _is, _norm, _normalise, _scale, _split, _stations, damped_modes,
@@ -392,6 +391,8 @@ def _track(speeds, cand_s, cand_V, count: int, x_index, y_index, freq_weight: fl
         V = _align(cand_s[i + 1], cand_V[i + 1], shp[i], cluster_tol)
         mac_ij = mac_matrix(shp[i], V)
         dist = np.abs(cand_s[i + 1][None, :] - pred[:, None]) / np.maximum(np.abs(pred), 1e-300)[:, None]
+        from scipy.optimize import linear_sum_assignment  # loaded on use (startup)
+
         rows, cols = linear_sum_assignment((1.0 - mac_ij) + freq_weight * dist)
         eig[i + 1, rows], shp[i + 1][:, rows] = cand_s[i + 1][cols], V[:, cols]
         mac[i + 1, rows] = mac_ij[rows, cols]

@@ -41,7 +41,6 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sps
 import scipy.sparse.linalg as spla
-from scipy.interpolate import CubicHermiteSpline, PPoly
 
 from mechgen.errors import ConvergenceError, InputError
 from mechgen.runtime.bvp import (BVP, BVPResult, _BudgetSpent, _Failure, _full_p, _ivp_options, _MultipleShooting,
@@ -441,6 +440,8 @@ class Discretisation:
                              _CollocationPolynomial(self.mesh, Y, K, self.Lc))
         F = self._cache["f_nodes"] if self._key == (np.asarray(u, float).tobytes(), float(lam)) else \
             self.problem.fv(self.mesh, Y, q)
+        from scipy.interpolate import CubicHermiteSpline  # loaded on use: scipy.interpolate brings scipy.optimize
+
         spline = CubicHermiteSpline(self.mesh, Y, F, axis=1)
         return BVPResult(self.mesh.copy(), Y, q, residual_norm, iterations, "collocation (fixed mesh)", spline)
 
@@ -483,6 +484,8 @@ class _CollocationPolynomial:
         # coefficient of (s - s_i)^(m + 1): sum_j K_ij Lc[j, m] / ((m + 1) h^m)
         coef = np.einsum("ija,jm->mia", K, Lc) / ((m + 1)[:, None, None] * h[None, :, None] ** m[:, None, None])
         c = np.concatenate([coef[::-1], Y[:, :-1].T[None]], axis=0)  # descending powers, constant last
+        from scipy.interpolate import PPoly  # loaded on use: scipy.interpolate brings scipy.optimize
+
         self._pp = PPoly(c, np.asarray(mesh, float), extrapolate=True)
 
     def __call__(self, s):

@@ -45,7 +45,6 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sps
 import scipy.sparse.linalg as spla
-from scipy.optimize import brentq
 
 from mechgen.errors import ConvergenceError, InputError
 from mechgen.runtime.bvp import BVP, BVPResult, Discretisation
@@ -471,6 +470,8 @@ def _locate_fold(system, x_i, t_i, step, *, tol, max_corrector, w=None):
         fa, fb = t_i[-1], tlam(b)
         if fa * fb > 0:
             return None
+        from scipy.optimize import brentq  # loaded on use (startup)
+
         sigma = brentq(tlam, a, b, xtol=1e-14 * max(1.0, step), maxiter=100)
         return cache[sigma] if sigma in cache else _segment_point(system, x_i, t_i, sigma, tol=tol,
                                                                   max_corrector=max_corrector, w=w)
@@ -573,6 +574,8 @@ def minimize_along_branch(branch: Branch, output: Callable, *, gradient: Callabl
             a, b = slope(i, 0.0), slope(i, length)
             if a * b > 0:
                 continue
+            from scipy.optimize import brentq  # loaded on use (startup)
+
             sigma = brentq(lambda s: slope(i, s), 0.0, length, xtol=1e-13 * max(1.0, length), maxiter=100)
             x, _ = point(i, sigma)
             return Extremum(x[:n].copy(), float(x[n]), float(output(x[:n], x[n])), kind, i, abs(slope(i, sigma)))

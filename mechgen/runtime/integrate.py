@@ -11,7 +11,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from mechgen.errors import ConvergenceError, KernelError
 
@@ -40,6 +39,8 @@ def integrate_first_order(rhs, x0, t_end: float, *, jac=None, method: str = "BDF
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}; expected one of {METHODS}")
     kwargs = {"jac": jac} if (jac is not None and method in IMPLICIT) else {}
+    from scipy.integrate import solve_ivp  # loaded on use: scipy.integrate brings scipy.optimize
+
     sol = solve_ivp(rhs, (0.0, float(t_end)), np.asarray(x0, float), method=method, rtol=rtol, atol=atol,
                     t_eval=t_eval, **kwargs)
     if not sol.success:

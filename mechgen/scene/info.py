@@ -1,25 +1,59 @@
-"""Model facts the scene loader validates against (names only, nothing symbolic)."""
+"""Model facts the scene loader validates against (names only, nothing symbolic).
+
+A :class:`ModelInfo` is what a scene run needs to know of a model before (and, when its
+kernels are cached, instead of) importing it: parameter names, defaults, choices and
+kinds, coordinates, outputs, fields, parts. It is JSON-able and cached by the model
+file's content (:func:`model_info`):
+
+* ``mechgen/generated/<model>/info.json`` for the built-in models (written by
+  ``mechgen regen``, read-only at run time),
+* else the user compile cache (kind ``info``),
+* else the model is imported once and its facts are stored in the user cache.
+
+An entry is valid when its key, ``content_key(INFO_SCHEMA, sources_digest(), sha256 of the
+model file, attribute)``, equals the one of the model file now on disk; a model whose file
+cannot be known before import (a module without a ``.py`` source) is imported every time.
+"""
 from __future__ import annotations
 
-from dataclasses import dataclass
+import json
+from dataclasses import asdict, dataclass, field, replace
+from functools import lru_cache
+from pathlib import Path
 
 from mechgen import models
 from mechgen.errors import InputError
 
+#: version of the JSON layout of a ModelInfo (part of its cache key)
+INFO_SCHEMA = "model-info-2"
+GENERATED = Path(__file__).resolve().parent.parent / "generated"
+
 
 @dataclass(frozen=True)
 class ParamInfo:
-    """What a scene may set for one parameter."""
+    """What a scene may set for one parameter.
+
+    ``numeric``: may appear in expressions (not a choice, not a size); ``runtime``: a choice of
+    the numerics only (Param.runtime), left out of the kernels' cache key.
+    """
 
     default: float | str
     choices: tuple[str, ...] | None
     integer: bool
     below: float | None = None
+    numeric: bool = True
+    runtime: bool = False
 
 
 @dataclass(frozen=True)
 class ModelInfo:
-    """Names of a model's parameters, coordinates and outputs."""
+    """Names of a model's parameters, coordinates and outputs, and the kind of model it is.
+
+    ``params`` is in declaration order. ``coordinates`` are the scene-visible coordinates (a
+    chain's sites expanded), ``coordinates_all`` the model's own names (Model.coordinates_all).
+    ``part_params`` are always free (Model.part_params); ``chain`` is ``(coordinate, sites
+    parameter)`` of a lattice model.
+    """
 
     name: str
     params: dict
@@ -31,8 +65,139 @@ class ModelInfo:
     stress_form: bool = False
     fields: tuple[str, ...] = ()
     shape_outputs: tuple[str, ...] = ()
+    internals: bool = False
+    chain: tuple[str, str] | None = None
+    coordinates_all: tuple[str, ...] = ()
+    part_params: tuple[str, ...] = ()
+    file: str | None = field(default=None, compare=False)
     #: the canonical reference of the model (mechgen.models.resolve): what a scene's run compiles
-    key: str = ""
+    key: str = field(default="", compare=False)
+
+    def param(self, name: str) -> ParamInfo:
+        """The ParamInfo of ``name`` (InputError naming the model when there is none)."""
+        try:
+            return self.params[name]
+        except KeyError:
+            raise InputError(f"model {self.name} has no parameter {name!r}", key=name,
+                             expected=f"one of {', '.join(self.params)}") from None
+
+    def to_json(self) -> dict:
+        """JSON form (see :func:`info_from_json`)."""
+        data = asdict(self)
+        data.pop("file")
+        data.pop("key")
+        # orders matter (free names and parts follow the declaration): pairs, not objects that sort_keys reorders
+        data["params"] = [[k, v] for k, v in data["params"].items()]
+        data["parts"] = None if self.parts is None else [[k, list(v)] for k, v in self.parts.items()]
+        return data
+
+
+def info_of_model(model) -> ModelInfo:
+    """The ModelInfo of an imported :class:`~mechgen.symbolic.model.Model`."""
+    params = {p.name: ParamInfo(p.default, p.choices, p.integer, p.below, p.is_numeric, p.runtime)
+              for p in model.param_list}
+    coords = model.coordinates_all
+    chain = None
+    if model.is_lattice:
+        n = int(model.param(model.chain_spec.sites).default)
+        coords = tuple(f"{model.chain_spec.coordinate}_{i + 1}" for i in range(n))
+        chain = (model.chain_spec.coordinate, model.chain_spec.sites)
+    cont = model.continuum
+    return ModelInfo(model.name, params, tuple(coords), tuple(model.output_names), cont is not None,
+                     cont.length if cont else None, {k: tuple(v) for k, v in model.parts.items()},
+                     model.complementary_fn is not None, tuple(model.field_names),
+                     tuple(o.name for o in getattr(model, "shape_outputs", ())), bool(model.internals), chain,
+                     tuple(model.coordinates_all), tuple(model.part_params()), model.file)
+
+
+def info_from_json(data: dict, *, file: str | None = None) -> ModelInfo:
+    """A ModelInfo from its JSON form (tuples restored)."""
+    def tup(v):
+        return tuple(v) if v is not None else None
+
+    params = {k: ParamInfo(v["default"], tup(v["choices"]), v["integer"], v["below"], v["numeric"], v["runtime"])
+              for k, v in data["params"]}
+    parts = {k: tuple(v) for k, v in data["parts"]} if data.get("parts") is not None else None
+    return ModelInfo(data["name"], params, tuple(data["coordinates"]), tuple(data["outputs"]), data["continuum"],
+                     data["length"], parts, data["stress_form"], tuple(data["fields"]), tuple(data["shape_outputs"]),
+                     data["internals"], tup(data["chain"]), tuple(data["coordinates_all"]),
+                     tuple(data["part_params"]), file)
+
+
+def info_key(source: models.ModelSource) -> str | None:
+    """Cache key of a model's facts: schema, mechgen sources, the model file's bytes, the attribute (None: no file)."""
+    from mechgen.codegen.cache import content_key, file_sha256, sources_digest
+
+    if source.file is None or not Path(source.file).is_file():
+        return None
+    return content_key(INFO_SCHEMA, sources_digest(), file_sha256(Path(source.file)), source.attribute)
+
+
+def info_document(info: ModelInfo, key: str) -> str:
+    """The text of an ``info.json``: the key it is valid for and the facts (deterministic)."""
+    return json.dumps({"schema": INFO_SCHEMA, "key": key, "info": info.to_json()}, indent=1, sort_keys=True) + "\n"
+
+
+def _read_info(path: Path, key: str, file: str | None) -> ModelInfo | None:
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+        if doc.get("schema") != INFO_SCHEMA or doc.get("key") != key:
+            return None
+        return info_from_json(doc["info"], file=file)
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+
+
+def cached_info(source: models.ModelSource) -> ModelInfo | None:
+    """The stored facts of a model when they match its file now on disk (committed layer, then user cache)."""
+    from mechgen.codegen.cache import lookup
+
+    key = info_key(source)
+    if key is None:
+        return None
+    file = str(source.file)
+    if source.origin == "built-in":
+        found = _read_info(GENERATED / source.key / "info.json", key, file)
+        if found is not None:
+            return found
+    entry = lookup("info", key)
+    return _read_info(entry / "info.json", key, file) if entry is not None else None
+
+
+def source_info(source: models.ModelSource) -> ModelInfo:
+    """The facts of a model: from the caches when valid, else imported once and stored in the user cache."""
+    found = cached_info(source)
+    if found is not None:
+        return found
+    info = info_of_model(source.load())
+    key = info_key(source)
+    if key is not None:
+        from mechgen.codegen.cache import get_or_create
+
+        text = info_document(info, key)
+        get_or_create("info", key, lambda folder: (folder / "info.json").write_text(text, encoding="utf-8"))
+    return info
+
+
+@lru_cache(maxsize=64)
+def _model_info(key: str, stamp: tuple) -> ModelInfo:
+    return source_info(models.resolve(key))
+
+
+def model_info(ref: str, *, base: str | Path | None = None) -> ModelInfo:
+    """The :class:`ModelInfo` a model reference names (built-in name, path, module:attribute), cached.
+
+    Memoised per process by the reference and the model file's modification stamp.
+    """
+    source = models.resolve(ref, base=base)
+    stamp = ()
+    if source.file is not None:
+        try:
+            st = Path(source.file).stat()
+            stamp = (st.st_mtime_ns, st.st_size)
+        except OSError:
+            pass
+    return _model_info(source.key, stamp)
 
 
 def lookup_model(ref: str, base=None) -> ModelInfo | None:
@@ -48,13 +213,4 @@ def lookup_model(ref: str, base=None) -> ModelInfo | None:
         if models.is_path(ref) or ":" in ref:
             raise
         return None
-    model = source.load()
-    params = {p.name: ParamInfo(p.default, p.choices, p.integer, p.below) for p in model.param_list}
-    coords = model.coordinates_all
-    if model.is_lattice:
-        n = int(model.param(model.chain_spec.sites).default)
-        coords = tuple(f"{model.chain_spec.coordinate}_{i + 1}" for i in range(n))
-    cont = model.continuum
-    return ModelInfo(model.name, params, coords, model.output_names, cont is not None,
-                     cont.length if cont else None, dict(model.parts), model.complementary_fn is not None,
-                     model.field_names, tuple(o.name for o in getattr(model, "shape_outputs", ())), source.key)
+    return replace(model_info(source.key), key=source.key)

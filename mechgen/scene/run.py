@@ -3,6 +3,9 @@
 Result dict (DESIGN.md): {"scene", "model", "backend", "analyses": [{"name", "kind", "outputs", "seconds"}]}
 plus "build" (kernels built, operation counts, stage times). Entries whose name
 starts with "_" are working data and never reach JSON.
+
+What a scene compiles is planned from model facts alone (mechgen.scene.plan), so a scene whose
+kernels are cached or committed (mechgen/generated) runs without importing its model or sympy.
 """
 from __future__ import annotations
 
@@ -12,49 +15,57 @@ from pathlib import Path
 from typing import Mapping
 
 from mechgen import models
-from mechgen.pipeline import compile_model
-from mechgen.errors import InputError
 from mechgen.analyses.context import NAME, POINTS, PointRunner, public
 from mechgen.analyses.registry import get
 from mechgen.analyses.result import run_analysis
+from mechgen.errors import InputError
+from mechgen.pipeline import compile_request, file_digest
 from mechgen.runtime.mesh import Layout
-from mechgen.scene.info import lookup_model
+from mechgen.scene.info import lookup_model, model_info
 from mechgen.scene.load import load_scene
-from mechgen.symbolic.specialize import specialize
+from mechgen.scene.plan import derive_with, plan_scene, point_request, request_for
 
 
 @lru_cache(maxsize=8)
-def _system_for(model_ref, values: tuple, free: tuple, active, kernels: tuple, backend: str):
-    """The compiled system; ``model_ref`` a Model (cached by identity: an edited model file loads as a new
-    Model) or a model reference. ``meta["source"]`` is the model's canonical reference (mechgen.models)."""
-    model = models.get(model_ref) if isinstance(model_ref, str) else model_ref
-    spec = specialize(model, dict(values), free=free, active=active)
-    return compile_model(model, spec, kernels=set(kernels), backend=backend)
+def system_of(source_key: str, request):
+    """The compiled system of a request (mechgen.scene.plan); the model is imported only to derive.
+
+    Memoised per process: a compiled system is immutable, so every analysis may share it.
+    """
+    return compile_request(request, derive_with(models.resolve(source_key), request))
 
 
-def _laid_out(system, layout: Layout | None):
-    """The system with the scene's segments and parts (a copy; the cached system stays bare)."""
+def system_for(model_ref: str, values: tuple, free: tuple, active, kernels: tuple, backend: str, *,
+               fresh: bool = False):
+    """The compiled system (and build report) of scene-style values ``((name, value), ...)``: the
+    benchmarks' entry; a scene run plans with :func:`mechgen.scene.plan.plan_scene`. ``fresh``
+    bypasses the in-process memo (the on-disk compile cache is still used)."""
+    source = models.resolve(model_ref)
+    request = request_for(model_info(source.key), file_digest(source.file), dict(values), free=free, active=active,
+                          kernels=kernels, backend=backend, source=source.key)
+    build = system_of.__wrapped__ if fresh else system_of
+    return build(source.key, request)
+
+
+def laid_out(system, layout: Layout | None):
+    """The system with the scene's segments and parts (a new system; the shared one stays bare)."""
     if layout is None or not (layout.segments or layout.parts):
         return system
     return system.with_layout(layout)
 
 
-def _sweep_point(task: tuple) -> dict:
-    """Run the inner analysis of a sweep at one grid point (module level: picklable)."""
-    source, values, free, active, kernels, backend, kind, options, point, layout = task
-    model = models.get(source)  # the canonical reference: resolves in a worker process too
-    system, _ = _system_for(model, values, free, active, kernels, backend)
-    sizes = {k: v for k, v in point.items() if not model.param(k).is_numeric}
-    if sizes:
-        system, _ = _system_for(model, tuple(sorted({**dict(values), **sizes}.items())), free, active,
-                                kernels, backend)
-    system = _laid_out(system, layout).with_param_vector(
-        [float(point.get(n, dict(values).get(n, model.param(n).default))) for n in system.meta.get("params", [])])
+def sweep_point(task: tuple) -> dict:
+    """Run the inner analysis of a sweep at one grid point (module level: picklable for worker processes)."""
+    source_key, request, values, kind, options, point, layout = task
+    info = model_info(source_key)  # the canonical reference: resolves in a worker process too
+    system, _ = system_of(source_key, point_request(request, info, point) or request)
+    system = laid_out(system, layout).with_param_vector(
+        [float(point.get(n, dict(values).get(n, info.param(n).default))) for n in system.meta.get("params", [])])
     return public(get(kind).run(system, options, {}))
 
 
 def _point_task(scene: tuple, layout, kind: str, options: dict, point: dict) -> tuple:
-    """The task _sweep_point takes: the scene's compile inputs, the analysis, the point and the layout."""
+    """The task sweep_point takes: the scene's compile inputs, the analysis, the point and the layout."""
     return (*scene, kind, options, point, layout)
 
 
@@ -62,21 +73,17 @@ def run_scene(scene, *, overrides=(), backend: str | None = None) -> dict:
     """Run every analysis of a scene (a file, or a dict of its contents) and return the results dict."""
     scn = load_scene(scene if isinstance(scene, Mapping) else str(scene), overrides=list(overrides),
                      lookup_model=lookup_model, model_names=models.known)
-    model = models.get(scn.source)
-    backend = backend or scn.backend
-    internal = bool(model.internals)
-    kernels = sorted(set().union(*(get(a.kind).needs(a.options, internal=internal) for a in scn.analyses)))
-    free = tuple(n for n in scn.free if model.param(n).is_numeric)
+    plan = plan_scene(scn, backend=backend)
     fixed = tuple(sorted((k, v) for k, v in scn.params.items()))
     started = time.perf_counter()
-    system, report = _system_for(model, fixed, free, scn.active, tuple(kernels), backend)
+    system, report = system_of(plan.source.key, plan.main)
     layout = Layout(scn.segments, scn.parts)
-    system = _laid_out(system, layout)
+    system = laid_out(system, layout)
     results = {"scene": Path(scn.path).name, "title": scn.title, "model": scn.model, "backend": report.backend,
                "params": dict(scn.params), "build": report.to_json(), "analyses": []}
     results["build"]["seconds_total"] = time.perf_counter() - started
-    scene_inputs = (scn.source, fixed, free, scn.active, tuple(kernels), backend)
-    context: dict = {POINTS: PointRunner(_sweep_point, partial(_point_task, scene_inputs, layout))}
+    scene_inputs = (plan.source.key, plan.main, fixed)
+    context: dict = {POINTS: PointRunner(sweep_point, partial(_point_task, scene_inputs, layout))}
     for analysis in scn.analyses:
         context[NAME] = analysis.name
         result = run_analysis(analysis.name, analysis.kind, system, dict(analysis.options), context)

@@ -1,0 +1,67 @@
+"""``mechgen bench startup``: a cached scene run timed as a whole process, with its import share.
+
+For each scene (the Laval rotor and a continuum, the Euler-Bernoulli beam's modes) the scene is
+run once to fill the caches, then ``python -X importtime -m mechgen run SCENE`` is started
+``repeats`` times in a fresh subprocess. Reported per scene: the median wall time of the whole
+process (interpreter start, imports, kernel load, analyses, output), the median time spent in
+imports (the sum of the top-level cumulative times that ``-X importtime`` prints) and its share,
+and whether sympy, jinja2, scipy.optimize or mechgen.symbolic were imported (they must not be: a
+cached run derives nothing). Writes ``out/startup.{json,md}``.
+"""
+from __future__ import annotations
+
+import json
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+SCENES = ("laval_rotor.toml", "beam_modes.toml")
+HEAVY = ("sympy", "jinja2", "scipy.optimize", "mechgen.symbolic")
+TARGET_S = 0.5
+
+
+def import_seconds(stderr: str) -> tuple[float, set[str]]:
+    """Total import time (s) of an ``-X importtime`` log (top-level entries) and the modules it names."""
+    total, names = 0.0, set()
+    for line in stderr.splitlines():
+        if not line.startswith("import time:") or "self [us]" in line:
+            continue
+        _, cumulative, name = line[len("import time:"):].split("|")
+        names.add(name.strip())
+        if not name.startswith("  "):  # one space after the bar: a top-level import
+            total += int(cumulative) * 1e-6
+    return total, names
+
+
+def time_scene(scene: Path, repeats: int = 7) -> dict:
+    """Median whole-process time of a cached ``mechgen run scene`` and its import share."""
+    cmd = [sys.executable, "-X", "importtime", "-m", "mechgen", "run", str(scene)]
+    subprocess.run(cmd[:1] + cmd[3:], check=True, capture_output=True)  # fill the caches
+    walls, imports, heavy = [], [], set()
+    for _ in range(repeats):
+        start = time.perf_counter()
+        proc = subprocess.run(cmd, check=True, capture_output=True, text=True)
+        walls.append(time.perf_counter() - start)
+        seconds, names = import_seconds(proc.stderr)
+        imports.append(seconds)
+        heavy |= {h for h in HEAVY if h in names}
+    wall, imp = statistics.median(walls), statistics.median(imports)
+    return {"scene": scene.name, "repeats": repeats, "wall_s": wall, "imports_s": imp, "import_share": imp / wall,
+            "wall_min_s": min(walls), "heavy_imports": sorted(heavy), "target_s": TARGET_S}
+
+
+def run_startup_benchmarks(out: Path, *, quick: bool = False) -> dict:
+    """Time every scene of :data:`SCENES`; writes ``out/startup.{json,md}``."""
+    folder = Path(__file__).resolve().parents[1] / "scenes"
+    rows = [time_scene(folder / name, repeats=3 if quick else 7) for name in SCENES]
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "startup.json").write_text(json.dumps(rows, indent=2))
+    lines = ["| scene | whole process (median, s) | imports (s) | import share | heavy imports |",
+             "|---|---|---|---|---|"]
+    lines += [f"| {r['scene']} | {r['wall_s']:.3f} | {r['imports_s']:.3f} | {r['import_share']:.0%} | "
+              f"{', '.join(r['heavy_imports']) or 'none'} |" for r in rows]
+    (out / "startup.md").write_text("\n".join(lines) + "\n")
+    print("\n".join(lines))
+    return {"rows": rows}
