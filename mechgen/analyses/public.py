@@ -24,7 +24,7 @@ __all__ = ["analysis", "campbell", "continuation", "modes", "simulate", "stabili
 def _model_info(system):
     from mechgen.scene.info import lookup_model
 
-    name = system.meta.get("model")
+    name = system.meta.get("source") or system.meta.get("model")  # the canonical reference, for users' models
     info = lookup_model(name) if name else None
     if info is None:
         raise InputError(f"the system's model {name!r} is not one mechgen can look up", key="system",
