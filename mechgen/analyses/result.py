@@ -69,8 +69,17 @@ class Result:
 
 def run_analysis(name: str, kind: str, system, options: dict, context: dict) -> Result:
     """Run a validated analysis through its kind's runner and time it."""
+    from mechgen.runtime.threads import blas_threads_for
+
     clock = time.perf_counter()
-    outputs = get(kind).run(system, options, context)
+    with blas_threads_for(_unknowns(system)):
+        outputs = get(kind).run(system, options, context)
     shown = public(outputs)
     working = {k: v for k, v in outputs.items() if k not in shown}
     return Result(name, kind, shown, time.perf_counter() - clock, working)
+
+
+def _unknowns(system) -> int:
+    """The size that decides the BLAS threads: the unknowns of a lumped model or a chain, a continuum's
+    dof count (from its discretisation, which the analysis builds anyway)."""
+    return int(system.n)

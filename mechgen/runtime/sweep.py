@@ -11,6 +11,7 @@ from concurrent.futures import ProcessPoolExecutor
 from tqdm import tqdm
 
 from mechgen.errors import MechgenError
+from mechgen.runtime.threads import single_thread_worker
 
 
 class SweepError(MechgenError):
@@ -30,7 +31,7 @@ def sweep(func, points: list, *, workers: int = 0, progress: bool = True, desc: 
                 results[i] = _call(func, point)
                 bar.update()
             return results
-        with ProcessPoolExecutor(max_workers=workers) as pool:
+        with ProcessPoolExecutor(max_workers=workers, initializer=single_thread_worker) as pool:
             futures = [pool.submit(func, point) for point in points]
             for i, fut in enumerate(futures):
                 try:

@@ -1,0 +1,38 @@
+"""BLAS threads sized to the problem (mechgen.runtime.threads): one thread for small dense work,
+the library's default above, and a user's own choice in the environment always kept."""
+import subprocess
+import sys
+
+import pytest
+
+threadpoolctl = pytest.importorskip("threadpoolctl")
+
+from mechgen.runtime.threads import SMALL, blas_threads_for  # noqa: E402
+
+
+def _blas_threads() -> list[int]:
+    return [info["num_threads"] for info in threadpoolctl.threadpool_info() if info["user_api"] == "blas"]
+
+
+def test_small_problems_run_on_one_thread_and_large_ones_keep_the_default(monkeypatch):
+    for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+        monkeypatch.delenv(name, raising=False)
+    import numpy  # noqa: F401  (loads the BLAS whose threads are counted)
+
+    before = _blas_threads()
+    with blas_threads_for(SMALL):
+        assert set(_blas_threads()) <= {1}
+    assert _blas_threads() == before
+    with blas_threads_for(SMALL + 1):
+        assert _blas_threads() == before
+
+
+def test_a_users_choice_is_kept():
+    code = ("import numpy, threadpoolctl; from mechgen.runtime.threads import blas_threads_for\n"
+            "with blas_threads_for(4):\n"
+            "    print([i['num_threads'] for i in threadpoolctl.threadpool_info() if i['user_api'] == 'blas'])")
+    env = {"OPENBLAS_NUM_THREADS": "2", "PATH": "/usr/bin:/bin"}
+    import os
+    env["PYTHONPATH"] = os.pathsep.join(sys.path)
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[2]"
