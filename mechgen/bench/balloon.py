@@ -168,7 +168,8 @@ class Mechgen:
         from mechgen.runtime.continuation import point_at
 
         res = branch.system.to_result(point_at(branch, lam), lam)
-        system = (self.system if N == int(self.system.choices["N"]) else self.system.refined(N)).with_param_vector(res.p)
+        system = self.system if N == int(self.system.choices["N"]) else self.system.refined(N)
+        system = system.with_param_vector(res.p)
         stability_at(system, self.bvp, res)                     # tables built: untimed
         seconds, out = _timed(lambda: stability_at(system, self.bvp, res))
         return float(out.frequencies[0]), seconds

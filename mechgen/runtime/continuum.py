@@ -56,13 +56,14 @@ class FieldSystem:
     runtime choices; ``fixed``: the numeric values folded into the kernels.
 
     ``params`` is a read-only array; ``kernels``, ``meta``, ``fixed``, ``choices`` and
-    ``layout`` are read-only too, and no attribute can be assigned after construction: :meth:`with_params` and
-    :meth:`with_layout` give new systems. The memo (discretisation, reduction, assembler,
-    point tables, penalty, mass factor) holds pure functions of the frozen state: every key
-    names what its value depends on (the length, and the parameter vector where the value
-    depends on it), so that systems differing only in parameter values share it. ``_cache``
-    is accepted for compatibility and ignored: a system built by ``dataclasses.replace``
-    starts with its own memo. ``rebuild(system, values)``, given by the compile layer,
+    ``layout`` are read-only too, and no attribute can be assigned after construction:
+    :meth:`with_params` and :meth:`with_layout` give new systems. The memo (shear ratios,
+    discretisation, reduction, assembler, point tables, penalty, mass factor) holds pure
+    functions of the frozen state: every key names what its value depends on (the length,
+    the shear ratios, and the parameter vector where the value depends on it), so that
+    systems differing only in parameter values share it. ``_cache`` is accepted for
+    compatibility and ignored: a system built by ``dataclasses.replace`` starts with its own
+    memo. ``rebuild(system, values)``, given by the compile layer,
     recompiles for names folded into the kernels (``fixed`` and ``folded``).
     """
 
