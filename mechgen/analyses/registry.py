@@ -21,6 +21,7 @@ MODULES = (
     "mechgen.analyses.sweep",
     "mechgen.analyses.campbell",
     "mechgen.analyses.continuation",
+    "mechgen.analyses.response",
 )
 
 
