@@ -37,7 +37,8 @@ FIXED_FACTOR: float | None = None
 #: calibration factor: alpha0 = CALIBRATION * max|diag K| is soft enough that its round-off never matters
 CALIBRATION = 1e2
 
-#: AccuracyWarning above this predicted relative error of the lowest eigenvalue
+#: AccuracyWarning above this predicted relative error of the lowest eigenvalue (or above 4 R, when the
+#: unpenalised problem's own worst-case round-off R = eps Lambda / lambda_lo is larger already)
 PENALTY_TARGET = 1e-6
 
 EPS = float(np.finfo(float).eps)
@@ -66,14 +67,19 @@ class PenaltyChoice:
 
 
 def _lowest_mode(A, B):
-    """Lowest (lambda, phi) of A phi = lambda B phi, phi^T B phi = 1 (dense eigh, or sparse shift-invert)."""
+    """Lowest (lambda, phi) of A phi = lambda B phi, phi^T B phi = 1 (A positive definite: dense inverse
+    eigh, or sparse shift-invert about 0)."""
     if sps.issparse(A) and A.shape[0] > 400:
         lam, phi = spla.eigsh(A.tocsc(), k=1, M=sps.csc_matrix(B), sigma=0.0, which="LM")
         return float(lam[0]), phi[:, 0]
     A = A.toarray() if sps.issparse(A) else np.asarray(A)
     B = B.toarray() if sps.issparse(B) else np.asarray(B)
-    lam, phi = sla.eigh(A, B, subset_by_index=[0, 0])
-    return float(lam[0]), phi[:, 0]
+    n = A.shape[0]
+    # the inverse problem B phi = mu A phi (Cholesky of A): its round-off, eps * max mu, is small
+    # relative to the largest mu = 1 / lambda_lo; eigh(A, B) would err by eps * lambda_max instead
+    mu, phi = sla.eigh(B, A, subset_by_index=[n - 1, n - 1])
+    lam = 1.0 / float(mu[0])
+    return lam, phi[:, 0] * np.sqrt(lam)
 
 
 def penalty_choice(red: "Reduction", K, M, fixed: float | None = None) -> PenaltyChoice:
@@ -125,7 +131,7 @@ def penalty_choice(red: "Reduction", K, M, fixed: float | None = None) -> Penalt
         f = PENALTY_FACTOR
     choice = PenaltyChoice(float(f * s.max()), f, k_max, P, R, f * s)
     error = choice.predicted()
-    if error > PENALTY_TARGET:
+    if error > max(PENALTY_TARGET, 4 * R):  # 4 R: beyond the unpenalised problem's own round-off bound R
         import warnings
 
         from mechgen.runtime.modes import AccuracyWarning
