@@ -32,7 +32,8 @@ import scipy.sparse.linalg as spla
 from mechgen.errors import InputError, KernelError
 from mechgen.runtime.assemble import Assembler, element_matrices, element_vectors, jets_at_points
 from mechgen.runtime import constrain
-from mechgen.runtime.constrain import PENALTY_FACTOR, PenaltyChoice, Reduction, binding, penalty_choice, reduction  # noqa: F401 (PENALTY_FACTOR: a public name here before)
+from mechgen.runtime.constrain import (  # noqa: F401 (PENALTY_FACTOR: importable from here before)
+    PENALTY_FACTOR, PenaltyChoice, Reduction, binding, penalty_choice, reduction)
 from mechgen.runtime.discretise import DISCRETISATIONS, GLOBAL, Discretisation, discretise
 from mechgen.runtime.elements import reference
 from mechgen.runtime.kernels import Kernel
@@ -579,7 +580,7 @@ class FieldSystem:
 
     @property
     def penalty(self) -> float:
-        """The largest row penalty alpha_j = f s_j (about f * max|diag K|; 0 without penalty rows).
+        """alpha = f * max|diag K| of the unconstrained zero-state K (0 without penalty rows).
 
         f balances the penalty error of the lowest eigenvalue against the round-off
         (mechgen.runtime.constrain.penalty_choice: f* = sqrt(P / R)); see :attr:`penalty_choice`.
