@@ -86,10 +86,21 @@ def test_element_convergence_rate(disc, rate):
 
 
 def test_penalty_converges_to_elimination():
-    """The penalty method (seed 002) with factor 1e6 matches elimination to about 1e-9."""
+    """The penalty method (seed 002) matches elimination to the accuracy its rule states.
+
+    The bound 1e-8 this test had held only by round-off luck on one BLAS kernel (the factor 1e6 put the
+    spectrum's span at 6e13, eps * 6e13 = 1e-2; under OPENBLAS_CORETYPE=Haswell the error was 34 %).
+    The rule (mechgen.runtime.constrain.penalty_choice) balances the penalty error P/f against the
+    round-off: it predicts a lowest-eigenvalue error of P/f (frequency: half), here 1.7e-7, and the
+    penalty error of mode i grows with its reaction, ~omega_i / omega_1 (1.2e-5 at the fifth)."""
     exact = beam_frequencies("clamped-free", "hermite", 32)
     penalised = beam_frequencies("clamped-free", "hermite", 32, constraints="penalty")
-    assert np.abs(penalised / exact - 1).max() < 1e-8
+    model = models.get("euler_bernoulli_beam")
+    spec = specialize(model, {"bc": "clamped-free", "discretisation": "hermite", "N": 32, "constraints": "penalty"})
+    choice = compile_model(model, spec, kernels={"linear"})[0].penalty_choice
+    err = np.abs(penalised / exact - 1)
+    assert err[0] == pytest.approx(choice.P / choice.factor / 2, rel=0.05)
+    assert np.all(err < 1.5 * err[0] * exact / exact[0])
 
 
 def test_penalty_refused_for_global_bases():

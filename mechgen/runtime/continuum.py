@@ -31,7 +31,9 @@ import scipy.sparse.linalg as spla
 
 from mechgen.errors import InputError, KernelError
 from mechgen.runtime.assemble import Assembler, element_matrices, element_vectors, jets_at_points
-from mechgen.runtime.constrain import PENALTY_FACTOR, Reduction, binding, reduction
+from mechgen.runtime import constrain
+from mechgen.runtime.constrain import (  # noqa: F401 (PENALTY_FACTOR: importable from here before)
+    PENALTY_FACTOR, PenaltyChoice, Reduction, binding, penalty_choice, reduction)
 from mechgen.runtime.discretise import DISCRETISATIONS, GLOBAL, Discretisation, discretise
 from mechgen.runtime.elements import reference
 from mechgen.runtime.kernels import Kernel
@@ -468,7 +470,7 @@ class FieldSystem:
                 extra = B.T @ sps.csr_matrix(self._coeff(loc[k])[0]) @ B
                 mats[k] = mats[k] + (extra if sps.issparse(mats[k]) else extra.toarray())
         stiff = {"linear": "K", "tangent": "r_q"}[kernel]
-        return {k: self.reduction.matrix(mats[k], self.penalty if k == stiff else 0.0, border=k == stiff)
+        return {k: self.reduction.matrix(mats[k], self._row_penalties if k == stiff else 0.0, border=k == stiff)
                 for k in names}
 
     def _coeff(self, arr: np.ndarray) -> np.ndarray:
@@ -504,7 +506,7 @@ class FieldSystem:
         """r(q, q', q'') = Z^T (sum_e B^T W rho + sum_ends B_at^T rho_at + penalty C^T C x)."""
         full = self._full((q, v, a))
         red = self.reduction
-        return red.vector(self._full_residual(full, t) + red.penalty_force(full[0], self.penalty), q)
+        return red.vector(self._full_residual(full, t) + red.penalty_force(full[0], self._row_penalties), q)
 
     def reactions(self, q, t: float = 0.0) -> list[dict]:
         """Boundary reactions of an equilibrium: the Lagrange multipliers lambda of C x = 0.
@@ -579,16 +581,33 @@ class FieldSystem:
 
     @property
     def penalty(self) -> float:
-        """alpha = PENALTY_FACTOR * max|diag K| of the unconstrained zero-state K (0 without penalty rows)."""
-        if self.reduction.penalty_rows is None:
-            return 0.0
-        def alpha() -> float:
-            local = self._pointwise("linear", self._jets(None))
-            ke = element_matrices(self.disc.tables, self.disc.weights, self._coeff(local["K"]))
-            K = self.assembler.matrix(ke)
-            return PENALTY_FACTOR * max(float(np.abs(K.diagonal()).max()), 1e-300)
+        """alpha = f * max|diag K| of the unconstrained zero-state K (0 without penalty rows).
 
-        return self._memo.get(("alpha", *self._reduction_key(), self._pkey), alpha)
+        f balances the penalty error of the lowest eigenvalue against the round-off
+        (mechgen.runtime.constrain.penalty_choice: f* = sqrt(P / R)); see :attr:`penalty_choice`.
+        """
+        choice = self.penalty_choice
+        return 0.0 if choice is None else choice.alpha
+
+    @property
+    def _row_penalties(self):
+        """alpha_j of each penalty row (0.0 without penalty rows)."""
+        choice = self.penalty_choice
+        return 0.0 if choice is None else choice.alphas
+
+    @property
+    def penalty_choice(self) -> PenaltyChoice | None:
+        """The penalty factor and its error model (predicted relative error of the lowest eigenvalue)."""
+        if self.reduction.penalty_rows is None:
+            return None
+
+        def choose() -> PenaltyChoice:
+            local = self._pointwise("linear", self._jets(None))
+            K, M = (self.assembler.matrix(element_matrices(self.disc.tables, self.disc.weights, self._coeff(local[k])))
+                    for k in ("K", "M"))
+            return penalty_choice(self.reduction, K, M, constrain.FIXED_FACTOR)
+
+        return self._memo.get(("alpha", *self._reduction_key(), self._pkey, constrain.FIXED_FACTOR), choose)
 
     def outputs(self, q, v=None, z=None, t: float = 0.0) -> dict[str, float]:
         """Energies: integrals of the kinetic and potential densities plus the end terms."""
