@@ -99,3 +99,19 @@ def test_a_posteriori_errors_of_every_mode(N):
     predicted = system.penalty_errors(res.shapes, res.eigenvalues) / 2  # frequencies: half
     np.testing.assert_allclose(1 - res.frequencies / exact, predicted, rtol=0.05)
     assert np.all(beam(N, "eliminate").penalty_errors(np.eye(3)[:, :1], np.ones(1)) == 0)
+
+
+@pytest.mark.parametrize("N", [32, 128])
+def test_modes_analysis_warns_from_the_computed_modes(monkeypatch, N):
+    """The modes analysis checks every mode it returns: silent by default, a warning for a too soft penalty."""
+    from mechgen.analyses.modes import run_modes
+
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        run_modes(beam(N, "penalty"), {"count": 5}, {})
+    assert not penalty_warnings(record)
+    monkeypatch.setattr(constrain, "FIXED_FACTOR", 1e-2)
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        run_modes(beam(N, "penalty"), {"count": 5}, {})
+    assert any("mode 5" in m for m in penalty_warnings(record))

@@ -98,6 +98,24 @@ def penalty_errors(red: "Reduction", alphas, shapes: np.ndarray, eigenvalues: np
     return np.einsum("j,ji->i", alphas, CX**2) / np.asarray(eigenvalues, float)
 
 
+#: a-posteriori AccuracyWarning when a computed mode's predicted penalty error exceeds this (relative eigenvalue)
+MODE_TARGET = 1e-4
+
+
+def warn_penalty_errors(errors: np.ndarray, target: float = MODE_TARGET) -> None:
+    """AccuracyWarning naming the worst mode when any a-posteriori penalty error e_i exceeds ``target``."""
+    errors = np.asarray(errors, float)
+    if errors.size and errors.max() > target:
+        import warnings
+
+        from mechgen.runtime.modes import AccuracyWarning
+
+        i = int(np.argmax(errors))
+        warnings.warn(f"penalty constraints: mode {i + 1}'s eigenvalue is low by about {errors[i]:.1g} (relative, "
+                      "from its reactions sum_j alpha_j (C x)_j^2 / lambda); use constraints = 'eliminate' or "
+                      "'multiplier', or ask for fewer modes", AccuracyWarning, stacklevel=3)
+
+
 def penalty_choice(red: "Reduction", K, M, fixed: float | None = None) -> PenaltyChoice:
     """The penalty alpha = f k_max on every row (k_max = max|diag K|) from the spectrum and the precision eps.
 
