@@ -87,3 +87,31 @@ def test_bad_penalty_warns(monkeypatch, N, factor):
 def test_no_penalty_without_penalty_rows():
     assert beam(8, "eliminate").penalty == 0.0
     assert beam(8, "eliminate").penalty_choice is None
+
+
+@pytest.mark.parametrize("N", [32, 128])
+def test_a_posteriori_errors_of_every_mode(N):
+    """sum_j alpha_j (C x_i)_j^2 / lambda_i from the computed shapes predicts each mode's error (first order)."""
+    exact = frequencies(beam(N, "eliminate"))
+    system = beam(N, "penalty")
+    mats = system.linear()
+    res = modes(mats["M"], mats["K"], count=5)
+    predicted = system.penalty_errors(res.shapes, res.eigenvalues) / 2  # frequencies: half
+    np.testing.assert_allclose(1 - res.frequencies / exact, predicted, rtol=0.05)
+    assert np.all(beam(N, "eliminate").penalty_errors(np.eye(3)[:, :1], np.ones(1)) == 0)
+
+
+@pytest.mark.parametrize("N", [32, 128])
+def test_modes_analysis_warns_from_the_computed_modes(monkeypatch, N):
+    """The modes analysis checks every mode it returns: silent by default, a warning for a too soft penalty."""
+    from mechgen.analyses.modes import run_modes
+
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        run_modes(beam(N, "penalty"), {"count": 5}, {})
+    assert not penalty_warnings(record)
+    monkeypatch.setattr(constrain, "FIXED_FACTOR", 1e-2)
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        run_modes(beam(N, "penalty"), {"count": 5}, {})
+    assert any("mode 5" in m for m in penalty_warnings(record))

@@ -16,6 +16,7 @@ from mechgen.analyses.operating_point import linear_about, operating_point
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import LINEAR_OPTIONS
 from mechgen.analyses.whirl import is_gyroscopic, run_damped_modes
+from mechgen.runtime.constrain import warn_penalty_errors
 from mechgen.runtime.modes import modes as solve_modes
 
 def needs(options: dict, *, internal: bool) -> set[str]:
@@ -40,6 +41,8 @@ def run_modes(system, options: dict, context: dict) -> dict:
         return out
     res = solve_modes(mats["M"], mats["K"], count=options.get("count"),
                       allow_singular_mass=getattr(system, "has_multipliers", False))
+    if getattr(system, "penalty_choice", None) is not None:  # penalty constraints: a-posteriori error of each mode
+        warn_penalty_errors(system.penalty_errors(res.shapes, res.eigenvalues))
     out = {"frequencies": [float(f) for f in res.frequencies], "_shapes": res.shapes}
     if system.is_field and options.get("count"):
         out.update(field_shapes(system, res.shapes, "shapes"))

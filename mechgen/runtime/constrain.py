@@ -82,6 +82,40 @@ def _lowest_mode(A, B):
     return lam, phi[:, 0] * np.sqrt(lam)
 
 
+def penalty_errors(red: "Reduction", alphas, shapes: np.ndarray, eigenvalues: np.ndarray) -> np.ndarray:
+    """A-posteriori penalty error of each computed mode: e_i = sum_j alpha_j (C x_i)_j^2 / lambda_i (relative).
+
+    For a mass-normalised penalised mode x_i (x_i^T M x_i = 1, reduced shapes expanded by x = Z q)
+    the reactions are r = diag(alpha) C x_i, and lambda_i(alpha) = lambda_c,i - sum_j r_j^2 / alpha_j + ...,
+    so e_i estimates (lambda_c,i - lambda_i) / lambda_i to first order in 1/alpha (frequencies: e_i / 2),
+    for every mode asked for (higher modes carry larger reactions than the lowest one the rule balances).
+    """
+    if red.penalty_rows is None:
+        return np.zeros(len(eigenvalues))
+    X = np.column_stack([red.expand(q) for q in np.asarray(shapes, float).T])
+    CX = np.asarray(red.penalty_rows, float) @ X
+    alphas = np.broadcast_to(np.asarray(alphas, float), (CX.shape[0],))
+    return np.einsum("j,ji->i", alphas, CX**2) / np.asarray(eigenvalues, float)
+
+
+#: a-posteriori AccuracyWarning when a computed mode's predicted penalty error exceeds this (relative eigenvalue)
+MODE_TARGET = 1e-4
+
+
+def warn_penalty_errors(errors: np.ndarray, target: float = MODE_TARGET) -> None:
+    """AccuracyWarning naming the worst mode when any a-posteriori penalty error e_i exceeds ``target``."""
+    errors = np.asarray(errors, float)
+    if errors.size and errors.max() > target:
+        import warnings
+
+        from mechgen.runtime.modes import AccuracyWarning
+
+        i = int(np.argmax(errors))
+        warnings.warn(f"penalty constraints: mode {i + 1}'s eigenvalue is low by about {errors[i]:.1g} (relative, "
+                      "from its reactions sum_j alpha_j (C x)_j^2 / lambda); use constraints = 'eliminate' or "
+                      "'multiplier', or ask for fewer modes", AccuracyWarning, stacklevel=3)
+
+
 def penalty_choice(red: "Reduction", K, M, fixed: float | None = None) -> PenaltyChoice:
     """The penalty alpha = f k_max on every row (k_max = max|diag K|) from the spectrum and the precision eps.
 

@@ -33,7 +33,7 @@ from mechgen.errors import InputError, KernelError
 from mechgen.runtime.assemble import Assembler, element_matrices, element_vectors, jets_at_points
 from mechgen.runtime import constrain
 from mechgen.runtime.constrain import (  # noqa: F401 (PENALTY_FACTOR: importable from here before)
-    PENALTY_FACTOR, PenaltyChoice, Reduction, binding, penalty_choice, reduction)
+    PENALTY_FACTOR, PenaltyChoice, Reduction, binding, penalty_choice, penalty_errors, reduction)
 from mechgen.runtime.discretise import DISCRETISATIONS, GLOBAL, Discretisation, discretise
 from mechgen.runtime.elements import reference
 from mechgen.runtime.kernels import Kernel
@@ -588,6 +588,11 @@ class FieldSystem:
         """
         choice = self.penalty_choice
         return 0.0 if choice is None else choice.alpha
+
+    def penalty_errors(self, shapes: np.ndarray, eigenvalues: np.ndarray) -> np.ndarray:
+        """A-posteriori relative eigenvalue error of each mass-normalised mode the penalty causes
+        (mechgen.runtime.constrain.penalty_errors; zeros without penalty rows)."""
+        return penalty_errors(self.reduction, self._row_penalties, shapes, eigenvalues)
 
     @property
     def _row_penalties(self):
