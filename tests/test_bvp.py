@@ -1,4 +1,4 @@
-"""Two-point BVP solvers (mechgen.runtime.bvp) against closed forms and literature values.
+"""Two-point BVP solvers (mechgen.runtime.steady.bvp) against closed forms and literature values.
 
 References:
 * Bratu problem y'' + lam e^y = 0, y(0) = y(1) = 0: the closed form
@@ -22,7 +22,7 @@ import pytest
 from scipy.optimize import brentq
 
 from mechgen.errors import ConvergenceError, InputError
-from mechgen.runtime.bvp import (BVP, Discretisation, check_jacobians, collocate, multiple_shoot,
+from mechgen.runtime.steady.bvp import (BVP, Discretisation, check_jacobians, collocate, multiple_shoot,
                                  on_unit_interval, shoot)
 
 

@@ -1,4 +1,4 @@
-"""Pseudo-arclength continuation (mechgen.runtime.continuation) against exact folds.
+"""Pseudo-arclength continuation (mechgen.runtime.steady.continuation) against exact folds.
 
 References:
 * u^2 + lam^2 = 1: folds at lam = +-1, u = 0 (a circle).
@@ -15,8 +15,8 @@ import scipy.sparse as sps
 from scipy.optimize import brentq, minimize_scalar
 
 from mechgen.errors import ConvergenceError, InputError
-from mechgen.runtime.bvp import collocate
-from mechgen.runtime.continuation import System, continuation, continue_bvp, minimize_along_branch
+from mechgen.runtime.steady.bvp import collocate
+from mechgen.runtime.steady.continuation import System, continuation, continue_bvp, minimize_along_branch
 from test_bvp import MESH, S, _bratu_guess, bratu, bratu_exact, bratu_theta
 
 Z_C = brentq(lambda z: z * np.tanh(z) - 1, 0.5, 2.0, xtol=1e-15)

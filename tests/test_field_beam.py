@@ -15,8 +15,8 @@ from scipy.optimize import brentq
 from mechgen import models
 from mechgen.pipeline import compile_model
 from mechgen.errors import InputError
-from mechgen.runtime.discretise import UnderIntegrationWarning
-from mechgen.runtime.modes import modes
+from mechgen.runtime.fields.discretise import UnderIntegrationWarning
+from mechgen.runtime.linear.modes import modes
 from mechgen.symbolic.specialize import specialize
 
 EQUATIONS = {
@@ -172,7 +172,7 @@ def test_free_vibration_in_the_first_mode_returns_after_one_period():
 
     omega_1 = 1.8751^2 sqrt(EI / rhoA L^4); quintic elements (N = 2) are within 1e-7 of it.
     """
-    from mechgen.runtime.integrate import integrate_first_order
+    from mechgen.runtime.core.integrate import integrate_first_order
     from mechgen.analyses.simulate import initial_state, run_simulate
 
     model = models.get("euler_bernoulli_beam")

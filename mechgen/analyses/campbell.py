@@ -1,6 +1,6 @@
 """``campbell``: a Campbell diagram, the damped modes over a range of one parameter (the spin speed).
 
-The modes are tracked across speeds (mechgen.runtime.campbell) and critical speeds are found where a
+The modes are tracked across speeds (mechgen.runtime.linear.campbell) and critical speeds are found where a
 whirl frequency crosses a multiple of the speed. Scene keys: ``over`` (one numeric parameter with two
 or more increasing values), ``count`` (modes, default 8), ``multiples`` (of the speed, default [1]),
 ``method`` (auto, exact, reduced), ``about`` and ``at`` (the operating point). Outputs: ``speeds``,
@@ -19,7 +19,7 @@ from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import REQUIRED, Option
 from mechgen.analyses.whirl import SPARSE_N, whirl_stations
 from mechgen.errors import SceneError
-from mechgen.runtime.campbell import campbell, critical_speeds, fit_speed_polynomial
+from mechgen.runtime.linear.campbell import campbell, critical_speeds, fit_speed_polynomial
 from mechgen.scene.values import fail, is_choice, join, param_info, type_name
 
 
@@ -71,7 +71,7 @@ def run_campbell(system, options: dict, context: dict) -> dict:
 
     With more than four speeds the matrices are tested for a polynomial dependence on the speed
     (fit_speed_polynomial: three or four assemblies); when it holds, no further assembly is needed and
-    the Campbell runs on the reduced basis (mechgen.runtime.campbell), else it assembles at every speed.
+    the Campbell runs on the reduced basis (mechgen.runtime.linear.campbell), else it assembles at every speed.
     ``options['method'] = 'exact'`` forces full-size solves at every speed."""
     name, speeds = _speed_parameter(system, options)
     if not system.meta.get("whirl"):

@@ -1,7 +1,7 @@
 """``continuation``: branches of a continuum's steady states (boundary value problems in s).
 
 ``continuation`` follows such a steady state in one parameter by pseudo-arclength
-(mechgen.runtime.continuation), through turning points, with the stability verdict
+(mechgen.runtime.steady.continuation), through turning points, with the stability verdict
 of the Galerkin linearisation about every point; it reports ``branch`` (one entry
 per point: the parameter, the outputs, ``verdict``), ``folds`` and, with
 ``minimize``, the least value of an output along the branch (``<output>_min`` and
@@ -29,7 +29,7 @@ More keys of ``continuation``:
 * ``bounds = { p_e = [0, 12] }``: the branch ends where an output leaves its range
   (the continuation then runs in chunks of 20 points);
 * ``at = { p_e = 5.0 }``: the points where an output crosses the value, located by
-  Brent's method along the branch (mechgen.runtime.branch_scan.crossing): output
+  Brent's method along the branch (mechgen.runtime.steady.branch_scan.crossing): output
   ``at_<output>``, a list of {parameter, the output, the aliased outputs, the shape
   outputs, ``verdict``, ``refinement``} sorted by the parameter (the verdict holds when
   the model discretised with 2N and 4N terms agrees, else it is 'unconverged'), and
@@ -38,7 +38,7 @@ More keys of ``continuation``:
 
 With stability, ``stability_changes`` lists where the verdict changes between
 consecutive points, located by bisection along the branch to 1e-9 of the segment
-(mechgen.runtime.branch_scan.switch): {parameter, aliased and shape outputs,
+(mechgen.runtime.steady.branch_scan.switch): {parameter, aliased and shape outputs,
 ``from``, ``to``}. ``aliases`` may also name an analysis output:
 ``balloons_at_tension = "at_p_e"``.
 """
@@ -55,8 +55,8 @@ from mechgen.analyses.bvp_states import (bvp_summary, shape_declarations, shape_
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import REQUIRED, Option
 from mechgen.errors import SceneError
-from mechgen.runtime import branch_scan
-from mechgen.runtime.continuation import minimize_along_branch
+from mechgen.runtime.steady import branch_scan
+from mechgen.runtime.steady.continuation import minimize_along_branch
 from mechgen.scene.expr import is_identifier
 from mechgen.scene.values import IDENTIFIER_RULE, fail, is_choice, join, listing, param_info, show
 

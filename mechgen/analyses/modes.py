@@ -16,7 +16,7 @@ from mechgen.analyses.operating_point import linear_about, operating_point
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import LINEAR_OPTIONS
 from mechgen.analyses.whirl import is_gyroscopic, run_damped_modes
-from mechgen.runtime.modes import modes as solve_modes
+from mechgen.runtime.linear.modes import modes as solve_modes
 
 def needs(options: dict, *, internal: bool) -> set[str]:
     """M, D, G, K: the linear kernel."""

@@ -17,8 +17,8 @@ from mechgen.analyses.operating_point import vector
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import ABSENT, ALL_OUTPUTS, REQUIRED, Option
 from mechgen.errors import SceneError
-from mechgen.runtime.integrate import integrate_first_order, leapfrog
-from mechgen.runtime.modes import modes as solve_modes
+from mechgen.runtime.core.integrate import integrate_first_order, leapfrog
+from mechgen.runtime.linear.modes import modes as solve_modes
 from mechgen.scene.values import fail, listing, show, type_name
 
 METHODS = ("BDF", "Radau", "LSODA", "RK45", "DOP853", "leapfrog")

@@ -3,7 +3,7 @@ boundary value problem in s.
 
 Scene keys: ``guess`` (coordinates), ``tol``, ``max_iter``; for a continuum whose boundary conditions
 carry values (a string between two eyelets) ``method`` = shooting / multiple_shooting / collocation
-(mechgen.runtime.steady_bvp) with ``mesh`` / ``nodes``, ``bulge`` (sine amplitudes added to the
+(mechgen.runtime.steady.steady_bvp) with ``mesh`` / ``nodes``, ``bulge`` (sine amplitudes added to the
 guess), ``form`` (lagrangian, or hamiltonian: the stress form), ``aliases`` (outputs under the
 scene's names), ``stability`` (the Galerkin verdict about the state), ``hold = {output = value}``
 with ``free = "parameter"`` (solve for the parameter that holds an end value), ``params =
@@ -32,8 +32,8 @@ from mechgen.analyses.parameters import info_of, parameter_dict, with_free_param
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import Option
 from mechgen.errors import ConvergenceError, SceneError
-from mechgen.runtime.newton import newton
-from mechgen.runtime.steady_bvp import hamiltonian_bvp, holding, solve_steady, steady_bvp, stress_guess
+from mechgen.runtime.steady.newton import newton
+from mechgen.runtime.steady.steady_bvp import hamiltonian_bvp, holding, solve_steady, steady_bvp, stress_guess
 from mechgen.scene.expr import is_identifier
 from mechgen.scene.values import IDENTIFIER_RULE, fail, is_choice, join, listing, param_info, show, type_name
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from mechgen.errors import InputError
-from mechgen.runtime.damped import damped_modes, whirl
+from mechgen.runtime.linear.damped import damped_modes, whirl
 
 #: above this many unknowns a damped-modes analysis with a ``count`` uses sparse shift-invert
 SPARSE_N = 100

@@ -20,7 +20,7 @@ from mechgen.analyses.registry import get
 from mechgen.analyses.result import run_analysis
 from mechgen.errors import InputError
 from mechgen.pipeline import compile_request, file_digest
-from mechgen.runtime.mesh import Layout
+from mechgen.runtime.fields.mesh import Layout
 from mechgen.scene.info import lookup_model, model_info
 from mechgen.scene.load import load_scene
 from mechgen.scene.plan import derive_with, plan_scene, point_request, request_for

@@ -16,7 +16,7 @@ from typing import Callable
 import numpy as np
 
 from mechgen.errors import KernelError
-from mechgen.runtime.pattern import extent
+from mechgen.runtime.core.pattern import extent
 
 
 def load_module(path: Path, name: str):

@@ -26,8 +26,8 @@ import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
 from mechgen.errors import InputError, KernelError
-from mechgen.runtime.kernels import Kernel
-from mechgen.runtime.pattern import Pattern, build_pattern, extent
+from mechgen.runtime.core.kernels import Kernel
+from mechgen.runtime.core.pattern import Pattern, build_pattern, extent
 
 
 class Memo:

@@ -11,7 +11,7 @@ basis (one element) gives a dense matrix; elements give CSR through an index
 map computed once per dof map.
 
 Speed: on a uniform mesh every element has the same table, and
-:func:`~mechgen.runtime.discretise.discretise` hands it over as a broadcast view
+:func:`~mechgen.runtime.fields.discretise.discretise` hands it over as a broadcast view
 (stride 0 along the elements). Then only the (a, b) pairs whose coefficient is
 not identically zero are visited and the element matrices are one product
 (elements, points x pairs) @ (points x pairs, dofs x dofs) of the weighted

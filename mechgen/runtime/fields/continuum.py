@@ -12,7 +12,7 @@ conditions. With x = Z q (constraints eliminated):
 
 Linearisation about a base state uses its jets at the points: either from a dof
 vector q, or given directly as data (``jets=``, shape (elements, points, jets)).
-The interface matches :class:`~mechgen.runtime.system.System` (``n``, ``m``,
+The interface matches :class:`~mechgen.runtime.core.system.System` (``n``, ``m``,
 ``linear``, ``residual``, ``tangent``, ``outputs``, ``rhs``, ``jacobian``), so
 every analysis runs on it; :meth:`refined` gives the same model at another size.
 
@@ -30,13 +30,13 @@ import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
 from mechgen.errors import InputError, KernelError
-from mechgen.runtime.assemble import Assembler, element_matrices, element_vectors, jets_at_points
-from mechgen.runtime.constrain import PENALTY_FACTOR, Reduction, binding, reduction
-from mechgen.runtime.discretise import DISCRETISATIONS, GLOBAL, Discretisation, discretise
-from mechgen.runtime.elements import reference
-from mechgen.runtime.kernels import Kernel
-from mechgen.runtime.mesh import Layout, build_mesh
-from mechgen.runtime.system import Memo, folded_parameter, frozen_vector, number, read_only, unknown_parameters
+from mechgen.runtime.fields.assemble import Assembler, element_matrices, element_vectors, jets_at_points
+from mechgen.runtime.fields.constrain import PENALTY_FACTOR, Reduction, binding, reduction
+from mechgen.runtime.fields.discretise import DISCRETISATIONS, GLOBAL, Discretisation, discretise
+from mechgen.runtime.fields.elements import reference
+from mechgen.runtime.core.kernels import Kernel
+from mechgen.runtime.fields.mesh import Layout, build_mesh
+from mechgen.runtime.core.system import Memo, folded_parameter, frozen_vector, number, read_only, unknown_parameters
 
 
 #: the values a continuum's runtime choices take (others, such as a model's own runtime choices, are strings)
@@ -141,7 +141,7 @@ class FieldSystem:
         """The same kernels, parameters and choices with segments and parts ``layout`` (a new memo)."""
         if layout is not None and not isinstance(layout, Layout):
             raise InputError(f"layout is {type(layout).__name__}", key="layout",
-                             expected="a mechgen.runtime.mesh.Layout of segments and parts")
+                             expected="a mechgen.runtime.fields.mesh.Layout of segments and parts")
         if layout == self.layout:
             return self
         return replace(self, layout=layout)
@@ -309,13 +309,13 @@ class FieldSystem:
 
     # -- steady boundary value problem --------------------------------------------
     def steady_form(self):
-        """The steady equations in s as a lumped :class:`~mechgen.runtime.system.System` (kernels ``bvp_*``).
+        """The steady equations in s as a lumped :class:`~mechgen.runtime.core.system.System` (kernels ``bvp_*``).
 
         Its first-order form is the boundary value problem: ``rhs(s, y)`` and
         ``jacobian(s, y)`` with y = (u, u_s), and ``outputs(u, u_s, t=s)`` the model's
         outputs and the boundary values ``bc_<field>_<order>_<end>``.
         """
-        from mechgen.runtime.system import System
+        from mechgen.runtime.core.system import System
 
         kernels = {k.removeprefix("bvp_"): v for k, v in self.kernels.items() if k.startswith("bvp_")}
         if "residual" not in kernels:
@@ -482,7 +482,7 @@ class FieldSystem:
             raise InputError(f"{self.meta.get('model')} holds a pointwise constraint (its multiplier is part of a "
                              "steady state): small motions only about a boundary-value steady state",
                              key="about", expected="modes or stability 'about' a steady analysis with "
-                             "form = 'hamiltonian' (mechgen.runtime.constrained)")
+                             "form = 'hamiltonian' (mechgen.runtime.steady.constrained)")
         return self._matrices("linear", ("M", "D", "G", "K"), q, v, None, t, jets)
 
     def tangent(self, q, v=None, a=None, z=None, t: float = 0.0) -> dict:

@@ -16,7 +16,7 @@ Fewer points than the minimum give an :class:`UnderIntegrationWarning`.
 
 Elements are uniform, so every element has the same table: ``tables`` is then a
 read-only broadcast view (stride 0 along the elements) of one reference table,
-which the assembly recognises and uses (mechgen.runtime.assemble). Gauss rules and
+which the assembly recognises and uses (mechgen.runtime.fields.assemble). Gauss rules and
 global-basis tables are memoised (read-only arrays): the beam basis needs its
 roots and a high-order normalisation rule, and a sweep or a refinement study
 rebuilds the same discretisation many times.
@@ -32,9 +32,9 @@ from typing import Callable
 
 import numpy as np
 
-from mechgen.runtime import bases
-from mechgen.runtime.elements import reference, timoshenko_shapes
-from mechgen.runtime.mesh import Mesh, build_mesh, dof_map
+from mechgen.runtime.fields import bases
+from mechgen.runtime.fields.elements import reference, timoshenko_shapes
+from mechgen.runtime.fields.mesh import Mesh, build_mesh, dof_map
 
 ELEMENTS = ("hermite", "quintic", "lagrange1", "lagrange2", "timoshenko2")
 GLOBAL = ("sine", "cosine", "legendre", "beam")
@@ -230,7 +230,7 @@ def discretise(kind: str, size: int, length: float, fields, jets, *, quadrature:
                constraints=(), mesh: Mesh | None = None, shear=None, joints: str = "assembly") -> Discretisation:
     """Tables of ``jets`` ((field, order) pairs) for ``size`` elements or basis functions per field.
 
-    Elements may lie on a given ``mesh`` (segments and parts, mechgen.runtime.mesh);
+    Elements may lie on a given ``mesh`` (segments and parts, mechgen.runtime.fields.mesh);
     ``timoshenko2`` needs ``shear`` = ([(w, psi, sign), ...], phi of shape (elements, pairs)).
     ``joints = "multiplier"`` keeps the segments apart (no dof shared at their interfaces);
     the caller then joins them by constraints.

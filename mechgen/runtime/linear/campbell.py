@@ -44,7 +44,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from mechgen.errors import InputError
-from mechgen.runtime.damped import (DampedModes, _is, _norm, _normalise, _scale, _split, _stations, damped_modes,
+from mechgen.runtime.linear.damped import (DampedModes, _is, _norm, _normalise, _scale, _split, _stations, damped_modes,
                                     whirl_sign)
 
 #: the automatic choice uses the reduced basis from this many speeds on ...

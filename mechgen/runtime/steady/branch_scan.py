@@ -1,6 +1,6 @@
 """Scanning a branch of steady states: both ways from a start, output bounds, crossings, switches of a label.
 
-:func:`follow` continues a BVP in one parameter (mechgen.runtime.continuation.continue_bvp)
+:func:`follow` continues a BVP in one parameter (mechgen.runtime.steady.continuation.continue_bvp)
 in one direction or both ways from the start, and ends the branch where ``inside(u, lam)``
 turns false (an output leaves its bounds): it then runs in chunks of ``chunk`` points, each
 restarted from the last accepted point in the direction of its tangent, and drops the first
@@ -26,7 +26,7 @@ import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
 from mechgen.errors import ConvergenceError, InputError
-from mechgen.runtime.continuation import Branch, continue_bvp
+from mechgen.runtime.steady.continuation import Branch, continue_bvp
 
 DIRECTIONS = ("increasing", "decreasing", "both")
 
@@ -100,7 +100,7 @@ def follow(problem, guess, index: int, *, direction: str = "increasing", inside=
     ``direction``: 'increasing' or 'decreasing' (the parameter's direction at the start) or
     'both' (the two half-branches, ``max_points`` each, joined: the start is then an inner point).
     ``inside(u, lam, system) -> bool`` ends the branch where it turns false (status 'bounds').
-    ``options`` go to :func:`~mechgen.runtime.continuation.continuation` (ds, lam_min, lam_max ...).
+    ``options`` go to :func:`~mechgen.runtime.steady.continuation.continuation` (ds, lam_min, lam_max ...).
     """
     if direction not in DIRECTIONS:
         raise InputError(f"unknown branch direction {direction!r}", key="direction", expected=", ".join(DIRECTIONS))

@@ -1,10 +1,10 @@
 """Stability along a branch of steady states: the Galerkin linearisation about every point.
 
-For each point (u, lam) of a :class:`~mechgen.runtime.continuation.Branch` of a steady BVP
-(:func:`mechgen.runtime.continuation.continue_bvp` on a
-:class:`~mechgen.runtime.steady_bvp.SteadyBVP`), the steady state's jets at the
+For each point (u, lam) of a :class:`~mechgen.runtime.steady.continuation.Branch` of a steady BVP
+(:func:`mechgen.runtime.steady.continuation.continue_bvp` on a
+:class:`~mechgen.runtime.steady.steady_bvp.SteadyBVP`), the steady state's jets at the
 discretisation's quadrature points give the linearised M, D, G, K
-(FieldSystem.linear(jets=...)), and :func:`mechgen.runtime.stability.stability` the
+(FieldSystem.linear(jets=...)), and :func:`mechgen.runtime.linear.stability.stability` the
 eigenvalues of M q'' + (D + G) q' + K q = 0 and the verdict, each with a system at that
 point's parameters (System.with_param_vector: the given system is never changed).
 """
@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from mechgen.runtime.constrained import linear_about_bvp
-from mechgen.runtime.stability import StabilityResult, stability
+from mechgen.runtime.steady.constrained import linear_about_bvp
+from mechgen.runtime.linear.stability import StabilityResult, stability
 
 
 def _dense(A) -> np.ndarray:

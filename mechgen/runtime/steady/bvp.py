@@ -25,9 +25,9 @@ are given (mechgen generates them); nothing here differentiates numerically.
   the Jacobian is block-bidiagonal plus the boundary rows, factored by SuperLU.
 * :func:`collocate` - ``scipy.integrate.solve_bvp`` (3-stage Lobatto IIIA, 4th order,
   adaptive mesh) fed with the analytic ``fun_jac`` and ``bc_jac``.
-* :class:`Discretisation` (module :mod:`mechgen.runtime.collocation`, re-exported here) -
+* :class:`Discretisation` (module :mod:`mechgen.runtime.steady.collocation`, re-exported here) -
   the same residuals as a square system F(u, lam) = 0 with a sparse Jacobian, lam =
-  p[lam_index] (for :mod:`mechgen.runtime.continuation`): the multiple-shooting residual
+  p[lam_index] (for :mod:`mechgen.runtime.steady.continuation`): the multiple-shooting residual
   above, or collocation on a fixed mesh (Hermite-Simpson, 4th order at the nodes, or
   s-stage Gauss-Legendre, order 2s).
 
@@ -808,4 +808,4 @@ def check_jacobians(problem: BVP, s: float, y, p=None, *, ya=None, yb=None, h: f
     return out
 
 
-from mechgen.runtime.collocation import Discretisation  # noqa: E402  (re-exported: it builds on this module)
+from mechgen.runtime.steady.collocation import Discretisation  # noqa: E402  (re-exported: it builds on this module)

@@ -1,6 +1,6 @@
 """A BVP as a square system F(u, lam) = 0 for continuation: collocation on a fixed mesh, or multiple shooting.
 
-The problem is a :class:`mechgen.runtime.bvp.BVP` (y' = f(s, y, p), g(y(a), y(b), p) = 0,
+The problem is a :class:`mechgen.runtime.steady.bvp.BVP` (y' = f(s, y, p), g(y(a), y(b), p) = 0,
 ``p[unknown]`` solved for); lam = p[lam_index] is the continuation parameter and the other
 parameters stay fixed. Mesh a = s_0 < ... < s_M = b, h_i = s_{i+1} - s_i. Three schemes:
 
@@ -26,10 +26,10 @@ parameters stay fixed. Mesh a = s_0 < ... < s_M = b, h_i = s_{i+1} - s_i. Three 
   arclength of a branch measures the nodes and parameters only (``arclength_weights``).
   The dense output is the collocation polynomial of each interval (order s + 1 uniformly).
 * ``multiple_shooting``: the continuity conditions of the flows between the nodes
-  (mechgen.runtime.bvp.multiple_shoot), u = (Y_0, ..., Y_K, p_u).
+  (mechgen.runtime.steady.bvp.multiple_shoot), u = (Y_0, ..., Y_K, p_u).
 
 The rows are the interval (or continuity) rows, then g, then (gauss) the stage rows; F_u
-is a CSC matrix and F_lam a vector. For :func:`mechgen.runtime.continuation.continuation`
+is a CSC matrix and F_lam a vector. For :func:`mechgen.runtime.steady.continuation.continuation`
 the discretisation also offers ``evaluate(u, lam, jac)`` (the residual alone when ``jac``
 is False, and the last point cached), ``bordered(J, F_lam, row)`` (a solver of the
 bordered Newton system [[F_u, F_lam], [row]] that keeps the sparsity pattern between calls)
@@ -43,7 +43,7 @@ import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
 from mechgen.errors import ConvergenceError, InputError
-from mechgen.runtime.bvp import (BVP, BVPResult, _BudgetSpent, _Failure, _full_p, _ivp_options, _MultipleShooting,
+from mechgen.runtime.steady.bvp import (BVP, BVPResult, _BudgetSpent, _Failure, _full_p, _ivp_options, _MultipleShooting,
                                  _nodes)
 
 METHODS = ("collocation", "gauss", "multiple_shooting")

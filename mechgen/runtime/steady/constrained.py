@@ -33,7 +33,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from mechgen.errors import InputError
-from mechgen.runtime.assemble import element_matrices, element_vectors
+from mechgen.runtime.fields.assemble import element_matrices, element_vectors
 
 
 def linear_about_bvp(system, bvp, result) -> dict:

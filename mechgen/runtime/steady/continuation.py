@@ -28,7 +28,7 @@ fold's lam is accurate to the square of the location error. The branch ends at
 ``max_points`` or where lam leaves [lam_min, lam_max] (the last point is then put exactly
 on the bound).
 
-:func:`continue_bvp` continues a BVP (:class:`mechgen.runtime.bvp.BVP`) in one of its
+:func:`continue_bvp` continues a BVP (:class:`mechgen.runtime.steady.bvp.BVP`) in one of its
 parameters through a collocation or multiple-shooting :class:`Discretisation`;
 :func:`minimize_along_branch` locates an extremum of a scalar output phi(u, lam) along a
 branch as a zero of d phi/ds (exact with the output's gradient, else central differences
@@ -47,7 +47,7 @@ import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
 from mechgen.errors import ConvergenceError, InputError
-from mechgen.runtime.bvp import BVP, BVPResult, Discretisation
+from mechgen.runtime.steady.bvp import BVP, BVPResult, Discretisation
 
 
 @dataclass(frozen=True)
@@ -121,7 +121,7 @@ def _eval(system, u, lam, jac=True):
     """(F, F_u, F_lam) at (u, lam); (F, None, None) without ``jac`` or where F is not finite.
 
     A system with ``evaluate(u, lam, jac)`` and ``bordered(J, F_lam, row)`` (a
-    :class:`~mechgen.runtime.bvp.Discretisation`) gives F_u in its own form, for its own solver."""
+    :class:`~mechgen.runtime.steady.bvp.Discretisation`) gives F_u in its own form, for its own solver."""
     evaluate = _own(system, "evaluate")
     with np.errstate(all="ignore"):
         if evaluate is not None:
@@ -484,7 +484,7 @@ def continue_bvp(problem: BVP, guess: BVPResult, lam_index: int, *, method: str 
                  stages: int | None = None, rtol_ivp: float = 1e-10, ivp_method: str = "DOP853",
                  **options) -> Branch:
     """Continue a BVP in the fixed parameter p[lam_index], starting from ``guess`` (a
-    BVPResult, e.g. from :func:`~mechgen.runtime.bvp.collocate`).
+    BVPResult, e.g. from :func:`~mechgen.runtime.steady.bvp.collocate`).
 
     ``method`` is 'collocation' (Hermite-Simpson on a fixed mesh; ``mesh`` an interval count or
     nodes), 'gauss' (``stages``-point Gauss-Legendre collocation, default 4: order 8) or

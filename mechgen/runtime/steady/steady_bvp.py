@@ -12,7 +12,7 @@ one condition per essential boundary condition of the model (a field or its
 slope at an end; 2n of them). The BVP's parameter vector is the kernels' free
 parameters (so a branch may follow any of them: dF/dp by central differences);
 L is one of them when the length parameter is free. Solved by shooting, multiple shooting or
-collocation (mechgen.runtime.bvp). The solution's jets at any points feed the
+collocation (mechgen.runtime.steady.bvp). The solution's jets at any points feed the
 linearisation about it (FieldSystem.linear(jets=...)): modes and stability of
 the steady state with the model's Galerkin discretisation.
 """
@@ -24,7 +24,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from mechgen.errors import InputError
-from mechgen.runtime.bvp import BVP, BVPResult, collocate, multiple_shoot, shoot
+from mechgen.runtime.steady.bvp import BVP, BVPResult, collocate, multiple_shoot, shoot
 
 METHODS = ("shooting", "multiple_shooting", "collocation")
 
@@ -153,10 +153,10 @@ def steady_bvp(field_system) -> SteadyBVP:
     def accelerations(s_pts, y, p, with_jacobian: bool):
         """u_ss = -H^-1 r(u, u_s, 0) at every point (batched kernels), and optionally
         d u_ss / d y = -H^-1 [r_u, r_us] at that u_ss (prepared kernel calls, the last
-        batches memoised: mechgen.runtime.steady_kernels)."""
+        batches memoised: mechgen.runtime.steady.steady_kernels)."""
         impl = getattr(accelerations, "impl", None)
         if impl is None:
-            from mechgen.runtime.steady_kernels import SteadyAccelerations
+            from mechgen.runtime.steady.steady_kernels import SteadyAccelerations
 
             impl = accelerations.impl = SteadyAccelerations(residual, tangent, n)
         if not with_jacobian:

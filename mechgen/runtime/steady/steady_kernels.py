@@ -11,7 +11,7 @@ first-order density), so at a batch of points
 (the last by the implicit function theorem, r(u, u_s, u_ss(p); s(p), p) = 0; the partial
 derivative in p_j by central differences of the residual alone, with s moving with p when a
 parameter sets the length). The kernels are called through prepared calls
-(:meth:`mechgen.runtime.kernels.Kernel.bind`) on buffers kept per batch size, and the last few
+(:meth:`mechgen.runtime.core.kernels.Kernel.bind`) on buffers kept per batch size, and the last few
 batches are memoised, so f, f_y and f_p at the same points share one evaluation. Non-finite
 kernel values give NaN results (callers test finiteness: a Newton step that leaves the
 physical states is then shortened instead of stopping the run).

@@ -1,0 +1,3 @@
+"""The core of the runtime: loading generated kernels (``kernels``), the compiled lumped and lattice
+system (``system``), sparsity patterns (``pattern``), time integration (``integrate``) and parallel
+parameter sweeps (``sweep``)."""
