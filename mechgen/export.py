@@ -28,7 +28,7 @@ import tempfile
 from dataclasses import replace
 from pathlib import Path
 
-from mechgen import __version__
+from mechgen.version import __version__
 from mechgen.errors import InputError
 
 EXPORT_BACKENDS = ("c", "casadi")

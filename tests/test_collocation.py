@@ -10,7 +10,8 @@ scipy's QZ-free eig of the first-order companion matrix for the gyroscopic eigen
 import numpy as np
 import pytest
 
-from mechgen.runtime.steady.bvp import Discretisation, collocate
+from mechgen.runtime.steady.bvp import collocate
+from mechgen.runtime.steady.collocation import DiscreteBVP
 from mechgen.runtime.steady.continuation import continue_bvp, point_at
 from mechgen.runtime.linear.stability import conservative_gyroscopic, stability
 from test_bvp import MESH, S, _bratu_guess, bratu, bratu_exact, bratu_theta
@@ -18,7 +19,7 @@ from test_continuation import LAM_C
 
 
 def _gauss(M, stages, lam=1.0):
-    return Discretisation(bratu(), 0, [lam], M, method="gauss", stages=stages)
+    return DiscreteBVP(bratu(), 0, [lam], M, method="gauss", stages=stages)
 
 
 @pytest.mark.parametrize("stages", [2, 3, 4])

@@ -19,7 +19,7 @@ from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import REQUIRED, Option
 from mechgen.analyses.whirl import SPARSE_N, whirl_stations
 from mechgen.errors import SceneError
-from mechgen.runtime.linear.campbell import campbell, critical_speeds, fit_speed_polynomial
+from mechgen.runtime.linear.campbell import CampbellOptions, campbell, critical_speeds, fit_speed_polynomial
 from mechgen.scene.values import fail, is_choice, join, param_info, type_name
 
 
@@ -96,8 +96,8 @@ def run_campbell(system, options: dict, context: dict) -> dict:
     # matrices polynomial in the speed (a rotor's G = Omega G1): four assemblies, then sparse adds
     poly = fit_speed_polynomial(assembled, speeds[0], speeds[-1]) if len(speeds) > 4 else None
     matrices_at = assembled_at if poly is None else poly.combined({"M": ("M",), "C": ("D", "G"), "K": ("K",)})
-    res = campbell(matrices_at, speeds, count, x_index=stations[0], y_index=stations[1], sparse=sparse,
-                   method=options.get("method", "auto"))
+    res = campbell(matrices_at, speeds, count, CampbellOptions(sparse=sparse, method=options.get("method", "auto")),
+                   x_index=stations[0], y_index=stations[1])
     crit = critical_speeds(res, options.get("multiples", [1.0]), refine=matrices_at, sparse=sparse)
     freqs = np.asarray(res.frequencies)
     return {"speeds": [float(w) for w in res.speeds], "frequencies": [[float(f) for f in row] for row in freqs],

@@ -56,7 +56,7 @@ from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import REQUIRED, Option
 from mechgen.errors import SceneError
 from mechgen.runtime.steady import branch_scan
-from mechgen.runtime.steady.continuation import minimize_along_branch
+from mechgen.runtime.steady.continuation import ContinuationOptions, minimize_along_branch
 from mechgen.scene.expr import is_identifier
 from mechgen.scene.values import IDENTIFIER_RULE, fail, is_choice, join, listing, param_info, show
 
@@ -201,7 +201,9 @@ def _follow(system, bvp, result, options: dict, aliases: dict):
     index = bvp.params.index(name)
     here, stop = float(result.p[index]), float(options["stop"])
     towards = "increasing" if stop >= here else "decreasing"
-    bound = {"lam_max": stop} if stop >= here else {"lam_min": stop}
+    steps = ContinuationOptions(ds=options.get("step", 0.05),
+                                ds_max=options.get("max_step", max(1.0, abs(stop - here) / 20)),
+                                **({"lam_max": stop} if stop >= here else {"lam_min": stop}))
     bounds = options.get("bounds") or {}
 
     def inside(u, lam, disc):
@@ -216,10 +218,8 @@ def _follow(system, bvp, result, options: dict, aliases: dict):
     return branch_scan.follow(bvp.problem, result, index, direction=options.get("direction", towards),
                               inside=inside if bounds else None,
                               mesh=options.get("mesh", 100), method=options.get("method", "collocation"),
-                              stages=options.get("stages"), ds=options.get("step", 0.05),
-                              ds_max=options.get("max_step", max(1.0, abs(stop - here) / 20)),
-                              max_points=options.get("max_points", 200),
-                              **bound)
+                              stages=options.get("stages"), max_points=options.get("max_points", 200),
+                              options=steps)
 
 
 def _check_names(options: dict, known: dict) -> None:

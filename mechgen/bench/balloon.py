@@ -126,11 +126,13 @@ class Mechgen:
         self._steps: dict = {}
 
     def _continue(self, config, ds, max_points, ds_max=None):
-        from mechgen.runtime.steady.continuation import continue_bvp
+        from mechgen.runtime.steady.continuation import ContinuationOptions, continue_bvp
 
         scheme, stages, mesh = config
+        steps = ContinuationOptions(ds=ds, ds_max=ds if ds_max is None else ds_max, max_points=max_points,
+                                    lam_max=STOP)
         return continue_bvp(self.bvp.problem, self.start, self.index, method=scheme, stages=stages, mesh=mesh,
-                            ds=ds, ds_max=ds if ds_max is None else ds_max, max_points=max_points, lam_max=STOP)
+                            options=steps)
 
     def step(self, config) -> float:
         """The step giving about POINTS points to STOP (from an untimed pilot branch's arclength)."""

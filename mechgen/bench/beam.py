@@ -209,9 +209,9 @@ def _assembly_only(system):
     try:
         disc = system.disc
         na = len(disc.jets)
-        local = system._pointwise("linear", np.zeros(disc.points.shape + (na,)))
+        local = system.pointwise("linear", np.zeros(disc.points.shape + (na,)))
         coeff = {k: np.asarray(local[k]).reshape(disc.points.shape + (na, na)) for k in ("M", "K")}
-    except Exception:  # noqa: BLE001 - private API of continuum.py; the row is simply left out
+    except Exception:  # noqa: BLE001 - a system without pointwise kernels: the row is simply left out
         return None
     pairs = {k: [tuple(ab) for ab in np.argwhere(np.any(c != 0, axis=(0, 1)))] for k, c in coeff.items()}
     asm = system.assembler

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from mechgen import __version__
+from mechgen.version import __version__
 from mechgen.codegen.emit_c import kernel_context
 from mechgen.codegen.escape import c_comment, c_comment_lines
 from mechgen.codegen.ir import Extent, KernelIR, Port

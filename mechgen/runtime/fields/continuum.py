@@ -415,7 +415,9 @@ class FieldSystem:
             raise KernelError(f"{exc} (pointwise kernel of {self.meta.get('model')})") from None
         return {k: v.reshape(shape + (v.shape[-1],)) for k, v in out.items()}
 
-    def _pointwise(self, kernel: str, j, j_t=None, j_tt=None, t: float = 0.0) -> dict:
+    def pointwise(self, kernel: str, j, j_t=None, j_tt=None, t: float = 0.0) -> dict:
+        """The pointwise kernel's outputs at every Gauss point (arrays shaped like the points) from the jets
+        j (and their rates), each segment with its own parameters."""
         disc = self.disc
         segment = disc.mesh.segment if disc.mesh is not None else np.zeros(len(disc.points), int)
         return self._by_segment(kernel, segment, [j, j_t, j_tt], t, disc.points)
@@ -449,14 +451,14 @@ class FieldSystem:
         disc = self.disc
         return [None if x is None else jets_at_points(disc.tables, disc.dofs, x) for x in full]
 
-    def _matrices(self, kernel: str, names, q, v, a, t: float, jets=None) -> dict:
+    def reduced_matrices(self, kernel: str, names, q, v, a, t: float, jets=None) -> dict:
         """Reduced global matrices ``names`` of a tangent-type kernel at the state (q, v, a)."""
         disc = self.disc
         full = self._full((q, v, a))
         j = self._jets_of(full)
         if jets is not None:
             j[0] = np.asarray(jets, float)
-        local = self._pointwise(kernel, *j, t=t)
+        local = self.pointwise(kernel, *j, t=t)
         mats = {}
         for k in names:
             coeff = self._coeff(local[k])
@@ -483,17 +485,17 @@ class FieldSystem:
                              "steady state): small motions only about a boundary-value steady state",
                              key="about", expected="modes or stability 'about' a steady analysis with "
                              "form = 'hamiltonian' (mechgen.runtime.steady.constrained)")
-        return self._matrices("linear", ("M", "D", "G", "K"), q, v, None, t, jets)
+        return self.reduced_matrices("linear", ("M", "D", "G", "K"), q, v, None, t, jets)
 
     def tangent(self, q, v=None, a=None, z=None, t: float = 0.0) -> dict:
         """dr/dq, dr/dq', dr/dq'' (reduced; the penalty term in dr/dq)."""
-        return self._matrices("tangent", ("r_q", "r_v", "r_a"), q, v, a, t)
+        return self.reduced_matrices("tangent", ("r_q", "r_v", "r_a"), q, v, a, t)
 
     def _full_residual(self, full, t: float) -> np.ndarray:
         """sum_e B^T W rho + sum_ends B_at^T rho_at over all dofs (no boundary conditions)."""
         disc = self.disc
         j = self._jets_of(full)
-        rho = self._pointwise("residual", *j, t=t)["r"]
+        rho = self.pointwise("residual", *j, t=t)["r"]
         r = self.assembler.vector(element_vectors(disc.tables, disc.weights, rho))
         for B, loc in self._ends("residual", full, t):
             r = r + B.T @ loc["r"][0]
@@ -582,7 +584,7 @@ class FieldSystem:
         if self.reduction.penalty_rows is None:
             return 0.0
         def alpha() -> float:
-            local = self._pointwise("linear", self._jets(None))
+            local = self.pointwise("linear", self._jets(None))
             ke = element_matrices(self.disc.tables, self.disc.weights, self._coeff(local["K"]))
             K = self.assembler.matrix(ke)
             return PENALTY_FACTOR * max(float(np.abs(K.diagonal()).max()), 1e-300)
@@ -594,7 +596,7 @@ class FieldSystem:
         disc = self.disc
         full = self._full((q, v))
         j = self._jets_of(full)
-        local = self._pointwise("outputs", *j, t=t)
+        local = self.pointwise("outputs", *j, t=t)
         values = {k: float(np.sum(disc.weights * arr[..., 0])) for k, arr in local.items()}
         for _, loc in self._ends("outputs", full + [None], t):
             for k, arr in loc.items():

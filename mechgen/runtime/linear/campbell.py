@@ -44,8 +44,8 @@ import numpy as np
 import scipy.linalg as sla
 
 from mechgen.errors import InputError
-from mechgen.runtime.linear.damped import (DampedModes, _is, _norm, _normalise, _scale, _split, _stations, damped_modes,
-                                    whirl_sign)
+from mechgen.runtime.linear.damped import (DampedModes, damped_modes, frequency_scale, has_symmetry, matrix_norm,
+                                           normalise_columns, split_modes, station_indices, whirl_sign)
 
 #: the automatic choice uses the reduced basis from this many speeds on ...
 REDUCED_MIN_SPEEDS = 5
@@ -124,7 +124,7 @@ def _align(s: np.ndarray, V: np.ndarray, R: np.ndarray, tol: float) -> np.ndarra
             rest = W - Qb @ (Qb.conj().T @ W)
             U = np.linalg.svd(rest, full_matrices=False)[0]
             chosen.extend(U[:, j] for j in range(p - len(chosen)))
-        V[:, J] = _normalise(np.column_stack(chosen))
+        V[:, J] = normalise_columns(np.column_stack(chosen))
     return V
 
 
@@ -229,14 +229,14 @@ def fit_speed_polynomial(evaluate, lo: float, hi: float, *, rtol: float = 1e-12,
     keys = list(at_lo)
     if any(set(d) != set(keys) for d in (at_hi, at_probe)):
         return None
-    scale = {k: max(_norm(d[k]) for d in (at_lo, at_hi, at_probe)) for k in keys}
+    scale = {k: max(matrix_norm(d[k]) for d in (at_lo, at_hi, at_probe)) for k in keys}
 
     def fitted(terms: dict) -> SpeedPolynomial | None:
         for key, coefs in terms.items():
             for k in range(1, len(coefs)):
-                if _norm(coefs[k]) <= 1e-14 * scale[key]:
+                if matrix_norm(coefs[k]) <= 1e-14 * scale[key]:
                     coefs[k] = None
-            if _norm(_evaluate({key: coefs}, probe)[key] - at_probe[key]) > rtol * scale[key]:
+            if matrix_norm(_evaluate({key: coefs}, probe)[key] - at_probe[key]) > rtol * scale[key]:
                 return None
             while coefs[-1] is None and len(coefs) > 1:
                 coefs.pop()
@@ -249,7 +249,7 @@ def fit_speed_polynomial(evaluate, lo: float, hi: float, *, rtol: float = 1e-12,
     at_mid = evaluate(center)
     if set(at_mid) != set(keys):
         return None
-    scale = {k: max(scale[k], _norm(at_mid[k])) for k in keys}
+    scale = {k: max(scale[k], matrix_norm(at_mid[k])) for k in keys}
     return fitted({k: [at_mid[k], 0.5 * (at_hi[k] - at_lo[k]), 0.5 * (at_hi[k] + at_lo[k]) - at_mid[k]]
                    for k in keys})
 
@@ -259,9 +259,9 @@ def fit_speed_polynomial(evaluate, lo: float, hi: float, *, rtol: float = 1e-12,
 
 def _structured(B: np.ndarray, A) -> np.ndarray:
     """B = V^T A V made exactly symmetric (skew) when A is symmetric (skew)."""
-    if _is(A, 1):
+    if has_symmetry(A, 1):
         return 0.5 * (B + B.T)
-    if _is(A, -1):
+    if has_symmetry(A, -1):
         return 0.5 * (B - B.T)
     return B
 
@@ -290,7 +290,8 @@ class ReducedModel:
         self.poly = poly
         self.V = np.zeros((n, 0))
         self.terms: dict = {}
-        kinds = {key: [None if A is None else (1 if _is(A, 1) else -1 if _is(A, -1) else 0) for A in coefs]
+        kinds = {key: [None if A is None else (1 if has_symmetry(A, 1) else -1 if has_symmetry(A, -1) else 0)
+                       for A in coefs]
                  for key, coefs in poly.terms.items()}
         self.conservative = (all(k in (None, 1) for k in kinds["M"]) and all(k in (None, 1) for k in kinds["K"])
                              and all(k in (None, -1) for k in kinds["C"]))
@@ -325,8 +326,8 @@ class ReducedModel:
         dm = _gyroscopic_modes(mats["M"], mats["C"], mats["K"], min(m, self.size)) if self.conservative else None
         if dm is None:
             dm = damped_modes(mats["M"], mats["C"], mats["K"], min(m, self.size), sparse=False)
-        return dataclasses.replace(dm, shapes=_normalise(self.V @ dm.shapes),
-                                   real_shapes=_normalise(self.V @ dm.real_shapes).real)
+        return dataclasses.replace(dm, shapes=normalise_columns(self.V @ dm.shapes),
+                                   real_shapes=normalise_columns(self.V @ dm.real_shapes).real)
 
     def accepted(self, eta: np.ndarray, residual_tol: float) -> np.ndarray:
         """True where the backward error promises an eigenvalue to about ``residual_tol`` relative."""
@@ -356,7 +357,7 @@ def _gyroscopic_modes(M: np.ndarray, G: np.ndarray, K: np.ndarray, count: int) -
     # eigenvalues +-mu in pairs, ascending: the count smallest positive ones are r .. r + count - 1
     mu, W = sla.eigh(1j * H, driver="evx", subset_by_index=[r, r + min(count, r) - 1])
     X = sla.solve_triangular(LK.T, W[r:], lower=False)
-    return _split(1j * mu, X, count, _scale(M, G, K), 1e-6)
+    return split_modes(1j * mu, X, count, frequency_scale(M, G, K), 1e-6)
 
 
 # ------------------------------------------------------------------------------------------- tracking
@@ -405,14 +406,52 @@ def _check_method(method: str) -> None:
         raise InputError(f"method is {method!r}", key="method", expected="'auto', 'exact' or 'reduced'")
 
 
-def campbell(matrices_at, speeds, count: int, *, x_index, y_index, sparse: bool | None = None,
-             spare: int | None = None, sigma: float | None = None, freq_weight: float = 1.0,
-             cluster_tol: float = 1e-6, planar_tol: float = 1e-6, method: str = "auto",
-             residual_tol: float = 1e-9, mac_min: float = 0.8) -> CampbellResult:
+@dataclass(frozen=True)
+class CampbellOptions:
+    """The solver and tracking options of :func:`campbell` (the defaults are its defaults).
+
+    Attributes:
+        sparse: the eigensolver per speed (None: ARPACK for sparse input above SPARSE_MIN_N dofs, see
+            :func:`~mechgen.runtime.linear.damped.damped_modes`; True/False force it).
+        spare: extra modes per speed so that curves may reorder between speeds (None: max(2, count // 2)).
+        sigma: the sparse path's real shift (None: chosen from M and K).
+        freq_weight: weight of the frequency distance against the shape distance (MAC) in the tracking.
+        cluster_tol: relative frequency gap under which modes count as one degenerate cluster (aligned
+            within it instead of matched one by one).
+        planar_tol: an orbit whose minor/major axis ratio is below this is planar (its whirl is taken
+            from its neighbours).
+        method: 'exact', 'reduced' or 'auto' (see :func:`campbell`).
+        residual_tol: the largest backward error eta of a reduced speed's tracked modes.
+        mac_min: the smallest MAC of a curve to the previous speed that a reduced speed may have.
+    """
+
+    sparse: bool | None = None
+    spare: int | None = None
+    sigma: float | None = None
+    freq_weight: float = 1.0
+    cluster_tol: float = 1e-6
+    planar_tol: float = 1e-6
+    method: str = "auto"
+    residual_tol: float = 1e-9
+    mac_min: float = 0.8
+
+    @classmethod
+    def of(cls, options: "CampbellOptions | None" = None, **overrides) -> "CampbellOptions":
+        """``options`` (the defaults when None) with ``overrides`` replaced; TypeError on an unknown name."""
+        unknown = sorted(set(overrides) - {f.name for f in dataclasses.fields(cls)})
+        if unknown:
+            raise TypeError(f"campbell got unexpected keyword argument(s) {', '.join(map(repr, unknown))}")
+        return dataclasses.replace(options if options is not None else cls(), **overrides)
+
+
+def campbell(matrices_at, speeds, count: int, options: CampbellOptions | None = None, *, x_index, y_index,
+             **overrides) -> CampbellResult:
     """Track the ``count`` lowest damped modes (at the first speed) over increasing ``speeds``.
 
     ``matrices_at(speed)`` returns ``dict(M=..., C=..., K=...)`` (the caller forms C = D + G(speed));
     ``x_index``, ``y_index`` name the lateral dofs of the stations used for the whirl labels.
+    ``options`` (a :class:`CampbellOptions`, its defaults when None) choose the solver and the
+    tracking; keyword ``overrides`` replace single options (``campbell(..., sparse=True)``).
     ``spare`` extra modes per speed (default max(2, count // 2)) let curves reorder between speeds.
 
     ``method``: 'exact' solves the full problem at every speed; 'reduced' uses the reduced basis (module
@@ -422,6 +461,10 @@ def campbell(matrices_at, speeds, count: int, *, x_index, y_index, sparse: bool 
     ``residual_tol`` (for a conservative gyroscopic system, whose reduced eigenvalues err by about
     eta^2: when 1e3 eta^2 is) and no curve's MAC to the previous speed is below ``mac_min``.
     """
+    opts = CampbellOptions.of(options, **overrides)
+    sparse, spare, sigma, freq_weight = opts.sparse, opts.spare, opts.sigma, opts.freq_weight
+    cluster_tol, planar_tol, method = opts.cluster_tol, opts.planar_tol, opts.method
+    residual_tol, mac_min = opts.residual_tol, opts.mac_min
     _check_method(method)
     speeds = np.asarray(speeds, dtype=float)
     if speeds.ndim != 1 or speeds.size == 0 or not np.all(np.isfinite(speeds)):
@@ -441,7 +484,7 @@ def campbell(matrices_at, speeds, count: int, *, x_index, y_index, sparse: bool 
     if count > n:
         raise InputError(f"count {count} is larger than the {n} modes a system of {n} degrees of freedom has",
                          key="count", expected=f"at most {n}")
-    _stations(x_index, y_index, n)
+    station_indices(x_index, y_index, n)
     m = min(count + int(spare), n)
     S = len(speeds)
     poly = matrices_at if isinstance(matrices_at, SpeedPolynomial) else None

@@ -116,13 +116,14 @@ def _check_count(count, n: int) -> int | None:
     return int(count)
 
 
-def _norm(X) -> float:
+def matrix_norm(X) -> float:
+    """The Frobenius norm ||X||_F of a dense or sparse matrix."""
     return float(spla.norm(X) if sps.issparse(X) else np.linalg.norm(X))
 
 
-def _scale(M, C, K) -> float:
+def frequency_scale(M, C, K) -> float:
     """sqrt(||K|| / ||M||) (Frobenius); ||C|| / ||M|| when K = 0; 1 when nothing sets a scale."""
-    nm, nk, nc = _norm(M), _norm(K), _norm(C)
+    nm, nk, nc = matrix_norm(M), matrix_norm(K), matrix_norm(C)
     if nm > 0 and nk > 0:
         return float(np.sqrt(nk / nm))
     if nm > 0 and nc > 0:
@@ -133,7 +134,7 @@ def _scale(M, C, K) -> float:
 # -------------------------------------------------------------------------------------------- solvers
 
 
-def _normalise(Q: np.ndarray) -> np.ndarray:
+def normalise_columns(Q: np.ndarray) -> np.ndarray:
     """Columns divided by their largest component (the first within 1e-9 of the largest |.|)."""
     Q = np.array(Q, dtype=complex)
     if Q.size == 0:
@@ -205,7 +206,7 @@ def _sparse_eig(M, C, K, n: int, count: int, sigma: float, scale: float, imag_to
         k = min(2 * k, N - 2)
 
 
-def _is(A, sign: int, tol: float = 1e-12) -> bool:
+def has_symmetry(A, sign: int, tol: float = 1e-12) -> bool:
     """True when A = sign A^T to ``tol`` relative (sparse or dense; a zero matrix is both)."""
     return bool(abs(A - sign * A.T).max() <= tol * max(abs(A).max(), 1e-300))
 
@@ -231,7 +232,10 @@ def _rayleigh_refined(M, C, K, s: np.ndarray, Q: np.ndarray) -> np.ndarray:
     return out
 
 
-def _split(s: np.ndarray, Q: np.ndarray, count: int | None, scale: float, imag_tol: float) -> DampedModes:
+def split_modes(s: np.ndarray, Q: np.ndarray, count: int | None, scale: float, imag_tol: float) -> DampedModes:
+    """Eigenpairs (s, Q) sorted into :class:`DampedModes`: oscillating ones (Im s > imag_tol * scale) by
+    wd = Im s (the first ``count`` kept), real ones (|Im s| <= imag_tol * scale) by |s|, columns
+    normalised (:func:`normalise_columns`); the conjugates (Im s < 0) are dropped."""
     tol = imag_tol * scale
     osc = s.imag > tol
     real = np.abs(s.imag) <= tol
@@ -239,10 +243,10 @@ def _split(s: np.ndarray, Q: np.ndarray, count: int | None, scale: float, imag_t
     order = np.lexsort((so.real, so.imag))
     if count is not None:
         order = order[:count]
-    so, Qo = so[order], _normalise(Qo[:, order])
+    so, Qo = so[order], normalise_columns(Qo[:, order])
     sr, Qr = s[real].real, Q[:, real]
     order = np.argsort(np.abs(sr), kind="stable")
-    sr, Qr = sr[order], _normalise(Qr[:, order]).real
+    sr, Qr = sr[order], normalise_columns(Qr[:, order]).real
     wd, wn = so.imag, np.abs(so)
     zeta = -so.real / np.where(wn > 0, wn, 1.0)
     log_dec = -2.0 * np.pi * so.real / wd + 0.0  # + 0.0: no -0.0 for undamped modes
@@ -268,23 +272,24 @@ def damped_modes(M, C, K, count: int | None = None, *, sparse: bool | None = Non
     use_sparse = (anysparse and count is not None and n > SPARSE_MIN_N) if sparse is None else bool(sparse)
     if use_sparse and 2 * count >= 2 * n - 2:
         use_sparse = False  # ARPACK needs k < N - 1; a problem this small is solved densely
-    scale = _scale(M, C, K)
+    scale = frequency_scale(M, C, K)
     if use_sparse:
         if sigma is None:
             sigma = _default_sigma(M, K)
         s, Q = _sparse_eig(M, C, K, n, count, float(sigma), scale, imag_tol)
-        if _is(C, -1) and _is(M, 1) and _is(K, 1):
+        if has_symmetry(C, -1) and has_symmetry(M, 1) and has_symmetry(K, 1):
             s = _rayleigh_refined(M, C, K, s, Q)
     else:
         dense = [x.toarray() if sps.issparse(x) else x for x in (M, C, K)]
         s, Q = _dense_eig(*dense, n, scale)
-    return _split(s, Q, count, scale, imag_tol)
+    return split_modes(s, Q, count, scale, imag_tol)
 
 
 # ---------------------------------------------------------------------------------------------- whirl
 
 
-def _stations(x_index, y_index, n: int) -> tuple[np.ndarray, np.ndarray]:
+def station_indices(x_index, y_index, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The x and y dof indices of the stations as equal-length integer arrays in [0, n) (InputError otherwise)."""
     xi = np.atleast_1d(np.asarray(x_index))
     yi = np.atleast_1d(np.asarray(y_index))
     if xi.ndim != 1 or yi.ndim != 1 or xi.shape != yi.shape or xi.size == 0:
@@ -304,7 +309,7 @@ def _orbits(shapes, x_index, y_index):
     Q = np.asarray(shapes, dtype=complex)
     if Q.ndim == 1:
         Q = Q[:, None]
-    xi, yi = _stations(x_index, y_index, Q.shape[0])
+    xi, yi = station_indices(x_index, y_index, Q.shape[0])
     X, Y = Q[xi], Q[yi]                         # stations x modes
     P = np.imag(X * np.conj(Y))
     S = np.abs(X) ** 2 + np.abs(Y) ** 2

@@ -26,7 +26,7 @@ import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
 from mechgen.errors import ConvergenceError, InputError
-from mechgen.runtime.steady.continuation import Branch, continue_bvp
+from mechgen.runtime.steady.continuation import Branch, ContinuationOptions, continue_bvp
 
 DIRECTIONS = ("increasing", "decreasing", "both")
 
@@ -62,15 +62,18 @@ def _truncate(branch: Branch, keep: int) -> Branch:
                    folds=tuple(f for f in branch.folds if f.index + 1 < keep))
 
 
-def _one_way(problem, guess, index, direction: int, inside, *, chunk: int, max_points: int, mesh, **options):
+def _one_way(problem, guess, index, direction: int, inside, *, chunk: int, max_points: int, mesh,
+             options: ContinuationOptions, **discretisation):
     """The branch from ``guess`` in one direction, ended where ``inside`` fails (then in chunks)."""
     if inside is None:
-        return continue_bvp(problem, guess, index, mesh=mesh, direction=direction, max_points=max_points,
-                            **options)
+        return continue_bvp(problem, guess, index, mesh=mesh, options=replace(options, direction=direction,
+                                                                              max_points=max_points),
+                            **discretisation)
     pieces, total, start = [], 1, guess
     while True:
         size = min(chunk, max_points - total + 1)
-        piece = continue_bvp(problem, start, index, mesh=mesh, direction=direction, max_points=size, **options)
+        piece = continue_bvp(problem, start, index, mesh=mesh,
+                             options=replace(options, direction=direction, max_points=size), **discretisation)
         outside = next((j for j in range(1, len(piece.lam)) if not inside(piece.u[j], piece.lam[j], piece.system)),
                        None)
         if outside is not None:
@@ -82,7 +85,7 @@ def _one_way(problem, guess, index, direction: int, inside, *, chunk: int, max_p
             return _join(pieces, piece.status, piece.message)
         start = piece.system.to_result(piece.u[-1], piece.lam[-1])
         direction = _sign(piece.tangents[-1][-1], direction)
-        options["ds"] = float(piece.arclength[-1] - piece.arclength[-2])
+        options = replace(options, ds=float(piece.arclength[-1] - piece.arclength[-2]))
 
 
 def _reverse(branch: Branch) -> Branch:
@@ -94,19 +97,25 @@ def _reverse(branch: Branch) -> Branch:
 
 
 def follow(problem, guess, index: int, *, direction: str = "increasing", inside=None, chunk: int = 20,
-           max_points: int = 200, mesh=100, **options) -> Branch:
+           max_points: int = 200, mesh=100, options: ContinuationOptions | None = None, **extra) -> Branch:
     """The branch of ``problem`` through ``guess`` (a BVPResult) in the parameter p[index].
 
     ``direction``: 'increasing' or 'decreasing' (the parameter's direction at the start) or
     'both' (the two half-branches, ``max_points`` each, joined: the start is then an inner point).
     ``inside(u, lam, system) -> bool`` ends the branch where it turns false (status 'bounds').
-    ``options`` go to :func:`~mechgen.runtime.steady.continuation.continuation` (ds, lam_min, lam_max ...).
+    ``options`` (:class:`~mechgen.runtime.steady.continuation.ContinuationOptions`: ds, lam_min,
+    lam_max ...; direction and max_points are set here) go to the continuation; in ``extra``,
+    single options override them and the rest (method, stages, ...) go to
+    :func:`~mechgen.runtime.steady.continuation.continue_bvp`.
     """
     if direction not in DIRECTIONS:
         raise InputError(f"unknown branch direction {direction!r}", key="direction", expected=", ".join(DIRECTIONS))
+    names = ContinuationOptions.names()
+    options = ContinuationOptions.of(options, **{k: v for k, v in extra.items() if k in names})
+    discretisation = {k: v for k, v in extra.items() if k not in names}
     ways = {"increasing": (1,), "decreasing": (-1,), "both": (-1, 1)}[direction]
     halves = [_one_way(problem, guess, index, d, inside, chunk=chunk, max_points=max_points, mesh=mesh,
-                       **dict(options)) for d in ways]
+                       options=options, **discretisation) for d in ways]
     if len(halves) == 1:
         return halves[0]
     down, up = halves

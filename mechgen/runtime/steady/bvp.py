@@ -25,7 +25,7 @@ are given (mechgen generates them); nothing here differentiates numerically.
   the Jacobian is block-bidiagonal plus the boundary rows, factored by SuperLU.
 * :func:`collocate` - ``scipy.integrate.solve_bvp`` (3-stage Lobatto IIIA, 4th order,
   adaptive mesh) fed with the analytic ``fun_jac`` and ``bc_jac``.
-* :class:`Discretisation` (module :mod:`mechgen.runtime.steady.collocation`, re-exported here) -
+* :class:`~mechgen.runtime.steady.collocation.DiscreteBVP` (which builds on this module) -
   the same residuals as a square system F(u, lam) = 0 with a sparse Jacobian, lam =
   p[lam_index] (for :mod:`mechgen.runtime.steady.continuation`): the multiple-shooting residual
   above, or collocation on a fixed mesh (Hermite-Simpson, 4th order at the nodes, or
@@ -55,7 +55,7 @@ import scipy.sparse.linalg as spla
 
 from mechgen.errors import ConvergenceError, InputError
 
-__all__ = ["BVP", "BVPResult", "Discretisation", "IVP_METHODS", "check_jacobians", "collocate", "multiple_shoot",
+__all__ = ["BVP", "BVPResult", "IVP_METHODS", "check_jacobians", "collocate", "multiple_shoot",
            "on_unit_interval", "shoot"]
 
 IVP_METHODS = ("DOP853", "Radau", "RK45", "BDF", "LSODA")
@@ -223,7 +223,8 @@ class BVP:
                                  expected=f"shape {shape}")
 
 
-def _full_p(problem: BVP, p) -> np.ndarray:
+def full_parameters(problem: BVP, p) -> np.ndarray:
+    """A copy of the parameter vector p as ``(n_p,)`` finite floats (empty when n_p = 0); InputError otherwise."""
     if problem.n_p == 0:
         if p is not None and np.size(p) != 0:
             raise InputError(f"{problem.name}: parameters given but the problem has n_p = 0", key="p",
@@ -288,11 +289,11 @@ class _PiecewiseDense:
 
 
 # ----------------------------------------------------------------------------- integration
-class _Failure(Exception):
+class IVPFailure(Exception):
     """The residual cannot be evaluated (an initial value problem blew up or stopped)."""
 
 
-class _BudgetSpent(Exception):
+class BudgetSpent(Exception):
     """The solve used up its right-hand side evaluations (``max_nfev``)."""
 
 
@@ -313,9 +314,9 @@ def _flow(problem: BVP, s0, s1, y0, p, cols, *, rtol, atol, method, budget, blow
     def guard(out):
         budget.used += 1
         if budget.used > budget.limit:
-            raise _BudgetSpent()
+            raise BudgetSpent()
         if not np.isfinite(out).all():
-            raise _Failure("the right-hand side overflowed (NaN or Inf)")
+            raise IVPFailure("the right-hand side overflowed (NaN or Inf)")
         return out
 
     f, f_y, f_p = problem.f, problem.f_y, problem.f_p
@@ -345,7 +346,7 @@ def _flow(problem: BVP, s0, s1, y0, p, cols, *, rtol, atol, method, budget, blow
             Z = z.reshape(n, ncol, order="F")
             y = Z[:, 0]
             if np.abs(y).max() > blowup:
-                raise _Failure("the trajectory overflowed (|y| beyond %.0e)" % blowup)
+                raise IVPFailure("the trajectory overflowed (|y| beyond %.0e)" % blowup)
             fy = fy1(s, y)
             out = np.empty_like(Z)
             out[:, 0] = f1(s, y)
@@ -366,7 +367,7 @@ def _flow(problem: BVP, s0, s1, y0, p, cols, *, rtol, atol, method, budget, blow
     else:
         def rhs(s, y):
             if np.abs(y).max() > blowup:
-                raise _Failure("the trajectory overflowed (|y| beyond %.0e)" % blowup)
+                raise IVPFailure("the trajectory overflowed (|y| beyond %.0e)" % blowup)
             return guard(f1(s, y))
 
         def jac(s, y):
@@ -381,19 +382,21 @@ def _flow(problem: BVP, s0, s1, y0, p, cols, *, rtol, atol, method, budget, blow
 
             sol = solve_ivp(rhs, (s0, s1), z0, method=method, rtol=rtol, atol=atol, dense_output=dense, **kwargs)
     except (ValueError, np.linalg.LinAlgError, ZeroDivisionError, OverflowError) as exc:
-        raise _Failure(f"the integrator failed ({exc})") from exc
+        raise IVPFailure(f"the integrator failed ({exc})") from exc
     if sol.status != 0:
-        raise _Failure(f"the integrator stopped at s = {sol.t[-1]:.6g} ({sol.message})")
+        raise IVPFailure(f"the integrator stopped at s = {sol.t[-1]:.6g} ({sol.message})")
     z1 = sol.y[:, -1]
     if not np.all(np.isfinite(z1)):
-        raise _Failure("the trajectory is not finite")
+        raise IVPFailure("the trajectory is not finite")
     if not var:
         return z1, None, None, sol
     Z1 = z1.reshape(n, ncol, order="F")
     return Z1[:, 0], Z1[:, 1:1 + n], Z1[:, 1 + n:], sol
 
 
-def _ivp_options(problem, rtol_ivp, atol_ivp, ivp_method, max_nfev, blowup):
+def ivp_options(problem, rtol_ivp, atol_ivp, ivp_method, max_nfev, blowup):
+    """The checked keyword options of every flow of one solve (rtol, atol = rtol_ivp / 100 unless given,
+    method, a shared budget of ``max_nfev`` right-hand side evaluations, blowup); InputError when bad."""
     if ivp_method not in IVP_METHODS:
         raise InputError(f"{problem.name}: unknown integrator {ivp_method!r}", key="ivp_method",
                          expected=f"one of {IVP_METHODS}")
@@ -437,10 +440,10 @@ class _Singular(Exception):
 
 
 def _damped_newton(evaluate, x0, *, solve, tol, max_iter, method):
-    """Newton with backtracking on ||R||_2; ``evaluate(x)`` returns (R, J) or raises _Failure."""
+    """Newton with backtracking on ||R||_2; ``evaluate(x)`` returns (R, J) or raises IVPFailure."""
     try:
         return _newton_loop(evaluate, x0, solve=solve, tol=tol, max_iter=max_iter, method=method)
-    except _BudgetSpent:
+    except BudgetSpent:
         raise ConvergenceError(f"{method}: the budget of right-hand side evaluations (max_nfev) is spent; the "
                                "integrations are too costly (stiff? try ivp_method='Radau') or diverge") from None
 
@@ -449,7 +452,7 @@ def _newton_loop(evaluate, x0, *, solve, tol, max_iter, method):
     x = np.array(x0, float)
     try:
         r, J = evaluate(x)
-    except _Failure as exc:
+    except IVPFailure as exc:
         raise ConvergenceError(f"{method}: the residual cannot be evaluated at the initial guess: {exc}. "
                                "A better guess, or multiple shooting / collocation, is needed") from None
     norm = float(np.linalg.norm(r))
@@ -475,7 +478,7 @@ def _newton_loop(evaluate, x0, *, solve, tol, max_iter, method):
             try:
                 r_t, J_t = evaluate(trial)
                 n_t = float(np.linalg.norm(r_t))
-            except _Failure as exc:
+            except IVPFailure as exc:
                 n_t, why = np.inf, str(exc)
             if n_t <= (1.0 - 1e-4 * alpha) * norm:
                 break
@@ -505,10 +508,10 @@ def shoot(problem: BVP, guess, *, p=None, tol: float = 1e-10, max_iter: int = 40
     if isinstance(guess, BVPResult):
         p = guess.p if p is None else p
         guess = guess.y[:, 0]
-    p = _full_p(problem, p)
+    p = full_parameters(problem, p)
     y0 = _state(problem, guess, "guess")
     problem.check(y0, p)
-    opts = _ivp_options(problem, rtol_ivp, atol_ivp, ivp_method, max_nfev, blowup)
+    opts = ivp_options(problem, rtol_ivp, atol_ivp, ivp_method, max_nfev, blowup)
     n, unk = problem.n, list(problem.unknown)
     a, b = problem.interval
 
@@ -524,7 +527,7 @@ def shoot(problem: BVP, guess, *, p=None, tol: float = 1e-10, max_iter: int = 40
         Ga, Gb, Gp = problem.bc_jac(ya, yb, q)
         J = np.hstack([Ga + Gb @ Phi, Gb @ Psi + Gp[:, unk]])
         if not (np.all(np.isfinite(R)) and np.all(np.isfinite(J))):
-            raise _Failure("the boundary residual or its Jacobian is not finite")
+            raise IVPFailure("the boundary residual or its Jacobian is not finite")
         return R, J
 
     x0 = np.concatenate([y0, p[unk]])
@@ -534,14 +537,15 @@ def shoot(problem: BVP, guess, *, p=None, tol: float = 1e-10, max_iter: int = 40
     opts["budget"].used = 0
     try:
         _, _, _, sol = _flow(problem, a, b, ya, q, None, dense=True, **opts)
-    except (_Failure, _BudgetSpent) as exc:  # pragma: no cover - the same trajectory just succeeded
+    except (IVPFailure, BudgetSpent) as exc:  # pragma: no cover - the same trajectory just succeeded
         raise ConvergenceError(f"single shooting: the final trajectory failed: {exc}") from None
     dense = sol.sol
     return BVPResult(sol.t, sol.y, q, norm, it, "single shooting", dense)
 
 
 # ----------------------------------------------------------------------------- multiple shooting
-def _nodes(problem: BVP, nodes) -> np.ndarray:
+def mesh_nodes(problem: BVP, nodes) -> np.ndarray:
+    """Nodes a = s_0 < ... < s_K = b from an interval count (uniform) or increasing nodes (ends snapped to a, b)."""
     a, b = problem.interval
     if isinstance(nodes, (int, np.integer)):
         if nodes < 1:
@@ -571,7 +575,7 @@ def _interp_guess(problem: BVP, mesh, values, at) -> np.ndarray:
     return np.stack([np.interp(at, mesh, values[i]) for i in range(problem.n)])
 
 
-class _MultipleShooting:
+class ShootingResidual:
     """R(x) and its sparse Jacobian for x = (Y_0, ..., Y_K, p[unknown]) (rows: continuity, then g)."""
 
     def __init__(self, problem: BVP, nodes, opts):
@@ -613,7 +617,7 @@ class _MultipleShooting:
                 dpar[j * n:(j + 1) * n] = Psi
         R[K * n:] = prob.bc(Y[:, 0], Y[:, K], q)
         if not np.all(np.isfinite(R)):
-            raise _Failure("the boundary residual is not finite")
+            raise IVPFailure("the boundary residual is not finite")
         if not jac:
             return R, None, None
         k = len(unk)
@@ -634,7 +638,7 @@ class _MultipleShooting:
         J = sps.csc_matrix((np.concatenate(data), (np.concatenate(rows), np.concatenate(colz))),
                            shape=(self.size, self.size))
         if not np.all(np.isfinite(J.data)):
-            raise _Failure("the Jacobian is not finite")
+            raise IVPFailure("the Jacobian is not finite")
         dpar[K * n:] = Gp[:, cols]
         return R, J, dpar[:, k:]
 
@@ -660,12 +664,12 @@ def multiple_shoot(problem: BVP, guess_mesh, guess_values, *, p=None, nodes=10, 
     interpolated linearly to the nodes; ``p`` as for :func:`shoot`. Newton with line
     search on the node values and unknown parameters until ||R||_2 <= tol.
     """
-    p = _full_p(problem, p)
-    s_nodes = _nodes(problem, nodes)
+    p = full_parameters(problem, p)
+    s_nodes = mesh_nodes(problem, nodes)
     Y0 = _interp_guess(problem, guess_mesh, guess_values, s_nodes)
     problem.check(Y0[:, 0], p)
-    opts = _ivp_options(problem, rtol_ivp, atol_ivp, ivp_method, max_nfev, blowup)
-    ms = _MultipleShooting(problem, s_nodes, opts)
+    opts = ivp_options(problem, rtol_ivp, atol_ivp, ivp_method, max_nfev, blowup)
+    ms = ShootingResidual(problem, s_nodes, opts)
     x0 = np.concatenate([Y0.T.ravel(), p[list(problem.unknown)]])
 
     def evaluate(x):
@@ -677,7 +681,7 @@ def multiple_shoot(problem: BVP, guess_mesh, guess_values, *, p=None, nodes=10, 
     opts["budget"].used = 0
     try:
         s, y, dense, q = ms.dense(x, p)
-    except (_Failure, _BudgetSpent) as exc:  # pragma: no cover
+    except (IVPFailure, BudgetSpent) as exc:  # pragma: no cover
         raise ConvergenceError(f"{method}: the final trajectory failed: {exc}") from None
     return BVPResult(s, y, q, norm, it, "multiple shooting", dense)
 
@@ -691,7 +695,7 @@ def collocate(problem: BVP, mesh, guess, *, p=None, tol: float = 1e-8, bc_tol: f
     solve_bvp's relative collocation-residual tolerance (it refines the mesh until met),
     ``bc_tol`` the boundary-residual tolerance (default ``tol``).
     """
-    p = _full_p(problem, p)
+    p = full_parameters(problem, p)
     mesh = np.asarray(mesh, float).ravel()
     a, b = problem.interval
     Y = _interp_guess(problem, mesh, guess, mesh)
@@ -780,7 +784,7 @@ def on_unit_interval(problem: BVP, length_index: int, *, autonomous: bool = Fals
 def check_jacobians(problem: BVP, s: float, y, p=None, *, ya=None, yb=None, h: float = 1e-6) -> dict:
     """Largest relative error of each supplied Jacobian against central differences at one
     point (a debugging aid for generated kernels; the solvers never difference)."""
-    p = _full_p(problem, p)
+    p = full_parameters(problem, p)
     y = _state(problem, y, "y")
     ya = y if ya is None else _state(problem, ya, "ya")
     yb = y if yb is None else _state(problem, yb, "yb")
@@ -807,5 +811,3 @@ def check_jacobians(problem: BVP, s: float, y, p=None, *, ya=None, yb=None, h: f
         out["g_p"] = rel(Gp, fd(lambda v: problem.bc(ya, yb, v), p))
     return out
 
-
-from mechgen.runtime.steady.collocation import Discretisation  # noqa: E402  (re-exported: it builds on this module)

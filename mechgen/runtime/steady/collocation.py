@@ -43,8 +43,8 @@ import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
 from mechgen.errors import ConvergenceError, InputError
-from mechgen.runtime.steady.bvp import (BVP, BVPResult, _BudgetSpent, _Failure, _full_p, _ivp_options, _MultipleShooting,
-                                 _nodes)
+from mechgen.runtime.steady.bvp import (BVP, BVPResult, BudgetSpent, IVPFailure, ShootingResidual, full_parameters,
+                                        ivp_options, mesh_nodes)
 
 METHODS = ("collocation", "gauss", "multiple_shooting")
 
@@ -113,7 +113,7 @@ class _Blocks:
         self.__dict__.update(kw)
 
 
-class Discretisation:
+class DiscreteBVP:
     """A BVP discretised as F(u, lam) = 0, lam = p[lam_index] (see the module doc).
 
     ``method``: 'collocation' (Hermite-Simpson), 'gauss' (``stages`` Gauss-Legendre points per
@@ -128,14 +128,14 @@ class Discretisation:
             raise InputError(f"{problem.name}: unknown discretisation {method!r}", key="method",
                              expected="'collocation', 'gauss' or 'multiple_shooting'")
         self.problem, self.method = problem, method
-        self.p = _full_p(problem, p)
+        self.p = full_parameters(problem, p)
         if not (isinstance(lam_index, (int, np.integer)) and 0 <= lam_index < problem.n_p) \
                 or lam_index in problem.unknown:
             raise InputError(f"{problem.name}: lam_index = {lam_index!r} (unknown parameters: "
                              f"{list(problem.unknown)}, n_p = {problem.n_p})", key="lam_index",
                              expected="the index of a fixed parameter")
         self.lam_index = int(lam_index)
-        self.mesh = _nodes(problem, mesh)
+        self.mesh = mesh_nodes(problem, mesh)
         n, M, k = problem.n, len(self.mesh) - 1, problem.k
         self.stages = 0
         if method == "gauss":
@@ -153,8 +153,8 @@ class Discretisation:
         self.unk = list(problem.unknown)
         self.cols = self.unk + [self.lam_index]  # the parameter columns of f_p the Newton systems need
         if method == "multiple_shooting":
-            opts = _ivp_options(problem, rtol_ivp, atol_ivp, ivp_method, max_nfev, blowup)
-            self._ms = _MultipleShooting(problem, self.mesh, opts)
+            opts = ivp_options(problem, rtol_ivp, atol_ivp, ivp_method, max_nfev, blowup)
+            self._ms = ShootingResidual(problem, self.mesh, opts)
         else:
             self._plain = _Pattern(n, M, k, bordered=False)
             self._border = _Pattern(n, M, k, bordered=True)
@@ -170,7 +170,7 @@ class Discretisation:
         """u from node values Y (n, M + 1), the parameter vector (default: the fixed one) and, for Gauss
         collocation, the stage values (M, s, n) (default: Y interpolated linearly)."""
         Y = np.asarray(Y, float)
-        q = self.p if p is None else _full_p(self.problem, p)
+        q = self.p if p is None else full_parameters(self.problem, p)
         if Y.shape != (self.problem.n, len(self.mesh)):
             raise InputError(f"{self.name}: node values of shape {Y.shape}", key="Y",
                              expected=f"shape ({self.problem.n}, {len(self.mesh)})")
@@ -192,7 +192,7 @@ class Discretisation:
         """(u0, lam0) from a solution (or guess) given as a BVPResult (its dense output at the mesh and stages)."""
         n = self.problem.n
         Y = np.asarray(guess.sol(self.mesh), float).reshape(n, -1)
-        self.problem.check(Y[:, 0], _full_p(self.problem, guess.p))
+        self.problem.check(Y[:, 0], full_parameters(self.problem, guess.p))
         stages = None
         if self.n_stages:
             M = len(self.mesh) - 1
@@ -247,7 +247,7 @@ class Discretisation:
         try:
             R, J, dl = self._ms.evaluate(np.asarray(u, float), q, extra_cols=[self.lam_index])
             cache.update(F=R, J=J, Fl=dl[:, 0])
-        except (_Failure, _BudgetSpent):
+        except (IVPFailure, BudgetSpent):
             nan = np.full(self.n_unknowns, np.nan)
             cache.update(F=nan, J=None, Fl=nan)
 
@@ -429,7 +429,7 @@ class Discretisation:
             try:
                 self._ms.opts["budget"].used = 0
                 s, y, dense, _ = self._ms.dense(np.asarray(u, float), q)
-            except (_Failure, _BudgetSpent) as exc:
+            except (IVPFailure, BudgetSpent) as exc:
                 raise ConvergenceError(f"{self.name}: the trajectory through this point fails: {exc}") from None
             return BVPResult(s, y, q, residual_norm, iterations, "multiple shooting", dense)
         if self.method == "gauss":

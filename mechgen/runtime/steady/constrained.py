@@ -76,9 +76,9 @@ def constrained_linear(system, bvp, result, jets: np.ndarray, multipliers: int |
     if red.multiplier_rows is not None:
         raise InputError("constrained continua take their boundary conditions by elimination or penalty",
                          key="constraints", expected="constraints = 'eliminate' or 'penalty'")
-    mats = system._matrices("linear", ("M", "D", "G", "K"), None, None, None, 0.0, jets)
+    mats = system.reduced_matrices("linear", ("M", "D", "G", "K"), None, None, None, 0.0, jets)
     dense = {k: v.toarray() if hasattr(v, "toarray") else np.asarray(v) for k, v in mats.items()}
-    local = system._pointwise("constraint", jets)
+    local = system.pointwise("constraint", jets)
     na = len(disc.jets)
     g_j = np.asarray(local["g_j"]).reshape(disc.points.shape + (na,))
     g_jj = np.asarray(local["g_jj"]).reshape(disc.points.shape + (na, na))
@@ -109,12 +109,12 @@ def projected_strain_linear(system, jets: np.ndarray, multipliers: int | None = 
     if red.multiplier_rows is not None:
         raise InputError("a projected strain takes its boundary conditions by elimination or penalty",
                          key="constraints", expected="constraints = 'eliminate' or 'penalty'")
-    mats = system._matrices("linear", ("M", "D", "G", "K"), None, None, None, 0.0, jets)
+    mats = system.reduced_matrices("linear", ("M", "D", "G", "K"), None, None, None, 0.0, jets)
     dense = {k: v.toarray() if hasattr(v, "toarray") else np.asarray(v) for k, v in mats.items()}
     na = len(disc.jets)
     shape = disc.points.shape
-    V_jj = np.asarray(system._pointwise("linear", jets)["K"]).reshape(shape + (na, na))
-    local = system._pointwise("strain", jets)
+    V_jj = np.asarray(system.pointwise("linear", jets)["K"]).reshape(shape + (na, na))
+    local = system.pointwise("strain", jets)
     g_j = np.asarray(local["g_j"]).reshape(shape + (na,))
     g_jj = np.asarray(local["g_jj"]).reshape(shape + (na, na))
     on = np.flatnonzero(np.any(g_j != 0, axis=tuple(range(len(shape)))))

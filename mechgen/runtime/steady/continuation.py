@@ -15,7 +15,7 @@ step; the tangent at the new point is solved with the last step's factorisation 
 Jacobian one quadratically small step away, and the same row t_i). A system may bring its
 own linear algebra: ``evaluate(u, lam, jac)`` -> (F, J, F_lam) with J in any form, and
 ``bordered(J, F_lam, row)`` -> a solver of the bordered system (a collocation
-:class:`Discretisation` condenses and keeps its sparsity pattern); and
+:class:`DiscreteBVP` condenses and keeps its sparsity pattern); and
 ``arclength_weights`` W (the dot products above become t . W x: unknowns slaved to others,
 such as collocation stage values, weigh 0).
 
@@ -29,7 +29,7 @@ fold's lam is accurate to the square of the location error. The branch ends at
 on the bound).
 
 :func:`continue_bvp` continues a BVP (:class:`mechgen.runtime.steady.bvp.BVP`) in one of its
-parameters through a collocation or multiple-shooting :class:`Discretisation`;
+parameters through a collocation or multiple-shooting :class:`DiscreteBVP`;
 :func:`minimize_along_branch` locates an extremum of a scalar output phi(u, lam) along a
 branch as a zero of d phi/ds (exact with the output's gradient, else central differences
 along the branch).
@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields, replace
 from typing import Any, Callable
 
 import numpy as np
@@ -47,11 +47,12 @@ import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
 from mechgen.errors import ConvergenceError, InputError
-from mechgen.runtime.steady.bvp import BVP, BVPResult, Discretisation
+from mechgen.runtime.steady.bvp import BVP, BVPResult
+from mechgen.runtime.steady.collocation import DiscreteBVP
 
 
 @dataclass(frozen=True)
-class System:
+class ParametricEquations:
     """F(u, lam) (n,), F_u(u, lam) (n, n) dense or sparse, F_lam(u, lam) (n,)."""
 
     F: Callable
@@ -102,6 +103,64 @@ class Extremum:
     slope: float
 
 
+@dataclass(frozen=True)
+class ContinuationOptions:
+    """Step control and stopping rules of :func:`continuation` (the defaults are its defaults).
+
+    Attributes:
+        ds: the first step length (arclength in the weighted norm, see the module doc).
+        ds_min, ds_max: the step stays in [ds_min, ds_max]; below ds_min the branch ends ('min_step').
+        direction: +1 to start towards increasing lam, -1 towards decreasing lam.
+        max_points: the branch ends after this many accepted points ('max_points').
+        lam_min, lam_max: the branch ends where lam leaves [lam_min, lam_max], with a last point on the bound.
+        tol: the corrector's tolerance on ||F||.
+        max_corrector: Newton steps per corrector (4 x as many for the start at fixed lam0).
+        grow: the step's growth factor after a correction in at most 3 steps.
+        max_turn: the largest angle (radians) between consecutive tangents; a step turning more is halved.
+        locate_folds: locate each fold by Brent's method (else the point after the fold is recorded, located=False).
+
+    Checked by :meth:`check`: 0 < ds_min <= ds <= ds_max, direction +1 or -1, max_points >= 1,
+    lam_min < lam_max, 0 < max_turn < pi, tol > 0, grow >= 1.
+    """
+
+    ds: float = 0.05
+    ds_min: float = 1e-8
+    ds_max: float = 1.0
+    direction: int = 1
+    max_points: int = 200
+    lam_min: float = -np.inf
+    lam_max: float = np.inf
+    tol: float = 1e-10
+    max_corrector: int = 8
+    grow: float = 1.5
+    max_turn: float = 0.5
+    locate_folds: bool = True
+
+    @classmethod
+    def names(cls) -> tuple[str, ...]:
+        """The option names (the keyword arguments :func:`continuation` accepts besides ``callback``)."""
+        return tuple(f.name for f in fields(cls))
+
+    @classmethod
+    def of(cls, options: "ContinuationOptions | None" = None, **overrides) -> "ContinuationOptions":
+        """``options`` (the defaults when None) with ``overrides`` replaced; TypeError on an unknown name."""
+        unknown = sorted(set(overrides) - set(cls.names()))
+        if unknown:
+            raise TypeError(f"continuation got unexpected keyword argument(s) {', '.join(map(repr, unknown))}")
+        return replace(options if options is not None else cls(), **overrides)
+
+    def check(self) -> None:
+        """InputError unless the options are consistent (see the class doc)."""
+        ds, ds_min, ds_max, lam_min, lam_max = self.ds, self.ds_min, self.ds_max, self.lam_min, self.lam_max
+        if not (0 < ds_min <= ds <= ds_max) or self.direction not in (1, -1) or self.max_points < 1 \
+                or not lam_min < lam_max or not 0 < self.max_turn < math.pi or self.tol <= 0 or self.grow < 1:
+            raise InputError(f"continuation: ds_min = {ds_min}, ds = {ds}, ds_max = {ds_max}, direction = "
+                             f"{self.direction}, max_points = {self.max_points}, lam range [{lam_min}, {lam_max}], "
+                             f"max_turn = {self.max_turn}",
+                             key="options", expected="0 < ds_min <= ds <= ds_max, direction +1 or -1, max_points >= 1, "
+                             "lam_min < lam_max, 0 < max_turn < pi, tol > 0, grow >= 1")
+
+
 # ----------------------------------------------------------------------------- linear algebra
 class _Singular(Exception):
     pass
@@ -121,7 +180,7 @@ def _eval(system, u, lam, jac=True):
     """(F, F_u, F_lam) at (u, lam); (F, None, None) without ``jac`` or where F is not finite.
 
     A system with ``evaluate(u, lam, jac)`` and ``bordered(J, F_lam, row)`` (a
-    :class:`~mechgen.runtime.steady.bvp.Discretisation`) gives F_u in its own form, for its own solver."""
+    :class:`~mechgen.runtime.steady.collocation.DiscreteBVP`) gives F_u in its own form, for its own solver."""
     evaluate = _own(system, "evaluate")
     with np.errstate(all="ignore"):
         if evaluate is not None:
@@ -326,24 +385,22 @@ def _check_system(system, u, lam):
     return u
 
 
-def continuation(system, u0, lam0: float, *, ds: float = 0.05, ds_min: float = 1e-8, ds_max: float = 1.0,
-                 direction: int = 1, max_points: int = 200, lam_min: float = -np.inf, lam_max: float = np.inf,
-                 tol: float = 1e-10, max_corrector: int = 8, grow: float = 1.5, max_turn: float = 0.5,
-                 callback: Callable | None = None, locate_folds: bool = True) -> Branch:
+def continuation(system, u0, lam0: float, options: ContinuationOptions | None = None, *,
+                 callback: Callable | None = None, **overrides) -> Branch:
     """Continue F(u, lam) = 0 from (u0, lam0) in the direction of increasing lam
     (``direction=+1``) or decreasing lam (-1).
 
-    ``system`` has F, F_u, F_lam (a :class:`System`, a :class:`Discretisation`, ...). The
-    start is first corrected at fixed lam0 (Newton). ``max_turn`` is the largest angle
-    (radians) between consecutive tangents; ``callback(u, lam)`` is called at every
-    accepted point and its values are kept in ``Branch.data``.
+    ``system`` has F, F_u, F_lam (a :class:`ParametricEquations`, a :class:`DiscreteBVP`, ...). The
+    start is first corrected at fixed lam0 (Newton). ``options`` (a :class:`ContinuationOptions`,
+    its defaults when None) set the steps and the stopping rules; keyword ``overrides`` replace
+    single options (``continuation(F, u0, lam0, ds=0.1, lam_max=2.0)``). ``callback(u, lam)`` is
+    called at every accepted point and its values are kept in ``Branch.data``.
     """
-    if not (0 < ds_min <= ds <= ds_max) or direction not in (1, -1) or max_points < 1 or not lam_min < lam_max \
-            or not 0 < max_turn < math.pi or tol <= 0 or grow < 1:
-        raise InputError(f"continuation: ds_min = {ds_min}, ds = {ds}, ds_max = {ds_max}, direction = {direction}, "
-                         f"max_points = {max_points}, lam range [{lam_min}, {lam_max}], max_turn = {max_turn}",
-                         key="options", expected="0 < ds_min <= ds <= ds_max, direction +1 or -1, max_points >= 1, "
-                         "lam_min < lam_max, 0 < max_turn < pi, tol > 0, grow >= 1")
+    opts = ContinuationOptions.of(options, **overrides)
+    opts.check()
+    ds, ds_min, ds_max, direction, max_points = opts.ds, opts.ds_min, opts.ds_max, opts.direction, opts.max_points
+    lam_min, lam_max, tol, max_corrector, grow = opts.lam_min, opts.lam_max, opts.tol, opts.max_corrector, opts.grow
+    max_turn, locate_folds = opts.max_turn, opts.locate_folds
     lam0 = float(lam0)
     u = _check_system(system, u0, lam0)
     if not lam_min <= lam0 <= lam_max:
@@ -482,23 +539,23 @@ def _locate_fold(system, x_i, t_i, step, *, tol, max_corrector, w=None):
 # ----------------------------------------------------------------------------- BVP continuation
 def continue_bvp(problem: BVP, guess: BVPResult, lam_index: int, *, method: str = "collocation", mesh=100,
                  stages: int | None = None, rtol_ivp: float = 1e-10, ivp_method: str = "DOP853",
-                 **options) -> Branch:
+                 options: ContinuationOptions | None = None, **overrides) -> Branch:
     """Continue a BVP in the fixed parameter p[lam_index], starting from ``guess`` (a
     BVPResult, e.g. from :func:`~mechgen.runtime.steady.bvp.collocate`).
 
     ``method`` is 'collocation' (Hermite-Simpson on a fixed mesh; ``mesh`` an interval count or
     nodes), 'gauss' (``stages``-point Gauss-Legendre collocation, default 4: order 8) or
-    'multiple_shooting' (``mesh`` the shooting nodes); ``options`` go to
-    :func:`continuation`. ``branch.system`` is the :class:`Discretisation`; its
-    ``to_result(u, lam)`` turns a branch point into a BVPResult.
+    'multiple_shooting' (``mesh`` the shooting nodes); ``options`` and the keyword ``overrides``
+    (``callback`` and single options) go to :func:`continuation`. ``branch.system`` is the
+    :class:`DiscreteBVP`; its ``to_result(u, lam)`` turns a branch point into a BVPResult.
     """
     if not isinstance(guess, BVPResult):
         raise InputError(f"{problem.name}: continue_bvp needs a BVPResult to start from, got "
                          f"{type(guess).__name__}", key="guess", expected="a BVPResult")
-    disc = Discretisation(problem, lam_index, guess.p, mesh, method=method, stages=stages, rtol_ivp=rtol_ivp,
-                          ivp_method=ivp_method)
+    disc = DiscreteBVP(problem, lam_index, guess.p, mesh, method=method, stages=stages, rtol_ivp=rtol_ivp,
+                       ivp_method=ivp_method)
     u0, lam0 = disc.start(guess)
-    return continuation(disc, u0, lam0, **options)
+    return continuation(disc, u0, lam0, options, **overrides)
 
 
 def point_at(branch: Branch, lam: float, *, tol: float = 1e-10) -> np.ndarray:
