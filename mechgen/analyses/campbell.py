@@ -60,7 +60,7 @@ def frees(options: dict) -> list[str]:
 
 def _speed_parameter(system, options: dict) -> tuple[str, list[float]]:
     (name, values), = options["over"].items()
-    if name not in system.meta.get("params", []):
+    if name not in system.metadata.params:
         raise SceneError(f"campbell over {name!r}, which the compiled kernels fold as a constant",
                          key="over", expected="a numeric model parameter (kept free by the scene)")
     return name, [float(v) for v in values]
@@ -74,8 +74,8 @@ def run_campbell(system, options: dict, context: dict) -> dict:
     the Campbell runs on the reduced basis (mechgen.runtime.linear.campbell), else it assembles at every speed.
     ``options['method'] = 'exact'`` forces full-size solves at every speed."""
     name, speeds = _speed_parameter(system, options)
-    if not system.meta.get("whirl"):
-        raise SceneError(f"model {system.meta.get('model')} declares no whirl pair", key="kind",
+    if not system.metadata.whirl:
+        raise SceneError(f"model {system.metadata.model} declares no whirl pair", key="kind",
                          expected="a model with Model.whirl_pair (a rotor) for a campbell analysis")
     stations = whirl_stations(system)
     if stations is None:

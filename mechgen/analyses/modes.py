@@ -33,7 +33,7 @@ def run_modes(system, options: dict, context: dict) -> dict:
     """
     q = operating_point(system, options, context)
     mats = linear_about(system, q, options, context)
-    if is_gyroscopic(mats) or system.meta.get("whirl"):
+    if is_gyroscopic(mats) or system.metadata.whirl:
         out = run_damped_modes(system, mats, options)
         if system.is_field and options.get("count"):
             out.update(field_shapes(system, np.real(out["_shapes"]), "shapes"))

@@ -17,7 +17,8 @@ import numpy as np
 
 from mechgen.scene.expr import is_identifier
 from mechgen.scene.values import (IDENTIFIER_RULE, NUMBER, ModelInfoLike, choice_value, evaluate, expression,
-                                  fail, finish, finite, is_choice, is_number, join, listing, param_info, show, type_name)
+                                  fail, finish, finite, is_choice, is_number, join, listing, param_info, show,
+                                  type_name)
 
 MAX_GRID = 1_000_000
 

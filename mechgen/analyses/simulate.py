@@ -137,7 +137,7 @@ def run_simulate(system, options: dict, context: dict) -> dict:
     e0 = energies[0]
     out["energy_drift"] = float(np.max(np.abs(energies - e0)) / max(abs(e0), 1e-300))
     out["t_end"] = t_end
-    if system.is_lattice and system.meta.get("ends") == "fixed":
+    if system.is_lattice and system.metadata.ends == "fixed":
         out["mode_energies"] = mode_energies(system, q_end, v_end)
     if options.get("series"):
         out["t"] = [float(t) for t in ts]

@@ -109,7 +109,7 @@ def balloon_system(N: int = N_GALERKIN):
     kernels = ("bvp_outputs", "bvp_residual", "bvp_tangent", "linear")
     seconds, (system, report) = _timed(lambda: system_for(scn.model, tuple(sorted(scn.params.items())), free,
                                                            scn.active, kernels, scn.backend))
-    return system, {"N": N, "compile_s": seconds, "backend": report.backend, "params": list(system.meta["params"])}
+    return system, {"N": N, "compile_s": seconds, "backend": report.backend, "params": list(system.metadata.params)}
 
 
 # -- mechgen --------------------------------------------------------------------------------------------------

@@ -4,7 +4,7 @@ Grouped by what the modules do (each subpackage's ``__init__`` is empty, so impo
 module loads only what it needs):
 
 * :mod:`~mechgen.runtime.core` - kernels (loading generated code), the compiled lumped/lattice
-  ``System``, sparsity patterns, time integration and parallel sweeps;
+  ``System`` and its typed ``SystemMeta``, sparsity patterns, time integration and parallel sweeps;
 * :mod:`~mechgen.runtime.linear` - linear analyses about an operating point and rotor
   post-processing: undamped modes, stability, damped modes, Campbell diagrams;
 * :mod:`~mechgen.runtime.steady` - steady states and boundary-value problems: Newton,

@@ -60,7 +60,7 @@ def sweep_point(task: tuple) -> dict:
     info = model_info(source_key)  # the canonical reference: resolves in a worker process too
     system, _ = system_of(source_key, point_request(request, info, point) or request)
     system = laid_out(system, layout).with_param_vector(
-        [float(point.get(n, dict(values).get(n, info.param(n).default))) for n in system.meta.get("params", [])])
+        [float(point.get(n, dict(values).get(n, info.param(n).default))) for n in system.metadata.params])
     return public(get(kind).run(system, options, {}))
 
 

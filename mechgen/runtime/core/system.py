@@ -27,6 +27,7 @@ import scipy.sparse.linalg as spla
 
 from mechgen.errors import InputError, KernelError
 from mechgen.runtime.core.kernels import Kernel
+from mechgen.runtime.core.meta import SystemMeta
 from mechgen.runtime.core.pattern import Pattern, build_pattern, extent
 
 
@@ -97,8 +98,9 @@ def folded_parameter(model, name: str) -> InputError:
 class System:
     """Kernels plus numbers: the object every analysis works on. Immutable.
 
-    ``params`` (the free parameters' values, in ``meta['params']`` order) is a read-only
-    array, ``kernels`` and ``meta`` are read-only mappings, and no attribute can be assigned
+    ``params`` (the free parameters' values, in ``metadata.params`` order) is a read-only
+    array, ``kernels`` and ``meta`` are read-only mappings (``metadata`` is the typed view of
+    ``meta``, :class:`~mechgen.runtime.core.meta.SystemMeta`), and no attribute can be assigned
     after construction; :meth:`with_params` gives a
     new system. ``patterns`` is a memo, a pure function of the frozen kernels and ``sites``:
     the CSR patterns of sparse outputs and the prepared single-state kernel calls
@@ -115,12 +117,14 @@ class System:
     rebuild: Callable | None = field(default=None, repr=False)
     folded: tuple[str, ...] = ()
     patterns: dict = field(init=False, repr=False)
+    metadata: SystemMeta = field(init=False, repr=False)
 
     is_field = False
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "kernels", read_only(self.kernels))
         object.__setattr__(self, "meta", read_only(self.meta))
+        object.__setattr__(self, "metadata", SystemMeta.of(self.meta))
         object.__setattr__(self, "params", frozen_vector(self.params))
         object.__setattr__(self, "sites", int(self.sites))
         object.__setattr__(self, "folded", tuple(self.folded))
@@ -132,8 +136,8 @@ class System:
         params = frozen_vector(params)
         if params.shape != self.params.shape:
             raise InputError(f"{len(params)} parameter values for the {len(self.params)} free parameters of "
-                             f"{self.meta.get('model')}", key="params",
-                             expected=f"values of {', '.join(self.meta.get('params', [])) or 'none'}")
+                             f"{self.metadata.model}", key="params",
+                             expected=f"values of {', '.join(self.metadata.params) or 'none'}")
         if np.array_equal(params, self.params):
             return self
         new = replace(self, params=params)
@@ -148,16 +152,16 @@ class System:
         compile time a recompiled system through ``rebuild`` (InputError without one); any other
         name an InputError listing the known ones.
         """
-        names = list(self.meta.get("params", []))
-        sites_param = self.meta.get("sites_param") if self.is_lattice else None
+        names = list(self.metadata.params)
+        sites_param = self.metadata.sites_param if self.is_lattice else None
         unknown = [k for k in values if k not in names and k != sites_param and k not in self.folded]
         if unknown:
-            raise unknown_parameters(self.meta.get("model"), unknown,
+            raise unknown_parameters(self.metadata.model, unknown,
                                      names + list(self.folded) + ([sites_param] if sites_param else []))
         folded = [k for k in values if k in self.folded]
         if folded:
             if self.rebuild is None:
-                raise folded_parameter(self.meta.get("model"), folded[0])
+                raise folded_parameter(self.metadata.model, folded[0])
             return self.rebuild(self, dict(values))
         params = np.array(self.params)
         for name, value in values.items():
@@ -175,38 +179,38 @@ class System:
 
     def with_layout(self, layout) -> "System":
         """Segments and parts belong to continua; a lumped or chain system has none."""
-        raise InputError(f"model {self.meta.get('model')} is not a continuum", key="segments",
+        raise InputError(f"model {self.metadata.model} is not a continuum", key="segments",
                          expected="segments and parts only for continua")
 
     def param_values(self) -> dict:
         """The current values of the free parameters (and a chain's number of sites) by name."""
-        out = {n: float(v) for n, v in zip(self.meta.get("params", []), self.params)}
-        if self.is_lattice and self.meta.get("sites_param"):
-            out[self.meta["sites_param"]] = self.sites
+        out = {n: float(v) for n, v in zip(self.metadata.params, self.params)}
+        if self.is_lattice and self.metadata.sites_param:
+            out[self.metadata.sites_param] = self.sites
         return out
 
     # -- shape --------------------------------------------------------------
     @property
     def is_lattice(self) -> bool:
         """True for chain models (sparse matrices)."""
-        return self.meta.get("kind") == "lattice"
+        return self.metadata.is_lattice
 
     @property
     def n(self) -> int:
         """Number of degrees of freedom."""
-        return self.sites if self.is_lattice else len(self.meta["coordinates"])
+        return self.sites if self.is_lattice else len(self.metadata.coordinates)
 
     @property
     def m(self) -> int:
         """Number of internal variables."""
-        return len(self.meta.get("internal", []))
+        return len(self.metadata.internal)
 
     @property
     def coordinates(self) -> list[str]:
         """Coordinate names (for a chain: name_1 .. name_N)."""
         if self.is_lattice:
-            return [f"{self.meta['coordinates'][0]}_{i + 1}" for i in range(self.sites)]
-        return list(self.meta["coordinates"])
+            return [f"{self.metadata.coordinates[0]}_{i + 1}" for i in range(self.sites)]
+        return list(self.metadata.coordinates)
 
     def sizes(self, kernel: str) -> dict:
         """Runtime sizes of ``kernel``."""
@@ -286,7 +290,7 @@ class System:
         values = {k: float(val[0]) for k, val in raw.items()}
         bad = [k for k, val in values.items() if not np.isfinite(val)]
         if bad:
-            raise KernelError(f"kernel outputs of {self.meta.get('model')} produced NaN/Inf in {', '.join(bad)} "
+            raise KernelError(f"kernel outputs of {self.metadata.model} produced NaN/Inf in {', '.join(bad)} "
                               f"at q = {np.asarray(q).ravel()[:6].tolist()}")
         return values
 
@@ -325,7 +329,7 @@ class System:
             parts.append(self.bound("rates").evaluate(q=q, v=v, z=z, t=t)["g"].copy())
         out = np.concatenate(parts)
         if not np.all(np.isfinite(out)):
-            raise KernelError(f"kernel residual/tangent of {self.meta.get('model')} gave NaN/Inf at t = {t}, "
+            raise KernelError(f"kernel residual/tangent of {self.metadata.model} gave NaN/Inf at t = {t}, "
                               f"x = {np.asarray(x)[:6]}")
         return out
 

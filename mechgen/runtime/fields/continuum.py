@@ -35,6 +35,7 @@ from mechgen.runtime.fields.constrain import PENALTY_FACTOR, Reduction, binding,
 from mechgen.runtime.fields.discretise import DISCRETISATIONS, GLOBAL, Discretisation, discretise
 from mechgen.runtime.fields.elements import reference
 from mechgen.runtime.core.kernels import Kernel
+from mechgen.runtime.core.meta import SystemMeta
 from mechgen.runtime.fields.mesh import Layout, build_mesh
 from mechgen.runtime.core.system import Memo, folded_parameter, frozen_vector, number, read_only, unknown_parameters
 
@@ -170,6 +171,11 @@ class FieldSystem:
         return self._memo.get(("shear", length, self._pkey), make)
 
     # -- discretisation -------------------------------------------------------
+    @property
+    def metadata(self) -> SystemMeta:
+        """The typed view of ``meta`` (:class:`~mechgen.runtime.core.meta.SystemMeta`)."""
+        return SystemMeta.of(self.meta)
+
     @property
     def info(self) -> dict:
         """Field facts from the kernel meta."""

@@ -104,7 +104,7 @@ def projected_strain_linear(system, jets: np.ndarray, multipliers: int | None = 
     """M, D, G, K with the axial stiffness W_gg g_j g_j^T projected on the cosines (module docstring)."""
     disc, red = system.disc, system.reduction
     if "strain" not in system.kernels:
-        raise InputError(f"{system.meta.get('model')} declares no strain measure", key="strain",
+        raise InputError(f"{system.metadata.model} declares no strain measure", key="strain",
                          expected="strain = 'pointwise' (or a model with model.strain_density)")
     if red.multiplier_rows is not None:
         raise InputError("a projected strain takes its boundary conditions by elimination or penalty",
@@ -127,7 +127,7 @@ def projected_strain_linear(system, jets: np.ndarray, multipliers: int | None = 
     misfit = np.abs(np.einsum("...ki,...i->...k", A, coef[..., 0]) - v).max() / max(np.abs(v).max(), 1e-300)
     W_gg = coef[..., 1, 0]
     if misfit > 1e-8 or not np.all(W_gg > 0):
-        raise InputError(f"the stiffness of {system.meta.get('model')} is not W(g) of its strain measure here "
+        raise InputError(f"the stiffness of {system.metadata.model} is not W(g) of its strain measure here "
                          f"(misfit {misfit:.1e}, least W_gg {W_gg.min():.3g})", key="strain",
                          expected="strain = 'pointwise'")
     axial = W_gg[..., None, None] * g_j[..., :, None] * g_j[..., None, :]

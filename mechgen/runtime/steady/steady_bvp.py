@@ -121,7 +121,7 @@ def _end_conditions(start, end, size: int, n_p: int) -> tuple:
 
 def _layout(field_system) -> tuple:
     """(fields, the free parameters' names, the length's index among them or None, the fixed length)."""
-    names = tuple(field_system.meta.get("params", []))
+    names = tuple(field_system.metadata.params)
     length = field_system.info["length"]
     return (tuple(field_system.info["fields"]), names, names.index(length) if length in names else None,
             field_system.value(length))
@@ -140,7 +140,7 @@ def steady_bvp(field_system) -> SteadyBVP:
                              expected="values and slopes only (first-order densities)")
         conditions.append((fields.index(f) + n * int(k), at, bc[f"bc_{f}_{k}_{at}"]))
     if len(conditions) != 2 * n:
-        raise InputError(f"the steady BVP of {field_system.meta.get('model')} has {len(conditions)} boundary "
+        raise InputError(f"the steady BVP of {field_system.metadata.model} has {len(conditions)} boundary "
                          f"conditions for {2 * n} first-order unknowns", key="boundary",
                          expected="n conditions per field pair: values or slopes at the two ends")
     start = [(i, v) for i, at, v in conditions if at == "start"]
@@ -216,7 +216,7 @@ def steady_bvp(field_system) -> SteadyBVP:
     g, g_ya, g_yb, g_p = _end_conditions(start, end, 2 * n, len(names))
     problem = BVP(f, f_y, g, g_ya, g_yb, (0.0, 1.0), 2 * n, n_p=len(names), f_p=f_p if names else None,
                   g_p=g_p if names else None, vectorized=True,
-                  name=f"steady state of {field_system.meta.get('model')}")
+                  name=f"steady state of {field_system.metadata.model}")
     return SteadyBVP(problem, fields, fixed_length, st, names, length_index,
                      np.array(field_system.params, float))
 
@@ -229,7 +229,7 @@ def hamiltonian_bvp(field_system) -> SteadyBVP:
     """
     kernels = {k.removeprefix("hbvp_"): v for k, v in field_system.kernels.items() if k.startswith("hbvp_")}
     if "rates" not in kernels:
-        raise InputError(f"the kernels of {field_system.meta.get('model')} were built without the Hamiltonian "
+        raise InputError(f"the kernels of {field_system.metadata.model} were built without the Hamiltonian "
                          "steady form", key="form", expected="a model with a complementary_density and the "
                          "hbvp_rates, hbvp_rates_tangent and hbvp_outputs kernels")
     fields, names, length_index, fixed_length = _layout(field_system)
@@ -245,7 +245,7 @@ def hamiltonian_bvp(field_system) -> SteadyBVP:
                              key="form", expected="form = 'lagrangian' for conditions on slopes")
         (start if at == "start" else end).append((fields.index(f), float(np.ravel(bc[f"bc_{f}_{k}_{at}"])[0])))
     if len(start) + len(end) != 2 * n:
-        raise InputError(f"the Hamiltonian steady BVP of {field_system.meta.get('model')} has {len(start) + len(end)} "
+        raise InputError(f"the Hamiltonian steady BVP of {field_system.metadata.model} has {len(start) + len(end)} "
                          f"boundary conditions for {2 * n} unknowns", key="boundary",
                          expected="every field's value fixed at both ends")
     rates, tangent = kernels["rates"], kernels["rates_tangent"]
@@ -272,7 +272,7 @@ def hamiltonian_bvp(field_system) -> SteadyBVP:
     g, g_ya, g_yb, g_p = _end_conditions(start, end, 2 * n, len(names))
     problem = BVP(f, f_y, g, g_ya, g_yb, (0.0, 1.0), 2 * n, n_p=len(names), f_p=f_p if names else None,
                   g_p=g_p if names else None, vectorized=True,
-                  name=f"steady state of {field_system.meta.get('model')} (Hamiltonian form)")
+                  name=f"steady state of {field_system.metadata.model} (Hamiltonian form)")
     return replace(reader, problem=problem)
 
 
