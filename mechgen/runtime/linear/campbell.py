@@ -44,6 +44,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from mechgen.errors import InputError
+from mechgen.runtime.core.options import Options
 from mechgen.runtime.linear.damped import (DampedModes, damped_modes, frequency_scale, has_symmetry, matrix_norm,
                                            normalise_columns, split_modes, station_indices, whirl_sign)
 
@@ -407,7 +408,7 @@ def _check_method(method: str) -> None:
 
 
 @dataclass(frozen=True)
-class CampbellOptions:
+class CampbellOptions(Options):
     """The solver and tracking options of :func:`campbell` (the defaults are its defaults).
 
     Attributes:
@@ -434,14 +435,6 @@ class CampbellOptions:
     method: str = "auto"
     residual_tol: float = 1e-9
     mac_min: float = 0.8
-
-    @classmethod
-    def of(cls, options: "CampbellOptions | None" = None, **overrides) -> "CampbellOptions":
-        """``options`` (the defaults when None) with ``overrides`` replaced; TypeError on an unknown name."""
-        unknown = sorted(set(overrides) - {f.name for f in dataclasses.fields(cls)})
-        if unknown:
-            raise TypeError(f"campbell got unexpected keyword argument(s) {', '.join(map(repr, unknown))}")
-        return dataclasses.replace(options if options is not None else cls(), **overrides)
 
 
 def campbell(matrices_at, speeds, count: int, options: CampbellOptions | None = None, *, x_index, y_index,

@@ -54,8 +54,9 @@ import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
 from mechgen.errors import ConvergenceError, InputError
+from mechgen.runtime.core.options import Options
 
-__all__ = ["BVP", "BVPResult", "IVP_METHODS", "check_jacobians", "collocate", "multiple_shoot",
+__all__ = ["BVP", "BVPResult", "IVPOptions", "IVP_METHODS", "check_jacobians", "collocate", "multiple_shoot",
            "on_unit_interval", "shoot"]
 
 IVP_METHODS = ("DOP853", "Radau", "RK45", "BDF", "LSODA")
@@ -394,9 +395,31 @@ def _flow(problem: BVP, s0, s1, y0, p, cols, *, rtol, atol, method, budget, blow
     return Z1[:, 0], Z1[:, 1:1 + n], Z1[:, 1 + n:], sol
 
 
-def ivp_options(problem, rtol_ivp, atol_ivp, ivp_method, max_nfev, blowup):
+@dataclass(frozen=True)
+class IVPOptions(Options):
+    """How every flow of a shooting solve is integrated (``scipy.integrate.solve_ivp``); the defaults are
+    those of :func:`shoot` and :func:`multiple_shoot`.
+
+    Attributes:
+        rtol_ivp: the relative tolerance, 0 < rtol_ivp < 1.
+        atol_ivp: the absolute tolerance (None: rtol_ivp / 100).
+        ivp_method: the integrator, one of IVP_METHODS.
+        max_nfev: right-hand side evaluations allowed for the whole solve (>= 1).
+        blowup: a trajectory with |y| beyond this has blown up (> 0).
+    """
+
+    rtol_ivp: float = 1e-11
+    atol_ivp: float | None = None
+    ivp_method: str = "DOP853"
+    max_nfev: int = 200_000
+    blowup: float = 1e12
+
+
+def ivp_options(problem, options: IVPOptions) -> dict:
     """The checked keyword options of every flow of one solve (rtol, atol = rtol_ivp / 100 unless given,
     method, a shared budget of ``max_nfev`` right-hand side evaluations, blowup); InputError when bad."""
+    rtol_ivp, atol_ivp, ivp_method = options.rtol_ivp, options.atol_ivp, options.ivp_method
+    max_nfev, blowup = options.max_nfev, options.blowup
     if ivp_method not in IVP_METHODS:
         raise InputError(f"{problem.name}: unknown integrator {ivp_method!r}", key="ivp_method",
                          expected=f"one of {IVP_METHODS}")
@@ -495,11 +518,12 @@ def _newton_loop(evaluate, x0, *, solve, tol, max_iter, method):
 
 
 # ----------------------------------------------------------------------------- single shooting
-def shoot(problem: BVP, guess, *, p=None, tol: float = 1e-10, max_iter: int = 40, rtol_ivp: float = 1e-11,
-          atol_ivp: float | None = None, ivp_method: str = "DOP853", max_nfev: int = 200_000,
-          blowup: float = 1e12) -> BVPResult:
+def shoot(problem: BVP, guess, *, p=None, tol: float = 1e-10, max_iter: int = 40, ivp: IVPOptions | None = None,
+          **overrides) -> BVPResult:
     """Single shooting from the guess y(a) = ``guess`` (n,) and ``p`` (all n_p parameters; the
-    unknown ones are initial guesses). ``guess`` may also be a :class:`BVPResult`.
+    unknown ones are initial guesses). ``guess`` may also be a :class:`BVPResult`. The flows are
+    integrated as ``ivp`` (:class:`IVPOptions`, its defaults when None) says, with keyword
+    ``overrides`` of single options (``rtol_ivp=1e-9``).
 
     Newton (with line search) on (y(a), p[unknown]) until ||g||_2 <= tol; the Jacobian
     comes from the variational equations. Raises ConvergenceError when it fails (including
@@ -508,10 +532,11 @@ def shoot(problem: BVP, guess, *, p=None, tol: float = 1e-10, max_iter: int = 40
     if isinstance(guess, BVPResult):
         p = guess.p if p is None else p
         guess = guess.y[:, 0]
+    options = IVPOptions.of(ivp, **overrides)
     p = full_parameters(problem, p)
     y0 = _state(problem, guess, "guess")
     problem.check(y0, p)
-    opts = ivp_options(problem, rtol_ivp, atol_ivp, ivp_method, max_nfev, blowup)
+    opts = ivp_options(problem, options)
     n, unk = problem.n, list(problem.unknown)
     a, b = problem.interval
 
@@ -656,19 +681,19 @@ class ShootingResidual:
 
 
 def multiple_shoot(problem: BVP, guess_mesh, guess_values, *, p=None, nodes=10, tol: float = 1e-10,
-                   max_iter: int = 40, rtol_ivp: float = 1e-11, atol_ivp: float | None = None,
-                   ivp_method: str = "DOP853", max_nfev: int = 200_000, blowup: float = 1e12) -> BVPResult:
+                   max_iter: int = 40, ivp: IVPOptions | None = None, **overrides) -> BVPResult:
     """Multiple shooting on ``nodes`` (an interval count, uniform, or the node positions).
 
     The guess is given on any mesh (``guess_values`` (n, m) at ``guess_mesh`` (m,)) and
-    interpolated linearly to the nodes; ``p`` as for :func:`shoot`. Newton with line
-    search on the node values and unknown parameters until ||R||_2 <= tol.
+    interpolated linearly to the nodes; ``p``, ``ivp`` and the ``overrides`` as for :func:`shoot`.
+    Newton with line search on the node values and unknown parameters until ||R||_2 <= tol.
     """
+    options = IVPOptions.of(ivp, **overrides)
     p = full_parameters(problem, p)
     s_nodes = mesh_nodes(problem, nodes)
     Y0 = _interp_guess(problem, guess_mesh, guess_values, s_nodes)
     problem.check(Y0[:, 0], p)
-    opts = ivp_options(problem, rtol_ivp, atol_ivp, ivp_method, max_nfev, blowup)
+    opts = ivp_options(problem, options)
     ms = ShootingResidual(problem, s_nodes, opts)
     x0 = np.concatenate([Y0.T.ravel(), p[list(problem.unknown)]])
 

@@ -43,10 +43,13 @@ import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
 from mechgen.errors import ConvergenceError, InputError
-from mechgen.runtime.steady.bvp import (BVP, BVPResult, BudgetSpent, IVPFailure, ShootingResidual, full_parameters,
-                                        ivp_options, mesh_nodes)
+from mechgen.runtime.steady.bvp import (BVP, BVPResult, BudgetSpent, IVPFailure, IVPOptions, ShootingResidual,
+                                        full_parameters, ivp_options, mesh_nodes)
 
 METHODS = ("collocation", "gauss", "multiple_shooting")
+
+#: the integration of multiple shooting's flows unless told otherwise (rtol_ivp 1e-10, else the IVPOptions defaults)
+IVP_DEFAULTS = IVPOptions(rtol_ivp=1e-10)
 
 
 def gauss_tableau(stages: int):
@@ -117,13 +120,14 @@ class DiscreteBVP:
     """A BVP discretised as F(u, lam) = 0, lam = p[lam_index] (see the module doc).
 
     ``method``: 'collocation' (Hermite-Simpson), 'gauss' (``stages`` Gauss-Legendre points per
-    interval, default 4: order 8) or 'multiple_shooting' (``mesh`` the shooting nodes). The
-    other parameters are fixed at ``p``.
+    interval, default 4: order 8) or 'multiple_shooting' (``mesh`` the shooting nodes; its flows
+    are integrated as ``ivp`` says, :data:`IVP_DEFAULTS` when None, with keyword ``overrides`` of
+    single :class:`~mechgen.runtime.steady.bvp.IVPOptions`). The other parameters are fixed at ``p``.
     """
 
     def __init__(self, problem: BVP, lam_index: int, p, mesh, *, method: str = "collocation",
-                 stages: int | None = None, rtol_ivp: float = 1e-10, atol_ivp: float | None = None,
-                 ivp_method: str = "DOP853", max_nfev: int = 200_000, blowup: float = 1e12):
+                 stages: int | None = None, ivp: IVPOptions | None = None, **overrides):
+        ivp = IVPOptions.of(IVP_DEFAULTS if ivp is None else ivp, **overrides)
         if method not in METHODS:
             raise InputError(f"{problem.name}: unknown discretisation {method!r}", key="method",
                              expected="'collocation', 'gauss' or 'multiple_shooting'")
@@ -153,7 +157,7 @@ class DiscreteBVP:
         self.unk = list(problem.unknown)
         self.cols = self.unk + [self.lam_index]  # the parameter columns of f_p the Newton systems need
         if method == "multiple_shooting":
-            opts = ivp_options(problem, rtol_ivp, atol_ivp, ivp_method, max_nfev, blowup)
+            opts = ivp_options(problem, ivp)
             self._ms = ShootingResidual(problem, self.mesh, opts)
         else:
             self._plain = _Pattern(n, M, k, bordered=False)

@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field
 from typing import Any, Callable
 
 import numpy as np
@@ -47,6 +47,7 @@ import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
 from mechgen.errors import ConvergenceError, InputError
+from mechgen.runtime.core.options import Options
 from mechgen.runtime.steady.bvp import BVP, BVPResult
 from mechgen.runtime.steady.collocation import DiscreteBVP
 
@@ -104,7 +105,7 @@ class Extremum:
 
 
 @dataclass(frozen=True)
-class ContinuationOptions:
+class ContinuationOptions(Options):
     """Step control and stopping rules of :func:`continuation` (the defaults are its defaults).
 
     Attributes:
@@ -135,19 +136,6 @@ class ContinuationOptions:
     grow: float = 1.5
     max_turn: float = 0.5
     locate_folds: bool = True
-
-    @classmethod
-    def names(cls) -> tuple[str, ...]:
-        """The option names (the keyword arguments :func:`continuation` accepts besides ``callback``)."""
-        return tuple(f.name for f in fields(cls))
-
-    @classmethod
-    def of(cls, options: "ContinuationOptions | None" = None, **overrides) -> "ContinuationOptions":
-        """``options`` (the defaults when None) with ``overrides`` replaced; TypeError on an unknown name."""
-        unknown = sorted(set(overrides) - set(cls.names()))
-        if unknown:
-            raise TypeError(f"continuation got unexpected keyword argument(s) {', '.join(map(repr, unknown))}")
-        return replace(options if options is not None else cls(), **overrides)
 
     def check(self) -> None:
         """InputError unless the options are consistent (see the class doc)."""
