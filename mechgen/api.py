@@ -7,8 +7,8 @@
     mats = pendulum.linear([1.0 + 2.0 * 9.81 / 50.0, 0.0])      # M, D, G, K at an operating point
     stiffer = pendulum.with_params(k=80.0)                       # a new system; ``pendulum`` is unchanged
 
-The system (:class:`mechgen.runtime.system.System`, or
-:class:`mechgen.runtime.continuum.FieldSystem` for a continuum) gives ``linear(q, v)`` (M, D, G, K),
+The system (:class:`mechgen.runtime.core.system.System`, or
+:class:`mechgen.runtime.fields.continuum.FieldSystem` for a continuum) gives ``linear(q, v)`` (M, D, G, K),
 ``residual(q, v, a)``, ``tangent(q, v, a)`` (dr/dq, dr/dv, dr/da) and ``outputs(q, v)`` as numpy
 arrays. By default every numeric parameter stays a kernel input, so that ``with_params`` is cheap
 (a new parameter vector); a name fixed at compile time (``free`` narrower than all, or a
@@ -38,9 +38,9 @@ def compile(model, params: Mapping | None = None, *, free=None, backend: str = "
         backend: "c", "numpy" or "casadi" (C falls back to numpy, with a warning, without a compiler).
         kernels: the kernels to build (default: every kernel of the model; a continuum's steady
             boundary-value kernels ``bvp_*``/``hbvp_*`` only when asked for).
-        segments: a continuum's uniform pieces from s = 0: :class:`~mechgen.runtime.mesh.Segment`
+        segments: a continuum's uniform pieces from s = 0: :class:`~mechgen.runtime.fields.mesh.Segment`
             or mappings ``{"length", "elements", <numeric parameter>: value ...}``.
-        parts: lumped parts placed along a continuum: :class:`~mechgen.runtime.mesh.Part` or
+        parts: lumped parts placed along a continuum: :class:`~mechgen.runtime.fields.mesh.Part` or
             mappings ``{"kind", "at", <part parameter>: value ...}``.
 
     Returns:
@@ -83,7 +83,7 @@ def compile(model, params: Mapping | None = None, *, free=None, backend: str = "
 
 def _values(model, params) -> dict:
     """The given values, checked against the model's parameters (names, numbers, choices, sizes)."""
-    from mechgen.runtime.system import number
+    from mechgen.runtime.core.system import number
 
     if params is None:
         return {}
@@ -142,8 +142,8 @@ def _kernel_names(kernels) -> tuple[str, ...]:
 
 
 def _layout(model, segments, parts):
-    """A :class:`~mechgen.runtime.mesh.Layout` of the given segments and parts (None when there are none)."""
-    from mechgen.runtime.mesh import Layout, Part, Segment
+    """A :class:`~mechgen.runtime.fields.mesh.Layout` of the given segments and parts (None when there are none)."""
+    from mechgen.runtime.fields.mesh import Layout, Part, Segment
 
     if not segments and not parts:
         return None

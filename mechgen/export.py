@@ -28,7 +28,7 @@ import tempfile
 from dataclasses import replace
 from pathlib import Path
 
-from mechgen import __version__
+from mechgen.version import __version__
 from mechgen.errors import InputError
 
 EXPORT_BACKENDS = ("c", "casadi")
@@ -190,8 +190,8 @@ def _casadi_files(model, spec, irs) -> dict:
     from mechgen.codegen.emit_casadi import emit_casadi
     from mechgen.codegen.escape import py_docstring
     from mechgen.codegen.spec import kernel_spec
-    from mechgen.runtime.kernels import load_module
-    from mechgen.runtime.pattern import build_pattern
+    from mechgen.runtime.core.kernels import load_module
+    from mechgen.runtime.core.pattern import build_pattern
 
     named = [replace(ir, name=f"{model.name}_{ir.name}") for ir in irs]
     text = emit_casadi(named, model=model.name, title=py_docstring(spec.key()))

@@ -1,7 +1,7 @@
 """The compiler pipeline: declare -> derive -> lower -> emit -> build -> load.
 
 ``compile_model(model, spec, kernels, backend)`` returns a
-:class:`~mechgen.runtime.system.System` ready for the analyses and a
+:class:`~mechgen.runtime.core.system.System` ready for the analyses and a
 :class:`BuildReport` saying which kernels were built, their operation counts,
 the time of each stage and whether the artefact came from the cache.
 """
@@ -18,8 +18,8 @@ from typing import TYPE_CHECKING, Callable
 import numpy as np
 
 from mechgen.errors import CompilerUnavailable, InputError, MechgenError
-from mechgen.runtime.kernels import c_kernels, casadi_kernels, load_module, numpy_kernels
-from mechgen.runtime.system import System
+from mechgen.runtime.core.kernels import c_kernels, casadi_kernels, load_module, numpy_kernels
+from mechgen.runtime.core.system import System
 
 if TYPE_CHECKING:  # the symbolic side is imported only where text is derived (a cached run never needs it)
     from mechgen.codegen.ir import KernelIR
@@ -416,7 +416,7 @@ def compile_request(request: CompileRequest, derive_with: Callable[[], tuple], *
     if request.kind == "lattice":
         sites = int(sites if sites is not None else values[request.sites])
     if request.kind == "field":
-        from mechgen.runtime.continuum import FieldSystem
+        from mechgen.runtime.fields.continuum import FieldSystem
 
         fixed = {k: v for k, v in values.items() if k in request.numeric}
         names = (*_FIELD_CHOICES, *(n for n in request.runtime if n not in _FIELD_CHOICES))

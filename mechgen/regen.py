@@ -198,7 +198,7 @@ def compare_generated(committed: dict, fresh_: dict, backend: str) -> str | None
 
 def _kernels(generated: dict, backend: str) -> dict:
     from mechgen.codegen.build import get_caller, load_shared
-    from mechgen.runtime.kernels import c_kernels, load_module, numpy_kernels
+    from mechgen.runtime.core.kernels import c_kernels, load_module, numpy_kernels
 
     if backend == "c":
         return c_kernels(load_shared(generated["text"], stem="mgcheck"), generated["specs"], get_caller())
@@ -209,7 +209,7 @@ def _kernels(generated: dict, backend: str) -> dict:
         module = load_module(path, name)
     if backend == "numpy":
         return numpy_kernels(module)
-    from mechgen.runtime.kernels import casadi_kernels
+    from mechgen.runtime.core.kernels import casadi_kernels
 
     return casadi_kernels(module, generated["specs"])
 
@@ -222,7 +222,7 @@ def numeric_difference(committed: dict, fresh_: dict, backend: str, *, sites: in
     """
     import numpy as np
 
-    from mechgen.runtime.pattern import extent
+    from mechgen.runtime.core.pattern import extent
 
     ka, kb = _kernels(committed, backend), _kernels(fresh_, backend)
     for name, spec in committed["specs"].items():

@@ -8,7 +8,7 @@ import numpy as np
 
 from mechgen import models
 from mechgen.pipeline import compile_model
-from mechgen.runtime.mesh import Layout
+from mechgen.runtime.fields.mesh import Layout
 from mechgen.symbolic.specialize import specialize
 
 STEEL = {"E_s": 211e9, "G_s": 81.2e9, "rho": 7810.0, "D": 0.05, "L": 1.0}

@@ -8,7 +8,7 @@ import scipy.linalg as sla
 
 import mechgen
 from mechgen.errors import InputError
-from mechgen.runtime.mesh import Part, Segment
+from mechgen.runtime.fields.mesh import Part, Segment
 
 M_, K_, L0, G = 2.0, 50.0, 0.8, 9.81
 

@@ -20,9 +20,9 @@ import pytest
 
 from mechgen import models
 from mechgen.pipeline import compile_model
-from mechgen.runtime.continuation import continue_bvp
-from mechgen.runtime.stability import stability
-from mechgen.runtime.steady_bvp import solve_steady, steady_bvp
+from mechgen.runtime.steady.continuation import continue_bvp
+from mechgen.runtime.linear.stability import stability
+from mechgen.runtime.steady.steady_bvp import solve_steady, steady_bvp
 from mechgen.symbolic.specialize import specialize
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
@@ -131,7 +131,7 @@ def test_projected_strain_converges_within_half_a_percent_at_n_10_along_the_whol
     paper's claim, lowest ten frequencies within 0.5 % at N = 10, holds up to the branch's end lambda0 = 0.27
     (measured against N = 80: 6e-5, 4e-4, 9e-4; the pointwise stiffness: 6e-4, 3.3e-3, 8.7e-3), and both
     stiffnesses converge to the same frequencies (N = 40: 1e-6)."""
-    from mechgen.runtime.constrained import linear_about_bvp
+    from mechgen.runtime.steady.constrained import linear_about_bvp
 
     freqs = {}
     for N in (10, 40):
@@ -172,7 +172,7 @@ def test_drag_makes_the_balloon_leave_its_plane():
 @pytest.mark.parametrize("law", ["neo_hookean", "linear"])
 def test_generated_bvp_jacobians_match_central_differences(law):
     """dF/dy from the generated tangent kernel (at the actual u_ss) against central differences of F."""
-    from mechgen.runtime.bvp import check_jacobians
+    from mechgen.runtime.steady.bvp import check_jacobians
 
     bvp = steady_bvp(balloon(law, LAMBDA0_MIN))
     y = np.array([0.4, 0.05, 3.0, 2.0, 0.3, 10.5])

@@ -12,9 +12,9 @@ import pytest
 
 from mechgen import models
 from mechgen.pipeline import compile_model
-from mechgen.runtime.branch_stability import stability_along
-from mechgen.runtime.continuation import continue_bvp, minimize_along_branch, point_at
-from mechgen.runtime.steady_bvp import solve_steady, steady_bvp
+from mechgen.runtime.steady.branch_stability import stability_along
+from mechgen.runtime.steady.continuation import continue_bvp, minimize_along_branch, point_at
+from mechgen.runtime.steady.steady_bvp import solve_steady, steady_bvp
 from mechgen.symbolic.specialize import specialize
 from test_balloon import H, balloon, l0_of, reference, tension_vector
 

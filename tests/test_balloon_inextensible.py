@@ -1,4 +1,4 @@
-"""Small motions of the inextensible ballooning string: a constrained continuum (mechgen.runtime.constrained).
+"""Small motions of the inextensible ballooning string: a constrained continuum (mechgen.runtime.steady.constrained).
 
 The model declares the constraint g = (lambda^2 - 1)/2 = 0 (``model.constraint_density``) and no strain energy;
 the balloon comes from the Hamiltonian form (tests/test_balloon_stress_form.py checks it against the elliptic
@@ -18,9 +18,9 @@ import pytest
 from mechgen import models
 from mechgen.pipeline import compile_model
 from mechgen.errors import InputError
-from mechgen.runtime.constrained import linear_about_bvp
-from mechgen.runtime.stability import stability
-from mechgen.runtime.steady_bvp import hamiltonian_bvp, solve_steady
+from mechgen.runtime.steady.constrained import linear_about_bvp
+from mechgen.runtime.linear.stability import stability
+from mechgen.runtime.steady.steady_bvp import hamiltonian_bvp, solve_steady
 from mechgen.symbolic.specialize import specialize
 
 H, LAMBDA0 = 10.0, 0.05

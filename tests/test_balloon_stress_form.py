@@ -24,7 +24,7 @@ import pytest
 from mechgen import models
 from mechgen.pipeline import compile_model
 from mechgen.errors import ConvergenceError
-from mechgen.runtime.steady_bvp import hamiltonian_bvp, solve_steady, steady_bvp
+from mechgen.runtime.steady.steady_bvp import hamiltonian_bvp, solve_steady, steady_bvp
 from mechgen.symbolic.specialize import specialize
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))

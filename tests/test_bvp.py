@@ -1,4 +1,4 @@
-"""Two-point BVP solvers (mechgen.runtime.bvp) against closed forms and literature values.
+"""Two-point BVP solvers (mechgen.runtime.steady.bvp) against closed forms and literature values.
 
 References:
 * Bratu problem y'' + lam e^y = 0, y(0) = y(1) = 0: the closed form
@@ -22,8 +22,8 @@ import pytest
 from scipy.optimize import brentq
 
 from mechgen.errors import ConvergenceError, InputError
-from mechgen.runtime.bvp import (BVP, Discretisation, check_jacobians, collocate, multiple_shoot,
-                                 on_unit_interval, shoot)
+from mechgen.runtime.steady.bvp import BVP, check_jacobians, collocate, multiple_shoot, on_unit_interval, shoot
+from mechgen.runtime.steady.collocation import DiscreteBVP
 
 
 # ----------------------------------------------------------------------------- problems
@@ -197,7 +197,7 @@ def test_discretisation_residual_and_jacobian(method):
     """F vanishes at the (discretised) solution, and F_u, F_lam match differences of F."""
     prob = bratu()
     theta = bratu_theta(1.0, False)
-    disc = Discretisation(prob, 0, [1.0], 40 if method == "collocation" else 4, method=method)
+    disc = DiscreteBVP(prob, 0, [1.0], 40 if method == "collocation" else 4, method=method)
     u = disc.pack(bratu_exact(disc.mesh, theta))
     assert np.linalg.norm(disc.F(u, 1.0)) < (1e-5 if method == "collocation" else 1e-9)
     rng = np.random.default_rng(1)
@@ -252,7 +252,7 @@ def test_bad_input_raises_input_error():
     with pytest.raises(InputError, match="integrator"):
         shoot(prob, [0.0, 1.0], p=[1.0], ivp_method="Euler")
     with pytest.raises(InputError, match="lam_index"):
-        Discretisation(eigen_problem(), 0, [7.0], 10)              # the unknown parameter cannot be lam
+        DiscreteBVP(eigen_problem(), 0, [7.0], 10)              # the unknown parameter cannot be lam
 
 
 def test_evaluation_budget_stops_a_costly_solve():

@@ -284,7 +284,7 @@ def test_no_compiler_raises(cache_dir, no_compiler):
         build.build_shared(kernel(), stem="affine")
     with pytest.raises(CompilerUnavailable):
         build.load_shared(kernel(), stem="affine")
-    assert isinstance(build._make_caller(), build.CtypesCaller)
+    assert isinstance(build.make_caller(), build.CtypesCaller)
     assert entries(cache_dir) == []
 
 

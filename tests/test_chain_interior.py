@@ -15,7 +15,7 @@ import pytest
 import sympy as sp
 
 from mechgen.pipeline import compile_model
-from mechgen.runtime.pattern import affine_summary, interior
+from mechgen.runtime.core.pattern import affine_summary, interior
 from mechgen.symbolic.model import Model
 from mechgen.symbolic.params import Param
 from mechgen.symbolic.specialize import specialize

@@ -1,4 +1,4 @@
-"""Gauss-Legendre collocation for continuation (mechgen.runtime.collocation), the continuation's own-solver
+"""Gauss-Legendre collocation for continuation (mechgen.runtime.steady.collocation), the continuation's own-solver
 protocol, and the fast stability path for conservative gyroscopic systems.
 
 References: the Bratu closed form and its turning point lam_c = 3.513830719 (J. P. Boyd, Appl. Math. Comput.
@@ -10,15 +10,16 @@ scipy's QZ-free eig of the first-order companion matrix for the gyroscopic eigen
 import numpy as np
 import pytest
 
-from mechgen.runtime.bvp import Discretisation, collocate
-from mechgen.runtime.continuation import continue_bvp, point_at
-from mechgen.runtime.stability import conservative_gyroscopic, stability
+from mechgen.runtime.steady.bvp import collocate
+from mechgen.runtime.steady.collocation import DiscreteBVP
+from mechgen.runtime.steady.continuation import continue_bvp, point_at
+from mechgen.runtime.linear.stability import conservative_gyroscopic, stability
 from test_bvp import MESH, S, _bratu_guess, bratu, bratu_exact, bratu_theta
 from test_continuation import LAM_C
 
 
 def _gauss(M, stages, lam=1.0):
-    return Discretisation(bratu(), 0, [lam], M, method="gauss", stages=stages)
+    return DiscreteBVP(bratu(), 0, [lam], M, method="gauss", stages=stages)
 
 
 @pytest.mark.parametrize("stages", [2, 3, 4])

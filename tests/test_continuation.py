@@ -1,4 +1,4 @@
-"""Pseudo-arclength continuation (mechgen.runtime.continuation) against exact folds.
+"""Pseudo-arclength continuation (mechgen.runtime.steady.continuation) against exact folds.
 
 References:
 * u^2 + lam^2 = 1: folds at lam = +-1, u = 0 (a circle).
@@ -15,8 +15,8 @@ import scipy.sparse as sps
 from scipy.optimize import brentq, minimize_scalar
 
 from mechgen.errors import ConvergenceError, InputError
-from mechgen.runtime.bvp import collocate
-from mechgen.runtime.continuation import System, continuation, continue_bvp, minimize_along_branch
+from mechgen.runtime.steady.bvp import collocate
+from mechgen.runtime.steady.continuation import ParametricEquations, continuation, continue_bvp, minimize_along_branch
 from test_bvp import MESH, S, _bratu_guess, bratu, bratu_exact, bratu_theta
 
 Z_C = brentq(lambda z: z * np.tanh(z) - 1, 0.5, 2.0, xtol=1e-15)
@@ -28,7 +28,7 @@ def test_closed_form_turning_point():
 
 
 # ----------------------------------------------------------------------------- algebraic folds
-CIRCLE = System(lambda u, lam: np.array([u[0] ** 2 + lam ** 2 - 1.0]),
+CIRCLE = ParametricEquations(lambda u, lam: np.array([u[0] ** 2 + lam ** 2 - 1.0]),
                 lambda u, lam: np.array([[2 * u[0]]]),
                 lambda u, lam: np.array([2 * lam]), name="circle")
 
@@ -51,7 +51,7 @@ def _cubic(sparse):
     def F_u(u, lam):
         J = np.array([[1.0, -1.0], [3 * u[0] ** 2 - 1, 0.0]])
         return sps.csc_matrix(J) if sparse else J
-    return System(lambda u, lam: np.array([u[0] - u[1], u[0] ** 3 - u[0] - lam]), F_u,
+    return ParametricEquations(lambda u, lam: np.array([u[0] - u[1], u[0] ** 3 - u[0] - lam]), F_u,
                   lambda u, lam: np.array([0.0, -1.0]), name="cubic")
 
 
@@ -76,7 +76,7 @@ def test_cubic_folds_end_on_bound_and_callback(sparse):
 
 def test_stops_with_message_where_the_branch_ends():
     """u = sqrt(1 - lam) (NaN beyond lam = 1, singular F_lam at 1): stop below ds_min."""
-    sqrt_sys = System(lambda u, lam: np.array([u[0] - np.sqrt(1 - lam)]), lambda u, lam: np.eye(1),
+    sqrt_sys = ParametricEquations(lambda u, lam: np.array([u[0] - np.sqrt(1 - lam)]), lambda u, lam: np.eye(1),
                       lambda u, lam: np.array([0.5 / np.sqrt(1 - lam)]))
     br = continuation(sqrt_sys, [1.0], 0.0, ds=0.1, ds_min=1e-6)
     assert br.status == "min_step" and "ds_min" in br.message
@@ -85,13 +85,14 @@ def test_stops_with_message_where_the_branch_ends():
 
 def test_start_off_branch_and_bad_input():
     with pytest.raises(ConvergenceError, match="start"):
-        continuation(System(lambda u, lam: np.array([u[0] ** 2 + 1.0]), lambda u, lam: np.array([[2 * u[0]]]),
-                            lambda u, lam: np.array([0.0])), [0.5], 0.0)
+        continuation(ParametricEquations(lambda u, lam: np.array([u[0] ** 2 + 1.0]),
+                                         lambda u, lam: np.array([[2 * u[0]]]), lambda u, lam: np.array([0.0])),
+                     [0.5], 0.0)
     with pytest.raises(InputError, match="F returned"):
-        continuation(System(lambda u, lam: np.zeros(2), lambda u, lam: np.eye(1), lambda u, lam: np.zeros(1)),
-                     [0.0], 0.0)
+        continuation(ParametricEquations(lambda u, lam: np.zeros(2), lambda u, lam: np.eye(1),
+                                         lambda u, lam: np.zeros(1)), [0.0], 0.0)
     with pytest.raises(InputError, match="F_u"):
-        continuation(System(CIRCLE.F, lambda u, lam: np.eye(2), CIRCLE.F_lam), [-1.0], 0.0)
+        continuation(ParametricEquations(CIRCLE.F, lambda u, lam: np.eye(2), CIRCLE.F_lam), [-1.0], 0.0)
     with pytest.raises(InputError):
         continuation(CIRCLE, [-1.0], 0.0, ds=-0.1)
     with pytest.raises(InputError):

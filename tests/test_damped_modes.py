@@ -23,9 +23,9 @@ import scipy.sparse as sps
 from scipy.optimize import brentq
 
 from mechgen.errors import ConvergenceError, InputError
-from mechgen.runtime.campbell import (SpeedPolynomial, campbell, critical_speeds, fit_speed_polynomial,
+from mechgen.runtime.linear.campbell import (SpeedPolynomial, campbell, critical_speeds, fit_speed_polynomial,
                                       mac_matrix)
-from mechgen.runtime.damped import damped_modes, orbit_kappa, whirl, whirl_sign
+from mechgen.runtime.linear.damped import damped_modes, orbit_kappa, whirl, whirl_sign
 
 
 def laval(Id, Ip, k, speed, sign=1.0):

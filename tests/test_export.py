@@ -1,7 +1,7 @@
 """``mechgen export``: standalone C and CasADi Functions, checked against mechgen's own kernels.
 
 References: the Python path -- the numpy backend of :func:`mechgen.pipeline.compile_model`
-for the same specialisation (its kernels, and :func:`mechgen.runtime.pattern.build_pattern`
+for the same specialisation (its kernels, and :func:`mechgen.runtime.core.pattern.build_pattern`
 for a chain's CSR pattern and slot tables) -- and, for the CasADi integrator,
 scipy's ``solve_ivp`` over mechgen's own first-order right-hand side ``System.rhs``.
 The C files are compiled warning-free (``-std=c99 -Wall -Wextra -pedantic -Werror``) with

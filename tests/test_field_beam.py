@@ -15,8 +15,8 @@ from scipy.optimize import brentq
 from mechgen import models
 from mechgen.pipeline import compile_model
 from mechgen.errors import InputError
-from mechgen.runtime.discretise import UnderIntegrationWarning
-from mechgen.runtime.modes import modes
+from mechgen.runtime.fields.discretise import UnderIntegrationWarning
+from mechgen.runtime.linear.modes import modes
 from mechgen.symbolic.specialize import specialize
 
 EQUATIONS = {
@@ -90,7 +90,7 @@ def test_penalty_converges_to_elimination():
 
     The bound 1e-8 this test had held only by round-off luck on one BLAS kernel (the factor 1e6 put the
     spectrum's span at 6e13, eps * 6e13 = 1e-2; under OPENBLAS_CORETYPE=Haswell the error was 34 %).
-    The rule (mechgen.runtime.constrain.penalty_choice) balances the penalty error P/f against the
+    The rule (mechgen.runtime.fields.constrain.penalty_choice) balances the penalty error P/f against the
     round-off: it predicts a lowest-eigenvalue error of P/f (frequency: half), here 1.7e-7, and the
     penalty error of mode i grows with its reaction, ~omega_i / omega_1 (1.2e-5 at the fifth)."""
     exact = beam_frequencies("clamped-free", "hermite", 32)
@@ -183,7 +183,7 @@ def test_free_vibration_in_the_first_mode_returns_after_one_period():
 
     omega_1 = 1.8751^2 sqrt(EI / rhoA L^4); quintic elements (N = 2) are within 1e-7 of it.
     """
-    from mechgen.runtime.integrate import integrate_first_order
+    from mechgen.runtime.core.integrate import integrate_first_order
     from mechgen.analyses.simulate import initial_state, run_simulate
 
     model = models.get("euler_bernoulli_beam")

@@ -44,7 +44,7 @@ def test_zero_parameter_folds_terms_away():
 
 def test_discretisation_names_agree():
     """The scene's choices (symbolic side) are exactly the ones the runtime implements."""
-    from mechgen.runtime.discretise import DISCRETISATIONS as RUNTIME
+    from mechgen.runtime.fields.discretise import DISCRETISATIONS as RUNTIME
     from mechgen.symbolic.discretisations import DISCRETISATIONS as DECLARED
 
     assert DECLARED == RUNTIME

@@ -132,7 +132,7 @@ def test_linear_elements_lock_in_shear():
 def test_extreme_shear_stiffness_warns_instead_of_silent_garbage():
     """Hard case: kGA/EI = 1e9 with rhoI = 1e-9 spans 4e13 in eigenvalue; the low modes lose ~1e-2 to round-off
     (measured 8 % on the first), so modes() must say so rather than return them silently."""
-    from mechgen.runtime.modes import AccuracyWarning
+    from mechgen.runtime.linear.modes import AccuracyWarning
 
     model = models.get("timoshenko_beam")
     spec = specialize(model, {"discretisation": "legendre", "N": 20, "kGA": 1e9, "rhoI": 1e-9})

@@ -21,7 +21,7 @@ import scipy.linalg as sla
 
 from mechgen import models
 from mechgen.pipeline import compile_model
-from mechgen.runtime.modes import modes
+from mechgen.runtime.linear.modes import modes
 from mechgen.symbolic.specialize import specialize
 
 skfem = pytest.importorskip("skfem", reason="scikit-fem is not installed (it is in the 'test' extra: "

@@ -93,7 +93,7 @@ def test_sparse_shift_invert_stability_of_a_large_discretisation():
 
 
 def test_sparse_and_dense_stability_agree():
-    from mechgen.runtime.stability import stability, stability_sparse
+    from mechgen.runtime.linear.stability import stability, stability_sparse
 
     system = system_of("follower_column", P=23.0, N=24)
     mats = system.linear()

@@ -1,16 +1,16 @@
-"""Starting guesses of the runtime (mechgen.runtime.guesses): numpy only, and right by their own geometry."""
+"""Starting guesses of the runtime (mechgen.runtime.steady.guesses): numpy only, and right by their own geometry."""
 import subprocess
 import sys
 
 import numpy as np
 import pytest
 
-from mechgen.runtime.guesses import loop_count, sine_loop_guesses
+from mechgen.runtime.steady.guesses import loop_count, sine_loop_guesses
 from mechgen.symbolic.params import Namespace
 
 
 def test_guesses_module_imports_no_sympy():
-    code = "import sys, mechgen.runtime.guesses; print('sympy' in sys.modules)"
+    code = "import sys, mechgen.runtime.steady.guesses; print('sympy' in sys.modules)"
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert done.stdout.strip() == "False"
 

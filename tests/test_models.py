@@ -4,7 +4,7 @@ import pytest
 
 from mechgen import models
 from mechgen.pipeline import compile_model
-from mechgen.runtime.integrate import leapfrog
+from mechgen.runtime.core.integrate import leapfrog
 from mechgen.analyses.modes import run_modes
 from mechgen.analyses.simulate import run_simulate
 from mechgen.analyses.stability import run_stability

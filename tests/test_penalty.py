@@ -1,4 +1,4 @@
-"""Penalty constraints (mechgen.runtime.constrain.penalty_choice): the rule, its convergence rate, its warning.
+"""Penalty constraints (mechgen.runtime.fields.constrain.penalty_choice): the rule, its convergence rate, its warning.
 
 Reference: the same clamped-free beam with its boundary conditions eliminated (exact constraint,
 no penalty). The rule's error model: the lowest eigenvalue errs by P/f (penalty, first order in
@@ -15,8 +15,8 @@ import pytest
 
 from mechgen import models
 from mechgen.pipeline import compile_model
-from mechgen.runtime import constrain
-from mechgen.runtime.modes import AccuracyWarning, modes
+from mechgen.runtime.fields import constrain
+from mechgen.runtime.linear.modes import AccuracyWarning, modes
 from mechgen.symbolic.specialize import specialize
 
 

@@ -17,8 +17,8 @@ import numpy as np
 import pytest
 from rotors import shaft
 
-from mechgen.runtime.damped import damped_modes
-from mechgen.runtime.mesh import Layout, Part, Segment
+from mechgen.runtime.linear.damped import damped_modes
+from mechgen.runtime.fields.mesh import Layout, Part, Segment
 
 
 def section(E=211e9, G=81.2e9, D=0.05, kappa=None):

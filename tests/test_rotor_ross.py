@@ -19,8 +19,8 @@ import numpy as np
 import pytest
 from rotors import shaft
 
-from mechgen.runtime.damped import damped_modes, whirl
-from mechgen.runtime.mesh import Layout, Part, Segment
+from mechgen.runtime.linear.damped import damped_modes, whirl
+from mechgen.runtime.fields.mesh import Layout, Part, Segment
 
 DATA = Path(__file__).resolve().parents[1] / "benchmarks" / "ross_data" / "ross_reference.json"
 SPEEDS = ("0.0", "500.0", "1000.0", "2000.0")

@@ -1,4 +1,4 @@
-"""BLAS threads sized to the problem (mechgen.runtime.threads): one thread for small dense work,
+"""BLAS threads sized to the problem (mechgen.runtime.core.threads): one thread for small dense work,
 the library's default above, and a user's own choice in the environment always kept."""
 import subprocess
 import sys
@@ -7,7 +7,7 @@ import pytest
 
 threadpoolctl = pytest.importorskip("threadpoolctl")
 
-from mechgen.runtime.threads import SMALL, blas_threads_for  # noqa: E402
+from mechgen.runtime.core.threads import SMALL, blas_threads_for  # noqa: E402
 
 
 def _blas_threads() -> list[int]:
@@ -28,7 +28,7 @@ def test_small_problems_run_on_one_thread_and_large_ones_keep_the_default(monkey
 
 
 def test_a_users_choice_is_kept():
-    code = ("import numpy, threadpoolctl; from mechgen.runtime.threads import blas_threads_for\n"
+    code = ("import numpy, threadpoolctl; from mechgen.runtime.core.threads import blas_threads_for\n"
             "with blas_threads_for(4):\n"
             "    print([i['num_threads'] for i in threadpoolctl.threadpool_info() if i['user_api'] == 'blas'])")
     env = {"OPENBLAS_NUM_THREADS": "2", "PATH": "/usr/bin:/bin"}

@@ -4,14 +4,14 @@
 ``radius_max`` ...) and the fields' slopes at the ends (``x_s_start`` ...), aliased. Shape outputs
 (``Model.shape_output``: the balloon's ``loops``) are numbers measured on the sampled state
 (``shape_values``). ``stability_about`` is the verdict of the Galerkin linearisation about one
-state (mechgen.runtime.branch_stability).
+state (mechgen.runtime.steady.branch_stability).
 """
 from __future__ import annotations
 
 import numpy as np
 
 from mechgen.analyses.parameters import info_of, model_of, parameter_dict
-from mechgen.runtime.branch_stability import stability_along
+from mechgen.runtime.steady.branch_stability import stability_along
 
 SAMPLES = 201
 SHAPE_SAMPLES = 1001
@@ -42,7 +42,7 @@ def reported(verdict) -> dict:
 
 
 def stability_about(system, bvp, result) -> dict:
-    """The Galerkin linearisation's stability about one steady state (mechgen.runtime.branch_stability)."""
+    """The Galerkin linearisation's stability about one steady state (mechgen.runtime.steady.branch_stability)."""
     return reported(stability_along(system, bvp, None, [result])[0])
 
 

@@ -1,6 +1,6 @@
 """``campbell``: a Campbell diagram, the damped modes over a range of one parameter (the spin speed).
 
-The modes are tracked across speeds (mechgen.runtime.campbell) and critical speeds are found where a
+The modes are tracked across speeds (mechgen.runtime.linear.campbell) and critical speeds are found where a
 whirl frequency crosses a multiple of the speed. Scene keys: ``over`` (one numeric parameter with two
 or more increasing values), ``count`` (modes, default 8), ``multiples`` (of the speed, default [1]),
 ``method`` (auto, exact, reduced), ``about`` and ``at`` (the operating point). Outputs: ``speeds``,
@@ -19,7 +19,7 @@ from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import REQUIRED, Option
 from mechgen.analyses.whirl import SPARSE_N, whirl_stations
 from mechgen.errors import SceneError
-from mechgen.runtime.campbell import campbell, critical_speeds, fit_speed_polynomial
+from mechgen.runtime.linear.campbell import CampbellOptions, campbell, critical_speeds, fit_speed_polynomial
 from mechgen.scene.values import fail, is_choice, join, param_info, type_name
 
 
@@ -60,7 +60,7 @@ def frees(options: dict) -> list[str]:
 
 def _speed_parameter(system, options: dict) -> tuple[str, list[float]]:
     (name, values), = options["over"].items()
-    if name not in system.meta.get("params", []):
+    if name not in system.metadata.params:
         raise SceneError(f"campbell over {name!r}, which the compiled kernels fold as a constant",
                          key="over", expected="a numeric model parameter (kept free by the scene)")
     return name, [float(v) for v in values]
@@ -71,11 +71,11 @@ def run_campbell(system, options: dict, context: dict) -> dict:
 
     With more than four speeds the matrices are tested for a polynomial dependence on the speed
     (fit_speed_polynomial: three or four assemblies); when it holds, no further assembly is needed and
-    the Campbell runs on the reduced basis (mechgen.runtime.campbell), else it assembles at every speed.
+    the Campbell runs on the reduced basis (mechgen.runtime.linear.campbell), else it assembles at every speed.
     ``options['method'] = 'exact'`` forces full-size solves at every speed."""
     name, speeds = _speed_parameter(system, options)
-    if not system.meta.get("whirl"):
-        raise SceneError(f"model {system.meta.get('model')} declares no whirl pair", key="kind",
+    if not system.metadata.whirl:
+        raise SceneError(f"model {system.metadata.model} declares no whirl pair", key="kind",
                          expected="a model with Model.whirl_pair (a rotor) for a campbell analysis")
     stations = whirl_stations(system)
     if stations is None:
@@ -96,8 +96,8 @@ def run_campbell(system, options: dict, context: dict) -> dict:
     # matrices polynomial in the speed (a rotor's G = Omega G1): four assemblies, then sparse adds
     poly = fit_speed_polynomial(assembled, speeds[0], speeds[-1]) if len(speeds) > 4 else None
     matrices_at = assembled_at if poly is None else poly.combined({"M": ("M",), "C": ("D", "G"), "K": ("K",)})
-    res = campbell(matrices_at, speeds, count, x_index=stations[0], y_index=stations[1], sparse=sparse,
-                   method=options.get("method", "auto"))
+    res = campbell(matrices_at, speeds, count, CampbellOptions(sparse=sparse, method=options.get("method", "auto")),
+                   x_index=stations[0], y_index=stations[1])
     crit = critical_speeds(res, options.get("multiples", [1.0]), refine=matrices_at, sparse=sparse)
     freqs = np.asarray(res.frequencies)
     return {"speeds": [float(w) for w in res.speeds], "frequencies": [[float(f) for f in row] for row in freqs],

@@ -1,7 +1,7 @@
 """``continuation``: branches of a continuum's steady states (boundary value problems in s).
 
 ``continuation`` follows such a steady state in one parameter by pseudo-arclength
-(mechgen.runtime.continuation), through turning points, with the stability verdict
+(mechgen.runtime.steady.continuation), through turning points, with the stability verdict
 of the Galerkin linearisation about every point; it reports ``branch`` (one entry
 per point: the parameter, the outputs, ``verdict``), ``folds`` and, with
 ``minimize``, the least value of an output along the branch (``<output>_min`` and
@@ -29,7 +29,7 @@ More keys of ``continuation``:
 * ``bounds = { p_e = [0, 12] }``: the branch ends where an output leaves its range
   (the continuation then runs in chunks of 20 points);
 * ``at = { p_e = 5.0 }``: the points where an output crosses the value, located by
-  Brent's method along the branch (mechgen.runtime.branch_scan.crossing): output
+  Brent's method along the branch (mechgen.runtime.steady.branch_scan.crossing): output
   ``at_<output>``, a list of {parameter, the output, the aliased outputs, the shape
   outputs, ``verdict``, ``refinement``} sorted by the parameter (the verdict holds when
   the model discretised with 2N and 4N terms agrees, else it is 'unconverged'), and
@@ -38,7 +38,7 @@ More keys of ``continuation``:
 
 With stability, ``stability_changes`` lists where the verdict changes between
 consecutive points, located by bisection along the branch to 1e-9 of the segment
-(mechgen.runtime.branch_scan.switch): {parameter, aliased and shape outputs,
+(mechgen.runtime.steady.branch_scan.switch): {parameter, aliased and shape outputs,
 ``from``, ``to``}. ``aliases`` may also name an analysis output:
 ``balloons_at_tension = "at_p_e"``.
 """
@@ -55,8 +55,8 @@ from mechgen.analyses.bvp_states import (bvp_summary, shape_declarations, shape_
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import REQUIRED, Option
 from mechgen.errors import SceneError
-from mechgen.runtime import branch_scan
-from mechgen.runtime.continuation import minimize_along_branch
+from mechgen.runtime.steady import branch_scan
+from mechgen.runtime.steady.continuation import ContinuationOptions, minimize_along_branch
 from mechgen.scene.expr import is_identifier
 from mechgen.scene.values import IDENTIFIER_RULE, fail, is_choice, join, listing, param_info, show
 
@@ -201,7 +201,9 @@ def _follow(system, bvp, result, options: dict, aliases: dict):
     index = bvp.params.index(name)
     here, stop = float(result.p[index]), float(options["stop"])
     towards = "increasing" if stop >= here else "decreasing"
-    bound = {"lam_max": stop} if stop >= here else {"lam_min": stop}
+    steps = ContinuationOptions(ds=options.get("step", 0.05),
+                                ds_max=options.get("max_step", max(1.0, abs(stop - here) / 20)),
+                                **({"lam_max": stop} if stop >= here else {"lam_min": stop}))
     bounds = options.get("bounds") or {}
 
     def inside(u, lam, disc):
@@ -216,10 +218,8 @@ def _follow(system, bvp, result, options: dict, aliases: dict):
     return branch_scan.follow(bvp.problem, result, index, direction=options.get("direction", towards),
                               inside=inside if bounds else None,
                               mesh=options.get("mesh", 100), method=options.get("method", "collocation"),
-                              stages=options.get("stages"), ds=options.get("step", 0.05),
-                              ds_max=options.get("max_step", max(1.0, abs(stop - here) / 20)),
-                              max_points=options.get("max_points", 200),
-                              **bound)
+                              stages=options.get("stages"), max_points=options.get("max_points", 200),
+                              options=steps)
 
 
 def _check_names(options: dict, known: dict) -> None:

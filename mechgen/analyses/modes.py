@@ -16,8 +16,8 @@ from mechgen.analyses.operating_point import linear_about, operating_point
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import LINEAR_OPTIONS
 from mechgen.analyses.whirl import is_gyroscopic, run_damped_modes
-from mechgen.runtime.constrain import warn_penalty_errors
-from mechgen.runtime.modes import modes as solve_modes
+from mechgen.runtime.fields.constrain import warn_penalty_errors
+from mechgen.runtime.linear.modes import modes as solve_modes
 
 def needs(options: dict, *, internal: bool) -> set[str]:
     """M, D, G, K: the linear kernel."""
@@ -34,7 +34,7 @@ def run_modes(system, options: dict, context: dict) -> dict:
     """
     q = operating_point(system, options, context)
     mats = linear_about(system, q, options, context)
-    if is_gyroscopic(mats) or system.meta.get("whirl"):
+    if is_gyroscopic(mats) or system.metadata.whirl:
         out = run_damped_modes(system, mats, options)
         if system.is_field and options.get("count"):
             out.update(field_shapes(system, np.real(out["_shapes"]), "shapes"))

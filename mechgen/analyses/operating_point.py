@@ -3,13 +3,13 @@
 ``operating_point`` gives the q about which M, D, G, K are assembled: the q of an earlier
 ``steady`` analysis named by ``about``, the coordinates of ``at``, or zero. ``linear_about``
 gives the matrices themselves; about a continuum's boundary-value steady state they come from
-its jets at the quadrature points (mechgen.runtime.constrained.linear_about_bvp).
+its jets at the quadrature points (mechgen.runtime.steady.constrained.linear_about_bvp).
 """
 from __future__ import annotations
 
 import numpy as np
 
-from mechgen.runtime.constrained import linear_about_bvp
+from mechgen.runtime.steady.constrained import linear_about_bvp
 
 
 def vector(system, table: dict | None, base: np.ndarray | None = None) -> np.ndarray:

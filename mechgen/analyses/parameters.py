@@ -7,14 +7,14 @@ from mechgen.errors import SceneError
 
 def model_of(system):
     """The system's Model, by its canonical reference (``meta["source"]``, set by the pipeline); imports it."""
-    return models.get(system.meta.get("source") or system.meta["model"])
+    return models.get(system.metadata.reference)
 
 
 def info_of(system):
     """The system's model facts (mechgen.scene.info.ModelInfo), from the caches: no import of the model."""
     from mechgen.scene.info import model_info
 
-    return model_info(system.meta.get("source") or system.meta["model"])
+    return model_info(system.metadata.reference)
 
 
 def parameter_dict(system, p) -> dict:
@@ -22,14 +22,14 @@ def parameter_dict(system, p) -> dict:
     info = info_of(system)
     values = {name: float(prm.default) for name, prm in info.params.items() if prm.numeric}
     values.update({k: float(v) for k, v in getattr(system, "fixed", {}).items()})
-    values.update(zip(system.meta.get("params", []), (float(v) for v in p)))
+    values.update(zip(system.metadata.params, (float(v) for v in p)))
     return values
 
 
 def with_free_params(system, values: dict, key: str = "params"):
     """A new system with some free parameters set (``steady``'s ``params``, a sweep's point);
     the system given is left as it was."""
-    names = list(system.meta.get("params", []))
+    names = list(system.metadata.params)
     for name in values:
         if name not in names:
             raise SceneError(f"parameter {name!r} is not free in the compiled kernels", key=f"{key}.{name}",

@@ -24,7 +24,7 @@ __all__ = ["analysis", "campbell", "continuation", "modes", "simulate", "stabili
 def _model_info(system):
     from mechgen.scene.info import lookup_model
 
-    name = system.meta.get("source") or system.meta.get("model")  # the canonical reference, for users' models
+    name = system.metadata.reference  # the canonical reference, for users' models
     info = lookup_model(name) if name else None
     if info is None:
         raise InputError(f"the system's model {name!r} is not one mechgen can look up", key="system",
@@ -46,7 +46,7 @@ def _known_values(system) -> dict:
     """The parameter values the system itself records (its free ones, a continuum's fixed ones), for
     expression strings in options; a value folded into the kernels and not recorded is not guessed."""
     values = {k: float(v) for k, v in getattr(system, "fixed", {}).items()}
-    values.update(zip(system.meta.get("params", []), (float(v) for v in system.params)))
+    values.update(zip(system.metadata.params, (float(v) for v in system.params)))
     return values
 
 

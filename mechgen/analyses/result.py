@@ -69,7 +69,7 @@ class Result:
 
 def run_analysis(name: str, kind: str, system, options: dict, context: dict) -> Result:
     """Run a validated analysis through its kind's runner and time it."""
-    from mechgen.runtime.threads import blas_threads_for
+    from mechgen.runtime.core.threads import blas_threads_for
 
     clock = time.perf_counter()
     with blas_threads_for(_unknowns(system)):

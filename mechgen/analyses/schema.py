@@ -16,8 +16,9 @@ from typing import Any, Callable, Mapping, Sequence
 import numpy as np
 
 from mechgen.scene.expr import is_identifier
-from mechgen.scene.values import (IDENTIFIER_RULE, NUMBER, ModelInfo, choice_value, evaluate, expression, fail,
-                                  finish, finite, is_choice, is_number, join, listing, param_info, show, type_name)
+from mechgen.scene.values import (IDENTIFIER_RULE, NUMBER, ModelInfoLike, choice_value, evaluate, expression,
+                                  fail, finish, finite, is_choice, is_number, join, listing, param_info, show,
+                                  type_name)
 
 MAX_GRID = 1_000_000
 
@@ -60,7 +61,7 @@ class OptionContext:
     """
 
     file: str | None
-    model: ModelInfo
+    model: ModelInfoLike
     params: dict
     depends: dict
     coordinates: tuple[str, ...]

@@ -17,8 +17,8 @@ from mechgen.analyses.operating_point import vector
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import ABSENT, ALL_OUTPUTS, REQUIRED, Option
 from mechgen.errors import SceneError
-from mechgen.runtime.integrate import integrate_first_order, leapfrog
-from mechgen.runtime.modes import modes as solve_modes
+from mechgen.runtime.core.integrate import integrate_first_order, leapfrog
+from mechgen.runtime.linear.modes import modes as solve_modes
 from mechgen.scene.values import fail, listing, show, type_name
 
 METHODS = ("BDF", "Radau", "LSODA", "RK45", "DOP853", "leapfrog")
@@ -137,7 +137,7 @@ def run_simulate(system, options: dict, context: dict) -> dict:
     e0 = energies[0]
     out["energy_drift"] = float(np.max(np.abs(energies - e0)) / max(abs(e0), 1e-300))
     out["t_end"] = t_end
-    if system.is_lattice and system.meta.get("ends") == "fixed":
+    if system.is_lattice and system.metadata.ends == "fixed":
         out["mode_energies"] = mode_energies(system, q_end, v_end)
     if options.get("series"):
         out["t"] = [float(t) for t in ts]

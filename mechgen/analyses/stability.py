@@ -13,8 +13,8 @@ from mechgen.analyses import figures, schema, summary
 from mechgen.analyses.operating_point import linear_about, operating_point
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import LINEAR_OPTIONS, Option
-from mechgen.runtime.stability import stability as solve_stability
-from mechgen.runtime.stability import stability_first_order, stability_sparse
+from mechgen.runtime.linear.stability import stability as solve_stability
+from mechgen.runtime.linear.stability import stability_first_order, stability_sparse
 
 #: above this many unknowns, a stability analysis with a ``count`` of sparse matrices uses shift-invert
 SPARSE_STABILITY_N = 400

@@ -3,7 +3,7 @@ boundary value problem in s.
 
 Scene keys: ``guess`` (coordinates), ``tol``, ``max_iter``; for a continuum whose boundary conditions
 carry values (a string between two eyelets) ``method`` = shooting / multiple_shooting / collocation
-(mechgen.runtime.steady_bvp) with ``mesh`` / ``nodes``, ``bulge`` (sine amplitudes added to the
+(mechgen.runtime.steady.steady_bvp) with ``mesh`` / ``nodes``, ``bulge`` (sine amplitudes added to the
 guess), ``form`` (lagrangian, or hamiltonian: the stress form), ``aliases`` (outputs under the
 scene's names), ``stability`` (the Galerkin verdict about the state), ``hold = {output = value}``
 with ``free = "parameter"`` (solve for the parameter that holds an end value), ``params =
@@ -32,8 +32,8 @@ from mechgen.analyses.parameters import info_of, parameter_dict, with_free_param
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import Option
 from mechgen.errors import ConvergenceError, SceneError
-from mechgen.runtime.newton import newton
-from mechgen.runtime.steady_bvp import hamiltonian_bvp, holding, solve_steady, steady_bvp, stress_guess
+from mechgen.runtime.steady.newton import newton
+from mechgen.runtime.steady.steady_bvp import hamiltonian_bvp, holding, solve_steady, steady_bvp, stress_guess
 from mechgen.scene.expr import is_identifier
 from mechgen.scene.values import IDENTIFIER_RULE, fail, is_choice, join, listing, param_info, show, type_name
 
@@ -194,7 +194,7 @@ def run_steady(system, options: dict, context: dict) -> dict:
                              expected="'newton' for a lumped or chain model")
         return run_steady_bvp(system, options, context)
     if system.is_field and system.info.get("boundary_values"):
-        raise SceneError(f"model {system.meta.get('model')} fixes its ends at nonzero values: its steady state is "
+        raise SceneError(f"model {system.metadata.model} fixes its ends at nonzero values: its steady state is "
                          "a boundary value problem in s", key="method",
                          expected="method = 'collocation', 'shooting' or 'multiple_shooting'")
     y0 = np.concatenate([vector(system, options.get("guess")), np.zeros(system.m)])
@@ -220,7 +220,7 @@ def _start_with_shape(system, bvp, options: dict, method: str):
     declared = {d.name: d for d in shape_declarations(system)}
     if name not in declared or declared[name].start is None:
         with_start = [n for n, d in declared.items() if d.start is not None]
-        raise SceneError(f"model {system.meta['model']} declares no starting guesses for {name!r}",
+        raise SceneError(f"model {system.metadata.model} declares no starting guesses for {name!r}",
                          key=f"shape.{name}", expected="one of: " + (", ".join(with_start) or "(none)"))
     mesh = options.get("mesh", 200)
     sigma = np.linspace(0.0, 1.0, mesh + 1)
@@ -257,7 +257,7 @@ def _start_with_shape(system, bvp, options: dict, method: str):
         gave.append(f"{name} = {got:g}")
     where = ", ".join(f"{k} = {v:g}" for k, v in parameter_dict(system, bvp.start).items())
     raise ConvergenceError(f"steady: no state with {name} = {float(value):g} from the {len(gave)} starting guesses "
-                           f"of model {system.meta['model']} by {method} ({bvp.form} form, {where}): they gave "
+                           f"of model {system.metadata.model} by {method} ({bvp.form} form, {where}): they gave "
                            f"{'; '.join(gave)}. Try another start (params), method = 'collocation' with "
                            "form = 'hamiltonian', or another value")
 

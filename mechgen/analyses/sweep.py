@@ -15,7 +15,7 @@ from mechgen.analyses.context import NAME, POINTS, PointRunner, public
 from mechgen.analyses.parameters import with_free_params
 from mechgen.analyses.registry import AnalysisKind, get, kinds, register
 from mechgen.analyses.schema import REQUIRED, AnalysisSpec, Option
-from mechgen.runtime.sweep import sweep
+from mechgen.runtime.core.sweep import sweep
 from mechgen.scene.values import fail, type_name
 
 
@@ -71,7 +71,7 @@ def collect(grid: list[dict], results: list[dict]) -> dict:
 
 
 def run_sweep(system, options: dict, context: dict) -> dict:
-    """The inner analysis at every grid point (mechgen.runtime.sweep: serial, or ``workers`` processes).
+    """The inner analysis at every grid point (mechgen.runtime.core.sweep: serial, or ``workers`` processes).
 
     A scene's run gives the points through ``context[POINTS]`` (compiled again where a point sets a
     size); otherwise each point runs on a copy of ``system`` with the point's free parameters set.

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from mechgen.errors import InputError
-from mechgen.runtime.damped import damped_modes, whirl
+from mechgen.runtime.linear.damped import damped_modes, whirl
 
 #: above this many unknowns a damped-modes analysis with a ``count`` uses sparse shift-invert
 SPARSE_N = 100
@@ -27,7 +27,7 @@ def is_gyroscopic(mats: dict) -> bool:
 def whirl_stations(system) -> tuple[np.ndarray, np.ndarray] | None:
     """Indices (into the unknowns) of the x and y displacements whose orbits classify whirl, or None
     (no whirl pair, or unknowns that are not a selection of nodal values)."""
-    pair = system.meta.get("whirl")
+    pair = system.metadata.whirl
     if not pair:
         return None
     if system.is_field:
@@ -49,7 +49,7 @@ def run_damped_modes(system, mats: dict, options: dict) -> dict:
     out = {"frequencies": [float(w) for w in res.wd],
            "eigenvalues": [[float(s.real), float(s.imag)] for s in res.eigenvalues],
            "log_dec": [float(d) for d in res.log_dec], "_shapes": res.shapes}
-    pair = system.meta.get("whirl")
+    pair = system.metadata.whirl
     if pair:
         stations = whirl_stations(system)
         shapes = res.shapes

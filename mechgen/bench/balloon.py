@@ -109,7 +109,7 @@ def balloon_system(N: int = N_GALERKIN):
     kernels = ("bvp_outputs", "bvp_residual", "bvp_tangent", "linear")
     seconds, (system, report) = _timed(lambda: system_for(scn.model, tuple(sorted(scn.params.items())), free,
                                                            scn.active, kernels, scn.backend))
-    return system, {"N": N, "compile_s": seconds, "backend": report.backend, "params": list(system.meta["params"])}
+    return system, {"N": N, "compile_s": seconds, "backend": report.backend, "params": list(system.metadata.params)}
 
 
 # -- mechgen --------------------------------------------------------------------------------------------------
@@ -117,7 +117,7 @@ class Mechgen:
     """mechgen's side: the steady BVP, its start at lambda0 = -0.5, branches, stability, p_e,min."""
 
     def __init__(self, system):
-        from mechgen.runtime.steady_bvp import solve_steady, steady_bvp
+        from mechgen.runtime.steady.steady_bvp import solve_steady, steady_bvp
 
         self.system = system.with_params(lambda0=START)  # the scene's start value
         self.bvp = steady_bvp(self.system)
@@ -126,11 +126,13 @@ class Mechgen:
         self._steps: dict = {}
 
     def _continue(self, config, ds, max_points, ds_max=None):
-        from mechgen.runtime.continuation import continue_bvp
+        from mechgen.runtime.steady.continuation import ContinuationOptions, continue_bvp
 
         scheme, stages, mesh = config
+        steps = ContinuationOptions(ds=ds, ds_max=ds if ds_max is None else ds_max, max_points=max_points,
+                                    lam_max=STOP)
         return continue_bvp(self.bvp.problem, self.start, self.index, method=scheme, stages=stages, mesh=mesh,
-                            ds=ds, ds_max=ds if ds_max is None else ds_max, max_points=max_points, lam_max=STOP)
+                            options=steps)
 
     def step(self, config) -> float:
         """The step giving about POINTS points to STOP (from an untimed pilot branch's arclength)."""
@@ -143,7 +145,7 @@ class Mechgen:
 
     def run(self, config, stability: bool = True) -> dict:
         """Branch (timed), then stability at every point (timed): times, points, verdicts and the branch."""
-        from mechgen.runtime.branch_stability import stability_along
+        from mechgen.runtime.steady.branch_stability import stability_along
 
         ds = self.step(config)
         t_branch, branch = _timed(lambda: self._continue(config, ds, POINTS + 20))
@@ -157,15 +159,15 @@ class Mechgen:
 
     def pe_min(self, branch) -> tuple[float, float]:
         """(p_e,min, lambda0 there) located along the branch."""
-        from mechgen.runtime.continuation import minimize_along_branch
+        from mechgen.runtime.steady.continuation import minimize_along_branch
 
         best = minimize_along_branch(branch, lambda u, lam: self.pe(branch, u, lam), kind="min")
         return float(best.value), float(best.lam)
 
     def omega1(self, branch, N: int, lam: float = LAMBDA_F) -> tuple[float, float]:
         """(omega_1 at lambda0 = lam with N sines per component, seconds of one stability evaluation)."""
-        from mechgen.runtime.branch_stability import stability_at
-        from mechgen.runtime.continuation import point_at
+        from mechgen.runtime.steady.branch_stability import stability_at
+        from mechgen.runtime.steady.continuation import point_at
 
         res = branch.system.to_result(point_at(branch, lam), lam)
         system = self.system if N == int(self.system.choices["N"]) else self.system.refined(N)

@@ -113,7 +113,7 @@ def _beam(bc: str, disc: str, size: int, backend: str):
 
 def work_precision(ladders: dict, *, repeats: int = 5, backend: str = "c") -> list[dict]:
     """One row per (discretisation, size): unknowns, max relative error of the first five frequencies, seconds."""
-    from mechgen.runtime.modes import modes
+    from mechgen.runtime.linear.modes import modes
 
     exact = clamped_free_roots(COUNT) ** 2
     rows = []
@@ -204,14 +204,14 @@ def _skfem_assembler(skfem, elements: int):
 
 def _assembly_only(system):
     """A callable assembling M and K from pointwise coefficients evaluated once (None if not reachable)."""
-    from mechgen.runtime.assemble import element_matrices
+    from mechgen.runtime.fields.assemble import element_matrices
 
     try:
         disc = system.disc
         na = len(disc.jets)
-        local = system._pointwise("linear", np.zeros(disc.points.shape + (na,)))
+        local = system.pointwise("linear", np.zeros(disc.points.shape + (na,)))
         coeff = {k: np.asarray(local[k]).reshape(disc.points.shape + (na, na)) for k in ("M", "K")}
-    except Exception:  # noqa: BLE001 - private API of continuum.py; the row is simply left out
+    except Exception:  # noqa: BLE001 - a system without pointwise kernels: the row is simply left out
         return None
     pairs = {k: [tuple(ab) for ab in np.argwhere(np.any(c != 0, axis=(0, 1)))] for k, c in coeff.items()}
     asm = system.assembler

@@ -27,7 +27,7 @@ Steps, all in one process, BLAS limited to one thread for both tools (threadpool
    polynomial in Omega (``fit_speed_polynomial``: three assemblies, then sparse adds), the modes are
    solved at full size (sparse shift-invert) at the first and last speed and on a reduced basis at the
    others, with a residual safeguard that solves at full size where the basis falls short
-   (``mechgen.runtime.campbell``). Compilation (a
+   (``mechgen.runtime.linear.campbell``). Compilation (a
    ``compile_model`` call with the compile cache as it is) and mechgen's first Campbell call (mesh and
    discretisation tables built) are reported apart, as is ROSS's first ``run_modal`` (numba JIT).
 3. **Profile** of mechgen's campbell analysis (cProfile): where the time goes, and the library's two
@@ -122,7 +122,7 @@ def rotor_system(N: int, discretisation: str = "timoshenko2", *, fresh: bool = F
     (with the on-disk compile cache as it is) is measured.
     """
     from mechgen import models
-    from mechgen.runtime.mesh import Layout
+    from mechgen.runtime.fields.mesh import Layout
     from mechgen.scene.info import lookup_model
     from mechgen.scene.load import load_scene
     from mechgen.scene.run import laid_out, system_for
@@ -156,7 +156,7 @@ def mechgen_damped_solve(system, speed: float, count: int = COUNT) -> dict:
 
 def mechgen_campbell(system, speeds, multiples=(), method: str = "auto") -> dict:
     """mechgen's ``campbell`` analysis (the scene runner) over ``speeds``, 8 curves (``method``: see
-    mechgen.runtime.campbell.campbell; 'auto' is the scene's)."""
+    mechgen.runtime.linear.campbell.campbell; 'auto' is the scene's)."""
     from mechgen.analyses.campbell import run_campbell
 
     return run_campbell(system, {"over": {"Omega": list(speeds)}, "count": COUNT, "multiples": list(multiples),

@@ -340,7 +340,7 @@ def load_mgcall():
     return _with_retry(build, lambda path: _import_extension("mgcall", path))
 
 
-def _make_caller():
+def make_caller():
     """The mgcall module, or the ctypes fallback if it cannot be built."""
     try:
         return load_mgcall()
@@ -356,4 +356,4 @@ def get_caller():
     ``bind`` returns a callable with no arguments that runs the kernel with the
     stored pointers and returns its int result, keeping ``keepalive`` alive.
     """
-    return _make_caller()
+    return make_caller()

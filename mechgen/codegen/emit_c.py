@@ -10,7 +10,7 @@ with the number of sites.
 """
 from __future__ import annotations
 
-from mechgen import __version__
+from mechgen.version import __version__
 from mechgen.codegen.emit_c_loop import loop_block, stored_ports
 from mechgen.codegen.ir import Block, KernelIR, Port
 from mechgen.codegen.printing import c_code

@@ -10,8 +10,8 @@ module adds, for model ``M`` and kernel ``K``:
 * for a kernel with sparse (CSR) outputs, ``long M_K_nnz(long sites)`` and
   ``int M_K_pattern(long sites, long *indptr, long *indices, long *slots0, ...)``: the CSR
   pattern (sites x sites) and the slot tables the kernel reads, computed in C from the
-  kernel's loop recipe exactly as :func:`mechgen.runtime.pattern.build_pattern` does, with
-  the affine summaries of :func:`mechgen.runtime.pattern.affine_summary` (all zeros would
+  kernel's loop recipe exactly as :func:`mechgen.runtime.core.pattern.build_pattern` does, with
+  the affine summaries of :func:`mechgen.runtime.core.pattern.affine_summary` (all zeros would
   also be valid: the kernel then addresses the CSR data through the slot table alone).
 
 Free text (model doc, parameter docs, choice values) reaches the files only through
@@ -21,7 +21,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from mechgen import __version__
+from mechgen.version import __version__
 from mechgen.codegen.emit_c import kernel_context
 from mechgen.codegen.escape import c_comment, c_comment_lines
 from mechgen.codegen.ir import Extent, KernelIR, Port

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import pprint
 
-from mechgen import __version__
-from mechgen.codegen.emit_numpy import _extent
+from mechgen.version import __version__
+from mechgen.codegen.emit_numpy import extent_expr
 from mechgen.codegen.ir import Block, KernelIR
 from mechgen.codegen.printing import casadi_code
 from mechgen.codegen.spec import kernel_spec
@@ -21,8 +21,8 @@ def _head(ir: KernelIR) -> list[str]:
     lines = []
     for i, p in enumerate(ir.inputs):
         if not p.integer:
-            lines.append(f"in{i} = ca.SX.sym({p.name!r}, {_extent(p.extent)})")
-    lines += [f"out{i} = ca.SX.zeros({_extent(p.extent)})" for i, p in enumerate(ir.outputs)]
+            lines.append(f"in{i} = ca.SX.sym({p.name!r}, {extent_expr(p.extent)})")
+    lines += [f"out{i} = ca.SX.zeros({extent_expr(p.extent)})" for i, p in enumerate(ir.outputs)]
     return lines
 
 
@@ -40,7 +40,7 @@ def _loop(block: Block, k: int, inp: dict, out: dict, slot_port: str | None) -> 
     periodic = block.loop.boundary == "periodic"
     rel = [g for g in block.gathers if g.relative]
     absolute = [g for g in block.gathers if not g.relative]
-    lines = [f"cnt = {_extent(block.loop.count)}", f"ns = {_extent(block.loop.sites)}"]
+    lines = [f"cnt = {extent_expr(block.loop.count)}", f"ns = {extent_expr(block.loop.sites)}"]
     lines += [f"{g.symbol.name} = ca.SX.sym({g.symbol.name!r})" for g in rel + absolute]
     lines += [f"{s.name} = {casadi_code(e)}" for s, e in block.assignments]
     exprs = ", ".join(casadi_code(w.expr) for w in block.writes)

@@ -8,14 +8,15 @@ from __future__ import annotations
 
 import pprint
 
-from mechgen import __version__
+from mechgen.version import __version__
 from mechgen.codegen.ir import Block, KernelIR
 from mechgen.codegen.printing import numpy_code
 from mechgen.codegen.spec import kernel_spec
 from mechgen.codegen.templating import render
 
 
-def _extent(ext) -> str:
+def extent_expr(ext) -> str:
+    """Python text of an extent's length, sum_k c_k sizes['name_k'] + const (the numpy and CasADi emitters)."""
     parts = [f"{c} * sizes[{ext_name!r}]" for ext_name, c in ext.terms]
     if ext.const or not parts:
         parts.append(str(ext.const))
@@ -41,7 +42,7 @@ def _straight(block: Block, idx: "_Indexed") -> list[str]:
 def _loop(block: Block, slot_index: int | None, idx: "_Indexed") -> list[str]:
     loop = block.loop
     periodic = loop.boundary == "periodic"
-    lines = [f"cnt = {_extent(loop.count)}", f"ns = {_extent(loop.sites)}", "e = np.arange(cnt)",
+    lines = [f"cnt = {extent_expr(loop.count)}", f"ns = {extent_expr(loop.sites)}", "e = np.arange(cnt)",
              "shape = (nb, cnt)"]
     offsets = sorted({g.index for g in block.gathers if g.relative} | {w.index for w in block.writes if w.relative
                                                                        and w.entry is None})

@@ -93,21 +93,21 @@ def _horner_in(expr: sp.Expr, form: sp.Expr, last: sp.Symbol, z: sp.Symbol) -> s
     return z**low * horner
 
 
-def _ops(expr: sp.Expr) -> int:
+def operation_count(expr: sp.Expr) -> int:
     """Floating-point operations of ``expr`` as the printers write it (x**3 is x*x*x)."""
     if expr.is_Atom:
         return 0
     if expr.is_Pow and expr.exp.is_Integer and 1 < abs(int(expr.exp)) <= 8:
         exp = int(expr.exp)
-        return abs(exp) - 1 + (exp < 0) + _ops(expr.base)
+        return abs(exp) - 1 + (exp < 0) + operation_count(expr.base)
     own = len(expr.args) - 1 if expr.is_Add or expr.is_Mul else 1
-    return own + sum(_ops(a) for a in expr.args)
+    return own + sum(operation_count(a) for a in expr.args)
 
 
 def _cost(expr: sp.Expr) -> int:
     """Operations of ``expr`` after CSE."""
     subs, (reduced,) = sp.cse([expr])
-    return sum(_ops(e) for _, e in subs) + _ops(reduced)
+    return sum(operation_count(e) for _, e in subs) + operation_count(reduced)
 
 
 def horner(expr: sp.Expr, local: set, forms: dict) -> sp.Expr:
@@ -124,7 +124,7 @@ def horner(expr: sp.Expr, local: set, forms: dict) -> sp.Expr:
         if rewritten is None:
             continue
         cost = _cost(expr) if cost is None else cost
-        if _cost(rewritten) + _ops(form) < cost:
+        if _cost(rewritten) + operation_count(form) < cost:
             if not form.is_Symbol:
                 forms.setdefault(form, z)
             return rewritten

@@ -32,16 +32,16 @@ velocity (zero by default: it then disappears from the generated code). Steady b
 u_tt + 2 e3 x u_t - (A u_s)_s - diag(1, 1, 0) u = 0 with
 A = (p/lambda) I + (p' - p/lambda) t t^T, t = r_s/lambda, and u = 0 at both eyelets
 (Galerkin with sin(j pi sigma), N per component; the inextensible string's motions
-keep t . u_s = 0, A = p I, mechgen.runtime.constrained; with ``strain = "projected"`` the
+keep t . u_s = 0, A = p I, mechgen.runtime.steady.constrained; with ``strain = "projected"`` the
 extensible laws' axial stiffness p' t t^T is seen through cos(k pi sigma) as well, the
 strain measure being g = (lambda^2 - 1)/2: N = 10 then converges about ten times better).
 Outputs: ``tension`` p,
 ``stretch`` lambda, ``radius`` sqrt(x^2 + y^2); the shape output ``loops`` with its starting guesses
-(``shape = { loops = 2 }``) comes from mechgen.runtime.guesses.
+(``shape = { loops = 2 }``) comes from mechgen.runtime.steady.guesses.
 """
 import sympy as sp
 
-from mechgen.runtime import guesses
+from mechgen.runtime.steady import guesses
 from mechgen.symbolic.field import fix
 from mechgen.symbolic.kinematics import frame_velocity
 from mechgen.symbolic.materials import green_strain, string_law
@@ -144,7 +144,7 @@ model.output("stretch", stretch, doc="lambda = |r_s|")
 model.output("radius", lambda u: sp.sqrt(u.x**2 + u.y**2), doc="distance from the axis")
 
 
-# Loop count and starting guesses for a balloon with a given loop count: numeric, in mechgen.runtime.guesses.
+# Loop count and starting guesses for a balloon with a given loop count: numeric, in mechgen.runtime.steady.guesses.
 loop_count = guesses.loop_count
 
 #: the tension levels (p_e scale) of the starting guesses tried, in order
@@ -152,7 +152,7 @@ START_TENSIONS = (2.0, 5.0, 10.0)
 
 
 def loop_start(value, s, p):
-    """Starting guesses for a balloon with ``value`` loops (mechgen.runtime.guesses.sine_loop_guesses: the
+    """Starting guesses for a balloon with ``value`` loops (mechgen.runtime.steady.guesses.sine_loop_guesses: the
     string from the guide eyelet to (1, 0, h), undeformed length l0, one guess per level of START_TENSIONS)."""
     return guesses.sine_loop_guesses(value, s, height=p.h, length=length(p), domain=p.L, stiffness=p.beta,
                                      tensions=START_TENSIONS)

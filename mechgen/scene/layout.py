@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from mechgen.runtime.mesh import Part, Segment
+from mechgen.runtime.fields.mesh import Part, Segment
 from mechgen.scene.values import NUMBER, evaluate, expression, fail, finite, is_number, join, listing, show, type_name
 
 DISCRETISATION_PARAMS = ("discretisation", "N", "quadrature", "constraints")

@@ -32,22 +32,10 @@ from mechgen.analyses.registry import kinds as analysis_kinds
 from mechgen.analyses.schema import AnalysisSpec, OptionContext, analysis_kind, validate
 from mechgen.scene.expr import CONSTANTS, Expression, is_identifier
 from mechgen.scene.layout import load_layout
-from mechgen.scene.values import IDENTIFIER_RULE, NUMBER, ModelInfo, ParamInfo
-# the value checks under the names this module has always used
-from mechgen.scene.values import choice_value as _choice_value
-from mechgen.scene.values import evaluate as _evaluate
-from mechgen.scene.values import expression as _expression
-from mechgen.scene.values import fail as _fail
-from mechgen.scene.values import finish as _finish
-from mechgen.scene.values import finite as _finite
-from mechgen.scene.values import is_choice as _is_choice
-from mechgen.scene.values import is_number as _is_number
-from mechgen.scene.values import join as _join
-from mechgen.scene.values import listing as _listing
-from mechgen.scene.values import param_info as _param_info
-from mechgen.scene.values import part as _part
-from mechgen.scene.values import show as _show
-from mechgen.scene.values import type_name as _type_name
+from mechgen.scene.info import ModelInfo, ParamInfo  # re-exported: the loader needs only what the protocols name
+from mechgen.scene.values import (IDENTIFIER_RULE, NUMBER, ModelInfoLike, ParamInfoLike, choice_value, evaluate,
+                                  expression, fail, finish, finite, is_choice, is_number, join, listing, param_info,
+                                  part, show, type_name)
 
 __all__ = ["AnalysisSpec", "ModelInfo", "ParamInfo", "Scene", "load_scene", "IDENTIFIER_RULE", "NUMBER"]
 
@@ -82,26 +70,26 @@ def _read(path: str) -> dict:
     """Read and parse the TOML file."""
     p = Path(path)
     if not p.is_file():
-        raise _fail(path, None, "scene file not found", "an existing scene file")
+        raise fail(path, None, "scene file not found", "an existing scene file")
     try:
         if p.stat().st_size > MAX_SCENE_BYTES:
-            raise _fail(path, None, f"scene file is larger than {MAX_SCENE_BYTES} bytes", "a small TOML file")
+            raise fail(path, None, f"scene file is larger than {MAX_SCENE_BYTES} bytes", "a small TOML file")
         raw = p.read_bytes()
     except OSError as exc:
-        raise _fail(path, None, f"cannot read the scene file ({exc.strerror})", "a readable scene file") from None
+        raise fail(path, None, f"cannot read the scene file ({exc.strerror})", "a readable scene file") from None
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:
-        raise _fail(path, None, f"scene file is not UTF-8 text (byte {exc.start})", "a UTF-8 TOML file") from None
+        raise fail(path, None, f"scene file is not UTF-8 text (byte {exc.start})", "a UTF-8 TOML file") from None
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise _fail(path, None, f"not valid TOML: {exc}", "a valid TOML document") from None
+        raise fail(path, None, f"not valid TOML: {exc}", "a valid TOML document") from None
 
 
 def _string(file: str, key: str, value: object, expected: str = "a string") -> str:
     if not isinstance(value, str):
-        raise _fail(file, key, f"{key} is {_type_name(value)}, not a string", expected)
+        raise fail(file, key, f"{key} is {type_name(value)}, not a string", expected)
     return value
 
 
@@ -124,7 +112,7 @@ def _model_info(file: str, name: str, lookup_model: Callable[..., Any], base: Pa
         except InputError as exc:
             if exc.file:  # the model's own file is at fault: its message names it
                 raise
-            raise _fail(file, "model", exc.message, exc.expected) from None
+            raise fail(file, "model", exc.message, exc.expected) from None
     return lookup_model(name) if _REGISTERED.fullmatch(name) else None
 
 
@@ -137,71 +125,71 @@ def _top_level(file: str, data: dict, lookup_model: Callable[..., Any],
     """
     for key in data:
         if key not in TOP_KEYS:
-            raise _fail(file, _part(key), f"unknown top-level key {_show(key)}", "one of: " + ", ".join(TOP_KEYS))
+            raise fail(file, part(key), f"unknown top-level key {show(key)}", "one of: " + ", ".join(TOP_KEYS))
     title = _string(file, "title", data.get("title", ""))
     if len(title) > MAX_TITLE:
-        raise _fail(file, "title", f"title is {len(title)} characters long", f"at most {MAX_TITLE} characters")
+        raise fail(file, "title", f"title is {len(title)} characters long", f"at most {MAX_TITLE} characters")
     if "model" not in data:
-        raise _fail(file, "model", "the scene names no model",
-                    "model = one of: " + _listing(sorted(model_names())) + "; or " + MODEL_FORMS)
+        raise fail(file, "model", "the scene names no model",
+                    "model = one of: " + listing(sorted(model_names())) + "; or " + MODEL_FORMS)
     name = _string(file, "model", data["model"])
     info = _model_info(file, name, lookup_model, base)
     if info is None:
-        raise _fail(file, "model", f"unknown model {_show(name)}",
-                    "one of: " + _listing(sorted(model_names())) + "; or " + MODEL_FORMS)
+        raise fail(file, "model", f"unknown model {show(name)}",
+                    "one of: " + listing(sorted(model_names())) + "; or " + MODEL_FORMS)
     backend = _string(file, "backend", data.get("backend", "c"))
     if backend not in BACKENDS:
-        raise _fail(file, "backend", f"unknown backend {_show(backend)}", "one of: " + ", ".join(BACKENDS))
+        raise fail(file, "backend", f"unknown backend {show(backend)}", "one of: " + ", ".join(BACKENDS))
     return title, info, backend
 
 
 # --------------------------------------------------------------------------- parameters
 
-def _raw_value(file: str | None, key: str, info: ParamInfo, value: object) -> Any:
+def _raw_value(file: str | None, key: str, info: ParamInfoLike, value: object) -> Any:
     """A parameter value as given: a number, an :class:`Expression` or a choice string."""
-    if _is_choice(info):
-        return _choice_value(file, key, info, value)
-    if _is_number(value):
-        return _finite(file, key, value)
+    if is_choice(info):
+        return choice_value(file, key, info, value)
+    if is_number(value):
+        return finite(file, key, value)
     if isinstance(value, str):
-        return _expression(file, key, value)
-    raise _fail(file, key, f"parameter value is {_type_name(value)}", NUMBER)
+        return expression(file, key, value)
+    raise fail(file, key, f"parameter value is {type_name(value)}", NUMBER)
 
 
-def _override_value(key: str, info: ParamInfo, text: str) -> Any:
+def _override_value(key: str, info: ParamInfoLike, text: str) -> Any:
     """Parse a ``--set`` value: a number, else an expression, else a choice string."""
     text = text.strip()
-    if _is_choice(info):
-        return _choice_value(None, key, info, text)
+    if is_choice(info):
+        return choice_value(None, key, info, text)
     for convert in (int, float):
         try:
-            return _finite(None, key, convert(text))
+            return finite(None, key, convert(text))
         except ValueError:
             continue
-    return _expression(None, key, text)
+    return expression(None, key, text)
 
 
-def _apply_overrides(raw: dict, model: ModelInfo, overrides: Sequence[str]) -> None:
+def _apply_overrides(raw: dict, model: ModelInfoLike, overrides: Sequence[str]) -> None:
     """Parse ``name=value`` strings into ``raw`` (name -> (value, file, key))."""
     for item in overrides:
         if not isinstance(item, str) or "=" not in item:
-            raise _fail(None, "--set", f"override {_show(item)} has no '='", "name=value")
+            raise fail(None, "--set", f"override {show(item)} has no '='", "name=value")
         name, text = (part.strip() for part in item.split("=", 1))
-        key = f"--set {_part(name)}"
-        info = _param_info(None, key, model, name)
+        key = f"--set {part(name)}"
+        info = param_info(None, key, model, name)
         raw[name] = (_override_value(key, info, text), None, key)
 
 
-def _scene_params(file: str, data: dict, model: ModelInfo) -> dict:
+def _scene_params(file: str, data: dict, model: ModelInfoLike) -> dict:
     """Model defaults, then the scene's [params]; name -> (raw value, file, key)."""
     raw: dict[str, tuple[Any, str | None, str]] = {
         name: (info.default, None, f"default of parameter {name}") for name, info in model.params.items()}
     table = data.get("params", {})
     if not isinstance(table, dict):
-        raise _fail(file, "params", f"params is {_type_name(table)}", "a table of name = value")
+        raise fail(file, "params", f"params is {type_name(table)}", "a table of name = value")
     for name, value in table.items():
-        key = _join("params", name)
-        info = _param_info(file, key, model, name)
+        key = join("params", name)
+        info = param_info(file, key, model, name)
         raw[name] = (_raw_value(file, key, info, value), file, key)
     return raw
 
@@ -209,7 +197,7 @@ def _scene_params(file: str, data: dict, model: ModelInfo) -> dict:
 class _Resolver:
     """Depth-first resolution of expression parameters with cycle detection."""
 
-    def __init__(self, model: ModelInfo, raw: dict) -> None:
+    def __init__(self, model: ModelInfoLike, raw: dict) -> None:
         self.model, self.raw = model, raw
         self.values: dict[str, float | int | str] = {}
         self.depends: dict[str, tuple[str, ...]] = {}
@@ -222,7 +210,7 @@ class _Resolver:
         value, file, key = self.raw[name]
         if name in self.stack:
             cycle = " -> ".join(self.stack[self.stack.index(name):] + [name])
-            raise _fail(file, key, f"parameters depend on each other in a cycle: {cycle}",
+            raise fail(file, key, f"parameters depend on each other in a cycle: {cycle}",
                         "expressions that do not refer back to themselves")
         if isinstance(value, Expression):
             self.stack.append(name)
@@ -231,21 +219,21 @@ class _Resolver:
                 self.resolve(dep)
             self.stack.pop()
             self.depends[name] = value.names
-            value = _evaluate(file, key, value, self.values)
+            value = evaluate(file, key, value, self.values)
         info = self.model.params[name]
-        self.values[name] = value if _is_choice(info) else _finish(file, key, info, value)
+        self.values[name] = value if is_choice(info) else finish(file, key, info, value)
 
     def _check_dependency(self, dep: str, file: str | None, key: str) -> None:
         if dep not in self.model.params:
-            numeric = [n for n, i in self.model.params.items() if not _is_choice(i)]
-            raise _fail(file, key, f"unknown name '{dep}' in expression",
-                        "a model parameter, " + " or ".join(CONSTANTS) + "; parameters: " + _listing(numeric))
-        if _is_choice(self.model.params[dep]):
-            raise _fail(file, key, f"parameter '{dep}' is a choice and has no numeric value",
+            numeric = [n for n, i in self.model.params.items() if not is_choice(i)]
+            raise fail(file, key, f"unknown name '{dep}' in expression",
+                        "a model parameter, " + " or ".join(CONSTANTS) + "; parameters: " + listing(numeric))
+        if is_choice(self.model.params[dep]):
+            raise fail(file, key, f"parameter '{dep}' is a choice and has no numeric value",
                         "numeric parameters only")
 
 
-def _resolve_params(file: str, data: dict, model: ModelInfo, overrides: Sequence[str]):
+def _resolve_params(file: str, data: dict, model: ModelInfoLike, overrides: Sequence[str]):
     """All parameter values (name -> float | int | str) and each expression parameter's names."""
     raw = _scene_params(file, data, model)
     _apply_overrides(raw, model, overrides)
@@ -255,60 +243,60 @@ def _resolve_params(file: str, data: dict, model: ModelInfo, overrides: Sequence
     return {name: resolver.values[name] for name in model.params}, resolver.depends
 
 
-def _free(file: str, data: dict, model: ModelInfo) -> list[str]:
+def _free(file: str, data: dict, model: ModelInfoLike) -> list[str]:
     value = data.get("free", [])
     if not isinstance(value, list):
-        raise _fail(file, "free", f"free is {_type_name(value)}", "an array of parameter names")
+        raise fail(file, "free", f"free is {type_name(value)}", "an array of parameter names")
     names: list[str] = []
     for i, name in enumerate(value, 1):
-        info = _param_info(file, f"free[{i}]", model, name)
-        if _is_choice(info):
-            raise _fail(file, f"free[{i}]", f"parameter '{name}' is a choice and cannot be kept symbolic",
+        info = param_info(file, f"free[{i}]", model, name)
+        if is_choice(info):
+            raise fail(file, f"free[{i}]", f"parameter '{name}' is a choice and cannot be kept symbolic",
                         "numeric parameters only")
         if name not in names:
             names.append(name)
     return names
 
 
-def _active(file: str, data: dict, model: ModelInfo) -> tuple[str, ...] | None:
+def _active(file: str, data: dict, model: ModelInfoLike) -> tuple[str, ...] | None:
     table = data.get("coordinates")
     if table is None:
         return None
     if not isinstance(table, dict):
-        raise _fail(file, "coordinates", f"coordinates is {_type_name(table)}", "a table with key 'active'")
+        raise fail(file, "coordinates", f"coordinates is {type_name(table)}", "a table with key 'active'")
     for key in table:
         if key != "active":
-            raise _fail(file, _join("coordinates", key), f"unknown key {_show(key)}", "active")
+            raise fail(file, join("coordinates", key), f"unknown key {show(key)}", "active")
     names = table.get("active")
     if not isinstance(names, list) or not names:
-        raise _fail(file, "coordinates.active", "active must be a non-empty array of coordinate names",
-                    "a non-empty array of the model's coordinates: " + _listing(model.coordinates))
+        raise fail(file, "coordinates.active", "active must be a non-empty array of coordinate names",
+                    "a non-empty array of the model's coordinates: " + listing(model.coordinates))
     for i, name in enumerate(names, 1):
         key = f"coordinates.active[{i}]"
         if not isinstance(name, str) or name not in model.coordinates:
-            raise _fail(file, key, f"unknown coordinate {_show(name)}",
-                        "one of the model's coordinates: " + _listing(model.coordinates))
+            raise fail(file, key, f"unknown coordinate {show(name)}",
+                        "one of the model's coordinates: " + listing(model.coordinates))
         if name in names[: i - 1]:
-            raise _fail(file, key, f"coordinate '{name}' is listed twice", "each coordinate once")
+            raise fail(file, key, f"coordinate '{name}' is listed twice", "each coordinate once")
     return tuple(c for c in model.coordinates if c in names)
 
 
 def _analysis_name(ctx: OptionContext, base: str, table: dict) -> str:
     key = f"{base}.name"
     if "name" not in table:
-        raise _fail(ctx.file, key, "missing key 'name'", IDENTIFIER_RULE)
+        raise fail(ctx.file, key, "missing key 'name'", IDENTIFIER_RULE)
     name = table["name"]
     if not is_identifier(name):
-        raise _fail(ctx.file, key, f"analysis name {_show(name)} is not an identifier", IDENTIFIER_RULE)
+        raise fail(ctx.file, key, f"analysis name {show(name)} is not an identifier", IDENTIFIER_RULE)
     if name in ctx.earlier:
-        raise _fail(ctx.file, key, f"analysis name '{name}' is used twice", "a name unique in the scene")
+        raise fail(ctx.file, key, f"analysis name '{name}' is used twice", "a name unique in the scene")
     return name
 
 
 def _analysis(ctx: OptionContext, index: int, table: object) -> AnalysisSpec:
     base = f"analysis[{index}]"
     if not isinstance(table, dict):
-        raise _fail(ctx.file, base, f"analysis entry is {_type_name(table)}", "an [[analysis]] table")
+        raise fail(ctx.file, base, f"analysis entry is {type_name(table)}", "an [[analysis]] table")
     name = _analysis_name(ctx, base, table)
     kind = analysis_kind(ctx, base, table, analysis_kinds())
     ctx.current, ctx.swept = name, ()
@@ -321,8 +309,8 @@ def _analysis(ctx: OptionContext, index: int, table: object) -> AnalysisSpec:
 def _analyses(ctx: OptionContext, data: dict) -> tuple[AnalysisSpec, ...]:
     entries = data.get("analysis")
     if not isinstance(entries, list) or not entries:
-        what = "the scene has no analysis" if entries is None else f"analysis is {_type_name(entries)}"
-        raise _fail(ctx.file, "analysis", what, "one or more [[analysis]] tables")
+        what = "the scene has no analysis" if entries is None else f"analysis is {type_name(entries)}"
+        raise fail(ctx.file, "analysis", what, "one or more [[analysis]] tables")
     ctx.all_names = tuple(e["name"] for e in entries if isinstance(e, dict) and isinstance(e.get("name"), str))
     return tuple(_analysis(ctx, i, entry) for i, entry in enumerate(entries, 1))
 
@@ -342,7 +330,7 @@ def _plain(value: object) -> object:
     return value
 
 
-def load_scene(path, *, overrides: Sequence[str] = (), lookup_model: Callable[..., ModelInfo | None],
+def load_scene(path, *, overrides: Sequence[str] = (), lookup_model: Callable[..., ModelInfoLike | None],
                model_names: Callable[[], list[str]]) -> Scene:
     """Load, validate and resolve a scene file, or a dict of a scene's contents.
 
@@ -372,7 +360,7 @@ def load_scene(path, *, overrides: Sequence[str] = (), lookup_model: Callable[..
     for name, info in model.params.items():
         below = getattr(info, "below", None)
         if below is not None and not params[name] < below:
-            raise _fail(file, f"params.{name}", f"{name} = {params[name]!r} is not below {below!r}",
+            raise fail(file, f"params.{name}", f"{name} = {params[name]!r} is not below {below!r}",
                         f"a value below {below!r}")
     free = _free(file, data, model)
     active = _active(file, data, model)

@@ -20,7 +20,7 @@ from mechgen.analyses.registry import get
 from mechgen.analyses.result import run_analysis
 from mechgen.errors import InputError
 from mechgen.pipeline import compile_request, file_digest
-from mechgen.runtime.mesh import Layout
+from mechgen.runtime.fields.mesh import Layout
 from mechgen.scene.info import lookup_model, model_info
 from mechgen.scene.load import load_scene
 from mechgen.scene.plan import derive_with, plan_scene, point_request, request_for
@@ -60,7 +60,7 @@ def sweep_point(task: tuple) -> dict:
     info = model_info(source_key)  # the canonical reference: resolves in a worker process too
     system, _ = system_of(source_key, point_request(request, info, point) or request)
     system = laid_out(system, layout).with_param_vector(
-        [float(point.get(n, dict(values).get(n, info.param(n).default))) for n in system.meta.get("params", [])])
+        [float(point.get(n, dict(values).get(n, info.param(n).default))) for n in system.metadata.params])
     return public(get(kind).run(system, options, {}))
 
 

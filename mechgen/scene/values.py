@@ -21,19 +21,21 @@ NUMBER = "a number or an expression string"
 _PLAIN_KEY = re.compile(r"[A-Za-z0-9_\-]{1,64}")
 
 
-class ParamInfo(Protocol):
-    """What the loader needs to know about one model parameter."""
+class ParamInfoLike(Protocol):
+    """What the loader needs to know about one model parameter (a :class:`mechgen.scene.info.ParamInfo`
+    has it; checks of values take anything that does)."""
 
     default: float | str
     choices: tuple[str, ...] | None
     integer: bool
 
 
-class ModelInfo(Protocol):
-    """Names of a model's parameters, coordinates and outputs."""
+class ModelInfoLike(Protocol):
+    """Names of a model's parameters, coordinates and outputs (a :class:`mechgen.scene.info.ModelInfo`
+    has them)."""
 
     name: str
-    params: Mapping[str, ParamInfo]
+    params: Mapping[str, ParamInfoLike]
     coordinates: tuple[str, ...]
     outputs: tuple[str, ...]
 
@@ -106,12 +108,12 @@ def evaluate(file: str | None, key: str, expr: Expression, values: Mapping[str, 
 
 # --------------------------------------------------------------------------- model parameters
 
-def is_choice(info: ParamInfo) -> bool:
+def is_choice(info: ParamInfoLike) -> bool:
     """True for a parameter whose value is a string (a discretisation, a law ...)."""
     return info.choices is not None or isinstance(info.default, str)
 
 
-def param_info(file: str | None, key: str, model: ModelInfo, name: object) -> ParamInfo:
+def param_info(file: str | None, key: str, model: ModelInfoLike, name: object) -> ParamInfoLike:
     """The model's parameter ``name``, or a SceneError listing the parameters."""
     if not isinstance(name, str) or name not in model.params:
         raise fail(file, key, f"model '{model.name}' has no parameter {show(name)}",
@@ -119,7 +121,7 @@ def param_info(file: str | None, key: str, model: ModelInfo, name: object) -> Pa
     return model.params[name]
 
 
-def choice_value(file: str | None, key: str, info: ParamInfo, value: object) -> str:
+def choice_value(file: str | None, key: str, info: ParamInfoLike, value: object) -> str:
     """A valid value of a choice parameter."""
     allowed = f"one of: {listing(list(info.choices))}" if info.choices is not None else IDENTIFIER_RULE
     if not isinstance(value, str):
@@ -130,7 +132,7 @@ def choice_value(file: str | None, key: str, info: ParamInfo, value: object) -> 
     return value
 
 
-def finish(file: str | None, key: str, info: ParamInfo, value: float) -> float | int:
+def finish(file: str | None, key: str, info: ParamInfoLike, value: float) -> float | int:
     """A numeric parameter value as the model takes it: an int for an integer parameter, else a float."""
     if not info.integer:
         return float(value)

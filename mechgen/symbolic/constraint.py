@@ -10,7 +10,7 @@ The ``constraint`` kernel gives both at the Gauss points: g_j (jets) and g_jj
 (jets x jets), in the jets of the field's local equations (mechgen.symbolic.field).
 A model's axial strain measure (``model.strain_density``, a string's (lambda^2 - 1)/2)
 gets the same derivatives in the ``strain`` kernel: the Galerkin stiffness can then
-project the strain on a smaller space (mechgen.runtime.constrained, ``projected``).
+project the strain on a smaller space (mechgen.runtime.steady.constrained, ``projected``).
 """
 from __future__ import annotations
 

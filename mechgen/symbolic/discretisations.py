@@ -1,4 +1,4 @@
-"""Names of the discretisations a continuum scene may choose (implemented in mechgen.runtime.discretise).
+"""Names of the discretisations a continuum scene may choose (implemented in mechgen.runtime.fields.discretise).
 
 Finite elements (N = elements): ``lagrange1`` and ``lagrange2`` (C0, jets up to
 first order in the energy), ``hermite`` (two-node cubic, value and slope per

@@ -143,7 +143,9 @@ class FieldEquations:
     shear_pairs: tuple = ()
 
 
-def _density(model: Model, fn, what: str, env: dict) -> sp.Expr:
+def density_expr(model: Model, fn, what: str, env: dict) -> sp.Expr:
+    """The density a model declared (``fn`` called with ``env``: jets and parameters) as a sympy
+    expression, 0 when none is declared; ModelError naming the function when it reads something undeclared."""
     if not fn:
         return sp.Integer(0)
     try:
@@ -155,7 +157,8 @@ def _density(model: Model, fn, what: str, env: dict) -> sp.Expr:
     return as_expr(value, what, model)
 
 
-def _constraints(model: Model, p_ns: Namespace) -> tuple[Constraint, ...]:
+def boundary_constraints(model: Model, p_ns: Namespace) -> tuple[Constraint, ...]:
+    """The model's ``@boundary`` list, ``fix(jet, 'start' | 'end'[, value])`` each, as checked Constraints."""
     if model.boundary_fn is None:
         return ()
     raw = call_declared(model.boundary_fn, p=p_ns)
@@ -176,10 +179,10 @@ def _constraints(model: Model, p_ns: Namespace) -> tuple[Constraint, ...]:
 
 def _local(model: Model, fns: dict, env: dict, u: Jets, test: Jets) -> tuple:
     """Densities (or point terms) T, V, R, W of one piece."""
-    T = _density(model, fns.get("kinetic"), "kinetic_density", env)
-    V = _density(model, fns.get("potential"), "potential_density", env)
-    R = _density(model, fns.get("dissipation"), "dissipation_density", env)
-    W = _density(model, fns.get("weak"), "weak_form", {**env, "test": test})
+    T = density_expr(model, fns.get("kinetic"), "kinetic_density", env)
+    V = density_expr(model, fns.get("potential"), "potential_density", env)
+    R = density_expr(model, fns.get("dissipation"), "dissipation_density", env)
+    W = density_expr(model, fns.get("weak"), "weak_form", {**env, "test": test})
     return T, V, R, W
 
 
@@ -231,7 +234,7 @@ def derive_field(model: Model, spec: Specialization) -> FieldEquations:
             here["part"] = Namespace({n: p_ns[f"{at}_{n}"] for n in model.parts[at]})
         ends[at] = _local(model, model.point_terms[at], here, u, test)
     orders = {f: -1 for f in model.field_names}
-    constraints = _constraints(model, p_ns)
+    constraints = boundary_constraints(model, p_ns)
     for f, k, _ in list(u.used) + list(test.used) + [(c.field, c.order, 0) for c in constraints]:
         orders[f] = max(orders[f], k)
     unused = [f for f, k in orders.items() if k < 0]

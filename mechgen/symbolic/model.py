@@ -322,7 +322,7 @@ class Model:
         """Declare scalar fields on s in [0, p.<length>] (a continuum model).
 
         Adds the discretisation parameters every continuum has: ``discretisation``
-        (a choice, see :data:`mechgen.runtime.discretise.DISCRETISATIONS`), ``N``
+        (a choice, see :data:`mechgen.runtime.fields.discretise.DISCRETISATIONS`), ``N``
         (elements, or basis functions per field), ``quadrature`` (Gauss points per
         element, 0 = chosen from the basis), ``constraints`` (``eliminate``,
         ``penalty`` or ``multiplier``) and ``joints`` (``assembly``: segments share
@@ -382,7 +382,7 @@ class Model:
         """Decorator (continuum): a pointwise constraint g(u, p) = 0 on the jets (an inextensible string:
         (|r_s|^2 - 1)/2), held by a multiplier field mu(s) (the energy mu g). Returning 0 means none (a law
         without it). Small motions about a steady state satisfy dg/dj . j' = 0 and feel the geometric
-        stiffness mu d2g/dj2 (mechgen.runtime.constrained); steady states use the Hamiltonian form, with
+        stiffness mu d2g/dj2 (mechgen.runtime.steady.constrained); steady states use the Hamiltonian form, with
         n = mu dg/du_s.
         """
         self.constraint_fn = fn
@@ -392,7 +392,7 @@ class Model:
         """Decorator (continuum): the scalar strain measure g(u, p) through which the slopes enter the strain
         energy (V = W(g, u): a string's stretch). With the runtime choice ``strain = "projected"`` the axial
         stiffness W_gg g_j g_j^T is replaced by its projection on cos(k pi s/L) (a mixed, locking-free
-        Galerkin stiffness; mechgen.runtime.constrained). Returning 0 means none."""
+        Galerkin stiffness; mechgen.runtime.steady.constrained). Returning 0 means none."""
         self.strain_fn = fn
         return fn
 

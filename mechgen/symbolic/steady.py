@@ -45,7 +45,7 @@ import sympy as sp
 
 from mechgen.errors import ModelError
 from mechgen.symbolic.derive import TIME, LumpedEquations, lagrange_residual
-from mechgen.symbolic.field import POSITION, Jets, _constraints, _density
+from mechgen.symbolic.field import POSITION, Jets, boundary_constraints, density_expr
 from mechgen.symbolic.model import Model, as_expr, call_declared
 from mechgen.symbolic.params import Namespace
 from mechgen.symbolic.specialize import Specialization, param_namespace
@@ -71,9 +71,9 @@ def derive_steady(model: Model, spec: Specialization) -> LumpedEquations:
                          "constraint (no strain energy to invert)", file=model.file, key="form",
                          expected="form = 'hamiltonian' (the stress form, from the complementary energy)")
     u, env, p_ns, free = _steady_env(model, spec)
-    T = _density(model, model.kinetic_fn, "kinetic_density", env)
-    V = _density(model, model.potential_fn, "potential_density", env)
-    R = _density(model, model.dissipation_fn, "dissipation_density", env)
+    T = density_expr(model, model.kinetic_fn, "kinetic_density", env)
+    V = density_expr(model, model.potential_fn, "potential_density", env)
+    R = density_expr(model, model.dissipation_fn, "dissipation_density", env)
     if any(k > 1 or m > 1 for _, k, m in u.used):
         raise ModelError(f"steady equations of {model.name} need densities of first order in s and t",
                          file=model.file, key="steady", expected="jets u, u_s, u_t only")
@@ -92,7 +92,7 @@ def derive_steady(model: Model, spec: Specialization) -> LumpedEquations:
         value = as_expr(call_declared(out.fn, n=stress, **{k: env[k] for k in ("u", "p", "s")}),
                         f"output {out.name}", model)
         outputs[out.name] = value.xreplace(still).xreplace({POSITION: TIME})
-    for c in _constraints(model, p_ns):
+    for c in boundary_constraints(model, p_ns):
         outputs[f"bc_{c.field}_{c.order}_{c.at}"] = sp.sympify(c.value)
     stray = set().union(*(sp.sympify(e).free_symbols for e in rho + list(outputs.values()))) - set(q + v + a + free)
     stray -= {TIME}
@@ -126,8 +126,8 @@ def derive_steady_hamiltonian(model: Model, spec: Specialization) -> LumpedEquat
     n_ns = Namespace(dict(zip(fields, n_syms)))
     C = as_expr(call_declared(model.complementary_fn, u=u, n=n_ns, p=p_ns, s=POSITION),
                 "complementary_density", model)
-    T = _density(model, model.kinetic_fn, "kinetic_density", env)
-    R = _density(model, model.dissipation_fn, "dissipation_density", env)
+    T = density_expr(model, model.kinetic_fn, "kinetic_density", env)
+    R = density_expr(model, model.dissipation_fn, "dissipation_density", env)
     if any(k > 1 or m > 1 for _, k, m in u.used):
         raise ModelError(f"steady equations of {model.name} need densities of first order in s and t",
                          file=model.file, key="steady", expected="jets u, u_s, u_t only")
@@ -149,7 +149,7 @@ def derive_steady_hamiltonian(model: Model, spec: Specialization) -> LumpedEquat
         value = as_expr(call_declared(out.fn, n=n_ns, **{k: env[k] for k in ("u", "p", "s")}),
                         f"output {out.name}", model)
         outputs[out.name] = value.xreplace(still).xreplace({POSITION: TIME}).xreplace(to_slopes)
-    for c in _constraints(model, p_ns):
+    for c in boundary_constraints(model, p_ns):
         if c.order > 0:
             raise ModelError(f"the Hamiltonian steady form of {model.name} fixes values only, not {c.field} of "
                              f"order {c.order}", file=model.file, key="boundary", expected="fix(field, end, value)")
@@ -173,7 +173,7 @@ def steady_field_meta(model: Model, spec: Specialization) -> dict:
     """The runtime's description of a continuum (mechgen.pipeline.field_meta) when only its steady
     Hamiltonian form is built: fields, their values and slopes as jets, length, end conditions."""
     p_ns, _ = param_namespace(model, spec)
-    constraints = _constraints(model, p_ns)
+    constraints = boundary_constraints(model, p_ns)
     meta = {"fields": list(model.field_names), "jets": [[f, k] for k in (0, 1) for f in model.field_names],
             "length": model.continuum.length, "points": [], "constant_mass": True,
             "constraints": [[c.field, c.order, c.at] for c in constraints]}
