@@ -6,9 +6,6 @@ An exception at a point is re-raised naming that point.
 from __future__ import annotations
 
 import sys
-from concurrent.futures import ProcessPoolExecutor
-
-from tqdm import tqdm
 
 from mechgen.errors import MechgenError
 from mechgen.runtime.core.threads import single_thread_worker
@@ -19,6 +16,8 @@ class SweepError(MechgenError):
 
 
 def _bar(total: int, progress: bool, desc: str):
+    from tqdm import tqdm  # imported when a sweep runs, not with every scene (startup)
+
     return tqdm(total=total, desc=desc, disable=not (progress and sys.stderr.isatty()), file=sys.stderr)
 
 
@@ -31,6 +30,8 @@ def sweep(func, points: list, *, workers: int = 0, progress: bool = True, desc: 
                 results[i] = _call(func, point)
                 bar.update()
             return results
+        from concurrent.futures import ProcessPoolExecutor
+
         with ProcessPoolExecutor(max_workers=workers, initializer=single_thread_worker) as pool:
             futures = [pool.submit(func, point) for point in points]
             for i, fut in enumerate(futures):
