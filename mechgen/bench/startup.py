@@ -10,12 +10,13 @@ cached run derives nothing). Writes ``out/startup.{json,md}``.
 """
 from __future__ import annotations
 
-import json
 import statistics
 import subprocess
 import sys
 import time
 from pathlib import Path
+
+from mechgen.bench.common import ROOT, write_json, write_text
 
 SCENES = ("laval_rotor.toml", "beam_modes.toml")
 HEAVY = ("sympy", "jinja2", "scipy.optimize", "mechgen.symbolic")
@@ -54,14 +55,13 @@ def time_scene(scene: Path, repeats: int = 7) -> dict:
 
 def run_startup_benchmarks(out: Path, *, quick: bool = False) -> dict:
     """Time every scene of :data:`SCENES`; writes ``out/startup.{json,md}``."""
-    folder = Path(__file__).resolve().parents[1] / "scenes"
+    folder = ROOT / "scenes"
     rows = [time_scene(folder / name, repeats=3 if quick else 7) for name in SCENES]
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "startup.json").write_text(json.dumps(rows, indent=2))
+    write_json(out / "startup.json", rows)
     lines = ["| scene | whole process (median, s) | imports (s) | import share | heavy imports |",
              "|---|---|---|---|---|"]
     lines += [f"| {r['scene']} | {r['wall_s']:.3f} | {r['imports_s']:.3f} | {r['import_share']:.0%} | "
               f"{', '.join(r['heavy_imports']) or 'none'} |" for r in rows]
-    (out / "startup.md").write_text("\n".join(lines) + "\n")
+    write_text(out / "startup.md", "\n".join(lines) + "\n")
     print("\n".join(lines))
     return {"rows": rows}
