@@ -115,3 +115,26 @@ def test_modes_analysis_warns_from_the_computed_modes(monkeypatch, N):
         warnings.simplefilter("always")
         run_modes(beam(N, "penalty"), {"count": 5}, {})
     assert any("mode 5" in m for m in penalty_warnings(record))
+
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_lowest_modes_survive_unresolved_high_modes(seed):
+    """A light dof spreads the spectrum as the beam's slope dofs do: K well scaled (random SPD, entries ~1),
+    M = diag(1, 1, 1, 1e-20). The top mode's mu = 1/omega^2 ~ 1e-20 lies below the inverse solver's
+    resolution (n eps max mu ~ 1e-15) and comes out of round-off with either sign; it must be kept as an
+    unresolved high mode, not make the solver fall back to K phi = lambda M phi (whose error eps * 1e20
+    swamps the low modes). Reference: the massless dof condensed out exactly (Schur complement
+    K11 - K12 K22^-1 K21 with M11 = I), to which the low modes converge as the mass -> 0 (O(1e-20))."""
+    import warnings
+
+    a = np.random.default_rng(seed).standard_normal((4, 4))
+    K = a @ a.T + 4 * np.eye(4)
+    M = np.diag([1.0, 1.0, 1.0, 1e-20])
+    condensed = K[:3, :3] - np.outer(K[:3, 3], K[3, :3]) / K[3, 3]
+    exact = np.sqrt(np.linalg.eigvalsh(condensed))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", AccuracyWarning)
+        res = modes(M, K)
+    assert res.frequencies[:3] == pytest.approx(exact, rel=1e-10)
+    assert res.frequencies[3] > 1e6

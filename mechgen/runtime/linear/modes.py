@@ -38,26 +38,44 @@ def _dense_inverse(M: np.ndarray, K: np.ndarray) -> ModesResult | None:
 
     The symmetric solver's error is about eps * max|eigenvalue|, so solving for mu
     = 1/omega^2 gets the *lowest* frequencies to full relative accuracy even when
-    K holds huge entries (penalty constraints, stiff supports).
+    K holds huge entries (penalty constraints, stiff supports). With K and M positive
+    definite every mu > 0; the highest modes' mu (below the solver's error n eps max mu)
+    are unresolved and may come out zero or slightly negative by round-off: they are held
+    at that error (lambda = 1 / (n eps max mu), beyond every resolved mode) instead of
+    abandoning this solver. A mu below minus that error means M is not positive definite (None).
     """
     try:
         sla.cho_factor(K)
     except np.linalg.LinAlgError:
         return None
     mu, phi = sla.eigh(M, K)
-    if np.any(mu <= 0):
+    resolution = len(mu) * np.finfo(float).eps * max(float(mu.max()), 0.0)
+    if resolution <= 0 or np.any(mu < -resolution):
         return None
+    mu = np.maximum(mu, resolution)
     order = np.argsort(1.0 / mu)
     mu, phi = mu[order], phi[:, order]
     lam = 1.0 / mu
     return ModesResult(lam, np.sqrt(lam), phi / np.sqrt(mu)[None, :])
 
 
+def _wide_spectrum(M: np.ndarray, K: np.ndarray, span: float = 1e6) -> bool:
+    """Whether the spectrum may span more than ``span``: huge entries of K against its smallest diagonal
+    (penalties, stiff supports), or diagonal ratios K_ii / M_ii that far apart (light slope dofs, fine
+    meshes). Then the lowest modes are solved for mu = 1/omega^2 (:func:`_dense_inverse`)."""
+    kd, md = np.abs(np.diag(K)), np.abs(np.diag(M))
+    if np.abs(K).max() > span * kd.min(initial=np.inf):
+        return True
+    both = (kd > 0) & (md > 0)
+    ratios = kd[both] / md[both]
+    return bool(ratios.size) and ratios.max() > span * ratios.min()
+
+
 def _dense(M, K, allow_singular_mass: bool = False) -> ModesResult:
     M, K = np.asarray(M, float), np.asarray(K, float)
     _check_symmetric(M, "M")
     _check_symmetric(K, "K")
-    if np.abs(K).max() > 1e6 * np.abs(np.diag(K)).min(initial=np.inf):
+    if _wide_spectrum(M, K):
         inverse = _dense_inverse(M, K)
         if inverse is not None:
             return inverse
