@@ -69,6 +69,17 @@ def frozen_vector(values) -> np.ndarray:
     return out
 
 
+def replacement_vector(system, params) -> np.ndarray | None:
+    """``params`` as a frozen vector for ``system.with_param_vector``: None when it equals the system's own
+    (the system itself serves), InputError naming the free parameters when its length is wrong."""
+    params = frozen_vector(params)
+    if params.shape != system.params.shape:
+        raise InputError(f"{len(params)} parameter values for the {len(system.params)} free parameters of "
+                         f"{system.metadata.model}", key="params",
+                         expected=f"values of {', '.join(system.metadata.params) or 'none'}")
+    return None if np.array_equal(params, system.params) else params
+
+
 def number(name: str, value) -> float:
     """A finite real parameter value, else InputError naming the parameter."""
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
@@ -133,12 +144,8 @@ class System:
     # -- new systems ----------------------------------------------------------
     def with_param_vector(self, params) -> "System":
         """The same kernels with another vector of free parameter values (``meta['params']`` order)."""
-        params = frozen_vector(params)
-        if params.shape != self.params.shape:
-            raise InputError(f"{len(params)} parameter values for the {len(self.params)} free parameters of "
-                             f"{self.metadata.model}", key="params",
-                             expected=f"values of {', '.join(self.metadata.params) or 'none'}")
-        if np.array_equal(params, self.params):
+        params = replacement_vector(self, params)
+        if params is None:
             return self
         new = replace(self, params=params)
         object.__setattr__(new, "patterns", self.patterns)  # same kernels and sites: the same memo

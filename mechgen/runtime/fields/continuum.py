@@ -39,7 +39,8 @@ from mechgen.runtime.fields.elements import reference
 from mechgen.runtime.core.kernels import Kernel
 from mechgen.runtime.core.meta import SystemMeta
 from mechgen.runtime.fields.mesh import Layout, build_mesh
-from mechgen.runtime.core.system import Memo, folded_parameter, frozen_vector, number, read_only, unknown_parameters
+from mechgen.runtime.core.system import (Memo, folded_parameter, frozen_vector, number, read_only,
+                                         replacement_vector, unknown_parameters)
 
 
 #: the values a continuum's runtime choices take (others, such as a model's own runtime choices, are strings)
@@ -101,12 +102,8 @@ class FieldSystem:
     # -- new systems ----------------------------------------------------------
     def with_param_vector(self, params) -> "FieldSystem":
         """The same kernels, choices and layout with another vector of free parameter values (the memo shared)."""
-        params = frozen_vector(params)
-        if params.shape != self.params.shape:
-            raise InputError(f"{len(params)} parameter values for the {len(self.params)} free parameters of "
-                             f"{self.meta.get('model')}", key="params",
-                             expected=f"values of {', '.join(self.meta.get('params', [])) or 'none'}")
-        if np.array_equal(params, self.params):
+        params = replacement_vector(self, params)
+        if params is None:
             return self
         new = replace(self, params=params)
         object.__setattr__(new, "_memo", self._memo)
