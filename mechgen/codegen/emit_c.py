@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from mechgen.version import __version__
 from mechgen.codegen.emit_c_loop import loop_block, stored_ports
+from mechgen.codegen.escape import c_comment, c_comment_lines, code_identifier
 from mechgen.codegen.ir import Block, KernelIR, Port
 from mechgen.codegen.printing import c_code
 from mechgen.codegen.templating import render
@@ -79,8 +80,8 @@ class _Names:
 
 
 def _straight(block: Block, names: _Names) -> list[str]:
-    lines = [f"const double {g.symbol.name} = {names.inp[g.port]}[{g.index}];" for g in block.gathers]
-    lines += [f"const double {s.name} = {c_code(e)};" for s, e in block.assignments]
+    lines = [f"const double {code_identifier(g.symbol.name)} = {names.inp[g.port]}[{g.index}];" for g in block.gathers]
+    lines += [f"const double {code_identifier(s.name)} = {c_code(e)};" for s, e in block.assignments]
     lines += [f"{names.out[w.port]}[{w.index}] {'+=' if w.accumulate else '='} {c_code(w.expr)};"
               for w in block.writes]
     return ["{"] + ["    " + line for line in lines] + ["}"]
@@ -92,13 +93,19 @@ def kernel_context(ir: KernelIR) -> dict:
     body = _batch_pointers(ir)
     for i, block in enumerate(ir.blocks):
         body += loop_block(ir, i, names.inp, names.out, names.out_len) if block.loop else _straight(block, names)
-    return {"name": ir.name, "doc": ir.doc, "port_doc": _port_doc(ir), "prologue": _prologue(ir), "body": body}
+    return {"name": code_identifier(ir.name), "doc": c_comment(ir.doc).replace("\n", " "),
+            "port_doc": [line for doc in _port_doc(ir) for line in c_comment_lines(doc, "")],
+            "prologue": _prologue(ir), "body": body}
 
 
 def emit_c(irs: list[KernelIR], *, model: str, title: str) -> str:
-    """The C99 source of all kernels of one model specialisation."""
-    return render("c99/kernels.c.j2", version=__version__, model=model, title=title,
-                  kernels=[kernel_context(ir) for ir in irs])
+    """The C99 source of all kernels of one model specialisation.
+
+    The model name, ``title`` (the specialisation's key, choice values included) and kernel and
+    port docs reach the source only through :func:`~mechgen.codegen.escape.c_comment`.
+    """
+    return render("c99/kernels.c.j2", version=__version__, model=c_comment(model).replace("\n", " "),
+                  title="\n * ".join(c_comment_lines(title, "")), kernels=[kernel_context(ir) for ir in irs])
 
 
 __all__ = ["emit_c", "kernel_context", "Port"]

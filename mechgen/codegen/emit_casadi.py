@@ -7,10 +7,9 @@ so the SX graph holds the local expressions once.
 """
 from __future__ import annotations
 
-import pprint
-
 from mechgen.version import __version__
 from mechgen.codegen.emit_numpy import extent_expr
+from mechgen.codegen.escape import code_identifier, py_docstring, py_literal
 from mechgen.codegen.ir import Block, KernelIR
 from mechgen.codegen.printing import casadi_code
 from mechgen.codegen.spec import kernel_spec
@@ -27,8 +26,8 @@ def _head(ir: KernelIR) -> list[str]:
 
 
 def _straight(block: Block, inp: dict, out: dict) -> list[str]:
-    lines = [f"{g.symbol.name} = in{inp[g.port]}[{g.index}]" for g in block.gathers]
-    lines += [f"{s.name} = {casadi_code(e)}" for s, e in block.assignments]
+    lines = [f"{code_identifier(g.symbol.name)} = in{inp[g.port]}[{g.index}]" for g in block.gathers]
+    lines += [f"{code_identifier(s.name)} = {casadi_code(e)}" for s, e in block.assignments]
     for w in block.writes:
         op = "+" if w.accumulate else ""
         lines.append(f"out{out[w.port]}[{w.index}] = {'out' + str(out[w.port]) + f'[{w.index}] + ' if op else ''}"
@@ -41,8 +40,8 @@ def _loop(block: Block, k: int, inp: dict, out: dict, slot_port: str | None) -> 
     rel = [g for g in block.gathers if g.relative]
     absolute = [g for g in block.gathers if not g.relative]
     lines = [f"cnt = {extent_expr(block.loop.count)}", f"ns = {extent_expr(block.loop.sites)}"]
-    lines += [f"{g.symbol.name} = ca.SX.sym({g.symbol.name!r})" for g in rel + absolute]
-    lines += [f"{s.name} = {casadi_code(e)}" for s, e in block.assignments]
+    lines += [f"{code_identifier(g.symbol.name)} = ca.SX.sym({g.symbol.name!r})" for g in rel + absolute]
+    lines += [f"{code_identifier(s.name)} = {casadi_code(e)}" for s, e in block.assignments]
     exprs = ", ".join(casadi_code(w.expr) for w in block.writes)
     args = ", ".join(g.symbol.name for g in rel + absolute)
     lines.append(f"local = ca.Function('local{k}', [{args}], [ca.vertcat({exprs})])")
@@ -83,7 +82,12 @@ def kernel_body(ir: KernelIR) -> list[str]:
 
 
 def emit_casadi(irs: list[KernelIR], *, model: str, title: str) -> str:
-    """The CasADi module text of all kernels of one model specialisation."""
-    spec = pprint.pformat({ir.name: kernel_spec(ir) for ir in irs}, width=110, sort_dicts=True)
-    return render("casadi/kernels.py.j2", version=__version__, model=model, title=title, spec=spec,
-                  kernels=[{"name": ir.name, "doc": ir.doc, "body": kernel_body(ir)} for ir in irs])
+    """The CasADi module text of all kernels of one model specialisation.
+
+    Free text reaches it only through :func:`~mechgen.codegen.escape.py_docstring`, the spec only
+    through :func:`~mechgen.codegen.escape.py_literal` (as in :func:`~mechgen.codegen.emit_numpy.emit_numpy`).
+    """
+    spec = py_literal({ir.name: kernel_spec(ir) for ir in irs})
+    return render("casadi/kernels.py.j2", version=__version__, model=py_docstring(model), title=py_docstring(title),
+                  spec=spec, kernels=[{"name": code_identifier(ir.name), "doc": py_docstring(ir.doc),
+                                       "body": kernel_body(ir)} for ir in irs])

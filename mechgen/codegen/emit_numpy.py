@@ -6,9 +6,8 @@ distinct entries so ``+=`` on an index array is exact).
 """
 from __future__ import annotations
 
-import pprint
-
 from mechgen.version import __version__
+from mechgen.codegen.escape import code_identifier, py_docstring, py_literal
 from mechgen.codegen.ir import Block, KernelIR
 from mechgen.codegen.printing import numpy_code
 from mechgen.codegen.spec import kernel_spec
@@ -31,9 +30,9 @@ def _head(ir: KernelIR) -> list[str]:
 
 
 def _straight(block: Block, idx: "_Indexed") -> list[str]:
-    lines = [f"{g.symbol.name} = in{idx.inp[g.port][0]}[{':, ' if idx.inp[g.port][1] else ''}{g.index}]"
-             for g in block.gathers]
-    lines += [f"{s.name} = {numpy_code(e)}" for s, e in block.assignments]
+    lines = [f"{code_identifier(g.symbol.name)} = in{idx.inp[g.port][0]}[{':, ' if idx.inp[g.port][1] else ''}"
+             f"{g.index}]" for g in block.gathers]
+    lines += [f"{code_identifier(s.name)} = {numpy_code(e)}" for s, e in block.assignments]
     lines += [f"out{idx.out[w.port]}[:, {w.index}] {'+=' if w.accumulate else '='} {numpy_code(w.expr)}"
               for w in block.writes]
     return lines
@@ -53,13 +52,14 @@ def _loop(block: Block, slot_index: int | None, idx: "_Indexed") -> list[str]:
             lines += [f"i{k + 8} = e + {k}", f"ok{k + 8} = (i{k + 8} >= 0) & (i{k + 8} < ns)",
                       f"i{k + 8} = np.clip(i{k + 8}, 0, max(ns - 1, 0))"]
     for g in block.gathers:
+        code_identifier(g.symbol.name)
         if not g.relative:
             lines.append(f"{g.symbol.name} = in{idx.inp[g.port][0]}[{g.index}]")
         elif periodic:
             lines.append(f"{g.symbol.name} = in{idx.inp[g.port][0]}[:, i{g.index + 8}]")
         else:
             lines.append(f"{g.symbol.name} = np.where(ok{g.index + 8}, in{idx.inp[g.port][0]}[:, i{g.index + 8}], 0.0)")
-    lines += [f"{s.name} = {numpy_code(e)}" for s, e in block.assignments]
+    lines += [f"{code_identifier(s.name)} = {numpy_code(e)}" for s, e in block.assignments]
     entries = {entry: col for col, entry in enumerate(block.entries)}
     for w in block.writes:
         val = f"_bc({numpy_code(w.expr)}, shape)"
@@ -95,7 +95,13 @@ def kernel_body(ir: KernelIR) -> list[str]:
 
 
 def emit_numpy(irs: list[KernelIR], *, model: str, title: str) -> str:
-    """The numpy module text of all kernels of one model specialisation."""
-    spec = pprint.pformat({ir.name: kernel_spec(ir) for ir in irs}, width=110, sort_dicts=True)
-    return render("numpy/kernels.py.j2", version=__version__, model=model, title=title, spec=spec,
-                  kernels=[{"name": ir.name, "doc": ir.doc, "body": kernel_body(ir)} for ir in irs])
+    """The module text of all kernels of one model specialisation (numpy).
+
+    The model name, ``title`` (the specialisation's key, choice values included) and kernel docs
+    reach the module only through :func:`~mechgen.codegen.escape.py_docstring`, the spec only
+    through :func:`~mechgen.codegen.escape.py_literal`.
+    """
+    spec = py_literal({ir.name: kernel_spec(ir) for ir in irs})
+    return render("numpy/kernels.py.j2", version=__version__, model=py_docstring(model), title=py_docstring(title),
+                  spec=spec, kernels=[{"name": code_identifier(ir.name), "doc": py_docstring(ir.doc),
+                                       "body": kernel_body(ir)} for ir in irs])

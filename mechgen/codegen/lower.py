@@ -15,6 +15,7 @@ import sympy as sp
 from mechgen.codegen.ir import Block, Gather, KernelIR, Port, Write, fixed
 from mechgen.codegen.rewrite import optimise
 from mechgen.errors import ModelError
+from mechgen.symbolic.finite import nonfinite_in
 
 
 def canonical_block(gathers: list[tuple[sp.Symbol, str, int, bool]], writes: list[Write], *,
@@ -39,6 +40,11 @@ def canonical_block(gathers: list[tuple[sp.Symbol, str, int, bool]], writes: lis
         raise ModelError(f"expressions of model {model} use symbols {names} that are not coordinates, "
                          "velocities, internal variables, time or parameters", key=names,
                          expected="only declared names")
+    bad = nonfinite_in(exprs)
+    if bad:  # second line of defence: the declared functions' results are checked where they return
+        raise ModelError(f"derived expressions of model {model} are singular at the fixed parameter values: they "
+                         f"hold {'; '.join(bad)}", key="params",
+                         expected="parameter values at which the model's laws and their derivatives are finite")
     assignments: list = []
     if cse and exprs:
         assignments, exprs = optimise(exprs, set(rename.values()))

@@ -3,14 +3,86 @@
 Small integer powers become bracketed products (``(x*x*x)``: exact and fast
 without -ffast-math), x**(1/2) becomes sqrt, x**-n becomes (1.0/(...)). Numbers print
 with 17 significant digits so a double survives the round trip.
+
+A number whose double is not finite (a constant folded at specialisation that overflows, such as
+1e200**2, or an integer beyond the double range) prints as the backend's infinity or NaN
+(C99 ``INFINITY``/``NAN`` of ``math.h``; ``np.inf``/``np.nan`` in the numpy and CasADi modules,
+which import numpy), never as a bare ``inf`` (a Python name). Other named constants (E, the
+Euler-Mascheroni constant ...) print as their doubles. ``zoo`` (complex infinity, a division by
+zero) and the imaginary unit have no real value: printing them is an error (the specialisation
+refuses such laws first, :func:`mechgen.symbolic.specialize.check_finite`). Symbol names pass
+:func:`mechgen.codegen.escape.code_identifier`.
 """
 from __future__ import annotations
+
+import math
 
 import sympy as sp
 from sympy.printing.c import C99CodePrinter
 from sympy.printing.pycode import PythonCodePrinter
 
 MAX_UNROLLED_POWER = 8
+
+
+def _double(value) -> float:
+    """The double of a sympy or Python number; +-inf where it overflows (an integer beyond 1.8e308)."""
+    try:
+        return float(value)
+    except OverflowError:
+        return math.inf if value > 0 else -math.inf
+
+
+class _Numbers:
+    """Number printing shared by the backends: ``_INF``/``_NAN`` name the backend's infinity and NaN."""
+
+    _INF = "INFINITY"
+    _NAN = "NAN"
+
+    def _number(self, value: float) -> str:
+        if math.isnan(value):
+            return self._NAN
+        if math.isinf(value):
+            return self._INF if value > 0 else f"(-{self._INF})"
+        return repr(value)
+
+    def _print_Float(self, expr):
+        return self._number(_double(expr))
+
+    def _print_Integer(self, expr):
+        return self._number(_double(expr))
+
+    def _print_Infinity(self, expr):
+        return self._number(math.inf)
+
+    def _print_NegativeInfinity(self, expr):
+        return self._number(-math.inf)
+
+    def _print_NaN(self, expr):
+        return self._NAN
+
+    def _print_NumberSymbol(self, expr):
+        return self._number(_double(expr))
+
+    _print_Exp1 = _print_EulerGamma = _print_GoldenRatio = _print_Catalan = _print_TribonacciConstant = \
+        _print_NumberSymbol
+
+    def _print_ComplexInfinity(self, expr):
+        raise ValueError("zoo (complex infinity: a division by zero) has no value in generated code")
+
+    def _print_ImaginaryUnit(self, expr):
+        raise ValueError("the imaginary unit I has no value in real generated code")
+
+    def _print_Symbol(self, expr):
+        from mechgen.codegen.escape import code_identifier
+
+        return code_identifier(expr.name)
+
+    def _rational(self, expr) -> str | None:
+        """``p/q`` as two doubles when both are finite (the form kernels have always had), else None."""
+        p, q = _double(expr.p), _double(expr.q)
+        if math.isfinite(p) and math.isfinite(q):
+            return f"{p!r}/{q!r}"
+        return None
 
 
 def _power_text(printer, expr: sp.Pow) -> str | None:
@@ -26,7 +98,7 @@ def _power_text(printer, expr: sp.Pow) -> str | None:
     return None
 
 
-class CPrinter(C99CodePrinter):
+class CPrinter(_Numbers, C99CodePrinter):
     """C99 printer for kernel expressions (doubles only)."""
 
     def _print_Pow(self, expr):
@@ -41,22 +113,18 @@ class CPrinter(C99CodePrinter):
         return f"pow({self._print(base)}, {self._print(sp.Float(exp) if exp.is_Rational else exp)})"
 
     def _print_Rational(self, expr):
-        return f"{float(expr.p)!r}/{float(expr.q)!r}"
-
-    def _print_Integer(self, expr):
-        return f"{float(expr)!r}"
-
-    def _print_Float(self, expr):
-        return repr(float(expr))
+        return self._rational(expr) or self._number(_double(expr))
 
     def _print_Pi(self, expr):
         return repr(float(sp.pi))
 
 
-class NumpyPrinter(PythonCodePrinter):
+class NumpyPrinter(_Numbers, PythonCodePrinter):
     """Printer for vectorised numpy code (module imported as ``np``)."""
 
     _module = "np"
+    _INF = "np.inf"
+    _NAN = "np.nan"
     _functions = {"sin", "cos", "tan", "asin", "acos", "atan", "atan2", "sinh", "cosh", "tanh", "exp", "log",
                   "sqrt", "Abs", "sign", "Max", "Min"}
     _np_names = {"asin": "arcsin", "acos": "arccos", "atan": "arctan", "atan2": "arctan2", "Abs": "abs",
@@ -85,20 +153,16 @@ class NumpyPrinter(PythonCodePrinter):
         return f"{self.parenthesize(base, 60)}**{self.parenthesize(sp.Float(exp) if exp.is_Rational else exp, 60)}"
 
     def _print_Rational(self, expr):
-        return f"({float(expr.p)!r}/{float(expr.q)!r})"
-
-    def _print_Integer(self, expr):
-        return f"{float(expr)!r}"
-
-    def _print_Float(self, expr):
-        return repr(float(expr))
+        text = self._rational(expr)
+        return f"({text})" if text else self._number(_double(expr))
 
     def _print_Pi(self, expr):
         return f"{self._module}.pi"
 
 
 class CasadiPrinter(NumpyPrinter):
-    """Printer for CasADi SX construction code (module imported as ``ca``)."""
+    """Printer for CasADi SX construction code (module imported as ``ca``; numpy as ``np``, whose ``np.inf`` and
+    ``np.nan`` are the non-finite constants)."""
 
     _module = "ca"
     _np_names = {"asin": "asin", "acos": "acos", "atan": "atan", "atan2": "atan2", "Abs": "fabs",

@@ -23,7 +23,6 @@ every kernel kind of a lumped model (residual, tangent, linear, outputs) follows
 """
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass, field
 
 import sympy as sp
@@ -31,11 +30,11 @@ import sympy as sp
 from mechgen.errors import ModelError
 from mechgen.symbolic.derive import TIME, LumpedEquations, lagrange_residual
 from mechgen.symbolic.model import Model, as_expr, call_declared
+from mechgen.symbolic.names import jet_of
 from mechgen.symbolic.params import Namespace
 from mechgen.symbolic.specialize import Specialization, param_namespace
 
 POSITION = sp.Symbol("s", real=True)
-_SUFFIX = re.compile(r"(s*)(t{0,2})\Z")
 ENDS = ("start", "end")
 
 
@@ -81,15 +80,8 @@ class Jets(Namespace):
 
     @staticmethod
     def parse(name: str, fields) -> tuple[str, int, int] | None:
-        """(field, space order, time order) of a jet name, or None."""
-        for f in sorted(fields, key=len, reverse=True):
-            if name == f:
-                return f, 0, 0
-            if name.startswith(f + "_"):
-                m = _SUFFIX.match(name[len(f) + 1:])
-                if m and m.group(0):
-                    return f, len(m.group(1)), len(m.group(2))
-        return None
+        """(field, space order, time order) of a jet name, or None (:func:`mechgen.symbolic.names.jet_of`)."""
+        return jet_of(name, fields)
 
     def symbol(self, field: str, k: int, m: int) -> sp.Symbol:
         """The symbol of jet (field, k, m)."""

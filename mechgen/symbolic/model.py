@@ -24,7 +24,8 @@ import sympy as sp
 from typing import Callable
 
 from mechgen.errors import MechgenError, ModelError
-from mechgen.symbolic.names import RESERVED, check_identifier
+from mechgen.symbolic.finite import nonfinite_in, number_text, singular_parameter
+from mechgen.symbolic.names import RESERVED, check_identifier, name_clash_error, output_clash
 from mechgen.symbolic.params import Namespace, Param, UnknownEntry
 
 ARG_NAMES = ("q", "v", "z", "p", "t")
@@ -197,7 +198,25 @@ def call_declared(fn: Callable, **available: object) -> object:
                          key=getattr(fn, "__name__", None),
                          expected=f"expressions of {', '.join(f'{n}.<name>' for n in names) or 'numbers'} only (a "
                                   "sympy Symbol made in the model file is not a parameter: declare it with Param)")
+    bad = nonfinite_in(result)
+    if bad:
+        raise _singular(fn, given, bad)
     return result
+
+
+def _singular(fn: Callable, given: dict, bad: list[str]) -> ModelError:
+    """The error for a declared function whose result holds zoo, nan, oo or I (mechgen.symbolic.finite)."""
+    file, at = _declared_at(fn)
+    name = getattr(fn, "__name__", "the function")
+    found = singular_parameter(fn, given)
+    if found is None:
+        return ModelError(f"{at}{name} is singular at the fixed parameter values: its result holds "
+                          f"{'; '.join(bad)}", file=file, key=name,
+                          expected="parameter values at which the declared expressions are finite and real")
+    param, value = found
+    return ModelError(f"{at}{name} is singular at parameter {param} = {number_text(value)}: its result holds "
+                      f"{'; '.join(bad)}", file=file, key=f"params.{param}",
+                      expected=f"a value of {param} at which {name} is finite and real")
 
 
 def _caller_file() -> str | None:
@@ -282,8 +301,10 @@ class Model:
         self.internals.append(Internal(name, rate, float(initial), doc))
 
     def output(self, name: str, fn: Callable, *, unit: str = "", doc: str = "") -> None:
-        """Declare a named output, a function of (q, v, z, p, t)."""
+        """Declare a named output, a function of (q, v, z, p, t); not named like a built-in output or a result key
+        (:data:`mechgen.symbolic.names.BUILTIN_OUTPUTS`, :data:`~mechgen.symbolic.names.RESULT_KEYS`)."""
         self._claim(name, "output")
+        self._unreported(name, "output")
         self.outputs.append(Output(name, fn, unit, doc))
 
     def shape_output(self, name: str, fn: Callable, *, start: Callable | None = None, doc: str = "") -> None:
@@ -301,6 +322,7 @@ class Model:
         ``shape = { name = value }``.
         """
         self._claim(name, "output")
+        self._unreported(name, "shape output")
         if name in {o.name for o in self.shape_outputs}:
             raise ModelError(f"output name {name!r} is already used in model {self.name}", file=self.file, key=name,
                              expected="a name not yet declared")
@@ -568,6 +590,11 @@ class Model:
         """First line of the docstring."""
         return self.doc.splitlines()[0] if self.doc else self.name
 
+    def _unreported(self, name: str, what: str) -> None:
+        clash = output_clash(name, self) if isinstance(name, str) else None
+        if clash is not None:
+            raise name_clash_error(self, name, what, clash)
+
     def _claim(self, name: str, what: str) -> None:
         check_identifier(name, what=what, file=self.file)
         if name in RESERVED:
@@ -581,3 +608,8 @@ class Model:
         if name in taken or name.endswith(("_dot", "_ddot")) and name.rsplit("_", 1)[0] in taken:
             raise ModelError(f"{what} name {name!r} is already used in model {self.name}", file=self.file,
                              key=name, expected="a name not yet declared")
+        if what == "coordinate" and {f"{name}_dot", f"{name}_ddot"} & taken:
+            used = sorted({f"{name}_dot", f"{name}_ddot"} & taken)[0]
+            raise ModelError(f"coordinate name {name!r} of model {self.name} derives the velocity/acceleration "
+                             f"name {used!r}, which is already declared", file=self.file, key=name,
+                             expected=f"a coordinate whose {name}_dot and {name}_ddot are not declared names")

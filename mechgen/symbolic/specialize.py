@@ -12,6 +12,7 @@ import sympy as sp
 
 from mechgen.errors import ModelError
 from mechgen.symbolic.model import Model
+from mechgen.symbolic.names import check_model_names
 from mechgen.symbolic.params import Namespace
 
 
@@ -43,6 +44,7 @@ class Specialization:
 
 def all_free(model: Model) -> Specialization:
     """Every numeric parameter symbolic; choices and sizes at their defaults."""
+    check_model_names(model)
     values = {p.name: p.default for p in model.param_list if not p.is_numeric}
     free = tuple(p.name for p in model.param_list if p.is_numeric)
     return Specialization(values=values, free=free, runtime=tuple(p.name for p in model.param_list if p.runtime))
@@ -52,8 +54,10 @@ def specialize(model: Model, values: dict, *, free: tuple[str, ...] = (), active
     """Build a :class:`Specialization` from resolved scene values.
 
     Every numeric parameter not in ``free`` is fixed (to ``values`` or its default);
-    the parameters of part kinds (:meth:`Model.part`) are always free.
+    the parameters of part kinds (:meth:`Model.part`) are always free. The model's names are
+    checked first (:func:`mechgen.symbolic.names.check_model_names`).
     """
+    check_model_names(model)
     free = tuple(free) + tuple(n for n in model.part_params() if n not in free)
     fixed: dict = {}
     free_values: dict = {}
@@ -89,7 +93,12 @@ def exact_number(value: float | int) -> sp.Expr:
 
 
 def param_namespace(model: Model, spec: Specialization) -> tuple[Namespace, tuple[sp.Symbol, ...]]:
-    """The ``p`` namespace handed to declared functions, and the free symbols in order."""
+    """The ``p`` namespace handed to declared functions, and the free symbols in order.
+
+    Every derivation starts here, so the model's names are checked here again (a Specialization
+    made by hand skips :func:`specialize`).
+    """
+    check_model_names(model)
     items: dict = {}
     free_syms = []
     for prm in model.param_list:
