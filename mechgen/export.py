@@ -194,7 +194,7 @@ def _casadi_files(model, spec, irs) -> dict:
     from mechgen.runtime.core.pattern import build_pattern
 
     named = [replace(ir, name=f"{model.name}_{ir.name}") for ir in irs]
-    text = emit_casadi(named, model=model.name, title=py_docstring(spec.key()))
+    text = emit_casadi(named, model=model.name, title=spec.key())
     sites = int(spec.values[model.chain_spec.sites]) if model.is_lattice else None
     files: dict = {}
     manifest = {"model": model.name, "mechgen": __version__, "backend": "casadi", "doc": model.doc,

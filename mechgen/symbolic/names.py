@@ -133,7 +133,7 @@ def _derived_by(name: str, model) -> str | None:
     if fields:
         if name == "s":
             return "the position s along the continuum"
-        jet = jet_of(name, fields)
+        jet = jet_of(name, [f for f in fields if f != name])  # a field w_s beside w is w's slope
         if jet is not None and jet[1:] != (0, 0):
             return f"the jet {name} of field {jet[0]} (u.{name}: derivatives of {jet[0]})"
         if name.startswith("test_") and jet_of(name[5:], fields) is not None:
