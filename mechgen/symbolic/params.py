@@ -11,7 +11,8 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
-from mechgen.symbolic.names import check_identifier
+from mechgen.errors import ModelError
+from mechgen.symbolic.names import check_identifier, declaring_file
 
 
 @dataclass(frozen=True)
@@ -32,6 +33,10 @@ class Param:
         below: an exclusive upper bound the value must stay under (checked when a
             scene or a specialisation sets it), e.g. 1 for a length parameter
             lambda0 = (l0 - h)/l0 that would make l0 negative.
+        minimum, maximum: inclusive bounds of the value (a Poisson ratio from -1 to 0.5,
+            a size's largest sensible count), checked when a scene sets it
+            (mechgen.scene.bounds). Bounds are facts for validation only: they are no
+            sympy assumptions and never change a derivation.
     """
 
     name: str
@@ -44,10 +49,13 @@ class Param:
     positive: bool = False
     runtime: bool = False
     below: float | None = None
+    minimum: float | None = None
+    maximum: float | None = None
     symbol: sp.Symbol = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         check_identifier(self.name, what="parameter")
+        self._check_bounds()
         if self.size:
             object.__setattr__(self, "integer", True)
         if isinstance(self.default, str) and not self.choices:
@@ -56,6 +64,27 @@ class Param:
         if self.positive:
             assumptions["positive"] = True
         object.__setattr__(self, "symbol", sp.Symbol(self.name, **assumptions))
+
+    def _check_bounds(self) -> None:
+        """minimum <= maximum, both finite numbers, and a numeric default inside them (ModelError naming
+        the declaring file)."""
+        import math
+
+        for what in ("minimum", "maximum"):
+            bound = getattr(self, what)
+            if bound is not None and (isinstance(bound, bool) or not isinstance(bound, (int, float))
+                                      or not math.isfinite(bound)):
+                raise ModelError(f"parameter {self.name}: {what} = {bound!r} is not a finite number",
+                                 file=declaring_file(), key=f"{self.name}.{what}", expected="a finite number or None")
+        low, high = self.minimum, self.maximum
+        if low is not None and high is not None and not low <= high:
+            raise ModelError(f"parameter {self.name}: minimum {low!r} is above maximum {high!r}",
+                             file=declaring_file(), key=f"{self.name}.minimum", expected="minimum <= maximum")
+        if isinstance(self.default, (int, float)) and not isinstance(self.default, bool):
+            if (low is not None and self.default < low) or (high is not None and self.default > high):
+                raise ModelError(f"parameter {self.name}: default {self.default!r} is outside "
+                                 f"[{low!r}, {high!r}]", file=declaring_file(), key=f"{self.name}.default",
+                                 expected="a default within the declared minimum and maximum")
 
     @property
     def is_choice(self) -> bool:
