@@ -175,7 +175,7 @@ def test_a_part_off_a_vertex_is_reported_at_its_at_key_with_a_fix(tmp_path, caps
     """Before: 'at key discretisation' and no file. The message suggests two segments or an N whose
     uniform mesh has a vertex at every part (0.6, 1.0 on L = 1.5: N = 15)."""
     path = _scene(tmp_path, "ross_example_rotor", ROSS_EDIT)
-    err = _fails(["run", path], capsys, str(path), "'parts[1].at'", "disk at s = 0.6", "not at a vertex",
+    err = _fails(["run", path], capsys, str(path), "'parts[1].at'", "disk at s = 0.6", "not at a mesh vertex",
                  "segment boundary", "[[segments]] length = 0.6, elements = 2", "[[segments]] length = 0.9",
                  "N = 15")
     assert "'discretisation'" not in err

@@ -174,7 +174,7 @@ def _check_vertices(file: str, model: Any, params: dict, segments: tuple, parts:
         if abs(nodes[k] - piece.at) <= 1e-9 * length:
             continue
         near = ", ".join(f"{x:g}" for x in nodes[max(k - 1, 0):k + 2])
-        raise fail(file, key, f"the {piece.kind} at s = {piece.at:g} is not at a vertex of the mesh (nearest "
+        raise fail(file, key, f"the {piece.kind} at s = {piece.at:g} is not at a mesh vertex (nearest "
                    f"vertices: {near}); parts sit on element boundaries",
                    _vertex_fix(segments, size, length, piece.at, [p.at for p in parts]))
 
