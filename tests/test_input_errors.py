@@ -158,12 +158,19 @@ def test_declared_minimum_and_maximum_of_a_user_model(tmp_path, capsys):
 def test_bad_bounds_in_a_declaration_name_the_declaring_file():
     from mechgen import Param
 
-    for kwargs, words in ((dict(minimum=1.0, maximum=0.0), "above maximum"),
-                          (dict(minimum=math.nan), "not a finite number"),
-                          (dict(maximum=0.1), "outside")):
+    for default, kwargs, words in ((0.3, dict(minimum=1.0, maximum=0.0), "above maximum"),
+                                   (0.3, dict(minimum=math.nan), "not a finite number"),
+                                   (0.3, dict(maximum=0.1), "outside"),
+                                   (None, {}, "not a finite number or a string"),
+                                   ([1.0], {}, "not a finite number or a string"),
+                                   (math.inf, {}, "not a finite number or a string"),
+                                   (-1.0, dict(positive=True), "not positive"),
+                                   (2.0, dict(below=1.0), "not below 1.0"),
+                                   (0.3, dict(below="one"), "below = 'one' is not a finite number"),
+                                   (2.5, dict(size=True), "not an integer")):
         with pytest.raises(ModelError, match=words) as info:
-            Param("nu", 0.3, **kwargs)
-        assert info.value.file == __file__
+            Param("nu", default, **kwargs)
+        assert info.value.file == __file__ and info.value.key.startswith("nu.")
 
 
 # ----------------------------------------------------------------------------- parts and --set (section 4)

@@ -55,9 +55,9 @@ class Param:
 
     def __post_init__(self) -> None:
         check_identifier(self.name, what="parameter")
-        self._check_bounds()
         if self.size:
             object.__setattr__(self, "integer", True)
+        self._check_bounds()
         if isinstance(self.default, str) and not self.choices:
             object.__setattr__(self, "choices", (self.default,))
         assumptions = {"real": True}
@@ -66,25 +66,41 @@ class Param:
         object.__setattr__(self, "symbol", sp.Symbol(self.name, **assumptions))
 
     def _check_bounds(self) -> None:
-        """minimum <= maximum, both finite numbers, and a numeric default inside them (ModelError naming
-        the declaring file)."""
+        """A numeric default is a finite number (an integer for a size); ``below``, ``minimum`` and
+        ``maximum`` are finite numbers, minimum <= maximum, and the default keeps every bound
+        (ModelError naming the declaring file)."""
         import math
 
+        def error(message: str, key: str, expected: str) -> ModelError:
+            return ModelError(f"parameter {self.name}: {message}", file=declaring_file(), key=f"{self.name}.{key}",
+                              expected=expected)
+
+        default = self.default
+        if not isinstance(default, str):
+            if isinstance(default, bool) or not isinstance(default, (int, float)) or not math.isfinite(default):
+                raise error(f"default {default!r} is not a finite number or a string", "default",
+                            "a finite number (a string for a choice)")
+            if self.integer and not float(default).is_integer():
+                raise error(f"default {default!r} is not an integer", "default", "an integer default for a size")
+            if self.positive and not default > 0:
+                raise error(f"default {default!r} is not positive", "default", "a default > 0 (positive=True)")
+        if self.below is not None and (isinstance(self.below, bool) or not isinstance(self.below, (int, float))
+                                       or not math.isfinite(self.below)):
+            raise error(f"below = {self.below!r} is not a finite number", "below", "a finite number or None")
+        if self.below is not None and not isinstance(default, str) and not default < self.below:
+            raise error(f"default {default!r} is not below {self.below!r}", "default", f"a default below {self.below!r}")
         for what in ("minimum", "maximum"):
             bound = getattr(self, what)
             if bound is not None and (isinstance(bound, bool) or not isinstance(bound, (int, float))
                                       or not math.isfinite(bound)):
-                raise ModelError(f"parameter {self.name}: {what} = {bound!r} is not a finite number",
-                                 file=declaring_file(), key=f"{self.name}.{what}", expected="a finite number or None")
+                raise error(f"{what} = {bound!r} is not a finite number", what, "a finite number or None")
         low, high = self.minimum, self.maximum
         if low is not None and high is not None and not low <= high:
-            raise ModelError(f"parameter {self.name}: minimum {low!r} is above maximum {high!r}",
-                             file=declaring_file(), key=f"{self.name}.minimum", expected="minimum <= maximum")
-        if isinstance(self.default, (int, float)) and not isinstance(self.default, bool):
+            raise error(f"minimum {low!r} is above maximum {high!r}", "minimum", "minimum <= maximum")
+        if not isinstance(self.default, str):
             if (low is not None and self.default < low) or (high is not None and self.default > high):
-                raise ModelError(f"parameter {self.name}: default {self.default!r} is outside "
-                                 f"[{low!r}, {high!r}]", file=declaring_file(), key=f"{self.name}.default",
-                                 expected="a default within the declared minimum and maximum")
+                raise error(f"default {self.default!r} is outside [{low!r}, {high!r}]", "default",
+                            "a default within the declared minimum and maximum")
 
     @property
     def is_choice(self) -> bool:
