@@ -344,3 +344,11 @@ def test_a_late_error_at_an_internal_key_names_the_scene_and_what_it_set(tmp_pat
     err = capsys.readouterr().err
     assert code == 2 and "Traceback" not in err
     assert str(path) in err and "'M'" in err and "params.quadrature = 1" in err and "positive definite" in err
+
+
+def test_segment_and_part_values_keep_the_declared_bounds(tmp_path, capsys):
+    """A segment's D is the model's D (declared positive); a part's rho is disk_rho."""
+    path = _scene(tmp_path, "stepped_rotor", ("D = 0.045", "D = -0.045"))
+    _fails(["run", path], capsys, str(path), "'segments[2].D'", "D = -0.045 is not positive")
+    path = _scene(tmp_path, "ross_example_rotor", ("rho = 7810.0\nwidth", "rho = 5e-324\nwidth"), file="part.toml")
+    _fails(["run", path], capsys, str(path), "'parts[1].rho'", "subnormal")

@@ -20,6 +20,7 @@ from __future__ import annotations
 from typing import Any
 
 from mechgen.runtime.fields.mesh import Part, Segment
+from mechgen.scene.bounds import LIMITS, check_value
 from mechgen.scene.values import NUMBER, evaluate, expression, fail, finite, is_number, join, listing, show, type_name
 
 DISCRETISATION_PARAMS = ("discretisation", "N", "quadrature", "constraints")
@@ -65,6 +66,7 @@ def _segments(file: str, data: dict, model: Any, params: dict) -> tuple[Segment,
                 raise fail(file, join(base, name), f"unknown segment key {show(name)}",
                             "length, elements or a numeric model parameter: " + listing(numeric))
             values[name] = _number(file, join(base, name), value, params)
+            check_value(file, join(base, name), name, model.params[name], values[name], LIMITS)
         out.append(Segment(length, elements, values))
     return tuple(out)
 
@@ -96,6 +98,9 @@ def _parts(file: str, data: dict, model: Any, params: dict) -> tuple[Part, ...]:
                 raise fail(file, join(base, name), f"unknown key {show(name)} for a {kind}",
                             "kind, at or a parameter of the part: " + listing(list(kinds[kind])))
             values[name] = _number(file, join(base, name), value, params)
+            full = f"{kind}_{name}"
+            if full in model.params:
+                check_value(file, join(base, name), name, model.params[full], values[name], LIMITS)
         out.append(Part(kind, at, values))
     return tuple(out)
 
