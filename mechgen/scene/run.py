@@ -92,13 +92,12 @@ def placed(exc: InputError, scn) -> SceneError:
     note = ""
     if exc.key in INTERNAL_KEYS:
         names = INTERNAL_KEYS[exc.key]
-        length = scn.segments and "segments" or None
         wanted = [n for n in scn.written if names is None or n in names]
         info = lookup_model(scn.source) if names is not None else None
         if info is not None and info.length in scn.written:
             wanted.append(info.length)
         shown = [f"{scn.written[n]} = {scn.params[n]!r}" for n in dict.fromkeys(wanted)][:8]
-        if length:
+        if scn.segments:
             shown.append("[[segments]]")
         if shown:
             note = f" (decided by what the scene sets: {', '.join(shown)})"
