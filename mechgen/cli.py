@@ -48,13 +48,56 @@ class _Parser(argparse.ArgumentParser):
     pass
 
 
-def _write_json(path: str, results: dict) -> None:
+def _existing_parent(path: Path) -> Path:
+    """The nearest ancestor of ``path`` that exists (the folder mkdir would create the rest in)."""
+    for parent in path.absolute().parents:
+        if os.path.lexists(parent):
+            return parent
+    return Path(path.absolute().anchor)
+
+
+def check_output(flag: str, path: str, *, folder: bool) -> None:
+    """Refuse an output path that cannot be written, before anything is computed: ``--json FILE``
+    must not be a folder, ``--plot DIR`` not a file, and the nearest existing ancestor of either
+    must be a writable folder (a file there, ``afile/x.json``, cannot be a folder)."""
     target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=".tmp-", suffix=".json")
-    with os.fdopen(fd, "w") as fh:
-        json.dump(results, fh, indent=2, default=float)
-    os.replace(tmp, target)
+    what = "a folder to write the plots into" if folder else "a path for the JSON file"
+    if not path:
+        raise InputError("the path is empty", key=flag, expected=what)
+    if folder and target.exists() and not target.is_dir():
+        raise InputError(f"{path} exists and is not a folder", key=flag, expected=what)
+    if not folder and target.is_dir():
+        raise InputError(f"{path} is a folder", key=flag, expected=what + " (a file name, such as results.json)")
+    if folder and target.is_dir():
+        base = target
+    else:
+        base = _existing_parent(target)
+        if not base.is_dir():
+            raise InputError(f"{base} is not a folder, so {path} cannot be created", key=flag, expected=what)
+    if not os.access(base, os.W_OK | os.X_OK):
+        raise InputError(f"the folder {base} is not writable", key=flag, expected=what)
+
+
+def _write_json(path: str, results: dict) -> None:
+    """Write the results JSON through a temporary file in the same folder (never half a file, never
+    a temporary file left behind)."""
+    target = Path(path)
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=".tmp-", suffix=".json")
+    except OSError as exc:
+        raise InputError(f"cannot write {path} ({exc.strerror})", key="--json",
+                         expected="a path for the JSON file in a writable folder") from None
+    try:
+        with os.fdopen(fd, "w") as fh:
+            json.dump(results, fh, indent=2, default=float)
+        os.replace(tmp, target)
+    except OSError as exc:
+        raise InputError(f"cannot write {path} ({exc.strerror})", key="--json",
+                         expected="a path for the JSON file in a writable folder") from None
+    finally:
+        if os.path.lexists(tmp):
+            os.unlink(tmp)
 
 
 def _cmd_run(args) -> int:
@@ -62,6 +105,10 @@ def _cmd_run(args) -> int:
     from mechgen.scene.run import check_backend, run_scene
 
     check_backend(args.backend)
+    if args.json_path is not None:
+        check_output("--json", args.json_path, folder=False)
+    if args.plot_dir is not None:
+        check_output("--plot", args.plot_dir, folder=True)
     results = run_scene(args.scene, overrides=args.overrides, backend=args.backend)
     print(summary(results))
     if args.json_path:

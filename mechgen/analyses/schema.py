@@ -70,6 +70,8 @@ class OptionContext:
     earlier: dict[str, str] = field(default_factory=dict)
     current: str = ""
     swept: tuple[str, ...] = ()
+    #: the scene's safety limits (mechgen.scene.bounds.scene_limits; empty: the defaults)
+    limits: Mapping[str, int] = field(default_factory=dict)
 
 
 # --------------------------------------------------------------------------- the schema walk
@@ -145,6 +147,25 @@ def int_at_least(ctx: OptionContext, key: str, value: object, low: int) -> int:
 def count(ctx: OptionContext, key: str, value: object) -> int:
     """An integer >= 1."""
     return int_at_least(ctx, key, value, 1)
+
+
+def count_within(limit: str) -> Callable:
+    """A check of an integer from 1 to the safety limit ``limit`` (mechgen.scene.bounds.LIMITS, which a
+    scene raises in its ``[limits]`` table); an integral float such as 1e6 counts as an integer."""
+    def check(ctx: OptionContext, key: str, value: object) -> int:
+        from mechgen.scene.bounds import LIMITS, number_text
+
+        if isinstance(value, float) and math.isfinite(value) and value.is_integer():
+            value = int(value)
+        n = count(ctx, key, value)
+        top = ctx.limits.get(limit, LIMITS[limit])
+        if n > top:
+            raise fail(ctx.file, key, f"{limit} = {number_text(n)} is above the safety limit {top}",
+                       f"an integer from 1 to {top} (the limit guards against typos: raise it with "
+                       f"[limits] {limit} = ... in the scene)")
+        return n
+
+    return check
 
 
 def boolean(ctx: OptionContext, key: str, value: object) -> bool:

@@ -50,7 +50,7 @@ SCHEMA = {"t_end": Option(schema.positive, REQUIRED, STEP), "method": Option(_me
           "atol": Option(schema.positive, 1e-10), "q0": Option(schema.coordinate_table, {}),
           "v0": Option(schema.coordinate_table, {}), "initial_mode": Option(schema.count),
           "amplitude": Option(schema.number, 1.0), "outputs": Option(_outputs, ALL_OUTPUTS),
-          "series": Option(schema.boolean, False), "samples": Option(schema.count, 201)}
+          "series": Option(schema.boolean, False), "samples": Option(schema.count_within("samples"), 201)}
 
 
 def check(ctx, base: str, options: dict) -> None:

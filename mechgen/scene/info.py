@@ -25,7 +25,7 @@ from mechgen import models
 from mechgen.errors import InputError
 
 #: version of the JSON layout of a ModelInfo (part of its cache key)
-INFO_SCHEMA = "model-info-2"
+INFO_SCHEMA = "model-info-3"
 GENERATED = Path(__file__).resolve().parent.parent / "generated"
 
 
@@ -34,7 +34,9 @@ class ParamInfo:
     """What a scene may set for one parameter.
 
     ``numeric``: may appear in expressions (not a choice, not a size); ``runtime``: a choice of
-    the numerics only (Param.runtime), left out of the kernels' cache key.
+    the numerics only (Param.runtime), left out of the kernels' cache key. The bounds a scene's
+    value is checked against at load time (mechgen.scene.bounds): ``positive`` (> 0),
+    ``minimum`` / ``maximum`` (inclusive), ``below`` (exclusive upper bound).
     """
 
     default: float | str
@@ -43,6 +45,9 @@ class ParamInfo:
     below: float | None = None
     numeric: bool = True
     runtime: bool = False
+    positive: bool = False
+    minimum: float | None = None
+    maximum: float | None = None
 
 
 @dataclass(frozen=True)
@@ -92,9 +97,25 @@ class ModelInfo:
         return data
 
 
+def declared_range(param, counts: set) -> tuple[float | None, float | None]:
+    """(minimum, maximum) of a parameter: the declaration's own (``Param.minimum`` / ``maximum`` when
+    it has them), and for a size at least 0, at least 1 for one that counts sites or elements
+    (``counts``: a chain's sites parameter, a continuum's N)."""
+    low, high = getattr(param, "minimum", None), getattr(param, "maximum", None)
+    if param.size:
+        floor = 1 if param.name in counts else 0
+        low = floor if low is None else max(low, floor)
+    return low, high
+
+
 def info_of_model(model) -> ModelInfo:
     """The ModelInfo of an imported :class:`~mechgen.symbolic.model.Model`."""
-    params = {p.name: ParamInfo(p.default, p.choices, p.integer, p.below, p.is_numeric, p.runtime)
+    cont = model.continuum
+    counts = {model.chain_spec.sites} if model.is_lattice else set()
+    if cont is not None:
+        counts.add("N")
+    params = {p.name: ParamInfo(p.default, p.choices, p.integer, p.below, p.is_numeric, p.runtime,
+                                p.positive, *declared_range(p, counts))
               for p in model.param_list}
     coords = model.coordinates_all
     chain = None
@@ -102,7 +123,6 @@ def info_of_model(model) -> ModelInfo:
         n = int(model.param(model.chain_spec.sites).default)
         coords = tuple(f"{model.chain_spec.coordinate}_{i + 1}" for i in range(n))
         chain = (model.chain_spec.coordinate, model.chain_spec.sites)
-    cont = model.continuum
     return ModelInfo(model.name, params, tuple(coords), tuple(model.output_names), cont is not None,
                      cont.length if cont else None, {k: tuple(v) for k, v in model.parts.items()},
                      model.complementary_fn is not None, tuple(model.field_names),
@@ -115,7 +135,8 @@ def info_from_json(data: dict, *, file: str | None = None) -> ModelInfo:
     def tup(v):
         return tuple(v) if v is not None else None
 
-    params = {k: ParamInfo(v["default"], tup(v["choices"]), v["integer"], v["below"], v["numeric"], v["runtime"])
+    params = {k: ParamInfo(v["default"], tup(v["choices"]), v["integer"], v["below"], v["numeric"], v["runtime"],
+                           v["positive"], v["minimum"], v["maximum"])
               for k, v in data["params"]}
     parts = {k: tuple(v) for k, v in data["parts"]} if data.get("parts") is not None else None
     return ModelInfo(data["name"], params, tuple(data["coordinates"]), tuple(data["outputs"]), data["continuum"],

@@ -20,6 +20,7 @@ from __future__ import annotations
 from typing import Any
 
 from mechgen.runtime.fields.mesh import Part, Segment
+from mechgen.scene.bounds import LIMITS, check_value
 from mechgen.scene.values import NUMBER, evaluate, expression, fail, finite, is_number, join, listing, show, type_name
 
 DISCRETISATION_PARAMS = ("discretisation", "N", "quadrature", "constraints")
@@ -65,6 +66,7 @@ def _segments(file: str, data: dict, model: Any, params: dict) -> tuple[Segment,
                 raise fail(file, join(base, name), f"unknown segment key {show(name)}",
                             "length, elements or a numeric model parameter: " + listing(numeric))
             values[name] = _number(file, join(base, name), value, params)
+            check_value(file, join(base, name), name, model.params[name], values[name], LIMITS)
         out.append(Segment(length, elements, values))
     return tuple(out)
 
@@ -79,6 +81,9 @@ def _parts(file: str, data: dict, model: Any, params: dict) -> tuple[Part, ...]:
     for i, table in enumerate(_tables(file, data, "parts"), 1):
         base = f"parts[{i}]"
         kind = table.get("kind")
+        if not isinstance(kind, str):
+            what = "missing key 'kind'" if kind is None else f"kind is {type_name(kind)}, not a string"
+            raise fail(file, f"{base}.kind", what, "a string, one of: " + listing(sorted(kinds)))
         if kind not in kinds:
             raise fail(file, f"{base}.kind", f"unknown part kind {show(kind)} for model '{model.name}'",
                         "one of: " + listing(sorted(kinds)))
@@ -93,6 +98,9 @@ def _parts(file: str, data: dict, model: Any, params: dict) -> tuple[Part, ...]:
                 raise fail(file, join(base, name), f"unknown key {show(name)} for a {kind}",
                             "kind, at or a parameter of the part: " + listing(list(kinds[kind])))
             values[name] = _number(file, join(base, name), value, params)
+            full = f"{kind}_{name}"
+            if full in model.params:
+                check_value(file, join(base, name), name, model.params[full], values[name], LIMITS)
         out.append(Part(kind, at, values))
     return tuple(out)
 
@@ -103,3 +111,99 @@ def load_layout(file: str, data: dict, model: Any, params: dict) -> tuple[tuple[
         key = "segments" if "segments" in data else "parts"
         raise fail(file, key, f"model '{model.name}' is not a continuum", "segments and parts only for continua")
     return _segments(file, data, model, params), _parts(file, data, model, params)
+
+
+# --------------------------------------------------------------------------- load-time checks of a layout
+
+def check_layout(file: str, data: dict, model: Any, params: dict, segments: tuple, parts: tuple,
+                 written: dict) -> None:
+    """What the mesh and the ``--set`` flags must agree with, checked before anything is compiled:
+    segments need finite elements, every part sits on a mesh vertex inside the domain, and no
+    ``--set`` names a value a segment or part table sets (the table's value would win)."""
+    if not getattr(model, "continuum", False):
+        return
+    _check_overrides(file, model, segments, parts, written)
+    if not segments and not parts:
+        return
+    from mechgen.runtime.fields.discretise import ELEMENTS, GLOBAL
+
+    kind = params.get("discretisation")
+    if kind in GLOBAL:
+        if segments:
+            raise fail(file, "segments", f"segments need finite elements; discretisation = {show(kind)} is a "
+                       "global basis", "discretisation = one of: " + listing(list(ELEMENTS)))
+        return
+    _check_vertices(file, model, params, segments, parts)
+
+
+def _check_overrides(file: str, model: Any, segments: tuple, parts: tuple, written: dict) -> None:
+    """Refuse ``--set NAME=value`` where a [[segments]] or [[parts]] table sets NAME (README: tables win
+    over [params] and --set, so the flag would be silently ignored)."""
+    length = getattr(model, "length", None)
+    for name, (_, key) in written.items():
+        if not key.startswith("--set"):
+            continue
+        places = [f"segments[{i}].{name}" for i, seg in enumerate(segments, 1) if name in seg.values]
+        for i, piece in enumerate(parts, 1):
+            short = name[len(piece.kind) + 1:] if name.startswith(f"{piece.kind}_") else None
+            if short is not None and short in piece.values:
+                places.append(f"parts[{i}].{short}")
+        if name == length and segments:
+            places = [f"segments[{i}].length" for i in range(1, len(segments) + 1)]
+            why = f"the length {name} is the sum of the segment lengths"
+        else:
+            why = f"the scene's tables set {name} themselves"
+        if places:
+            raise fail(None, key, f"this value would be ignored: {why} ({', '.join(places)} in {file})",
+                       f"a parameter no table of the scene sets; change {places[0]} in {file} instead")
+
+
+def _check_vertices(file: str, model: Any, params: dict, segments: tuple, parts: tuple) -> None:
+    """Each part at a mesh vertex (finite elements): reported at ``parts[i].at`` with a layout that
+    would put a vertex there (the mesh rule of mechgen.runtime.fields.mesh.build_mesh)."""
+    import numpy as np
+
+    from mechgen.runtime.fields.mesh import Layout, build_mesh
+
+    size = int(params.get("N", 1))
+    length = sum(seg.length for seg in segments) if segments else float(params[model.length])
+    if not segments and size > 10_000_000:
+        return  # bounds.check_params refused it already unless the limit was raised: the runtime checks
+    nodes = build_mesh(Layout(segments), size, length).nodes
+    for i, piece in enumerate(parts, 1):
+        key = f"parts[{i}].at"
+        if not -1e-12 * length <= piece.at <= length * (1 + 1e-12):
+            raise fail(file, key, f"the {piece.kind} at s = {piece.at:g} lies outside the domain [0, {length:g}]",
+                       f"a position from 0 to {length:g} (m)")
+        k = int(np.argmin(np.abs(nodes - piece.at)))
+        if abs(nodes[k] - piece.at) <= 1e-9 * length:
+            continue
+        near = ", ".join(f"{x:g}" for x in nodes[max(k - 1, 0):k + 2])
+        raise fail(file, key, f"the {piece.kind} at s = {piece.at:g} is not at a mesh vertex (nearest "
+                   f"vertices: {near}); parts sit on element boundaries",
+                   _vertex_fix(segments, size, length, piece.at, [p.at for p in parts]))
+
+
+def _vertex_fix(segments: tuple, size: int, length: float, at: float, every: list) -> str:
+    """What puts a vertex at s = ``at``: two segments split there, or (no segments) an N whose uniform
+    mesh has a vertex at every part position in ``every``."""
+    def split(seg_length: float, elements: int, offset: float, extra: str) -> str:
+        first = min(max(1, round(elements * offset / seg_length)), max(1, elements - 1))
+        return (f"[[segments]] length = {offset:g}, elements = {first}{extra} and [[segments]] length = "
+                f"{seg_length - offset:g}, elements = {max(1, elements - first)}{extra}")
+
+    if not segments:
+        text = "a segment boundary there: " + split(length, size, at, "")
+        def fits(n: int) -> bool:
+            return all(abs(x * n / length - round(x * n / length)) <= 1e-9 * n for x in every)
+
+        better = next((n for n in range(size, min(4 * size, size + 10_000) + 1) if fits(n)), None)
+        return text + (f", or N = {better}" if better is not None else "")
+    start = 0.0
+    for j, seg in enumerate(segments, 1):
+        if start <= at <= start + seg.length:
+            extra = "".join(f", {k} = {v:g}" for k, v in seg.values.items())
+            return f"a segment boundary there: replace segments[{j}] by " + split(seg.length, seg.elements,
+                                                                                   at - start, extra)
+        start += seg.length
+    return "a segment boundary there"

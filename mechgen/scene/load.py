@@ -15,9 +15,10 @@ names no kind.
 """
 from __future__ import annotations
 
+import math
 import os
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Mapping, Sequence
 
@@ -31,7 +32,8 @@ from mechgen.analyses.registry import get as get_kind
 from mechgen.analyses.registry import kinds as analysis_kinds
 from mechgen.analyses.schema import AnalysisSpec, OptionContext, analysis_kind, validate
 from mechgen.scene.expr import CONSTANTS, Expression, is_identifier
-from mechgen.scene.layout import load_layout
+from mechgen.scene.bounds import check_params, scene_limits
+from mechgen.scene.layout import check_layout, load_layout
 from mechgen.scene.info import ModelInfo, ParamInfo  # re-exported: the loader needs only what the protocols name
 from mechgen.scene.values import (IDENTIFIER_RULE, NUMBER, ModelInfoLike, ParamInfoLike, choice_value, evaluate,
                                   expression, fail, finish, finite, is_choice, is_number, join, listing, param_info,
@@ -40,7 +42,8 @@ from mechgen.scene.values import (IDENTIFIER_RULE, NUMBER, ModelInfoLike, ParamI
 __all__ = ["AnalysisSpec", "ModelInfo", "ParamInfo", "Scene", "load_scene", "IDENTIFIER_RULE", "NUMBER"]
 
 BACKENDS = ("c", "numpy", "casadi")
-TOP_KEYS = ("title", "model", "backend", "free", "params", "coordinates", "analysis", "segments", "parts")
+TOP_KEYS = ("title", "model", "backend", "free", "params", "coordinates", "analysis", "segments", "parts",
+            "limits")
 MAX_SCENE_BYTES = 10 * 1024 * 1024
 MAX_TITLE = 500
 
@@ -61,6 +64,8 @@ class Scene:
     parts: tuple = ()
     #: the canonical reference of the model (a built-in name, an absolute file path, module:attribute)
     source: str = ""
+    #: parameter name -> the key the scene or a --set flag wrote its value at (defaults left out)
+    written: Mapping[str, str] = field(default_factory=dict)
 
 
 
@@ -85,6 +90,9 @@ def _read(path: str) -> dict:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise fail(path, None, f"not valid TOML: {exc}", "a valid TOML document") from None
+    except RecursionError:
+        raise fail(path, None, "arrays or tables are nested too deeply for the TOML parser",
+                   "a scene nested a few levels deep") from None
 
 
 def _string(file: str, key: str, value: object, expected: str = "a string") -> str:
@@ -163,9 +171,13 @@ def _override_value(key: str, info: ParamInfoLike, text: str) -> Any:
         return choice_value(None, key, info, text)
     for convert in (int, float):
         try:
-            return finite(None, key, convert(text))
+            value = convert(text)
         except ValueError:
             continue
+        if isinstance(value, float) and math.isinf(value) and "inf" not in text.lower():
+            raise fail(None, key, f"{show(text)} is beyond the range of a double (about 1.8e+308)",
+                       "a finite number of magnitude at most 1.8e308")
+        return finite(None, key, value)
     return expression(None, key, text)
 
 
@@ -234,13 +246,15 @@ class _Resolver:
 
 
 def _resolve_params(file: str, data: dict, model: ModelInfoLike, overrides: Sequence[str]):
-    """All parameter values (name -> float | int | str) and each expression parameter's names."""
+    """All parameter values (name -> float | int | str), each expression parameter's names, and
+    where the scene or a ``--set`` wrote each value it gives (name -> (file, key); defaults left out)."""
     raw = _scene_params(file, data, model)
     _apply_overrides(raw, model, overrides)
     resolver = _Resolver(model, raw)
     for name in model.params:
         resolver.resolve(name)
-    return {name: resolver.values[name] for name in model.params}, resolver.depends
+    written = {name: (f, key) for name, (_, f, key) in raw.items() if f is not None or key.startswith("--set")}
+    return {name: resolver.values[name] for name in model.params}, resolver.depends, written
 
 
 def _free(file: str, data: dict, model: ModelInfoLike) -> list[str]:
@@ -349,26 +363,33 @@ def load_scene(path, *, overrides: Sequence[str] = (), lookup_model: Callable[..
         SceneError: the first problem found, naming the file, the key and what
             was expected.
     """
+    file = "<dict>" if isinstance(path, Mapping) else str(path)
+    try:
+        return _load(path, file, overrides, lookup_model, model_names)
+    except RecursionError:  # a value nested hundreds deep: tomllib, _plain or a check ran out of stack
+        raise fail(file, None, "arrays or tables are nested too deeply", "a scene nested a few levels deep") from None
+
+
+def _load(path, file: str, overrides: Sequence[str], lookup_model: Callable[..., ModelInfoLike | None],
+          model_names: Callable[[], list[str]]) -> Scene:
+    """The body of :func:`load_scene`."""
     if isinstance(path, Mapping):
-        file, data, base = "<dict>", _plain(path), Path.cwd()
+        data, base = _plain(path), Path.cwd()
     else:
-        file = str(path)
         data = _read(file)
         base = Path(file).resolve().parent
     title, model, backend = _top_level(file, data, lookup_model, model_names, base)
-    params, depends = _resolve_params(file, data, model, overrides)
-    for name, info in model.params.items():
-        below = getattr(info, "below", None)
-        if below is not None and not params[name] < below:
-            raise fail(file, f"params.{name}", f"{name} = {params[name]!r} is not below {below!r}",
-                        f"a value below {below!r}")
+    params, depends, written = _resolve_params(file, data, model, overrides)
+    limits = scene_limits(file, data, model)
+    check_params(model, params, written, limits)
     free = _free(file, data, model)
     active = _active(file, data, model)
-    ctx = OptionContext(file, model, params, depends, active or tuple(model.coordinates), active)
+    ctx = OptionContext(file, model, params, depends, active or tuple(model.coordinates), active, limits=limits)
     analyses = _analyses(ctx, data)
     for spec in analyses:
         free += [n for n in get_kind(spec.kind).frees(spec.options) if n not in free]
     segments, parts = load_layout(file, data, model, params)
+    check_layout(file, data, model, params, segments, parts, written)
     free += sorted({n for seg in segments for n in seg.values if n not in free})
     return Scene(file, title, model.name, backend, params, tuple(free), active, analyses, segments, parts,
-                 getattr(model, "key", "") or model.name)
+                 getattr(model, "key", "") or model.name, {name: key for name, (_, key) in written.items()})

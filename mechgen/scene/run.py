@@ -18,7 +18,7 @@ from mechgen import models
 from mechgen.analyses.context import NAME, POINTS, PointRunner, public
 from mechgen.analyses.registry import get
 from mechgen.analyses.result import run_analysis
-from mechgen.errors import InputError
+from mechgen.errors import InputError, SceneError
 from mechgen.pipeline import compile_request, file_digest
 from mechgen.runtime.fields.mesh import Layout
 from mechgen.scene.info import lookup_model, model_info
@@ -73,6 +73,39 @@ def run_scene(scene, *, overrides=(), backend: str | None = None) -> dict:
     """Run every analysis of a scene (a file, or a dict of its contents) and return the results dict."""
     scn = load_scene(scene if isinstance(scene, Mapping) else str(scene), overrides=list(overrides),
                      lookup_model=lookup_model, model_names=models.known)
+    try:
+        return _run_loaded(scn, backend)
+    except InputError as exc:
+        if exc.file is not None:
+            raise
+        raise placed(exc, scn) from None
+
+
+#: internal keys of late checks (runtime) -> the parameters that decide them
+INTERNAL_KEYS = {"discretisation": ("N", "discretisation", "quadrature", "constraints", "joints"), "M": None}
+
+
+def placed(exc: InputError, scn) -> SceneError:
+    """A bad-input error found after loading (compiling, discretising, factorising M), which names no
+    file, placed in the scene: its file, and for an internal key (``discretisation``, ``M``) the keys
+    the scene wrote that decide it (``params.N = 0``), so that the user sees what to change."""
+    note = ""
+    if exc.key in INTERNAL_KEYS:
+        names = INTERNAL_KEYS[exc.key]
+        wanted = [n for n in scn.written if names is None or n in names]
+        info = lookup_model(scn.source) if names is not None else None
+        if info is not None and info.length in scn.written:
+            wanted.append(info.length)
+        shown = [f"{scn.written[n]} = {scn.params[n]!r}" for n in dict.fromkeys(wanted)][:8]
+        if scn.segments:
+            shown.append("[[segments]]")
+        if shown:
+            note = f" (decided by what the scene sets: {', '.join(shown)})"
+    return SceneError(exc.message.rstrip(".") + note, file=scn.path, key=exc.key, expected=exc.expected)
+
+
+def _run_loaded(scn, backend: str | None) -> dict:
+    """Compile and run a loaded scene."""
     plan = plan_scene(scn, backend=backend)
     fixed = tuple(sorted((k, v) for k, v in scn.params.items()))
     started = time.perf_counter()

@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import math
 import re
+import sys
 from typing import Any, Mapping, Protocol, Sequence
 
 from mechgen.errors import InputError, SceneError
@@ -51,7 +52,10 @@ def part(name: object) -> str:
 
 def show(value: object) -> str:
     """A short single-line rendering of a user value for messages."""
-    text = repr(value)
+    try:
+        text = repr(value)
+    except ValueError:  # an int beyond sys.get_int_max_str_digits()
+        return "an integer of more than 4300 digits"
     return text if len(text) <= 60 else text[:56] + "..."
 
 
@@ -82,9 +86,20 @@ def is_number(value: object) -> bool:
 
 
 def finite(file: str | None, key: str, value: int | float) -> float | int:
-    """``value`` when it is finite, else a SceneError."""
+    """``value`` when it is finite, else a SceneError.
+
+    An integer is finite here when it converts to a float, |value| <= sys.float_info.max
+    (about 1.8e308): every numeric parameter reaches the kernels as a double.
+    """
     if isinstance(value, float) and not math.isfinite(value):
         raise fail(file, key, f"value {value} is not finite", "a finite number")
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) > sys.float_info.max:
+        try:
+            digits = len(str(abs(value)))
+        except ValueError:  # str() refuses ints of more than sys.get_int_max_str_digits() digits
+            digits = int(math.log10(abs(value))) + 1
+        raise fail(file, key, f"integer value of about {digits} digits is beyond the range of a double "
+                   f"(about {sys.float_info.max:.3g})", "a finite number of magnitude at most 1.8e308")
     return value
 
 

@@ -11,7 +11,8 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
-from mechgen.symbolic.names import check_identifier
+from mechgen.errors import ModelError
+from mechgen.symbolic.names import check_identifier, declaring_file
 
 
 @dataclass(frozen=True)
@@ -32,6 +33,10 @@ class Param:
         below: an exclusive upper bound the value must stay under (checked when a
             scene or a specialisation sets it), e.g. 1 for a length parameter
             lambda0 = (l0 - h)/l0 that would make l0 negative.
+        minimum, maximum: inclusive bounds of the value (a Poisson ratio from -1 to 0.5,
+            a size's largest sensible count), checked when a scene sets it
+            (mechgen.scene.bounds). Bounds are facts for validation only: they are no
+            sympy assumptions and never change a derivation.
     """
 
     name: str
@@ -44,18 +49,58 @@ class Param:
     positive: bool = False
     runtime: bool = False
     below: float | None = None
+    minimum: float | None = None
+    maximum: float | None = None
     symbol: sp.Symbol = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         check_identifier(self.name, what="parameter")
         if self.size:
             object.__setattr__(self, "integer", True)
+        self._check_bounds()
         if isinstance(self.default, str) and not self.choices:
             object.__setattr__(self, "choices", (self.default,))
         assumptions = {"real": True}
         if self.positive:
             assumptions["positive"] = True
         object.__setattr__(self, "symbol", sp.Symbol(self.name, **assumptions))
+
+    def _check_bounds(self) -> None:
+        """A numeric default is a finite number (an integer for a size); ``below``, ``minimum`` and
+        ``maximum`` are finite numbers, minimum <= maximum, and the default keeps every bound
+        (ModelError naming the declaring file)."""
+        import math
+
+        def error(message: str, key: str, expected: str) -> ModelError:
+            return ModelError(f"parameter {self.name}: {message}", file=declaring_file(), key=f"{self.name}.{key}",
+                              expected=expected)
+
+        default = self.default
+        if not isinstance(default, str):
+            if isinstance(default, bool) or not isinstance(default, (int, float)) or not math.isfinite(default):
+                raise error(f"default {default!r} is not a finite number or a string", "default",
+                            "a finite number (a string for a choice)")
+            if self.integer and not float(default).is_integer():
+                raise error(f"default {default!r} is not an integer", "default", "an integer default for a size")
+            if self.positive and not default > 0:
+                raise error(f"default {default!r} is not positive", "default", "a default > 0 (positive=True)")
+        if self.below is not None and (isinstance(self.below, bool) or not isinstance(self.below, (int, float))
+                                       or not math.isfinite(self.below)):
+            raise error(f"below = {self.below!r} is not a finite number", "below", "a finite number or None")
+        if self.below is not None and not isinstance(default, str) and not default < self.below:
+            raise error(f"default {default!r} is not below {self.below!r}", "default", f"a default below {self.below!r}")
+        for what in ("minimum", "maximum"):
+            bound = getattr(self, what)
+            if bound is not None and (isinstance(bound, bool) or not isinstance(bound, (int, float))
+                                      or not math.isfinite(bound)):
+                raise error(f"{what} = {bound!r} is not a finite number", what, "a finite number or None")
+        low, high = self.minimum, self.maximum
+        if low is not None and high is not None and not low <= high:
+            raise error(f"minimum {low!r} is above maximum {high!r}", "minimum", "minimum <= maximum")
+        if not isinstance(self.default, str):
+            if (low is not None and self.default < low) or (high is not None and self.default > high):
+                raise error(f"default {self.default!r} is outside [{low!r}, {high!r}]", "default",
+                            "a default within the declared minimum and maximum")
 
     @property
     def is_choice(self) -> bool:
