@@ -273,8 +273,8 @@ def _fall_back_to_numpy(problem: Exception) -> None:
     """Warn (once per process) that the C backend is unusable and numpy is used instead."""
     global _warned_no_compiler
     if not _warned_no_compiler:
-        warnings.warn(f"no C compiler available ({problem}): falling back to the numpy backend", RuntimeWarning,
-                      stacklevel=4)
+        what = "no C compiler available" if isinstance(problem, CompilerUnavailable) else "the C backend is unusable"
+        warnings.warn(f"{what} ({problem}): falling back to the numpy backend", RuntimeWarning, stacklevel=4)
         _warned_no_compiler = True
     else:
         log.info("C backend unavailable (%s): numpy backend", problem)

@@ -202,8 +202,8 @@ def _failed_source_path(key: str, stem: str, source: str) -> Path | None:
     return path
 
 
-def _compile(command: str, source_path: Path, output: Path, cflags: Sequence[str],
-             include_dirs: Sequence[str], ldflags: Sequence[str]) -> subprocess.CompletedProcess:
+def run_compiler(command: str, source_path: Path, output: Path, cflags: Sequence[str],
+                 include_dirs: Sequence[str], ldflags: Sequence[str]) -> subprocess.CompletedProcess:
     """Run the compiler once; raise CompilerUnavailable if it cannot be started."""
     argv = [*shlex.split(command), *cflags, *(f"-I{d}" for d in include_dirs),
             "-o", str(output), str(source_path), *ldflags]
@@ -224,7 +224,7 @@ def trivial_problem(command: str, cflags: Sequence[str], include_dirs: Sequence[
             source, output = Path(tmp) / "probe.c", Path(tmp) / "libprobe.so"
             source.write_text(TRIVIAL_SOURCE, encoding="utf-8")
             try:
-                done = _compile(command, source, output, cflags, include_dirs, ldflags)
+                done = run_compiler(command, source, output, cflags, include_dirs, ldflags)
             except (CompilerUnavailable, subprocess.SubprocessError) as exc:
                 problem = str(exc)
             else:
@@ -265,7 +265,7 @@ def _build_entry(source: str, *, stem: str, output_name: str, cflags: Sequence[s
         source_path = tmp / source_name
         source_path.write_text(built, encoding="utf-8")
         try:
-            done = _compile(command, source_path, tmp / output_name, cflags, include_dirs, ldflags)
+            done = run_compiler(command, source_path, tmp / output_name, cflags, include_dirs, ldflags)
         except subprocess.TimeoutExpired as exc:
             stderr = exc.stderr.decode(errors="replace") if isinstance(exc.stderr, bytes) else (exc.stderr or "")
             raise _build_error(f"C compiler timed out after {COMPILE_TIMEOUT:.0f} s", stderr, key, stem,

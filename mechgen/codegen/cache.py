@@ -312,7 +312,8 @@ def entry_problem(entry: Path, key: str) -> str | None:
     The entry must be a directory whose ``meta.json`` (at most MAX_META_BYTES, nested at most
     MAX_JSON_DEPTH deep) parses, names ``key``, the entry's kind folder and this cache format, lists
     plain file names with their sha256 (and size), and the directory must hold exactly those files
-    (plus ``meta.json``), regular files with those digests.
+    (plus ``meta.json``), regular files with those digests; a ``.json`` artefact is at most
+    MAX_DOCUMENT_BYTES and nested at most MAX_JSON_DEPTH deep.
     """
     try:
         if entry.is_symlink() or not entry.is_dir():
@@ -340,7 +341,13 @@ def entry_problem(entry: Path, key: str) -> str | None:
             size = sizes.get(name)
             if size is not None and (not isinstance(size, int) or path.lstat().st_size != size):
                 return f"{name} does not have the size meta.json lists"
-            if artefact_sha256(path) != digest:
+            if name.endswith(".json"):  # bounded here, so that no reader of the entry parses without bound
+                data = read_bounded(path, MAX_DOCUMENT_BYTES)
+                if hashlib.sha256(data).hexdigest() != digest:
+                    return f"{name} does not have the sha256 meta.json lists"
+                if json_depth(data.decode("utf-8")) > MAX_JSON_DEPTH:
+                    return f"{name} is nested deeper than {MAX_JSON_DEPTH} levels"
+            elif artefact_sha256(path) != digest:
                 return f"{name} does not have the sha256 meta.json lists"
     except (OSError, ValueError, UnicodeDecodeError) as exc:
         return f"unreadable: {_reason(exc)}"
@@ -432,7 +439,7 @@ def _remove(path: Path) -> None:
             pass
 
 
-def _write_meta(tmp: Path, kind: str, key: str) -> None:
+def write_meta(tmp: Path, kind: str, key: str) -> None:
     """Write ``meta.json`` listing every file of ``tmp`` with its sha256 and size."""
     files, sizes = {}, {}
     for path in sorted(tmp.iterdir()):
@@ -489,7 +496,7 @@ def _publish_in(root: Path, kind: str, key: str, fill: Callable[[Path], None], a
                 raise CacheUnusable(f"{tmp} was removed while the entry was built", vanished=True) from None
             raise
         try:
-            _write_meta(tmp, kind, key)
+            write_meta(tmp, kind, key)
             os.chmod(tmp, 0o755)
         except OSError as exc:
             raise CacheUnusable(f"cannot write in {tmp}: {_reason(exc)}", vanished=not tmp.is_dir()) from exc
