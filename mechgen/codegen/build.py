@@ -257,7 +257,8 @@ def _build_entry(source: str, *, stem: str, output_name: str, cflags: Sequence[s
                                   "no working C compiler found (set CC, or install cc/gcc/clang)")
     command, identity = found
     cflags, include_dirs, ldflags = tuple(cflags), tuple(map(str, include_dirs)), tuple(ldflags)
-    key = build_key(source, cflags, include_dirs, ldflags, identity, *extra_key)
+    # the file names are part of the entry: the same source under another stem is another entry
+    key = build_key(source, cflags, include_dirs, ldflags, identity, stem, output_name, *extra_key)
     source_name = f"lib{stem}.c"
     built = marked_source(source, key)
 
