@@ -251,11 +251,33 @@ def emit(backend: str, irs: list[KernelIR], *, model: str, title: str) -> str:
 
 
 def _store_text(kind: str, key: str, filename: str, text: str) -> tuple[Path, bool]:
-    """A generated text as a verified, atomically published cache entry; returns the file."""
-    from mechgen.codegen.cache import get_or_create
+    """A generated text as a verified, atomically published cache entry; returns the file and whether it was
+    a hit. An entry whose file is not exactly ``text`` (forged under matching metadata) is refused and
+    rebuilt; a cache that cannot take it gives a path in no cache (the text is loaded from memory anyway)."""
+    from mechgen.codegen.cache import get_or_create, read_bounded
 
-    entry, created = get_or_create(kind, key, lambda folder: (folder / filename).write_text(text))
+    data = text.encode("utf-8")
+
+    def check(entry: Path) -> str | None:
+        return None if read_bounded(entry / filename) == data else f"{filename} is not the text of its key"
+
+    try:
+        entry, created = get_or_create(kind, key, lambda folder: (folder / filename).write_bytes(data), check)
+    except OSError as exc:
+        log.info("generated module not cached: %s", exc)
+        return Path(f"<mechgen {filename}>"), False
     return entry / filename, not created
+
+
+def _fall_back_to_numpy(problem: Exception) -> None:
+    """Warn (once per process) that the C backend is unusable and numpy is used instead."""
+    global _warned_no_compiler
+    if not _warned_no_compiler:
+        what = "no C compiler available" if isinstance(problem, CompilerUnavailable) else "the C backend is unusable"
+        warnings.warn(f"{what} ({problem}): falling back to the numpy backend", RuntimeWarning, stacklevel=4)
+        _warned_no_compiler = True
+    else:
+        log.info("C backend unavailable (%s): numpy backend", problem)
 
 
 def _load(backend: str, text: str, specs: dict, key: str, report: BuildReport):
@@ -264,20 +286,16 @@ def _load(backend: str, text: str, specs: dict, key: str, report: BuildReport):
 
         hits = STATS["hit"]
         try:
-            lib = load_shared(text, stem="mgkernels")
+            lib = load_shared(text, stem="mgkernels", symbols=[f"mg_{name}" for name in specs])
             report.cached = STATS["hit"] > hits
-        except CompilerUnavailable:
-            global _warned_no_compiler
-            if not _warned_no_compiler:
-                warnings.warn("no C compiler found: falling back to the numpy backend", RuntimeWarning,
-                              stacklevel=3)
-                _warned_no_compiler = True
+        except (CompilerUnavailable, OSError) as exc:  # no usable compiler, or not even a temporary cache
+            _fall_back_to_numpy(exc)
             report.backend = "numpy"
             return None
         return c_kernels(lib, specs, get_caller())
     name = f"mg_{backend}_{key[:16]}"
     path, report.cached = _store_text(backend, key, f"{name}.py", text)
-    module = load_module(path, name)
+    module = load_module(path, name, source=text)  # the verified text itself, never the file's bytes
     return numpy_kernels(module) if backend == "numpy" else casadi_kernels(module, specs)
 
 
@@ -340,22 +358,116 @@ def committed_document(request: CompileRequest, key: str, generated: dict, text_
     return json.dumps(doc, indent=1) + "\n"
 
 
-def read_committed(model: str, key: str, backend: str, root: Path | None = None) -> dict | None:
-    """{'text', 'specs'} of a request from mechgen/generated/ (or ``root``) when its full key and text digest
-    match, else None."""
+_NAME_CHARS = frozenset("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_")
+
+
+def specs_problem(specs, text: str, backend: str, free=None) -> str | None:
+    """Why ``specs`` are not kernel specs of ``text`` (None when they are).
+
+    Each spec is an object named by its key (an identifier) with lists of input and output ports, a list
+    of size names and a meta object whose ``params`` are among ``free`` (when given); ``text`` defines
+    each kernel (``mg_NAME(`` in C and numpy text, ``build_NAME(`` in CasADi text).
+    """
+    if not isinstance(specs, dict) or not specs:
+        return "no kernel specs"
+    for name, spec in specs.items():
+        if not (isinstance(name, str) and name and set(name) <= _NAME_CHARS and not name[0].isdigit()):
+            return f"invalid kernel name {name!r}"
+        if not isinstance(spec, dict) or spec.get("name") != name:
+            return f"the spec of kernel {name} does not name it"
+        ports = [spec.get("inputs"), spec.get("outputs")]
+        if not all(isinstance(p, list) and all(isinstance(q, dict) and isinstance(q.get("name"), str)
+                                               for q in p) for p in ports):
+            return f"kernel {name}: invalid ports"
+        if not isinstance(spec.get("sizes"), list) or not isinstance(spec.get("meta"), dict):
+            return f"kernel {name}: invalid sizes or meta"
+        params = spec["meta"].get("params", [])
+        if free is not None and not (isinstance(params, list) and set(params) <= set(free)):
+            return f"kernel {name}: parameters {params} are not the request's free ones"
+        symbol = f"build_{name}(" if backend == "casadi" else f"mg_{name}("
+        if symbol not in text:
+            return f"the text defines no kernel {name}"
+    return None
+
+
+def document_problem(doc, key: str, request: CompileRequest | None, text: str, backend: str) -> str | None:
+    """Why a stored generation (an index entry or a committed JSON) is not the one of ``key`` (None when it is).
+
+    It must name ``key`` (and the request, when given), hold the sha256 of ``text`` and valid
+    :func:`specs_problem` specs for it.
+    """
     import hashlib
 
-    text_path, json_path = committed_paths(model, key, backend, GENERATED if root is None else root)
-    try:
-        doc = json.loads(json_path.read_text(encoding="utf-8"))
-        if doc.get("key") != key or doc.get("text") != text_path.name:
-            return None
-        text = text_path.read_bytes().decode("utf-8")
-    except (OSError, ValueError):
-        return None
+    if not isinstance(doc, dict):
+        return "not a JSON object"
+    if doc.get("key") != key:
+        return "it names another key"
+    if request is not None and doc.get("request") != request.describe():
+        return "it names another request"
     if hashlib.sha256(text.encode("utf-8")).hexdigest() != doc.get("sha256"):
+        return "the text does not have its recorded sha256"
+    return specs_problem(doc.get("specs"), text, backend, None if request is None else request.free)
+
+
+def read_committed(model: str, key: str, backend: str, root: Path | None = None,
+                   request: CompileRequest | None = None) -> dict | None:
+    """{'text', 'specs'} of a request from mechgen/generated/ (or ``root``) when its full key, the request
+    (when given), the text's sha256 and its specs match, else None.
+
+    A committed generation that is present but does not match (edited text, damaged JSON) is ignored with
+    a RuntimeWarning, so the request is derived instead.
+    """
+    from mechgen.codegen.cache import MAX_DOCUMENT_BYTES, parse_json, read_bounded
+
+    text_path, json_path = committed_paths(model, key, backend, GENERATED if root is None else root)
+    if not json_path.is_file():
+        return None
+    try:
+        doc = parse_json(read_bounded(json_path, MAX_DOCUMENT_BYTES), max_bytes=MAX_DOCUMENT_BYTES)
+        text = read_bounded(text_path, MAX_DOCUMENT_BYTES).decode("utf-8")
+        problem = document_problem(doc, key, request, text, backend)
+        if problem is None and (doc.get("text") != text_path.name or not isinstance(doc.get("kernels"), list)
+                                or list(doc["kernels"]) != list(doc["specs"])):
+            problem = "its kernel list or text name is not the one recorded"
+    except (OSError, ValueError) as exc:
+        problem = f"unreadable: {exc}"
+    if problem is not None:
+        warnings.warn(f"mechgen: ignored the committed generation {json_path} ({problem}); deriving instead",
+                      RuntimeWarning, stacklevel=2)
         return None
     return {"text": text, "specs": {name: doc["specs"][name] for name in doc["kernels"]}}
+
+
+def index_document(request: CompileRequest, key: str, generated: dict) -> str:
+    """The user cache's index entry of a request: its key, the request, the text, its sha256 and the specs."""
+    import hashlib
+
+    return json.dumps({"format": REQUEST_FORMAT, "key": key, "request": request.describe(),
+                       "sha256": hashlib.sha256(generated["text"].encode("utf-8")).hexdigest(),
+                       "text": generated["text"], "specs": generated["specs"]})
+
+
+def read_index(request: CompileRequest, key: str) -> dict | None:
+    """{'text', 'specs'} of a request from the user cache's index, when a verified entry holds it.
+
+    The entry's document is checked against the request (:func:`document_problem`); one that is not
+    (empty, forged, another request's) is refused: warned about, removed and rebuilt by the caller.
+    """
+    from mechgen.codegen.cache import MAX_DOCUMENT_BYTES, lookup, read_json
+
+    found: dict = {}
+
+    def check(entry: Path) -> str | None:
+        doc = read_json(entry / "generated.json", max_bytes=MAX_DOCUMENT_BYTES)
+        text = doc.get("text") if isinstance(doc, dict) else None
+        if not isinstance(text, str) or not text:
+            return "it holds no generated text"
+        problem = document_problem(doc, key, request, text, request.backend)
+        if problem is None:
+            found.update(text=text, specs=doc["specs"])
+        return problem
+
+    return found if lookup("index", key, check) is not None and found else None
 
 
 def generated_text(request: CompileRequest, derive_with: Callable[[], tuple], report: BuildReport) -> dict:
@@ -363,16 +475,16 @@ def generated_text(request: CompileRequest, derive_with: Callable[[], tuple], re
 
     ``derive_with()`` gives ``(model, spec)``; it is called only when neither cache holds the request.
     """
-    from mechgen.codegen.cache import get_or_create, lookup
+    from mechgen.codegen.cache import get_or_create
 
     key = request.key()
     if key is not None:
-        entry = lookup("index", key)
-        if entry is not None:
+        found = read_index(request, key)
+        if found is not None:
             report.seconds.update(derive=0.0, lower=0.0, emit=0.0)
             report.origin = "cache"
-            return json.loads((entry / "generated.json").read_text())
-        found = read_committed(request.model, key, request.backend)
+            return found
+        found = read_committed(request.model, key, request.backend, request=request)
         if found is not None:
             report.seconds.update(derive=0.0, lower=0.0, emit=0.0)
             report.origin = "generated"
@@ -384,7 +496,11 @@ def generated_text(request: CompileRequest, derive_with: Callable[[], tuple], re
     result = generate(model, spec, request.kernels, request.backend, request.cse, report)
     report.origin = "derived"
     if key is not None:
-        get_or_create("index", key, lambda folder: (folder / "generated.json").write_text(json.dumps(result)))
+        document = index_document(request, key, result)
+        try:
+            get_or_create("index", key, lambda folder: (folder / "generated.json").write_text(document))
+        except OSError as exc:  # not even a temporary cache: the generation is used uncached
+            log.info("generated text not cached: %s", exc)
     return result
 
 

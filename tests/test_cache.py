@@ -96,7 +96,10 @@ def test_cache_root_from_env(cache_dir):
 def test_build_load_bind_and_cache_hit(cache_dir):
     compiles = build.STATS["compile"]
     path = build.build_shared(kernel(2.0), stem="affine")
-    assert path.name == "libaffine.so" and (path.parent / "libaffine.c").read_text() == kernel(2.0)
+    key = path.parent.name
+    assert path.name == "libaffine.so"
+    assert (path.parent / "libaffine.c").read_text() == build.marked_source(kernel(2.0), key)
+    assert build.library_problem(path, key) is None
     assert path.parent.parent == cache_dir / "c"
     assert build.STATS["compile"] == compiles + 1
     mtime = path.stat().st_mtime_ns
@@ -145,7 +148,8 @@ def test_bad_entry_is_detected_and_rebuilt(cache_dir, how):
     path = build.build_shared(kernel(3.0), stem="affine")
     _corrupt(path.parent, how)
     key = path.parent.name
-    assert cache.lookup("c", key) is None
+    with pytest.warns(RuntimeWarning, match="damaged compile-cache entry"):
+        assert cache.lookup("c", key) is None
     assert not os.path.lexists(path.parent)
     compiles = build.STATS["compile"]
     rebuilt = build.build_shared(kernel(3.0), stem="affine")
@@ -156,17 +160,19 @@ def test_bad_entry_is_detected_and_rebuilt(cache_dir, how):
 
 
 @needs_cc
-def test_library_that_will_not_load_is_rebuilt_once(cache_dir):
+def test_forged_library_is_refused_before_loading_and_rebuilt(cache_dir):
     path = build.build_shared(kernel(5.0), stem="affine")
     # Corrupt the library *and* forge a matching meta.json: verification passes, dlopen fails.
     path.write_bytes(b"not an ELF file")
     meta = json.loads((path.parent / "meta.json").read_text())
     meta["files"][path.name] = cache.file_sha256(path)
+    meta["bytes"][path.name] = path.stat().st_size
     (path.parent / "meta.json").write_text(json.dumps(meta))
-    assert cache.lookup("c", path.parent.name) == path.parent
+    assert cache.lookup("c", path.parent.name) == path.parent  # meta.json alone cannot tell
 
     compiles = build.STATS["compile"]
-    lib = build.load_shared(kernel(5.0), stem="affine")
+    with pytest.warns(RuntimeWarning, match="does not carry its build key"):  # refused before dlopen
+        lib = build.load_shared(kernel(5.0), stem="affine")
     assert build.STATS["compile"] == compiles + 1
     run_affine(build.get_caller(), lib, 5.0)
 

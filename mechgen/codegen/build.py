@@ -12,6 +12,16 @@ The compiler is run with an argument list (never a shell) and a timeout; the
 cache key covers the source, flags, include directories, compiler identity,
 machine and a format version, so a cached library is reused only when it
 would be rebuilt identically.
+
+Every library carries its build key (``mechgen_build_key``, appended to the
+source), and a cached entry is used only when its source is the requested one
+and its library carries that key, checked on the file's bytes *before* it is
+loaded (a library of another build under forged metadata is never dlopen'ed).
+A compiler that exits 0 without writing such a library (``CC=/bin/true``, a
+script writing garbage), or cannot build even a trivial library, is
+unavailable (:class:`CompilerUnavailable`: the pipeline falls back to numpy);
+a compiler that builds the trivial library but fails on the source raises
+:class:`BuildError`.
 """
 from __future__ import annotations
 
@@ -39,7 +49,9 @@ from mechgen.errors import BuildError, CompilerUnavailable
 log = logging.getLogger("mechgen")
 
 DEFAULT_CFLAGS = ("-std=c99", "-O3", "-fPIC", "-shared", "-Wall", "-Wextra", "-Werror", "-pedantic")
-BUILD_FORMAT = "mechgen-build-1"
+BUILD_FORMAT = "mechgen-build-2"
+#: prefix of the build key string every library carries (see marked_source)
+KEY_MARKER = "mechgen-build-key:"
 KIND = "c"
 COMPILE_TIMEOUT = 120.0
 VERSION_TIMEOUT = 30.0
@@ -50,6 +62,15 @@ MGCALL_SOURCE = Path(__file__).parent / "templates" / "c99" / "mgcall.c"
 STATS: Counter = Counter()
 
 _compilers: dict[tuple[str | None, str | None], tuple[str, str] | None] = {}
+#: (command, flags) -> why the compiler cannot build a trivial shared library ("" when it can)
+_trivial: dict[tuple, str] = {}
+#: a library any working C compiler builds with mechgen's flags (it needs the C library's math.h)
+TRIVIAL_SOURCE = """\
+#include <math.h>
+double mechgen_probe(double x);
+double mechgen_probe(double x) { return sqrt(x); }
+const char mechgen_probe_marker[] = "mechgen-probe-ok";
+"""
 
 
 # ---------------------------------------------------------------------------
@@ -59,6 +80,7 @@ _compilers: dict[tuple[str | None, str | None], tuple[str, str] | None] = {}
 def reset_compiler_cache() -> None:
     """Forget the compilers found so far (tests change ``CC``/``PATH``)."""
     _compilers.clear()
+    _trivial.clear()
 
 
 def _probe(command: str) -> tuple[str, str] | None:
@@ -129,21 +151,59 @@ def build_key(source: str, cflags: Sequence[str], include_dirs: Sequence[str], l
                              "\0".join(ldflags), identity, platform.machine(), *extra)
 
 
-def _failed_source_path(key: str, stem: str, source: str) -> Path:
-    """Keep the source of a failed build in the cache for reading; return its path."""
-    folder = cache.cache_root() / "failed"
-    folder.mkdir(parents=True, exist_ok=True)
-    path = folder / f"{stem}-{key[:16]}.c"
-    fd, tmp = tempfile.mkstemp(dir=folder, prefix=cache.TMP_PREFIX)
-    with os.fdopen(fd, "w", encoding="utf-8") as fh:
-        fh.write(source)
-    os.chmod(tmp, 0o644)
-    os.replace(tmp, path)
+def marked_source(source: str, key: str) -> str:
+    """The source as built: ``source`` and a definition of ``mechgen_build_key``, the string
+    ``KEY_MARKER + key`` that the library's bytes are checked for before it is loaded."""
+    body = source if source.endswith("\n") else source + "\n"
+    return (f"{body}\n/* mechgen: the build key, checked in the library before it is loaded */\n"
+            f"const char mechgen_build_key[] = \"{KEY_MARKER}{key}\";\n")
+
+
+def library_problem(path: Path, key: str) -> str | None:
+    """Why the file at ``path`` is not a library built for ``key`` (read, never loaded); None if it is.
+
+    The library must be a regular file carrying exactly one build key string, ``KEY_MARKER + key``.
+    """
+    try:
+        data = cache.read_bounded(path)
+    except (OSError, ValueError) as exc:
+        return f"{Path(path).name} is unreadable ({exc})"
+    marker = KEY_MARKER.encode()
+    if data.count(marker) != 1 or (marker + key.encode()) not in data:
+        return f"{Path(path).name} does not carry its build key"
+    return None
+
+
+def entry_check(key: str, source_name: str, source: str, output_name: str) -> cache.Check:
+    """The content check of a build entry: its source is ``source`` and its library carries ``key``."""
+    expected = source.encode("utf-8")
+
+    def check(entry: Path) -> str | None:
+        if cache.read_bounded(entry / source_name) != expected:
+            return f"{source_name} is not the requested source"
+        return library_problem(entry / output_name, key)
+
+    return check
+
+
+def _failed_source_path(key: str, stem: str, source: str) -> Path | None:
+    """Keep the source of a failed build in the cache for reading; return its path (None if not writable)."""
+    try:
+        folder = cache.kind_dir("failed")
+        path = folder / f"{stem}-{key[:16]}.c"
+        fd, tmp = tempfile.mkstemp(dir=folder, prefix=cache.TMP_PREFIX)
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(source)
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except OSError as exc:
+        log.info("could not keep the failed source: %s", exc)
+        return None
     return path
 
 
-def _compile(command: str, source_path: Path, output: Path, cflags: Sequence[str],
-             include_dirs: Sequence[str], ldflags: Sequence[str]) -> subprocess.CompletedProcess:
+def run_compiler(command: str, source_path: Path, output: Path, cflags: Sequence[str],
+                 include_dirs: Sequence[str], ldflags: Sequence[str]) -> subprocess.CompletedProcess:
     """Run the compiler once; raise CompilerUnavailable if it cannot be started."""
     argv = [*shlex.split(command), *cflags, *(f"-I{d}" for d in include_dirs),
             "-o", str(output), str(source_path), *ldflags]
@@ -154,9 +214,33 @@ def _compile(command: str, source_path: Path, output: Path, cflags: Sequence[str
         raise CompilerUnavailable(f"cannot run C compiler {command!r}: {exc}") from exc
 
 
+def trivial_problem(command: str, cflags: Sequence[str], include_dirs: Sequence[str],
+                    ldflags: Sequence[str]) -> str:
+    """Why ``command`` cannot build :data:`TRIVIAL_SOURCE` into a shared library with these flags
+    ("" when it can: then a failed build is the source's fault). Memoised per process."""
+    memo = (command, tuple(cflags), tuple(include_dirs), tuple(ldflags))
+    if memo not in _trivial:
+        with tempfile.TemporaryDirectory(prefix="mechgen-probe-") as tmp:
+            source, output = Path(tmp) / "probe.c", Path(tmp) / "libprobe.so"
+            source.write_text(TRIVIAL_SOURCE, encoding="utf-8")
+            try:
+                done = run_compiler(command, source, output, cflags, include_dirs, ldflags)
+            except (CompilerUnavailable, subprocess.SubprocessError) as exc:
+                problem = str(exc)
+            else:
+                if done.returncode != 0:
+                    problem = f"exit {done.returncode}: {(done.stderr or done.stdout).strip()[:500]}"
+                elif not output.is_file() or b"mechgen-probe-ok" not in output.read_bytes():
+                    problem = "it exits 0 but writes no library"
+                else:
+                    problem = ""
+        _trivial[memo] = problem
+    return _trivial[memo]
+
+
 def _build_error(message: str, stderr: str, key: str, stem: str, source: str) -> BuildError:
     path = _failed_source_path(key, stem, source)
-    err = BuildError(f"{message} on {path}:\n{stderr.strip()}")
+    err = BuildError(f"{message} on {path or 'the generated source'}:\n{stderr.strip()}")
     err.stderr = stderr
     err.source_path = path
     return err
@@ -168,25 +252,37 @@ def _build_entry(source: str, *, stem: str, output_name: str, cflags: Sequence[s
     _check_stem(stem)
     found = _compiler()
     if found is None:
-        raise CompilerUnavailable("no working C compiler found (set CC, or install cc/gcc/clang)")
+        cc = os.environ.get("CC")
+        raise CompilerUnavailable(f"CC={cc!r} does not run ({cc} --version failed)" if cc else
+                                  "no working C compiler found (set CC, or install cc/gcc/clang)")
     command, identity = found
     cflags, include_dirs, ldflags = tuple(cflags), tuple(map(str, include_dirs)), tuple(ldflags)
-    key = build_key(source, cflags, include_dirs, ldflags, identity, *extra_key)
+    # the file names are part of the entry: the same source under another stem is another entry
+    key = build_key(source, cflags, include_dirs, ldflags, identity, stem, output_name, *extra_key)
+    source_name = f"lib{stem}.c"
+    built = marked_source(source, key)
 
     def fill(tmp: Path) -> None:
-        source_path = tmp / f"lib{stem}.c"
-        source_path.write_text(source, encoding="utf-8")
+        source_path = tmp / source_name
+        source_path.write_text(built, encoding="utf-8")
         try:
-            done = _compile(command, source_path, tmp / output_name, cflags, include_dirs, ldflags)
+            done = run_compiler(command, source_path, tmp / output_name, cflags, include_dirs, ldflags)
         except subprocess.TimeoutExpired as exc:
             stderr = exc.stderr.decode(errors="replace") if isinstance(exc.stderr, bytes) else (exc.stderr or "")
             raise _build_error(f"C compiler timed out after {COMPILE_TIMEOUT:.0f} s", stderr, key, stem,
                                source) from exc
-        if done.returncode != 0 or not (tmp / output_name).is_file():
+        if done.returncode != 0:
+            if tmp.is_dir():  # (not when the cache was removed meanwhile: the cache layer retries)
+                unusable = trivial_problem(command, cflags, include_dirs, ldflags)
+                if unusable:
+                    raise CompilerUnavailable(f"CC={command!r} cannot build a shared library ({unusable})")
             raise _build_error(f"C compiler {command!r} failed (exit {done.returncode})",
                                done.stderr or done.stdout, key, stem, source)
+        problem = library_problem(tmp / output_name, key)
+        if problem is not None and tmp.is_dir():
+            raise CompilerUnavailable(f"CC={command!r} exited 0 but wrote no valid library ({problem})")
 
-    entry, created = cache.get_or_create(KIND, key, fill)
+    entry, created = cache.get_or_create(KIND, key, fill, entry_check(key, source_name, built, output_name))
     STATS["miss" if created else "hit"] += 1
     return entry / output_name
 
@@ -217,7 +313,7 @@ def build_shared(source: str, *, stem: str, cflags: Sequence[str] = DEFAULT_CFLA
 def invalidate(path: Path) -> None:
     """Remove the cache entry holding ``path`` (a library that would not load)."""
     entry = Path(path).resolve().parent
-    if entry.parent.parent == cache.cache_root().resolve():
+    if cache.owns(entry):
         cache.discard(entry)
 
 
@@ -231,29 +327,48 @@ def load_library(path: Path | str) -> ctypes.CDLL:
 
 
 def _with_retry(build: Callable[[], Path], load: Callable[[Path], object]):
-    """Build and load; if loading fails, invalidate the entry and rebuild once."""
+    """Build and load; if loading fails, invalidate the entry and rebuild once.
+
+    When the library had vanished (the cache removed while in use), the rebuild goes to a temporary
+    cache (:func:`mechgen.codegen.cache.bypass`) if it vanishes again.
+    """
     path = build()
     try:
         return load(path)
     except (OSError, ImportError) as exc:
         log.warning("cached library %s would not load (%s); rebuilding", path, exc)
+        vanished = not os.path.exists(path)
         invalidate(path)
-    path = build()
-    try:
-        return load(path)
-    except (OSError, ImportError) as exc:
-        raise BuildError(f"freshly built library {path} would not load: {exc}") from exc
+    for last in (False, True):
+        path = build()
+        try:
+            return load(path)
+        except (OSError, ImportError) as exc:
+            if last or not (vanished and not os.path.exists(path)):
+                raise BuildError(f"freshly built library {path} would not load: {exc}") from exc
+            cache.bypass(cache.configured_root(), f"{path} was removed while it was loaded")
+
+
+def load_checked(path: Path | str, symbols: Sequence[str] = ()) -> ctypes.CDLL:
+    """Load a shared library that must export every name of ``symbols`` (OSError otherwise)."""
+    lib = load_library(path)
+    missing = [name for name in symbols if not hasattr(lib, name)]
+    if missing:
+        raise OSError(f"{path} does not export {', '.join(missing)}")
+    return lib
 
 
 def load_shared(source: str, *, stem: str, cflags: Sequence[str] = DEFAULT_CFLAGS,
-                include_dirs: Sequence[str] = (), ldflags: Sequence[str] = ()) -> ctypes.CDLL:
+                include_dirs: Sequence[str] = (), ldflags: Sequence[str] = (),
+                symbols: Sequence[str] = ()) -> ctypes.CDLL:
     """Build (or find in the cache) and load a shared library, rebuilding once if it will not load.
 
-    Arguments and errors are those of :func:`build_shared`; a library that
-    still will not load after a rebuild raises BuildError.
+    Arguments and errors are those of :func:`build_shared`; ``symbols`` are the names the library
+    must export. A library that still will not load (or lacks one of them) after a rebuild raises
+    BuildError.
     """
     return _with_retry(lambda: build_shared(source, stem=stem, cflags=cflags, include_dirs=include_dirs,
-                                            ldflags=ldflags), load_library)
+                                            ldflags=ldflags), lambda path: load_checked(path, symbols))
 
 
 def function_address(lib: ctypes.CDLL, name: str) -> int:

@@ -9,6 +9,7 @@ callable with no arguments (C: a vectorcall object, about 60 ns a call).
 from __future__ import annotations
 
 import ctypes
+import importlib.abc
 import importlib.util
 from pathlib import Path
 from typing import Callable
@@ -19,9 +20,38 @@ from mechgen.errors import KernelError
 from mechgen.runtime.core.pattern import extent
 
 
-def load_module(path: Path, name: str):
-    """Import a generated Python module from a file (no sys.path changes)."""
-    spec = importlib.util.spec_from_file_location(name, path)
+class TextLoader(importlib.abc.SourceLoader):
+    """Loads a module from given source text; ``path`` is its file name for tracebacks only.
+
+    What runs is exactly the text the caller verified, never bytes read again from the file (which
+    another process could have replaced in between).
+    """
+
+    def __init__(self, path: Path | str, source: str | bytes) -> None:
+        self.path = str(path)
+        self.data = source.encode("utf-8") if isinstance(source, str) else bytes(source)
+
+    def get_filename(self, fullname: str) -> str:
+        return self.path
+
+    def get_data(self, path: str) -> bytes:
+        return self.data
+
+
+def load_module(path: Path, name: str, source: str | bytes | None = None):
+    """Import a generated Python module (no sys.path or sys.modules changes).
+
+    Args:
+        path: the module's file (read when ``source`` is None; else only its name is used).
+        name: the module name.
+        source: the module's text, when the caller holds (and has verified) it.
+    """
+    if source is None:
+        spec = importlib.util.spec_from_file_location(name, path)
+    else:
+        loader = TextLoader(path, source)
+        spec = importlib.util.spec_from_loader(name, loader, origin=str(path))
+        spec.has_location = True
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
