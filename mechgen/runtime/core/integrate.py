@@ -30,6 +30,8 @@ IMPLICIT = ("BDF", "Radau", "LSODA")
 MIN_RTOL = 100 * float(np.finfo(float).eps)
 #: the leapfrog checks its wall-time budget and moves its bar every this many steps
 CHECK_EVERY = 1024
+#: an adaptive run is refused early when its projected steps exceed this many times max_steps
+PROJECT_MARGIN = 10.0
 
 
 @dataclass(frozen=True)
@@ -70,16 +72,31 @@ def integrate_first_order(rhs, x0, t_end: float, *, jac=None, method: str = "BDF
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}; expected one of {METHODS}")
     t_end = float(t_end)
-    kwargs = {"jac": jac} if (jac is not None and method in IMPLICIT) else {}
     last: list = [0.0, np.asarray(x0, float)]
+    accepted: list = [0.0, np.asarray(x0, float)]
 
     def fun(t, x):  # remembers the state of the latest evaluation, for the failure message
         last[0], last[1] = t, x
         return rhs(t, x)
 
+    def jacobian(t, x):
+        last[0], last[1] = t, x
+        return jac(t, x)
+
+    kwargs = {"jac": jacobian} if (jac is not None and method in IMPLICIT) else {}
+
+    def note() -> str:
+        """explain() at the latest evaluated state, or at the last accepted one when that one is not finite."""
+        if explain is None:
+            return ""
+        t_x, x = last[0], np.asarray(last[1], float)
+        if not np.all(np.isfinite(x)):
+            t_x, x = accepted[0], np.asarray(accepted[1], float)
+        return explain(t_x, x)
+
     def failed(what: str) -> str:
-        note = explain(last[0], np.asarray(last[1], float)) if explain is not None else ""
-        return f"{method} {what}" + (f"; {note}" if note else "")
+        why = note()
+        return f"{method} {what}" + (f"; {why}" if why else "")
 
     from numpy.linalg import LinAlgError
 
@@ -99,6 +116,7 @@ def integrate_first_order(rhs, x0, t_end: float, *, jac=None, method: str = "BDF
                                                   f"{str(message).rstrip('.')}"))
                 steps += 1
                 t = solver.t
+                accepted[0], accepted[1] = t, solver.y
                 if t_eval is None:
                     ts.append(t)
                     ys.append(solver.y.copy())
@@ -110,14 +128,16 @@ def integrate_first_order(rhs, x0, t_end: float, *, jac=None, method: str = "BDF
                         i_eval = i_new
                 if budget is not None:
                     budget.spend(1, lambda: _where(t, t_end, steps))
+                    if steps % CHECK_EVERY == 0:
+                        _project(budget, method, steps, t, t - solver.t_old, t_end)
                 bar.to(t)
-    except (LinAlgError, ZeroDivisionError) as exc:
+    except (LinAlgError, ZeroDivisionError, ValueError) as exc:  # a singular M; a NaN met by a check_finite solve
         raise ConvergenceError(failed(f"failed at t = {last[0]:.6g} of t_end = {t_end:.6g} ({exc})")) from exc
     except KernelError as exc:
-        note = explain(last[0], np.asarray(last[1], float)) if explain is not None else ""
-        if not note:
+        why = note()
+        if not why:
             raise
-        raise KernelError(f"{method} at t = {last[0]:.6g} of t_end = {t_end:.6g}: {note}") from exc
+        raise KernelError(f"{method} at t = {last[0]:.6g} of t_end = {t_end:.6g}: {why}") from exc
     if t_eval is None:
         t_out, x_out = np.array(ts), np.array(ys).reshape(len(ts), -1)
     else:
@@ -127,6 +147,20 @@ def integrate_first_order(rhs, x0, t_end: float, *, jac=None, method: str = "BDF
         raise KernelError(failed(f"state became NaN/Inf by t = {t:.6g} of t_end = {t_end:.6g}"))
     return Trajectory(t_out, x_out, nfev=solver.nfev, njev=solver.njev, success=True,
                       message="The solver successfully reached the end of the integration interval.", steps=steps)
+
+
+def _project(budget: Budget, method: str, steps: int, t: float, h: float, t_end: float) -> None:
+    """Once a tenth of the step budget is spent: refuse when the steps so far plus (t_end - t) / h at the
+    latest step size h exceed PROJECT_MARGIN times the budget (a step size that stopped growing: a fast
+    mode resolved over the whole interval); a margin that an early transient's short steps cannot reach."""
+    if budget.limit is None or steps < budget.limit / 10 or h <= 0:
+        return
+    estimate = steps + (t_end - t) / h
+    if estimate > PROJECT_MARGIN * budget.limit:
+        raise BudgetExceeded(f"{method} steps: at the step size of the latest step (h = {h:.3g}) t_end = {t_end:.6g} "
+                             f"needs about {estimate:.3g} steps, more than {PROJECT_MARGIN:g} x max_steps = "
+                             f"{budget.limit:,} (a fast mode resolved over the whole interval: shorten t_end, or "
+                             "raise max_steps)", key=budget.key, reached=_where(t, t_end, steps))
 
 
 def leapfrog(acceleration, q0, v0, dt: float, n_steps: int, *, record_every: int = 1, energy=None,

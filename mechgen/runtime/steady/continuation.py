@@ -119,6 +119,8 @@ class ContinuationOptions(Options):
         grow: the step's growth factor after a correction in at most 3 steps.
         max_turn: the largest angle (radians) between consecutive tangents; a step turning more is halved.
         locate_folds: locate each fold by Brent's method (else the point after the fold is recorded, located=False).
+        budget: a :class:`~mechgen.runtime.core.budget.Budget` whose wall time is checked before every step
+            (BudgetExceeded names the points accepted and the lam reached), or None.
 
     Checked by :meth:`check`: 0 < ds_min <= ds <= ds_max, direction +1 or -1, max_points >= 1,
     lam_min < lam_max, 0 < max_turn < pi, tol > 0, grow >= 1.
@@ -136,6 +138,7 @@ class ContinuationOptions(Options):
     grow: float = 1.5
     max_turn: float = 0.5
     locate_folds: bool = True
+    budget: Any = None
 
     def check(self) -> None:
         """InputError unless the options are consistent (see the class doc)."""
@@ -425,6 +428,8 @@ def continuation(system, u0, lam0: float, options: ContinuationOptions | None = 
     step = ds
     while len(xs) < max_points:
         x_i, t_i = xs[-1], ts[-1]
+        if opts.budget is not None:
+            opts.budget.check_time(lambda: f"{len(xs)} branch points, lam = {x_i[n]:.10g}")
         row = _row(w, t_i)
         pred = x_i + step * t_i
         if len(xs) > 1 and arc[-1] > arc[-2]:  # second order: x'' ~ (t_i - t_{i-1}) / (s_i - s_{i-1})
