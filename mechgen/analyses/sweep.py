@@ -103,7 +103,7 @@ def run_sweep(system, options: dict, context: dict) -> dict:
     tasks = Tasks(points, inner.kind, dict(inner.options), options["grid"])
     budget = Budget(f"sweep of {inner.kind}", unit="points", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
     results = sweep(points.evaluate, tasks, workers=options.get("workers", 0), progress=options.get("progress", True),
-                    desc=context.get(NAME, "sweep"), budget=budget)
+                    desc=context.get(NAME, "sweep"), budget=budget, labels=options["grid"])
     return collect(options["grid"], results)
 
 

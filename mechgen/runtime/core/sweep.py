@@ -20,10 +20,14 @@ class SweepError(MechgenError):
 
 
 def sweep(func, points: list, *, workers: int = 0, progress: bool = True, desc: str = "sweep",
-          budget: Budget | None = None, inner: str = "analysis") -> list:
-    """[func(point) for point in points], with ``workers`` > 1 local processes, under ``budget``."""
+          budget: Budget | None = None, inner: str = "analysis", labels=None) -> list:
+    """[func(point) for point in points], with ``workers`` > 1 local processes, under ``budget``; ``labels[i]``
+    names point i in messages (default: the point, or the last dict of a task tuple)."""
     results: list = [None] * len(points)
     total = len(points)
+
+    def label(i: int):
+        return labels[i] if labels is not None else points[i]
 
     def done(i: int) -> None:
         if budget is not None:
@@ -32,7 +36,7 @@ def sweep(func, points: list, *, workers: int = 0, progress: bool = True, desc: 
     with Progress(total, desc=desc, unit="point", enabled=progress) as bar:
         if workers <= 1:
             for i, point in enumerate(points):
-                results[i] = _call(func, point, inner)
+                results[i] = _call(func, point, inner, label(i))
                 bar.update()
                 done(i)
             return results
@@ -45,11 +49,11 @@ def sweep(func, points: list, *, workers: int = 0, progress: bool = True, desc: 
                 try:
                     results[i] = fut.result()
                 except BudgetExceeded as exc:
-                    raise _inner(exc, points[i], inner) from exc
+                    raise _inner(exc, label(i), inner) from exc
                 except MechgenError:
                     raise
                 except Exception as exc:  # re-raised with the point named
-                    raise SweepError(f"sweep point {_describe(points[i])} failed: {exc}") from exc
+                    raise SweepError(f"sweep point {_describe(label(i))} failed: {exc}") from exc
                 bar.update()
                 done(i)
         finally:
@@ -64,15 +68,15 @@ def _inner(exc: BudgetExceeded, point, inner: str) -> BudgetExceeded:
                           analysis=exc.analysis)
 
 
-def _call(func, point, inner: str):
+def _call(func, point, inner: str, label):
     try:
         return func(point)
     except BudgetExceeded as exc:
-        raise _inner(exc, point, inner) from exc
+        raise _inner(exc, label, inner) from exc
     except MechgenError:
         raise
     except Exception as exc:  # re-raised with the point named
-        raise SweepError(f"sweep point {_describe(point)} failed: {exc}") from exc
+        raise SweepError(f"sweep point {_describe(label)} failed: {exc}") from exc
 
 
 def _describe(point) -> str:
