@@ -198,6 +198,8 @@ def test_budget_keys_are_checked_like_every_key(tmp_path, capsys):
     assert code == 2 and "analysis[1].max_steps" in err
     code, err, _ = _run(tmp_path, PENDULUM + "t_end = 2.0\nmax_seconds = -1\n", capsys)
     assert code == 2 and "analysis[1].max_seconds" in err and "> 0" in err
+    code, err, _ = _run(tmp_path, PENDULUM + "t_end = 2.0\nsamples = 100000000\n", capsys)
+    assert code == 2 and "analysis[1].samples" in err and "2.98 GiB" in err and "at most 1,000,000" in err
 
 
 # --------------------------------------------------------------------------- non-finite and degenerate states

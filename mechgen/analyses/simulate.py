@@ -16,6 +16,7 @@ stability alone (at least t_end |lambda|max / c steps, c = 7 for RK45 and 12 for
 their stability intervals): a stiff problem wants BDF or Radau. Reaching a budget ends the run
 with exit 1 naming the analysis, the t reached of t_end and the key to raise.
 
+``samples`` above 10^6 is refused at the key (each sample is a state kept and an energy evaluated).
 ``rtol`` below 100 machine epsilons (2.2e-14, what scipy's integrators can honour; they would
 raise it silently) is refused at the key. A failed step (a step size below the spacing of the
 numbers), a singular mass matrix (a zero mass) or a kernel giving NaN/Inf ends the run with
@@ -46,6 +47,8 @@ STEP = "a number > 0 (or an expression)"
 DEFAULT_STEPS = {"leapfrog": 10_000_000, "adaptive": 100_000}
 #: stability intervals of the explicit methods, doubled (RK45: ~3.3, DOP853: ~6): steps >= t_end |lambda| / c
 EXPLICIT_REACH = {"RK45": 7.0, "DOP853": 12.0}
+#: at most this many output samples (each is a state kept and an energy evaluated)
+MAX_SAMPLES = 1_000_000
 #: the explicit methods' up-front stiffness estimate is made for first-order states up to this size
 ESTIMATE_SIZE = 400
 
@@ -82,6 +85,10 @@ SCHEMA = {"t_end": Option(schema.positive, REQUIRED, STEP), "method": Option(_me
 
 def check(ctx, base: str, options: dict) -> None:
     """leapfrog needs dt; dt <= t_end; initial_mode within the coordinates; rtol at least MIN_RTOL."""
+    if options["samples"] > MAX_SAMPLES:
+        raise fail(ctx.file, f"{base}.samples", f"samples {options['samples']:,} would hold "
+                   f"{options['samples'] * 2 * max(len(ctx.coordinates), 1) * 8 / 2**30:.3g} GiB of states and evaluate "
+                   f"the energy at each", f"at most {MAX_SAMPLES:,} samples")
     if options["method"] != "leapfrog" and options["rtol"] < MIN_RTOL:
         raise fail(ctx.file, f"{base}.rtol", f"rtol {options['rtol']!r} is below what the integrators can honour "
                    "in double precision", f"a relative tolerance >= {MIN_RTOL:.3g} (100 machine epsilons)")
