@@ -14,7 +14,8 @@ Keys: ``about`` (an earlier steady analysis), ``parameter``, ``stop``, ``max_poi
 ``stability`` (default true), ``minimize`` (an output), ``aliases``, ``max_seconds`` (the
 wall-time budget of the whole analysis, default 600 s: checked before every continuation step
 and between the stability verdicts and located points; reaching it ends the run with exit 1
-naming the branch points done, the parameter reached and the key).
+naming the branch points done, the parameter reached and the key), ``progress`` (default true: a
+bar of the branch points on stderr when it is a terminal and the branch takes over 2 s).
 
 More keys of ``continuation``:
 
@@ -131,7 +132,7 @@ SCHEMA = {"about": Option(_starts, REQUIRED), "parameter": Option(_parameter, RE
           "minimize": Option(schema.name), "aliases": Option(schema.aliases, {}),
           "direction": Option(schema.one_of("direction", DIRECTIONS)), "bounds": Option(_bounds),
           "at": Option(_output_values), "eigenvalues": Option(schema.boolean, False),
-          "max_seconds": Option(schema.positive)}
+          "max_seconds": Option(schema.positive), "progress": Option(schema.boolean)}
 
 
 def _check_branch_outputs(ctx, base: str, options: dict) -> None:
@@ -208,7 +209,8 @@ def _follow(system, bvp, result, options: dict, aliases: dict, budget: Budget | 
     towards = "increasing" if stop >= here else "decreasing"
     steps = ContinuationOptions(ds=options.get("step", 0.05),
                                 ds_max=options.get("max_step", max(1.0, abs(stop - here) / 20)),
-                                **({"lam_max": stop} if stop >= here else {"lam_min": stop}), budget=budget)
+                                **({"lam_max": stop} if stop >= here else {"lam_min": stop}), budget=budget,
+                                progress=options.get("progress", True))
     bounds = options.get("bounds") or {}
 
     def inside(u, lam, disc):
