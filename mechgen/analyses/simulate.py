@@ -13,7 +13,7 @@ accepted steps for the adaptive methods), ``max_seconds`` (wall time, default 60
 run lasts over 2 s). An explicit method (RK45, DOP853) is also refused up front when the fastest
 rate of the linearisation at the start, |lambda|max, needs more than ``max_steps`` steps for
 stability alone (at least t_end |lambda|max / c steps, c = 7 for RK45 and 12 for DOP853, twice
-their stability intervals): a stiff problem wants BDF or Radau. Reaching a budget ends the run
+their stability intervals): the implicit BDF and Radau have no such limit. Reaching a budget ends the run
 with exit 1 naming the analysis, the t reached of t_end and the key to raise.
 
 ``samples`` above 10^6 is refused at the key (each sample is a state kept and an energy evaluated).
@@ -30,10 +30,10 @@ from pathlib import Path
 import numpy as np
 
 from mechgen.analyses import schema, summary
+from mechgen.analyses.context import NAME
 from mechgen.analyses.operating_point import vector
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import ABSENT, ALL_OUTPUTS, REQUIRED, Option
-from mechgen.analyses.context import NAME
 from mechgen.errors import ConvergenceError, SceneError
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget, BudgetExceeded
 from mechgen.runtime.core.diagnose import explain_state
@@ -150,7 +150,7 @@ def budget_of(options: dict, method: str) -> Budget:
 def refuse_explicit_stiff(system, x0: np.ndarray, t_end: float, method: str, budget: Budget) -> None:
     """An explicit method needs at least t_end |lambda|max / c steps for stability alone (|lambda|max: the
     largest eigenvalue magnitude of d(dx/dt)/dx at the start; c: EXPLICIT_REACH); refuse when that is
-    more than the budget (the problem is stiff: BDF or Radau take far fewer steps)."""
+    more than the budget (the problem is stiff: the implicit methods have no such stability limit)."""
     if method not in EXPLICIT_REACH or x0.size > ESTIMATE_SIZE or budget.limit is None:
         return
     try:
