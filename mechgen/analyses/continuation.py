@@ -11,7 +11,11 @@ Shape outputs (mechgen.analyses.bvp_states: the balloon's ``loops``) are reporte
 of a branch, fold, crossing and stability change.
 
 Keys: ``about`` (an earlier steady analysis), ``parameter``, ``stop``, ``max_points``,
-``stability`` (default true), ``minimize`` (an output), ``aliases``.
+``stability`` (default true), ``minimize`` (an output), ``aliases``, ``max_seconds`` (the
+wall-time budget of the whole analysis, default 600 s: checked before every continuation step
+and between the stability verdicts and located points; reaching it ends the run with exit 1
+naming the branch points done, the parameter reached and the key), ``progress`` (default true: a
+bar of the branch points on stderr when it is a terminal and the branch takes over 2 s).
 
 More keys of ``continuation``:
 
@@ -55,6 +59,7 @@ from mechgen.analyses.bvp_states import (bvp_summary, shape_declarations, shape_
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import REQUIRED, Option
 from mechgen.errors import SceneError
+from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget
 from mechgen.runtime.steady import branch_scan
 from mechgen.runtime.steady.continuation import ContinuationOptions, minimize_along_branch
 from mechgen.scene.expr import is_identifier
@@ -126,7 +131,8 @@ SCHEMA = {"about": Option(_starts, REQUIRED), "parameter": Option(_parameter, RE
           "mesh": Option(schema.count, 100), "stability": Option(schema.boolean, True),
           "minimize": Option(schema.name), "aliases": Option(schema.aliases, {}),
           "direction": Option(schema.one_of("direction", DIRECTIONS)), "bounds": Option(_bounds),
-          "at": Option(_output_values), "eigenvalues": Option(schema.boolean, False)}
+          "at": Option(_output_values), "eigenvalues": Option(schema.boolean, False),
+          "max_seconds": Option(schema.positive), "progress": Option(schema.boolean)}
 
 
 def _check_branch_outputs(ctx, base: str, options: dict) -> None:
@@ -195,7 +201,7 @@ def _values(system, bvp, result, aliases: dict, names=()) -> dict:
     return out
 
 
-def _follow(system, bvp, result, options: dict, aliases: dict):
+def _follow(system, bvp, result, options: dict, aliases: dict, budget: Budget | None = None):
     """The branch from one start, with the options' direction, stop and bounds."""
     name = options["parameter"]
     index = bvp.params.index(name)
@@ -203,7 +209,8 @@ def _follow(system, bvp, result, options: dict, aliases: dict):
     towards = "increasing" if stop >= here else "decreasing"
     steps = ContinuationOptions(ds=options.get("step", 0.05),
                                 ds_max=options.get("max_step", max(1.0, abs(stop - here) / 20)),
-                                **({"lam_max": stop} if stop >= here else {"lam_min": stop}))
+                                **({"lam_max": stop} if stop >= here else {"lam_min": stop}), budget=budget,
+                                progress=options.get("progress", True))
     bounds = options.get("bounds") or {}
 
     def inside(u, lam, disc):
@@ -230,18 +237,22 @@ def _check_names(options: dict, known: dict) -> None:
                                  expected="an output of the steady state or an alias: " + ", ".join(sorted(known)))
 
 
-def _one_branch(system, start: dict, options: dict, label: str | None) -> dict:
-    """Points, folds, crossings and stability changes of the branch through one start."""
+def _one_branch(system, start: dict, options: dict, label: str | None, budget: Budget | None = None) -> dict:
+    """Points, folds, crossings and stability changes of the branch through one start (under ``budget``)."""
     bvp, result = start["_bvp"], start["_result"]
     name, aliases = options["parameter"], options.get("aliases", {})
     stability = options.get("stability", True)
     _check_names(options, {**bvp_summary(bvp, result, aliases), **shape_values(system, bvp, result)})
-    branch = _follow(system, bvp, result, options, aliases)
+    branch = _follow(system, bvp, result, options, aliases, budget)
+    spent = (lambda what: budget.check_time(f"{len(branch.lam)} branch points, then {what}")) if budget else \
+        (lambda what: None)
     disc = branch.system
     tag = {"start": label} if label else {}
     results = [disc.to_result(u, lam) for u, lam in zip(branch.u, branch.lam)]
     summaries = [{**bvp_summary(bvp, res, aliases), **shape_values(system, bvp, res)} for res in results]
+    spent("their outputs")
     stab = stability_of_each(system, bvp, results) if stability else [{}] * len(results)
+    spent("their stability")
     points = []
     for lam, res, summary, st in zip(branch.lam, results, summaries, stab):
         point = {**tag, name: float(lam), **{bvp.params[i]: float(res.p[i]) for i in bvp.problem.unknown},
@@ -269,6 +280,7 @@ def _one_branch(system, start: dict, options: dict, label: str | None) -> dict:
         for i in range(len(points) - 1):
             a, b = points[i]["verdict"], points[i + 1]["verdict"]
             if a != b:
+                spent(f"locating the stability change after point {i + 1}")
                 _, rec = located(branch_scan.switch(disc, X[i], X[i + 1], verdict, a))
                 out["stability_changes"].append({**rec, "from": a, "to": b})
     for key, value in (options.get("at") or {}).items():
@@ -276,6 +288,7 @@ def _one_branch(system, start: dict, options: dict, label: str | None) -> dict:
         values = [s[key] - value for s in summaries]
         for i in range(len(points)):
             if values[i] == 0.0 or (i + 1 < len(points) and values[i] * values[i + 1] < 0):
+                spent(f"locating {key} = {value:g} after point {i + 1}")
                 x = X[i] if values[i] == 0.0 else branch_scan.crossing(
                     disc, X[i], X[i + 1],
                     lambda x: _values(system, bvp, disc.to_result(x[:-1], x[-1]), aliases, (key,))[key] - value)
@@ -295,7 +308,9 @@ def run_continuation(system, options: dict, context: dict) -> dict:
     about = options["about"]
     starts = about if isinstance(about, list) else [about]
     name, aliases = options["parameter"], options.get("aliases", {})
-    branches = [_one_branch(system, context[s], options, s if isinstance(about, list) else None) for s in starts]
+    budget = Budget("continuation", unit="points", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
+    branches = [_one_branch(system, context[s], options, s if isinstance(about, list) else None, budget)
+                for s in starts]
     out = {"parameter": name, "shape_outputs": [d.name for d in shape_declarations(system)],
            "branch": [p for b in branches for p in b["points"]],
            "status": branches[0]["status"] if len(branches) == 1 else

@@ -125,7 +125,8 @@ def simulate(system, *, name: str | None = None, **options) -> Result:
     """The time response from ``q0``, ``v0`` (or ``initial_mode``) to ``t_end`` (required).
 
     Options: ``t_end``, ``method``, ``dt``, ``rtol``, ``atol``, ``q0``, ``v0``, ``initial_mode``,
-    ``amplitude``, ``outputs``, ``series``, ``samples``. Outputs: the model's outputs at ``t_end``,
+    ``amplitude``, ``outputs``, ``series``, ``samples``, and the work budget ``max_steps``,
+    ``max_seconds``, ``progress`` (a spent budget raises BudgetExceeded). Outputs: the model's outputs at ``t_end``,
     ``energy_drift``, ``t_end`` (and ``t``, ``energy_series`` with ``series=True``).
     """
     return _run("simulate", system, options, name)
@@ -162,7 +163,9 @@ def sweep(system, analysis: str = "modes", grid: Mapping[str, Any] | None = None
     with the point's values (``system`` is not changed). ``workers`` > 1 runs points in local
     processes (the system must then pickle; a scene's sweep compiles in each process instead);
     ``progress`` draws a bar on stderr (off by default here, on in scenes). Outputs: ``grid`` (the
-    points) and one list per output of the inner analysis.
+    points) and one list per output of the inner analysis. Keywords other than these go to the inner
+    analysis (``max_seconds`` there is each point's budget); the sweep's own wall-time budget is the
+    scene's ``max_seconds``: ``analysis("sweep", system, over=grid, analysis={"kind": ...}, max_seconds=60)``.
     """
     if grid is None:
         raise InputError("sweep() needs a grid", key="grid", expected="grid = {parameter: [values]}")

@@ -9,7 +9,9 @@ q(t) = Re(H(omega) e_j exp(i omega t)), where
 is the receptance (units of coordinate per unit of generalized force: m/N for a translation
 driven by a force). Scene keys: ``input`` (a coordinate name, required), ``omega`` (driving
 frequencies in rad/s: a list, or {start, stop, num}; required), ``outputs`` (the coordinates to
-report; default all), ``about`` / ``at`` (the operating point, as for ``modes``). Outputs:
+report; default all), ``about`` / ``at`` (the operating point, as for ``modes``), ``max_seconds``
+(the wall-time budget, default 600 s: the time of all the frequencies is estimated from the first
+ones and a response that would take longer is refused, naming the frequencies done). Outputs:
 ``omega`` (the frequencies), ``amplitude`` and ``phase`` (per output coordinate, |H_kj| and
 arg H_kj in rad, one value per frequency). A frequency at which the undamped system is singular
 (a resonance without damping) raises a ConvergenceError naming it.
@@ -21,8 +23,9 @@ import numpy as np
 from mechgen.analyses import summary
 from mechgen.analyses.operating_point import linear_about, operating_point
 from mechgen.analyses.registry import AnalysisKind, register
-from mechgen.analyses.schema import REQUIRED, Option, about, coordinate_table, value_range
+from mechgen.analyses.schema import REQUIRED, Option, about, coordinate_table, positive, value_range
 from mechgen.errors import ConvergenceError
+from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget
 from mechgen.scene.values import fail, listing, show, type_name
 
 
@@ -67,7 +70,8 @@ def check(ctx, base: str, options: dict) -> None:
 
 SCHEMA = {"input": Option(coordinate, REQUIRED, "a coordinate name"),
           "omega": Option(frequencies, REQUIRED, "driving frequencies in rad/s"),
-          "outputs": Option(coordinates), "about": Option(about), "at": Option(coordinate_table)}
+          "outputs": Option(coordinates), "about": Option(about), "at": Option(coordinate_table),
+          "max_seconds": Option(positive)}
 
 
 def needs(options: dict, *, internal: bool) -> set[str]:
@@ -90,7 +94,10 @@ def run_response(system, options: dict, context: dict) -> dict:
     force[j] = 1.0
     K, M, C = mats["K"], mats["M"], mats["D"] + mats["G"]
     columns = []
-    for w in options["omega"]:
+    omegas = options["omega"]
+    budget = Budget("response", unit="frequencies", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
+    for i, w in enumerate(omegas):
+        budget.project(i, len(omegas), lambda: f"{i:,} of {len(omegas):,} frequencies (omega = {w:g} rad/s)")
         A = K - w**2 * M + 1j * w * C
         if sps.issparse(A):
             h = spla.spsolve(sps.csc_matrix(A, dtype=complex), force)

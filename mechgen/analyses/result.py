@@ -68,12 +68,17 @@ class Result:
 
 
 def run_analysis(name: str, kind: str, system, options: dict, context: dict) -> Result:
-    """Run a validated analysis through its kind's runner and time it."""
+    """Run a validated analysis through its kind's runner and time it (a spent work budget is named by the
+    analysis: ``simulate 'swing': ...``)."""
+    from mechgen.runtime.core.budget import BudgetExceeded
     from mechgen.runtime.core.threads import blas_threads_for
 
     clock = time.perf_counter()
-    with blas_threads_for(_unknowns(system)):
-        outputs = get(kind).run(system, options, context)
+    try:
+        with blas_threads_for(_unknowns(system)):
+            outputs = get(kind).run(system, options, context)
+    except BudgetExceeded as exc:
+        raise exc.named(f"{kind} '{name}'") from None
     shown = public(outputs)
     working = {k: v for k, v in outputs.items() if k not in shown}
     return Result(name, kind, shown, time.perf_counter() - clock, working)

@@ -5,6 +5,23 @@ step ``dt``), ``rtol``, ``atol``, ``q0`` / ``v0`` (tables of coordinates), ``ini
 ``amplitude`` (start from a linear mode), ``outputs`` (which model outputs to report), ``series``
 (also report ``t`` and ``energy_series``), ``samples``. Outputs: the model's outputs at ``t_end``,
 ``energy_drift``, ``t_end``; a fixed-end chain also ``mode_energies``.
+
+Work budget (mechgen.runtime.core.budget): ``max_steps`` (integrator steps; default 10^7 for the
+leapfrog, whose t_end / dt steps are refused before the first one when they exceed it, and 10^5
+accepted steps for the adaptive methods), ``max_seconds`` (wall time, default 600) and
+``progress`` (default true: a bar with the remaining time on stderr when it is a terminal and the
+run lasts over 2 s). An explicit method (RK45, DOP853) is also refused up front when the fastest
+rate of the linearisation at the start, |lambda|max, needs more than ``max_steps`` steps for
+stability alone (at least t_end |lambda|max / c steps, c = 7 for RK45 and 12 for DOP853, twice
+their stability intervals): the implicit BDF and Radau have no such limit. Reaching a budget ends the run
+with exit 1 naming the analysis, the t reached of t_end and the key to raise.
+
+``samples`` above 10^6 is refused at the key (each sample is a state kept and an energy evaluated).
+``rtol`` below 100 machine epsilons (2.2e-14, what scipy's integrators can honour; they would
+raise it silently) is refused at the key. A failed step (a step size below the spacing of the
+numbers), a singular mass matrix (a zero mass) or a kernel giving NaN/Inf ends the run with
+exit 1 naming the t reached and, from mechgen.runtime.core.diagnose, the kernel, output entry
+and inputs, or the coordinate without inertia, or the fastest rate at the failing state.
 """
 from __future__ import annotations
 
@@ -13,16 +30,25 @@ from pathlib import Path
 import numpy as np
 
 from mechgen.analyses import schema, summary
+from mechgen.analyses.context import NAME
 from mechgen.analyses.operating_point import vector
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import ABSENT, ALL_OUTPUTS, REQUIRED, Option
-from mechgen.errors import SceneError
-from mechgen.runtime.core.integrate import integrate_first_order, leapfrog
+from mechgen.errors import ConvergenceError, SceneError
+from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget, BudgetExceeded
+from mechgen.runtime.core.diagnose import explain_state
+from mechgen.runtime.core.integrate import MIN_RTOL, integrate_first_order, leapfrog
 from mechgen.runtime.linear.modes import modes as solve_modes
 from mechgen.scene.values import fail, listing, show, type_name
 
 METHODS = ("BDF", "Radau", "LSODA", "RK45", "DOP853", "leapfrog")
 STEP = "a number > 0 (or an expression)"
+#: default max_steps: the leapfrog's fixed steps, the adaptive methods' accepted steps
+DEFAULT_STEPS = {"leapfrog": 10_000_000, "adaptive": 100_000}
+#: stability intervals of the explicit methods, doubled (RK45: ~3.3, DOP853: ~6): steps >= t_end |lambda| / c
+EXPLICIT_REACH = {"RK45": 7.0, "DOP853": 12.0}
+#: the explicit methods' up-front stiffness estimate is made for first-order states up to this size
+ESTIMATE_SIZE = 400
 
 
 def _outputs(ctx, key: str, value: object) -> list[str]:
@@ -50,11 +76,16 @@ SCHEMA = {"t_end": Option(schema.positive, REQUIRED, STEP), "method": Option(_me
           "atol": Option(schema.positive, 1e-10), "q0": Option(schema.coordinate_table, {}),
           "v0": Option(schema.coordinate_table, {}), "initial_mode": Option(schema.count),
           "amplitude": Option(schema.number, 1.0), "outputs": Option(_outputs, ALL_OUTPUTS),
-          "series": Option(schema.boolean, False), "samples": Option(schema.count_within("samples"), 201)}
+          "series": Option(schema.boolean, False), "samples": Option(schema.count_within("samples"), 201),
+          "max_steps": Option(schema.count, ABSENT), "max_seconds": Option(schema.positive, ABSENT),
+          "progress": Option(schema.boolean, ABSENT)}
 
 
 def check(ctx, base: str, options: dict) -> None:
-    """leapfrog needs dt; dt <= t_end; initial_mode within the coordinates."""
+    """leapfrog needs dt; dt <= t_end; initial_mode within the coordinates; rtol at least MIN_RTOL."""
+    if options["method"] != "leapfrog" and options["rtol"] < MIN_RTOL:
+        raise fail(ctx.file, f"{base}.rtol", f"rtol {options['rtol']!r} is below what the integrators can honour "
+                   "in double precision", f"a relative tolerance >= {MIN_RTOL:.3g} (100 machine epsilons)")
     if options["method"] == "leapfrog" and "dt" not in options:
         raise fail(ctx.file, f"{base}.dt", "method 'leapfrog' needs a time step dt", STEP)
     if "dt" in options and options["dt"] > options["t_end"]:
@@ -103,27 +134,74 @@ def mode_energies(system, q: np.ndarray, v: np.ndarray, count: int = 8) -> list[
     return [float(e) for e in 0.5 * (P**2 + omega2 * Q**2)]
 
 
+def budget_of(options: dict, method: str) -> Budget:
+    """The run's work budget: ``max_steps`` (default DEFAULT_STEPS of the method) and ``max_seconds``."""
+    steps = options.get("max_steps", DEFAULT_STEPS["leapfrog" if method == "leapfrog" else "adaptive"])
+    what = "leapfrog steps" if method == "leapfrog" else f"{method} steps"
+    return Budget(what, limit=int(steps), key="max_steps", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
+
+
+def refuse_explicit_stiff(system, x0: np.ndarray, t_end: float, method: str, budget: Budget) -> None:
+    """An explicit method needs at least t_end |lambda|max / c steps for stability alone (|lambda|max: the
+    largest eigenvalue magnitude of d(dx/dt)/dx at the start; c: EXPLICIT_REACH); refuse when that is
+    more than the budget (the problem is stiff: the implicit methods have no such stability limit)."""
+    if method not in EXPLICIT_REACH or x0.size > ESTIMATE_SIZE or budget.limit is None:
+        return
+    try:
+        J = system.jacobian(0.0, x0)
+        J = J.toarray() if hasattr(J, "toarray") else np.asarray(J, float)
+        fastest = float(np.max(np.abs(np.linalg.eigvals(J)))) if np.all(np.isfinite(J)) else 0.0
+    except Exception:  # no estimate: the step budget still holds during the run
+        return
+    needed = t_end * fastest / EXPLICIT_REACH[method]
+    if needed > budget.limit:
+        raise BudgetExceeded(f"{method} steps: an explicit method needs at least {needed:.3g} steps to stay stable "
+                             f"over t_end = {t_end:g} (the fastest rate at the start is |lambda| = {fastest:.3g}/s), "
+                             f"more than max_steps = {budget.limit:,}; the problem is stiff: the implicit methods "
+                             "BDF and Radau are not bound by this limit", key="max_steps",
+                             reached="nothing (refused before starting)")
+
+
+def leapfrog_masses(system, M) -> np.ndarray:
+    """1 / diag(M) for the leapfrog (a chain's lumped masses); a zero or non-finite mass is named."""
+    diag = np.asarray(M.diagonal() if hasattr(M, "diagonal") else np.diag(M), float)
+    bad = np.flatnonzero(~(np.isfinite(diag) & (diag > 0)))
+    if bad.size:
+        names = list(system.coordinates)
+        raise ConvergenceError(f"leapfrog: the mass matrix's diagonal entry of coordinate '{names[bad[0]]}' is "
+                               f"{diag[bad[0]]:.6g}; the leapfrog needs positive masses (a mass parameter of 0?)")
+    return 1.0 / diag
+
+
 def run_simulate(system, options: dict, context: dict) -> dict:
     """Time response; reports the model's outputs at t_end and the energy drift."""
     q0, v0 = initial_state(system, options)
     t_end = float(options["t_end"])
+    method = options.get("method", "BDF")
+    budget = budget_of(options, method)
+    progress = bool(options.get("progress", True))
+    desc = context.get(NAME, "simulate")
     energy = lambda q, v: system.outputs(q, v)["energy"]  # noqa: E731
-    if options.get("method") == "leapfrog":
+    if method == "leapfrog":
         dt = float(options["dt"])
         steps = int(round(t_end / dt))
+        budget.refuse(steps, f"nothing (refused before starting: t_end / dt = {steps:,} steps)")
         mats = system.linear(np.zeros(system.n))
-        M = mats["M"]
-        minv = 1.0 / (M.diagonal() if hasattr(M, "diagonal") else np.diag(M))
+        minv = leapfrog_masses(system, mats["M"])
         traj = leapfrog(lambda q: system.force(q) * minv, q0, v0, dt, steps,
-                        record_every=max(1, steps // 1000), energy=energy)
+                        record_every=max(1, steps // 1000), energy=energy, budget=budget, progress=progress,
+                        desc=desc)
         q_end, v_end, ts, energies = traj.q[-1], traj.v[-1], traj.t, np.asarray(traj.energy)
         z_end = None
     else:
         x0 = np.concatenate([q0, v0, np.zeros(system.m)])
+        refuse_explicit_stiff(system, x0, t_end, method, budget)
         n_out = int(options.get("samples", 201))
         t_eval = np.linspace(0.0, t_end, n_out)
-        traj = integrate_first_order(system.rhs, x0, t_end, jac=system.jacobian, method=options.get("method", "BDF"),
-                                     rtol=options.get("rtol", 1e-8), atol=options.get("atol", 1e-10), t_eval=t_eval)
+        traj = integrate_first_order(system.rhs, x0, t_end, jac=system.jacobian, method=method,
+                                     rtol=options.get("rtol", 1e-8), atol=options.get("atol", 1e-10), t_eval=t_eval,
+                                     budget=budget, progress=progress, desc=desc,
+                                     explain=lambda t, x: explain_state(system, t, x))
         xs = traj.x if traj.x.shape[0] == len(traj.t) else traj.x.T
         n = system.n
         q_end, v_end, z_end = xs[-1, :n], xs[-1, n:2 * n], xs[-1, 2 * n:]

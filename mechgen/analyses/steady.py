@@ -12,6 +12,8 @@ with ``free = "parameter"`` (solve for the parameter that holds an end value), `
 model declares with it: each is solved by the analysis's method and form, the first whose measure
 equals the value is kept, else a ConvergenceError lists what the guesses gave).
 
+``max_seconds`` bounds Newton's wall time (default 600 s; exit 1 naming the iteration reached).
+
 Outputs: ``iterations``, ``residual_norm``; a lumped model ``coordinates``; the model's outputs
 (Newton) or every output at the ends and its extremes along s, the fields' end slopes and the shape
 outputs (BVP, mechgen.analyses.bvp_states); a continuum ``s`` and ``deflection``, with Newton also
@@ -32,6 +34,8 @@ from mechgen.analyses.parameters import info_of, parameter_dict, with_free_param
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import Option
 from mechgen.errors import ConvergenceError, SceneError
+from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget
+from mechgen.runtime.core.diagnose import nonfinite_kernels
 from mechgen.runtime.steady.newton import newton
 from mechgen.runtime.steady.steady_bvp import hamiltonian_bvp, holding, solve_steady, steady_bvp, stress_guess
 from mechgen.scene.expr import is_identifier
@@ -124,7 +128,8 @@ SCHEMA = {"guess": Option(schema.coordinate_table, {}), "tol": Option(schema.pos
           "max_iter": Option(schema.count, 50), "method": Option(schema.one_of("steady method", METHODS)),
           "bulge": Option(_bulge), "mesh": Option(schema.count), "nodes": Option(schema.count),
           "aliases": Option(schema.aliases), "form": Option(_form), "params": Option(_params),
-          "shape": Option(_shape), "hold": Option(_hold), "free": Option(_free), "stability": Option(schema.boolean)}
+          "shape": Option(_shape), "hold": Option(_hold), "free": Option(_free), "stability": Option(schema.boolean),
+          "max_seconds": Option(schema.positive)}
 
 
 def check(ctx, base: str, options: dict) -> None:
@@ -199,7 +204,9 @@ def run_steady(system, options: dict, context: dict) -> dict:
                          expected="method = 'collocation', 'shooting' or 'multiple_shooting'")
     y0 = np.concatenate([vector(system, options.get("guess")), np.zeros(system.m)])
     residual, jacobian = _equilibrium_functions(system)
-    res = newton(residual, jacobian, y0, tol=options.get("tol", 1e-10), max_iter=options.get("max_iter", 50))
+    res = newton(residual, jacobian, y0, tol=options.get("tol", 1e-10), max_iter=options.get("max_iter", 50),
+                 budget=Budget("steady Newton iterations", seconds=float(options.get("max_seconds", DEFAULT_SECONDS))),
+                 explain=lambda y: nonfinite_kernels(system, {"q": y[:system.n], "z": y[system.n:] if system.m else None}))
     q, z = res.x[:system.n], res.x[system.n:]
     out = {"iterations": int(res.iterations), "residual_norm": float(res.residual_norm)}
     if not system.is_lattice and not system.is_field:

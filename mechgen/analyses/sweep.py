@@ -1,10 +1,14 @@
 """``sweep``: another analysis repeated over a grid of parameter values.
 
 Scene keys: ``over`` (parameter = [values] or {start, stop, num}; several parameters give their
-cartesian product, the first outermost), ``analysis`` (a table with the inner ``kind``: modes,
-stability, steady or simulate, and its keys), ``workers`` (local processes; 0 or 1: serial) and
-``progress``. Outputs: ``grid`` (the points, a list of {parameter: value}) plus one list per output
-of the inner analysis, in grid order.
+cartesian product, the first outermost; at most 10^6 points), ``analysis`` (a table with the inner
+``kind``: modes, stability, steady or simulate, and its keys), ``workers`` (local processes; 0 or 1:
+serial), ``progress`` (a bar with the remaining time on stderr when it is a terminal and the sweep
+lasts over 2 s) and ``max_seconds`` (the wall-time budget, default 600: the time of the whole grid
+is estimated from its first points and a sweep that would take longer is refused once the estimate
+is 2 s old, naming the estimate, the points done and the key). Outputs: ``grid`` (the points, a
+list of {parameter: value}) plus one list per output of the inner analysis, in grid order. An inner
+analysis keeps its own budget (``analysis.max_steps`` ...), per point.
 """
 from __future__ import annotations
 
@@ -14,7 +18,8 @@ from mechgen.analyses import figures, schema, summary
 from mechgen.analyses.context import NAME, POINTS, PointRunner, public
 from mechgen.analyses.parameters import with_free_params
 from mechgen.analyses.registry import AnalysisKind, get, kinds, register
-from mechgen.analyses.schema import REQUIRED, AnalysisSpec, Option
+from mechgen.analyses.schema import ABSENT, REQUIRED, AnalysisSpec, Option
+from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget
 from mechgen.runtime.core.sweep import sweep
 from mechgen.scene.values import fail, type_name
 
@@ -35,7 +40,8 @@ def _workers(ctx, key: str, value: object) -> int:
 
 SCHEMA = {"over": Option(schema.over, REQUIRED, "a table: parameter = [values] or {start, stop, num}"),
           "analysis": Option(_inner, REQUIRED, "a table with kind and its options"),
-          "workers": Option(_workers, 0), "progress": Option(schema.boolean, True)}
+          "workers": Option(_workers, 0), "progress": Option(schema.boolean, True),
+          "max_seconds": Option(schema.positive, ABSENT)}
 
 
 def check(ctx, base: str, options: dict) -> None:
@@ -70,6 +76,22 @@ def collect(grid: list[dict], results: list[dict]) -> dict:
     return out
 
 
+class Tasks:
+    """The sweep's tasks, made when a point is reached (a grid of 10^6 points starts at once)."""
+
+    def __init__(self, points: PointRunner, kind: str, options: dict, grid: list) -> None:
+        self.points, self.kind, self.options, self.grid = points, kind, options, grid
+
+    def __len__(self) -> int:
+        return len(self.grid)
+
+    def __getitem__(self, i: int):
+        return self.points.task(self.kind, dict(self.options), self.grid[i])
+
+    def __iter__(self):
+        return (self[i] for i in range(len(self)))
+
+
 def run_sweep(system, options: dict, context: dict) -> dict:
     """The inner analysis at every grid point (mechgen.runtime.core.sweep: serial, or ``workers`` processes).
 
@@ -78,9 +100,10 @@ def run_sweep(system, options: dict, context: dict) -> dict:
     """
     inner = options["analysis"]
     points = context.get(POINTS) or PointRunner(_at_point, lambda kind, opts, point: (system, kind, opts, point))
-    tasks = [points.task(inner.kind, dict(inner.options), point) for point in options["grid"]]
+    tasks = Tasks(points, inner.kind, dict(inner.options), options["grid"])
+    budget = Budget(f"sweep of {inner.kind}", unit="points", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
     results = sweep(points.evaluate, tasks, workers=options.get("workers", 0), progress=options.get("progress", True),
-                    desc=context.get(NAME, "sweep"))
+                    desc=context.get(NAME, "sweep"), budget=budget, labels=options["grid"])
     return collect(options["grid"], results)
 
 

@@ -1,21 +1,37 @@
 """Time integration: scipy's stiff and non-stiff integrators, and a symplectic leapfrog.
 
-* :func:`integrate_first_order` - dx/dt = f(t, x) with ``scipy.integrate.solve_ivp``
-  (BDF, Radau, LSODA with the generated Jacobian; RK45, DOP853 explicit).
+* :func:`integrate_first_order` - dx/dt = f(t, x) with scipy's ``OdeSolver`` classes (BDF, Radau,
+  LSODA with the generated Jacobian; RK45, DOP853 explicit), stepped here as ``solve_ivp`` steps
+  them (the same steps, samples at ``t_eval`` from each step's dense output) so that every step is
+  counted against a work :class:`~mechgen.runtime.core.budget.Budget` and drawn on a progress bar.
 * :func:`leapfrog` - velocity Verlet (Stormer-Verlet) for q'' = a(q), a separable
   Hamiltonian with the mass already inverted in ``a``: second order, symplectic,
-  so the energy error stays bounded over long times (no drift).
+  so the energy error stays bounded over long times (no drift). Its n_steps are known before it
+  starts, so a budget refuses too long a run up front.
+
+A failure (a step size below the spacing of the numbers, a singular mass matrix, a kernel giving
+NaN/Inf) raises ConvergenceError or KernelError saying where (t reached of t_end); ``explain(t, x)``,
+given by the caller, adds what went wrong at that state (which kernel, output and input) and is
+called only on that path.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 
 from mechgen.errors import ConvergenceError, KernelError
+from mechgen.runtime.core.budget import Budget, BudgetExceeded, Progress
 
 METHODS = ("BDF", "Radau", "LSODA", "RK45", "DOP853")
 IMPLICIT = ("BDF", "Radau", "LSODA")
+#: the smallest relative tolerance scipy's integrators honour (they raise a smaller one to it)
+MIN_RTOL = 100 * float(np.finfo(float).eps)
+#: the leapfrog checks its wall-time budget and moves its bar every this many steps
+CHECK_EVERY = 1024
+#: an adaptive run is refused early when its projected steps exceed this many times max_steps
+PROJECT_MARGIN = 10.0
 
 
 @dataclass(frozen=True)
@@ -31,28 +47,132 @@ class Trajectory:
     njev: int = 0
     success: bool = True
     message: str = ""
+    steps: int = 0
+
+
+def _solver_class(method: str):
+    import scipy.integrate as si  # loaded on use: scipy.integrate brings scipy.optimize
+
+    return {"BDF": si.BDF, "Radau": si.Radau, "LSODA": si.LSODA, "RK45": si.RK45, "DOP853": si.DOP853}[method]
+
+
+def _where(t: float, t_end: float, steps: int) -> str:
+    return f"t = {t:.6g} of t_end = {t_end:.6g} after {steps:,} steps"
 
 
 def integrate_first_order(rhs, x0, t_end: float, *, jac=None, method: str = "BDF", rtol: float = 1e-8,
-                          atol: float = 1e-10, t_eval=None) -> Trajectory:
-    """Integrate dx/dt = rhs(t, x) from 0 to t_end; rows of ``x`` are states at ``t``."""
+                          atol: float = 1e-10, t_eval=None, budget: Budget | None = None,
+                          progress: bool = False, desc: str = "simulate",
+                          explain: Callable[[float, np.ndarray], str] | None = None) -> Trajectory:
+    """Integrate dx/dt = rhs(t, x) from 0 to t_end; rows of ``x`` are states at ``t`` (``t_eval``, or every step).
+
+    Each accepted step is one unit of ``budget`` (BudgetExceeded names t reached); ``progress`` draws
+    a bar in t (see :class:`~mechgen.runtime.core.budget.Progress`).
+    """
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}; expected one of {METHODS}")
-    kwargs = {"jac": jac} if (jac is not None and method in IMPLICIT) else {}
-    from scipy.integrate import solve_ivp  # loaded on use: scipy.integrate brings scipy.optimize
+    t_end = float(t_end)
+    last: list = [0.0, np.asarray(x0, float)]
+    accepted: list = [0.0, np.asarray(x0, float)]
 
-    sol = solve_ivp(rhs, (0.0, float(t_end)), np.asarray(x0, float), method=method, rtol=rtol, atol=atol,
-                    t_eval=t_eval, **kwargs)
-    if not sol.success:
-        reached = sol.t[-1] if sol.t.size else 0.0
-        raise ConvergenceError(f"{method} stopped at t = {reached:.6g} of {t_end:.6g}: {sol.message}")
-    if not np.all(np.isfinite(sol.y)):
-        raise KernelError("the state became NaN/Inf during integration")
-    return Trajectory(sol.t, sol.y.T, nfev=sol.nfev, njev=sol.njev, success=True, message=sol.message)
+    def fun(t, x):  # remembers the state of the latest evaluation, for the failure message
+        last[0], last[1] = t, x
+        return rhs(t, x)
+
+    def jacobian(t, x):
+        last[0], last[1] = t, x
+        return jac(t, x)
+
+    kwargs = {"jac": jacobian} if (jac is not None and method in IMPLICIT) else {}
+
+    def note() -> str:
+        """explain() at the latest evaluated state, or at the last accepted one when that one is not finite."""
+        if explain is None:
+            return ""
+        t_x, x = last[0], np.asarray(last[1], float)
+        if not np.all(np.isfinite(x)):
+            t_x, x = accepted[0], np.asarray(accepted[1], float)
+        return explain(t_x, x)
+
+    def failed(what: str) -> str:
+        why = note()
+        return f"{method} {what}" + (f"; {why}" if why else "")
+
+    from numpy.linalg import LinAlgError
+
+    t_eval = None if t_eval is None else np.asarray(t_eval, float)
+    ts: list = []
+    ys: list = []
+    i_eval, steps, t = 0, 0, 0.0
+    try:
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # its first step's size, checked below
+            solver = _solver_class(method)(fun, 0.0, np.asarray(x0, float), t_end, rtol=rtol, atol=atol, **kwargs)
+        with Progress(t_end, desc=desc, unit="t", enabled=progress) as bar:
+            while solver.status == "running":
+                with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # finiteness is checked here
+                    message = solver.step()
+                if solver.status == "failed":
+                    raise ConvergenceError(failed(f"stopped at {_where(solver.t, t_end, steps)}: "
+                                                  f"{str(message).rstrip('.')}"))
+                steps += 1
+                t = solver.t
+                accepted[0], accepted[1] = t, solver.y
+                if t_eval is None:
+                    ts.append(t)
+                    ys.append(solver.y.copy())
+                else:
+                    i_new = int(np.searchsorted(t_eval, t, side="right"))
+                    if i_new > i_eval:
+                        ts.append(t_eval[i_eval:i_new])
+                        ys.append(solver.dense_output()(t_eval[i_eval:i_new]).T)
+                        i_eval = i_new
+                if budget is not None:
+                    budget.spend(1, lambda: _where(t, t_end, steps))
+                    if steps % CHECK_EVERY == 0:
+                        _project(budget, method, steps, t, t - solver.t_old, t_end)
+                bar.to(t)
+    except (LinAlgError, ZeroDivisionError, ValueError) as exc:  # a singular M; a NaN met by a check_finite solve
+        raise ConvergenceError(failed(f"failed at t = {last[0]:.6g} of t_end = {t_end:.6g} ({exc})")) from exc
+    except KernelError as exc:
+        why = note()
+        if not why:
+            raise
+        raise KernelError(f"{method} at t = {last[0]:.6g} of t_end = {t_end:.6g}: {why}") from exc
+    if t_eval is None:
+        t_out, x_out = np.array(ts), np.array(ys).reshape(len(ts), -1)
+    else:
+        t_out = np.hstack(ts) if ts else np.empty(0)
+        x_out = np.vstack(ys) if ys else np.empty((0, np.size(x0)))
+    if not np.all(np.isfinite(x_out)):
+        raise KernelError(failed(f"state became NaN/Inf by t = {t:.6g} of t_end = {t_end:.6g}"))
+    return Trajectory(t_out, x_out, nfev=solver.nfev, njev=solver.njev, success=True,
+                      message="The solver successfully reached the end of the integration interval.", steps=steps)
 
 
-def leapfrog(acceleration, q0, v0, dt: float, n_steps: int, *, record_every: int = 1, energy=None) -> Trajectory:
-    """Velocity Verlet: v += dt/2 a(q); q += dt v; v += dt/2 a(q) (one acceleration call per step)."""
+def _project(budget: Budget, method: str, steps: int, t: float, h: float, t_end: float) -> None:
+    """Once a tenth of the step budget is spent: refuse when the steps so far plus (t_end - t) / h at the
+    latest step size h exceed PROJECT_MARGIN times the budget (a step size that stopped growing: a fast
+    mode resolved over the whole interval); a margin that an early transient's short steps cannot reach."""
+    if budget.limit is None or steps < budget.limit / 10 or h <= 0:
+        return
+    estimate = steps + (t_end - t) / h
+    if estimate > PROJECT_MARGIN * budget.limit:
+        raise BudgetExceeded(f"{method} steps: at the step size of the latest step (h = {h:.3g}) t_end = {t_end:.6g} "
+                             f"needs about {estimate:.3g} steps, more than {PROJECT_MARGIN:g} x max_steps = "
+                             f"{budget.limit:,} (a fast mode resolved over the whole interval: shorten t_end, or "
+                             "raise max_steps)", key=budget.key, reached=_where(t, t_end, steps))
+
+
+def leapfrog(acceleration, q0, v0, dt: float, n_steps: int, *, record_every: int = 1, energy=None,
+             budget: Budget | None = None, progress: bool = False, desc: str = "leapfrog") -> Trajectory:
+    """Velocity Verlet: v += dt/2 a(q); q += dt v; v += dt/2 a(q) (one acceleration call per step).
+
+    ``budget`` refuses n_steps above its limit before the first step and checks its wall time every
+    CHECK_EVERY steps; a NaN/Inf state stops the run at the check that sees it.
+    """
+    t_end = n_steps * dt
+    if budget is not None:
+        budget.refuse(n_steps, f"nothing (refused before starting: t_end / dt = {n_steps:,} steps)")
     q, v = np.array(q0, float), np.array(v0, float)
     a = np.asarray(acceleration(q), float)
     n_rec = n_steps // record_every + 1
@@ -65,16 +185,31 @@ def leapfrog(acceleration, q0, v0, dt: float, n_steps: int, *, record_every: int
         if energy is not None:
             energies.append(float(energy(q, v)))
 
+    def unstable(step: int) -> KernelError:
+        return KernelError(f"leapfrog state became NaN/Inf by t = {step * dt:.6g} of t_end = {t_end:.6g} "
+                           f"(step {step:,} of {n_steps:,}; time step dt = {dt:g} too large for the stiffest mode?)")
+
     record(0, 0)
     k = 1
-    for step in range(1, n_steps + 1):
-        v += half * a
-        q += dt * v
-        a = np.asarray(acceleration(q), float)
-        v += half * a
-        if step % record_every == 0:
-            record(k, step)
-            k += 1
+    with Progress(n_steps, desc=desc, unit="step", enabled=progress) as bar:
+        for step in range(1, n_steps + 1):
+            v += half * a
+            q += dt * v
+            a = np.asarray(acceleration(q), float)
+            v += half * a
+            if step % record_every == 0:
+                record(k, step)
+                k += 1
+            if step % CHECK_EVERY == 0:
+                if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
+                    raise unstable(step)
+                if budget is not None:
+                    budget.check_time(lambda: _where(step * dt, t_end, step))
+                bar.to(step)
     if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
-        raise KernelError("leapfrog state became NaN/Inf (time step too large for the stiffest mode?)")
-    return Trajectory(ts[:k], q=qs[:k], v=vs[:k], energy=energies, nfev=n_steps + 1)
+        raise unstable(n_steps)
+    return Trajectory(ts[:k], q=qs[:k], v=vs[:k], energy=energies, nfev=n_steps + 1, steps=n_steps)
+
+
+__all__ = ["Budget", "BudgetExceeded", "IMPLICIT", "METHODS", "MIN_RTOL", "Trajectory", "integrate_first_order",
+           "leapfrog"]

@@ -102,8 +102,12 @@ class Kernel:
                 if not np.all(np.isfinite(arr)):
                     shown = {k: np.asarray(v).ravel()[:6].tolist() for k, v in inputs.items()
                              if not k.startswith("slots")}
-                    raise KernelError(f"kernel {self.name} produced NaN/Inf in output {port['name']} "
-                                      f"at inputs {shown}")
+                    flat = arr.reshape(nbatch, -1)
+                    bad = int(np.flatnonzero(~np.isfinite(flat))[0])
+                    batch, entry = divmod(bad, flat.shape[1])
+                    where = f"entry {entry} of {flat.shape[1]}" + (f" in batch row {batch}" if batched else "")
+                    raise KernelError(f"kernel {self.name} produced NaN/Inf in output {port['name']} ({where}, "
+                                      f"row-major, = {flat.ravel()[bad]}) at inputs {shown}")
         return {p["name"]: (a if batched else a[0]) for p, a in zip(self.spec["outputs"], outs)}
 
     def bind(self, inputs: dict, outputs: dict, sizes: dict | None = None) -> Callable[[], int]:

@@ -245,8 +245,8 @@ class System:
         bound.use(self.params)
         return bound
 
-    def call(self, kernel: str, **state) -> dict:
-        """Evaluate ``kernel`` at a state (missing state entries are zero)."""
+    def call(self, kernel: str, *, check: bool = True, **state) -> dict:
+        """Evaluate ``kernel`` at a state (missing state entries are zero); ``check``: NaN/Inf raises KernelError."""
         k = self.kernels[kernel]
         inputs = {}
         for port in k.spec["inputs"]:
@@ -261,7 +261,7 @@ class System:
                 length = self.m if name == "z" else self.n
                 value = state.get(name)
                 inputs[name] = np.zeros(length) if value is None else np.asarray(value, dtype=float)
-        out = k.evaluate(inputs, self.sizes(kernel))
+        out = k.evaluate(inputs, self.sizes(kernel), check=check)
         return self._shape(kernel, out)
 
     def _shape(self, kernel: str, out: dict) -> dict:

@@ -47,6 +47,7 @@ import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
 from mechgen.errors import ConvergenceError, InputError
+from mechgen.runtime.core.budget import Progress
 from mechgen.runtime.core.options import Options
 from mechgen.runtime.steady.bvp import BVP, BVPResult
 from mechgen.runtime.steady.collocation import DiscreteBVP
@@ -119,6 +120,9 @@ class ContinuationOptions(Options):
         grow: the step's growth factor after a correction in at most 3 steps.
         max_turn: the largest angle (radians) between consecutive tangents; a step turning more is halved.
         locate_folds: locate each fold by Brent's method (else the point after the fold is recorded, located=False).
+        budget: a :class:`~mechgen.runtime.core.budget.Budget` whose wall time is checked before every step
+            (BudgetExceeded names the points accepted and the lam reached), or None.
+        progress: draw a bar of the accepted points out of max_points on stderr (a terminal, after 2 s).
 
     Checked by :meth:`check`: 0 < ds_min <= ds <= ds_max, direction +1 or -1, max_points >= 1,
     lam_min < lam_max, 0 < max_turn < pi, tol > 0, grow >= 1.
@@ -136,6 +140,8 @@ class ContinuationOptions(Options):
     grow: float = 1.5
     max_turn: float = 0.5
     locate_folds: bool = True
+    budget: Any = None
+    progress: bool = False
 
     def check(self) -> None:
         """InputError unless the options are consistent (see the class doc)."""
@@ -423,8 +429,12 @@ def continuation(system, u0, lam0: float, options: ContinuationOptions | None = 
     cos_turn = math.cos(max_turn)
     status, message = "max_points", f"reached max_points = {max_points}"
     step = ds
+    bar = Progress(max_points, desc="continuation", unit="point", enabled=opts.progress)
     while len(xs) < max_points:
         x_i, t_i = xs[-1], ts[-1]
+        bar.to(len(xs))
+        if opts.budget is not None:
+            opts.budget.check_time(lambda: f"{len(xs)} branch points, lam = {x_i[n]:.10g}")
         row = _row(w, t_i)
         pred = x_i + step * t_i
         if len(xs) > 1 and arc[-1] > arc[-2]:  # second order: x'' ~ (t_i - t_{i-1}) / (s_i - s_{i-1})
@@ -484,6 +494,7 @@ def continuation(system, u0, lam0: float, options: ContinuationOptions | None = 
             step = min(step * grow, ds_max)
         elif iters >= max(4, max_corrector - 2):
             step = max(0.7 * step, ds_min)
+    bar.close()
     X, T = np.array(xs), np.array(ts)
     return Branch(X[:, :n], X[:, n], np.array(arc), T, tuple(folds), tuple(data), status, message, system)
 

@@ -3,7 +3,10 @@
 Each step solves J dx = -r (dense LU or sparse LU) and accepts the largest
 alpha in 1, 1/2, 1/4, ... that decreases ||r||; it stops when ||r|| <= tol (or
 the step is below tol relative to ||x||), and raises ConvergenceError after
-``max_iter`` iterations with the residual history.
+``max_iter`` iterations with the residual history. A ``budget``
+(mechgen.runtime.core.budget.Budget) bounds the wall time, checked every iteration; a
+non-finite residual or Jacobian raises KernelError with ``explain(x)`` (called only then: which
+kernel, output and input).
 """
 from __future__ import annotations
 
@@ -28,17 +31,22 @@ class NewtonResult:
     converged: bool
 
 
-def _finite_residual(residual, x):
+def _why(explain, x) -> str:
+    note = explain(x) if explain is not None else ""
+    return f": {note}" if note else ""
+
+
+def _finite_residual(residual, x, explain=None):
     r = np.asarray(residual(x), float)
     if not np.all(np.isfinite(r)):
-        raise KernelError(f"residual is not finite at x = {x[:6]}")
+        raise KernelError(f"residual is not finite at x = {x[:6]}{_why(explain, x)}")
     return r
 
 
-def _step(J, r) -> np.ndarray:
+def _step(J, r, explain=None, x=None) -> np.ndarray:
     if sps.issparse(J):
         if not np.all(np.isfinite(J.data)):
-            raise KernelError("Jacobian is not finite")
+            raise KernelError(f"Jacobian is not finite{_why(explain, x)}")
         try:
             dx = spla.splu(J.tocsc()).solve(-r)
         except RuntimeError as exc:
@@ -46,7 +54,7 @@ def _step(J, r) -> np.ndarray:
     else:
         J = np.atleast_2d(np.asarray(J, float))
         if not np.all(np.isfinite(J)):
-            raise KernelError("Jacobian is not finite")
+            raise KernelError(f"Jacobian is not finite{_why(explain, x)}")
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("error", sla.LinAlgWarning)
@@ -60,15 +68,18 @@ def _step(J, r) -> np.ndarray:
     return dx
 
 
-def newton(residual, jacobian, x0, *, tol: float = 1e-10, max_iter: int = 50, damping: bool = True) -> NewtonResult:
-    """Solve residual(x) = 0 from x0."""
+def newton(residual, jacobian, x0, *, tol: float = 1e-10, max_iter: int = 50, damping: bool = True,
+           budget=None, explain=None) -> NewtonResult:
+    """Solve residual(x) = 0 from x0 (``budget``, ``explain``: see the module doc)."""
     x = np.array(x0, dtype=float)
-    r = _finite_residual(residual, x)
+    r = _finite_residual(residual, x, explain)
     history = [float(np.linalg.norm(r))]
     for it in range(1, max_iter + 1):
         if history[-1] <= tol:
             return NewtonResult(x, it - 1, history[-1], True)
-        dx = _step(jacobian(x), r)
+        if budget is not None:
+            budget.check_time(lambda: f"Newton iteration {it} of max_iter = {max_iter}, residual norm {history[-1]:.3g}")
+        dx = _step(jacobian(x), r, explain, x)
         alpha = 1.0
         while True:
             trial = x + alpha * dx
@@ -78,7 +89,7 @@ def newton(residual, jacobian, x0, *, tol: float = 1e-10, max_iter: int = 50, da
                 break
             alpha /= 2
         if not np.isfinite(norm):
-            raise KernelError(f"residual is not finite after a Newton step at x = {trial[:6]}")
+            raise KernelError(f"residual is not finite after a Newton step at x = {trial[:6]}{_why(explain, trial)}")
         x, r = trial, np.asarray(r_trial, float)
         history.append(norm)
         if norm <= tol or np.linalg.norm(alpha * dx) <= tol * max(1.0, np.linalg.norm(x)) and norm <= 1e3 * tol:

@@ -1,0 +1,191 @@
+"""Work budgets and progress bars of the loops whose length a user controls.
+
+Every such loop (time steps, sweep points, branch points, driving frequencies, Newton iterations)
+runs under a :class:`Budget`: at most ``limit`` units of work (``unit``: steps, points ...) and at
+most ``seconds`` of wall time. Each has a default that no shipped scene comes near and a scene key
+that raises it (``key`` and ``seconds_key``). Reaching either ends the run with
+:class:`BudgetExceeded` (exit 1), whose message says what ran out, how far the work got and which
+key to raise. Where the work is known before it starts (a fixed-step integration: t_end / dt
+steps) :meth:`Budget.refuse` stops it up front; where it can be estimated from the first units (a
+sweep's points) :meth:`Budget.project` stops it once the estimate is reliable:
+
+    estimated total = elapsed * total / done        (seconds)
+
+after at least :data:`PROJECT_AFTER` seconds, refused when it exceeds ``seconds``.
+
+:class:`Progress` is a tqdm bar on stderr with the remaining time, drawn only when the caller lets
+it (the ``progress`` key), stderr is a terminal and the work has lasted :data:`DELAY` seconds, so
+quick runs, pipes and tests print nothing.
+"""
+from __future__ import annotations
+
+import sys
+import time
+from typing import Callable
+
+from mechgen.errors import MechgenError
+
+#: default wall-time budget of an analysis, seconds (the longest shipped scene's analysis takes ~20 s)
+DEFAULT_SECONDS = 600.0
+#: the scene key of the wall-time budget, the same in every kind
+SECONDS_KEY = "max_seconds"
+#: a bar appears after this many seconds (quick runs print nothing)
+DELAY = 2.0
+#: an estimate from the first units is trusted after this many seconds of them
+PROJECT_AFTER = 2.0
+
+
+class BudgetExceeded(MechgenError):
+    """A work budget ran out (exit 1): names what ran out, how far the work got and the key to raise.
+
+    ``analysis`` is filled in where the analysis is known (``mechgen.analyses.result.run_analysis``),
+    ``key`` is relative to the analysis's table (``max_steps``; a sweep's inner one ``analysis.max_steps``).
+    """
+
+    def __init__(self, message: str, *, key: str | None = None, reached: str = "", analysis: str = "") -> None:
+        self.message, self.key, self.reached, self.analysis = message, key, reached, analysis
+        super().__init__(self.paragraph())
+
+    def paragraph(self) -> str:
+        """``<analysis>: <message>[; reached <how far>]; raise <key> to allow more``."""
+        text = (f"{self.analysis}: " if self.analysis else "") + self.message
+        if self.reached:
+            text += f"; reached {self.reached}"
+        if self.key:
+            text += f"; raise '{self.key}' in the analysis's table to allow more"
+        return text
+
+    def named(self, analysis: str | None = None, *, prefix: str = "") -> "BudgetExceeded":
+        """The same error for the analysis ``analysis`` (kept when already named), its key under ``prefix``."""
+        key = f"{prefix}.{self.key}" if prefix and self.key else self.key
+        return BudgetExceeded(self.message, key=key, reached=self.reached,
+                              analysis=self.analysis or (analysis or ""))
+
+    def __reduce__(self):  # keyword arguments survive a worker process's pickling
+        return (_rebuild, (self.message, self.key, self.reached, self.analysis))
+
+
+def _rebuild(message, key, reached, analysis) -> BudgetExceeded:
+    return BudgetExceeded(message, key=key, reached=reached, analysis=analysis)
+
+
+class Budget:
+    """At most ``limit`` units of ``unit`` (None: no count limit) and ``seconds`` of wall time.
+
+    ``what`` names the loop in messages ("RK45 steps"); ``key`` and ``seconds_key`` are the scene
+    keys that raise the two limits. The clock starts at construction.
+    """
+
+    def __init__(self, what: str, *, limit: int | None = None, key: str | None = None, unit: str = "steps",
+                 seconds: float | None = DEFAULT_SECONDS, seconds_key: str = SECONDS_KEY,
+                 clock: Callable[[], float] = time.perf_counter) -> None:
+        self.what, self.limit, self.key, self.unit = what, limit, key, unit
+        self.seconds, self.seconds_key, self.clock = seconds, seconds_key, clock
+        self.used = 0
+        self.started = clock()
+
+    def elapsed(self) -> float:
+        """Wall seconds since the budget started."""
+        return self.clock() - self.started
+
+    def refuse(self, needed: int, reached: str = "nothing (refused before starting)") -> None:
+        """Raise before starting when the work is known to need ``needed`` units, more than the limit."""
+        if self.limit is not None and needed > self.limit:
+            raise BudgetExceeded(f"{self.what}: needs {needed:,} {self.unit}, more than {self.key} = "
+                                 f"{self.limit:,}", key=self.key, reached=reached)
+
+    def spend(self, units: int = 1, reached: Callable[[], str] | str = "") -> None:
+        """Count ``units`` more and check both limits; ``reached`` (text, or a function giving it: called only
+        on failure) says how far the work got."""
+        self.used += units
+        if self.limit is not None and self.used > self.limit:
+            raise BudgetExceeded(f"{self.what}: stopped after {self.limit:,} {self.unit} ({self.key} = "
+                                 f"{self.limit:,})", key=self.key, reached=_text(reached))
+        self.check_time(reached)
+
+    def check_time(self, reached: Callable[[], str] | str = "") -> None:
+        """Raise when the wall time is spent."""
+        if self.seconds is not None and self.elapsed() > self.seconds:
+            raise BudgetExceeded(f"{self.what}: stopped after {self.elapsed():.1f} s of wall time "
+                                 f"({self.seconds_key} = {self.seconds:g})", key=self.seconds_key,
+                                 reached=_text(reached))
+
+    def project(self, done: int, total: int, reached: Callable[[], str] | str = "") -> None:
+        """After ``done`` of ``total`` units: refuse when the estimate elapsed * total / done exceeds the
+        wall-time budget (trusted after PROJECT_AFTER seconds; the budget itself is checked always)."""
+        elapsed = self.elapsed()
+        if self.seconds is not None and done > 0 and elapsed >= min(PROJECT_AFTER, self.seconds) and done < total:
+            estimate = elapsed * total / done
+            if estimate > self.seconds:
+                raise BudgetExceeded(f"{self.what}: {total:,} {self.unit} would take about {_duration(estimate)} "
+                                     f"at the rate of the first {done:,} ({elapsed:.1f} s), more than "
+                                     f"{self.seconds_key} = {self.seconds:g}", key=self.seconds_key,
+                                     reached=_text(reached))
+        self.check_time(reached)
+
+
+def _text(reached: Callable[[], str] | str) -> str:
+    return reached() if callable(reached) else reached
+
+
+def _duration(seconds: float) -> str:
+    if seconds < 120:
+        return f"{seconds:.0f} s"
+    if seconds < 7200:
+        return f"{seconds / 60:.0f} min"
+    if seconds < 2 * 86400:
+        return f"{seconds / 3600:.1f} h"
+    return f"{seconds / 86400:.3g} days"
+
+
+class Progress:
+    """A progress bar with the remaining time (tqdm on stderr) up to ``total`` (a count or a time).
+
+    Drawn only when ``enabled``, stderr is a terminal and the work has lasted DELAY seconds; tqdm is
+    imported only then. Use as a context manager; :meth:`to` moves the bar to an absolute position.
+    """
+
+    def __init__(self, total: float, *, desc: str, unit: str = "it", enabled: bool = True,
+                 delay: float = DELAY) -> None:
+        self.bar = None
+        self.position = 0.0
+        if enabled and _is_terminal(sys.stderr):
+            from tqdm import tqdm  # only when a bar can be drawn (startup)
+
+            self.bar = tqdm(total=total, desc=desc, unit=unit, delay=delay, file=sys.stderr, leave=False,
+                            dynamic_ncols=True)
+
+    @property
+    def shown(self) -> bool:
+        """Whether a bar may be drawn at all (a terminal, and enabled)."""
+        return self.bar is not None
+
+    def update(self, amount: float = 1) -> None:
+        """Move the bar on by ``amount``."""
+        if self.bar is not None:
+            self.bar.update(amount)
+
+    def to(self, position: float) -> None:
+        """Move the bar to ``position``."""
+        if self.bar is not None and position > self.position:
+            self.bar.update(position - self.position)
+            self.position = position
+
+    def close(self) -> None:
+        """Remove the bar."""
+        if self.bar is not None:
+            self.bar.close()
+            self.bar = None
+
+    def __enter__(self) -> "Progress":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+def _is_terminal(stream) -> bool:
+    try:
+        return bool(stream.isatty())
+    except (AttributeError, ValueError):
+        return False
