@@ -594,6 +594,8 @@ def names_a_key(message: str, keys) -> bool:
         parts = re.split(r"[.\[\]=\s\"']+", text)
         if text in keys or any(part in keys for part in parts if part):
             return True
+        if text.endswith("...") and len(text) > 23 and any(key.startswith(text[:-3]) for key in keys):
+            return True  # a long key shortened by the message
     return any(flag in message for flag in FLAGS)
 
 

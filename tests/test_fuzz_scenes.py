@@ -104,6 +104,7 @@ def test_judge_accepts_the_contract_and_names_each_break():
     half = Outcome(2, "", ok2.err, 0.1, leftovers=[".tmp-abc.json"])
     assert any("half-written" in p for p in judge(half, "fpu_chain.toml", keys))
     assert names_a_key("at key '--set m': too large", set()) and not names_a_key("no key", {"N"})
+    assert names_a_key("at key '\"" + "x" * 30 + "...\"': unknown", {"x" * 200})
     assert last_message("warning: x\nmechgen: in a: b.\n") == "mechgen: in a: b."
 
 
