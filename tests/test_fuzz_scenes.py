@@ -41,7 +41,6 @@ pytestmark = pytest.mark.fuzz
 VALIDATION = "scene validation (load-time bounds at params.*)"
 BUDGET = "work budgets"
 MEMORY = "memory estimate before allocating"
-PRINTERS = "printers (non-finite constants)"
 NONFINITE = "non-finite values named (kernel, output, input) instead of a ValueError"
 OUTPUT = "output paths checked before computing"
 
