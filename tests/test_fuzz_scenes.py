@@ -20,11 +20,13 @@ from __future__ import annotations
 
 import math
 import os
+import shutil
 import tempfile
 from pathlib import Path
 
 import pytest
 from hypothesis import HealthCheck, Phase, given, settings
+from hypothesis.configuration import set_hypothesis_home_dir
 
 from fuzzing import (COMPILE_EXTENSIONS, FAST_SCENES, KILL_GRACE, Case, CaseTimeout, Deep, Outcome, base_doc,
                      case_strategy, check_case, dumps, judge, keys_of, last_message, names_a_key, run_case, set_path,
@@ -38,6 +40,12 @@ EXPLICIT_LIMIT_S = 10.0
 
 pytestmark = pytest.mark.fuzz
 
+# Hypothesis caches the constants of imported modules in its home folder (default: ./.hypothesis) also while
+# other test modules are collected after this one: point it at a temporary folder from import on (removed at
+# this module's teardown); the fixture below moves it under tmp_path while the tests run.
+_COLLECTION_HOME = tempfile.mkdtemp(prefix="mechgen-hypothesis-")
+set_hypothesis_home_dir(_COLLECTION_HOME)
+
 VALIDATION = "scene validation (load-time bounds at params.*)"
 BUDGET = "work budgets"
 MEMORY = "memory estimate before allocating"
@@ -49,11 +57,10 @@ OUTPUT = "output paths checked before computing"
 def hypothesis_home(tmp_path_factory):
     """Hypothesis's own files (its constants and unicode caches) go under the test's temporary folder, not
     into ``.hypothesis/`` in the current directory (``database=None`` keeps it from storing examples)."""
-    from hypothesis.configuration import set_hypothesis_home_dir
-
     set_hypothesis_home_dir(tmp_path_factory.mktemp("hypothesis"))
     yield
-    set_hypothesis_home_dir(None)
+    set_hypothesis_home_dir(_COLLECTION_HOME)
+    shutil.rmtree(_COLLECTION_HOME, ignore_errors=True)
 
 
 @pytest.fixture(scope="module")
