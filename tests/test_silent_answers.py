@@ -134,7 +134,7 @@ def test_free_chain_has_one_rigid_mode_apart_from_its_frequencies():
 
 def test_a_soft_mode_is_not_taken_for_a_rigid_one():
     """Ground springs g = 1e-8 k under the chain: K + g I has the chain's eigenvalues shifted by g, so the
-    lowest omega^2 is g/m exactly -- small, but 1e6 times the rigid threshold 10 n eps max|lambda|."""
+    lowest omega^2 is g/m exactly -- small, but about 1e7 times the rigid threshold 10 eps max|lambda|."""
     m, k = 2.0, 50.0
     chain = np.array([[1.0, -1.0, 0.0], [-1.0, 2.0, -1.0], [0.0, -1.0, 1.0]]) * k
     for g, rigid in ((1e-8 * k, 0), (0.0, 1)):
@@ -161,6 +161,19 @@ def test_free_free_beam_has_two_rigid_modes_then_the_closed_form():
     # supported, the same beam has none and is stable
     pinned = mechgen.stability(beam.with_params(bc="pinned-pinned"))
     assert pinned.outputs["verdict"] == "stable" and pinned.outputs["rigid_modes"] == 0
+
+
+def test_a_fine_free_free_beam_keeps_its_first_elastic_mode():
+    """512 hermite elements: Lambda = 2.5e14, the rigid eigenvalues come out near 1e-2 and the first elastic
+    lambda = (beta_1 L)^4 = 500.56; the threshold 10 eps Lambda = 0.55 separates them (a factor n would not)."""
+    from mechgen.runtime.linear.modes import AccuracyWarning
+
+    beam = mechgen.compile("euler_bernoulli_beam", {"bc": "free-free", "N": 512})
+    mats = beam.linear(np.zeros(beam.n))
+    with pytest.warns(AccuracyWarning):  # the spectrum spans 5e11: the low modes are good to about 1e-4
+        res = solve_modes(*(x.toarray() if hasattr(x, "toarray") else x for x in (mats["M"], mats["K"])))
+    assert res.rigid == 2
+    assert res.eigenvalues[2:4] == pytest.approx([b**4 for b in BETA_L[:2]], rel=1e-4)
 
 
 # ----------------------------------------------------------------------------- 3. light damping

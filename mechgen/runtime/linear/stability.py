@@ -27,9 +27,9 @@ and negative mu (divergence) grow.
 
 Rigid-body modes (K phi = 0: a free body, a continuum without supports) give s = 0 (a double root
 without damping, perturbed by round-off to about sqrt(eps) * scale). Their number ``rigid`` is the
-number of singular values of L^-1 K L^-T (M = L L^T) below RIGID_FACTOR * n * eps times the largest
+number of singular values of L^-1 K L^-T (M = L L^T) below RIGID_FACTOR * eps times the largest
 (mechgen.runtime.linear.modes.RIGID_FACTOR), looked for only when some |s| is below
-sqrt(RIGID_FACTOR * N * eps) * scale; the ``rigid`` ... ``2 rigid`` eigenvalues of smallest |s|
+sqrt(RIGID_FACTOR * eps) * scale; the ``rigid`` ... ``2 rigid`` eigenvalues of smallest |s|
 within that bound are set apart (``rigid_eigenvalues``) and the verdict is that of the others:
 
 * ``stable``      - every Re s <= tol_i and no rigid-body mode,
@@ -192,7 +192,7 @@ def _undamped(M: np.ndarray, K: np.ndarray, tolerance: float | None, floor: floa
 
 def rigid_modes(M: np.ndarray, K: np.ndarray) -> int:
     """How many rigid-body modes K phi = 0 has relative to M: singular values of L^-1 K L^-T (M = L L^T, or M
-    itself when not positive definite) below RIGID_FACTOR * n * eps times the largest."""
+    itself when not positive definite) below RIGID_FACTOR * eps times the largest."""
     from mechgen.runtime.linear.modes import rigid_tolerance
 
     try:
@@ -203,14 +203,15 @@ def rigid_modes(M: np.ndarray, K: np.ndarray) -> int:
     sv = sla.svdvals(X)
     if not sv.size or sv[0] <= 0:
         return int(sv.size)
-    return int(np.count_nonzero(sv <= rigid_tolerance(len(sv), float(sv[0]))))
+    return int(np.count_nonzero(sv <= rigid_tolerance(float(sv[0]))))
 
 
 def rigid_bound(N: int, scale: float) -> float:
-    """sqrt(RIGID_FACTOR * N * eps) * scale: how far round-off moves the double root s = 0 of a rigid mode."""
+    """sqrt(RIGID_FACTOR * eps) * scale: how far round-off moves the double root s = 0 of a rigid mode (lambda =
+    s^2 within RIGID_FACTOR eps scale^2; ``N``, the pencil's size, is not a factor: see modes.RIGID_FACTOR)."""
     from mechgen.runtime.linear.modes import RIGID_FACTOR
 
-    return float(np.sqrt(RIGID_FACTOR * N * np.finfo(float).eps) * scale)
+    return float(np.sqrt(RIGID_FACTOR * np.finfo(float).eps) * scale)
 
 
 def _symmetric(A: np.ndarray, sign: float, rel: float = 1e-10) -> bool:
