@@ -14,8 +14,11 @@ from mechgen.symbolic.specialize import specialize
 
 def test_only_the_kernels_an_analysis_needs_are_built():
     model = models.get("laval_rotor")
+    # modes: M, D, G, K, and the residual that checks the point is an equilibrium; about a steady state
+    # (found by it), M, D, G, K alone
     system, report = compile_model(model, specialize(model, {}), kernels=needs("modes", {}, internal=False))
-    assert set(report.kernels) == {"linear"} == set(system.kernels)
+    assert set(report.kernels) == {"linear", "residual"} == set(system.kernels)
+    assert needs("modes", {"about": "eq"}, internal=False) == {"linear"}
 
 
 def test_zero_parameter_disappears_from_the_kernel():

@@ -2,7 +2,8 @@
 
 The modes are tracked across speeds (mechgen.runtime.linear.campbell) and critical speeds are found where a
 whirl frequency crosses a multiple of the speed. Scene keys: ``over`` (one numeric parameter with two
-or more increasing values), ``count`` (modes, default 8), ``multiples`` (of the speed, default [1]),
+or more increasing values), ``count`` (modes; left out: min(8, the system's degrees of freedom), a count written larger than
+that is refused), ``multiples`` (of the speed, default [1]),
 ``method`` (auto, exact, reduced), ``about`` and ``at`` (the operating point). Outputs: ``speeds``,
 ``frequencies`` and ``whirl`` and ``log_dec`` (one row per speed), ``critical_speeds``, ``parameter``,
 ``method`` and ``exact_solves``.
@@ -43,7 +44,7 @@ def _multiples(ctx, key: str, value: object) -> list[float]:
 
 
 SCHEMA = {"over": Option(_speeds, REQUIRED, "a table: parameter = [values] or {start, stop, num}"),
-          "count": Option(schema.count, 8), "multiples": Option(_multiples, [1.0]),
+          "count": Option(schema.count), "multiples": Option(_multiples, [1.0]),
           "method": Option(schema.one_of("campbell method", ("auto", "exact", "reduced"))),
           "about": Option(schema.about), "at": Option(schema.coordinate_table)}
 
@@ -64,6 +65,22 @@ def _speed_parameter(system, options: dict) -> tuple[str, list[float]]:
         raise SceneError(f"campbell over {name!r}, which the compiled kernels fold as a constant",
                          key="over", expected="a numeric model parameter (kept free by the scene)")
     return name, [float(v) for v in values]
+
+
+#: the number of tracked modes when the scene does not say (fewer when the system has fewer)
+DEFAULT_COUNT = 8
+
+
+def _count(system, options: dict) -> int:
+    """The modes to track: ``count`` as written (at most the degrees of freedom), else min(DEFAULT_COUNT, n)."""
+    n = int(system.n)
+    if "count" not in options:
+        return min(DEFAULT_COUNT, n)
+    count = int(options["count"])
+    if count > n:
+        raise SceneError(f"count = {count} asks for more modes than the {n} a system of {n} degrees of freedom has",
+                         key="count", expected=f"at most {n}, or no count (the default is min({DEFAULT_COUNT}, {n}))")
+    return count
 
 
 def run_campbell(system, options: dict, context: dict) -> dict:
@@ -91,7 +108,7 @@ def run_campbell(system, options: dict, context: dict) -> dict:
         mats = assembled(speed)
         return {"M": mats["M"], "C": mats["D"] + mats["G"], "K": mats["K"]}
 
-    count = int(options.get("count", 8))
+    count = _count(system, options)
     sparse = system.n > SPARSE_N
     # matrices polynomial in the speed (a rotor's G = Omega G1): four assemblies, then sparse adds
     poly = fit_speed_polynomial(assembled, speeds[0], speeds[-1]) if len(speeds) > 4 else None

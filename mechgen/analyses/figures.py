@@ -9,7 +9,7 @@ from pathlib import Path
 
 from mechgen.errors import InputError
 
-VERDICT_COLOURS = {"stable": "k", "divergence": "tab:blue", "flutter": "tab:red", "unconverged": "tab:orange"}
+VERDICT_COLOURS = {"stable": "k", "neutral": "tab:green", "divergence": "tab:blue", "flutter": "tab:red", "unconverged": "tab:orange"}
 
 
 def pyplot():

@@ -2,7 +2,12 @@
 
 Scene keys: ``about`` (an earlier steady analysis), ``at`` (coordinates of the operating point),
 ``count`` (the lowest this many modes). Outputs: ``frequencies`` (ascending, rad/s or the model's
-unit); a continuum with ``count`` also ``s`` and ``shapes``. A system with damping, gyroscopic terms
+unit; elastic modes only); ``rigid_modes`` (how many rigid-body modes, K phi = 0 to the solver's
+accuracy, mechgen.runtime.linear.modes.rigid_count; they are not frequencies, and ``count`` counts
+the elastic modes after them) with, for a lumped model, ``rigid_shapes`` (one {coordinate: value}
+per rigid mode, largest entry 1); ``operating_point`` when the point given (``at``, or zero) was
+not an equilibrium and Newton found one (mechgen.analyses.operating_point.equilibrium_point); a
+continuum with ``count`` also ``s`` and ``shapes``. A system with damping, gyroscopic terms
 or a non-symmetric stiffness, and any rotor, gets its damped modes (mechgen.analyses.whirl) with
 ``eigenvalues``, ``log_dec`` and (rotors) ``whirl``.
 """
@@ -12,7 +17,7 @@ import numpy as np
 
 from mechgen.analyses import figures, summary
 from mechgen.analyses.fields import field_shapes
-from mechgen.analyses.operating_point import linear_about, operating_point
+from mechgen.analyses.operating_point import equilibrium_point, linear_about
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import LINEAR_OPTIONS
 from mechgen.analyses.whirl import is_gyroscopic, run_damped_modes
@@ -20,8 +25,8 @@ from mechgen.runtime.fields.constrain import warn_penalty_errors
 from mechgen.runtime.linear.modes import modes as solve_modes
 
 def needs(options: dict, *, internal: bool) -> set[str]:
-    """M, D, G, K: the linear kernel."""
-    return {"linear"}
+    """M, D, G, K: the linear kernel; the residual too, to check that the point is an equilibrium (no ``about``)."""
+    return {"linear"} if options.get("about") else {"linear", "residual"}
 
 
 def run_modes(system, options: dict, context: dict) -> dict:
@@ -32,20 +37,37 @@ def run_modes(system, options: dict, context: dict) -> dict:
     modes instead (mechgen.analyses.whirl): ``frequencies`` are then the damped natural
     frequencies, with ``eigenvalues``, ``log_dec`` and (rotors) ``whirl``.
     """
-    q = operating_point(system, options, context)
+    q, found = equilibrium_point(system, options, context)
     mats = linear_about(system, q, options, context)
     if is_gyroscopic(mats) or system.metadata.whirl:
         out = run_damped_modes(system, mats, options)
         if system.is_field and options.get("count"):
             out.update(field_shapes(system, np.real(out["_shapes"]), "shapes"))
-        return out
+        return _with_point(out, found)
     res = solve_modes(mats["M"], mats["K"], count=options.get("count"),
                       allow_singular_mass=getattr(system, "has_multipliers", False))
     if getattr(system, "penalty_choice", None) is not None:  # penalty constraints: a-posteriori error of each mode
         warn_penalty_errors(system.penalty_errors(res.shapes, res.eigenvalues))
-    out = {"frequencies": [float(f) for f in res.frequencies], "_shapes": res.shapes}
+    elastic = res.shapes[:, res.rigid:]
+    out = {"frequencies": [float(f) for f in res.frequencies[res.rigid:]], "rigid_modes": int(res.rigid),
+           "_shapes": elastic}
+    if res.rigid and not system.is_field and not system.is_lattice:
+        out["rigid_shapes"] = [_largest_one(system, res.shapes[:, j]) for j in range(res.rigid)]
     if system.is_field and options.get("count"):
-        out.update(field_shapes(system, res.shapes, "shapes"))
+        out.update(field_shapes(system, elastic, "shapes"))
+    return _with_point(out, found)
+
+
+def _largest_one(system, phi: np.ndarray) -> dict[str, float]:
+    """A mode shape as {coordinate: value}, scaled so that its largest |entry| is 1 (and positive)."""
+    top = phi[np.argmax(np.abs(phi))]
+    return {n: float(x / top) + 0.0 for n, x in zip(system.coordinates, phi)}
+
+
+def _with_point(out: dict, found: dict | None) -> dict:
+    """The outputs with ``operating_point`` (how the equilibrium was found) when the given point was not one."""
+    if found is not None:
+        out["operating_point"] = found
     return out
 
 

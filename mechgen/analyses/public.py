@@ -94,18 +94,23 @@ def modes(system, *, name: str | None = None, **options) -> Result:
     """Natural frequencies (and a continuum's mode shapes) about an operating point.
 
     Options (scene keys of ``kind = "modes"``): ``about`` (a steady Result), ``at`` ({coordinate:
-    value}), ``count``. Outputs: ``frequencies`` (ascending, rad/s or the model's unit); with
-    damping or gyroscopic terms, and for rotors, the damped modes (``eigenvalues``, ``log_dec``,
-    ``whirl``).
+    value}), ``count``. Outputs: ``frequencies`` (ascending, rad/s or the model's unit; elastic
+    modes), ``rigid_modes`` (how many rigid-body modes); with damping or gyroscopic terms, and for
+    rotors, the damped modes (``eigenvalues``, ``log_dec``, ``whirl``). A point that is not an
+    equilibrium is replaced by the one Newton finds from it (``operating_point`` says so), or the call
+    raises ConvergenceError naming the residual.
     """
     return _run("modes", system, options, name)
 
 
 def stability(system, *, name: str | None = None, **options) -> Result:
-    """Eigenvalues of M q'' + (D + G) q' + K q = 0 and the verdict (stable, divergence, flutter, unconverged).
+    """Eigenvalues of M q'' + (D + G) q' + K q = 0 and the verdict (stable, neutral, divergence, flutter,
+    unconverged; neutral: stable apart from rigid-body modes).
 
-    Options: ``about``, ``at``, ``count``, ``tolerance``, ``refine``, ``refine_rtol``. Outputs:
-    ``eigenvalues`` ([re, im] pairs), ``verdict``, ``frequencies``, ``growth_rate``.
+    Options: ``about``, ``at``, ``count``, ``tolerance`` (left out: each eigenvalue's own error bound; a
+    number: that times max|s| for all), ``refine``, ``refine_rtol``. Outputs: ``eigenvalues`` ([re, im]
+    pairs), ``verdict``, ``frequencies``, ``growth_rate``, ``rigid_modes``, ``unstable``, and for a
+    continuum ``refinement``.
     """
     return _run("stability", system, options, name)
 

@@ -1,16 +1,30 @@
 """``stability``: eigenvalues of the gyroscopic / damped system and the verdict.
 
-Scene keys: ``about``, ``at``, ``count`` (as for modes), ``tolerance`` (relative to the spectrum's
-scale), ``refine`` and ``refine_rtol`` (a continuum's verdict checked at twice the size). Outputs:
-``eigenvalues`` (list of [re, im]), ``verdict`` (stable / divergence / flutter / unconverged),
-``frequencies``, ``growth_rate`` and, refined, ``refinement``.
+Scene keys: ``about``, ``at``, ``count`` (as for modes), ``tolerance``, ``refine`` and ``refine_rtol``
+(a continuum's verdict checked at twice the size). ``tolerance`` left out (the default): each
+eigenvalue counts as growing when Re s exceeds the eigen-solve's own error bound for it (its
+condition number times the round-off of the solve, mechgen.runtime.linear.stability), so a light
+physical damping shifts no stability boundary by more than that accuracy; ``tolerance = 1e-8``
+(a number): a fixed threshold of that much times the spectrum's scale (the largest |s|) for every
+eigenvalue, the rule before (the sparse path, above SPARSE_STABILITY_N unknowns with ``count``,
+uses 1e-8 when none is given: ARPACK's accuracy).
+
+Outputs: ``eigenvalues`` (list of [re, im]; with ``count``, the 2 count of smallest |s|, from which the
+``count`` lowest ``frequencies`` are taken; the verdict is that of the whole computed spectrum),
+``verdict`` (stable / neutral / divergence / flutter / unconverged; ``neutral``: stable apart from
+rigid-body modes, which drift freely), ``frequencies``, ``growth_rate`` (of the modes that are not
+rigid), ``rigid_modes`` (how many), ``unstable`` ({real, complex}: eigenvalues with Re s above their
+threshold, complex ones counted once per pair), ``operating_point`` (when the given point was not an
+equilibrium and Newton found one: mechgen.analyses.operating_point.equilibrium_point) and, refined,
+``refinement``: the sizes, verdicts, sign structures (``unstable``) and growth rates at N and 2N, what
+was ``compared`` and whether the growth rates agree to ``refine_rtol`` (``growth_rate_converged``).
 """
 from __future__ import annotations
 
 import numpy as np
 
 from mechgen.analyses import figures, schema, summary
-from mechgen.analyses.operating_point import linear_about, operating_point
+from mechgen.analyses.operating_point import equilibrium_point, linear_about
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import LINEAR_OPTIONS, Option
 from mechgen.runtime.linear.stability import stability as solve_stability
@@ -19,17 +33,17 @@ from mechgen.runtime.linear.stability import stability_first_order, stability_sp
 #: above this many unknowns, a stability analysis with a ``count`` of sparse matrices uses shift-invert
 SPARSE_STABILITY_N = 400
 
-SCHEMA = {**LINEAR_OPTIONS, "tolerance": Option(schema.positive, 1e-8), "refine": Option(schema.boolean, True),
+SCHEMA = {**LINEAR_OPTIONS, "tolerance": Option(schema.positive), "refine": Option(schema.boolean, True),
           "refine_rtol": Option(schema.positive, 1e-2)}
 
 
 def needs(options: dict, *, internal: bool) -> set[str]:
-    """M, D, G, K: the linear kernel."""
-    return {"linear"}
+    """M, D, G, K: the linear kernel; the residual too, to check that the point is an equilibrium (no ``about``)."""
+    return {"linear"} if options.get("about") else {"linear", "residual"}
 
 
 def _stability_of(system, q, options: dict, context: dict):
-    tol = options.get("tolerance", 1e-8)
+    tol = options.get("tolerance")
     if system.m:
         z = np.asarray(context[options["about"]]["_z"]) if options.get("about") else np.zeros(system.m)
         A = system.jacobian(0.0, np.concatenate([q, np.zeros(system.n), z]))
@@ -41,20 +55,36 @@ def _stability_of(system, q, options: dict, context: dict):
     return solve_stability(dense["M"], dense["D"] + dense["G"], dense["K"], tolerance=tol)
 
 
-def refinement_verdict(verdicts: list[str], growth: list[float], scales: list[float], tolerance: float,
-                       rtol: float) -> str:
-    """The continuum's verdict from verdicts at two refinements.
+def refinement_verdict(verdicts: list[str], structures: list[tuple[int, int]]) -> str:
+    """The continuum's verdict from the verdicts at two refinements: it stands when the verdicts agree and so
+    does the sign structure (how many eigenvalues grow, real and complex); otherwise ``unconverged``.
 
-    Equal verdicts stand when stable, or when the growth rates agree to ``rtol``
-    (relative); otherwise ``unconverged``.
+    Near a stability boundary (just above a buckling load) the growth rate is small and converges slowly
+    with the mesh while the sign structure is already settled, so the growth rates are reported (with
+    whether they agree to ``refine_rtol``) but do not decide.
     """
-    if verdicts[0] != verdicts[1]:
+    if verdicts[0] != verdicts[1] or tuple(structures[0]) != tuple(structures[1]):
         return "unconverged"
-    if verdicts[0] == "stable":
-        return "stable"
-    g0, g1 = growth
-    floor = tolerance * max(scales)
-    return verdicts[0] if abs(g0 - g1) <= rtol * max(abs(g0), abs(g1)) + floor else "unconverged"
+    return verdicts[0]
+
+
+def _structure(res) -> dict:
+    return {"real": int(res.unstable[0]), "complex": int(res.unstable[1])}
+
+
+def _trimmed(res, count: int | None) -> tuple[list, list]:
+    """Eigenvalues and frequencies as reported: with ``count``, the 2 (count + rigid modes) eigenvalues of
+    smallest |s| (the part of the spectrum the sparse path computes) and the lowest ``count`` frequencies
+    among them."""
+    s = np.asarray(res.eigenvalues)
+    freqs = np.asarray(res.frequencies)
+    if count:
+        near = np.sort(np.argsort(np.abs(s), kind="stable")[: 2 * (count + res.rigid)])  # (imag, real) order
+        kept = s[near]
+        top = float(np.max(np.abs(kept.imag))) if kept.size else 0.0
+        freqs = freqs[freqs <= top * (1 + 1e-12)][:count]
+        s = kept
+    return [[float(x.real), float(x.imag)] for x in s], [float(f) for f in freqs]
 
 
 def run_stability(system, options: dict, context: dict) -> dict:
@@ -63,25 +93,30 @@ def run_stability(system, options: dict, context: dict) -> dict:
     With internal variables z the linearisation is the first-order one,
     x' = A x with A = d(dx/dt)/dx at (q, 0, z) (exact Jacobian, see System.jacobian).
     For a continuum (with ``refine``), the verdict is checked on the same model
-    discretised twice as finely: ``unconverged`` when the verdict changes or the
-    growth rate does not settle (``refinement`` reports both).
+    discretised twice as finely: ``unconverged`` when the verdict or the sign structure
+    changes (``refinement`` reports both, and the growth rates).
     """
-    q = operating_point(system, options, context)
+    q, found = equilibrium_point(system, options, context)
     res = _stability_of(system, q, options, context)
-    eig = [[float(s.real), float(s.imag)] for s in res.eigenvalues]
-    freqs = [float(f) for f in res.frequencies]
-    if options.get("count"):
-        freqs = freqs[: options["count"]]
-    out = {"eigenvalues": eig, "verdict": res.verdict, "frequencies": freqs, "growth_rate": float(res.growth_rate)}
+    eig, freqs = _trimmed(res, options.get("count"))
+    out = {"eigenvalues": eig, "verdict": res.verdict, "frequencies": freqs, "growth_rate": float(res.growth_rate),
+           "rigid_modes": int(res.rigid), "unstable": _structure(res)}
+    if found is not None:
+        out["operating_point"] = found
     if hasattr(system, "refined") and options.get("refine", True) and not options.get("about"):
         size = int(system.choices["N"])
         fine = system.refined(2 * size)
-        res2 = _stability_of(fine, np.zeros(fine.n), options, context)
-        out["verdict"] = refinement_verdict([res.verdict, res2.verdict], [res.growth_rate, res2.growth_rate],
-                                            [res.scale, res2.scale], options.get("tolerance", 1e-8),
-                                            options.get("refine_rtol", 1e-2))
+        q_fine = equilibrium_point(fine, options, context)[0] if found is not None else np.zeros(fine.n)
+        res2 = _stability_of(fine, q_fine, options, context)
+        out["verdict"] = refinement_verdict([res.verdict, res2.verdict], [res.unstable, res2.unstable])
+        g0, g1 = float(res.growth_rate), float(res2.growth_rate)
+        rtol = options.get("refine_rtol", 1e-2)
+        floor = max(res.threshold, res2.threshold)
         out["refinement"] = {"N": [size, 2 * size], "verdicts": [res.verdict, res2.verdict],
-                             "growth_rates": [float(res.growth_rate), float(res2.growth_rate)]}
+                             "unstable": [_structure(res), _structure(res2)], "growth_rates": [g0, g1],
+                             "growth_rate_converged": bool(abs(g0 - g1) <= rtol * max(abs(g0), abs(g1)) + floor),
+                             "compared": "verdict and sign structure (numbers of growing real and complex "
+                                         "eigenvalues) at N and 2N; growth rates reported, to refine_rtol"}
     return out
 
 

@@ -4,6 +4,18 @@ Frequencies are sign(lambda) sqrt(|lambda|) for the eigenvalues lambda = omega^2
 ascending: a negative frequency flags a divergence (negative-stiffness) mode.
 Shapes are mass-normalised (phi^T M phi = I). Units: rad/s, or the model's
 nondimensional frequency unit.
+
+Rigid-body modes (K phi = 0: a free-free continuum, an unsupported chain) have lambda = 0, which the
+solver returns as a round-off value of size at most about eps * max|lambda| (either sign; LAPACK's
+bound p(n) eps ||A||, with p(n) of order 1 in practice: measured |lambda| <= 3e-17 Lambda for a free
+chain and free-free beams of 16 to 512 elements). An eigenvalue with |lambda| <= RIGID_FACTOR * eps *
+Lambda, Lambda = max(max|lambda|, max_i K_ii / M_ii) (the largest Rayleigh quotient of a unit vector
+bounds max lambda from below, so Lambda is the spectrum's scale even when only the lowest modes are
+computed), is indistinguishable from zero at this accuracy: it counts as rigid (:func:`rigid_count`,
+``ModesResult.rigid``), not as a frequency. A factor n in the bound would swallow real modes of fine
+meshes (the free-free beam's first elastic lambda = 500.6 lies below 10 n eps Lambda = 561 at 512
+hermite elements). On the sparse path (the lowest ``count`` modes) a rigid eigenvalue must also be below
+sqrt(eps) times the largest computed one: a penalty makes max K_ii / M_ii huge there.
 """
 from __future__ import annotations
 
@@ -24,6 +36,47 @@ class ModesResult:
     eigenvalues: np.ndarray
     frequencies: np.ndarray
     shapes: np.ndarray
+    rigid: int = 0  #: how many of the leading modes are rigid-body modes (lambda = 0 to the solver's accuracy)
+
+
+#: |lambda| <= RIGID_FACTOR * eps * Lambda counts as zero (the symmetric solver's error is about p(n) eps Lambda
+#: with p(n) of order 1 in practice; the factor leaves a margin for the assembly's own round-off)
+RIGID_FACTOR = 10.0
+
+
+def spectrum_scale(M, K, lam: np.ndarray) -> float:
+    """Lambda = max(max|lambda|, max_i K_ii / M_ii): the scale round-off in lambda is relative to."""
+    kd, md = np.abs(np.asarray(K.diagonal(), float)), np.abs(np.asarray(M.diagonal(), float))
+    both = md > 0
+    ratio = float((kd[both] / md[both]).max()) if both.any() else 0.0
+    return max(float(np.abs(lam).max(initial=0.0)), ratio)
+
+
+def rigid_tolerance(scale: float) -> float:
+    """RIGID_FACTOR * eps * scale: the largest |lambda| indistinguishable from zero (scale: Lambda)."""
+    return RIGID_FACTOR * np.finfo(float).eps * scale
+
+
+def rigid_count(lam: np.ndarray, scale: float) -> int:
+    """How many eigenvalues lambda = omega^2 are rigid-body modes (|lambda| <= :func:`rigid_tolerance`)."""
+    return int(np.count_nonzero(np.abs(lam) <= rigid_tolerance(scale)))
+
+
+def _with_rigid(res: "ModesResult", M, K, *, partial: bool = False) -> "ModesResult":
+    """The result with its rigid modes moved to the front (their round-off eigenvalues kept) and counted.
+
+    ``partial`` (the lowest modes of the sparse path): a rigid eigenvalue must also be below sqrt(eps) times
+    the largest computed one, since max K_ii / M_ii there can be a penalty's (penalised supports make it
+    huge while the shift-inverted low modes stay accurate), which alone would take real modes for rigid.
+    """
+    lam = np.asarray(res.eigenvalues)
+    rigid = np.abs(lam) <= rigid_tolerance(spectrum_scale(M, K, lam))
+    if partial:
+        rigid &= np.abs(lam) <= np.sqrt(np.finfo(float).eps) * float(np.abs(lam).max(initial=0.0))
+    if not rigid.any():
+        return res
+    order = np.concatenate([np.flatnonzero(rigid), np.flatnonzero(~rigid)])
+    return ModesResult(lam[order], np.asarray(res.frequencies)[order], res.shapes[:, order], int(rigid.sum()))
 
 
 def _check_symmetric(A: np.ndarray, name: str) -> None:
@@ -84,11 +137,11 @@ def _dense(M, K, allow_singular_mass: bool = False) -> ModesResult:
     except np.linalg.LinAlgError as exc:
         singular = _semidefinite_mass(M, K) if allow_singular_mass else None
         if singular is not None:
-            return singular
+            return _with_rigid(singular, M, K)
         raise InputError("the mass matrix is not positive definite (singular or indefinite)", key="M",
                          expected="a positive definite mass matrix (check masses and inertias are > 0)") from exc
     _warn_if_inaccurate(lam)
-    return ModesResult(lam, np.sign(lam) * np.sqrt(np.abs(lam)), phi)
+    return _with_rigid(ModesResult(lam, np.sign(lam) * np.sqrt(np.abs(lam)), phi), M, K)
 
 
 class AccuracyWarning(UserWarning):
@@ -156,14 +209,21 @@ def modes(M, K, count: int | None = None, *, allow_singular_mass: bool = False) 
 
     ``allow_singular_mass``: M may be semi-definite (massless Lagrange multipliers); its
     infinite eigenvalues are dropped. Otherwise a singular M is an input error.
+    ``count`` counts elastic modes: rigid-body modes (``rigid`` of them, first, their eigenvalues the
+    solver's round-off) come on top of it.
     """
     n = M.shape[0]
     if sps.issparse(M) or sps.issparse(K):
         if count is not None and count < n - 1 and n > 200:
-            return _sparse(sps.csr_matrix(M), sps.csr_matrix(K), count)
+            Ms, Ks = sps.csr_matrix(M), sps.csr_matrix(K)
+            res = _with_rigid(_sparse(Ms, Ks, count), Ms, Ks, partial=True)
+            if res.rigid and count + res.rigid < n - 1:
+                res = _with_rigid(_sparse(Ms, Ks, count + res.rigid), Ms, Ks, partial=True)
+            return res
         M = M.toarray() if sps.issparse(M) else M
         K = K.toarray() if sps.issparse(K) else K
-    res = _dense(M, K, allow_singular_mass)
+    res = _dense(M, K, allow_singular_mass)  # rigid modes counted on the direct paths (K > 0 on the inverse one)
     if count is not None:
-        res = ModesResult(res.eigenvalues[:count], res.frequencies[:count], res.shapes[:, :count])
+        keep = res.rigid + count
+        res = ModesResult(res.eigenvalues[:keep], res.frequencies[:keep], res.shapes[:, :keep], res.rigid)
     return res
