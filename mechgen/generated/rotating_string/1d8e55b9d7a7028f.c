@@ -4,6 +4,49 @@
  */
 #include <math.h>
 
+/* residual: Lagrange residual r = M a - f
+ *   in[0]  q: length 4 per state
+ *   in[1]  v: length 4 per state
+ *   in[2]  a: length 4 per state
+ *   in[3]  z: length 0 per state
+ *   in[4]  t: length 1 per state
+ *   in[5]  s: length 1 per state
+ *   in[6]  p: length 1
+ *   out[0] r: length 4 per state shape (4, 1)
+ */
+int mg_residual(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    const long len_in0 = 4;
+    const long len_in1 = 4;
+    const long len_in2 = 4;
+    const double *const in6 = in[6];
+    const long len_out0 = 4;
+    for (long b = 0; b < nbatch; ++b) {
+        const double *const in0 = in[0] + b * len_in0;
+        const double *const in1 = in[1] + b * len_in1;
+        const double *const in2 = in[2] + b * len_in2;
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        {
+            const double g0 = in0[0];
+            const double g1 = in0[1];
+            const double g2 = in0[2];
+            const double g3 = in0[3];
+            const double g4 = in1[0];
+            const double g5 = in1[2];
+            const double g6 = in2[0];
+            const double g7 = in2[2];
+            const double g8 = in6[0];
+            out0[0] = -g0*(g8*g8) - 2.0*g5*g8 + g6;
+            out0[1] = g1;
+            out0[2] = g7 + g8*(-g2*g8 + 2.0*g4);
+            out0[3] = g3;
+        }
+    }
+    return 0;
+}
+
 /* linear: M, D, G, K of the linearisation (a = 0)
  *   in[0]  q: length 4 per state
  *   in[1]  v: length 4 per state

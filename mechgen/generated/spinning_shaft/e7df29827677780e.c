@@ -4,6 +4,74 @@
  */
 #include <math.h>
 
+/* residual: Lagrange residual r = M a - f
+ *   in[0]  q: length 8 per state
+ *   in[1]  v: length 8 per state
+ *   in[2]  a: length 8 per state
+ *   in[3]  z: length 0 per state
+ *   in[4]  t: length 1 per state
+ *   in[5]  s: length 1 per state
+ *   in[6]  p: length 17
+ *   out[0] r: length 8 per state shape (8, 1)
+ */
+int mg_residual(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    const long len_in0 = 8;
+    const long len_in1 = 8;
+    const long len_in2 = 8;
+    const double *const in6 = in[6];
+    const long len_out0 = 8;
+    for (long b = 0; b < nbatch; ++b) {
+        const double *const in0 = in[0] + b * len_in0;
+        const double *const in1 = in[1] + b * len_in1;
+        const double *const in2 = in[2] + b * len_in2;
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        {
+            const double g0 = in0[1];
+            const double g1 = in0[3];
+            const double g2 = in0[4];
+            const double g3 = in0[5];
+            const double g4 = in0[6];
+            const double g5 = in0[7];
+            const double g6 = in1[4];
+            const double g7 = in1[6];
+            const double g8 = in2[0];
+            const double g9 = in2[2];
+            const double g10 = in2[4];
+            const double g11 = in2[6];
+            const double g12 = in6[0];
+            const double g13 = in6[1];
+            const double t0 = -g0 + g4;
+            const double t1 = g1 + g2;
+            const double t2 = (g12*g12);
+            const double t3 = (3925.0/2.0)*3.141592653589793*t2;
+            const double t4 = 17302500000.0*3.141592653589793;
+            const double t5 = t2*t4;
+            const double t6 = cos(g4);
+            const double t7 = g13*t6;
+            const double t8 = (g12*g12*g12*g12);
+            const double t9 = 3.141592653589793*t8;
+            const double t10 = (3925.0/16.0)*t9;
+            const double t11 = g7*t10;
+            const double t12 = sin(g4);
+            const double t13 = t12*t6;
+            const double t14 = (3925.0/32.0)*3.141592653589793;
+            const double t15 = 3125000000.0*t9;
+            out0[0] = g8*t3;
+            out0[1] = -t0*t5;
+            out0[2] = g9*t3;
+            out0[3] = t1*t5;
+            out0[4] = g1*t5 + g10*(t10*(t12*t12) + t14*(t6*t6)*t8) + g2*t5 + g6*t11*t13 + t11*t7;
+            out0[5] = g3*t15;
+            out0[6] = t2*(-g0*t4 + g4*t4 + t2*((3925.0/32.0)*3.141592653589793*g11 - (g6*g6)*t13*t14 - 3925.0/16.0*3.141592653589793*g6*t7));
+            out0[7] = g5*t15;
+        }
+    }
+    return 0;
+}
+
 /* linear: M, D, G, K of the linearisation (a = 0)
  *   in[0]  q: length 8 per state
  *   in[1]  v: length 8 per state
@@ -81,6 +149,48 @@ int mg_linear(const double *const *in, double *const *out, const long *sizes, lo
     return 0;
 }
 
+/* residual_at_bearing: Lagrange residual r = M a - f
+ *   in[0]  q: length 8 per state
+ *   in[1]  v: length 8 per state
+ *   in[2]  a: length 8 per state
+ *   in[3]  z: length 0 per state
+ *   in[4]  t: length 1 per state
+ *   in[5]  s: length 1 per state
+ *   in[6]  p: length 17
+ *   out[0] r: length 8 per state shape (8, 1)
+ */
+int mg_residual_at_bearing(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    const long len_in0 = 8;
+    const long len_in1 = 8;
+    const double *const in6 = in[6];
+    const long len_out0 = 8;
+    for (long b = 0; b < nbatch; ++b) {
+        const double *const in0 = in[0] + b * len_in0;
+        const double *const in1 = in[1] + b * len_in1;
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        {
+            const double g0 = in0[0];
+            const double g1 = in0[2];
+            const double g2 = in1[0];
+            const double g3 = in1[2];
+            const double g4 = in6[9];
+            const double g5 = in6[10];
+            const double g6 = in6[11];
+            const double g7 = in6[12];
+            const double g8 = in6[13];
+            const double g9 = in6[14];
+            const double g10 = in6[15];
+            const double g11 = in6[16];
+            out0[0] = g0*g4 + g1*g5 + g2*g8 + g3*g9;
+            out0[2] = g0*g6 + g1*g7 + g10*g2 + g11*g3;
+        }
+    }
+    return 0;
+}
+
 /* linear_at_bearing: M, D, G, K of the linearisation (a = 0)
  *   in[0]  q: length 8 per state
  *   in[1]  v: length 8 per state
@@ -132,6 +242,71 @@ int mg_linear_at_bearing(const double *const *in, double *const *out, const long
             out3[2] = g1;
             out3[16] = g2;
             out3[18] = g3;
+        }
+    }
+    return 0;
+}
+
+/* residual_at_disk: Lagrange residual r = M a - f
+ *   in[0]  q: length 8 per state
+ *   in[1]  v: length 8 per state
+ *   in[2]  a: length 8 per state
+ *   in[3]  z: length 0 per state
+ *   in[4]  t: length 1 per state
+ *   in[5]  s: length 1 per state
+ *   in[6]  p: length 17
+ *   out[0] r: length 8 per state shape (8, 1)
+ */
+int mg_residual_at_disk(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    const long len_in0 = 8;
+    const long len_in1 = 8;
+    const long len_in2 = 8;
+    const double *const in6 = in[6];
+    const long len_out0 = 8;
+    for (long b = 0; b < nbatch; ++b) {
+        const double *const in0 = in[0] + b * len_in0;
+        const double *const in1 = in[1] + b * len_in1;
+        const double *const in2 = in[2] + b * len_in2;
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        {
+            const double g0 = in0[6];
+            const double g1 = in1[4];
+            const double g2 = in1[6];
+            const double g3 = in2[0];
+            const double g4 = in2[2];
+            const double g5 = in2[4];
+            const double g6 = in2[6];
+            const double g7 = in6[1];
+            const double g8 = in6[2];
+            const double g9 = in6[3];
+            const double g10 = in6[4];
+            const double g11 = in6[5];
+            const double g12 = in6[6];
+            const double g13 = in6[7];
+            const double g14 = in6[8];
+            const double t0 = (g13*g13);
+            const double t1 = (g14*g14);
+            const double t2 = 3.141592653589793*g11*(t0 - t1);
+            const double t3 = g12*t2;
+            const double t4 = g8 + (1.0/4.0)*t3;
+            const double t5 = sin(g0);
+            const double t6 = t3*(t0 + t1);
+            const double t7 = (1.0/64.0)*t6;
+            const double t8 = g10 + 2.0*t7;
+            const double t9 = cos(g0);
+            const double t10 = (g12*g12*g12)*t2;
+            const double t11 = (1.0/2.0)*g9 + (1.0/96.0)*t10 + (1.0/128.0)*t6;
+            const double t12 = 2.0*t11;
+            const double t13 = g1*t5;
+            const double t14 = t8*t9;
+            const double t15 = t14*(g7 + t13);
+            out0[0] = g3*t4;
+            out0[2] = g4*t4;
+            out0[4] = g2*(-4.0*t11*t13*t9 + t13*t14 + t15) + g5*(t12*(t9*t9) + (t5*t5)*t8);
+            out0[6] = (g1*g1)*t12*t5*t9 - g1*t15 + g6*(g9 + (1.0/48.0)*t10 + t7);
         }
     }
     return 0;

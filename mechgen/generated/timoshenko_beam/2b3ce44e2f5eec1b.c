@@ -4,6 +4,44 @@
  */
 #include <math.h>
 
+/* residual: Lagrange residual r = M a - f
+ *   in[0]  q: length 4 per state
+ *   in[1]  v: length 4 per state
+ *   in[2]  a: length 4 per state
+ *   in[3]  z: length 0 per state
+ *   in[4]  t: length 1 per state
+ *   in[5]  s: length 1 per state
+ *   in[6]  p: length 0
+ *   out[0] r: length 4 per state shape (4, 1)
+ */
+int mg_residual(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    const long len_in0 = 4;
+    const long len_in2 = 4;
+    const long len_out0 = 4;
+    for (long b = 0; b < nbatch; ++b) {
+        const double *const in0 = in[0] + b * len_in0;
+        const double *const in2 = in[2] + b * len_in2;
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        {
+            const double g0 = in0[1];
+            const double g1 = in0[2];
+            const double g2 = in0[3];
+            const double g3 = in2[0];
+            const double g4 = in2[2];
+            const double t0 = 1000.0*g0;
+            const double t1 = 1000.0*g1;
+            out0[0] = g3;
+            out0[1] = t0 - t1;
+            out0[2] = 0.001*g4 - t0 + t1;
+            out0[3] = g2;
+        }
+    }
+    return 0;
+}
+
 /* linear: M, D, G, K of the linearisation (a = 0)
  *   in[0]  q: length 4 per state
  *   in[1]  v: length 4 per state

@@ -4,6 +4,53 @@
  */
 #include <math.h>
 
+/* residual: Lagrange residual r = M a - f
+ *   in[0]  q: length 4 per state
+ *   in[1]  v: length 4 per state
+ *   in[2]  a: length 4 per state
+ *   in[3]  z: length 0 per state
+ *   in[4]  t: length 1 per state
+ *   in[5]  p: length 1
+ *   out[0] r: length 4 per state shape (4, 1)
+ */
+int mg_residual(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    const long len_in0 = 4;
+    const long len_in1 = 4;
+    const long len_in2 = 4;
+    const double *const in5 = in[5];
+    const long len_out0 = 4;
+    for (long b = 0; b < nbatch; ++b) {
+        const double *const in0 = in[0] + b * len_in0;
+        const double *const in1 = in[1] + b * len_in1;
+        const double *const in2 = in[2] + b * len_in2;
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        {
+            const double g0 = in0[0];
+            const double g1 = in0[1];
+            const double g2 = in0[2];
+            const double g3 = in0[3];
+            const double g4 = in1[2];
+            const double g5 = in1[3];
+            const double g6 = in2[0];
+            const double g7 = in2[1];
+            const double g8 = in2[2];
+            const double g9 = in2[3];
+            const double g10 = in5[0];
+            const double t0 = sin(g3);
+            const double t1 = cos(g3);
+            const double t2 = 0.2*t1;
+            out0[0] = 400000.0*g0 + 10.0*g6;
+            out0[1] = 400000.0*g1 + 10.0*g7;
+            out0[2] = 20000.0*g2 + g5*t2*(g10 + g4*t0) + g8*(0.2*(t0*t0) + 0.1*(t1*t1));
+            out0[3] = -g10*g4*t2 + 20000.0*g3 - 0.1*(g4*g4)*t0*t1 + 0.1*g9;
+        }
+    }
+    return 0;
+}
+
 /* linear: M, D, G, K of the linearisation (a = 0)
  *   in[0]  q: length 4 per state
  *   in[1]  v: length 4 per state

@@ -4,6 +4,88 @@
  */
 #include <math.h>
 
+/* residual: chain kernel residual
+ *   in[0]  q: length sites per state
+ *   in[1]  v: length sites per state
+ *   in[2]  a: length sites per state
+ *   in[3]  p: length 0
+ *   out[0] r: length sites per state
+ *   sizes: sites
+ */
+int mg_residual(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    const long sites = sizes[0];
+    const long len_in0 = sites;
+    const long len_in2 = sites;
+    const long len_out0 = sites;
+    for (long b = 0; b < nbatch; ++b) {
+        const double *const in0 = in[0] + b * len_in0;
+        const double *const in2 = in[2] + b * len_in2;
+        double *const out0 = out[0] + b * len_out0;
+        {
+            const long cnt = sites;
+            const long ns = sites;
+            const long lo = 0 < cnt ? 0 : cnt;
+            const long hi = ns - 0 > lo ? (ns - 0 < cnt ? ns - 0 : cnt) : lo;
+            const long zlo_out0 = hi > lo ? lo : 0;
+            const long zhi_out0 = hi > lo ? hi : 0;
+            for (long i = 0; i < zlo_out0; ++i) out0[i] = 0.0;
+            for (long i = zhi_out0; i < len_out0; ++i) out0[i] = 0.0;
+            for (long e = lo; e < hi; ++e) {
+                const double g0 = in2[e];
+                out0[e] = g0;
+            }
+            for (long e = 0; e < lo; ++e) {
+                const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
+                const double g0 = ok8 ? in2[e] : 0.0;
+                if (ok8) out0[e] += g0;
+            }
+            for (long e = hi; e < cnt; ++e) {
+                const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
+                const double g0 = ok8 ? in2[e] : 0.0;
+                if (ok8) out0[e] += g0;
+            }
+        }
+        {
+            const long cnt = sites + 1;
+            const long ns = sites;
+            const long lo = 1 < cnt ? 1 : cnt;
+            const long hi = ns - 0 > lo ? (ns - 0 < cnt ? ns - 0 : cnt) : lo;
+            double carry_out0 = 0.0;
+            for (long e = lo; e < hi; ++e) {
+                const double g0 = in0[e - 1];
+                const double g1 = in0[e];
+                const double t0 = -g0 + g1;
+                const double t1 = t0*(-0.25*t0 - 1.0);
+                out0[e - 1] += t1 - carry_out0;
+                carry_out0 = t1;
+            }
+            if (hi > lo) out0[hi - 1] -= carry_out0;
+            for (long e = 0; e < lo; ++e) {
+                const int ok7 = (e + -1 >= 0) && (e + -1 < ns);
+                const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
+                const double g0 = ok7 ? in0[e - 1] : 0.0;
+                const double g1 = ok8 ? in0[e] : 0.0;
+                const double t0 = -g0 + g1;
+                const double t1 = t0*(-0.25*t0 - 1.0);
+                if (ok7) out0[e - 1] += t1;
+                if (ok8) out0[e] += -t1;
+            }
+            for (long e = hi; e < cnt; ++e) {
+                const int ok7 = (e + -1 >= 0) && (e + -1 < ns);
+                const int ok8 = (e + 0 >= 0) && (e + 0 < ns);
+                const double g0 = ok7 ? in0[e - 1] : 0.0;
+                const double g1 = ok8 ? in0[e] : 0.0;
+                const double t0 = -g0 + g1;
+                const double t1 = t0*(-0.25*t0 - 1.0);
+                if (ok7) out0[e - 1] += t1;
+                if (ok8) out0[e] += -t1;
+            }
+        }
+    }
+    return 0;
+}
+
 /* linear: chain kernel linear
  *   in[0]  q: length sites per state
  *   in[1]  v: length sites per state

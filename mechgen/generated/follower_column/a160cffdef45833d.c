@@ -4,6 +4,41 @@
  */
 #include <math.h>
 
+/* residual: Lagrange residual r = M a - f
+ *   in[0]  q: length 3 per state
+ *   in[1]  v: length 3 per state
+ *   in[2]  a: length 3 per state
+ *   in[3]  z: length 0 per state
+ *   in[4]  t: length 1 per state
+ *   in[5]  s: length 1 per state
+ *   in[6]  p: length 1
+ *   out[0] r: length 3 per state shape (3, 1)
+ */
+int mg_residual(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    const long len_in0 = 3;
+    const long len_in2 = 3;
+    const double *const in6 = in[6];
+    const long len_out0 = 3;
+    for (long b = 0; b < nbatch; ++b) {
+        const double *const in0 = in[0] + b * len_in0;
+        const double *const in2 = in[2] + b * len_in2;
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        {
+            const double g0 = in0[1];
+            const double g1 = in0[2];
+            const double g2 = in2[0];
+            const double g3 = in6[0];
+            out0[0] = g2;
+            out0[1] = -g0*g3;
+            out0[2] = g1;
+        }
+    }
+    return 0;
+}
+
 /* linear: M, D, G, K of the linearisation (a = 0)
  *   in[0]  q: length 3 per state
  *   in[1]  v: length 3 per state
@@ -38,6 +73,35 @@ int mg_linear(const double *const *in, double *const *out, const long *sizes, lo
             out0[0] = 1.0;
             out3[4] = -g0;
             out3[8] = 1.0;
+        }
+    }
+    return 0;
+}
+
+/* residual_at_end: Lagrange residual r = M a - f
+ *   in[0]  q: length 3 per state
+ *   in[1]  v: length 3 per state
+ *   in[2]  a: length 3 per state
+ *   in[3]  z: length 0 per state
+ *   in[4]  t: length 1 per state
+ *   in[5]  s: length 1 per state
+ *   in[6]  p: length 1
+ *   out[0] r: length 3 per state shape (3, 1)
+ */
+int mg_residual_at_end(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    const long len_in0 = 3;
+    const double *const in6 = in[6];
+    const long len_out0 = 3;
+    for (long b = 0; b < nbatch; ++b) {
+        const double *const in0 = in[0] + b * len_in0;
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        {
+            const double g0 = in0[1];
+            const double g1 = in6[0];
+            out0[0] = g0*g1;
         }
     }
     return 0;
