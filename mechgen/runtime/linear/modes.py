@@ -15,6 +15,7 @@ import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
 from mechgen.errors import InputError
+from mechgen.runtime.core.memory import require_dense
 
 
 @dataclass(frozen=True)
@@ -158,6 +159,8 @@ def modes(M, K, count: int | None = None, *, allow_singular_mass: bool = False) 
     infinite eigenvalues are dropped. Otherwise a singular M is an input error.
     """
     n = M.shape[0]
+    if not ((sps.issparse(M) or sps.issparse(K)) and count is not None and count < n - 1 and n > 200):
+        require_dense(n, 6, "the dense symmetric eigenproblem")
     if sps.issparse(M) or sps.issparse(K):
         if count is not None and count < n - 1 and n > 200:
             return _sparse(sps.csr_matrix(M), sps.csr_matrix(K), count)

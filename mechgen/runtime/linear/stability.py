@@ -25,6 +25,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
+from mechgen.runtime.core.memory import require_dense
+
 
 @dataclass(frozen=True)
 class StabilityResult:
@@ -82,6 +84,7 @@ def stability(M, C, K, *, tolerance: float = 1e-8) -> StabilityResult:
     """Eigenvalues and verdict of M q'' + C q' + K q = 0 (dense)."""
     M, C, K = (np.atleast_2d(np.asarray(x, float)) for x in (M, C, K))
     n = M.shape[0]
+    require_dense(n, 40, "the dense stability eigenproblem")
     s = conservative_gyroscopic(M, C, K)
     if s is not None:  # K > 0: every |s| >= sqrt(lambda_min(K) / lambda_max(M)) > 0 sets the scale
         return _verdict(s, tolerance)
