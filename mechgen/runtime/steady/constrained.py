@@ -33,6 +33,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from mechgen.errors import InputError
+from mechgen.runtime.core.memory import require_dense
 from mechgen.runtime.fields.assemble import element_matrices, element_vectors
 
 
