@@ -16,7 +16,9 @@ stability alone (at least t_end |lambda|max / c steps, c = 7 for RK45 and 12 for
 their stability intervals): the implicit BDF and Radau have no such limit. Reaching a budget ends the run
 with exit 1 naming the analysis, the t reached of t_end and the key to raise.
 
-``samples`` above 10^6 is refused at the key (each sample is a state kept and an energy evaluated).
+``samples`` above the safety limit 10^6 (raised by the scene's ``[limits] samples``) is refused at the key, and
+any count whose states would not fit in memory (runtime.core.memory) too; each sample is a state kept and an
+energy evaluated.
 ``rtol`` below 100 machine epsilons (2.2e-14, what scipy's integrators can honour; they would
 raise it silently) is refused at the key. A failed step (a step size below the spacing of the
 numbers), a singular mass matrix (a zero mass) or a kernel giving NaN/Inf ends the run with
@@ -38,6 +40,7 @@ from mechgen.errors import ConvergenceError, SceneError
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget, BudgetExceeded
 from mechgen.runtime.core.diagnose import explain_state
 from mechgen.runtime.core.integrate import MIN_RTOL, integrate_first_order, leapfrog
+from mechgen.runtime.core.memory import dense_bytes, require
 from mechgen.runtime.linear.modes import modes as solve_modes
 from mechgen.scene.values import fail, listing, show, type_name
 
@@ -129,7 +132,7 @@ def mode_energies(system, q: np.ndarray, v: np.ndarray, count: int = 8) -> list[
     k = np.arange(1, min(count, n) + 1)
     S = np.sqrt(2.0 / (n + 1)) * np.sin(np.outer(k, idx) * np.pi / (n + 1))
     mats = system.linear(np.zeros(n))
-    omega2 = np.einsum("ki,ij,kj->k", S, mats["K"].toarray(), S)
+    omega2 = np.einsum("ki,ik->k", S, mats["K"] @ S.T)  # K stays sparse (a chain of 1e6 sites)
     Q, P = S @ q, S @ v
     return [float(e) for e in 0.5 * (P**2 + omega2 * Q**2)]
 
@@ -197,6 +200,7 @@ def run_simulate(system, options: dict, context: dict) -> dict:
         x0 = np.concatenate([q0, v0, np.zeros(system.m)])
         refuse_explicit_stiff(system, x0, t_end, method, budget)
         n_out = int(options.get("samples", 201))
+        require(dense_bytes(n_out, 3 * (2 * system.n + system.m) + 6), f"{n_out} output samples", key="samples")
         t_eval = np.linspace(0.0, t_end, n_out)
         traj = integrate_first_order(system.rhs, x0, t_end, jac=system.jacobian, method=method,
                                      rtol=options.get("rtol", 1e-8), atol=options.get("atol", 1e-10), t_eval=t_eval,

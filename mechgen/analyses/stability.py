@@ -27,6 +27,7 @@ from mechgen.analyses import figures, schema, summary
 from mechgen.analyses.operating_point import equilibrium_point, linear_about
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import LINEAR_OPTIONS, Option
+from mechgen.runtime.core.memory import require_dense
 from mechgen.runtime.linear.stability import stability as solve_stability
 from mechgen.runtime.linear.stability import stability_first_order, stability_sparse
 
@@ -51,6 +52,7 @@ def _stability_of(system, q, options: dict, context: dict):
     mats = linear_about(system, q, options, context)
     if options.get("count") and hasattr(mats["M"], "toarray") and system.n > SPARSE_STABILITY_N:
         return stability_sparse(mats["M"], mats["D"] + mats["G"], mats["K"], 2 * options["count"], tolerance=tol)
+    require_dense(system.n, 40, "the dense stability eigenproblem", expected="a count with finite elements (sparse)")
     dense = {k: (v.toarray() if hasattr(v, "toarray") else v) for k, v in mats.items()}
     return solve_stability(dense["M"], dense["D"] + dense["G"], dense["K"], tolerance=tol)
 

@@ -18,10 +18,14 @@ SPARSE_N = 100
 
 def is_gyroscopic(mats: dict) -> bool:
     """True when D or G has a nonzero entry or K is not symmetric (the symmetric eigenproblem would be wrong)."""
-    dense = {k: v.toarray() if hasattr(v, "toarray") else np.asarray(v) for k, v in mats.items()}
-    K = dense["K"]
-    scale = max(np.abs(K).max(), 1e-300)
-    return bool(np.any(dense["D"]) or np.any(dense["G"]) or np.abs(K - K.T).max() > 1e-12 * scale)
+    K = mats["K"] if hasattr(mats["K"], "toarray") else np.asarray(mats["K"])  # sparse stays sparse (N = 1e6)
+    scale = max(abs(K).max(), 1e-300)
+    return bool(_nonzero(mats["D"]) or _nonzero(mats["G"]) or abs(K - K.T).max() > 1e-12 * scale)
+
+
+def _nonzero(X) -> bool:
+    """Whether a dense or sparse matrix has a nonzero entry (without densifying a sparse one)."""
+    return X.count_nonzero() > 0 if hasattr(X, "count_nonzero") else bool(np.any(X))
 
 
 def whirl_stations(system) -> tuple[np.ndarray, np.ndarray] | None:

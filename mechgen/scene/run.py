@@ -119,7 +119,12 @@ def _run_loaded(scn, backend: str | None) -> dict:
     context: dict = {POINTS: PointRunner(sweep_point, partial(_point_task, scene_inputs, layout))}
     for analysis in scn.analyses:
         context[NAME] = analysis.name
-        result = run_analysis(analysis.name, analysis.kind, system, dict(analysis.options), context)
+        try:
+            result = run_analysis(analysis.name, analysis.kind, system, dict(analysis.options), context)
+        except InputError as exc:  # found while running (a size beyond memory, ...): name the scene file too
+            if exc.file is not None:
+                raise
+            raise type(exc)(exc.message, file=str(scn.path), key=exc.key, expected=exc.expected) from None
         context[analysis.name] = result.state
         results["analyses"].append(result.to_json())
     return results

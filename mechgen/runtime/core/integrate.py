@@ -23,6 +23,7 @@ import numpy as np
 
 from mechgen.errors import ConvergenceError, KernelError
 from mechgen.runtime.core.budget import Budget, BudgetExceeded, Progress
+from mechgen.runtime.core.memory import dense_bytes, require
 
 METHODS = ("BDF", "Radau", "LSODA", "RK45", "DOP853")
 IMPLICIT = ("BDF", "Radau", "LSODA")
@@ -176,6 +177,8 @@ def leapfrog(acceleration, q0, v0, dt: float, n_steps: int, *, record_every: int
     q, v = np.array(q0, float), np.array(v0, float)
     a = np.asarray(acceleration(q), float)
     n_rec = n_steps // record_every + 1
+    require(dense_bytes(n_rec, 2 * q.size + 2), f"the leapfrog record of {n_rec} states of {q.size} coordinates",
+            key="params.N")
     ts, qs, vs = np.empty(n_rec), np.empty((n_rec, q.size)), np.empty((n_rec, q.size))
     energies = []
     half = 0.5 * dt

@@ -24,6 +24,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sps
 
+from mechgen.runtime.core.memory import require_dense
+
 _SHARED_PRODUCTS_MAX = 1 << 22  # entries of the (points, pairs, dofs, dofs) product table of the shared path
 
 
@@ -110,6 +112,7 @@ class Assembler:
     def matrix(self, element_matrices: np.ndarray):
         """Global matrix: dense ndarray for a global basis, CSR for elements."""
         if self.dense:
+            require_dense(self.ndof, 2, "the dense assembly of a global basis")
             out = np.zeros((self.ndof, self.ndof))
             for d, ke in zip(self.dofs, element_matrices):
                 out[np.ix_(d, d)] += ke

@@ -34,9 +34,10 @@ from mechgen.runtime.fields.assemble import Assembler, element_matrices, element
 from mechgen.runtime.fields import constrain
 from mechgen.runtime.fields.constrain import (  # noqa: F401 (PENALTY_FACTOR: importable from here before)
     PENALTY_FACTOR, PenaltyChoice, Reduction, binding, penalty_choice, penalty_errors, reduction)
-from mechgen.runtime.fields.discretise import DISCRETISATIONS, GLOBAL, Discretisation, discretise
+from mechgen.runtime.fields.discretise import DISCRETISATIONS, GLOBAL, Discretisation, check_size, discretise
 from mechgen.runtime.fields.elements import reference
 from mechgen.runtime.core.kernels import Kernel
+from mechgen.runtime.core.memory import dense_bytes, require, require_dense
 from mechgen.runtime.core.meta import SystemMeta
 from mechgen.runtime.fields.mesh import Layout, build_mesh
 from mechgen.runtime.core.system import (Memo, folded_parameter, frozen_vector, number, read_only,
@@ -159,9 +160,18 @@ class FieldSystem:
             return (length, None, *depends)
         return (length, self._shear(length)[1].tobytes(), *depends)
 
+    def check_size(self) -> None:
+        """Refuse (InputError at params.N / params.quadrature) a discretisation beyond the memory limit, before
+        the mesh or any table is allocated (mechgen.runtime.fields.discretise.check_size)."""
+        segments = self.layout.segments if self.layout is not None else ()
+        size = sum(int(seg.elements) for seg in segments) if segments else int(self.choices["N"])
+        check_size(self.choices["discretisation"], size, len(self.info["fields"]), len(self.info["jets"]),
+                   int(self.choices["quadrature"]), key="segments.elements" if segments else "params.N")
+
     def _shear(self, length: float) -> tuple[list, np.ndarray]:
         """timoshenko2's shear pairs and ratios at this length and these parameters (memoised)."""
         def make():
+            self.check_size()
             try:
                 return self._shear_ratios(build_mesh(self.layout, int(self.choices["N"]), length))
             except ValueError as exc:
@@ -198,6 +208,7 @@ class FieldSystem:
         length = self.value(self.info["length"])
         jets = tuple((f, int(k)) for f, k in self.info["jets"])
         kind = self.choices["discretisation"]
+        self.check_size()
         try:
             if kind in GLOBAL:
                 if self.layout is not None and self.layout.segments:
@@ -571,6 +582,8 @@ class FieldSystem:
         """R with R q = the nodal values of ``fields`` (stacked field by field) for reduced unknowns q."""
         red = self.reduction
         dofs = np.concatenate(self._nodal_dofs(fields))
+        require(dense_bytes(len(dofs), red.n) + (dense_bytes(red.ndof, red.n) if red.Z is not None else 0),
+                f"the dense map of {red.n} unknowns to {len(dofs)} nodal values", key="params.N")
         if red.Z is None:
             R = np.zeros((len(dofs), red.n))
             R[np.arange(len(dofs)), dofs] = 1.0
@@ -668,6 +681,8 @@ class FieldSystem:
         """d(dx/dt)/dx with da/d(q, v) = -M^-1 [r_q, r_v] at the current acceleration."""
         q, v, _ = self.split(x)
         a = None if self.info.get("constant_mass") else self.rhs(t, x)[self.n:]
+        require_dense(self.n, 12, "the dense first-order Jacobian (implicit time integration)",
+                      expected="a smaller N, or an explicit method (RK45, DOP853) or leapfrog")
         tan = self.tangent(q, v, a, t=t)
         dense = lambda A: A.toarray() if sps.issparse(A) else A  # noqa: E731
         da = -self._mass_solve(q, v, t, np.hstack([dense(tan["r_q"]), dense(tan["r_v"])]))

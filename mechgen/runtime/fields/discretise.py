@@ -32,6 +32,7 @@ from typing import Callable
 
 import numpy as np
 
+from mechgen.runtime.core.memory import dense_bytes, require
 from mechgen.runtime.fields import bases
 from mechgen.runtime.fields.elements import reference, timoshenko_shapes
 from mechgen.runtime.fields.mesh import Mesh, build_mesh, dof_map
@@ -217,6 +218,49 @@ def minimum_points(kind: str, size: int) -> tuple[int, int]:
     return 2 * size + 8, 2 * size + 2
 
 
+def footprint(kind: str, size: int, nfields: int, njets: int, quadrature: int = 0) -> tuple[int, int, str]:
+    """(bytes of discretising and assembling, bytes of the Gauss rule, what they hold): an estimate (float64).
+
+    With nq Gauss points per element, na jets, nl dofs per element and field count nf:
+
+    * a global basis of N functions (ndof = nf N, one element): jet tables nq na ndof, basis tables
+      nq (na + 1) N per field, and the dense ndof x ndof matrices M, D, G, K with their element
+      copies: 8 ndof^2;
+    * N finite elements: per element nq (4 + 3 na + 4 na^2 + na nl) (points, jets, pointwise
+      coefficients, tables) and 15 nl^2 (element matrices, the CSR pattern and its index map);
+    * the Gauss rule (numpy's leggauss: the nq x nq companion matrix and its eigen-solver copy): 2 nq^2.
+
+    Integers throughout (no overflow at N = 1e6 or 1e308).
+    """
+    size, nfields, njets = int(size), max(int(nfields), 1), max(int(njets), 1)
+    if kind not in DISCRETISATIONS or size < 1:
+        return 0, 0, "nothing"  # refused with its own message by discretise
+    nq = int(quadrature) or minimum_points(kind, size)[0]
+    gauss = dense_bytes(2, nq, nq)
+    if kind in GLOBAL:
+        ndof = nfields * size
+        data = dense_bytes(nq, njets, ndof) + nfields * dense_bytes(nq, njets + 1, size) + dense_bytes(8, ndof, ndof)
+        return data, gauss, f"the {kind} basis of {size} functions per field (dense {ndof} x {ndof} matrices)"
+    per = 2 if kind == "timoshenko2" else reference(kind).ndof
+    nl = per * nfields
+    data = dense_bytes(size, nq * (4 + 3 * njets + 4 * njets**2 + njets * nl) + 15 * nl**2)
+    return data, gauss, f"{size} {kind} elements ({size * nq} Gauss points, {nl} dofs per element)"
+
+
+def check_size(kind: str, size: int, nfields: int, njets: int, quadrature: int = 0, *, key: str = "params.N") -> None:
+    """Refuse (InputError at ``key`` (the size) or params.quadrature, exit 2) a discretisation that cannot fit in
+    memory, before anything is allocated (mechgen.runtime.core.memory)."""
+    data, gauss, what = footprint(kind, size, nfields, njets, quadrature)
+    fix = f"a smaller {key.rpartition('.')[2]}"
+    if kind in GLOBAL:
+        fix += (", or finite elements (discretisation = 'lagrange2', 'hermite', ...: sparse matrices, the lowest "
+                "modes by shift-invert)")
+    require(data, what, key=key, expected=fix)
+    nq = int(quadrature) or (minimum_points(kind, int(size))[0] if kind in DISCRETISATIONS else 0)
+    require(gauss, f"the Gauss rule of {nq} points", key="params.quadrature" if quadrature else key,
+            expected="fewer Gauss points" if quadrature else fix)
+
+
 def end_conditions(constraints, field: str) -> tuple[str, str]:
     """'clamped' / 'pinned' / 'free' at (start, end) of a field from its constraints (for the beam basis)."""
     out = []
@@ -242,6 +286,7 @@ def discretise(kind: str, size: int, length: float, fields, jets, *, quadrature:
     if not length > 0:
         raise ValueError(f"domain length must be > 0, got {length}")
     fields = tuple(fields)
+    check_size(kind, size, len(fields), len(jets), quadrature)
     auto, minimum = minimum_points(kind, size)
     nq = quadrature or auto
     if nq < minimum:

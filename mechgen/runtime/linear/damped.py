@@ -37,6 +37,7 @@ import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
 from mechgen.errors import ConvergenceError, InputError
+from mechgen.runtime.core.memory import require_dense
 
 #: with sparse input and ``sparse=None``, systems of at most this many unknowns are solved densely
 SPARSE_MIN_N = 100
@@ -280,6 +281,7 @@ def damped_modes(M, C, K, count: int | None = None, *, sparse: bool | None = Non
         if has_symmetry(C, -1) and has_symmetry(M, 1) and has_symmetry(K, 1):
             s = _rayleigh_refined(M, C, K, s, Q)
     else:
+        require_dense(n, 24, "the dense damped eigenproblem")
         dense = [x.toarray() if sps.issparse(x) else x for x in (M, C, K)]
         s, Q = _dense_eig(*dense, n, scale)
     return split_modes(s, Q, count, scale, imag_tol)

@@ -27,6 +27,7 @@ import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
 from mechgen.errors import InputError
+from mechgen.runtime.core.memory import require_dense
 
 
 @dataclass(frozen=True)
@@ -213,6 +214,8 @@ def modes(M, K, count: int | None = None, *, allow_singular_mass: bool = False) 
     solver's round-off) come on top of it.
     """
     n = M.shape[0]
+    if not ((sps.issparse(M) or sps.issparse(K)) and count is not None and count < n - 1 and n > 200):
+        require_dense(n, 6, "the dense symmetric eigenproblem")
     if sps.issparse(M) or sps.issparse(K):
         if count is not None and count < n - 1 and n > 200:
             Ms, Ks = sps.csr_matrix(M), sps.csr_matrix(K)

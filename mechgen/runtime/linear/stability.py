@@ -56,6 +56,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.linalg as sla
 
+from mechgen.runtime.core.memory import require_dense
+
 
 #: the automatic threshold: ACCURACY_FACTOR * eps * ||A|| * kappa_i (LAPACK's bound, see the module doc)
 ACCURACY_FACTOR = 1.0
@@ -242,6 +244,7 @@ def stability(M, C, K, *, tolerance: float | None = None) -> StabilityResult:
     """Eigenvalues and verdict of M q'' + C q' + K q = 0 (dense); ``tolerance`` None: automatic (module doc)."""
     M, C, K = (np.atleast_2d(np.asarray(x, float)) for x in (M, C, K))
     n = M.shape[0]
+    require_dense(n, 40, "the dense stability eigenproblem")
     s = conservative_gyroscopic(M, C, K)
     if s is not None:  # K > 0 to rounding: Re s = 0, and a K singular to the solver's accuracy has rigid modes
         scale = spectrum_scale(s)

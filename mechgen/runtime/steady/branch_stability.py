@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from mechgen.runtime.core.memory import require_dense
 from mechgen.runtime.steady.constrained import linear_about_bvp
 from mechgen.runtime.linear.stability import StabilityResult, stability
 
@@ -24,6 +25,7 @@ def stability_at(system, bvp, result) -> StabilityResult:
     """Eigenvalues and verdict about one steady state ``result`` (a BVPResult of ``bvp``), with the result's
     parameters (a system at them, when ``system``'s differ)."""
     mats = linear_about_bvp(system.with_param_vector(result.p), bvp, result)
+    require_dense(mats["M"].shape[0], 40, "the dense stability eigenproblem along a branch")
     return stability(_dense(mats["M"]), _dense(mats["D"]) + _dense(mats["G"]), _dense(mats["K"]))
 
 

@@ -33,6 +33,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from mechgen.errors import InputError
+from mechgen.runtime.core.memory import require_dense
 from mechgen.runtime.fields.assemble import element_matrices, element_vectors
 
 
@@ -77,6 +78,7 @@ def constrained_linear(system, bvp, result, jets: np.ndarray, multipliers: int |
         raise InputError("constrained continua take their boundary conditions by elimination or penalty",
                          key="constraints", expected="constraints = 'eliminate' or 'penalty'")
     mats = system.reduced_matrices("linear", ("M", "D", "G", "K"), None, None, None, 0.0, jets)
+    require_dense(system.n, 8, "the dense linearisation about a constrained steady state")
     dense = {k: v.toarray() if hasattr(v, "toarray") else np.asarray(v) for k, v in mats.items()}
     local = system.pointwise("constraint", jets)
     na = len(disc.jets)
@@ -110,6 +112,7 @@ def projected_strain_linear(system, jets: np.ndarray, multipliers: int | None = 
         raise InputError("a projected strain takes its boundary conditions by elimination or penalty",
                          key="constraints", expected="constraints = 'eliminate' or 'penalty'")
     mats = system.reduced_matrices("linear", ("M", "D", "G", "K"), None, None, None, 0.0, jets)
+    require_dense(system.n, 8, "the dense linearisation about a constrained steady state")
     dense = {k: v.toarray() if hasattr(v, "toarray") else np.asarray(v) for k, v in mats.items()}
     na = len(disc.jets)
     shape = disc.points.shape

@@ -19,6 +19,7 @@ import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
 from mechgen.errors import ConvergenceError, KernelError
+from mechgen.runtime.core.memory import require_dense
 
 
 @dataclass(frozen=True)
@@ -52,6 +53,7 @@ def _step(J, r, explain=None, x=None) -> np.ndarray:
         except RuntimeError as exc:
             raise ConvergenceError(f"singular Jacobian: {exc}") from exc
     else:
+        require_dense(np.size(r), 3, "the dense Newton step")
         J = np.atleast_2d(np.asarray(J, float))
         if not np.all(np.isfinite(J)):
             raise KernelError(f"Jacobian is not finite{_why(explain, x)}")
