@@ -76,6 +76,18 @@ def test_budget_wall_time_and_projection_from_the_first_units():
         budget.check_time()
 
 
+def test_an_accepted_long_estimate_is_said_once_on_stderr(capsys):
+    clock = Clock()
+    budget = Budget("sweep of stability", unit="points", seconds=600.0, clock=clock)
+    clock.now = 2.0
+    budget.project(100, 1000)  # 20 s for all: below NOTICE_ABOVE, nothing said
+    assert capsys.readouterr().err == ""
+    budget.project(10, 1000)  # 200 s for all: accepted (600 s budget) and announced once
+    budget.project(11, 1000)
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "1,000 points will take about 3 min (max_seconds = 600)" in err
+
+
 def test_budget_error_survives_pickling_with_its_fields():
     import pickle
 

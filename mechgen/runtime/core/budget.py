@@ -11,7 +11,9 @@ sweep's points) :meth:`Budget.project` stops it once the estimate is reliable:
 
     estimated total = elapsed * total / done        (seconds)
 
-after at least :data:`PROJECT_AFTER` seconds, refused when it exceeds ``seconds``.
+after at least :data:`PROJECT_AFTER` seconds, refused when it exceeds ``seconds``. An accepted
+estimate above :data:`NOTICE_ABOVE` seconds is said once on stderr (the bar below is drawn only on a
+terminal), so that a long run through a pipe is not silent.
 
 :class:`Progress` is a tqdm bar on stderr with the remaining time, drawn only when the caller lets
 it (the ``progress`` key), stderr is a terminal and the work has lasted :data:`DELAY` seconds, so
@@ -33,6 +35,8 @@ SECONDS_KEY = "max_seconds"
 DELAY = 2.0
 #: an estimate from the first units is trusted after this many seconds of them
 PROJECT_AFTER = 2.0
+#: an accepted estimate longer than this is announced once on stderr, seconds
+NOTICE_ABOVE = 30.0
 
 
 class BudgetExceeded(MechgenError):
@@ -83,6 +87,7 @@ class Budget:
         self.seconds, self.seconds_key, self.clock = seconds, seconds_key, clock
         self.used = 0
         self.started = clock()
+        self.noticed = False
 
     def elapsed(self) -> float:
         """Wall seconds since the budget started."""
@@ -121,6 +126,10 @@ class Budget:
                                      f"at the rate of the first {done:,} ({elapsed:.1f} s), more than "
                                      f"{self.seconds_key} = {self.seconds:g}", key=self.seconds_key,
                                      reached=_text(reached))
+            if estimate > NOTICE_ABOVE and not self.noticed:
+                self.noticed = True
+                sys.stderr.write(f"mechgen: {self.what}: {total:,} {self.unit} will take about "
+                                 f"{_duration(estimate)} ({self.seconds_key} = {self.seconds:g})\n")
         self.check_time(reached)
 
 

@@ -486,8 +486,25 @@ class FieldSystem:
                 extra = B.T @ sps.csr_matrix(self._coeff(loc[k])[0]) @ B
                 mats[k] = mats[k] + (extra if sps.issparse(mats[k]) else extra.toarray())
         stiff = {"linear": "K", "tangent": "r_q"}[kernel]
-        return {k: self.reduction.matrix(mats[k], self._row_penalties if k == stiff else 0.0, border=k == stiff)
-                for k in names}
+        reduced = {k: self.reduction.matrix(mats[k], self._row_penalties if k == stiff else 0.0, border=k == stiff)
+                   for k in names}
+        for k, m in reduced.items():
+            self._require_finite(kernel, k, m)
+        return reduced
+
+    def _require_finite(self, kernel: str, name: str, matrix) -> None:
+        """KernelError when an assembled matrix holds NaN/Inf (a kernel overflowed, or the element sums did:
+        a length such as 1e200 gives EI/h^3 = 0 and rhoA h = inf), naming the matrix and the values that set it."""
+        data = matrix.data if sps.issparse(matrix) else np.asarray(matrix)
+        if np.isfinite(data).all():
+            return
+        values = {**self.param_values(), **{k: v for k, v in self.fixed.items() if isinstance(v, (int, float))},
+                  self.info["length"]: self.value(self.info["length"])}
+        shown = ", ".join(f"{n} = {v:.6g}" for n, v in values.items() if isinstance(v, float) and v != 0
+                          and not 1e-150 < abs(v) < 1e150) or "none beyond 1e+/-150"
+        raise KernelError(f"the assembled {name} of {self.meta.get('model')} (kernel {kernel!r}) holds "
+                          f"{int(np.size(data) - np.isfinite(data).sum())} NaN/Inf entries: a value overflows double "
+                          f"precision in the element sums (extreme values: {shown})")
 
     def _coeff(self, arr: np.ndarray) -> np.ndarray:
         """A flat (..., jets * jets) kernel output as (..., jets, jets) coefficients."""
