@@ -392,7 +392,7 @@ def run_balloon_benchmarks(out: Path, quick: bool = False) -> dict:
                                "mechgen_p_e_min_error": target, "baseline_per_point_s": match["per_point_s"],
                                "ratio_per_point": match["per_point_s"] / h["mechgen"]["per_point_median_s"]}
         res["headline"] = h
-    res["user_path"] = user_path([ROOT / "scenes" / USER_SCENE], repeats=1 if quick else 3)
+    res["user_path"] = user_path([ROOT / "scenes" / USER_SCENE], repeats=1 if quick else 3, warm=not quick)
     env["loadavg_after"] = list(os.getloadavg())
     write_json(out / "balloon_branch.json", res, indent=1)
     table = report_markdown(res)

@@ -317,7 +317,7 @@ def run_field_benchmarks(out: Path, quick: bool = False) -> dict:
         rows = work_precision(QUICK_LADDERS if quick else LADDERS, repeats=2 if quick else 5)
         assembly = assembly_comparison(ASSEMBLY_ELEMENTS, repeats=3 if quick else 7, min_time=0.0 if quick else 0.05)
     users = user_path([ROOT / "scenes" / name for name in (USER_SCENES[:1] if quick else USER_SCENES)],
-                      repeats=1 if quick else 3)
+                      repeats=1 if quick else 3, warm=not quick)
     files = _write_work_precision(rows, out, exact)
     write_json(out / "beam_assembly.json", assembly)
     write_text(out / "beam_assembly.md", assembly_markdown(assembly))

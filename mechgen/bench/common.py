@@ -174,7 +174,7 @@ def user_path(scenes: Iterable[Path], repeats: int = 3, *, overrides: tuple[str,
     for scene in scenes:
         un, pin = _medians(runs[scene]["unpinned"]), _medians(runs[scene]["pinned"])
         ratio = un["median_s"] / pin["median_s"]
-        rows.append({"scene": scene.name, "overrides": list(overrides), "repeats": repeats, "unpinned": un,
+        rows.append({"scene": scene.name, "overrides": list(overrides), "repeats": repeats, "warm": warm, "unpinned": un,
                      "pinned": pin, "ratio_unpinned_over_pinned": ratio, "target": UNPINNED_TARGET,
                      "within_target": ratio <= UNPINNED_TARGET,
                      "analyses_ratio": {n: un["analyses_median_s"][n] / max(pin["analyses_median_s"][n], 1e-9)
@@ -186,7 +186,7 @@ def user_path_markdown(rows: list[dict], title: str = "As a user runs it") -> st
     """A table of :func:`user_path` rows: both configurations' medians, their ratio and the slowest
     analysis's ratio."""
     lines = [f"## {title}", "",
-             "`mechgen run SCENE` as a whole process (cached), median of "
+             f"`mechgen run SCENE` as a whole process ({'cached' if all(r['warm'] for r in rows) else 'no warm-up run: the first may compile, a quick run'}), median of "
              f"{rows[0]['repeats'] if rows else 0}, interleaved: unpinned = the default environment "
              f"(no {', '.join(THREAD_VARS)}), pinned = all of them 1. Target: unpinned / pinned <= "
              f"{UNPINNED_TARGET:g}.", "",

@@ -284,7 +284,7 @@ def run_fpu_benchmarks(*, out: Path, quick: bool = False) -> dict:
     overhead = call_overhead()
     builds = build_times((8, 100_000) if not quick else (8, 1000))
     start = scene_start(ROOT / "scenes" / "spring_pendulum.toml")
-    users = user_path([ROOT / "scenes" / USER_SCENE], repeats=1 if quick else 3)
+    users = user_path([ROOT / "scenes" / USER_SCENE], repeats=1 if quick else 3, warm=not quick)
     out = Path(out)
     write_csv(out / "fpu_kernels.csv", rows)
     result = {"kernels": rows, "call_overhead": overhead, "builds": builds, "scene_start": start, "user_path": users}

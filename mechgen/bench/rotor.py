@@ -644,7 +644,7 @@ def run_rotor_benchmarks(out: Path, quick: bool = False) -> dict:
         res["work_precision"] = work_precision(repeats, quick, ross_row)
     # as a user runs it: both tools unpinned and both pinned (child processes), and the whole scene
     res["configurations"] = user_configurations(len(speeds), repeats, with_ross=not quick)
-    res["user_path"] = user_path([SCENE], repeats=repeats)
+    res["user_path"] = user_path([SCENE], repeats=repeats, warm=not quick)
     env["loadavg_after"] = list(os.getloadavg())
     write_json(out / "rotor_campbell.json", res, indent=1)
     table = report_markdown(res)
