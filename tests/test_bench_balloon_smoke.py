@@ -34,4 +34,6 @@ def test_quick_balloon_benchmark_writes_reports(tmp_path, capsys):
     assert fine["p_e_min_error"] < coarse["p_e_min_error"] / 50                     # order 8: 2^8 in theory
     galerkin = data["work_precision"]["galerkin"]
     assert galerkin[-1]["mechgen_omega_1_error"] < galerkin[0]["mechgen_omega_1_error"]
+    user = data["user_path"][0]  # the scene as a user runs it, beside the pinned figures
+    assert user["scene"] == "balloon_branches.toml" and user["unpinned"]["median_s"] > 0 and "as a user" in md
     assert "balloon_branch.md" in capsys.readouterr().out

@@ -31,6 +31,12 @@ def test_quick_rotor_benchmark_writes_reports(tmp_path, capsys):
     assert errors[("mechgen quintic", 24)] < 1e-8
     for fix in data["candidate_fixes"]:  # the measured candidate fixes compute the same Campbell diagram
         assert fix["max_rel_diff_vs_run_campbell"] < TOL
+    conf = data["configurations"]  # as a user runs it: unpinned (default environment) and pinned children
+    assert all(v is None for v in conf["unpinned"]["environment"].values())
+    assert set(conf["pinned"]["environment"].values()) == {"1"}
+    for side in ("unpinned", "pinned"):
+        assert conf[side]["mechgen"]["median_s"] > 0 and conf[side]["speeds"] == camp["speeds"]
+    assert data["user_path"][0]["scene"] == "ross_example_rotor.toml" and "As a user runs both" in md
     out = capsys.readouterr().out
     assert "rotor_campbell.md" in out
     if HAVE_ROSS:

@@ -14,4 +14,7 @@ def test_quick_benchmark_writes_reports(tmp_path, capsys):
     methods = {r["method"] for r in data["kernels"]}
     assert {"generated C", "hand C -O3", "numpy", "sympy.lambdify", "casadi SX"} <= methods
     assert (tmp_path / "fpu_kernels.csv").read_text().startswith("method,quantity,N,batch,seconds")
+    (user,) = data["user_path"]  # the scene as a user runs it, beside the pinned figures
+    assert user["scene"] == "fpu_chain.toml" and user["unpinned"]["median_s"] > 0 and user["pinned"]["median_s"] > 0
+    assert json.loads((tmp_path / "beam_user_path.json").read_text())[0]["scene"] == "beam_modes.toml"
     assert "gen/hand" in capsys.readouterr().out

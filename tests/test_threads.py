@@ -17,7 +17,8 @@ def _blas_threads() -> list[int]:
 def test_small_problems_run_on_one_thread_and_large_ones_keep_the_default(monkeypatch):
     for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
         monkeypatch.delenv(name, raising=False)
-    import numpy  # noqa: F401  (loads the BLAS whose threads are counted)
+    import numpy  # noqa: F401  (loads the BLAS whose threads are counted: numpy's and scipy's own)
+    import scipy.linalg  # noqa: F401
 
     before = _blas_threads()
     with blas_threads_for(SMALL):
@@ -36,3 +37,20 @@ def test_a_users_choice_is_kept():
     env["PYTHONPATH"] = os.pathsep.join(sys.path)
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True).stdout
     assert out.strip() == "[2]"
+
+
+def test_scipys_own_blas_is_limited_too_when_the_analysis_is_the_first_to_import_it():
+    # numpy and scipy ship separate OpenBLAS builds; a limit set before scipy.linalg is loaded must still
+    # reach scipy's (the first analysis of a process imports it)
+    code = ("import sys, numpy, threadpoolctl\n"
+            "assert 'scipy.linalg' not in sys.modules\n"
+            "from mechgen.runtime.core.threads import blas_threads_for\n"
+            "with blas_threads_for(4):\n"
+            "    import scipy.linalg\n"
+            "    print(sorted({i['num_threads'] for i in threadpoolctl.threadpool_info() if i['user_api'] == 'blas'}))")
+    import os
+    env = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS",
+                                                              "MKL_NUM_THREADS")}
+    env["PYTHONPATH"] = os.pathsep.join(sys.path)
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[1]"

@@ -34,18 +34,23 @@ REGISTRY: dict[str, Suite] = {s.name: s for s in (
           "FPU chain kernels: generated C against hand C, numpy, sympy.lambdify, CasADi; call overhead, build and "
           "scene start times", ("fpu_kernels.csv", "fpu_kernels.json", "fpu_kernels.md")),
     Suite("beam", "mechgen.bench.beam", "run_field_benchmarks",
-          "clamped-free beam: work against precision of four discretisations, assembly against scikit-fem",
+          "clamped-free beam: work against precision of four discretisations, assembly against scikit-fem; the "
+          "continua scenes unpinned against pinned",
           ("beam_work_precision.csv", "beam_work_precision.md", "beam_work_precision.png", "beam_assembly.json",
-           "beam_assembly.md")),
+           "beam_assembly.md", "beam_user_path.json", "beam_user_path.md")),
     Suite("rotor", "mechgen.bench.rotor", "run_rotor_benchmarks",
-          "Campbell diagrams of ROSS's example rotor, mechgen against ROSS", ("rotor_campbell.json",
+          "Campbell diagrams of ROSS's example rotor, mechgen against ROSS, pinned and as a user runs both", ("rotor_campbell.json",
                                                                               "rotor_campbell.md")),
     Suite("balloon", "mechgen.bench.balloon", "run_balloon_benchmarks",
           "the ballooning string's branch with stability against a hand-written scipy baseline",
           ("balloon_branch.json", "balloon_branch.md")),
     Suite("startup", "mechgen.bench.startup", "run_startup_benchmarks",
-          "whole-process start of a cached scene (laval_rotor, beam_modes): median wall time and import share",
+          "whole-process start of a cached scene (laval_rotor, beam_modes): median wall time and import share, "
+          "unpinned against pinned",
           ("startup.json", "startup.md")),
+    Suite("threads", "mechgen.bench.threads", "run_threads_benchmarks",
+          "every shipped scene as a whole process, default environment against one BLAS thread (unpinned / pinned)",
+          ("threads.json", "threads.md")),
 )}
 
 #: the suite names (``mechgen bench`` with none runs them all)
@@ -65,7 +70,10 @@ def run_benchmarks(models_: list[str] | None = None, *, out: Path, quick: bool =
     ``fpu``: FPU chain kernels, writes ``out/fpu_kernels.{csv,json,md}``; ``beam``: the continua
     work-precision and assembly study (:mod:`mechgen.bench.beam`); ``rotor``: Campbell diagrams against ROSS
     (:mod:`mechgen.bench.rotor`); ``balloon``: the ballooning string's branch with stability against a
-    hand-written scipy baseline (:mod:`mechgen.bench.balloon`). Returns {suite: its results}.
+    hand-written scipy baseline (:mod:`mechgen.bench.balloon`); ``startup``: whole-process start of cached
+    scenes (:mod:`mechgen.bench.startup`); ``threads``: every shipped scene unpinned against pinned
+    (:mod:`mechgen.bench.threads`). Every suite also times its scenes as a user runs them (default
+    environment) beside its pinned figures. Returns {suite: its results}.
     """
     from mechgen.errors import InputError
 

@@ -29,6 +29,10 @@ Steps, in one process, BLAS limited to one thread (threadpoolctl):
    collocation ladder (scheme, stages, mesh) and the baseline's rtol ladder; and omega_1 error vs time
    of one stability evaluation over Galerkin N (both tools).
 
+4. **As a user runs it** (issue #12): ``mechgen run scenes/balloon_branches.toml`` as a whole process, the default
+   environment (no BLAS thread variables) against pinned to one BLAS thread, interleaved, median of 3
+   (``user_path``; :func:`mechgen.bench.common.user_path`).
+
 ``quick=True``: one repeat, short ladders. Writes ``out/balloon_branch.json`` and ``out/balloon_branch.md``.
 Timing targets live here, never in unit tests (the load average is recorded: absolute times drift).
 """
@@ -42,7 +46,8 @@ from pathlib import Path
 
 import numpy as np
 
-from mechgen.bench.common import ROOT, blas_info, blas_threads, environment, write_json, write_text
+from mechgen.bench.common import (ROOT, blas_info, blas_threads, environment, user_path, user_path_markdown,
+                                  write_json, write_text)
 from mechgen.bench.common import timed as _timed  # the local name the suite's steps use
 
 SCENE = ROOT / "scenes" / "balloon_branches.toml"
@@ -50,6 +55,8 @@ BASELINE = ROOT / "benchmarks" / "balloon_handwritten.py"
 H = 10.0
 START, STOP = -0.5, 0.27
 POINTS = 200
+#: the scene timed as a user runs it
+USER_SCENE = "balloon_branches.toml"
 N_GALERKIN, N_REFERENCE = 10, 40
 LAMBDA_F = 0.2                    # lambda0 of the frequency check (a large single loop: visible truncation error)
 TARGET = 3.0                      # issue #4: mechgen at least 3x faster at equal accuracy
@@ -337,6 +344,8 @@ def report_markdown(res: dict) -> str:
     for row in wp["galerkin"]:
         L.append(f"| {row['N']} | {row['mechgen_omega_1_error']:.1e} | {_ms(row['mechgen_s'])} | "
                  f"{row['baseline_omega_1_error']:.1e} | {_ms(row['baseline_s'])} |")
+    if res.get("user_path"):
+        L += ["", user_path_markdown(res["user_path"], "The scene as a user runs it")]
     return "\n".join(L)
 
 
@@ -383,6 +392,7 @@ def run_balloon_benchmarks(out: Path, quick: bool = False) -> dict:
                                "mechgen_p_e_min_error": target, "baseline_per_point_s": match["per_point_s"],
                                "ratio_per_point": match["per_point_s"] / h["mechgen"]["per_point_median_s"]}
         res["headline"] = h
+    res["user_path"] = user_path([ROOT / "scenes" / USER_SCENE], repeats=1 if quick else 3, warm=not quick)
     env["loadavg_after"] = list(os.getloadavg())
     write_json(out / "balloon_branch.json", res, indent=1)
     table = report_markdown(res)

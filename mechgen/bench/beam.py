@@ -30,7 +30,14 @@ scikit-fem.
      coefficients already evaluated).
 
 Every ratio is mechgen / scikit-fem measured in the same process on the same
-machine. Entry point: :func:`run_field_benchmarks`.
+machine.
+
+3. **As a user runs it** (issue #12): the continua scenes (``USER_SCENES``: ``beam_modes``,
+   ``timoshenko_modes``, ``beck_column``) as whole ``mechgen run`` processes, the default environment (no BLAS
+   thread variables) against pinned to one BLAS thread, interleaved, median of 3 (quick: the first, once):
+   ``beam_user_path.{json,md}`` (:func:`mechgen.bench.common.user_path`).
+
+Entry point: :func:`run_field_benchmarks`.
 """
 from __future__ import annotations
 
@@ -41,7 +48,8 @@ from pathlib import Path
 
 import numpy as np
 
-from mechgen.bench.common import loglog_plot, repeat_times, write_csv, write_json, write_text
+from mechgen.bench.common import (ROOT, loglog_plot, repeat_times, user_path, user_path_markdown, write_csv,
+                                  write_json, write_text)
 
 MODEL = "euler_bernoulli_beam"
 COUNT = 5
@@ -53,6 +61,8 @@ LADDERS = {
 }
 QUICK_LADDERS = {"hermite": [4, 16, 64], "quintic": [2, 8], "legendre": [8, 16], "beam": [5, 10]}
 ASSEMBLY_ELEMENTS = 2000
+#: the continua scenes timed as a user runs them
+USER_SCENES = ("beam_modes.toml", "timoshenko_modes.toml", "beck_column.toml")
 PLOT_FLOOR = 1e-16  # errors below this (exact to round-off) are drawn at the floor of the log plot
 
 
@@ -306,10 +316,17 @@ def run_field_benchmarks(out: Path, quick: bool = False) -> dict:
         warnings.simplefilter("ignore", RuntimeWarning)  # a missing compiler falls back to numpy: recorded per row
         rows = work_precision(QUICK_LADDERS if quick else LADDERS, repeats=2 if quick else 5)
         assembly = assembly_comparison(ASSEMBLY_ELEMENTS, repeats=3 if quick else 7, min_time=0.0 if quick else 0.05)
+    users = user_path([ROOT / "scenes" / name for name in (USER_SCENES[:1] if quick else USER_SCENES)],
+                      repeats=1 if quick else 3, warm=not quick)
     files = _write_work_precision(rows, out, exact)
     write_json(out / "beam_assembly.json", assembly)
     write_text(out / "beam_assembly.md", assembly_markdown(assembly))
-    files += [out / "beam_assembly.json", out / "beam_assembly.md"]
+    users_md = user_path_markdown(users, "The continua scenes as a user runs them")
+    write_json(out / "beam_user_path.json", users)
+    write_text(out / "beam_user_path.md", users_md + "\n")
+    files += [out / "beam_assembly.json", out / "beam_assembly.md", out / "beam_user_path.json",
+              out / "beam_user_path.md"]
     print(work_precision_markdown(rows, exact))
     print(assembly_markdown(assembly))
-    return {"work_precision": rows, "assembly": assembly, "files": [str(f) for f in files]}
+    print(users_md)
+    return {"work_precision": rows, "assembly": assembly, "user_path": users, "files": [str(f) for f in files]}

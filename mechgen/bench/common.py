@@ -6,7 +6,9 @@ Timing (each function states what it measures):
 * :func:`best_time` - the best mean of enough calls to last a minimum time (micro-benchmarks);
 * :func:`repeat_times` - the per-call seconds of several timed runs after a warm-up (their best and median);
 * :func:`in_fresh_process` and :func:`empty_cache` - a whole new interpreter, optionally with an empty
-  compile cache (first-run and start-up timings).
+  compile cache (first-run and start-up timings);
+* :func:`scene_process` and :func:`user_path` - ``mechgen run SCENE`` as a user runs it (a new process, the
+  default environment: no BLAS thread variables) beside the same run pinned to one BLAS thread.
 
 Fairness: :func:`blas_threads` limits BLAS/OpenMP threads for every tool alike, :func:`blas_info` records
 them, :func:`environment` records the machine and the load average. Reports: :func:`write_csv`,
@@ -21,6 +23,7 @@ import io
 import json
 import os
 import platform
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -96,12 +99,108 @@ def empty_cache():
                 os.environ["MECHGEN_CACHE"] = old
 
 
-def in_fresh_process(code: str, *args: str) -> dict:
+def in_fresh_process(code: str, *args: str, env: dict | None = None) -> dict:
     """Run ``code`` in a new interpreter (cold imports and sympy caches, the current $MECHGEN_CACHE) from the
-    repository root with ``args`` as sys.argv[1:]; its last stdout line is JSON, returned parsed."""
-    done = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True, check=True,
-                          env=os.environ.copy(), cwd=ROOT)
+    repository root with ``args`` as sys.argv[1:] and ``env`` (default: this process's environment); its last
+    stdout line is JSON, returned parsed. A failed run raises RuntimeError with the end of its stderr."""
+    done = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True,
+                          env=os.environ.copy() if env is None else env, cwd=ROOT)
+    if done.returncode != 0:
+        raise RuntimeError(f"benchmark child process exited {done.returncode}: {done.stderr[-2000:]}")
     return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+# -- the user path: a scene as a whole process, default environment against pinned -----------------------------
+#: the variables through which BLAS/OpenMP thread counts are chosen (stripped from a user-path child)
+THREAD_VARS = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+#: a scene may be at most this much slower unpinned than pinned (issue #12)
+UNPINNED_TARGET = 1.2
+
+
+def user_env(pinned: bool = False) -> dict:
+    """This process's environment without :data:`THREAD_VARS` (the default a user has), or with all of them
+    set to 1 (``pinned``: the benchmarks' one BLAS thread)."""
+    env = {k: v for k, v in os.environ.items() if k not in THREAD_VARS}
+    if pinned:
+        env.update(dict.fromkeys(THREAD_VARS, "1"))
+    return env
+
+
+def scene_process(scene: Path, *, pinned: bool = False, overrides: tuple[str, ...] = ()) -> dict:
+    """One ``python -m mechgen run SCENE --json ...`` in a new process from the repository root, environment
+    :func:`user_env` (``pinned``), ``--set`` for each of ``overrides``: {"wall_s": the whole process's wall time,
+    "analyses_s": {analysis name: the seconds the scene JSON records for it}}. A failed run raises
+    RuntimeError with the end of its stderr."""
+    with tempfile.TemporaryDirectory() as tmp:
+        target = Path(tmp) / "out.json"
+        cmd = [sys.executable, "-m", "mechgen", "run", str(scene), "--json", str(target),
+               *(f"--set={o}" for o in overrides)]
+        start = time.perf_counter()
+        done = subprocess.run(cmd, capture_output=True, text=True, env=user_env(pinned), cwd=ROOT)
+        wall = time.perf_counter() - start
+        if done.returncode != 0:
+            raise RuntimeError(f"mechgen run {Path(scene).name} exited {done.returncode}: {done.stderr[-2000:]}")
+        data = json.loads(target.read_text())
+    return {"wall_s": wall, "analyses_s": {a["name"]: float(a["seconds"]) for a in data["analyses"]}}
+
+
+def _medians(runs: list[dict]) -> dict:
+    names = runs[0]["analyses_s"]
+    return {"median_s": statistics.median(r["wall_s"] for r in runs), "all_s": [r["wall_s"] for r in runs],
+            "analyses_median_s": {n: statistics.median(r["analyses_s"][n] for r in runs) for n in names}}
+
+
+def user_path(scenes: Iterable[Path], repeats: int = 3, *, overrides: tuple[str, ...] = (),
+              warm: bool = True) -> list[dict]:
+    """Every scene as a user runs it (:func:`scene_process`, default environment) and pinned to one BLAS
+    thread, interleaved so that the machine's load falls on both alike: after one untimed run of each scene
+    (``warm``: fills the compile cache), ``repeats`` rounds in which each scene runs unpinned then pinned
+    (pinned first in every other round). Per scene: both configurations' median whole-process wall time
+    (and of each analysis, as the scene JSON records it), ``ratio_unpinned_over_pinned`` of the medians and
+    whether it is within :data:`UNPINNED_TARGET` (also per analysis: ``analyses_ratio``)."""
+    scenes = [Path(s) for s in scenes]
+    if warm:
+        for scene in scenes:
+            scene_process(scene, overrides=overrides)
+    runs = {s: {"unpinned": [], "pinned": []} for s in scenes}
+    for k in range(repeats):
+        for scene in scenes:
+            for pinned in ((False, True) if k % 2 == 0 else (True, False)):
+                got = scene_process(scene, pinned=pinned, overrides=overrides)
+                runs[scene]["pinned" if pinned else "unpinned"].append(got)
+                print(f"[user path] round {k + 1}/{repeats} {scene.name} {'pinned' if pinned else 'unpinned'}: "
+                      f"{got['wall_s']:.2f} s", file=sys.stderr, flush=True)
+    rows = []
+    for scene in scenes:
+        un, pin = _medians(runs[scene]["unpinned"]), _medians(runs[scene]["pinned"])
+        ratio = un["median_s"] / pin["median_s"]
+        rows.append({"scene": scene.name, "overrides": list(overrides), "repeats": repeats, "warm": warm, "unpinned": un,
+                     "pinned": pin, "ratio_unpinned_over_pinned": ratio, "target": UNPINNED_TARGET,
+                     "within_target": ratio <= UNPINNED_TARGET,
+                     "analyses_ratio": {n: un["analyses_median_s"][n] / max(pin["analyses_median_s"][n], 1e-9)
+                                        for n in un["analyses_median_s"]}})
+    return rows
+
+
+def user_path_markdown(rows: list[dict], title: str = "As a user runs it") -> str:
+    """A table of :func:`user_path` rows: both configurations' medians, their ratio and the slowest
+    analysis's ratio."""
+    lines = [f"## {title}", "",
+             f"`mechgen run SCENE` as a whole process ({'cached' if all(r['warm'] for r in rows) else 'no warm-up run: the first may compile, a quick run'}), median of "
+             f"{rows[0]['repeats'] if rows else 0}, interleaved: unpinned = the default environment "
+             f"(no {', '.join(THREAD_VARS)}), pinned = all of them 1. Target: unpinned / pinned <= "
+             f"{UNPINNED_TARGET:g}.", "",
+             "| scene | unpinned | pinned | unpinned / pinned | slowest analysis (unpinned / pinned) |",
+             "|---|---|---|---|---|"]
+    for r in rows:
+        ratios = r["analyses_ratio"]
+        worst = max(ratios, key=lambda n: ratios[n]) if ratios else None
+        an = "-" if worst is None else (f"{worst}: {r['unpinned']['analyses_median_s'][worst]:.3f} s / "
+                                        f"{r['pinned']['analyses_median_s'][worst]:.3f} s = {ratios[worst]:.2f}")
+        flag = "" if r["within_target"] else " (over target)"
+        lines.append(f"| {r['scene']} | {r['unpinned']['median_s']:.3f} s | {r['pinned']['median_s']:.3f} s | "
+                     f"{r['ratio_unpinned_over_pinned']:.2f}{flag} | {an} |")
+    return "\n".join(lines)
 
 
 # -- fairness and the machine ---------------------------------------------------------------------------------

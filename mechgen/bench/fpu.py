@@ -15,6 +15,10 @@ generation + compile time (first run with an empty cache, and cached, each in a
 new Python process), and the time a scene takes to start solving. Every ratio is
 measured in one run on one machine; the numbers of the methods are checked
 against each other before timing.
+
+The user path (issue #12): ``mechgen run scenes/fpu_chain.toml`` as a whole process in the default
+environment (no BLAS thread variables) against the same run pinned to one BLAS thread, interleaved, median
+of 3 (``user_path`` in ``fpu_kernels.json``, a table in ``fpu_kernels.md``; :func:`mechgen.bench.common.user_path`).
 """
 from __future__ import annotations
 
@@ -23,13 +27,16 @@ from pathlib import Path
 
 import numpy as np
 
-from mechgen.bench.common import ROOT, best_time, empty_cache, in_fresh_process, write_csv, write_json, write_text
+from mechgen.bench.common import (ROOT, best_time, empty_cache, in_fresh_process, user_path, user_path_markdown,
+                                  write_csv, write_json, write_text)
 
 __all__ = ["best_time", "empty_cache", "numpy_force", "numpy_stiffness", "fpu_system", "kernel_rows",
            "call_overhead", "build_times", "scene_start", "report_markdown", "run_fpu_benchmarks"]
 
 GAMMA, ALPHA, BETA = 1.0, 0.25, 0.1
 HAND_C = ROOT / "benchmarks" / "hand_fpu.c"
+#: the scene timed as a user runs it
+USER_SCENE = "fpu_chain.toml"
 
 
 def numpy_force(u: np.ndarray) -> np.ndarray:
@@ -277,11 +284,12 @@ def run_fpu_benchmarks(*, out: Path, quick: bool = False) -> dict:
     overhead = call_overhead()
     builds = build_times((8, 100_000) if not quick else (8, 1000))
     start = scene_start(ROOT / "scenes" / "spring_pendulum.toml")
+    users = user_path([ROOT / "scenes" / USER_SCENE], repeats=1 if quick else 3, warm=not quick)
     out = Path(out)
     write_csv(out / "fpu_kernels.csv", rows)
-    result = {"kernels": rows, "call_overhead": overhead, "builds": builds, "scene_start": start}
+    result = {"kernels": rows, "call_overhead": overhead, "builds": builds, "scene_start": start, "user_path": users}
     write_json(out / "fpu_kernels.json", result)
-    table = report_markdown(rows, overhead, builds, start)
+    table = report_markdown(rows, overhead, builds, start) + "\n\n" + user_path_markdown(users, "The scene as a user runs it")
     write_text(out / "fpu_kernels.md", table + "\n")
     print(table)
     print(f"\nwrote {out / 'fpu_kernels.csv'}, {out / 'fpu_kernels.json'}, {out / 'fpu_kernels.md'}")

@@ -10,7 +10,7 @@ damping) with each of its six shaft elements split in eight:
   (as ``benchmarks/ross_reference.py`` builds it), 294 dofs (ROSS's nodes also carry the axial and
   torsional dofs, exactly decoupled from the lateral ones).
 
-Steps, all in one process, BLAS limited to one thread for both tools (threadpoolctl):
+Steps 1-5 in one process, BLAS limited to one thread for both tools (threadpoolctl); step 6 as a user runs it:
 
 1. **Accuracy first.** The first eight damped natural frequencies of mechgen's ``modes`` analysis and of
    ROSS's ``run_modal`` (its lateral modes; ROSS's lists also hold a torsional mode at 774 rad/s) agree
@@ -42,8 +42,16 @@ Steps, all in one process, BLAS limited to one thread for both tools (threadpool
    reference (two-node element, N = 384 and 768, second order; cross-checked against quintic N = 48),
    and the time per Campbell speed.
 
+6. **As a user runs it** (issue #12): the Campbell comparison of step 2 again in two child processes, one
+   per configuration: *unpinned* (the default environment: no OPENBLAS/OMP/MKL_NUM_THREADS, so ROSS runs
+   with OpenBLAS's default threads and mechgen with its own thread control) and *pinned* (all three = 1);
+   mechgen through its public ``mechgen.campbell`` (``multiples = []``), ROSS's ``run_campbell`` as above,
+   interleaved, median of 3, Campbell diagrams checked to agree (``configurations``: both times and
+   ROSS / mechgen per configuration; the target >= 20 is the unpinned one). And the whole scene,
+   ``mechgen run scenes/ross_example_rotor.toml`` as a process, unpinned against pinned (``user_path``).
+
 ``quick=True`` (< 60 s): 10 Campbell speeds, one repeat, no critical-speed run, a 604-unknown "large"
-rotor, reference from N = 192 and 384, no ROSS run on the large rotor. Writes ``out/rotor_campbell.json`` and
+rotor, reference from N = 192 and 384, no ROSS run on the large rotor nor in step 6. Writes ``out/rotor_campbell.json`` and
 ``out/rotor_campbell.md``. When ROSS is not installed, mechgen's parts run and the report says so.
 Timing targets live here, never in unit tests; absolute times drift with the machine's load
 (the load average is recorded).
@@ -62,7 +70,8 @@ from pathlib import Path
 
 import numpy as np
 
-from mechgen.bench.common import ROOT, blas_info, blas_threads, environment, write_json, write_text
+from mechgen.bench.common import (ROOT, blas_info, blas_threads, environment, user_path, user_path_markdown,
+                                  write_json, write_text)
 from mechgen.bench.common import timed as _timed  # the local name the suite's steps use
 
 SCENE = ROOT / "scenes" / "ross_example_rotor.toml"
@@ -227,6 +236,78 @@ def campbell_agreement(mech_freqs, ross_camp) -> float:
         for v in wd[i, lateral[i]]:
             worst = max(worst, float(np.min(np.abs(mech[i] - v)) / abs(v)))
     return worst
+
+
+# -- as a user runs it: both tools unpinned, and both pinned --------------------------------------------------
+_CONFIGURATION = """
+import json, sys
+from mechgen.bench.rotor import configuration_timing
+print(json.dumps(configuration_timing(int(sys.argv[1]), int(sys.argv[2]), with_ross=sys.argv[3] == "1")))
+"""
+
+
+def configuration_timing(n_speeds: int, repeats: int, with_ross: bool = True) -> dict:
+    """ROSS's run_campbell against mechgen's campbell analysis as the scene runner and ``mechgen.campbell`` run it
+    (``run_analysis``, with mechgen's thread control; tracking only, ``multiples = []``, as ROSS; and the public
+    ``mechgen.campbell`` with its default critical speeds, timed after the pairs) on the rotor of :func:`rotor_system` (N = 48), in this process's BLAS configuration as it is (no
+    threadpoolctl limit from the benchmark: mechgen's own thread control decides for mechgen, the
+    environment for ROSS). Warm-ups first (mechgen's first call, ROSS's first run_modal and a 2-speed
+    run_campbell), then ``repeats`` interleaved runs of each; the Campbell diagrams are checked to agree to
+    TOL. ``with_ross=False``: mechgen only. Run it in a child process whose environment is the configuration
+    (:func:`user_configurations`)."""
+    import mechgen
+    from mechgen.analyses.result import run_analysis
+    from mechgen.bench.common import THREAD_VARS
+
+    rs, skipped = import_ross() if with_ross else (None, "not run (quick)")
+    speeds = speeds_of(n_speeds)
+    system, _info = rotor_system(6 * SPLIT)
+
+    def mech():  # the scene runner's path (run_analysis: its thread control), tracking only as ROSS
+        return run_analysis("campbell", "campbell", system, {"over": {"Omega": speeds}, "count": COUNT,
+                                                             "multiples": []}, {})
+
+    def public():  # the public function, its defaults: critical speeds (multiples = [1]) as well
+        return mechgen.campbell(system, over={"Omega": speeds}, count=COUNT)
+
+    out: dict = {"environment": {k: os.environ.get(k) for k in THREAD_VARS}, "blas": blas_info(),
+                 "speeds": len(speeds), "repeats": repeats, "ross_skipped": skipped}
+    out["mechgen_first_call_s"], res = _timed(mech)
+    rotor = None
+    if rs is not None:
+        rotor = ross_rotor(rs, SPLIT)
+        out["ross_first_run_modal_s"], _ = _timed(lambda: ross_lateral(rotor, 0.0))
+        out["ross_first_run_campbell_2_speeds_s"], _ = _timed(lambda: ross_campbell(rotor, [0.0, MAX_SPEED]))
+    mech_t, ross_t, camp = [], [], None
+    for _ in range(repeats):
+        if rotor is not None:
+            t, camp = _timed(lambda: ross_campbell(rotor, speeds))
+            ross_t.append(t)
+        t, res = _timed(mech)
+        mech_t.append(t)
+    out["mechgen"] = _summary(mech_t)
+    public()
+    out["mechgen_public_with_critical_speeds"] = _summary([_timed(public)[0] for _ in range(repeats)])
+    if rotor is not None:
+        out["ross"] = _summary(ross_t)
+        agree = campbell_agreement(res.outputs["frequencies"], camp)
+        if not agree <= TOL:
+            raise AssertionError(f"Campbell diagrams of mechgen and ROSS differ by {agree:.3e} relative (> {TOL:g})")
+        out["campbell_max_rel_diff"] = agree
+        out["ratio_ross_over_mechgen"] = out["ross"]["median_s"] / out["mechgen"]["median_s"]
+        out["ratio_ross_over_mechgen_public_with_critical_speeds"] = (
+            out["ross"]["median_s"] / out["mechgen_public_with_critical_speeds"]["median_s"])
+    return out
+
+
+def user_configurations(n_speeds: int, repeats: int, with_ross: bool = True) -> dict:
+    """:func:`configuration_timing` in two child processes: ``unpinned`` (the default environment, no BLAS
+    thread variables, as a user runs both tools) and ``pinned`` (OPENBLAS/OMP/MKL_NUM_THREADS = 1)."""
+    from mechgen.bench.common import in_fresh_process, user_env
+
+    return {name: in_fresh_process(_CONFIGURATION, str(n_speeds), str(repeats), "1" if with_ross else "0",
+                                   env=user_env(pinned))
+            for name, pinned in (("unpinned", False), ("pinned", True))}
 
 
 # -- profile and candidate fixes ------------------------------------------------------------------------------
@@ -456,6 +537,35 @@ def report_markdown(res: dict) -> str:
         crit = "" if crit is None else f"; {crit:.2f} with critical speeds"
         L.append(f"\n**ROSS / mechgen = {ratio:.2f}** (tracking only{crit}): target >= {TARGET:g} "
                  f"{'met' if ratio >= TARGET else 'NOT met'}.")
+    conf = res.get("configurations")
+    if conf:
+        un = conf["unpinned"]
+        L += ["", f"## As a user runs both: unpinned and pinned ({un['speeds']} speeds, median of {un['repeats']})", "",
+              "Each configuration in its own process: ROSS `run_campbell` against mechgen's campbell analysis "
+              "as `mechgen run` runs it (`run_analysis`, tracking only: `multiples = []`), interleaved; then the "
+              "public `mechgen.campbell(system, over=..., count=8)` (with its default critical speeds). *Unpinned*: the default "
+              "environment (no OPENBLAS/OMP/MKL_NUM_THREADS; mechgen's own thread control decides for mechgen); "
+              "*pinned*: all three = 1.", "",
+              "| configuration | ROSS | mechgen | ROSS / mechgen (target >= 20 unpinned) | `mechgen.campbell` with "
+              "critical speeds | ROSS / that | BLAS threads at start |",
+              "|---|---|---|---|---|---|---|"]
+        for name in ("unpinned", "pinned"):
+            c = conf[name]
+            threads = ", ".join(f"{b['api']} {b['num_threads']}" for b in c["blas"]) or "-"
+            ross = c.get("ross")
+            L.append(f"| {name} | {'-' if ross is None else _fmt_s(ross['median_s'])} "
+                     f"({'-' if ross is None else ', '.join(_fmt_s(x) for x in ross['all_s'])}) | "
+                     f"{_fmt_s(c['mechgen']['median_s'])} ({', '.join(_fmt_s(x) for x in c['mechgen']['all_s'])}) | "
+                     f"{'-' if ross is None else format(c['ratio_ross_over_mechgen'], '.1f')} | "
+                     f"{_fmt_s(c['mechgen_public_with_critical_speeds']['median_s'])} | "
+                     f"{'-' if ross is None else format(c['ratio_ross_over_mechgen_public_with_critical_speeds'], '.1f')}"
+                     f" | {threads} |")
+        if "ratio_ross_over_mechgen" in un:
+            L.append(f"\n**Unpinned ROSS / mechgen = {un['ratio_ross_over_mechgen']:.1f}**, pinned "
+                     f"{conf['pinned']['ratio_ross_over_mechgen']:.1f}: target >= {TARGET:g} (unpinned) "
+                     f"{'met' if un['ratio_ross_over_mechgen'] >= TARGET else 'NOT met'}.")
+    if res.get("user_path"):
+        L += ["", user_path_markdown(res["user_path"], "The scene as a user runs it")]
     prof = res.get("profile")
     if prof:
         L += ["", f"## Where mechgen's time goes (cProfile, {prof['speeds']} speeds, multiples = {prof['multiples']})",
@@ -532,6 +642,9 @@ def run_rotor_benchmarks(out: Path, quick: bool = False) -> dict:
                         "seconds_per_speed": ct["ross"]["median_s"] / ct["speeds"],
                         "frequencies": [res["accuracy"]["rows"][k]["ross"] for k in range(2)]}
         res["work_precision"] = work_precision(repeats, quick, ross_row)
+    # as a user runs it: both tools unpinned and both pinned (child processes), and the whole scene
+    res["configurations"] = user_configurations(len(speeds), repeats, with_ross=not quick)
+    res["user_path"] = user_path([SCENE], repeats=repeats, warm=not quick)
     env["loadavg_after"] = list(os.getloadavg())
     write_json(out / "rotor_campbell.json", res, indent=1)
     table = report_markdown(res)

@@ -24,24 +24,42 @@ def user_chose_threads() -> bool:
     return any(os.environ.get(name) for name in USER_CHOICE)
 
 
+def controller():
+    """The threadpoolctl controller of the loaded BLAS/OpenMP libraries, built once per process.
+
+    numpy and scipy each ship their own OpenBLAS; scipy's is loaded only when scipy.linalg is first
+    imported, and a limit applies only to the libraries loaded when it is set, so scipy.linalg is
+    imported first (else the first analysis of a process, which imports it inside the limit, would run
+    scipy's dense work on the default threads). Built once, a limit costs microseconds; a fresh
+    ``threadpool_limits`` rescans the process's libraries each time (1-20 ms, per analysis and per
+    sweep point).
+    """
+    global _CONTROLLER
+    if _CONTROLLER is None:
+        import numpy  # noqa: F401  (numpy's BLAS)
+        import scipy.linalg  # noqa: F401  (scipy's own BLAS, see above)
+        from threadpoolctl import ThreadpoolController
+
+        _CONTROLLER = ThreadpoolController()
+    return _CONTROLLER
+
+
 def blas_threads_for(unknowns: int):
     """A context in which BLAS runs on one thread when ``unknowns`` <= SMALL (else, or when the
     user chose, a context that changes nothing)."""
     if unknowns > SMALL or user_chose_threads():
         return nullcontext()
-    from threadpoolctl import threadpool_limits
-
-    return threadpool_limits(limits=1, user_api="blas")
+    return controller().limit(limits=1, user_api="blas")
 
 
 def single_thread_worker() -> None:
-    """Process-pool initializer: this worker's BLAS on one thread, for the worker's lifetime."""
+    """Process-pool initializer: this worker's BLAS (numpy's and scipy's) on one thread, for the worker's
+    lifetime."""
     if user_chose_threads():
         return
-    from threadpoolctl import threadpool_limits
-
     global _WORKER_LIMIT
-    _WORKER_LIMIT = threadpool_limits(limits=1, user_api="blas")
+    _WORKER_LIMIT = controller().limit(limits=1, user_api="blas")
 
 
+_CONTROLLER = None
 _WORKER_LIMIT = None

@@ -51,6 +51,23 @@ CHOICE_VALUES = {"discretisation": DISCRETISATIONS, "constraints": ("eliminate",
 SIZE_CHOICES = ("N", "quadrature")
 
 
+def point_terms(terms, shape) -> sps.csr_matrix:
+    """sum_p B_p^T C_p B_p of the end terms and placed parts, as one sparse matrix of ``shape``.
+
+    B_p (jets x dofs, CSR) touches a few dofs only: each product is formed densely on those
+    (B_p restricted to its nonzero columns) and all of them are scattered at once (duplicates
+    summed), instead of two sparse products and a sparse sum per part and matrix.
+    """
+    rows, cols, vals = [], [], []
+    for B, C in terms:
+        idx = np.unique(B.indices)
+        Bd = B.toarray()[:, idx]
+        rows.append(np.repeat(idx, idx.size))
+        cols.append(np.tile(idx, idx.size))
+        vals.append((Bd.T @ np.asarray(C) @ Bd).ravel())
+    return sps.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=shape)
+
+
 @dataclass(frozen=True, eq=False)
 class FieldSystem:
     """Kernels of a continuum's local piece, parameter values and the discretisation choices. Immutable.
@@ -481,9 +498,10 @@ class FieldSystem:
             coeff = self._coeff(local[k])
             pairs = [tuple(ab) for ab in np.argwhere(np.any(coeff != 0, axis=(0, 1)))]
             mats[k] = self.assembler.matrix(element_matrices(disc.tables, disc.weights, coeff, pairs))
-        for B, loc in self._ends(kernel, full, t):
+        ends = list(self._ends(kernel, full, t))
+        if ends:
             for k in names:
-                extra = B.T @ sps.csr_matrix(self._coeff(loc[k])[0]) @ B
+                extra = point_terms([(B, self._coeff(loc[k])[0]) for B, loc in ends], mats[k].shape)
                 mats[k] = mats[k] + (extra if sps.issparse(mats[k]) else extra.toarray())
         stiff = {"linear": "K", "tangent": "r_q"}[kernel]
         reduced = {k: self.reduction.matrix(mats[k], self._row_penalties if k == stiff else 0.0, border=k == stiff)

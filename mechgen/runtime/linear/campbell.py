@@ -258,22 +258,26 @@ def fit_speed_polynomial(evaluate, lo: float, hi: float, *, rtol: float = 1e-12,
 # ----------------------------------------------------------------------------------------- reduced model
 
 
-def _structured(B: np.ndarray, A) -> np.ndarray:
-    """B = V^T A V made exactly symmetric (skew) when A is symmetric (skew)."""
-    if has_symmetry(A, 1):
-        return 0.5 * (B + B.T)
-    if has_symmetry(A, -1):
-        return 0.5 * (B - B.T)
-    return B
-
-
 def backward_errors(mats: dict, s: np.ndarray, X: np.ndarray) -> np.ndarray:
     """eta_j = ||(s_j^2 M + s_j C + K) x_j|| / (|s_j|^2 ||M x_j|| + |s_j| ||C x_j|| + ||K x_j||) per column."""
-    MX, CX, KX = mats["M"] @ X, mats["C"] @ X, mats["K"] @ X
+    return residual_norms(mats["M"] @ X, mats["C"] @ X, mats["K"] @ X, s)
+
+
+def residual_norms(MX: np.ndarray, CX: np.ndarray, KX: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """The backward errors of :func:`backward_errors` from the products M X, C X, K X."""
     R = MX * s**2 + CX * s + KX
     a = np.abs(s)
     den = a**2 * np.linalg.norm(MX, axis=0) + a * np.linalg.norm(CX, axis=0) + np.linalg.norm(KX, axis=0)
     return np.linalg.norm(R, axis=0) / np.where(den > 0, den, 1.0)
+
+
+def _symmetrised(B: np.ndarray, kind) -> np.ndarray:
+    """B = V^T A V made exactly symmetric (kind 1: A symmetric) or skew (kind -1: A skew); kind 0 as it is."""
+    if kind == 1:
+        return 0.5 * (B + B.T)
+    if kind == -1:
+        return 0.5 * (B - B.T)
+    return B
 
 
 class ReducedModel:
@@ -291,9 +295,10 @@ class ReducedModel:
         self.poly = poly
         self.V = np.zeros((n, 0))
         self.terms: dict = {}
-        kinds = {key: [None if A is None else (1 if has_symmetry(A, 1) else -1 if has_symmetry(A, -1) else 0)
-                       for A in coefs]
-                 for key, coefs in poly.terms.items()}
+        self.kinds = kinds = {key: [None if A is None else (1 if has_symmetry(A, 1) else -1 if has_symmetry(A, -1)
+                                                            else 0) for A in coefs]
+                              for key, coefs in poly.terms.items()}
+        self.products: dict = {}  # key -> [A_k V]: full-size products with the basis (backward errors)
         self.conservative = (all(k in (None, 1) for k in kinds["M"]) and all(k in (None, 1) for k in kinds["K"])
                              and all(k in (None, -1) for k in kinds["C"]))
 
@@ -317,9 +322,27 @@ class ReducedModel:
         new = np.linalg.qr(new)[0]
         self.V = np.hstack([self.V, new])
         V = self.V
-        self.terms = {key: [None if A is None else _structured(V.T @ np.asarray(A @ V), A) for A in coefs]
-                      for key, coefs in self.poly.terms.items()}
+        self.products = {key: [None if A is None else np.asarray(A @ V) for A in coefs]
+                         for key, coefs in self.poly.terms.items()}
+        self.terms = {key: [None if AV is None else _symmetrised(V.T @ AV, kind)
+                            for AV, kind in zip(self.products[key], self.kinds[key])]
+                      for key in self.poly.terms}
         return new.shape[1]
+
+    def backward_errors(self, speed: float, s: np.ndarray, X: np.ndarray) -> np.ndarray:
+        """:func:`backward_errors` of shapes X in the span of V at ``speed``, from the products A_k V kept by
+        :meth:`enrich`: A(speed) X = sum_k t^k (A_k V)(V^T X), dense, no sparse sums per speed."""
+        Y = self.V.T @ X
+        t = self.poly.t(speed)
+        prods = {}
+        for key in ("M", "C", "K"):
+            total = None
+            for k, AV in enumerate(self.products[key]):
+                if AV is not None:
+                    term = (t**k) * (AV @ Y)
+                    total = term if total is None else total + term
+            prods[key] = np.zeros_like(X) if total is None else total
+        return residual_norms(prods["M"], prods["C"], prods["K"], s)
 
     def modes(self, speed: float, m: int) -> DampedModes:
         """The ``m`` lowest damped modes of the reduced problem at ``speed``, shapes x = V y at full size."""
@@ -539,7 +562,7 @@ def _campbell_reduced(poly, speeds, count, m, n, sparse, sigma, first, residual_
                 solve_exact(i)
                 continue
             found[i] = dm
-            eta[i] = backward_errors(poly(float(speeds[i])), dm.eigenvalues, dm.shapes)
+            eta[i] = model.backward_errors(float(speeds[i]), dm.eigenvalues, dm.shapes)
         eig, shp, mac, chosen = _track(speeds, [dm.eigenvalues for dm in found], [dm.shapes for dm in found],
                                        count, **track)
         bad = {}
