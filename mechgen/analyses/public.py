@@ -37,9 +37,14 @@ def _context(system, function: str, earlier: Mapping[str, Result]) -> OptionCont
     info = _model_info(system)
     coordinates = tuple(info.coordinates) if system.is_field else tuple(system.coordinates)
     active = None if set(coordinates) == set(info.coordinates) else coordinates
+    from mechgen.scene.bounds import LIMITS, MAX_LIMIT
+
+    # the scene's safety limits guard typos in a file a user cannot raise from Python: a caller is bounded
+    # by the memory estimate before allocating (mechgen.runtime.core.memory) instead
     return OptionContext(file=None, model=info, params=_known_values(system), depends={},
                          coordinates=coordinates, active=active, all_names=tuple(earlier),
-                         earlier={n: r.kind for n, r in earlier.items()}, current=function)
+                         earlier={n: r.kind for n, r in earlier.items()}, current=function,
+                         limits={name: MAX_LIMIT for name in LIMITS})
 
 
 def _known_values(system) -> dict:

@@ -445,6 +445,8 @@ def write_meta(tmp: Path, kind: str, key: str) -> None:
     for path in sorted(tmp.iterdir()):
         if path.name == META:
             continue
+        if not os.path.lexists(path):  # removed while the entry is written (the cache deleted): an OSError
+            raise FileNotFoundError(f"{path} vanished while its cache entry was written")
         if path.is_symlink() or not path.is_file() or not _FILE_RE.fullmatch(path.name):
             raise ValueError(f"cache entry may hold only plain files, found {path.name!r}")
         files[path.name] = artefact_sha256(path)

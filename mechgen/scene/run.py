@@ -124,7 +124,7 @@ def _run_loaded(scn, backend: str | None) -> dict:
         except InputError as exc:  # found while running (a size beyond memory, ...): name the scene file too
             if exc.file is not None:
                 raise
-            raise type(exc)(exc.message, file=str(scn.path), key=exc.key, expected=exc.expected) from None
+            raise placed(exc, scn) from None
         context[analysis.name] = result.state
         results["analyses"].append(result.to_json())
     return results
