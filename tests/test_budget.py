@@ -326,3 +326,32 @@ def test_response_refused_from_the_estimate_of_its_first_frequencies(pendulum):
                          omega={"start": 0.1, "stop": 100.0, "num": 1_000_000}, max_seconds=0.01)
     assert str(err.value).startswith("response 'frf': response: 1,000,000 frequencies would take about")
     assert err.value.key == "max_seconds"
+
+
+def test_campbell_solved_at_every_speed_is_refused_from_its_first_speeds():
+    """A Laval tilt rotor (M = I_d, G = I_p Omega J, K = k) whose every speed 'takes' 1 s on a hand-moved clock:
+    100 speeds project to 100 s, more than a 10 s budget; with a 1000 s budget the diagram is the closed form
+    of the forward whirl, (I_p Omega + sqrt(I_p^2 Omega^2 + 4 I_d k)) / (2 I_d) (Friswell et al. 2010, 3.5)."""
+    from mechgen.runtime.linear.campbell import campbell
+
+    Id, Ip, k = 1.0, 0.5, 4.0
+
+    def timed(clock):
+        def mats(speed):
+            clock.now += 1.0
+            G = Ip * speed * np.array([[0.0, 1.0], [-1.0, 0.0]])
+            return {"M": Id * np.eye(2), "C": G, "K": k * np.eye(2)}
+        return mats
+
+    speeds = np.linspace(0.0, 10.0, 100)
+    clock = Clock()
+    budget = Budget("campbell over Omega", unit="speeds", seconds=10.0, clock=clock)
+    with pytest.raises(BudgetExceeded) as err:
+        campbell(timed(clock), speeds, 2, method="exact", budget=budget, x_index=[0], y_index=[1])
+    assert "100 speeds would take about" in str(err.value) and err.value.key == "max_seconds"
+    assert clock.now < 10.0  # refused from the estimate, before the budget itself ran out
+    clock = Clock()
+    res = campbell(timed(clock), speeds, 2, method="exact", x_index=[0], y_index=[1],
+                   budget=Budget("campbell over Omega", unit="speeds", seconds=1000.0, clock=clock))
+    forward = (Ip * speeds + np.sqrt(Ip**2 * speeds**2 + 4 * Id * k)) / (2 * Id)
+    assert np.allclose(res.frequencies.max(axis=1), forward, rtol=1e-12)

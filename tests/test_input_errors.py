@@ -352,3 +352,22 @@ def test_segment_and_part_values_keep_the_declared_bounds(tmp_path, capsys):
     _fails(["run", path], capsys, str(path), "'segments[2].D'", "D = -0.045 is not positive")
     path = _scene(tmp_path, "ross_example_rotor", ("rho = 7810.0\nwidth", "rho = 5e-324\nwidth"), file="part.toml")
     _fails(["run", path], capsys, str(path), "'parts[1].rho'", "subnormal")
+
+
+# ----------------------------------------------------------------------------- sweep grids (section 5)
+
+@pytest.mark.parametrize("over, key, words", [
+    ("{ N = [4, 0] }", "'analysis[3].over.N[2]'", ["N = 0", "an integer from 1 to"]),
+    ("{ rhoA = [1.0, -2.0] }", "'analysis[3].over.rhoA[2]'", ["declared positive", "> 0"]),
+    ("{ EI = { start = -1.0, stop = 1.0, num = 3 } }", "'analysis[3].over.EI'", ["declared positive"]),
+])
+def test_a_sweep_grid_value_meets_the_bounds_a_written_value_meets(over, key, words, tmp_path, capsys):
+    """A grid's values are values the scene writes: refused at load, at the grid's key, like params.X."""
+    path = _scene(tmp_path, "beam_modes", append=f"""
+[[analysis]]
+name = "grid"
+kind = "sweep"
+over = {over}
+analysis = {{ kind = "modes", count = 2 }}
+""")
+    _fails(["run", path], capsys, str(path), key, *words)

@@ -4,7 +4,8 @@ The modes are tracked across speeds (mechgen.runtime.linear.campbell) and critic
 whirl frequency crosses a multiple of the speed. Scene keys: ``over`` (one numeric parameter with two
 or more increasing values), ``count`` (modes; left out: min(8, the system's degrees of freedom), a count written larger than
 that is refused), ``multiples`` (of the speed, default [1]),
-``method`` (auto, exact, reduced), ``about`` and ``at`` (the operating point). Outputs: ``speeds``,
+``method`` (auto, exact, reduced), ``about`` and ``at`` (the operating point), ``max_seconds`` (the wall-time
+budget, default 600 s: the exact path refuses once its first speeds project past it; exit 1). Outputs: ``speeds``,
 ``frequencies`` and ``whirl`` and ``log_dec`` (one row per speed), ``critical_speeds``, ``parameter``,
 ``method`` and ``exact_solves``.
 """
@@ -17,9 +18,10 @@ import numpy as np
 from mechgen.analyses import schema, summary
 from mechgen.analyses.operating_point import operating_point
 from mechgen.analyses.registry import AnalysisKind, register
-from mechgen.analyses.schema import REQUIRED, Option
+from mechgen.analyses.schema import ABSENT, REQUIRED, Option
 from mechgen.analyses.whirl import SPARSE_N, whirl_stations
 from mechgen.errors import SceneError
+from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget
 from mechgen.runtime.linear.campbell import CampbellOptions, campbell, critical_speeds, fit_speed_polynomial
 from mechgen.scene.values import fail, is_choice, join, param_info, type_name
 
@@ -46,7 +48,8 @@ def _multiples(ctx, key: str, value: object) -> list[float]:
 SCHEMA = {"over": Option(_speeds, REQUIRED, "a table: parameter = [values] or {start, stop, num}"),
           "count": Option(schema.count), "multiples": Option(_multiples, [1.0]),
           "method": Option(schema.one_of("campbell method", ("auto", "exact", "reduced"))),
-          "about": Option(schema.about), "at": Option(schema.coordinate_table)}
+          "about": Option(schema.about), "at": Option(schema.coordinate_table),
+          "max_seconds": Option(schema.positive, ABSENT)}
 
 
 def needs(options: dict, *, internal: bool) -> set[str]:
@@ -113,7 +116,10 @@ def run_campbell(system, options: dict, context: dict) -> dict:
     # matrices polynomial in the speed (a rotor's G = Omega G1): four assemblies, then sparse adds
     poly = fit_speed_polynomial(assembled, speeds[0], speeds[-1]) if len(speeds) > 4 else None
     matrices_at = assembled_at if poly is None else poly.combined({"M": ("M",), "C": ("D", "G"), "K": ("K",)})
-    res = campbell(matrices_at, speeds, count, CampbellOptions(sparse=sparse, method=options.get("method", "auto")),
+    budget = Budget(f"campbell over {name}", unit="speeds",
+                    seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
+    res = campbell(matrices_at, speeds, count, CampbellOptions(sparse=sparse, method=options.get("method", "auto"),
+                                                                budget=budget),
                    x_index=stations[0], y_index=stations[1])
     crit = critical_speeds(res, options.get("multiples", [1.0]), refine=matrices_at, sparse=sparse)
     freqs = np.asarray(res.frequencies)

@@ -254,7 +254,8 @@ def value_range(ctx: OptionContext, key: str, table: dict) -> list[float]:
 
 
 def parameter_values(ctx: OptionContext, key: str, param: str, value: object) -> list[float | int]:
-    """The values a grid gives one parameter: an array (of numbers or choices) or {start, stop, num}."""
+    """The values a grid gives one parameter: an array (of numbers or choices) or {start, stop, num}, each within
+    the parameter's declared bounds and size limits (mechgen.scene.bounds.check_value), as a written value is."""
     info = param_info(ctx.file, key, ctx.model, param)
     if is_choice(info):
         if not isinstance(value, list) or not value:
@@ -267,7 +268,13 @@ def parameter_values(ctx: OptionContext, key: str, param: str, value: object) ->
     else:
         what = "empty array" if value == [] else f"value is {type_name(value)}"
         raise fail(ctx.file, key, what, "a non-empty array of numbers or a table {start, stop, num}")
-    return [finish(ctx.file, key, info, v) for v in values]
+    values = [finish(ctx.file, key, info, v) for v in values]
+    from mechgen.scene.bounds import check_value  # the bounds every value the scene writes meets
+
+    ranged = isinstance(value, dict)
+    for i, v in enumerate(values, 1):
+        check_value(ctx.file, key if ranged else f"{key}[{i}]", param, info, v, ctx.limits)
+    return values
 
 
 def check_not_derived(ctx: OptionContext, key: str, param: str) -> None:

@@ -447,6 +447,8 @@ class CampbellOptions(Options):
         method: 'exact', 'reduced' or 'auto' (see :func:`campbell`).
         residual_tol: the largest backward error eta of a reduced speed's tracked modes.
         mac_min: the smallest MAC of a curve to the previous speed that a reduced speed may have.
+        budget: a :class:`mechgen.runtime.core.budget.Budget` checked at every speed's solve (None: none);
+            the exact path projects the whole diagram's time from its first speeds.
     """
 
     sparse: bool | None = None
@@ -458,6 +460,7 @@ class CampbellOptions(Options):
     method: str = "auto"
     residual_tol: float = 1e-9
     mac_min: float = 0.8
+    budget: object = None
 
 
 def campbell(matrices_at, speeds, count: int, options: CampbellOptions | None = None, *, x_index, y_index,
@@ -480,7 +483,7 @@ def campbell(matrices_at, speeds, count: int, options: CampbellOptions | None = 
     opts = CampbellOptions.of(options, **overrides)
     sparse, spare, sigma, freq_weight = opts.sparse, opts.spare, opts.sigma, opts.freq_weight
     cluster_tol, planar_tol, method = opts.cluster_tol, opts.planar_tol, opts.method
-    residual_tol, mac_min = opts.residual_tol, opts.mac_min
+    residual_tol, mac_min, budget = opts.residual_tol, opts.mac_min, opts.budget
     _check_method(method)
     speeds = np.asarray(speeds, dtype=float)
     if speeds.ndim != 1 or speeds.size == 0 or not np.all(np.isfinite(speeds)):
@@ -514,10 +517,13 @@ def campbell(matrices_at, speeds, count: int, options: CampbellOptions | None = 
     model = None
     if reduced:
         eig, shp, mac, model, n_exact = _campbell_reduced(poly, speeds, count, m, n, sparse, sigma, first,
-                                                          residual_tol, mac_min, track)
+                                                          residual_tol, mac_min, track, budget)
     else:
-        found = [_modes_at(first if i == 0 else matrices_at(float(w)), float(w), n, m, count, sparse, sigma)
-                 for i, w in enumerate(speeds)]
+        found = []
+        for i, w in enumerate(speeds):
+            found.append(_modes_at(first if i == 0 else matrices_at(float(w)), float(w), n, m, count, sparse, sigma))
+            if budget is not None:
+                budget.project(i + 1, S, lambda: f"{i + 1:,} of {S:,} speeds (up to {float(w):g})")
         eig, shp, mac, _ = _track(speeds, [dm.eigenvalues for dm in found], [dm.shapes for dm in found], count,
                                   **track)
         n_exact = S
@@ -536,8 +542,9 @@ def campbell(matrices_at, speeds, count: int, options: CampbellOptions | None = 
         basis_size=0 if model is None else model.size, reduced=model)
 
 
-def _campbell_reduced(poly, speeds, count, m, n, sparse, sigma, first, residual_tol, mac_min, track):
-    """Reduced-basis candidates with the safeguard (module docstring): (eig, shp, mac, model, exact solves)."""
+def _campbell_reduced(poly, speeds, count, m, n, sparse, sigma, first, residual_tol, mac_min, track, budget=None):
+    """Reduced-basis candidates with the safeguard (module docstring): (eig, shp, mac, model, exact solves);
+    ``budget`` (or None) is checked at every full-size solve."""
     S = len(speeds)
     model = ReducedModel(poly, n)
     found: list = [None] * S
@@ -549,6 +556,8 @@ def _campbell_reduced(poly, speeds, count, m, n, sparse, sigma, first, residual_
         found[i], eta[i] = dm, np.zeros(len(dm.eigenvalues))
         exact.add(i)
         model.enrich(dm.shapes)
+        if budget is not None:
+            budget.check_time(lambda: f"{len(exact)} full-size solves of {S:,} speeds")
 
     for i in sorted({0, S - 1}):
         solve_exact(i)
