@@ -35,5 +35,5 @@ def test_quick_balloon_benchmark_writes_reports(tmp_path, capsys):
     galerkin = data["work_precision"]["galerkin"]
     assert galerkin[-1]["mechgen_omega_1_error"] < galerkin[0]["mechgen_omega_1_error"]
     user = data["user_path"][0]  # the scene as a user runs it, beside the pinned figures
-    assert user["scene"] == "balloon_branches.toml" and user["unpinned"]["median_s"] > 0 and "as a user" in md
+    assert user["scene"] == "balloon_frequencies.toml" and user["unpinned"]["median_s"] > 0 and "as a user" in md
     assert "balloon_branch.md" in capsys.readouterr().out
