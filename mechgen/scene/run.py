@@ -119,12 +119,7 @@ def _run_loaded(scn, backend: str | None) -> dict:
     context: dict = {POINTS: PointRunner(sweep_point, partial(_point_task, scene_inputs, layout))}
     for analysis in scn.analyses:
         context[NAME] = analysis.name
-        try:
-            result = run_analysis(analysis.name, analysis.kind, system, dict(analysis.options), context)
-        except InputError as exc:  # found while running (a size beyond memory, ...): name the scene file too
-            if exc.file is not None:
-                raise
-            raise placed(exc, scn) from None
+        result = run_analysis(analysis.name, analysis.kind, system, dict(analysis.options), context)
         context[analysis.name] = result.state
         results["analyses"].append(result.to_json())
     return results
