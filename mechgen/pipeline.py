@@ -174,6 +174,10 @@ def derive(model: Model, spec: Specialization):
         from mechgen.symbolic.lattice import derive_lattice
 
         return derive_lattice(model, spec)
+    if model.is_hybrid:
+        from mechgen.symbolic.hybrid import derive_hybrid
+
+        return derive_hybrid(model, spec)
     from mechgen.symbolic.derive import derive_lumped
 
     return derive_lumped(model, spec)
@@ -193,8 +197,38 @@ def lower_all(model: Model, eqs, kernels, *, cse: bool = True) -> list[KernelIR]
         for ir in irs:
             ir.meta["field"] = meta
         return _with_whirl(model, irs)
+    if model.is_hybrid:
+        return _with_whirl(model, lower_hybrid(model, eqs, kernels, cse=cse))
     lower = lower_lattice if model.is_lattice else lower_lumped
     return _with_whirl(model, [lower(eqs, k, cse=cse) for k in all_kernels(model) if k in kernels])
+
+
+def lower_hybrid(model: Model, eqs, kernels, *, cse: bool = True) -> list[KernelIR]:
+    """The kernels of a hybrid model (mechgen.symbolic.hybrid.HybridEquations): each requested kernel per mode
+    (``<kernel>__i``) and, with a residual or force, the guards of each mode and the resets; every kernel's
+    meta holds the modes and guards (``meta["hybrid"]``)."""
+    import sympy as sp
+
+    from mechgen.codegen.lower_lumped import lower_lumped, lower_matrices
+
+    wanted = [k for k in all_kernels(model) if k in kernels]
+    irs = [replace(lower_lumped(mode_eqs, k, cse=cse), name=f"{k}__{i}")
+           for k in wanted for i, mode_eqs in enumerate(eqs.equations)]
+    if {"residual", "force"} & set(kernels):
+        for i, (mode_eqs, guards) in enumerate(zip(eqs.equations, eqs.guards)):
+            if not guards:
+                continue
+            g = sp.Matrix([ge.g for ge in guards])
+            g_t = sp.Matrix([ge.g_t for ge in guards])
+            irs.append(lower_matrices(mode_eqs, f"guards__{i}", f"guards leaving mode {i} and their rates",
+                                      {"g": g, "g_t": g_t}, cse=cse, accel=True))
+        for j, column in enumerate(eqs.resets):
+            irs.append(lower_matrices(eqs.equations[0], f"reset__{j}", f"state after reset {j}", {"x": column},
+                                      cse=cse))
+    meta = eqs.meta()
+    for ir in irs:
+        ir.meta["hybrid"] = meta
+    return irs
 
 
 def _constraint_kernel(model: Model, spec: Specialization, eqs, cse: bool) -> list[KernelIR]:
@@ -538,6 +572,10 @@ def compile_request(request: CompileRequest, derive_with: Callable[[], tuple], *
         names = (*_FIELD_CHOICES, *(n for n in request.runtime if n not in _FIELD_CHOICES))
         choices = {k: values[k] for k in names if k in values}
         system = FieldSystem(loaded, meta, params, fixed, choices, report.backend)
+    elif "hybrid" in meta:
+        from mechgen.runtime.core.hybrid_system import HybridSystem
+
+        system = HybridSystem(loaded, meta, params, 0, report.backend)
     else:
         system = System(loaded, meta, params, sites or 0, report.backend)
     log.info("built %s [%s, %s]: %s", request.model, report.backend, report.origin, report.seconds)

@@ -54,8 +54,9 @@ def _same_as_scene(result: Result, entry: dict) -> None:
 
 
 def test_the_registry_lists_the_seven_kinds_each_with_a_function():
-    # the seven of the refactor first, then kinds added since (response: tests/test_response.py)
-    assert registry.kinds()[:len(KINDS)] == KINDS and registry.kinds()[len(KINDS):] == ("response",)
+    # the seven of the refactor first, then kinds added since (response: tests/test_response.py; impact,
+    # restitution: tests/test_impacts.py)
+    assert registry.kinds()[:len(KINDS)] == KINDS and registry.kinds()[len(KINDS):] == ("response", "impact", "restitution")
     for kind in KINDS:
         record = registry.get(kind)
         assert record.name == kind and record.schema and callable(record.run) and callable(record.summary)

@@ -18,7 +18,8 @@ from mechgen.analyses.result import Result, run_analysis
 from mechgen.analyses.schema import OptionContext, validate
 from mechgen.errors import InputError
 
-__all__ = ["analysis", "campbell", "continuation", "modes", "simulate", "stability", "steady", "sweep"]
+__all__ = ["analysis", "campbell", "continuation", "impact", "modes", "restitution", "simulate", "stability", "steady",
+           "sweep"]
 
 
 def _model_info(system):
@@ -137,9 +138,30 @@ def simulate(system, *, name: str | None = None, **options) -> Result:
     Options: ``t_end``, ``method``, ``dt``, ``rtol``, ``atol``, ``q0``, ``v0``, ``initial_mode``,
     ``amplitude``, ``outputs``, ``series``, ``samples``, and the work budget ``max_steps``,
     ``max_seconds``, ``progress`` (a spent budget raises BudgetExceeded). Outputs: the model's outputs at ``t_end``,
-    ``energy_drift``, ``t_end`` (and ``t``, ``energy_series`` with ``series=True``).
+    ``energy_drift``, ``t_end`` (and ``t``, ``energy_series`` with ``series=True``). A hybrid model
+    (mechgen.symbolic.hybrid) also takes ``mode``, ``max_events``, ``zeno_events``, ``zeno_span`` and reports
+    ``events`` (``{t, from, to, guard}``), ``final_mode`` and ``t_final`` (mechgen.analyses.simulate_hybrid).
     """
     return _run("simulate", system, options, name)
+
+
+def impact(system, *, name: str | None = None, **options) -> Result:
+    """One impact of a hybrid model from contact to release (mechgen.analyses.impact).
+
+    Options: ``t_end`` and ``v0`` (required), ``q0``, ``method``, ``rtol``, ``atol``, ``coordinate``,
+    ``contact_mode``, ``force_output``, ``curve``, ``samples``. Outputs: ``restitution``,
+    ``contact_duration``, ``energy_lost``, ``released`` (and the hysteresis series with ``curve=True``).
+    """
+    return _run("impact", system, options, name)
+
+
+def restitution(system, *, name: str | None = None, **options) -> Result:
+    """Impacts over a grid ``over = {"zeta": [...]}`` of a parameter left free (mechgen.analyses.restitution).
+
+    Options: ``over`` (required), the impact's options, ``hysteresis``. Outputs: the parameter's values
+    under its name, ``restitution``, ``contact_duration``, ``energy_lost``, ``released``, ``hysteresis``.
+    """
+    return _run("restitution", system, options, name)
 
 
 def campbell(system, *, name: str | None = None, **options) -> Result:

@@ -22,6 +22,8 @@ MODULES = (
     "mechgen.analyses.campbell",
     "mechgen.analyses.continuation",
     "mechgen.analyses.response",
+    "mechgen.analyses.impact",
+    "mechgen.analyses.restitution",
 )
 
 

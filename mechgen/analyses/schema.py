@@ -72,6 +72,8 @@ class OptionContext:
     swept: tuple[str, ...] = ()
     #: the scene's safety limits (mechgen.scene.bounds.scene_limits; empty: the defaults)
     limits: Mapping[str, int] = field(default_factory=dict)
+    #: parameter name -> (file, key) where the scene or a --set flag wrote its value (defaults left out)
+    written: Mapping[str, tuple] = field(default_factory=dict)
 
 
 # --------------------------------------------------------------------------- the schema walk

@@ -68,6 +68,15 @@ def _outputs(ctx, key: str, value: object) -> list[str]:
     return names
 
 
+def _mode(ctx, key: str, value: object) -> str:
+    modes = tuple(getattr(ctx.model, "modes", ()))
+    if not modes:
+        raise fail(ctx.file, key, f"model {ctx.model.name} has no modes", "no 'mode' key (a smooth model)")
+    if not isinstance(value, str) or value not in modes:
+        raise fail(ctx.file, key, f"unknown mode {show(value)}", "one of the model's modes: " + ", ".join(modes))
+    return value
+
+
 def _method(ctx, key: str, value: object) -> str:
     if not isinstance(value, str) or value not in METHODS:
         raise fail(ctx.file, key, f"unknown method {show(value)}", "one of: " + ", ".join(METHODS))
@@ -81,7 +90,9 @@ SCHEMA = {"t_end": Option(schema.positive, REQUIRED, STEP), "method": Option(_me
           "amplitude": Option(schema.number, 1.0), "outputs": Option(_outputs, ALL_OUTPUTS),
           "series": Option(schema.boolean, False), "samples": Option(schema.count_within("samples"), 201),
           "max_steps": Option(schema.count, ABSENT), "max_seconds": Option(schema.positive, ABSENT),
-          "progress": Option(schema.boolean, ABSENT)}
+          "progress": Option(schema.boolean, ABSENT), "mode": Option(_mode, ABSENT),
+          "max_events": Option(schema.count, ABSENT), "zeno_events": Option(schema.count, ABSENT),
+          "zeno_span": Option(schema.positive, ABSENT)}
 
 
 def check(ctx, base: str, options: dict) -> None:
@@ -178,6 +189,10 @@ def leapfrog_masses(system, M) -> np.ndarray:
 
 def run_simulate(system, options: dict, context: dict) -> dict:
     """Time response; reports the model's outputs at t_end and the energy drift."""
+    if hasattr(system, "modes"):
+        from mechgen.analyses.simulate_hybrid import run_hybrid
+
+        return run_hybrid(system, options, context)
     q0, v0 = initial_state(system, options)
     t_end = float(options["t_end"])
     method = options.get("method", "BDF")

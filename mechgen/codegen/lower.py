@@ -33,7 +33,9 @@ def canonical_block(gathers: list[tuple[sp.Symbol, str, int, bool]], writes: lis
             local = sp.Symbol(f"g{len(kept)}", real=True)
             rename[sym] = local
             kept.append(Gather(local, port, index, relative))
-    exprs = [w.expr.xreplace(rename) for w in writes]
+    # derivatives of sign/Abs/Heaviside are taken almost everywhere: their DiracDelta terms are dropped (a contact
+    # law k |x|^n sign(x) has the stiffness k n |x|^(n-1), not a delta at x = 0)
+    exprs = [_almost_everywhere(w.expr).xreplace(rename) for w in writes]
     stray = set().union(*(e.free_symbols for e in exprs)) - set(rename.values()) if exprs else set()
     if stray:
         names = ", ".join(sorted(s.name for s in stray))
@@ -51,6 +53,13 @@ def canonical_block(gathers: list[tuple[sp.Symbol, str, int, bool]], writes: lis
     new_writes = tuple(Write(w.port, w.index, e, w.accumulate, w.relative, w.entry)
                        for w, e in zip(writes, exprs))
     return Block(tuple(kept), new_writes, tuple((s, e) for s, e in assignments), loop)
+
+
+def _almost_everywhere(expr: sp.Expr) -> sp.Expr:
+    """``expr`` with every DiracDelta (and derivative of one) replaced by 0."""
+    if not expr.has(sp.DiracDelta):
+        return expr
+    return expr.replace(lambda e: isinstance(e, sp.DiracDelta), lambda e: sp.Integer(0))
 
 
 def dense_writes(port: str, matrix: sp.Matrix) -> list[Write]:

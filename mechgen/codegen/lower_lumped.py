@@ -9,6 +9,11 @@ Kernel names and what they compute (n coordinates, m internal variables):
 * ``rates``     dz/dt = g(q, v, z, t)                  -> g[m]
 * ``rates_tangent``                                    -> g_q[m*n], g_v[m*n], g_z[m*m]
 * ``outputs``   declared outputs and energies          -> one port of length 1 each
+
+A hybrid model (mechgen.symbolic.hybrid) has each of these per mode i, named ``<kernel>__i``, and
+
+* ``guards__i`` the guards leaving mode i, g(q, v, z, t) and dg/dt(q, v, a, z, t) -> g[k], g_t[k]
+* ``reset__j``  the state after reset j, (q+, v+, z+)(q, v, z, t)             -> x[2n+m]
 """
 from __future__ import annotations
 
@@ -56,9 +61,10 @@ def _meta(eqs: LumpedEquations) -> dict:
 
 
 def lower_matrices(eqs: LumpedEquations, name: str, doc: str, mats: dict[str, sp.Matrix], *,
-                   cse: bool = True) -> KernelIR:
-    """A kernel of named matrices of the state (no acceleration input), e.g. a constraint's derivatives."""
-    return _matrix_kernel(eqs, name, doc, mats, accel=False, cse=cse)
+                   cse: bool = True, accel: bool = False) -> KernelIR:
+    """A kernel of named matrices of the state (an acceleration input with ``accel``), e.g. a constraint's
+    derivatives, a hybrid model's guards."""
+    return _matrix_kernel(eqs, name, doc, mats, accel=accel, cse=cse)
 
 
 def lower_lumped(eqs: LumpedEquations, name: str, *, cse: bool = True) -> KernelIR:

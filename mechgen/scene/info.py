@@ -25,7 +25,7 @@ from mechgen import models
 from mechgen.errors import InputError
 
 #: version of the JSON layout of a ModelInfo (part of its cache key)
-INFO_SCHEMA = "model-info-3"
+INFO_SCHEMA = "model-info-4"
 GENERATED = Path(__file__).resolve().parent.parent / "generated"
 
 
@@ -74,6 +74,8 @@ class ModelInfo:
     chain: tuple[str, str] | None = None
     coordinates_all: tuple[str, ...] = ()
     part_params: tuple[str, ...] = ()
+    #: a hybrid model's modes (mechgen.symbolic.hybrid), the initial one first; empty for a smooth model
+    modes: tuple[str, ...] = ()
     file: str | None = field(default=None, compare=False)
     #: the canonical reference of the model (mechgen.models.resolve): what a scene's run compiles
     key: str = field(default="", compare=False)
@@ -127,7 +129,14 @@ def info_of_model(model) -> ModelInfo:
                      cont.length if cont else None, {k: tuple(v) for k, v in model.parts.items()},
                      model.complementary_fn is not None, tuple(model.field_names),
                      tuple(o.name for o in getattr(model, "shape_outputs", ())), bool(model.internals), chain,
-                     tuple(model.coordinates_all), tuple(model.part_params()), model.file)
+                     tuple(model.coordinates_all), tuple(model.part_params()), _modes(model), model.file)
+
+
+def _modes(model) -> tuple[str, ...]:
+    """The modes of a hybrid model, the initial one first (empty for a smooth one)."""
+    names = tuple(getattr(model, "mode_names", ()))
+    initial = getattr(model, "initial_mode", None)
+    return tuple([initial] + [n for n in names if n != initial]) if names else ()
 
 
 def info_from_json(data: dict, *, file: str | None = None) -> ModelInfo:
@@ -142,7 +151,7 @@ def info_from_json(data: dict, *, file: str | None = None) -> ModelInfo:
     return ModelInfo(data["name"], params, tuple(data["coordinates"]), tuple(data["outputs"]), data["continuum"],
                      data["length"], parts, data["stress_form"], tuple(data["fields"]), tuple(data["shape_outputs"]),
                      data["internals"], tup(data["chain"]), tuple(data["coordinates_all"]),
-                     tuple(data["part_params"]), file)
+                     tuple(data["part_params"]), tuple(data.get("modes", ())), file)
 
 
 def info_key(source: models.ModelSource) -> str | None:

@@ -384,7 +384,8 @@ def _load(path, file: str, overrides: Sequence[str], lookup_model: Callable[...,
     check_params(model, params, written, limits)
     free = _free(file, data, model)
     active = _active(file, data, model)
-    ctx = OptionContext(file, model, params, depends, active or tuple(model.coordinates), active, limits=limits)
+    ctx = OptionContext(file, model, params, depends, active or tuple(model.coordinates), active, limits=limits,
+                        written=written)
     analyses = _analyses(ctx, data)
     for spec in analyses:
         free += [n for n in get_kind(spec.kind).frees(spec.options) if n not in free]

@@ -78,7 +78,7 @@ def plan_scene(scn, *, backend: str | None = None, base: str | Path | None = Non
     main = request_for(info, file_digest(source.file), dict(scn.params), free=free, active=scn.active,
                        kernels=kernels, backend=backend, source=source.key)
     points = {a.name: [point_request(main, info, p) for p in a.options["grid"]]
-              for a in scn.analyses if a.kind == "sweep"}
+              for a in scn.analyses if "grid" in a.options}
     return ScenePlan(main, points, source, info)
 
 

@@ -90,10 +90,11 @@ def _scalar(value: object, what: str, model: Model) -> sp.Expr:
     return as_expr(value, what, model)
 
 
-def _forces(model: Model, names, env) -> list[sp.Expr]:
-    if model.forces_fn is None:
+def _forces(model: Model, names, env, fn=None) -> list[sp.Expr]:
+    fn = model.forces_fn if fn is None else fn
+    if fn is None:
         return [sp.Integer(0)] * len(names)
-    raw = call_declared(model.forces_fn, **env)
+    raw = call_declared(fn, **env)
     if not isinstance(raw, dict):
         raw = dict(zip(model.coordinate_names, raw))
     unknown = set(raw) - set(model.coordinate_names)
@@ -118,21 +119,38 @@ def lagrange_residual(T: sp.Expr, V: sp.Expr, R: sp.Expr, q, v, a) -> list[sp.Ex
     return res
 
 
-def derive_lumped(model: Model, spec: Specialization) -> LumpedEquations:
-    """Derive the residual, internal rates and outputs of a lumped model."""
+def _energy(model: Model, scope, what: str, env) -> sp.Expr:
+    """The model-wide energy ``what`` plus the mode's own (``scope``: a ModeScope or None)."""
+    total = sp.Integer(0)
+    for owner in (model, scope):
+        fn = getattr(owner, f"{what}_fn", None) if owner is not None else None
+        if fn is not None:
+            total += _scalar(call_declared(fn, **env), what, model)
+    return total
+
+
+def derive_lumped(model: Model, spec: Specialization, mode: str | None = None) -> LumpedEquations:
+    """Derive the residual, internal rates and outputs of a lumped model (of one mode of a hybrid model:
+    the model-wide terms plus the mode's, mechgen.symbolic.hybrid)."""
     if model.is_lattice:
         raise ModelError(f"model {model.name} is a lattice; use derive_lattice", file=model.file)
+    scope = model.mode_scopes[mode] if mode is not None else None
     names, q, v, a, z, q_ns, v_ns, z_ns = _state_symbols(model, spec)
     p_ns, free = param_namespace(model, spec)
     env = {"q": q_ns, "v": v_ns, "z": z_ns, "p": p_ns, "t": TIME}
-    zero = sp.Integer(0)
-    T = _scalar(call_declared(model.kinetic_fn, **env), "kinetic", model) if model.kinetic_fn else zero
-    V = _scalar(call_declared(model.potential_fn, **env), "potential", model) if model.potential_fn else zero
-    R = _scalar(call_declared(model.dissipation_fn, **env), "dissipation", model) if model.dissipation_fn else zero
+    T = _energy(model, scope, "kinetic", env)
+    V = _energy(model, scope, "potential", env)
+    R = _energy(model, scope, "dissipation", env)
     Q = _forces(model, names, env)
+    if scope is not None and scope.forces_fn is not None:
+        Q = [a_ + b_ for a_, b_ in zip(Q, _forces(model, names, env, scope.forces_fn))]
     res = [r - Qi for r, Qi in zip(lagrange_residual(T, V, R, q, v, a), Q)]
-    rates = [_scalar(call_declared(i.rate, **env), f"rate of {i.name}", model) for i in model.internals]
-    outputs = {o.name: _scalar(call_declared(o.fn, **env), f"output {o.name}", model) for o in model.outputs}
+    laws = scope.rates if scope is not None else {}
+    rates = [_scalar(call_declared(laws.get(i.name, i.rate), **env), f"rate of {i.name}", model)
+             for i in model.internals]
+    own = scope.outputs if scope is not None else {}
+    outputs = {o.name: _scalar(call_declared(own.get(o.name, o.fn), **env), f"output {o.name}", model)
+               for o in model.outputs}
     outputs.update(kinetic_energy=T, potential_energy=V, energy=T + V)
     return LumpedEquations(
         model=model.name, coordinates=names, q=q, v=v, a=a, z=z, params=free,

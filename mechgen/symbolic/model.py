@@ -279,6 +279,10 @@ class Model:
         self.parts: dict[str, tuple[str, ...]] = {}
         self.shear_pairs: list[tuple[str, str, int]] = []
         self.whirl: tuple[str, str] | None = None
+        #: hybrid models (mechgen.symbolic.hybrid): the modes in declaration order, the initial one, the guards
+        self.mode_scopes: dict = {}
+        self.initial_mode: str | None = None
+        self.guards: list = []
 
     # -- declarations ---------------------------------------------------
     def params(self, *params: Param) -> Namespace:
@@ -549,6 +553,60 @@ class Model:
         """Decorator (lattice): energy of the bond between neighbours, fn(a, b, p)."""
         self.bond_potential_fn = fn
         return fn
+
+    # -- hybrid models (mechgen.symbolic.hybrid) ---------------------------
+    def mode(self, name: str, *, initial: bool = False):
+        """Declare a mode of a hybrid model; returns its :class:`~mechgen.symbolic.hybrid.ModeScope`, whose
+        decorators (kinetic, potential, dissipation, forces, internal, guard, terminal) act in that mode only.
+        The first mode declared is the initial one unless another says ``initial=True``."""
+        from mechgen.symbolic.hybrid import ModeScope
+
+        if self.continuum is not None or self.chain_spec is not None:
+            raise ModelError(f"mode {name!r} of model {self.name}: modes are for lumped models", file=self.file,
+                             key=f"mode {name}", expected="a model of coordinates (no fields, no chain)")
+        check_identifier(name, what="mode", file=self.file)
+        if name in self.mode_scopes:
+            raise ModelError(f"mode {name!r} is declared twice in model {self.name}", file=self.file,
+                             key=f"mode {name}", expected="each mode once")
+        scope = ModeScope(self, name)
+        self.mode_scopes[name] = scope
+        if initial or self.initial_mode is None:
+            self.initial_mode = name
+        return scope
+
+    def hybrid_internal(self, name: str, *, initial: float = 0.0, doc: str = "") -> None:
+        """Add internal variable ``name`` to the state (once; a mode's law declares it, frozen elsewhere)."""
+        if any(i.name == name for i in self.internals):
+            return
+        self.internal(name, rate=lambda: 0, initial=initial, doc=doc)
+
+    def add_guard(self, guard) -> None:
+        """Record a :class:`~mechgen.symbolic.hybrid.Guard` (declared through a mode or :meth:`terminal`)."""
+        self.guards.append(guard)
+
+    def terminal(self, *, direction: str = "both") -> Callable:
+        """Decorator (hybrid): an event function g(q, v, z, p, t) that ends the run in every mode when it
+        changes sign in ``direction`` (rising, falling, both): a projectile at rest."""
+        from mechgen.symbolic.hybrid import Guard, DIRECTIONS
+
+        def register(fn: Callable) -> Callable:
+            if direction not in DIRECTIONS:
+                raise ModelError(f"terminal direction {direction!r} of model {self.name}", file=self.file,
+                                 key="terminal.direction", expected="one of: " + ", ".join(DIRECTIONS))
+            name = check_identifier(getattr(fn, "__name__", "terminal"), what="guard", file=self.file)
+            self.add_guard(Guard(name, fn, None, None, DIRECTIONS[direction], None, True))
+            return fn
+        return register
+
+    @property
+    def is_hybrid(self) -> bool:
+        """True for a model with modes (mechgen.symbolic.hybrid)."""
+        return bool(self.mode_scopes)
+
+    @property
+    def mode_names(self) -> tuple[str, ...]:
+        """The modes in declaration order (empty for a smooth model)."""
+        return tuple(self.mode_scopes)
 
     # -- queries ----------------------------------------------------------
     def param(self, name: str) -> Param:

@@ -1,0 +1,395 @@
+"""Event-driven integration of a hybrid system: integrate a mode, find its guards' zeros, reset, go on.
+
+Between events the state x = (q, v, z) of mode i obeys dx/dt = f_i(t, x) (the mode's first-order
+form, mechgen.runtime.core.system), integrated by scipy's ``OdeSolver`` classes step by step (the
+implicit BDF/Radau/LSODA with the mode's generated Jacobian, or the explicit RK45/DOP853). After
+every accepted step [t0, t1] the guards g_k of the mode are checked on the step, an event is
+located on the step's dense output and the state there is recomputed to the integrator's own
+accuracy; the reset then gives the state the next mode starts from.
+
+Rules (the documented behaviour of each hard case):
+
+* **Crossing.** A guard fires when its sign changes the way of its direction (rising: - to +,
+  falling: + to -, both: either) between two points of a step where it is evaluated. The sign
+  tracked is the last nonzero one, so a guard that touches zero and turns back (**grazing**)
+  never fires.
+* **Missed events.** A step is checked at its ends with the values g and the rates dg/dt (the
+  generated ``g_t`` kernel): the interval is split in two (dense output, up to
+  :data:`MAX_DEPTH` times, 2^-12 of the step) whenever a double crossing inside it is possible:
+  the cubic Hermite interpolant of g through both ends changes sign inside, or g reaches zero
+  within the interval when extrapolated from either end at its rate. A guard oscillating faster
+  than the dynamics (g = x - A sin(w t), w large) is resolved this way; one that crosses twice
+  inside 2^-12 of a step while its sampled values and rates all keep away from zero can be missed.
+* **Location.** The zero is found by Brent's method on g along the dense output (to a few
+  machine epsilons in t); the state there is integrated afresh from the step's start to that
+  time (the dense output of the implicit methods is less accurate than their steps), and one
+  Newton correction t* = t - g/g_t, x* = x + (t* - t) f(x) puts g to zero at that accuracy.
+* **Simultaneous events.** The earliest zero wins; zeros within the location tolerance
+  (:func:`time_tolerance`) are a tie, won by a terminal guard, then by the guard declared first.
+* **Start of a mode** (t = 0 or just after a reset). A guard within the location tolerance of
+  zero at its rate (|g| <= |g_t| dt_tol, or g = 0) takes the sign it is moving to; it fires at once
+  when that motion is its direction (an impact starting at contact, t = 0: the event is logged at
+  t = 0). When g = 0 and g_t = 0 its sign is taken from the first point where it is nonzero.
+* **Zeno / chattering.** More than ``zeno_events`` events within ``zeno_span`` (default 1e-9
+  t_end), or more than ``max_events`` in all, end the run with BudgetExceeded (exit 1) naming the
+  time, the mode and the key; never a hang.
+"""
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from mechgen.errors import ConvergenceError, KernelError
+from mechgen.runtime.core.budget import Budget, BudgetExceeded, Progress
+from mechgen.runtime.core.integrate import IMPLICIT, METHODS
+
+#: a suspicious interval of a step is halved at most this many times (2^-12 of the step)
+MAX_DEPTH = 12
+EPS = float(np.finfo(float).eps)
+
+
+@dataclass(frozen=True)
+class EventRules:
+    """Bounds of the event loop: at most ``max_events`` events, and no ``zeno_events`` of them within
+    ``zeno_span`` (None: 1e-9 t_end)."""
+
+    max_events: int = 10_000
+    zeno_events: int = 100
+    zeno_span: float | None = None
+
+
+@dataclass(frozen=True)
+class Event:
+    """One event: time, the mode left and the mode entered (None: the run ended), the guard, the states."""
+
+    t: float
+    source: int
+    target: int | None
+    guard: str
+    x_before: np.ndarray
+    x_after: np.ndarray
+
+
+@dataclass(frozen=True)
+class HybridTrajectory:
+    """Samples (t, x, mode index per sample), the events, and where the run ended."""
+
+    t: np.ndarray
+    x: np.ndarray
+    mode: np.ndarray
+    events: tuple
+    final_mode: int
+    t_final: float
+    x_final: np.ndarray
+    terminated: bool
+    steps: int = 0
+    nfev: int = 0
+    njev: int = 0
+    guard_evaluations: int = 0
+    extra: dict = field(default_factory=dict)
+
+
+def time_tolerance(t: float, t_end: float) -> float:
+    """The location tolerance in time: a guard within |g_t| times this of zero is on its surface."""
+    return max(1e-12 * abs(t_end), 64 * EPS * abs(t))
+
+
+def _solver_class(method: str):
+    import scipy.integrate as si
+
+    return {"BDF": si.BDF, "Radau": si.Radau, "LSODA": si.LSODA, "RK45": si.RK45, "DOP853": si.DOP853}[method]
+
+
+class _Segment:
+    """The flow of one mode with its guards: rhs, Jacobian and guard evaluations counted."""
+
+    def __init__(self, system, mode: int) -> None:
+        self.system = system
+        self.index = mode
+        self.view = system.mode(mode)
+        self.guards = system.guards(mode)
+        self.evaluations = 0
+
+    def rhs(self, t, x):
+        return self.view.rhs(t, x)
+
+    def jac(self, t, x):
+        return self.view.jacobian(t, x)
+
+    def values(self, t: float, x: np.ndarray, with_rates: bool = True):
+        """(g, g_t) at (t, x); g_t from the mode's dx/dt there (zeros without ``with_rates``)."""
+        self.evaluations += 1
+        dxdt = self.view.rhs(t, x) if with_rates else None
+        g, g_t = self.system.guard_values(self.index, t, x, dxdt)
+        return g, (g_t if with_rates else np.zeros_like(g))
+
+
+def _possible_crossing(sign: np.ndarray, ga, da, gb, db, h: float) -> np.ndarray:
+    """Guards that may cross zero (twice) inside an interval of length h whose ends keep the sign ``sign``:
+    the cubic Hermite through (ga, da), (gb, db) changes sign inside, or g reaches zero within h at either
+    end's rate."""
+    s = np.where(sign != 0, sign, np.sign(ga))
+    reach = (s * ga - h * np.maximum(0.0, -s * da) <= 0) | (s * gb - h * np.maximum(0.0, s * db) <= 0)
+    # cubic Hermite p(u) on u in [0, 1]: its interior extrema
+    c1, c2 = h * da, 3 * (gb - ga) - h * (2 * da + db)
+    c3 = 2 * (ga - gb) + h * (da + db)
+    cubic = np.zeros_like(reach)
+    for k in np.flatnonzero(~reach & (s != 0)):
+        roots = np.roots([3 * c3[k], 2 * c2[k], c1[k]]) if (c3[k] or c2[k]) else np.array([])
+        for u in roots[np.isreal(roots)].real:
+            if 0 < u < 1 and s[k] * (ga[k] + c1[k] * u + c2[k] * u**2 + c3[k] * u**3) < 0:
+                cubic[k] = True
+    return (reach | cubic) & (s != 0)
+
+
+def _crossed(sign: np.ndarray, g: np.ndarray, directions: np.ndarray) -> np.ndarray:
+    """Guards whose tracked sign ``sign`` flips to the sign of g the way of their direction."""
+    new = np.sign(g)
+    flip = (sign != 0) & (new != 0) & (new == -sign)
+    return flip & ((directions == 0) | (directions == new))
+
+
+def integrate_hybrid(system, x0, t_end: float, *, mode: int | None = None, method: str = "Radau",
+                     rtol: float = 1e-8, atol: float = 1e-10, t_eval=None, budget: Budget | None = None,
+                     rules: EventRules = EventRules(), progress: bool = False, desc: str = "simulate",
+                     explain: Callable | None = None,
+                     stop_after: Callable[[Event], bool] | None = None) -> HybridTrajectory:
+    """Integrate a :class:`~mechgen.runtime.core.hybrid_system.HybridSystem` from x0 at t = 0 in ``mode``
+    (default its initial mode) to t_end or a terminal event, by the rules of the module doc.
+
+    Samples are taken at ``t_eval`` (sorted, in [0, t_end]), else at every step end and on both
+    sides of every event. ``budget`` counts accepted steps; ``rules`` bound the events;
+    ``stop_after(event)`` true ends the run after that event (an impact measured up to its release).
+    """
+    if method not in METHODS:
+        raise ValueError(f"unknown method {method!r}; expected one of {METHODS}")
+    t_end = float(t_end)
+    mode = system.initial_mode if mode is None else int(mode)
+    t_eval = None if t_eval is None else np.asarray(t_eval, float)
+    zeno_span = rules.zeno_span if rules.zeno_span is not None else 1e-9 * t_end
+    names = system.modes
+    ts, xs, ms = [], [], []
+    events: list[Event] = []
+    recent: deque = deque(maxlen=max(2, rules.zeno_events))
+    stats = {"steps": 0, "nfev": 0, "njev": 0, "guards": 0}
+    i_eval = 0
+    t, x = 0.0, np.array(x0, float)
+    terminated = False
+
+    def sample_until(t_hi: float, dense, seg: int, inclusive: bool) -> None:
+        nonlocal i_eval
+        if t_eval is None:
+            return
+        side = "right" if inclusive else "left"
+        i_new = int(np.searchsorted(t_eval, t_hi, side=side))
+        if i_new > i_eval:
+            chunk = t_eval[i_eval:i_new]
+            ts.append(chunk)
+            xs.append(np.atleast_2d(dense(chunk).T) if dense is not None else np.tile(x, (len(chunk), 1)))
+            ms.append(np.full(len(chunk), seg))
+            i_eval = i_new
+
+    def record(tk: float, xk: np.ndarray, seg: int) -> None:
+        if t_eval is None:
+            ts.append(np.array([tk]))
+            xs.append(np.array(xk, float)[None, :])
+            ms.append(np.array([seg]))
+
+    def where(tk: float, seg: int) -> str:
+        return f"t = {tk:.9g} of t_end = {t_end:.6g} in mode {names[seg]}"
+
+    def fire(seg: "_Segment", k: int, tk: float, xk: np.ndarray) -> tuple[int | None, np.ndarray]:
+        info = seg.guards[k]
+        x_after = xk if info.reset is None else system.reset(info.reset, tk, xk)
+        if not np.all(np.isfinite(x_after)):
+            raise KernelError(f"reset of guard {info.name} gave NaN/Inf at {where(tk, seg.index)}")
+        target = None if info.terminal else info.to
+        events.append(Event(tk, seg.index, target, info.name, np.array(xk), np.array(x_after)))
+        recent.append(tk)
+        if len(events) > rules.max_events:
+            raise BudgetExceeded(f"events: more than max_events = {rules.max_events:,} events", key="max_events",
+                                 reached=where(tk, seg.index))
+        if len(recent) == recent.maxlen and recent[-1] - recent[0] <= zeno_span:
+            raise BudgetExceeded(f"events: {len(recent)} events within {recent[-1] - recent[0]:.3g} (at most "
+                                 f"zeno_span = {zeno_span:.3g}): a Zeno or chattering approach (guard {info.name} "
+                                 f"of mode {names[seg.index]})", key="zeno_events", reached=where(tk, seg.index))
+        return target, x_after
+
+    record(t, x, mode)
+    with Progress(t_end, desc=desc, unit="t", enabled=progress) as bar:
+        while True:
+            seg = _Segment(system, mode)
+            directions = np.array([g.direction for g in seg.guards], dtype=float)
+            g0, d0 = seg.values(t, x)
+            tol = time_tolerance(t, t_end)
+            surface = (g0 == 0) | (np.abs(g0) <= np.abs(d0) * tol)
+            sign = np.where(surface, np.sign(d0), np.sign(g0))
+            at_once = [k for k in np.flatnonzero(surface & (sign != 0))
+                       if directions[k] in (0, sign[k])]
+            if at_once:
+                k = at_once[0]  # the guards are in priority order: terminal first, then declared order
+                target, x = fire(seg, k, t, x)
+                record(t, x, mode if target is None else target)
+                if target is None or (stop_after is not None and stop_after(events[-1])):
+                    terminated = True
+                    mode = mode if target is None else target
+                    break
+                mode = target
+                continue
+            if t >= t_end:
+                break
+            hit = _integrate_segment(seg, x, t, t_end, method, rtol, atol, sign, directions, budget, stats,
+                                     sample_until, record, bar, explain, where)
+            if hit is None:
+                t, x = t_end, hit_state(stats)
+                break
+            k, t, x_before = hit
+            sample_until(t, stats["dense"], mode, inclusive=True)
+            target, x = fire(seg, k, t, x_before)
+            record(t, x_before, mode)
+            record(t, x, mode if target is None else target)
+            stats["guards"] += seg.evaluations
+            if target is None or (stop_after is not None and stop_after(events[-1])):
+                terminated = True
+                mode = mode if target is None else target
+                break
+            mode = target
+    t_out = np.hstack(ts) if ts else np.empty(0)
+    x_out = np.vstack(xs) if xs else np.empty((0, np.size(x0)))
+    m_out = np.hstack(ms).astype(int) if ms else np.empty(0, int)
+    return HybridTrajectory(t_out, x_out, m_out, tuple(events), mode, float(t), np.array(x), terminated,
+                            stats["steps"], stats["nfev"], stats["njev"], stats["guards"])
+
+
+def hit_state(stats: dict) -> np.ndarray:
+    """The state at the end of the last segment (t_end reached without an event)."""
+    return stats["y_end"]
+
+
+def _integrate_segment(seg, x, t, t_end, method, rtol, atol, sign, directions, budget, stats, sample_until,
+                       record, bar, explain, where):
+    """Integrate one mode from (t, x) until a guard fires (-> (guard, t*, x*)) or t_end (-> None)."""
+    from numpy.linalg import LinAlgError
+
+    kwargs = {"jac": seg.jac} if method in IMPLICIT else {}
+    try:
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            solver = _solver_class(method)(seg.rhs, t, x, t_end, rtol=rtol, atol=atol, **kwargs)
+        y_old, t_old = np.array(x), t
+        g_old, d_old = seg.values(t, x)
+        while solver.status == "running":
+            with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+                message = solver.step()
+            if solver.status == "failed":
+                raise ConvergenceError(f"{method} stopped at {where(solver.t, seg.index)}: "
+                                       f"{str(message).rstrip('.')}")
+            stats["steps"] += 1
+            t_new, y_new = solver.t, np.array(solver.y)
+            if not np.all(np.isfinite(y_new)):
+                raise KernelError(f"{method}: state became NaN/Inf by {where(t_new, seg.index)}")
+            dense = solver.dense_output()
+            stats["dense"] = dense
+            g_new, d_new = seg.values(t_new, y_new)
+            found = _scan(seg, dense, sign, directions, (t_old, g_old, d_old), (t_new, g_new, d_new))
+            if found is not None:
+                k, t_lo, t_hi = found
+                t_star, x_star = _locate(seg, dense, k, t_lo, t_hi, t_old, y_old, method, rtol, atol, kwargs,
+                                         t_end)
+                stats["nfev"] += solver.nfev
+                stats["njev"] += getattr(solver, "njev", 0)
+                return k, t_star, x_star
+            nonzero = np.sign(g_new) != 0
+            sign = np.where(nonzero, np.sign(g_new), sign)
+            sample_until(t_new, dense, seg.index, inclusive=True)
+            record(t_new, y_new, seg.index)
+            if budget is not None:
+                budget.spend(1, lambda: where(t_new, seg.index))
+            bar.to(t_new)
+            t_old, y_old, g_old, d_old = t_new, y_new, g_new, d_new
+    except (LinAlgError, ZeroDivisionError, ValueError) as exc:
+        why = explain(t_old, y_old) if explain is not None else ""
+        raise ConvergenceError(f"{method} failed near {where(t_old, seg.index)} ({exc})"
+                               + (f"; {why}" if why else "")) from exc
+    stats["nfev"] += solver.nfev
+    stats["njev"] += getattr(solver, "njev", 0)
+    stats["y_end"] = np.array(solver.y)
+    return None
+
+
+def _scan(seg, dense, sign, directions, a, b):
+    """The earliest interval (guard, t_lo, t_hi) of the step [a, b] in which a guard crosses, or None.
+
+    ``a`` and ``b`` are (t, g, g_t) at the step's ends; ``sign`` (updated in place along the way) the
+    tracked signs at the start. Suspicious intervals are halved (module doc, "Missed events")."""
+    stack = [(a, b, 0)]
+    while stack:
+        (ta, ga, da), (tb, gb, db), depth = stack.pop()
+        crossed = _crossed(sign, gb, directions)
+        double = _possible_crossing(sign, ga, da, gb, db, tb - ta) & ~crossed
+        if (crossed.any() or double.any()) and depth < MAX_DEPTH and (double.any() or _many_roots(ga, da, gb, db,
+                                                                                                  tb - ta, crossed)):
+            tm = 0.5 * (ta + tb)
+            xm = dense(tm)
+            gm, dm = seg.values(tm, xm)
+            stack.append(((tm, gm, dm), (tb, gb, db), depth + 1))
+            stack.append(((ta, ga, da), (tm, gm, dm), depth + 1))
+            continue
+        if crossed.any():
+            ks = np.flatnonzero(crossed)
+            roots = [(_root(seg, dense, k, ta, tb), k) for k in ks]
+            t_first = min(r for r, _ in roots)
+            tol = time_tolerance(t_first, tb)
+            k = min(k for r, k in roots if r <= t_first + tol)  # tie: the first in priority order
+            return k, ta, tb
+        nonzero = np.sign(gb) != 0
+        sign[...] = np.where(nonzero, np.sign(gb), sign)
+    return None
+
+
+def _many_roots(ga, da, gb, db, h, crossed) -> bool:
+    """Whether a crossing guard's cubic Hermite on the interval has an interior extremum (maybe 3 roots)."""
+    for k in np.flatnonzero(crossed):
+        c1, c2, c3 = h * da[k], 3 * (gb[k] - ga[k]) - h * (2 * da[k] + db[k]), 2 * (ga[k] - gb[k]) + h * (da[k] + db[k])
+        roots = np.roots([3 * c3, 2 * c2, c1]) if (c3 or c2) else np.array([])
+        if any(0 < u < 1 for u in roots[np.isreal(roots)].real):
+            return True
+    return False
+
+
+def _root(seg, dense, k: int, ta: float, tb: float) -> float:
+    """The zero of guard k on [ta, tb] along the dense output (Brent's method, a few epsilons in t)."""
+    from scipy.optimize import brentq
+
+    def g(tt):
+        return seg.values(tt, dense(tt), with_rates=False)[0][k]
+
+    ga, gb = g(ta), g(tb)
+    if ga == 0:
+        return ta
+    if gb == 0 or np.sign(ga) == np.sign(gb):
+        return tb
+    return brentq(g, ta, tb, xtol=4 * EPS * max(abs(ta), abs(tb), 1e-300), rtol=4 * EPS, maxiter=200)
+
+
+def _locate(seg, dense, k, t_lo, t_hi, t_old, y_old, method, rtol, atol, kwargs, t_end):
+    """(t*, x*) of guard k's zero in [t_lo, t_hi]: the dense output's zero, the state integrated afresh from
+    the step's start (t_old, y_old) to it, and one Newton correction on g."""
+    t_d = _root(seg, dense, k, t_lo, t_hi)
+    if t_d > t_old:
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            fresh = _solver_class(method)(seg.rhs, t_old, y_old, t_d, rtol=rtol, atol=atol,
+                                          first_step=t_d - t_old, **kwargs)
+            while fresh.status == "running":
+                fresh.step()
+        x_d = np.array(fresh.y) if fresh.status == "finished" else dense(t_d)
+    else:
+        x_d = np.array(y_old)
+    f = seg.rhs(t_d, x_d)
+    g, g_t = seg.system.guard_values(seg.index, t_d, x_d, f)
+    if g_t[k] != 0 and abs(g[k] / g_t[k]) <= max(t_hi - t_lo, time_tolerance(t_d, t_end)):
+        dt = -g[k] / g_t[k]
+        return t_d + dt, x_d + dt * f
+    return t_d, x_d
