@@ -118,6 +118,14 @@ class CPrinter(_Numbers, C99CodePrinter):
     def _print_Pi(self, expr):
         return repr(float(sp.pi))
 
+    def _print_signed_power(self, expr):
+        x, n = (self._print(a) for a in expr.args)
+        return f"copysign(pow(fabs({x}), {n}), {x})"
+
+    def _print_abs_power(self, expr):
+        x, n = (self._print(a) for a in expr.args)
+        return f"pow(fabs({x}), {n})"
+
 
 class NumpyPrinter(_Numbers, PythonCodePrinter):
     """Printer for vectorised numpy code (module imported as ``np``)."""
@@ -142,6 +150,16 @@ class NumpyPrinter(_Numbers, PythonCodePrinter):
     _print_sin = _print_cos = _print_tan = _print_asin = _print_acos = _print_atan = _print_Function
     _print_atan2 = _print_sinh = _print_cosh = _print_tanh = _print_exp = _print_log = _print_Function
     _print_Abs = _print_sign = _print_Max = _print_Min = _print_Function
+
+    def _print_signed_power(self, expr):
+        x, n = (self._print(a) for a in expr.args)
+        m = self._module
+        return f"({m}.sign({x})*{m}.{self._np_names['Abs'] if 'Abs' in self._np_names else 'abs'}({x})**({n}))"
+
+    def _print_abs_power(self, expr):
+        x, n = (self._print(a) for a in expr.args)
+        m = self._module
+        return f"({m}.{self._np_names['Abs'] if 'Abs' in self._np_names else 'abs'}({x})**({n}))"
 
     def _print_Pow(self, expr, rational=False):
         text = _power_text(self, expr)

@@ -29,6 +29,7 @@ import sympy as sp
 
 from mechgen.symbolic.model import Model
 from mechgen.symbolic.params import Param
+from mechgen.symbolic.powers import abs_power, signed_power
 
 LAWS = ("kelvin_voigt", "modified_kelvin_voigt", "maxwell", "standard_linear", "hunt_crossley")
 
@@ -65,7 +66,7 @@ def contact_force(q, v, z, p):
     if p.law == "standard_linear":
         return _sls(p)[0] * (q.x - z.y)
     alpha = 3 * sp.pi * p.zeta / (2 * p.v_in)
-    return p.k * sp.Abs(q.x) ** p.n * sp.sign(q.x) * (1 + alpha * v.x)
+    return p.k * signed_power(q.x, p.n) * (1 + alpha * v.x)
 
 
 @model.kinetic
@@ -83,7 +84,7 @@ def stored(q, z, p):
     if p.law == "standard_linear":
         k1, k2, _ = _sls(p)
         return k1 / 2 * (q.x - z.y) ** 2 + k2 / 2 * z.y**2
-    return p.k * sp.Abs(q.x) ** (p.n + 1) / (p.n + 1)
+    return p.k * abs_power(q.x, p.n + 1) / (p.n + 1)
 
 
 @contact.dissipation
@@ -93,7 +94,7 @@ def dashpot(q, v, p):
         return p.zeta * sp.sqrt(p.k * p.m) * v.x**2
     if p.law == "hunt_crossley":
         alpha = 3 * sp.pi * p.zeta / (2 * p.v_in)
-        return p.k * alpha * sp.Abs(q.x) ** p.n * v.x**2 / 2
+        return p.k * alpha * abs_power(q.x, p.n) * v.x**2 / 2
     return 0
 
 

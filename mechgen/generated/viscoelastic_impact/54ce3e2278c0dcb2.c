@@ -58,8 +58,7 @@ int mg_residual__1(const double *const *in, double *const *out, const long *size
             const double g1 = in1[0];
             const double g2 = in2[0];
             const double g3 = in5[0];
-            const double t0 = pow(fabs(g0), 1.5);
-            out0[0] = (3.0/2.0)*3.141592653589793*g1*g3*t0 + g2 + 1.0*t0*(((g0) > 0) - ((g0) < 0));
+            out0[0] = (3.0/2.0)*3.141592653589793*g1*g3*pow(fabs(g0), 1.5) + g2 + 1.0*copysign(pow(fabs(g0), 1.5), g0);
         }
     }
     return 0;
@@ -138,12 +137,9 @@ int mg_tangent__1(const double *const *in, double *const *out, const long *sizes
             const double g0 = in0[0];
             const double g1 = in1[0];
             const double g2 = in5[0];
-            const double t0 = fabs(g0);
-            const double t1 = pow(t0, 0.5);
-            const double t2 = (((g0) > 0) - ((g0) < 0));
-            const double t3 = 3.141592653589793*g2;
-            out0[0] = 2.25*g1*t1*t2*t3 + 1.5*t1*(t2*t2);
-            out1[0] = (3.0/2.0)*pow(t0, 1.5)*t3;
+            const double t0 = 3.141592653589793*g2;
+            out0[0] = 2.25*g1*t0*copysign(pow(fabs(g0), 0.5), g0) + 1.5*pow(fabs(g0), 0.5);
+            out1[0] = (3.0/2.0)*t0*pow(fabs(g0), 1.5);
             out2[0] = 1.0;
         }
     }
@@ -350,15 +346,14 @@ int mg_outputs__1(const double *const *in, double *const *out, const long *sizes
             const double g0 = in0[0];
             const double g1 = in1[0];
             const double g2 = in4[0];
-            const double t0 = fabs(g0);
-            const double t1 = (1.0/2.0)*(g1*g1);
-            const double t2 = 0.4*pow(t0, 2.5);
+            const double t0 = (1.0/2.0)*(g1*g1);
+            const double t1 = 0.4*pow(fabs(g0), 2.5);
             out0[0] = g0;
             out1[0] = g1;
-            out2[0] = pow(t0, 1.5)*((3.0/2.0)*3.141592653589793*g1*g2 + 1.0)*(((g0) > 0) - ((g0) < 0));
-            out3[0] = t1;
-            out4[0] = t2;
-            out5[0] = t1 + t2;
+            out2[0] = ((3.0/2.0)*3.141592653589793*g1*g2 + 1.0)*copysign(pow(fabs(g0), 1.5), g0);
+            out3[0] = t0;
+            out4[0] = t1;
+            out5[0] = t0 + t1;
         }
     }
     return 0;
