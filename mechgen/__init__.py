@@ -7,7 +7,7 @@ The public names (DESIGN.md, "the user's three jobs"), importable from ``mechgen
 * compiling it: ``compile(model, params=..., backend=...)`` -> an immutable compiled system
   (``with_params(**values)`` gives a new one);
 * one function per analysis kind, each returning a ``Result``: ``modes``, ``stability``,
-  ``steady``, ``continuation``, ``simulate``, ``sweep``, ``campbell``; and ``analysis(kind, system,
+  ``steady``, ``continuation``, ``simulate``, ``sweep``, ``campbell``, ``fit``; and ``analysis(kind, system,
   **options)`` for any registered kind by name (``response`` has no function of its own);
 * ``run(scene)``: a scene file (or a dict of its contents), built on the same functions;
 * the errors: ``MechgenError`` and its kinds.
@@ -36,6 +36,7 @@ _EXPORTS = {
     "simulate": "mechgen.analyses.public",
     "sweep": "mechgen.analyses.public",
     "campbell": "mechgen.analyses.public",
+    "fit": "mechgen.analyses.public",
     "analysis": "mechgen.analyses.public",
     "MechgenError": "mechgen.errors",
     "InputError": "mechgen.errors",
