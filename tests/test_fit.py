@@ -99,6 +99,16 @@ def test_as_many_rows_as_parameters_reports_null_standard_errors(pendulum):
     assert any("no degree of freedom" in line for line in get("fit").summary(fit.outputs))
 
 
+def test_parameters_the_data_cannot_separate_get_null_standard_errors(pendulum):
+    # y = a b x determines only the product a b (here 3): J's columns b x and a x are parallel
+    x = np.array([1.0, 2.0, 3.0, 4.0])
+    fit = mechgen.fit(pendulum, parameters=["a", "b"], start={"a": 1.0, "b": 2.0}, data={"x": x, "y": 3.0 * x},
+                      observed="y", expression="a * b * x")
+    assert fit["a"] * fit["b"] == pytest.approx(3.0, rel=1e-9)
+    assert fit["a_stderr"] is None and fit["covariance"] is None and fit["dof"] == 2
+    assert any("do not determine" in line for line in get("fit").summary(fit.outputs))
+
+
 T = np.linspace(0.0, 4.0, 40)
 DECAY = {"parameters": ["A", "tau", "c"], "start": {"A": 1.0, "tau": 3.0, "c": 0.0}, "observed": "y",
          "expression": "A * exp(-t / tau) + c"}
@@ -110,6 +120,20 @@ def test_noise_free_decay_is_recovered_exactly(pendulum):
     assert [fit["A"], fit["tau"], fit["c"]] == pytest.approx([2.5, 0.8, 0.3], rel=1e-9)
     assert max(fit["A_stderr"], fit["tau_stderr"], fit["c_stderr"]) < 1e-9
     assert fit["rms"] < 1e-12 and fit["converged"]
+
+
+def test_a_trial_step_outside_the_domain_is_shortened_and_a_bad_start_is_refused(pendulum):
+    # y = 2 sqrt(x - 0.99): Gauss-Newton steps from these starts overshoot a past min(x) = 1, where
+    # sqrt is undefined; the trust region shrinks instead and the closed form's a, b come back
+    x = np.array([1.0, 1.5, 2.0, 3.0, 4.0, 6.0])
+    data = {"x": x, "y": 2.0 * np.sqrt(x - 0.99)}
+    for start in ({"a": 0.0, "b": 1.0}, {"a": -5.0, "b": 0.2}, {"a": 0.5, "b": 10.0}):
+        fit = mechgen.fit(pendulum, parameters=["a", "b"], start=start, data=data, observed="y",
+                          expression="b * sqrt(x - a)")
+        assert [fit["a"], fit["b"]] == pytest.approx([0.99, 2.0], rel=1e-9)
+    with pytest.raises(SceneError, match=r"fit.expression.*not finite.*data row 1 \(parameters a = 2, b = 1\)"):
+        mechgen.fit(pendulum, parameters=["a", "b"], start={"a": 2.0, "b": 1.0}, data=data, observed="y",
+                    expression="b * sqrt(x - a)")
 
 
 def test_noisy_decay_standard_errors_match_theory_and_monte_carlo(pendulum):
@@ -213,6 +237,21 @@ def test_scene_with_a_csv_file_runs_from_the_command_line(tmp_path, capsys):
     assert [outputs["K_stderr"], outputs["k_stderr"]] == pytest.approx(np.sqrt(np.diag(C)), rel=1e-10)
     assert spring["outputs"]["k"] == pytest.approx(40.0, rel=1e-10)   # the spring frequencies sqrt(40 / m)
     assert "K: 611.607 +- 9.27798" in out
+
+
+def test_a_scene_that_needs_no_kernels_is_cached_like_any_other(tmp_path, monkeypatch):
+    """An expression fit compiles a request for no kernels; its cache entry is valid on the next run
+    (it was once refused as damaged, 'no kernel specs', warned about and rebuilt every run)."""
+    import warnings
+
+    from mechgen.scene.run import system_for
+
+    monkeypatch.setenv("MECHGEN_CACHE", str(tmp_path / "cache"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        _, first = system_for("spring_pendulum", (), (), None, (), "numpy", fresh=True)
+        _, second = system_for("spring_pendulum", (), (), None, (), "numpy", fresh=True)
+    assert first.kernels == second.kernels == {} and second.cached
 
 
 def test_scene_plots_data_and_residuals(tmp_path, capsys):

@@ -50,11 +50,17 @@ from mechgen.analyses import fit_data, summary
 from mechgen.analyses.fit_check import check, frees, needs, SCHEMA
 from mechgen.analyses.fit_model import AnalysisModel, ExpressionModel
 from mechgen.analyses.registry import AnalysisKind, register
+from mechgen.errors import SceneError
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget
 
 
 class _Cached:
-    """The model at the latest parameters asked for (least_squares asks for f, then J, at the same point)."""
+    """The model at the latest parameters asked for (least_squares asks for f, then J, at the same point).
+
+    An expression outside its domain (sqrt of a negative number ...) at a trial point after the start
+    gives NaN residuals, on which least_squares (trf) shrinks its trust region and tries a shorter step;
+    at the start it is the scene's error.
+    """
 
     def __init__(self, model, rows: np.ndarray, budget: Budget) -> None:
         self.model, self.rows, self.budget = model, rows, budget
@@ -63,7 +69,13 @@ class _Cached:
     def __call__(self, theta: np.ndarray):
         if self.theta is None or not np.array_equal(theta, self.theta):
             self.budget.spend(1, lambda: f"{self.budget.used - 1} evaluations")
-            self.value, self.theta = self.model.predict(theta, self.rows), np.array(theta)
+            try:
+                value = self.model.predict(theta, self.rows)
+            except SceneError:
+                if self.theta is None or not self.model.exact:
+                    raise
+                value = (np.full(len(self.rows), np.nan), None)
+            self.value, self.theta = value, np.array(theta)
         return self.value
 
 
