@@ -7,8 +7,8 @@ The public names (DESIGN.md, "the user's three jobs"), importable from ``mechgen
 * compiling it: ``compile(model, params=..., backend=...)`` -> an immutable compiled system
   (``with_params(**values)`` gives a new one);
 * one function per analysis kind, each returning a ``Result``: ``modes``, ``stability``,
-  ``steady``, ``continuation``, ``simulate``, ``sweep``, ``campbell``, ``impact``, ``restitution``; and
-  ``analysis(kind, system,
+  ``steady``, ``continuation``, ``simulate``, ``sweep``, ``campbell``, ``fit``, ``impact``, ``restitution``;
+  and ``analysis(kind, system,
   **options)`` for any registered kind by name (``response`` has no function of its own);
 * ``run(scene)``: a scene file (or a dict of its contents), built on the same functions;
 * the errors: ``MechgenError`` and its kinds.
@@ -37,6 +37,7 @@ _EXPORTS = {
     "simulate": "mechgen.analyses.public",
     "sweep": "mechgen.analyses.public",
     "campbell": "mechgen.analyses.public",
+    "fit": "mechgen.analyses.public",
     "impact": "mechgen.analyses.public",
     "restitution": "mechgen.analyses.public",
     "analysis": "mechgen.analyses.public",

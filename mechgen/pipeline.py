@@ -395,14 +395,15 @@ def committed_document(request: CompileRequest, key: str, generated: dict, text_
 _NAME_CHARS = frozenset("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_")
 
 
-def specs_problem(specs, text: str, backend: str, free=None) -> str | None:
+def specs_problem(specs, text: str, backend: str, free=None, *, empty: bool = False) -> str | None:
     """Why ``specs`` are not kernel specs of ``text`` (None when they are).
 
-    Each spec is an object named by its key (an identifier) with lists of input and output ports, a list
+    ``empty``: no specs at all is right (a request for no kernels: a scene whose analyses, such as an
+    expression ``fit``, use none). Each spec is an object named by its key (an identifier) with lists of input and output ports, a list
     of size names and a meta object whose ``params`` are among ``free`` (when given); ``text`` defines
     each kernel (``mg_NAME(`` in C and numpy text, ``build_NAME(`` in CasADi text).
     """
-    if not isinstance(specs, dict) or not specs:
+    if not isinstance(specs, dict) or (not specs and not empty):
         return "no kernel specs"
     for name, spec in specs.items():
         if not (isinstance(name, str) and name and set(name) <= _NAME_CHARS and not name[0].isdigit()):
@@ -440,7 +441,8 @@ def document_problem(doc, key: str, request: CompileRequest | None, text: str, b
         return "it names another request"
     if hashlib.sha256(text.encode("utf-8")).hexdigest() != doc.get("sha256"):
         return "the text does not have its recorded sha256"
-    return specs_problem(doc.get("specs"), text, backend, None if request is None else request.free)
+    return specs_problem(doc.get("specs"), text, backend, None if request is None else request.free,
+                         empty=request is not None and not request.kernels)
 
 
 def read_committed(model: str, key: str, backend: str, root: Path | None = None,

@@ -54,16 +54,17 @@ def _same_as_scene(result: Result, entry: dict) -> None:
 
 
 def test_the_registry_lists_the_seven_kinds_each_with_a_function():
-    # the seven of the refactor first, then kinds added since (response: tests/test_response.py; impact,
-    # restitution: tests/test_impacts.py)
-    assert registry.kinds()[:len(KINDS)] == KINDS and registry.kinds()[len(KINDS):] == ("response", "impact", "restitution")
+    # the seven of the refactor first, then kinds added since (response: tests/test_response.py, fit:
+    # tests/test_fit.py; impact, restitution: tests/test_impacts.py)
+    assert registry.kinds()[:len(KINDS)] == KINDS
+    assert registry.kinds()[len(KINDS):] == ("response", "fit", "impact", "restitution")
     for kind in KINDS:
         record = registry.get(kind)
         assert record.name == kind and record.schema and callable(record.run) and callable(record.summary)
         assert callable(getattr(mechgen, kind)) and getattr(mechgen, kind).__module__ == "mechgen.analyses.public"
     assert [k for k in KINDS if registry.get(k).sweepable] == ["modes", "stability", "steady", "simulate"]
-    with pytest.raises(InputError, match="unknown analysis kind 'fit'"):
-        registry.get("fit")
+    with pytest.raises(InputError, match="unknown analysis kind 'levitate'"):
+        registry.get("levitate")
 
 
 def test_the_package_names_no_kind_of_its_own():

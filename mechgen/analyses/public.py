@@ -18,8 +18,8 @@ from mechgen.analyses.result import Result, run_analysis
 from mechgen.analyses.schema import OptionContext, validate
 from mechgen.errors import InputError
 
-__all__ = ["analysis", "campbell", "continuation", "impact", "modes", "restitution", "simulate", "stability", "steady",
-           "sweep"]
+__all__ = ["analysis", "campbell", "continuation", "fit", "impact", "modes", "restitution", "simulate", "stability",
+           "steady", "sweep"]
 
 
 def _model_info(system):
@@ -184,6 +184,22 @@ def continuation(system, about, *, name: str | None = None, **options) -> Result
     ``status``, ``points`` ...
     """
     return _run("continuation", system, {"about": about, **options}, name)
+
+
+def fit(system, *, name: str | None = None, **options) -> Result:
+    """Least-squares estimates of ``parameters`` from ``data`` (scipy.optimize.least_squares).
+
+    Options (scene keys of ``kind = "fit"``, mechgen.analyses.fit): ``parameters`` (names, required),
+    ``data`` ({column: values} or a CSV path, relative to the working directory), ``observed`` (the
+    column to reproduce), ``sigma``, ``group``, ``start``, ``tol``, ``max_seconds``,
+    ``max_evaluations``, and the model: ``expression`` (a formula of columns, ``constants`` and the
+    parameters; ``system`` is then not used) or ``analysis`` ({"kind": "modes", ...}) with ``output``
+    ("name" or "name[i]") and ``inputs`` (columns that set model parameters per row; they and the
+    parameters must be free in ``system``), ``jacobian``, ``diff_step``. Outputs: each parameter
+    ``p`` and ``p_stderr``, ``residuals``, ``fitted``, ``observed``, ``rms``, ``dof``,
+    ``covariance``, ``converged``, ``evaluations`` (``groups`` when grouped) ...
+    """
+    return _run("fit", system, options, name)
 
 
 def sweep(system, analysis: str = "modes", grid: Mapping[str, Any] | None = None, *, name: str | None = None,

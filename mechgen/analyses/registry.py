@@ -22,6 +22,7 @@ MODULES = (
     "mechgen.analyses.campbell",
     "mechgen.analyses.continuation",
     "mechgen.analyses.response",
+    "mechgen.analyses.fit",
     "mechgen.analyses.impact",
     "mechgen.analyses.restitution",
 )

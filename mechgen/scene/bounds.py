@@ -19,6 +19,7 @@ Rules, for a value v the scene wrote (model defaults are the model's business an
       size = 20_000_000      # every size parameter (default 10 000 000)
       quadrature = 200       # Gauss points per element (default 100)
       samples = 5_000_000    # samples a simulate analysis stores (default 1 000 000)
+      rows = 5_000_000       # rows of a fit's data (default 1 000 000)
 
   A limit is only a guard against a typo (N = 1e308, quadrature = 100000 is a 74.5 GiB
   Gauss table); the memory a large size needs is estimated where it is allocated.
@@ -31,7 +32,7 @@ from typing import Mapping
 from mechgen.scene.values import ModelInfoLike, fail, is_choice, is_number, join, listing, show, type_name
 
 #: default safety limits; ``size`` applies to every size parameter without an entry of its own
-LIMITS = {"size": 10_000_000, "quadrature": 100, "samples": 1_000_000}
+LIMITS = {"size": 10_000_000, "quadrature": 100, "samples": 1_000_000, "rows": 1_000_000}
 #: the largest limit a scene may set (beyond it an int no longer converts exactly to a float)
 MAX_LIMIT = 2**53
 TINY = sys.float_info.min
@@ -54,7 +55,7 @@ def _whole(bound) -> str:
 
 
 def scene_limits(file: str, data: dict, model: ModelInfoLike) -> dict[str, int]:
-    """The scene's ``[limits]`` over :data:`LIMITS`: keys ``size``, ``samples`` or a size parameter's
+    """The scene's ``[limits]`` over :data:`LIMITS`: keys ``size``, ``samples``, ``rows`` or a size parameter's
     name; values integers from 1 to 2**53."""
     table = data.get("limits", {})
     if not isinstance(table, dict):
@@ -75,7 +76,7 @@ def scene_limits(file: str, data: dict, model: ModelInfoLike) -> dict[str, int]:
 
 def size_limit(limits: Mapping[str, int], name: str) -> tuple[int, str]:
     """The safety limit of a size parameter and the ``[limits]`` key that raises it."""
-    if name in limits and name not in ("size", "samples"):
+    if name in limits and name not in ("size", "samples", "rows"):
         return limits[name], name
     return limits["size"], "size"
 
