@@ -200,7 +200,18 @@ def lower_all(model: Model, eqs, kernels, *, cse: bool = True) -> list[KernelIR]
     if model.is_hybrid:
         return _with_whirl(model, lower_hybrid(model, eqs, kernels, cse=cse))
     lower = lower_lattice if model.is_lattice else lower_lumped
-    return _with_whirl(model, [lower(eqs, k, cse=cse) for k in all_kernels(model) if k in kernels])
+    irs = [lower(eqs, k, cse=cse) for k in all_kernels(model) if k in kernels]
+    return _with_whirl(model, irs + _initial_kernel(eqs, kernels, cse))
+
+
+def _initial_kernel(eqs, kernels, cse: bool) -> list[KernelIR]:
+    """The ``initial`` kernel (the declared initial state, mechgen.symbolic.initial) beside a time response's."""
+    from mechgen.codegen.lower_lumped import lower_matrices
+
+    column = getattr(eqs, "initial", None)
+    if column is None or not {"residual", "force"} & set(kernels):
+        return []
+    return [lower_matrices(eqs, "initial", "the declared initial state (q, v, z)", {"x": column}, cse=cse)]
 
 
 def lower_hybrid(model: Model, eqs, kernels, *, cse: bool = True) -> list[KernelIR]:
@@ -225,6 +236,7 @@ def lower_hybrid(model: Model, eqs, kernels, *, cse: bool = True) -> list[Kernel
         for j, column in enumerate(eqs.resets):
             irs.append(lower_matrices(eqs.equations[0], f"reset__{j}", f"state after reset {j}", {"x": column},
                                       cse=cse))
+    irs += _initial_kernel(eqs.equations[0], kernels, cse)
     meta = eqs.meta()
     for ir in irs:
         ir.meta["hybrid"] = meta

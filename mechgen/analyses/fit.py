@@ -105,14 +105,20 @@ def _solve(model, rows: np.ndarray, y: np.ndarray, sigma: np.ndarray, options: d
 
     lb, ub = options["_bounds"]
     tol = options["tol"]
-    res = least_squares(residual, options["_start"], jac=exact if model.exact else options["jacobian"],
-                        bounds=(lb, ub), method="trf", x_scale="jac", ftol=tol, xtol=tol, gtol=tol,
-                        diff_step=None if model.exact else options["diff_step"])
-    jac = exact(res.x) if model.exact else res.jac
-    fitted = cached(res.x)[0] if model.exact else y[rows] - res.fun / w
+    # solve for u = theta / scale (scale: |start|, or 1 for a start at 0): least_squares' gtol compares a gradient
+    # with bounds scaling (trf, Coleman-Li) that keeps the parameters' units; R ~ 1e9 Pa would stop it at once
+    start = np.asarray(options["_start"], dtype=float)
+    scale = np.where(start != 0, np.abs(start), 1.0)
+    res = least_squares(lambda u: residual(u * scale), start / scale,
+                        jac=(lambda u: exact(u * scale) * scale) if model.exact else options["jacobian"],
+                        bounds=(np.asarray(lb) / scale, np.asarray(ub) / scale), method="trf", x_scale="jac",
+                        ftol=tol, xtol=tol, gtol=tol, diff_step=None if model.exact else options["diff_step"])
+    x = res.x * scale
+    jac = exact(x) if model.exact else res.jac / scale
+    fitted = cached(x)[0] if model.exact else y[rows] - res.fun / w
     cov = _covariance(np.asarray(jac, dtype=float), float(np.sum(res.fun**2)))
-    return {"x": res.x, "cov": cov, "fitted": fitted, "converged": bool(res.success), "message": res.message,
-            "dof": len(rows) - len(res.x)}
+    return {"x": x, "cov": cov, "fitted": fitted, "converged": bool(res.success), "message": res.message,
+            "dof": len(rows) - len(x)}
 
 
 def run_fit(system, options: dict, context: dict) -> dict:

@@ -1,7 +1,8 @@
 """``impact``: one compliant impact of a hybrid model, measured from contact to release.
 
-The run starts at ``q0`` / ``v0`` (tables of coordinates; an impact model starts at x = 0 moving in,
-so the contact guard fires at t = 0) in the model's initial mode and ends at the first event that
+The run starts at the model's declared initial state (``@model.initial``) with the entries of ``q0`` /
+``v0`` (tables of coordinates) replacing those they name (an impact model starts at x = 0 moving in, so
+the contact guard fires at t = 0) in the model's initial mode and ends at the first event that
 leaves the contact mode (``contact_mode``, default the mode the first event enters), or at ``t_end``
 when the body never leaves it (``released`` false: a perfectly plastic impact, e = 0). Along
 ``coordinate`` (default the first), with v_c the velocity entering contact and v_r the velocity
@@ -56,7 +57,7 @@ def hybrid_only(ctx, base: str, options: dict) -> None:
 
 SCHEMA = {"t_end": Option(schema.positive, REQUIRED, STEP), "method": Option(_method, "DOP853"),
           "rtol": Option(schema.positive, 1e-10), "atol": Option(schema.positive, 1e-12),
-          "q0": Option(schema.coordinate_table, {}), "v0": Option(schema.coordinate_table, REQUIRED),
+          "q0": Option(schema.coordinate_table, {}), "v0": Option(schema.coordinate_table, {}),
           "coordinate": Option(_coordinate, ABSENT), "contact_mode": Option(schema.name, ABSENT),
           "force_output": Option(schema.name, "force"), "curve": Option(schema.boolean, False),
           "samples": Option(schema.count_within("samples"), 200), "max_steps": Option(schema.count, ABSENT),
@@ -78,7 +79,15 @@ def measure(system, options: dict) -> dict:
     n = system.n
     coordinate = options.get("coordinate", system.coordinates[0])
     i = list(system.coordinates).index(coordinate)
-    x0 = np.concatenate([vector(system, options.get("q0")), vector(system, options.get("v0")), np.zeros(system.m)])
+    from mechgen.analyses.simulate import declared_start
+
+    start = declared_start(system)
+    if start is None and not options.get("v0"):
+        raise SceneError(f"model {system.metadata.model} declares no initial state and the impact gives no v0",
+                         key="v0", expected="a table v0 = {coordinate = speed} (or @model.initial in the model)")
+    base = np.zeros(2 * n + system.m) if start is None else start
+    x0 = np.concatenate([vector(system, options.get("q0"), base[:n]), vector(system, options.get("v0"), base[n:2 * n]),
+                         base[2 * n:]])
     contact = options.get("contact_mode")
     contact = None if contact is None else system.mode_index(contact)
     state = {"contact": contact}

@@ -118,9 +118,20 @@ def needs(options: dict, *, internal: bool) -> set[str]:
     return {"residual", "tangent", "outputs"} | start | ({"rates", "rates_tangent"} if internal else set())
 
 
+def declared_start(system) -> np.ndarray | None:
+    """The model's declared initial state (q, v, z) at the system's parameters (kernel ``initial``), or None."""
+    if "initial" not in system.kernels:
+        return None
+    return np.asarray(system.call("initial")["x"], float).ravel()
+
+
 def initial_state(system, options: dict) -> tuple[np.ndarray, np.ndarray]:
-    """(q0, v0) from the options: tables of coordinates, or a linear mode times an amplitude."""
-    q0, v0 = vector(system, options.get("q0")), vector(system, options.get("v0"))
+    """(q0, v0) from the options: tables of coordinates over the model's declared initial state (zero when it
+    declares none), or a linear mode times an amplitude."""
+    start = declared_start(system)
+    n = system.n
+    q0 = vector(system, options.get("q0"), None if start is None else start[:n])
+    v0 = vector(system, options.get("v0"), None if start is None else start[n:2 * n])
     if options.get("initial_mode"):
         k = int(options["initial_mode"])
         if k > system.n:

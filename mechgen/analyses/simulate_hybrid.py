@@ -57,7 +57,10 @@ def run_hybrid(system, options: dict, context: dict) -> dict:
     t_end = float(options["t_end"])
     method = options.get("method", "BDF")
     mode = start_mode(system, options)
-    x0 = np.concatenate([q0, v0, np.zeros(system.m)])
+    from mechgen.analyses.simulate import declared_start
+
+    start = declared_start(system)
+    x0 = np.concatenate([q0, v0, np.zeros(system.m) if start is None else start[2 * system.n:]])
     n_out = int(options.get("samples", 201))
     require(dense_bytes(n_out, 3 * x0.size + 6), f"{n_out} output samples", key="samples")
     traj = integrate_hybrid(system, x0, t_end, mode=mode, method=method, rtol=options.get("rtol", 1e-8),

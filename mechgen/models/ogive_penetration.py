@@ -16,7 +16,7 @@ tunnel V1^2 = (m Vs^2 - 4 pi a^3 R) / (m + 4 pi a^3 N rho). Integrating the tunn
     P = m / (2 pi a^2 rho N) ln(1 + N rho V1^2 / R) + 4a      (the depth of penetration).
 
 When m Vs^2 < 4 pi a^3 R the projectile stops in the crater: V1^2 is taken as 0 (c = pi a R / 4) and
-P = Vs sqrt(m / c). The terminal guard ``at_rest`` (V falling through 0) ends the run in either phase.
+P = Vs sqrt(m / c). A run starts at x = 0 with V = Vs (``@model.initial``). The terminal guard ``at_rest`` (V falling through 0) ends the run in either phase.
 Outputs: ``depth`` x (m) and ``velocity`` V (m/s).
 """
 import sympy as sp
@@ -52,6 +52,12 @@ def tunnel_speed_squared(p):
 def crater_stiffness(p):
     """c = pi a (R + N rho V1^2) / 4 (N/m)."""
     return sp.pi * p.a * (p.R + nose_factor(p) * p.rho * tunnel_speed_squared(p)) / 4
+
+
+@model.initial
+def strike(p):
+    """At the target's face (x = 0) at the striking velocity."""
+    return {"x_dot": p.Vs}
 
 
 @model.kinetic

@@ -69,6 +69,12 @@ def contact_force(q, v, z, p):
     return p.k * signed_power(q.x, p.n) * (1 + alpha * v.x)
 
 
+@model.initial
+def first_contact(p):
+    """At the contact (x = 0) moving in at v_in."""
+    return {"x_dot": p.v_in}
+
+
 @model.kinetic
 def kinetic(v, p):
     return p.m / 2 * v.x**2

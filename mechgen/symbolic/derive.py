@@ -22,6 +22,7 @@ import sympy as sp
 
 from mechgen.errors import ModelError
 from mechgen.symbolic.model import Model, as_expr, call_declared
+from mechgen.symbolic.initial import initial_column
 from mechgen.symbolic.params import Namespace
 from mechgen.symbolic.specialize import Specialization, param_namespace
 
@@ -47,6 +48,8 @@ class LumpedEquations:
     rates: sp.Matrix
     outputs: dict
     position: tuple[sp.Symbol, ...] = ()
+    #: the declared initial state (mechgen.symbolic.initial), None when the model declares none
+    initial: sp.Matrix | None = None
 
     @property
     def t(self) -> sp.Symbol:
@@ -157,4 +160,5 @@ def derive_lumped(model: Model, spec: Specialization, mode: str | None = None) -
         param_names=tuple(s.name for s in free), internal_names=tuple(i.name for i in model.internals),
         kinetic=T, potential=V, residual=sp.Matrix(res) if res else sp.zeros(0, 1),
         rates=sp.Matrix(rates) if rates else sp.zeros(0, 1), outputs=outputs,
+        initial=initial_column(model, p_ns, names, tuple(i.name for i in model.internals)),
     )

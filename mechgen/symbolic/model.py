@@ -268,6 +268,7 @@ class Model:
         self.constraint_fn: Callable | None = None
         self.strain_fn: Callable | None = None
         self.forces_fn: Callable | None = None
+        self.initial_fn: Callable | None = None
         self.chain_spec: Chain | None = None
         self.site_kinetic_fn: Callable | None = None
         self.site_potential_fn: Callable | None = None
@@ -517,6 +518,13 @@ class Model:
     def boundary(self, fn: Callable) -> Callable:
         """Decorator (continuum): essential boundary conditions fn(p) -> [fix(jet, 'start' | 'end'), ...]."""
         self.boundary_fn = fn
+        return fn
+
+    def initial(self, fn: Callable) -> Callable:
+        """Decorator: the initial state fn(p) -> {name: value} (coordinates, ``<x>_dot`` velocities, internal
+        variables; others 0), generated as the kernel ``initial`` (mechgen.symbolic.initial); a scene's
+        ``q0`` / ``v0`` replace the entries they name."""
+        self.initial_fn = fn
         return fn
 
     def kinetic(self, fn: Callable) -> Callable:

@@ -436,3 +436,26 @@ int mg_guards__1(const double *const *in, double *const *out, const long *sizes,
     }
     return 0;
 }
+
+/* initial: the declared initial state (q, v, z)
+ *   in[0]  q: length 1 per state
+ *   in[1]  v: length 1 per state
+ *   in[2]  z: length 1 per state
+ *   in[3]  t: length 1 per state
+ *   in[4]  p: length 1
+ *   out[0] x: length 3 per state shape (3, 1)
+ */
+int mg_initial(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    (void)in;
+    const long len_out0 = 3;
+    for (long b = 0; b < nbatch; ++b) {
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        {
+            out0[1] = 1.0;
+        }
+    }
+    return 0;
+}
