@@ -4,7 +4,7 @@ Scene keys: ``over`` (as sweep's: parameter = [values] or {start, stop, num}; at
 parameter, e.g. ``law``, and one numeric one, e.g. ``zeta``), the impact's keys (``t_end``, ``v0``,
 ``q0``, ``method``, ``rtol``, ``atol``, ``coordinate``, ``contact_mode``, ``force_output``), ``hysteresis``
 (how many values of the numeric parameter also record the force-penetration curve, spread over its
-grid; default 4, 0 for none), ``samples`` (points per curve), ``progress`` and ``max_seconds`` (the whole
+grid; default 4, 0 for none; or a list of values: the grid's nearest), ``samples`` (points per curve), ``progress`` and ``max_seconds`` (the whole
 grid, as sweep's). A numeric parameter of ``over`` that the command line sets (``--set zeta=0.3``)
 is run at that single value.
 
@@ -31,8 +31,17 @@ MEASURED = ("restitution", "contact_duration", "energy_lost", "released")
 
 SCHEMA = {**{k: v for k, v in IMPACT.items() if k != "curve"},
           "over": Option(schema.over, schema.REQUIRED, "a table: parameter = [values] or {start, stop, num}"),
-          "hysteresis": Option(lambda ctx, key, value: schema.int_at_least(ctx, key, value, 0), 4),
+          "hysteresis": Option(lambda ctx, key, value: _hysteresis(ctx, key, value), 4),
           "progress": Option(schema.boolean, True)}
+
+
+def _hysteresis(ctx, key: str, value: object):
+    """A count (>= 0) of curves spread over the grid, or a list of values of the numeric parameter."""
+    if isinstance(value, list):
+        if not value:
+            raise fail(ctx.file, key, "empty array", "a count, or a non-empty array of parameter values")
+        return [schema.number(ctx, f"{key}[{i}]", v) for i, v in enumerate(value, 1)]
+    return schema.int_at_least(ctx, key, value, 0)
 
 
 def check(ctx, base: str, options: dict) -> None:
@@ -64,8 +73,12 @@ def _at_point(task: tuple) -> dict:
     return public(get(kind).run(with_free_params(system, point, key="grid"), options, {}))
 
 
-def curve_points(values: list, count: int) -> set:
-    """Indices of ``count`` values spread evenly over a grid of ``len(values)`` (ends included)."""
+def curve_points(values: list, count) -> set:
+    """Indices of ``count`` values spread evenly over a grid of ``len(values)`` (ends included), or, for a list
+    of parameter values, of the grid values nearest to them."""
+    if isinstance(count, list):
+        return {int(min(range(len(values)), key=lambda i: abs(values[i] - v))) for v in count} if values[0] is not None \
+            else {0}
     if count <= 0 or not values:
         return set()
     if count >= len(values):
@@ -80,7 +93,7 @@ def run_restitution(system, options: dict, context: dict) -> dict:
     choice = next((n for n in names if isinstance(over[n][0], str)), None)
     numeric = next((n for n in names if n != choice), None)
     values = over[numeric] if numeric else [None]
-    curves = curve_points(values, int(options.get("hysteresis", 4)))
+    curves = curve_points(values, options.get("hysteresis", 4))
     base = {k: v for k, v in options.items() if k in IMPACT}
     points = context.get(POINTS) or PointRunner(_at_point, lambda kind, opts, point: (system, kind, opts, point))
     grid = options["grid"]

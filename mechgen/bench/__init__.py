@@ -48,6 +48,10 @@ REGISTRY: dict[str, Suite] = {s.name: s for s in (
           "whole-process start of a cached scene (laval_rotor, beam_modes): median wall time and import share, "
           "unpinned against pinned",
           ("startup.json", "startup.md")),
+    Suite("impacts", "mechgen.bench.impacts", "run_impact_benchmarks",
+          "restitution over 200 damping ratios for five contact laws against hand-written solve_ivp with events; "
+          "work-precision per law and integrator", ("impacts.json", "impacts.md", "impacts.csv",
+                                                    "impacts_work_precision.png")),
     Suite("threads", "mechgen.bench.threads", "run_threads_benchmarks",
           "every shipped scene as a whole process, default environment against one BLAS thread (unpinned / pinned)",
           ("threads.json", "threads.md")),
