@@ -24,6 +24,21 @@ def _lumped(eqs) -> list[str]:
     return lines
 
 
+def _hybrid(eqs) -> list[str]:
+    """Each mode's equations, then the guards leaving it and the resets."""
+    direction = {1: "rising", -1: "falling", 0: "both"}
+    lines = [f"modes {list(eqs.modes)} (starts in {eqs.modes[eqs.initial]})"]
+    for name, mode_eqs, guards in zip(eqs.modes, eqs.equations, eqs.guards):
+        lines += ["", f"== mode {name}"] + _lumped(mode_eqs) + ["guards leaving it:"]
+        for ge in guards:
+            to = "end of run" if ge.guard.terminal else f"-> {ge.guard.to}"
+            reset = f", reset {ge.reset}" if ge.reset is not None else ""
+            lines.append(f"  {ge.guard.name}: g = {ge.g} ({direction[ge.guard.direction]}) {to}{reset}")
+    for j, column in enumerate(eqs.resets):
+        lines.append(f"reset {j}: (q, v, z) -> {list(column)}")
+    return lines
+
+
 def _lattice(eqs) -> list[str]:
     return [f"chain of {eqs.sites} sites, coordinate {eqs.coordinate}, {eqs.ends} ends",
             f"site kinetic T_s = {eqs.site_kinetic}", f"site potential V_s = {eqs.site_potential}",
@@ -60,7 +75,10 @@ def show_model(name: str) -> str:
              "parameters:"]
     lines += [f"  {p.name:10s} = {p.default!r:10} {p.unit:10s} {p.doc}" for p in model.param_list]
     lines.append("")
-    lines += _field(eqs) if model.is_field else _lattice(eqs) if model.is_lattice else _lumped(eqs)
+    if model.is_hybrid:
+        lines += _hybrid(eqs)
+    else:
+        lines += _field(eqs) if model.is_field else _lattice(eqs) if model.is_lattice else _lumped(eqs)
     lines.append("")
     lines.append("outputs: " + ", ".join(model.output_names))
     return "\n".join(lines)
