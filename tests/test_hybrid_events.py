@@ -219,6 +219,27 @@ def overtaken(q, p, t):
     return q.x - p.c * t**3
 '''
 
+# a timer g = t^2 (tau - t): g = g_t = 0 at t = 0, one zero at tau; the particle drifts slowly
+TIMER = '''\
+"""A timer with g = dg/dt = 0 at the start."""
+from mechgen import Model, Param
+
+model = Model("timer", doc=__doc__)
+model.params(Param("m", 1.0, "kg"), Param("tau", 0.01, "s"))
+model.coordinates("x")
+run = model.mode("run")
+
+
+@model.kinetic
+def kinetic(v, p):
+    return p.m / 2 * v.x**2
+
+
+@run.terminal(direction="both")
+def timer(t, p):
+    return t**2 * (p.tau - t)
+'''
+
 # a slowly drifting particle watched by a fast guard g = x - A sin(w t)
 FAST = '''\
 """A fast oscillating guard on a slow particle."""
@@ -283,7 +304,7 @@ model.output("position", lambda q: q.x, unit="m")
 
 TWINS_FREE = TWINS.split("@flight.terminal")[0].replace('"twins"', '"twins_free"')
 
-SOURCES = {"ball": BALL, "twins": TWINS, "twins_free": TWINS_FREE, "clock": CLOCK, "drift": DRIFT, "throw": THROW, "pushed": PUSHED,
+SOURCES = {"ball": BALL, "twins": TWINS, "twins_free": TWINS_FREE, "clock": CLOCK, "drift": DRIFT, "throw": THROW, "pushed": PUSHED, "timer": TIMER,
            "fast": FAST, "stop": STOP}
 
 
@@ -494,6 +515,17 @@ def test_unknown_sign_at_the_start_waits_for_a_nonzero_value(systems):
         tr = integrate_hybrid(systems("pushed"), np.array([0.0, 0.0]), 5.0, method=method, rtol=1e-12, atol=1e-14)
         assert [e.guard for e in tr.events] == ["overtaken"]
         assert tr.events[0].t == pytest.approx(2.0, rel=1e-9)
+
+
+def test_unknown_sign_inside_a_long_first_step(systems):
+    """g = t^2 (tau - t), tau = 10 ms: g = g_t = 0 at t = 0, positive after, one zero at t = tau. The particle
+    drifts at 1e-6 m/s from x = 1 km, so the integrator's first step (~60 ms for RK45) spans the zero: the sign
+    must come from the step's first 2^-12, not from its end (where g is already negative)."""
+    y0 = np.array([1e3, 1e-6])
+    assert _first_step("RK45", y0, 1e-10, 1e-12) > 0.05
+    tr = integrate_hybrid(systems("timer"), y0, 1.0, method="RK45", rtol=1e-10, atol=1e-12)
+    assert [e.guard for e in tr.events] == ["timer"]
+    assert tr.events[0].t == pytest.approx(0.01, rel=1e-12)
 
 
 # ----------------------------------------------------------------------------- 5. simultaneous events
