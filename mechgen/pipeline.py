@@ -166,6 +166,9 @@ def all_kernels(model: Model) -> tuple[str, ...]:
 
 def derive(model: Model, spec: Specialization):
     """Derived equations (lumped or lattice) of a specialisation."""
+    from mechgen.symbolic.hybrid import check_hybrid
+
+    check_hybrid(model)  # guards without modes, modes in a continuum or chain: refused for every kind of model
     if model.is_field:
         from mechgen.symbolic.field import derive_field
 

@@ -7,6 +7,8 @@ so the SX graph holds the local expressions once.
 """
 from __future__ import annotations
 
+import re
+
 from mechgen.version import __version__
 from mechgen.codegen.emit_numpy import extent_expr
 from mechgen.codegen.escape import code_identifier, py_docstring, py_literal
@@ -77,8 +79,14 @@ def kernel_body(ir: KernelIR) -> list[str]:
     outs = ", ".join(f"out{i}" for i, _ in enumerate(ir.outputs))
     names_in = [p.name for p in ir.inputs if not p.integer]
     names_out = [p.name for p in ir.outputs]
-    lines.append(f"return ca.Function({ir.name!r}, [{ins}], [{outs}], {names_in!r}, {names_out!r})")
+    lines.append(f"return ca.Function({casadi_name(ir.name)!r}, [{ins}], [{outs}], {names_in!r}, {names_out!r})")
     return lines
+
+
+def casadi_name(name: str) -> str:
+    """The label of a kernel's casadi.Function: CasADi refuses consecutive underscores, which the kernels of a
+    hybrid model's modes carry (``residual__0``, mechgen.pipeline.lower_hybrid), so runs of them become one."""
+    return re.sub(r"_{2,}", "_", name)
 
 
 def emit_casadi(irs: list[KernelIR], *, model: str, title: str) -> str:

@@ -147,8 +147,9 @@ def _guard_name(fn: Callable, model) -> str:
 
 
 def check_hybrid(model) -> None:
-    """Raise ModelError (naming the model file and the item) for a guard naming an unknown mode, a guard
-    in a model without modes, two guards of one name in a mode, or a mode without energies."""
+    """Raise ModelError (naming the model file and the item) for a guard in a model without modes, modes in
+    a continuum or chain, a guard naming an unknown mode, two guards of one name in a mode, or a mode
+    without energies. Called for every model before its derivation (mechgen.pipeline.derive)."""
     modes = list(model.mode_scopes)
     if not modes:
         if model.guards:
@@ -156,6 +157,11 @@ def check_hybrid(model) -> None:
             raise ModelError(f"guard {g.name!r} of model {model.name} is declared but the model has no modes",
                              file=model.file, key=f"guard {g.name}", expected="model.mode(...) declarations first")
         return
+    if model.continuum is not None or model.chain_spec is not None:
+        kind = "continuum" if model.continuum is not None else "chain"
+        raise ModelError(f"mode {modes[0]!r} of model {model.name}: modes are for lumped models, and this one is a "
+                         f"{kind}", file=model.file, key=f"mode {modes[0]}",
+                         expected="a model of coordinates (no fields, no chain)")
     seen = set()
     for g in model.guards:
         for end, label in ((g.source, "leaves"), (g.to, "enters")):

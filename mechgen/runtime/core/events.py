@@ -7,35 +7,50 @@ every accepted step [t0, t1] the guards g_k of the mode are checked on the step,
 located on the step's dense output and the state there is recomputed to the integrator's own
 accuracy; the reset then gives the state the next mode starts from.
 
-Rules (the documented behaviour of each hard case):
+Rules (the documented behaviour of each hard case; tests/test_hybrid_events.py checks each against a
+closed form):
 
 * **Crossing.** A guard fires when its sign changes the way of its direction (rising: - to +,
   falling: + to -, both: either) between two points of a step where it is evaluated. The sign
-  tracked is the last nonzero one, so a guard that touches zero and turns back (**grazing**)
-  never fires.
-* **Missed events.** A step is checked at its ends with the values g and the rates dg/dt (the
-  generated ``g_t`` kernel): the interval is split in two (dense output, up to
-  :data:`MAX_DEPTH` times, 2^-12 of the step) whenever a double crossing inside it is possible:
-  the cubic Hermite interpolant of g through both ends changes sign inside, or g reaches zero
-  within the interval when extrapolated from either end at its rate. A guard oscillating faster
-  than the dynamics (g = x - A sin(w t), w large) is resolved this way; one that crosses twice
-  inside 2^-12 of a step while its sampled values and rates all keep away from zero can be missed.
+  tracked is the last nonzero one, so a guard that touches zero and turns back (**grazing**,
+  g = (x - 1)^2 or -v^2 at an apex) never fires, and one that crosses at a tangency with a sign change
+  (g = (x - 1)^3) fires once.
+* **Missed events.** Every accepted step is checked at its ends with the values g and the rates
+  dg/dt (the generated ``g_t`` kernel, with the integrator's own dx/dt at the step's end where it keeps
+  one: RK45, DOP853, Radau; BDF and LSODA pay one extra dx/dt). An interval is halved (dense output,
+  up to :data:`MAX_DEPTH` times: 2^-12 of the step), the earlier half checked first, while a guard of
+  unchanged sign could hide two zeros in it: a zero is within reach of either end at that end's
+  rate towards zero (s g_a <= h max(0, -s g_t,a), or the same backwards from b), the cubic Hermite
+  interpolant through both ends dips through zero inside, or the end rates depart from the chord
+  (|h g_t - (g_b - g_a)| at either end) by as much as g's larger distance from zero (g varies faster
+  than the interval resolves: a fast t-dependent guard). An interval whose guard changed sign is
+  halved while its cubic turns inside (the zero may not be the first). A guard on its surface moving
+  away (just after a reset) costs nothing. So a pair of zeros is found when g stays past zero for
+  longer than 2^-12 of the step and its zeros are more than that apart: for g = x - A sin(w t) with
+  |x| ~ A/2 (past zero a third of each period) steps of up to 2^12/3 ~ 1365 periods; a pair closer than
+  that, or hidden between two samples where g sits at its extremes with zero slopes (aliasing), can be
+  missed, and at the depth limit the zero found in an interval holding several may not be the first.
+  A guard varying faster than the steps costs up to 2^13 evaluations per step; an ordinary one one.
 * **Location.** The zero is found by Brent's method on g along the dense output (to a few
   machine epsilons in t); the state there is integrated afresh from the step's start to that
   time (the dense output of the implicit methods is less accurate than their steps), and one
-  Newton correction t* = t - g/g_t, x* = x + (t* - t) f(x) puts g to zero at that accuracy.
+  Newton correction t* = t - g/g_t, x* = x + (t* - t) f(x) puts g to zero at that accuracy. The
+  event time then carries the integrator's own error (Kelvin-Voigt restitution: error ~ rtol).
 * **Simultaneous events.** The earliest zero wins; zeros within the location tolerance
-  (:func:`time_tolerance`) are a tie, won by a terminal guard, then by the guard declared first.
+  (:func:`time_tolerance`) of it, a guard crossing just after the interval included, are a tie, won
+  by a terminal guard, then by the guard declared first (the order of HybridSystem.guards).
 * **Start of a mode** (t = 0 or just after a reset). A guard within the location tolerance of
   zero at its rate (|g| <= |g_t| dt_tol, or g = 0) takes the sign it is moving to; it fires at once
   when that motion is its direction (an impact starting at contact, t = 0: the event is logged at
-  t = 0). When g = 0 and g_t = 0 its sign is taken from the first point where it is nonzero.
+  t = 0), and not when it moves away. When g = 0 and g_t = 0 its sign is unknown: the first step's
+  first 2^-12 is sampled for the first point where g is nonzero, and it fires only on a later crossing.
 * **Zeno / chattering.** More than ``zeno_events`` events within ``zeno_span`` (default 1e-9
   t_end), or more than ``max_events`` in all, end the run with BudgetExceeded (exit 1) naming the
-  time, the mode and the key; never a hang.
+  time, the mode and the key; never a hang (each step's checks are bounded, and so is Brent).
 """
 from __future__ import annotations
 
+import math
 from collections import deque
 from dataclasses import dataclass, field
 from typing import Callable
@@ -53,7 +68,7 @@ EPS = float(np.finfo(float).eps)
 
 @dataclass(frozen=True)
 class EventRules:
-    """Bounds of the event loop: at most ``max_events`` events, and no ``zeno_events`` of them within
+    """Bounds of the event loop: at most ``max_events`` events, and no more than ``zeno_events`` of them within
     ``zeno_span`` (None: 1e-9 t_end)."""
 
     max_events: int = 10_000
@@ -104,14 +119,17 @@ def _solver_class(method: str):
 
 
 class _Segment:
-    """The flow of one mode with its guards: rhs, Jacobian and guard evaluations counted."""
+    """The flow of one mode with its guards: rhs, Jacobian, and the guard evaluations counted in ``counts``
+    (``guards``: calls of the guard kernel; ``rates``: the extra dx/dt evaluations their rates needed)."""
 
-    def __init__(self, system, mode: int) -> None:
+    def __init__(self, system, mode: int, t_end: float, counts: dict) -> None:
         self.system = system
         self.index = mode
         self.view = system.mode(mode)
         self.guards = system.guards(mode)
-        self.evaluations = 0
+        self.directions = np.array([g.direction for g in self.guards], dtype=float)
+        self.t_end = t_end
+        self.counts = counts
 
     def rhs(self, t, x):
         return self.view.rhs(t, x)
@@ -119,30 +137,65 @@ class _Segment:
     def jac(self, t, x):
         return self.view.jacobian(t, x)
 
-    def values(self, t: float, x: np.ndarray, with_rates: bool = True):
-        """(g, g_t) at (t, x); g_t from the mode's dx/dt there (zeros without ``with_rates``)."""
-        self.evaluations += 1
-        dxdt = self.view.rhs(t, x) if with_rates else None
-        g, g_t = self.system.guard_values(self.index, t, x, dxdt)
+    def values(self, t: float, x: np.ndarray, with_rates: bool = True, dxdt: np.ndarray | None = None):
+        """(g, g_t) at (t, x); g_t from the mode's dx/dt there (``dxdt`` when the integrator has it; zeros
+        without ``with_rates``)."""
+        self.counts["guards"] += 1
+        if with_rates and dxdt is None:
+            self.counts["rates"] += 1
+            dxdt = self.view.rhs(t, x)
+        g, g_t = self.system.guard_values(self.index, t, x, dxdt if with_rates else None)
         return g, (g_t if with_rates else np.zeros_like(g))
 
 
-def _possible_crossing(sign: np.ndarray, ga, da, gb, db, h: float) -> np.ndarray:
-    """Guards that may cross zero (twice) inside an interval of length h whose ends keep the sign ``sign``:
-    the cubic Hermite through (ga, da), (gb, db) changes sign inside, or g reaches zero within h at either
-    end's rate."""
-    s = np.where(sign != 0, sign, np.sign(ga))
-    reach = (s * ga - h * np.maximum(0.0, -s * da) <= 0) | (s * gb - h * np.maximum(0.0, s * db) <= 0)
-    # cubic Hermite p(u) on u in [0, 1]: its interior extrema
-    c1, c2 = h * da, 3 * (gb - ga) - h * (2 * da + db)
-    c3 = 2 * (ga - gb) + h * (da + db)
-    cubic = np.zeros_like(reach)
-    for k in np.flatnonzero(~reach & (s != 0)):
-        roots = np.roots([3 * c3[k], 2 * c2[k], c1[k]]) if (c3[k] or c2[k]) else np.array([])
-        for u in roots[np.isreal(roots)].real:
-            if 0 < u < 1 and s[k] * (ga[k] + c1[k] * u + c2[k] * u**2 + c3[k] * u**3) < 0:
-                cubic[k] = True
-    return (reach | cubic) & (s != 0)
+def _hermite(s: float, ga: float, da: float, gb: float, db: float, h: float) -> tuple[int, bool]:
+    """The cubic Hermite p(u), u in [0, 1], through (ga, h da) and (gb, h db): its sign changes counted along
+    its value at 0 (taken as the tracked sign ``s``), at its interior extrema and at 1; whether it has an
+    interior extremum."""
+    c1, c2, c3 = h * da, 3 * (gb - ga) - h * (2 * da + db), 2 * (ga - gb) + h * (da + db)
+    # p'(u) = c1 + 2 c2 u + 3 c3 u^2
+    crit: list[float] = []
+    if c3 != 0.0:
+        disc = c2 * c2 - 3 * c1 * c3
+        if disc >= 0.0:
+            q = -(c2 + math.copysign(math.sqrt(disc), c2))
+            crit = [q / (3 * c3)] + ([c1 / q] if q != 0.0 else [])
+    elif c2 != 0.0:
+        crit = [-c1 / (2 * c2)]
+    inside = sorted(u for u in crit if 0.0 < u < 1.0)
+    changes, last = 0, s
+    for value in [ga + u * (c1 + u * (c2 + u * c3)) for u in inside] + [gb]:
+        if value != 0.0 and math.copysign(1.0, value) != last:
+            changes, last = changes + 1, -last
+    return changes, bool(inside)
+
+
+def _suspicious(sign: np.ndarray, ga, da, gb, db, h: float, at_start: bool) -> bool:
+    """Whether the interval of length h with ends (ga, da), (gb, db) must be halved (module doc, "Missed
+    events"): for a guard whose tracked sign ``sign`` holds at both ends, a zero is within reach of either
+    end at its rate or the cubic Hermite dips through zero inside; for one whose sign flipped, the cubic
+    turns inside (the zero may not be the only one); for one of unknown sign (g = g_t = 0 at the start of
+    the mode), the interval starts the mode."""
+    for k in range(len(sign)):
+        s = float(sign[k])
+        if s == 0.0:
+            if at_start:
+                return True
+            continue
+        a, ra, b, rb = float(ga[k]), float(da[k]), float(gb[k]), float(db[k])
+        if b != 0.0 and math.copysign(1.0, b) != s:  # flipped
+            if _hermite(s, a, ra, b, rb, h)[1]:
+                return True
+            continue
+        toward_a, toward_b = -s * ra, s * rb  # rates towards zero: forwards from a, backwards from b
+        if (toward_a > 0 and s * a <= h * toward_a) or (toward_b > 0 and s * b <= h * toward_b):
+            return True
+        chord = b - a  # unresolved: the rates depart from the chord by as much as g's distance from zero
+        if max(abs(h * ra - chord), abs(h * rb - chord)) >= max(s * a, s * b):
+            return True
+        if _hermite(s, a, ra, b, rb, h)[0] > 0:
+            return True
+    return False
 
 
 def _crossed(sign: np.ndarray, g: np.ndarray, directions: np.ndarray) -> np.ndarray:
@@ -173,8 +226,10 @@ def integrate_hybrid(system, x0, t_end: float, *, mode: int | None = None, metho
     names = system.modes
     ts, xs, ms = [], [], []
     events: list[Event] = []
-    recent: deque = deque(maxlen=max(2, rules.zeno_events))
-    stats = {"steps": 0, "nfev": 0, "njev": 0, "guards": 0}
+    recent: deque = deque(maxlen=max(2, rules.zeno_events + 1))
+    stats = {"steps": 0, "nfev": 0, "njev": 0}
+    counts = {"guards": 0, "rates": 0}
+    segments: dict[int, _Segment] = {}
     i_eval = 0
     t, x = 0.0, np.array(x0, float)
     terminated = False
@@ -213,22 +268,20 @@ def integrate_hybrid(system, x0, t_end: float, *, mode: int | None = None, metho
             raise BudgetExceeded(f"events: more than max_events = {rules.max_events:,} events", key="max_events",
                                  reached=where(tk, seg.index))
         if len(recent) == recent.maxlen and recent[-1] - recent[0] <= zeno_span:
-            raise BudgetExceeded(f"events: {len(recent)} events within {recent[-1] - recent[0]:.3g} (at most "
-                                 f"zeno_span = {zeno_span:.3g}): a Zeno or chattering approach (guard {info.name} "
-                                 f"of mode {names[seg.index]})", key="zeno_events", reached=where(tk, seg.index))
+            raise BudgetExceeded(f"events: {len(recent)} events within {recent[-1] - recent[0]:.3g} (more than "
+                                 f"zeno_events = {rules.zeno_events} within zeno_span = {zeno_span:.3g}): a Zeno or "
+                                 f"chattering approach (guard {info.name} of mode {names[seg.index]})",
+                                 key="zeno_events", reached=where(tk, seg.index))
         return target, x_after
 
     record(t, x, mode)
     with Progress(t_end, desc=desc, unit="t", enabled=progress) as bar:
         while True:
-            seg = _Segment(system, mode)
-            directions = np.array([g.direction for g in seg.guards], dtype=float)
+            if mode not in segments:
+                segments[mode] = _Segment(system, mode, t_end, counts)
+            seg = segments[mode]
             g0, d0 = seg.values(t, x)
-            tol = time_tolerance(t, t_end)
-            surface = (g0 == 0) | (np.abs(g0) <= np.abs(d0) * tol)
-            sign = np.where(surface, np.sign(d0), np.sign(g0))
-            at_once = [k for k in np.flatnonzero(surface & (sign != 0))
-                       if directions[k] in (0, sign[k])]
+            sign, at_once = start_signs(g0, d0, seg.directions, time_tolerance(t, t_end))
             if at_once:
                 k = at_once[0]  # the guards are in priority order: terminal first, then declared order
                 target, x = fire(seg, k, t, x)
@@ -241,17 +294,16 @@ def integrate_hybrid(system, x0, t_end: float, *, mode: int | None = None, metho
                 continue
             if t >= t_end:
                 break
-            hit = _integrate_segment(seg, x, t, t_end, method, rtol, atol, sign, directions, budget, stats,
+            hit = _integrate_segment(seg, x, t, (g0, d0), method, rtol, atol, sign, budget, stats,
                                      sample_until, record, bar, explain, where)
             if hit is None:
-                t, x = t_end, hit_state(stats)
+                t, x = t_end, stats["y_end"]
                 break
             k, t, x_before = hit
             sample_until(t, stats["dense"], mode, inclusive=True)
             target, x = fire(seg, k, t, x_before)
             record(t, x_before, mode)
             record(t, x, mode if target is None else target)
-            stats["guards"] += seg.evaluations
             if target is None or (stop_after is not None and stop_after(events[-1])):
                 terminated = True
                 mode = mode if target is None else target
@@ -261,25 +313,43 @@ def integrate_hybrid(system, x0, t_end: float, *, mode: int | None = None, metho
     x_out = np.vstack(xs) if xs else np.empty((0, np.size(x0)))
     m_out = np.hstack(ms).astype(int) if ms else np.empty(0, int)
     return HybridTrajectory(t_out, x_out, m_out, tuple(events), mode, float(t), np.array(x), terminated,
-                            stats["steps"], stats["nfev"], stats["njev"], stats["guards"])
+                            stats["steps"], stats["nfev"], stats["njev"], counts["guards"],
+                            {"rate_evaluations": counts["rates"]})
 
 
-def hit_state(stats: dict) -> np.ndarray:
-    """The state at the end of the last segment (t_end reached without an event)."""
-    return stats["y_end"]
+def start_signs(g0: np.ndarray, d0: np.ndarray, directions: np.ndarray, tol: float):
+    """The tracked signs of the guards at the start of a mode, and the guards that fire there at once (module
+    doc, "Start of a mode"): a guard on its surface (g = 0, or |g| <= |g_t| tol) takes the sign it moves to
+    (0 when g_t = 0 too: unknown until a point where g is nonzero) and fires when that is its direction."""
+    surface = (g0 == 0) | (np.abs(g0) <= np.abs(d0) * tol)
+    sign = np.where(surface, np.sign(d0), np.sign(g0))
+    at_once = [int(k) for k in np.flatnonzero(surface & (sign != 0)) if directions[k] in (0, sign[k])]
+    return sign, at_once
 
 
-def _integrate_segment(seg, x, t, t_end, method, rtol, atol, sign, directions, budget, stats, sample_until,
-                       record, bar, explain, where):
-    """Integrate one mode from (t, x) until a guard fires (-> (guard, t*, x*)) or t_end (-> None)."""
+def _end_rate(solver, seg, t: float, y: np.ndarray) -> np.ndarray:
+    """dx/dt at the step's end: the integrator's own (RK45, DOP853, Radau keep it), else evaluated."""
+    f = getattr(solver, "f", None)
+    if f is not None and getattr(solver, "t", None) == t:
+        return np.asarray(f)
+    seg.counts["rates"] += 1
+    return seg.rhs(t, y)
+
+
+def _integrate_segment(seg, x, t, start, method, rtol, atol, sign, budget, stats, sample_until, record, bar,
+                       explain, where):
+    """Integrate one mode from (t, x) until a guard fires (-> (guard, t*, x*)) or t_end (-> None).
+    ``start``: the guards' (g, g_t) at (t, x); ``sign``: their tracked signs there."""
     from numpy.linalg import LinAlgError
 
     kwargs = {"jac": seg.jac} if method in IMPLICIT else {}
+    t_end = seg.t_end
+    y_old, t_old = np.array(x), t
     try:
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             solver = _solver_class(method)(seg.rhs, t, x, t_end, rtol=rtol, atol=atol, **kwargs)
-        y_old, t_old = np.array(x), t
-        g_old, d_old = seg.values(t, x)
+        g_old, d_old = start
+        t_start = t
         while solver.status == "running":
             with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
                 message = solver.step()
@@ -292,17 +362,15 @@ def _integrate_segment(seg, x, t, t_end, method, rtol, atol, sign, directions, b
                 raise KernelError(f"{method}: state became NaN/Inf by {where(t_new, seg.index)}")
             dense = solver.dense_output()
             stats["dense"] = dense
-            g_new, d_new = seg.values(t_new, y_new)
-            found = _scan(seg, dense, sign, directions, (t_old, g_old, d_old), (t_new, g_new, d_new))
+            g_new, d_new = seg.values(t_new, y_new, dxdt=_end_rate(solver, seg, t_new, y_new))
+            found = _scan(seg, dense, sign, (t_old, g_old, d_old), (t_new, g_new, d_new), t_start)
             if found is not None:
-                k, t_lo, t_hi = found
-                t_star, x_star = _locate(seg, dense, k, t_lo, t_hi, t_old, y_old, method, rtol, atol, kwargs,
-                                         t_end)
+                k, t_root, t_lo, t_hi = found
+                t_star, x_star = _locate(seg, dense, k, t_root, t_lo, t_hi, t_old, y_old, method, rtol, atol,
+                                         kwargs)
                 stats["nfev"] += solver.nfev
                 stats["njev"] += getattr(solver, "njev", 0)
                 return k, t_star, x_star
-            nonzero = np.sign(g_new) != 0
-            sign = np.where(nonzero, np.sign(g_new), sign)
             sample_until(t_new, dense, seg.index, inclusive=True)
             record(t_new, y_new, seg.index)
             if budget is not None:
@@ -319,44 +387,44 @@ def _integrate_segment(seg, x, t, t_end, method, rtol, atol, sign, directions, b
     return None
 
 
-def _scan(seg, dense, sign, directions, a, b):
-    """The earliest interval (guard, t_lo, t_hi) of the step [a, b] in which a guard crosses, or None.
+def _scan(seg, dense, sign, a, b, t_start):
+    """The earliest crossing of the step [a, b]: (guard, its zero, t_lo, t_hi bracketing it), or None.
 
     ``a`` and ``b`` are (t, g, g_t) at the step's ends; ``sign`` (updated in place along the way) the
-    tracked signs at the start. Suspicious intervals are halved (module doc, "Missed events")."""
+    tracked signs at the start; ``t_start`` the time the mode started. Suspicious intervals are halved
+    (module doc, "Missed events"), the earlier half first."""
+    directions = seg.directions
     stack = [(a, b, 0)]
     while stack:
         (ta, ga, da), (tb, gb, db), depth = stack.pop()
-        crossed = _crossed(sign, gb, directions)
-        double = _possible_crossing(sign, ga, da, gb, db, tb - ta) & ~crossed
-        if (crossed.any() or double.any()) and depth < MAX_DEPTH and (double.any() or _many_roots(ga, da, gb, db,
-                                                                                                  tb - ta, crossed)):
+        if depth < MAX_DEPTH and _suspicious(sign, ga, da, gb, db, tb - ta, ta == t_start):
             tm = 0.5 * (ta + tb)
-            xm = dense(tm)
-            gm, dm = seg.values(tm, xm)
+            gm, dm = seg.values(tm, dense(tm))
             stack.append(((tm, gm, dm), (tb, gb, db), depth + 1))
             stack.append(((ta, ga, da), (tm, gm, dm), depth + 1))
             continue
+        crossed = _crossed(sign, gb, directions)
         if crossed.any():
-            ks = np.flatnonzero(crossed)
-            roots = [(_root(seg, dense, k, ta, tb), k) for k in ks]
-            t_first = min(r for r, _ in roots)
-            tol = time_tolerance(t_first, tb)
-            k = min(k for r, k in roots if r <= t_first + tol)  # tie: the first in priority order
-            return k, ta, tb
+            return _first(seg, dense, sign, crossed, ta, tb)
         nonzero = np.sign(gb) != 0
         sign[...] = np.where(nonzero, np.sign(gb), sign)
     return None
 
 
-def _many_roots(ga, da, gb, db, h, crossed) -> bool:
-    """Whether a crossing guard's cubic Hermite on the interval has an interior extremum (maybe 3 roots)."""
-    for k in np.flatnonzero(crossed):
-        c1, c2, c3 = h * da[k], 3 * (gb[k] - ga[k]) - h * (2 * da[k] + db[k]), 2 * (ga[k] - gb[k]) + h * (da[k] + db[k])
-        roots = np.roots([3 * c3, 2 * c2, c1]) if (c3 or c2) else np.array([])
-        if any(0 < u < 1 for u in roots[np.isreal(roots)].real):
-            return True
-    return False
+def _first(seg, dense, sign, crossed, ta: float, tb: float):
+    """(guard, zero, t_lo, t_hi) of the winner among the guards crossing in [ta, tb] and those crossing
+    within the location tolerance after the earliest zero (module doc, "Simultaneous events")."""
+    roots = {int(k): _root(seg, dense, int(k), ta, tb) for k in np.flatnonzero(crossed)}
+    t_first = min(roots.values())
+    t_tie = t_first + time_tolerance(t_first, seg.t_end)
+    t_hi = {k: tb for k in roots}
+    others = ~crossed & (sign != 0)
+    if t_tie > tb and others.any():
+        g_tie, _ = seg.values(t_tie, dense(t_tie), with_rates=False)
+        for k in np.flatnonzero(_crossed(sign, g_tie, seg.directions) & others):
+            roots[int(k)], t_hi[int(k)] = _root(seg, dense, int(k), ta, t_tie), t_tie
+    k = min(k for k, r in roots.items() if r <= t_tie)  # the guards are in priority order
+    return k, roots[k], ta, t_hi[k]
 
 
 def _root(seg, dense, k: int, ta: float, tb: float) -> float:
@@ -374,10 +442,9 @@ def _root(seg, dense, k: int, ta: float, tb: float) -> float:
     return brentq(g, ta, tb, xtol=4 * EPS * max(abs(ta), abs(tb), 1e-300), rtol=4 * EPS, maxiter=200)
 
 
-def _locate(seg, dense, k, t_lo, t_hi, t_old, y_old, method, rtol, atol, kwargs, t_end):
-    """(t*, x*) of guard k's zero in [t_lo, t_hi]: the dense output's zero, the state integrated afresh from
+def _locate(seg, dense, k, t_d, t_lo, t_hi, t_old, y_old, method, rtol, atol, kwargs):
+    """(t*, x*) of guard k's zero t_d (on the dense output, in [t_lo, t_hi]): the state integrated afresh from
     the step's start (t_old, y_old) to it, and one Newton correction on g."""
-    t_d = _root(seg, dense, k, t_lo, t_hi)
     if t_d > t_old:
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             fresh = _solver_class(method)(seg.rhs, t_old, y_old, t_d, rtol=rtol, atol=atol,
@@ -388,8 +455,8 @@ def _locate(seg, dense, k, t_lo, t_hi, t_old, y_old, method, rtol, atol, kwargs,
     else:
         x_d = np.array(y_old)
     f = seg.rhs(t_d, x_d)
-    g, g_t = seg.system.guard_values(seg.index, t_d, x_d, f)
-    if g_t[k] != 0 and abs(g[k] / g_t[k]) <= max(t_hi - t_lo, time_tolerance(t_d, t_end)):
+    g, g_t = seg.values(t_d, x_d, dxdt=f)
+    if g_t[k] != 0 and abs(g[k] / g_t[k]) <= max(t_hi - t_lo, time_tolerance(t_d, seg.t_end)):
         dt = -g[k] / g_t[k]
         return t_d + dt, x_d + dt * f
     return t_d, x_d
