@@ -11,11 +11,10 @@ is run at that single value.
 Outputs: the numeric parameter's values under its own name (``zeta``), and ``restitution``,
 ``contact_duration``, ``energy_lost`` and ``released``: objects mapping each choice (``kelvin_voigt``
 ...) to a list aligned with it (plain lists without a choice parameter); ``hysteresis`` (per choice,
-a list of {parameter value, ``penetration``, ``force``}); ``impacts`` and ``seconds_per_impact``.
+a list of {parameter value, ``penetration``, ``force``}); ``impacts`` (the analysis's ``seconds`` in the
+result, divided by it, is the time per impact).
 """
 from __future__ import annotations
-
-import time
 
 from mechgen.analyses import schema, summary
 from mechgen.analyses.context import NAME, POINTS, PointRunner, public
@@ -103,10 +102,8 @@ def run_restitution(system, options: dict, context: dict) -> dict:
         tasks.append(points.task("impact", {**base, "curve": index in curves}, point))
     budget = Budget("restitution impacts", unit="points",
                     seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
-    started = time.perf_counter()
     results = sweep(points.evaluate, tasks, workers=0, progress=options.get("progress", True),
                     desc=context.get(NAME, "restitution"), budget=budget, labels=grid)
-    seconds = time.perf_counter() - started
     keys = [point[choice] for point in grid] if choice else [None] * len(grid)
     out: dict = {numeric or "point": list(values)}
     for what in MEASURED:
@@ -121,7 +118,6 @@ def run_restitution(system, options: dict, context: dict) -> dict:
                                              r["penetration_series"], "force": r["force_series"]})
     out["hysteresis"] = hyst if choice else hyst.get(None, [])
     out["impacts"] = len(grid)
-    out["seconds_per_impact"] = seconds / max(1, len(grid))
     return out
 
 
