@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import ctypes
 import logging
+import math
 from functools import lru_cache
 from pathlib import Path
 
@@ -119,6 +120,11 @@ def _library():
     return lib, None
 
 
+def forget_library() -> None:
+    """Forget the loaded (or refused) loop library: the next run builds or finds it again (tests change CC)."""
+    _library.cache_clear()
+
+
 def loop_library():
     """The loaded C loop library (CompilerUnavailable or BuildError when it cannot be had)."""
     lib, why = _library()
@@ -132,6 +138,7 @@ class _Tables:
 
     def __init__(self, system) -> None:
         self.keep = []
+        self.names: list[tuple[str, ...]] = []  # the guards' names per mode
         n_modes = len(system.modes)
         self.modes = (CMode * n_modes)()
         self.max_guards = 0
@@ -142,6 +149,7 @@ class _Tables:
                 if name in system.kernels:
                     setattr(mode, kind, self.kernel(system.kernels[name], kind))
             guards = system.guards(i)
+            self.names.append(tuple(g.name for g in guards))
             mode.nguards = len(guards)
             self.max_guards = max(self.max_guards, len(guards))
             for field, values in (("direction", [g.direction for g in guards]),
@@ -223,34 +231,61 @@ def _tables(system) -> _Tables:
     return system.patterns[key]
 
 
-class _Buffers:
-    """The sample and event buffers the C loop writes, grown (doubled) when it asks."""
+def _arena(dtype, shapes: dict) -> tuple[dict, dict]:
+    """Arrays of the given shapes (name -> tuple) carved from one zeroed block, and their addresses (one
+    address lookup for the block: the costly part of a short run's setup)."""
+    dtype = np.dtype(dtype)
+    counts = [math.prod(shape) for shape in shapes.values()]
+    block = np.zeros(max(1, sum(counts)), dtype=dtype)
+    base, size = block.ctypes.data, dtype.itemsize
+    arrays, addresses, at = {}, {}, 0
+    for (name, shape), count in zip(shapes.items(), counts):
+        arrays[name] = block[at: at + count].reshape(shape)
+        addresses[name] = base + at * size
+        at += count
+    return arrays, addresses
 
-    def __init__(self, problem: CProblem, nx: int, samples: int, events: int) -> None:
+
+class _Buffers:
+    """The state, sample and event arrays the C loop reads and writes (``arrays``, by name), set up with two
+    allocations; the sample or event buffers are grown (doubled, in place of the old ones) when it asks."""
+
+    def __init__(self, problem: CProblem, state: CState, nx: int, ng: int, ring: int, samples: int,
+                 events: int) -> None:
         self.problem, self.nx = problem, nx
-        self.s_t, self.s_x, self.s_mode = np.zeros(0), np.zeros((0, nx)), np.zeros(0, LONG)
-        self.e_t, self.e_before, self.e_after = np.zeros(0), np.zeros((0, nx)), np.zeros((0, nx))
-        self.e_source, self.e_target, self.e_guard = (np.zeros(0, LONG) for _ in range(3))
-        self.grow_samples(samples)
-        self.grow_events(events)
+        reals = {"x": (nx,), "f": (nx,), "sign": (ng,), "g_old": (ng,), "d_old": (ng,), "recent": (ring,),
+                 "err_x": (nx,), **self._reals("s", samples), **self._reals("e", events)}
+        longs = {**self._longs("s", samples), **self._longs("e", events)}
+        self.arrays, addresses = _arena(float, reals)
+        more, at = _arena(LONG, longs)
+        self.arrays.update(more)
+        addresses.update(at)
+        for name, address in addresses.items():
+            setattr(state if name in self.STATE else problem, name, address)
+        problem.sample_cap, problem.event_cap = samples, events
+
+    STATE = ("x", "f", "sign", "g_old", "d_old", "recent", "err_x")
+
+    def _reals(self, group: str, rows: int) -> dict:
+        if group == "s":
+            return {"s_t": (rows,), "s_x": (rows, self.nx)}
+        return {"e_t": (rows,), "e_before": (rows, self.nx), "e_after": (rows, self.nx)}
 
     @staticmethod
-    def _grown(arr: np.ndarray, rows: int) -> np.ndarray:
-        out = np.zeros((rows,) + arr.shape[1:], dtype=arr.dtype)
-        out[: len(arr)] = arr
-        return out
+    def _longs(group: str, rows: int) -> dict:
+        return {"s_mode": (rows,)} if group == "s" else {"e_source": (rows,), "e_target": (rows,), "e_guard": (rows,)}
 
-    def grow_samples(self, rows: int) -> None:
-        self.s_t, self.s_x, self.s_mode = (self._grown(a, rows) for a in (self.s_t, self.s_x, self.s_mode))
-        p = self.problem
-        p.sample_cap, p.s_t, p.s_x, p.s_mode = rows, self.s_t.ctypes.data, self.s_x.ctypes.data, self.s_mode.ctypes.data
-
-    def grow_events(self, rows: int) -> None:
-        names = ("e_t", "e_before", "e_after", "e_source", "e_target", "e_guard")
-        for name in names:
-            setattr(self, name, self._grown(getattr(self, name), rows))
-            setattr(self.problem, name, getattr(self, name).ctypes.data)
-        self.problem.event_cap = rows
+    def grow(self, group: str) -> None:
+        """Double the sample (``group`` "s") or event ("e") buffers, keeping what they hold."""
+        cap = "sample_cap" if group == "s" else "event_cap"
+        keep = getattr(self.problem, cap)
+        for dtype, shapes in ((float, self._reals(group, 2 * keep)), (LONG, self._longs(group, 2 * keep))):
+            arrays, addresses = _arena(dtype, shapes)
+            for name, arr in arrays.items():
+                arr[:keep] = self.arrays[name][:keep]
+                self.arrays[name] = arr
+                setattr(self.problem, name, addresses[name])
+        setattr(self.problem, cap, 2 * keep)
 
 
 def integrate_hybrid_c(system, x0, t_end: float, *, mode: int | None = None, rtol: float = 1e-8,
@@ -291,13 +326,12 @@ def integrate_hybrid_c(system, x0, t_end: float, *, mode: int | None = None, rto
     if t_eval is not None:
         problem.n_eval, problem.t_eval = (len(t_eval), t_eval.ctypes.data) if len(t_eval) else (-1, None)
         keep.append(t_eval)
-    buffers = _Buffers(problem, nx, len(t_eval) if t_eval is not None else 256, 16)
-    x, f = x0.copy(), np.zeros(nx)
-    sign, g_old, d_old = np.zeros(ng), np.zeros(ng), np.zeros(ng)
-    recent, err_x = np.zeros(max(2, rules.zeno_events)), np.zeros(nx)
-    state = CState(phase=-1, mode=start, t=0.0, x=x.ctypes.data, f=f.ctypes.data, sign=sign.ctypes.data,
-                   g_old=g_old.ctypes.data, d_old=d_old.ctypes.data, recent=recent.ctypes.data,
-                   err_x=err_x.ctypes.data)
+    state = CState(phase=-1, mode=start, t=0.0)
+    buffers = _Buffers(problem, state, nx, ng, max(2, rules.zeno_events),
+                       len(t_eval) if t_eval is not None else 256, 16)
+    arrays = buffers.arrays
+    x, err_x = arrays["x"], arrays["err_x"]
+    x[...] = x0
     events: list[Event] = []
 
     def where(tk: float, seg: int) -> str:
@@ -305,11 +339,11 @@ def integrate_hybrid_c(system, x0, t_end: float, *, mode: int | None = None, rto
 
     def new_events() -> None:
         for e in range(len(events), state.n_events):
-            target = int(buffers.e_target[e])
-            source = int(buffers.e_source[e])
-            events.append(Event(float(buffers.e_t[e]), source, None if target < 0 else target,
-                                system.guards(source)[int(buffers.e_guard[e])].name,
-                                buffers.e_before[e].copy(), buffers.e_after[e].copy()))
+            target = int(arrays["e_target"][e])
+            source = int(arrays["e_source"][e])
+            events.append(Event(float(arrays["e_t"][e]), source, None if target < 0 else target,
+                                tables.names[source][int(arrays["e_guard"][e])],
+                                arrays["e_before"][e].copy(), arrays["e_after"][e].copy()))
 
     terminated = False
     with Progress(t_end, desc=desc, unit="t", enabled=progress) as bar:
@@ -324,9 +358,9 @@ def integrate_hybrid_c(system, x0, t_end: float, *, mode: int | None = None, rto
                 raise _error(rc, system, state, err_x, where, rules, zeno_span, explain)
             bar.to(state.t)
             if rc == FULL_SAMPLES:
-                buffers.grow_samples(2 * problem.sample_cap)
+                buffers.grow("s")
             elif rc == FULL_EVENTS:
-                buffers.grow_events(2 * problem.event_cap)
+                buffers.grow("e")
             elif rc == PAUSED:
                 new_events()
                 if stop_after(events[-1]):
@@ -339,8 +373,8 @@ def integrate_hybrid_c(system, x0, t_end: float, *, mode: int | None = None, rto
                 break
     new_events()
     count = state.n_samples
-    return HybridTrajectory(buffers.s_t[:count].copy(), buffers.s_x[:count].copy(),
-                            buffers.s_mode[:count].astype(int), tuple(events), int(state.mode), float(state.t),
+    return HybridTrajectory(arrays["s_t"][:count].copy(), arrays["s_x"][:count].copy(),
+                            arrays["s_mode"][:count].astype(int), tuple(events), int(state.mode), float(state.t),
                             x.copy(), terminated, int(state.steps), int(state.nfev), 0, int(state.nguard),
                             {"loop": "c"})
 
