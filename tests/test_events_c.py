@@ -337,3 +337,47 @@ def test_simulate_takes_the_loop_key_for_a_model_with_modes_only():
     smooth = mechgen.compile(pendulum, {}, kernels=["residual", "tangent", "outputs"])
     with pytest.raises(MechgenError, match="no modes"):
         mechgen.simulate(smooth, t_end=1.0, loop="c")
+
+
+def test_resuming_at_clean_points_changes_nothing(ball, monkeypatch):
+    """Buffers grown from one row, a slice of one step and a pause after every event give the very numbers
+    of one uninterrupted call (the C loop resumes exactly where it stopped)."""
+    run = dict(method="DOP853", rtol=1e-11, atol=1e-13)
+    whole = integrate_hybrid(ball, np.array([1.0, 0.0]), 1.3, loop="c", **run)
+    monkeypatch.setattr(events_c, "SLICE", 1)
+    monkeypatch.setattr(events_c, "FIRST_ROWS", (1, 1))
+    pieces = integrate_hybrid(ball, np.array([1.0, 0.0]), 1.3, loop="c", stop_after=lambda e: False,
+                              budget=Budget("DOP853 steps", limit=10_000, key="max_steps"), **run)
+    assert len(whole.t) > 20 and len(whole.events) >= 5
+    np.testing.assert_array_equal(pieces.t, whole.t)
+    np.testing.assert_array_equal(pieces.x, whole.x)
+    np.testing.assert_array_equal(pieces.mode, whole.mode)
+    assert [(e.t, e.guard) for e in pieces.events] == [(e.t, e.guard) for e in whole.events]
+    np.testing.assert_array_equal(pieces.x_final, whole.x_final)
+
+
+def test_a_force_giving_nan_is_a_kernel_error_in_both_loops():
+    """y'' = sqrt(y) - 1 from y = 1 moving down: y < 0 (sqrt of a negative: NaN) is reached before t = 3."""
+    from mechgen.errors import KernelError
+
+    model = Model("sqrt_spring", doc="a force defined for y >= 0 only")
+    model.coordinates("y")
+
+    @model.kinetic
+    def kinetic(v):
+        return v.y**2 / 2
+
+    @model.forces
+    def force(q):
+        return {"y": sp.sqrt(q.y) - 1}
+
+    free = model.mode("free", initial=True)
+
+    @free.terminal(direction="rising")
+    def far(q):
+        return q.y - 10
+
+    system = mechgen.compile(model, {}, kernels=["residual", "tangent", "outputs"])
+    for loop in ("c", "python"):
+        with pytest.raises(KernelError, match="NaN/Inf"):
+            integrate_hybrid(system, np.array([1.0, -2.0]), 3.0, method="DOP853", loop=loop)

@@ -41,6 +41,8 @@ SOURCE = Path(__file__).resolve().parent.parent.parent / "codegen" / "templates"
 STEM = "mghybrid"
 #: the C loop hands back to Python (budget clock, progress bar) after this many steps
 SLICE = 20_000
+#: the rows the sample buffer (without t_eval) and the event buffer start with (doubled when full)
+FIRST_ROWS = (256, 16)
 PORTS = 8
 INPUTS = {"q": 0, "v": 1, "a": 2, "z": 3, "t": 4, "p": 5}
 #: the outputs each kernel kind gives the loop
@@ -328,7 +330,7 @@ def integrate_hybrid_c(system, x0, t_end: float, *, mode: int | None = None, rto
         keep.append(t_eval)
     state = CState(phase=-1, mode=start, t=0.0)
     buffers = _Buffers(problem, state, nx, ng, max(2, rules.zeno_events),
-                       len(t_eval) if t_eval is not None else 256, 16)
+                       len(t_eval) if t_eval is not None else FIRST_ROWS[0], FIRST_ROWS[1])
     arrays = buffers.arrays
     x, err_x = arrays["x"], arrays["err_x"]
     x[...] = x0
