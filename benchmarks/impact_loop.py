@@ -68,6 +68,32 @@ def handwritten(law: str, zeta: float):
     return rhs, release, x0
 
 
+def exact(law: str, zeta: float) -> float:
+    """e in closed form (Butcher & Segalman eqs. 4, 10-11, 16; Hunt-Crossley's implicit relation), or for the
+    standard linear solid from the matrix exponential of its linear contact phase."""
+    import math
+
+    from scipy.linalg import expm
+    from scipy.optimize import brentq
+
+    if law in ("kelvin_voigt", "maxwell"):
+        return math.exp(-zeta * math.pi / math.sqrt(1 - zeta**2))
+    if law == "modified_kelvin_voigt":
+        b = math.sqrt(1 - zeta**2)
+        return math.exp(-(zeta / b) * math.atan2(2 * zeta * b, 2 * zeta**2 - 1))
+    if law == "hunt_crossley":
+        a = 1.5 * math.pi * zeta
+        return brentq(lambda e: math.log((1 + a) / (1 - a * e)) - a * (1 + e), 1e-14, min(1, 1 / a) * (1 - 1e-15),
+                      xtol=1e-16)
+    k1, k2, c = 1 / EPS, 1 / (1 - EPS), 2 * zeta / (1 - EPS)
+    A = np.array([[0, 1, 0], [-k1, 0, k1], [k1 / c, 0, -(k1 + k2) / c]])
+    s0 = np.array([0.0, 1.0, 0.0])
+    force = lambda t: (expm(A * t) @ s0) @ [k1, 0, -k1]  # noqa: E731
+    grid = np.linspace(1e-6, 10, 2001)
+    i = next(i for i in range(len(grid) - 1) if force(grid[i]) > 0 >= force(grid[i + 1]))
+    return -(expm(A * brentq(force, grid[i], grid[i + 1], xtol=1e-16)) @ s0)[1]
+
+
 def scipy_impact(law: str, zeta: float) -> float:
     rhs, release, x0 = handwritten(law, zeta)
     sol = solve_ivp(rhs, (0.0, T_END), x0, method="DOP853", rtol=RTOL, atol=ATOL, events=release)
@@ -105,16 +131,18 @@ def main() -> None:
     args = ap.parse_args()
     print(f"per impact (best of {args.repeat} x {args.count}), zeta = {ZETA}, rtol = {RTOL:g}, DOP853")
     print(f"{'law':22s} {'python loop':>12s} {'C loop':>10s} {'solve_ivp':>10s} {'py/C':>7s} {'ivp/C':>7s}"
-          "   e (C loop)       e (solve_ivp)   |diff|")
+          "   e exact          err C    err py   err ivp")
     for law in LAWS:
         system, _ = compile_model(model, specialize(model, {"law": law}, free=["zeta"]), backend="c")
         system = system.with_params(zeta=ZETA)
-        e_c, e_ivp = mechgen_impact(system, "c"), scipy_impact(law, ZETA)
+        e_c, e_py, e_ivp = mechgen_impact(system, "c"), mechgen_impact(system, "python"), scipy_impact(law, ZETA)
+        e_ref = exact(law, ZETA)
         t_py = best(lambda: mechgen_impact(system, "python"), max(1, args.count // 10), args.repeat)
         t_c = best(lambda: mechgen_impact(system, "c"), args.count, args.repeat)
         t_ivp = best(lambda: scipy_impact(law, ZETA), max(1, args.count // 10), args.repeat)
         print(f"{law:22s} {t_py * 1e3:9.2f} ms {t_c * 1e3:7.3f} ms {t_ivp * 1e3:7.2f} ms {t_py / t_c:6.0f}x "
-              f"{t_ivp / t_c:6.1f}x   {e_c:.13f}  {e_ivp:.13f}  {abs(e_c - e_ivp):.1e}")
+              f"{t_ivp / t_c:6.1f}x   {e_ref:.13f}  {abs(e_c - e_ref) / e_ref:.1e}  {abs(e_py - e_ref) / e_ref:.1e}  "
+              f"{abs(e_ivp - e_ref) / e_ref:.1e}")
 
 
 if __name__ == "__main__":

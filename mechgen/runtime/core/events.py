@@ -174,7 +174,7 @@ def integrate_hybrid(system, x0, t_end: float, *, mode: int | None = None, metho
     if loop != "python" and method in METHODS:
         from mechgen.runtime.core.events_c import c_loop_problem, integrate_hybrid_c
 
-        why = c_loop_problem(system, method)
+        why = c_loop_problem(system, method, rtol, atol)
         if why is None:
             return integrate_hybrid_c(system, x0, t_end, mode=mode, rtol=rtol, atol=atol, t_eval=t_eval,
                                       budget=budget, rules=rules, progress=progress, desc=desc, explain=explain,

@@ -207,11 +207,14 @@ def _supported(system) -> str | None:
     return None
 
 
-def c_loop_problem(system, method: str = "DOP853") -> str | None:
-    """Why :func:`integrate_hybrid_c` cannot run ``system`` with ``method`` (None when it can): the loop is
-    DOP853 on a lumped hybrid system of the C backend, and needs a C compiler (for its own library)."""
+def c_loop_problem(system, method: str = "DOP853", rtol=1e-8, atol=1e-10) -> str | None:
+    """Why :func:`integrate_hybrid_c` cannot run ``system`` with ``method`` and these tolerances (None when it
+    can): the loop is DOP853 with scalar tolerances on a lumped hybrid system of the C backend, and needs a
+    C compiler (for its own library)."""
     if method != "DOP853":
         return f"the C event loop integrates with DOP853 only (method {method!r})"
+    if np.ndim(rtol) or np.ndim(atol):
+        return "the C event loop takes scalar tolerances rtol and atol only"
     if not hasattr(system, "modes"):
         return "the system has no modes"
     if getattr(system, "backend", None) != "c":
@@ -324,10 +327,8 @@ def integrate_hybrid_c(system, x0, t_end: float, *, mode: int | None = None, rto
                        t_end=t_end, max_events=int(rules.max_events), zeno_events=int(rules.zeno_events),
                        zeno_span=float(zeno_span), stop_mode=-1, pause=int(stop_after is not None),
                        budget_left=-1, slice=SLICE)
-    keep = [params]
-    if t_eval is not None:
+    if t_eval is not None:  # (params and t_eval stay referenced here while the loop reads them)
         problem.n_eval, problem.t_eval = (len(t_eval), t_eval.ctypes.data) if len(t_eval) else (-1, None)
-        keep.append(t_eval)
     state = CState(phase=-1, mode=start, t=0.0)
     buffers = _Buffers(problem, state, nx, ng, max(2, rules.zeno_events),
                        len(t_eval) if t_eval is not None else FIRST_ROWS[0], FIRST_ROWS[1])
