@@ -15,7 +15,9 @@ at release:
 With ``curve = true`` the outputs also hold ``penetration_series`` and ``force_series`` (the
 coordinate and the output ``force_output``, default ``force``) at ``samples`` times over the
 contact: the force-penetration hysteresis. Integration keys as simulate (mechgen.analyses.simulate):
-``method`` (default DOP853), ``rtol`` (1e-10), ``atol`` (1e-12), ``max_steps``, ``max_seconds``.
+``method`` (default DOP853), ``rtol`` (1e-10), ``atol`` (1e-12), ``max_steps``, ``max_seconds``, and
+``loop`` (default ``auto``: the compiled event loop of mechgen.runtime.core.events_c for DOP853 on the C
+backend, else the Python one; ``python`` or ``c`` to choose).
 """
 from __future__ import annotations
 
@@ -26,7 +28,7 @@ from mechgen.analyses.operating_point import vector
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import ABSENT, REQUIRED, Option
 from mechgen.errors import SceneError
-from mechgen.runtime.core.events import integrate_hybrid
+from mechgen.runtime.core.events import LOOPS, integrate_hybrid
 from mechgen.scene.values import fail, listing, show
 
 STEP = "a number > 0 (or an expression)"
@@ -61,7 +63,7 @@ SCHEMA = {"t_end": Option(schema.positive, REQUIRED, STEP), "method": Option(_me
           "coordinate": Option(_coordinate, ABSENT), "contact_mode": Option(schema.name, ABSENT),
           "force_output": Option(schema.name, "force"), "curve": Option(schema.boolean, False),
           "samples": Option(schema.count_within("samples"), 200), "max_steps": Option(schema.count, ABSENT),
-          "max_seconds": Option(schema.positive, ABSENT)}
+          "max_seconds": Option(schema.positive, ABSENT), "loop": Option(schema.one_of("loop", LOOPS), "auto")}
 
 
 def needs(options: dict, *, internal: bool) -> set[str]:
@@ -99,7 +101,8 @@ def measure(system, options: dict) -> dict:
         return event.source == state["contact"]
 
     method = options.get("method", "DOP853")
-    run = dict(method=method, rtol=options.get("rtol", 1e-10), atol=options.get("atol", 1e-12))
+    run = dict(method=method, rtol=options.get("rtol", 1e-10), atol=options.get("atol", 1e-12),
+               loop=options.get("loop", "auto"))
     t_end = float(options["t_end"])
     traj = integrate_hybrid(system, x0, t_end, budget=budget_of(options, method), stop_after=left_contact, **run)
     entry = next((e for e in traj.events if e.target == state["contact"]), None)

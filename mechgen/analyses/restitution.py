@@ -2,7 +2,7 @@
 
 Scene keys: ``over`` (as sweep's: parameter = [values] or {start, stop, num}; at most one choice
 parameter, e.g. ``law``, and one numeric one, e.g. ``zeta``), the impact's keys (``t_end``, ``v0``,
-``q0``, ``method``, ``rtol``, ``atol``, ``coordinate``, ``contact_mode``, ``force_output``), ``hysteresis``
+``q0``, ``method``, ``rtol``, ``atol``, ``coordinate``, ``contact_mode``, ``force_output``, ``loop``), ``hysteresis``
 (how many values of the numeric parameter also record the force-penetration curve, spread over its
 grid; default 4, 0 for none; or a list of values: the grid's nearest), ``samples`` (points per curve), ``progress`` and ``max_seconds`` (the whole
 grid, as sweep's). A numeric parameter of ``over`` that the command line sets (``--set zeta=0.3``)

@@ -4,7 +4,9 @@ Scene keys: ``t_end`` (required), ``method`` (BDF, Radau, LSODA, RK45, DOP853, o
 step ``dt``), ``rtol``, ``atol``, ``q0`` / ``v0`` (tables of coordinates), ``initial_mode`` with
 ``amplitude`` (start from a linear mode), ``outputs`` (which model outputs to report), ``series``
 (also report ``t`` and ``energy_series``), ``samples``. Outputs: the model's outputs at ``t_end``,
-``energy_drift``, ``t_end``; a fixed-end chain also ``mode_energies``.
+``energy_drift``, ``t_end``; a fixed-end chain also ``mode_energies``. A model with modes is run by
+mechgen.analyses.simulate_hybrid, with the keys ``mode``, ``max_events``, ``zeno_events``, ``zeno_span``
+and ``loop`` (the event loop: ``auto``, ``python`` or ``c``).
 
 Work budget (mechgen.runtime.core.budget): ``max_steps`` (integrator steps; default 10^7 for the
 leapfrog, whose t_end / dt steps are refused before the first one when they exceed it, and 10^5
@@ -77,6 +79,15 @@ def _mode(ctx, key: str, value: object) -> str:
     return value
 
 
+def _loop(ctx, key: str, value: object) -> str:
+    """The event loop of a hybrid model (mechgen.runtime.core.events.LOOPS)."""
+    from mechgen.runtime.core.events import LOOPS
+
+    if not getattr(ctx.model, "modes", ()):
+        raise fail(ctx.file, key, f"model {ctx.model.name} has no modes", "no 'loop' key (a smooth model)")
+    return schema.one_of("loop", LOOPS)(ctx, key, value)
+
+
 def _method(ctx, key: str, value: object) -> str:
     if not isinstance(value, str) or value not in METHODS:
         raise fail(ctx.file, key, f"unknown method {show(value)}", "one of: " + ", ".join(METHODS))
@@ -92,7 +103,7 @@ SCHEMA = {"t_end": Option(schema.positive, REQUIRED, STEP), "method": Option(_me
           "max_steps": Option(schema.count, ABSENT), "max_seconds": Option(schema.positive, ABSENT),
           "progress": Option(schema.boolean, ABSENT), "mode": Option(_mode, ABSENT),
           "max_events": Option(schema.count, ABSENT), "zeno_events": Option(schema.count, ABSENT),
-          "zeno_span": Option(schema.positive, ABSENT)}
+          "zeno_span": Option(schema.positive, ABSENT), "loop": Option(_loop, ABSENT)}
 
 
 def check(ctx, base: str, options: dict) -> None:

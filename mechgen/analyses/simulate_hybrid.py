@@ -5,7 +5,9 @@ the run starts in; default the model's initial mode), ``max_events`` (default 10
 (default 100) and ``zeno_span`` (default 1e-9 t_end): more than ``zeno_events`` events within
 ``zeno_span`` is a Zeno or chattering approach and ends the run (exit 1, naming time and mode).
 The rules for grazing, simultaneous events, events at t = 0 and events inside a step are those of
-mechgen.runtime.core.events. Outputs: the model's outputs at the end of the run (in the mode it
+mechgen.runtime.core.events; ``loop`` chooses the event loop that applies them (default ``auto``: the
+compiled one of mechgen.runtime.core.events_c for DOP853 on the C backend, else the Python one;
+``python`` or ``c`` to choose). Outputs: the model's outputs at the end of the run (in the mode it
 ended in), ``events`` (a list of ``{t, from, to, guard}``; ``to`` is null for a terminal event),
 ``final_mode``, ``t_final`` (t_end, or the time of the terminal event), ``energy_drift`` and
 ``t_end``; with ``series``: ``t``, ``energy_series`` and ``mode_series``.
@@ -67,7 +69,7 @@ def run_hybrid(system, options: dict, context: dict) -> dict:
                             atol=options.get("atol", 1e-10), t_eval=np.linspace(0.0, t_end, n_out),
                             budget=budget_of(options, method), rules=rules_of(options),
                             progress=bool(options.get("progress", True)), desc=context.get(NAME, "simulate"),
-                            explain=lambda t, x: explain_state(system, t, x))
+                            explain=lambda t, x: explain_state(system, t, x), loop=options.get("loop", "auto"))
     n = system.n
     views = {}
 

@@ -57,10 +57,12 @@ from typing import Callable
 
 import numpy as np
 
-from mechgen.errors import ConvergenceError, KernelError
+from mechgen.errors import ConvergenceError, InputError, KernelError
 from mechgen.runtime.core.budget import Budget, BudgetExceeded, Progress
 from mechgen.runtime.core.integrate import IMPLICIT, METHODS
 
+#: the event loops: this module's ("python"), the compiled one ("c"), or the compiled one where it applies
+LOOPS = ("auto", "python", "c")
 #: a suspicious interval of a step is halved at most this many times (2^-12 of the step)
 MAX_DEPTH = 12
 EPS = float(np.finfo(float).eps)
@@ -209,14 +211,31 @@ def integrate_hybrid(system, x0, t_end: float, *, mode: int | None = None, metho
                      rtol: float = 1e-8, atol: float = 1e-10, t_eval=None, budget: Budget | None = None,
                      rules: EventRules = EventRules(), progress: bool = False, desc: str = "simulate",
                      explain: Callable | None = None,
-                     stop_after: Callable[[Event], bool] | None = None) -> HybridTrajectory:
+                     stop_after: Callable[[Event], bool] | None = None, loop: str = "auto") -> HybridTrajectory:
     """Integrate a :class:`~mechgen.runtime.core.hybrid_system.HybridSystem` from x0 at t = 0 in ``mode``
     (default its initial mode) to t_end or a terminal event, by the rules of the module doc.
 
     Samples are taken at ``t_eval`` (sorted, in [0, t_end]), else at every step end and on both
     sides of every event. ``budget`` counts accepted steps; ``rules`` bound the events;
     ``stop_after(event)`` true ends the run after that event (an impact measured up to its release).
+    ``loop``: "python" (this loop), "c" (the compiled loop of mechgen.runtime.core.events_c: DOP853 on
+    the C backend) or "auto" (the compiled one where it can run, else this one).
     """
+    # -- loop dispatch: the compiled DOP853 loop (mechgen.runtime.core.events_c) where it applies ---------
+    if loop not in LOOPS:
+        raise ValueError(f"unknown loop {loop!r}; expected one of {LOOPS}")
+    if loop != "python" and method in METHODS:
+        from mechgen.runtime.core.events_c import c_loop_problem, integrate_hybrid_c
+
+        why = c_loop_problem(system, method, rtol, atol)
+        if why is None:
+            return integrate_hybrid_c(system, x0, t_end, mode=mode, rtol=rtol, atol=atol, t_eval=t_eval,
+                                      budget=budget, rules=rules, progress=progress, desc=desc, explain=explain,
+                                      stop_after=stop_after)
+        if loop == "c":
+            raise InputError(f"loop 'c' cannot run here: {why}", key="loop",
+                             expected="method DOP853 on the C backend with a C compiler, or loop 'auto'/'python'")
+    # -- end of the loop dispatch ------------------------------------------------------------------------
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}; expected one of {METHODS}")
     t_end = float(t_end)

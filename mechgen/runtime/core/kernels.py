@@ -58,12 +58,16 @@ def load_module(path: Path, name: str, source: str | bytes | None = None):
 
 
 class Kernel:
-    """One kernel: its spec and an implementation ``impl(ins, outs, sizes, nbatch)``."""
+    """One kernel: its spec and an implementation ``impl(ins, outs, sizes, nbatch)``; a C kernel also has the
+    ``address`` of its function ``mg_<name>`` in the loaded library (the compiled time loops call it directly;
+    None for the other backends)."""
 
-    def __init__(self, spec: dict, impl: Callable, backend: str, binder: Callable | None = None) -> None:
+    def __init__(self, spec: dict, impl: Callable, backend: str, binder: Callable | None = None,
+                 address: int | None = None) -> None:
         self.spec = spec
         self.name = spec["name"]
         self.backend = backend
+        self.address = address
         self._impl = impl
         self._binder = binder
         self.output_names = [p["name"] for p in spec["outputs"]]
@@ -155,7 +159,7 @@ def c_kernels(lib: ctypes.CDLL, spec: dict, caller) -> dict[str, Kernel]:
         def impl(ins, outs, sizes, nbatch, binder=binder):
             return binder(ins, outs, sizes, nbatch)()
 
-        kernels[name] = Kernel(kspec, impl, "c", binder)
+        kernels[name] = Kernel(kspec, impl, "c", binder, address)
     return kernels
 
 
