@@ -96,7 +96,8 @@ class CState(ctypes.Structure):
                 ("recent", c_void_p), ("n_recent", c_long), ("i_eval", c_long), ("n_samples", c_long),
                 ("n_events", c_long), ("steps", c_long), ("nfev", c_long), ("nguard", c_long),
                 ("counted", c_long), ("err_kind", c_long), ("err_mode", c_long), ("err_rc", c_long),
-                ("err_guard", c_long), ("err_t", c_double), ("err_span", c_double), ("err_x", c_void_p)]
+                ("err_guard", c_long), ("err_t", c_double), ("err_span", c_double), ("err_x", c_void_p),
+                ("nrate", c_long), ("t_start", c_double)]
 
 
 LAYOUT = (CKernel, CMode, CProblem, CState)
@@ -330,7 +331,7 @@ def integrate_hybrid_c(system, x0, t_end: float, *, mode: int | None = None, rto
     if t_eval is not None:  # (params and t_eval stay referenced here while the loop reads them)
         problem.n_eval, problem.t_eval = (len(t_eval), t_eval.ctypes.data) if len(t_eval) else (-1, None)
     state = CState(phase=-1, mode=start, t=0.0)
-    buffers = _Buffers(problem, state, nx, ng, max(2, rules.zeno_events),
+    buffers = _Buffers(problem, state, nx, ng, max(2, rules.zeno_events + 1),
                        len(t_eval) if t_eval is not None else FIRST_ROWS[0], FIRST_ROWS[1])
     arrays = buffers.arrays
     x, err_x = arrays["x"], arrays["err_x"]
@@ -379,7 +380,7 @@ def integrate_hybrid_c(system, x0, t_end: float, *, mode: int | None = None, rto
     return HybridTrajectory(arrays["s_t"][:count].copy(), arrays["s_x"][:count].copy(),
                             arrays["s_mode"][:count].astype(int), tuple(events), int(state.mode), float(state.t),
                             x.copy(), terminated, int(state.steps), int(state.nfev), 0, int(state.nguard),
-                            {"loop": "c"})
+                            {"loop": "c", "rate_evaluations": int(state.nrate)})
 
 
 def _error(rc: int, system, state: CState, err_x: np.ndarray, where, rules, zeno_span, explain) -> Exception:
@@ -408,9 +409,9 @@ def _error(rc: int, system, state: CState, err_x: np.ndarray, where, rules, zeno
         return BudgetExceeded(f"events: more than max_events = {rules.max_events:,} events", key="max_events",
                               reached=where(t, seg))
     if rc == E_ZENO:
-        count = max(2, rules.zeno_events)
-        return BudgetExceeded(f"events: {count} events within {state.err_span:.3g} (at most zeno_span = "
-                              f"{zeno_span:.3g}): a Zeno or chattering approach (guard "
+        count = max(2, rules.zeno_events + 1)
+        return BudgetExceeded(f"events: {count} events within {state.err_span:.3g} (more than zeno_events = "
+                              f"{rules.zeno_events} within zeno_span = {zeno_span:.3g}): a Zeno or chattering approach (guard "
                               f"{system.guards(seg)[state.err_guard].name} of mode {system.modes[seg]})",
                               key="zeno_events", reached=where(t, seg))
     if rc == E_BUDGET:

@@ -50,7 +50,7 @@ enum {
     MGH_E_SINGULAR = -5,   /* M is singular (err_t, err_x: the step's start) */
     MGH_E_SMALL = -6,      /* the step size fell below 10 ulp of t (err_t) */
     MGH_E_EVENTS = -7,     /* more than max_events events */
-    MGH_E_ZENO = -8,       /* zeno_events events within zeno_span (err_span) */
+    MGH_E_ZENO = -8,       /* more than zeno_events events within zeno_span (err_span) */
     MGH_E_BUDGET = -9,     /* more than budget_left steps */
     MGH_E_GUARD = -10,     /* a guard value or rate is NaN/Inf */
     MGH_E_MEMORY = -11,
@@ -107,13 +107,15 @@ typedef struct {
     double *f;                 /* nx: dx/dt at (t, x) inside a mode */
     double h_abs;              /* the next step size inside a mode */
     double *sign, *g_old, *d_old;   /* max_guards: tracked signs, g and dg/dt at (t, x) */
-    double *recent;            /* max(2, zeno_events): times of the latest events (a ring) */
+    double *recent;            /* max(2, zeno_events + 1): times of the latest events (a ring) */
     long n_recent;             /* events put in the ring */
     long i_eval, n_samples, n_events;
     long steps, nfev, nguard, counted;  /* counted: budget steps of this call */
     long err_kind, err_mode, err_rc, err_guard;
     double err_t, err_span;
     double *err_x;             /* nx */
+    long nrate;                /* evaluations of dx/dt for guard rates only (interval midpoints, mode starts) */
+    double t_start;            /* the time the current mode started */
 } mgh_state;
 
 /* the layout the Python side checks before its first call */
@@ -191,11 +193,11 @@ typedef struct {
     const mgh_problem *P;
     mgh_state *S;
     long n, m, nx, ng, ring;
-    long *flags;               /* 2 * max_guards: crossed, possible double crossing */
+    long *flags;               /* 2 * max_guards: crossed, crossing just after (a tie) */
     double *mem;
     double *zeros, *kout[MGH_PORTS], *M, *b, *K, *F;
     double *y_old, *f_old, *y_new, *f_new, *ytmp, *xm, *fm, *xd, *fd, *xa, *xs, *fy, *ff, *fy2, *ff2;
-    double *g_new, *d_new, *gm, *dm, *gt, *gtt, *ca, *cda, *cb, *cdb, *roots;
+    double *g_new, *d_new, *gm, *dm, *gt, *gtt, *ca, *cda, *cb, *cdb, *roots, *t_his;
     double *st_g;              /* MGH_STACK entries of 4 * max_guards: ga, da, gb, db */
     double st_ta[MGH_STACK], st_tb[MGH_STACK];
     long st_depth[MGH_STACK];
@@ -675,18 +677,60 @@ static int crossed_rule(double sign, double g, long direction)
     return sign != 0 && s != 0 && s == -sign && (direction == 0 || (double)direction == s);
 }
 
-static int possible_rule(double sign, double ga, double da, double gb, double db, double h)
+/* events.py _hermite: the sign changes of the cubic Hermite through (ga, h da), (gb, h db) counted from the
+ * tracked sign s along its interior extrema (in order) and its end; *inside: whether it has an interior extremum */
+static long hermite_changes(double s, double ga, double da, double gb, double db, double h, int *inside)
 {
-    double s = sign != 0 ? sign : sgn(ga), u[2], cs[3], p;
-    long nu, i;
-    if (s == 0)
-        return 0;
-    if (s * ga - h * fmax(0.0, -s * da) <= 0 || s * gb - h * fmax(0.0, s * db) <= 0)
-        return 1;
-    nu = hermite_extrema(ga, da, gb, db, h, u, cs);
-    for (i = 0; i < nu; ++i) {
-        p = ga + cs[0] * u[i] + cs[1] * u[i] * u[i] + cs[2] * u[i] * u[i] * u[i];
-        if (s * p < 0)
+    double u[2], cs[3], values[3], last = s, swap;
+    long nu = hermite_extrema(ga, da, gb, db, h, u, cs), i, n = 0, changes = 0;
+    if (nu == 2 && u[1] < u[0]) {
+        swap = u[0];
+        u[0] = u[1];
+        u[1] = swap;
+    }
+    for (i = 0; i < nu; ++i)
+        values[n++] = ga + u[i] * (cs[0] + u[i] * (cs[1] + u[i] * cs[2]));
+    values[n++] = gb;
+    for (i = 0; i < n; ++i) {
+        if (values[i] != 0.0 && sgn(values[i]) != last) {
+            changes++;
+            last = -last;
+        }
+    }
+    *inside = nu > 0;
+    return changes;
+}
+
+/* events.py _suspicious: whether the interval of length h with ends (ga, da), (gb, db) must be halved ("Missed
+ * events"): a guard of unchanged sign whose zero is within reach of either end at its rate, whose end rates
+ * depart from the chord by as much as its distance from zero, or whose cubic dips through zero; a guard whose
+ * sign flipped and whose cubic turns inside; a guard of unknown sign on the interval that starts the mode */
+static int suspicious(const double *sign, const double *ga, const double *da, const double *gb, const double *db,
+                      long ng, double h, int at_start)
+{
+    long k;
+    int inside;
+    for (k = 0; k < ng; ++k) {
+        double s = sign[k], a = ga[k], ra = da[k], b = gb[k], rb = db[k], toward_a, toward_b, chord;
+        if (s == 0) {
+            if (at_start)
+                return 1;
+            continue;
+        }
+        if (b != 0.0 && sgn(b) != s) {
+            hermite_changes(s, a, ra, b, rb, h, &inside);
+            if (inside)
+                return 1;
+            continue;
+        }
+        toward_a = -s * ra;
+        toward_b = s * rb;
+        if ((toward_a > 0 && s * a <= h * toward_a) || (toward_b > 0 && s * b <= h * toward_b))
+            return 1;
+        chord = b - a;
+        if (fmax(fabs(h * ra - chord), fabs(h * rb - chord)) >= fmax(s * a, s * b))
+            return 1;
+        if (hermite_changes(s, a, ra, b, rb, h, &inside) > 0)
             return 1;
     }
     return 0;
@@ -793,9 +837,10 @@ static int scan(mgh_ctx *c, long mode, double *sign, double t0, double t1, long 
 {
     const mgh_mode *md = &c->P->modes[mode];
     long ng = md->nguards, sp = 0, k, depth, best;
-    long *crossed = c->flags, *dbl = c->flags + c->ng;
-    double ta, tb, tm, h, t_first, tol, u[2], cs[3];
-    int rc, any_crossed, any_double, many;
+    long *crossed = c->flags, *tie = c->flags + c->ng;
+    double *t_his = c->t_his;
+    double ta, tb, tm, h, t_first, t_tie;
+    int rc, any_crossed, others;
     push(c, &sp, t0, c->S->g_old, c->S->d_old, t1, c->g_new, c->d_new, 0);
     while (sp > 0) {
         double *slot;
@@ -809,33 +854,28 @@ static int scan(mgh_ctx *c, long mode, double *sign, double t0, double t1, long 
         memcpy(c->cb, slot + 2 * c->ng, (size_t)ng * sizeof(double));
         memcpy(c->cdb, slot + 3 * c->ng, (size_t)ng * sizeof(double));
         h = tb - ta;
-        any_crossed = 0;
-        any_double = 0;
-        for (k = 0; k < ng; ++k) {
-            crossed[k] = crossed_rule(sign[k], c->cb[k], md->direction[k]);
-            dbl[k] = !crossed[k] && possible_rule(sign[k], c->ca[k], c->cda[k], c->cb[k], c->cdb[k], h);
-            any_crossed |= (int)crossed[k];
-            any_double |= (int)dbl[k];
-        }
-        many = 0;
-        if (any_crossed && !any_double)
-            for (k = 0; k < ng && !many; ++k)
-                if (crossed[k] && hermite_extrema(c->ca[k], c->cda[k], c->cb[k], c->cdb[k], h, u, cs) > 0)
-                    many = 1;
-        if ((any_crossed || any_double) && depth < MGH_MAX_DEPTH && (any_double || many)) {
+        if (depth < MGH_MAX_DEPTH && suspicious(sign, c->ca, c->cda, c->cb, c->cdb, ng, h, ta == c->S->t_start)) {
             tm = 0.5 * (ta + tb);
             dense_eval(c, tm, c->xm);
             if ((rc = rhs(c, mode, tm, c->xm, c->fm)) != 0)
                 return rc;
+            c->S->nrate++;
             if ((rc = guards(c, mode, tm, c->xm, c->fm, c->gm, c->dm)) != 0)
                 return rc;
             push(c, &sp, tm, c->gm, c->dm, tb, c->cb, c->cdb, depth + 1);
             push(c, &sp, ta, c->ca, c->cda, tm, c->gm, c->dm, depth + 1);
             continue;
         }
-        if (any_crossed) {
+        any_crossed = 0;
+        for (k = 0; k < ng; ++k) {
+            crossed[k] = crossed_rule(sign[k], c->cb[k], md->direction[k]);
+            any_crossed |= (int)crossed[k];
+        }
+        if (any_crossed) {  /* events.py _first: the earliest zero, ties within the location tolerance */
             t_first = INFINITY;
             for (k = 0; k < ng; ++k) {
+                tie[k] = 0;
+                t_his[k] = tb;
                 if (crossed[k]) {
                     if ((rc = root(c, mode, k, ta, tb, &c->roots[k])) != 0)
                         return rc;
@@ -843,14 +883,31 @@ static int scan(mgh_ctx *c, long mode, double *sign, double t0, double t1, long 
                         t_first = c->roots[k];
                 }
             }
-            tol = time_tolerance(t_first, tb);
+            t_tie = t_first + time_tolerance(t_first, c->P->t_end);
+            others = 0;
+            for (k = 0; k < ng; ++k)
+                others |= !crossed[k] && sign[k] != 0;
+            if (t_tie > tb && others) {  /* a guard crossing just after the interval is a tie */
+                dense_eval(c, t_tie, c->xm);
+                if ((rc = guards(c, mode, t_tie, c->xm, NULL, c->gm, c->dm)) != 0)
+                    return rc;
+                for (k = 0; k < ng; ++k)
+                    tie[k] = !crossed[k] && sign[k] != 0 && crossed_rule(sign[k], c->gm[k], md->direction[k]);
+                for (k = 0; k < ng; ++k) {
+                    if (tie[k]) {
+                        if ((rc = root(c, mode, k, ta, t_tie, &c->roots[k])) != 0)
+                            return rc;
+                        t_his[k] = t_tie;
+                    }
+                }
+            }
             best = -1;
             for (k = 0; k < ng && best < 0; ++k)
-                if (crossed[k] && c->roots[k] <= t_first + tol)
+                if ((crossed[k] || tie[k]) && c->roots[k] <= t_tie)
                     best = k;
             *k_out = best;
             *t_lo = ta;
-            *t_hi = tb;
+            *t_hi = t_his[best];
             *t_root = c->roots[best];
             return 1;
         }
@@ -923,6 +980,9 @@ static int start_mode(mgh_ctx *c)
         return MGH_FULL_EVENTS;
     if ((rc = rhs(c, S->mode, S->t, S->x, S->f)) != 0)
         return rc;
+    S->t_start = S->t;
+    if (ng > 0)
+        S->nrate++;
     if ((rc = guards(c, S->mode, S->t, S->x, S->f, S->g_old, S->d_old)) != 0)
         return rc;
     tol = time_tolerance(S->t, P->t_end);
@@ -1075,8 +1135,8 @@ static int setup(mgh_ctx *c, const mgh_problem *P, mgh_state *S)
     c->m = m;
     c->nx = nx;
     c->ng = ng;
-    c->ring = P->zeno_events > 2 ? P->zeno_events : 2;
-    total = nx + n * n + n + 16 * nx + 7 * nx + 15 * nx + 11 * ng + MGH_STACK * 4 * ng;
+    c->ring = P->zeno_events + 1 > 2 ? P->zeno_events + 1 : 2;  /* more than zeno_events within zeno_span */
+    total = nx + n * n + n + 16 * nx + 7 * nx + 15 * nx + 12 * ng + MGH_STACK * 4 * ng;
     for (j = 0; j < MGH_PORTS; ++j) {
         len[j] = 1;
         for (i = 0; i < P->nmodes; ++i) {
@@ -1113,7 +1173,7 @@ static int setup(mgh_ctx *c, const mgh_problem *P, mgh_state *S)
     MGH_TAKE(xs, nx); MGH_TAKE(fy, nx); MGH_TAKE(ff, nx); MGH_TAKE(fy2, nx); MGH_TAKE(ff2, nx);
     MGH_TAKE(g_new, ng); MGH_TAKE(d_new, ng); MGH_TAKE(gm, ng); MGH_TAKE(dm, ng); MGH_TAKE(gt, ng);
     MGH_TAKE(gtt, ng); MGH_TAKE(ca, ng); MGH_TAKE(cda, ng); MGH_TAKE(cb, ng); MGH_TAKE(cdb, ng);
-    MGH_TAKE(roots, ng);
+    MGH_TAKE(roots, ng); MGH_TAKE(t_his, ng);
     MGH_TAKE(st_g, MGH_STACK * 4 * ng);
     for (j = 0; j < MGH_PORTS; ++j)
         MGH_TAKE(kout[j], len[j]);
