@@ -9,7 +9,8 @@ SERIES = ("t", "energy_series", "grid", "s", "shapes")
 
 
 def fmt(value, width: int = 8, depth: int = 0) -> str:
-    """One line: numbers to 6 digits, lists cut at ``width`` items, nesting below two levels only sized."""
+    """One line: numbers to 6 digits, lists (and objects below the top) cut at ``width`` items with their size,
+    nesting below two levels only sized; an output that is an object shows all its keys."""
     if isinstance(value, float):
         return f"{value:.6g}"
     if isinstance(value, list):
@@ -18,9 +19,13 @@ def fmt(value, width: int = 8, depth: int = 0) -> str:
         shown = ", ".join(fmt(v, width, depth + 1) for v in value[:width])
         return f"[{shown}, ...] ({len(value)})" if len(value) > width else f"[{shown}]"
     if isinstance(value, dict):
+        # an object's keys are names, not samples: at the top it is shown whole, below that cut like a list
+        limit = len(value) if depth == 0 else width
         if depth >= 2:
-            return "{" + ", ".join(str(k) for k in list(value)[:width]) + "}"
-        return "{" + ", ".join(f"{k}: {fmt(v, width, depth + 1)}" for k, v in list(value.items())[:width]) + "}"
+            shown = ", ".join(str(k) for k in list(value)[:limit])
+        else:
+            shown = ", ".join(f"{k}: {fmt(v, width, depth + 1)}" for k, v in list(value.items())[:limit])
+        return "{" + shown + (f", ...}} ({len(value)})" if len(value) > limit else "}")
     return str(value)
 
 
