@@ -67,7 +67,13 @@ def nonfinite_kernels(system, state: dict, kernels=("residual", "tangent", "rate
             if bad.size:
                 k = int(bad[0])
                 shape = dense.shape if dense.ndim == 2 else None
-                found.append(f"kernel '{kernel}' output {_entry(port, dense, k, shape, names)} = "
+                if kernel == "rates":  # dz/dt: one entry per internal variable
+                    internal = list(getattr(getattr(system, "metadata", None), "internal", ()) or ())
+                    dense, shape = dense.ravel(), None
+                    where = f"{port}[{k}]" + (f" (internal variable '{internal[k]}')" if k < len(internal) else "")
+                else:
+                    where = _entry(port, dense, k, shape, names)
+                found.append(f"kernel '{kernel}' output {where} = "
                              f"{dense.ravel()[k]}" + (f" ({bad.size} entries non-finite)" if bad.size > 1 else ""))
     if not found:
         return ""

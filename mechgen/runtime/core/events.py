@@ -59,6 +59,7 @@ import numpy as np
 
 from mechgen.errors import ConvergenceError, InputError, KernelError
 from mechgen.runtime.core.budget import Budget, BudgetExceeded, Progress
+from mechgen.runtime.core.diagnose import explain_state
 from mechgen.runtime.core.integrate import IMPLICIT, METHODS
 
 #: the event loops: this module's ("python"), the compiled one ("c"), or the compiled one where it applies
@@ -114,6 +115,15 @@ def time_tolerance(t: float, t_end: float) -> float:
     return max(1e-12 * abs(t_end), 64 * EPS * abs(t))
 
 
+def diagnosis(system, mode: int, t: float, x: np.ndarray) -> str:
+    """Why the flow of ``mode`` fails at (t, x): the non-finite kernel output, a singular mass matrix or the
+    largest rate, found on the mode's own kernels (diagnose.explain_state); "" when nothing is found."""
+    try:
+        return explain_state(system.mode(mode), t, np.asarray(x, float))
+    except Exception:  # the diagnosis never hides the error it explains
+        return ""
+
+
 def _solver_class(method: str):
     import scipy.integrate as si
 
@@ -134,7 +144,11 @@ class _Segment:
         self.counts = counts
 
     def rhs(self, t, x):
-        return self.view.rhs(t, x)
+        try:
+            return self.view.rhs(t, x)
+        except KernelError as exc:
+            why = diagnosis(self.system, self.index, t, x)
+            raise KernelError(f"{exc} in mode {self.system.modes[self.index]}" + (f"; {why}" if why else "")) from exc
 
     def jac(self, t, x):
         return self.view.jacobian(t, x)
@@ -145,7 +159,7 @@ class _Segment:
         self.counts["guards"] += 1
         if with_rates and dxdt is None:
             self.counts["rates"] += 1
-            dxdt = self.view.rhs(t, x)
+            dxdt = self.rhs(t, x)
         g, g_t = self.system.guard_values(self.index, t, x, dxdt if with_rates else None)
         return g, (g_t if with_rates else np.zeros_like(g))
 
@@ -397,7 +411,7 @@ def _integrate_segment(seg, x, t, start, method, rtol, atol, sign, budget, stats
             bar.to(t_new)
             t_old, y_old, g_old, d_old = t_new, y_new, g_new, d_new
     except (LinAlgError, ZeroDivisionError, ValueError) as exc:
-        why = explain(t_old, y_old) if explain is not None else ""
+        why = diagnosis(seg.system, seg.index, t_old, y_old) or (explain(t_old, y_old) if explain is not None else "")
         raise ConvergenceError(f"{method} failed near {where(t_old, seg.index)} ({exc})"
                                + (f"; {why}" if why else "")) from exc
     stats["nfev"] += solver.nfev

@@ -32,7 +32,7 @@ import numpy as np
 
 from mechgen.errors import BuildError, CompilerUnavailable, ConvergenceError, KernelError
 from mechgen.runtime.core.budget import BudgetExceeded, Progress
-from mechgen.runtime.core.events import Event, EventRules, HybridTrajectory
+from mechgen.runtime.core.events import Event, EventRules, HybridTrajectory, diagnosis
 from mechgen.runtime.core.pattern import extent
 
 log = logging.getLogger("mechgen")
@@ -390,7 +390,9 @@ def _error(rc: int, system, state: CState, err_x: np.ndarray, where, rules, zeno
     if rc == E_KERNEL:
         return KernelError(f"kernel {KINDS[state.err_kind]}__{state.err_guard} returned error code {state.err_rc}")
     if rc == E_RHS:
-        return KernelError(f"kernel residual/tangent of {model} gave NaN/Inf at t = {t}, x = {err_x[:6]}")
+        why = diagnosis(system, seg, t, err_x.copy())
+        return KernelError(f"kernel residual/tangent of {model} gave NaN/Inf at t = {t}, x = {err_x[:6]} in mode "
+                           f"{system.modes[seg]}" + (f"; {why}" if why else ""))
     if rc == E_STATE:
         return KernelError(f"DOP853: state became NaN/Inf by {where(t, seg)}")
     if rc == E_RESET:
@@ -403,7 +405,7 @@ def _error(rc: int, system, state: CState, err_x: np.ndarray, where, rules, zeno
         if rc == E_SMALL:
             return ConvergenceError(f"DOP853 stopped at {where(t, seg)}: Required step size is less than "
                                     "spacing between numbers")
-        why = explain(t, err_x.copy()) if explain is not None else ""
+        why = diagnosis(system, seg, t, err_x.copy()) or (explain(t, err_x.copy()) if explain is not None else "")
         return ConvergenceError(f"DOP853 failed near {where(t, seg)} (Singular matrix)" + (f"; {why}" if why else ""))
     if rc == E_EVENTS:
         return BudgetExceeded(f"events: more than max_events = {rules.max_events:,} events", key="max_events",

@@ -324,6 +324,7 @@ static int rhs(mgh_ctx *c, long mode, double t, const double *x, double *f)
     for (i = 0; i < c->nx; ++i) {
         if (!isfinite(f[i])) {
             fail_at(c, t, x);
+            c->S->err_mode = mode;
             return MGH_E_RHS;
         }
     }
