@@ -30,7 +30,7 @@ def _parser() -> argparse.ArgumentParser:
     regen = sub.add_parser("regen", help="rewrite mechgen/generated for the built-in models")
     regen.add_argument("--check", action="store_true", help="fail if mechgen/generated is stale")
     bench = sub.add_parser("bench", help="run the benchmarks")
-    bench.add_argument("models", nargs="*", help="suites: fpu, beam, rotor, balloon (default: all)")
+    bench.add_argument("models", nargs="*", help="suites to run (names: mechgen bench --list; default: all)")
     bench.add_argument("--list", dest="list_suites", action="store_true", help="name the suites and exit")
     bench.add_argument("--out", default="bench-out")
     bench.add_argument("--quick", action="store_true")
