@@ -1,7 +1,8 @@
 """``simulate``: the time response from an initial state.
 
-Scene keys: ``t_end`` (required), ``method`` (BDF, Radau, LSODA, RK45, DOP853, or ``leapfrog`` with a
-step ``dt``), ``rtol``, ``atol``, ``q0`` / ``v0`` (tables of coordinates), ``initial_mode`` with
+Scene keys: ``t_end`` (required), ``method`` (BDF, Radau, LSODA, RK45, DOP853, ``leapfrog`` with a
+step ``dt``, or ``cvodes``: SUNDIALS' variable-order BDF with the exact Jacobian, compiled through CasADi,
+for a lumped model built with ``backend = "casadi"``: mechgen.runtime.core.sundials), ``rtol``, ``atol``, ``q0`` / ``v0`` (tables of coordinates), ``initial_mode`` with
 ``amplitude`` (start from a linear mode), ``outputs`` (which model outputs to report), ``series``
 (also report ``t`` and ``energy_series``), ``samples``. Outputs: the model's outputs at ``t_end``,
 ``energy_drift``, ``t_end``; a fixed-end chain also ``mode_energies``. A model with modes is run by
@@ -38,7 +39,7 @@ from mechgen.analyses.context import NAME
 from mechgen.analyses.operating_point import vector
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import ABSENT, ALL_OUTPUTS, REQUIRED, Option
-from mechgen.errors import ConvergenceError, SceneError
+from mechgen.errors import ConvergenceError, InputError, SceneError
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget, BudgetExceeded
 from mechgen.runtime.core.diagnose import explain_state
 from mechgen.runtime.core.integrate import MIN_RTOL, integrate_first_order, leapfrog
@@ -46,7 +47,7 @@ from mechgen.runtime.core.memory import dense_bytes, require
 from mechgen.runtime.linear.modes import modes as solve_modes
 from mechgen.scene.values import fail, listing, show, type_name
 
-METHODS = ("BDF", "Radau", "LSODA", "RK45", "DOP853", "leapfrog")
+METHODS = ("BDF", "Radau", "LSODA", "RK45", "DOP853", "leapfrog", "cvodes")
 STEP = "a number > 0 (or an expression)"
 #: default max_steps: the leapfrog's fixed steps, the adaptive methods' accepted steps
 DEFAULT_STEPS = {"leapfrog": 10_000_000, "adaptive": 100_000}
@@ -111,6 +112,9 @@ def check(ctx, base: str, options: dict) -> None:
     if options["method"] != "leapfrog" and options["rtol"] < MIN_RTOL:
         raise fail(ctx.file, f"{base}.rtol", f"rtol {options['rtol']!r} is below what the integrators can honour "
                    "in double precision", f"a relative tolerance >= {MIN_RTOL:.3g} (100 machine epsilons)")
+    if options["method"] == "cvodes" and getattr(ctx.model, "modes", ()):
+        raise fail(ctx.file, f"{base}.method", f"method 'cvodes' has no event location, and model {ctx.model.name} "
+                   "has modes", "one of the event loops' methods: BDF, Radau, LSODA, RK45, DOP853")
     if options["method"] == "leapfrog" and "dt" not in options:
         raise fail(ctx.file, f"{base}.dt", "method 'leapfrog' needs a time step dt", STEP)
     if "dt" in options and options["dt"] > options["t_end"]:
@@ -209,6 +213,19 @@ def leapfrog_masses(system, M) -> np.ndarray:
     return 1.0 / diag
 
 
+def _cvodes(system, x0, t_end, t_eval, options, budget, progress, desc):
+    """The run with SUNDIALS' CVODES on the system's CasADi kernels (mechgen.runtime.core.sundials)."""
+    from mechgen.runtime.core.sundials import cvodes_problem, integrate_cvodes
+
+    why = cvodes_problem(system)
+    if why:
+        raise InputError(why, key="method", expected="a method of this system's backend: BDF, Radau, LSODA, RK45, "
+                         "DOP853 or leapfrog, or backend 'casadi' for 'cvodes'")
+    return integrate_cvodes(system, x0, t_end, t_eval=t_eval, rtol=options.get("rtol", 1e-8),
+                            atol=options.get("atol", 1e-10), budget=budget, progress=progress, desc=desc,
+                            explain=lambda t, x: explain_state(system, t, x))
+
+
 def run_simulate(system, options: dict, context: dict) -> dict:
     """Time response; reports the model's outputs at t_end and the energy drift."""
     if hasattr(system, "modes"):
@@ -238,11 +255,14 @@ def run_simulate(system, options: dict, context: dict) -> dict:
         refuse_explicit_stiff(system, x0, t_end, method, budget)
         n_out = int(options.get("samples", 201))
         require(dense_bytes(n_out, 3 * (2 * system.n + system.m) + 6), f"{n_out} output samples", key="samples")
-        t_eval = np.linspace(0.0, t_end, n_out)
-        traj = integrate_first_order(system.rhs, x0, t_end, jac=system.jacobian, method=method,
-                                     rtol=options.get("rtol", 1e-8), atol=options.get("atol", 1e-10), t_eval=t_eval,
-                                     budget=budget, progress=progress, desc=desc,
-                                     explain=lambda t, x: explain_state(system, t, x))
+        t_eval = np.linspace(0.0, t_end, max(n_out, 2))
+        if method == "cvodes":
+            traj = _cvodes(system, x0, t_end, t_eval, options, budget, progress, desc)
+        else:
+            traj = integrate_first_order(system.rhs, x0, t_end, jac=system.jacobian, method=method,
+                                         rtol=options.get("rtol", 1e-8), atol=options.get("atol", 1e-10),
+                                         t_eval=t_eval, budget=budget, progress=progress, desc=desc,
+                                         explain=lambda t, x: explain_state(system, t, x))
         xs = traj.x if traj.x.shape[0] == len(traj.t) else traj.x.T
         n = system.n
         q_end, v_end, z_end = xs[-1, :n], xs[-1, n:2 * n], xs[-1, 2 * n:]

@@ -63,14 +63,23 @@ class Kernel:
     None for the other backends)."""
 
     def __init__(self, spec: dict, impl: Callable, backend: str, binder: Callable | None = None,
-                 address: int | None = None) -> None:
+                 address: int | None = None, function: Callable | None = None) -> None:
         self.spec = spec
         self.name = spec["name"]
         self.backend = backend
         self.address = address
         self._impl = impl
         self._binder = binder
+        self._function = function
         self.output_names = [p["name"] for p in spec["outputs"]]
+
+    def casadi_function(self, sizes: dict | None = None):
+        """The casadi.Function of a CasADi kernel at ``sizes`` (built once per sizes), to be called on CasADi
+        symbols (mechgen.runtime.core.sundials builds dx/dt from them); other backends have none."""
+        if self._function is None:
+            raise KernelError(f"kernel {self.name} is a {self.backend} kernel; only CasADi kernels have a "
+                              "casadi.Function")
+        return self._function(dict(sizes or {}))
 
     def _arrays(self, inputs: dict, sizes: dict) -> tuple[list, int, bool]:
         """Input arrays in port order; a missing batched state port is zero."""
@@ -186,5 +195,11 @@ def casadi_kernels(module, spec: dict) -> dict[str, Kernel]:
                     o[b] = np.asarray(r).ravel()
             return 0
 
-        kernels[name] = Kernel(kspec, impl, "casadi")
+        def function(sizes, builder=builder, built={}):  # noqa: B006 - one dict per kernel, by design
+            key = tuple(sorted(sizes.items()))
+            if key not in built:
+                built[key] = builder(sizes, {})  # a kernel without integer slot ports (lumped)
+            return built[key]
+
+        kernels[name] = Kernel(kspec, impl, "casadi", function=function)
     return kernels

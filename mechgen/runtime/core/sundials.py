@@ -1,0 +1,150 @@
+"""SUNDIALS' CVODES through CasADi: a compiled stiff integrator for a system's first-order form.
+
+The first-order form of a lumped system (mechgen.runtime.core.system), x = (q, v, z):
+
+    dx/dt = f(t, x; p) = (v,  a,  g),   a = -M^-1 r(q, v, 0, z, t),  M = dr/da,  g = rates(q, v, z, t)
+
+is built as one CasADi expression from the system's own CasADi kernels (``residual``, ``tangent``,
+``rates``: the same Kernel IR as the C and numpy backends), with M^-1 r a linear-solve node, not an
+inverse. CVODES integrates it with variable-order (1 to 5) BDF and Newton iterations on the exact
+Jacobian df/dx that CasADi differentiates from it; every step, Newton iteration and Jacobian
+evaluation runs in compiled code, so a stiff run costs what its steps cost and not the Python around them.
+
+The run is cut into :data:`CHUNKS` equal pieces of the sample grid (one integrator, reused: time
+enters as t0 + tau with t0 a parameter), so that the work budget's wall time and the progress bar are
+checked between pieces; ``max_steps`` bounds CVODES's steps within each piece (its ``max_num_steps``)
+and the steps of the whole run. A failure (too much work, a step below round-off, repeated Newton
+or error-test failures, a non-finite rate) ends the run with a ConvergenceError naming the piece of
+t it happened in, the CVODES flag, and what diagnose.explain_state finds at the piece's start.
+
+Tolerances: CVODES's local error test ||e_i / (rtol |x_i| + atol)||_rms <= 1, the same form as scipy's.
+"""
+from __future__ import annotations
+
+import re
+
+import numpy as np
+
+from mechgen.errors import ConvergenceError, KernelError
+from mechgen.runtime.core.budget import Budget, BudgetExceeded, Progress
+from mechgen.runtime.core.integrate import Trajectory
+
+#: the sample grid is integrated in this many pieces (budget and progress are checked between them)
+CHUNKS = 20
+#: the method's name in scenes and in integrate_cvodes' results
+NAME = "cvodes"
+
+
+def cvodes_problem(system) -> str | None:
+    """Why CVODES cannot run this system (None when it can): it needs the CasADi kernels of a lumped model."""
+    try:
+        import casadi  # noqa: F401
+    except ImportError:  # pragma: no cover - casadi is a dependency
+        return "CasADi is not installed"
+    if getattr(system, "backend", None) != "casadi":
+        return (f"method 'cvodes' runs on the CasADi kernels, and this system was built with the "
+                f"{getattr(system, 'backend', '?')} backend: set backend = \"casadi\" in the scene (or "
+                "mechgen.compile(..., backend=\"casadi\"))")
+    if system.metadata.kind != "lumped":
+        return f"method 'cvodes' integrates lumped models; this one is a {system.metadata.kind} model"
+    for name in ("residual", "tangent") + (("rates",) if system.m else ()):
+        if name not in system.kernels:
+            return f"the system has no '{name}' kernel"
+    return None
+
+
+def first_order_expression(system):
+    """(x, t, p, f): CasADi MX symbols of the state, time and free parameters and the expression f(t, x; p)
+    of the module doc, from the system's CasADi kernels."""
+    import casadi as ca
+
+    n, m = int(system.n), int(system.m)
+    x, t, p = ca.MX.sym("x", 2 * n + m), ca.MX.sym("t"), ca.MX.sym("p", len(system.params))
+    q, v, z = x[:n], x[n:2 * n], x[2 * n:]
+    a0 = ca.MX.zeros(n)
+
+    def call(kernel: str, **ports):
+        fn = system.kernels[kernel].casadi_function(system.sizes(kernel))
+        names = fn.name_in()
+        out = fn(*[ports[name] for name in names])
+        return dict(zip(fn.name_out(), out if isinstance(out, (list, tuple)) else [out]))
+
+    state = {"q": q, "v": v, "a": a0, "z": z, "t": t, "p": p}
+    r0 = call("residual", **state)["r"]
+    M = ca.reshape(call("tangent", **state)["r_a"], n, n).T  # the kernels' matrices are row-major
+    parts = [v, -ca.solve(M, r0)]
+    if m:
+        parts.append(call("rates", **{k: state[k] for k in ("q", "v", "z", "t", "p")})["g"])
+    return x, t, p, ca.vertcat(*parts)
+
+
+def _flag(message: str) -> str:
+    found = re.search(r'"(CV_[A-Z_]+)"', message)
+    return found.group(1) if found else message.strip().splitlines()[-1][:200]
+
+
+def integrate_cvodes(system, x0, t_end: float, *, t_eval, rtol: float = 1e-8, atol: float = 1e-10,
+                     budget: Budget | None = None, progress: bool = False, desc: str = "simulate",
+                     explain=None) -> Trajectory:
+    """Integrate the system's dx/dt = f(t, x) from 0 to t_end with CVODES; states at the uniform ``t_eval``
+    (from 0 to t_end; module doc for pieces, budget and failures)."""
+    import casadi as ca
+
+    t_eval = np.asarray(t_eval, float)
+    if t_eval.size < 2 or t_eval[0] != 0.0 or not np.allclose(np.diff(t_eval), t_eval[1] - t_eval[0], rtol=1e-9):
+        raise ValueError("integrate_cvodes samples a uniform grid from t = 0")
+    x_sym, t_sym, p_sym, f = first_order_expression(system)
+    t0, tau = ca.MX.sym("t0"), ca.MX.sym("tau")
+    ode = ca.substitute(f, t_sym, t0 + tau)
+    intervals = t_eval.size - 1
+    per = max(1, -(-intervals // CHUNKS))  # intervals per piece
+    dt = float(t_eval[1] - t_eval[0])
+    limit = budget.limit if budget is not None and budget.limit is not None else 100_000
+    options = {"abstol": float(atol), "reltol": float(rtol), "max_num_steps": int(limit),
+               "disable_internal_warnings": True, "newton_scheme": "direct", "linear_solver": "csparse"}
+    integrators: dict[int, object] = {}
+
+    def integrator(k: int):
+        if k not in integrators:
+            integrators[k] = ca.integrator("cvodes", "cvodes", {"x": x_sym, "t": tau, "p": ca.vertcat(p_sym, t0),
+                                                                "ode": ode}, 0.0, [dt * (i + 1) for i in range(k)],
+                                           options)
+        return integrators[k]
+
+    params = np.asarray(system.params, float)
+    x = np.asarray(x0, float).copy()
+    rows, steps, nfev, njev, done = [x.copy()], 0, 0, 0, 0
+    with Progress(t_end, desc=desc, unit="t", enabled=progress) as bar:
+        while done < intervals:
+            k = min(per, intervals - done)
+            start = float(t_eval[done])
+            F = integrator(k)
+            try:
+                out = F(x0=x, p=np.concatenate([params, [start]]))
+            except RuntimeError as exc:
+                end = float(t_eval[done + k])
+                why = explain(start, x) if explain is not None else ""
+                flag = _flag(str(exc))
+                where = f"between t = {start:.6g} and {end:.6g} of t_end = {float(t_end):.6g}"
+                if flag == "CV_TOO_MUCH_WORK":
+                    raise BudgetExceeded(f"{NAME} steps: more than max_steps = {limit:,} steps within one "
+                                         f"{k * dt:.3g} of t", key=budget.key if budget is not None else
+                                         "max_steps", reached=where) from exc
+                raise ConvergenceError(f"{NAME} failed {where} ({flag})" + (f"; {why}" if why else "")) from exc
+            stats = F.stats()
+            steps += int(stats.get("nsteps", 0))
+            nfev += int(stats.get("nfevals", 0))
+            njev += int(stats.get("nlinsetups", 0))
+            block = np.asarray(out["xf"], float).reshape(x.size, k).T
+            if not np.all(np.isfinite(block)):
+                raise KernelError(f"{NAME}: state became NaN/Inf between t = {start:.6g} and "
+                                  f"{float(t_eval[done + k]):.6g} of t_end = {float(t_end):.6g}")
+            rows.extend(block)
+            x = block[-1].copy()
+            done += k
+            t_now = float(t_eval[done])
+            if budget is not None:
+                budget.spend(int(stats.get("nsteps", 0)), lambda: f"t = {t_now:.6g} of t_end = {float(t_end):.6g}")
+            bar.to(t_now)
+    return Trajectory(t_eval.copy(), np.array(rows), nfev=nfev, njev=njev, success=True,
+                      message="CVODES reached the end of the integration interval.", steps=steps)
