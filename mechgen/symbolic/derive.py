@@ -73,8 +73,6 @@ class LumpedEquations:
 
     def force(self) -> sp.Matrix:
         """Potential force -dV/dq (for symplectic integration of separable systems)."""
-        if not self.q:
-            return sp.zeros(0, 1)
         return -sp.Matrix([self.potential]).jacobian(sp.Matrix(self.q)).T
 
 
