@@ -212,3 +212,24 @@ def test_stability_boundary_of_a_users_model_without_internal_variables(tmp_path
     assert out["verdict"] == "stable" and out["crossing"] == "complex"
     with pytest.raises(ConvergenceError, match="same sign at both ends"):
         mechgen.analysis("stability_boundary", system, parameter="g", bracket=[0.5, 1.0])
+
+
+def test_steady_newton_takes_its_own_parameter_values_and_aliases():
+    """steady (Newton) with params = {V2: V1} is steady sliding at V1: mu = mu0 + (a - b) ln(V1/V*) to 1e-12,
+    reported also under its alias; an alias of no output is refused naming the key."""
+    system = compiled(k=6e9)
+    out = mechgen.steady(system, params={"V2": BASE["V1"]}, aliases={"mu_steady_before": "mu"}, tol=1e-14)
+    assert abs(out["mu_steady_before"] - mu_ss(BASE, BASE["V1"])) < 1e-12 and out["mu"] == out["mu_steady_before"]
+    assert abs(out["velocity"] / BASE["V1"] - 1) < 1e-12
+    with pytest.raises(mechgen.SceneError, match="aliases.friction"):
+        mechgen.steady(system, aliases={"friction": "mu_total"})
+
+
+@pytest.mark.parametrize("options, key", [({"bracket": [2e9, 1e9]}, "bracket"),
+                                          ({"bracket": [1e9]}, "bracket"),
+                                          ({"bracket": [1e9, 2e10], "labels": {"wobbly": "x"}}, "labels.wobbly"),
+                                          ({"bracket": [1e9, 2e10], "parameter": "law"}, "parameter")])
+def test_stability_boundary_refuses_bad_options_at_their_key(options, key):
+    system = compiled()
+    with pytest.raises(mechgen.InputError, match=key.replace(".", r"\.")):
+        mechgen.analysis("stability_boundary", system, **{"parameter": "k", **options})
