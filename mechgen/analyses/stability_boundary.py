@@ -25,7 +25,7 @@ from mechgen.analyses.operating_point import vector
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import ABSENT, REQUIRED, Option
 from mechgen.analyses.steady import equilibrium_functions
-from mechgen.errors import ConvergenceError
+from mechgen.errors import ConvergenceError, InputError
 from mechgen.runtime.linear.stability import stability as solve_stability
 from mechgen.runtime.linear.stability import stability_first_order
 from mechgen.runtime.steady.newton import newton
@@ -97,9 +97,20 @@ def _pairs(s) -> list[list[float]]:
     return [[float(x.real), float(x.imag)] for x in np.asarray(s)]
 
 
+def own_value(system, name: str) -> float:
+    """The system's own value of the parameter searched over (free in its kernels)."""
+    values = system.param_values()
+    if name not in values:
+        raise InputError(f"parameter {name!r} was folded into the compiled kernels: the verdict at the system's "
+                         "own value needs it free", key="parameter",
+                         expected="a parameter kept free at compile time (mechgen.compile(..., free=[...]))")
+    return values[name]
+
+
 def run_stability_boundary(system, options: dict, context: dict) -> dict:
     """p_c with g(p_c) = 0 between the bracket's ends, and the verdict at the system's own parameter value."""
     name, (low, high) = options["parameter"], options["bracket"]
+    here = float(own_value(system, name))
     if options.get("about"):
         start = np.concatenate([context[options["about"]]["_q"], np.asarray(context[options["about"]]["_z"])])
     else:
@@ -127,9 +138,8 @@ def run_stability_boundary(system, options: dict, context: dict) -> dict:
                                f"iterations ({name} = {critical:.12g}); raise max_iter")
     res = at(critical)
     s = np.asarray(res.eigenvalues)
-    crossing = s[np.argmin(np.abs(s.real))]
-    own_value = dict(zip(system.metadata.params, system.params))[name]
-    own = at(float(own_value))
+    crossing = s[np.argmax(s.real)]  # the eigenvalue whose real part is the growth rate
+    own = at(here)
     labels = options.get("labels", {})
     return {f"{name}_critical": float(critical), "frequency_critical": float(abs(crossing.imag)),
             "crossing": "complex" if abs(crossing.imag) > res.threshold else "real",
