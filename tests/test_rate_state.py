@@ -9,15 +9,15 @@ References derived here (independent of mechgen):
 * Velocity step V1 -> V2 at infinite stiffness (V imposed), from steady sliding at V1 (theta0 = D_c/V1):
   aging law (linear in theta): theta(t) = D_c/V2 + (theta0 - D_c/V2) exp(-V2 t/D_c);
   slip law (linear in Omega = ln(V2 theta/D_c) with slip d = V2 t): Omega = ln(V2/V1) exp(-d/D_c), so
-  mu - mu_ss(V2) = b ln(V2/V1) exp(-d/D_c) (Ruina 1983, eq. for the slip law's exponential decay);
+  mu - mu_ss(V2) = b ln(V2/V1) exp(-d/D_c) (the slip law's exponential decay with slip, Ruina 1983);
   steady change mu_ss(V2) - mu_ss(V1) = (a - b) ln(V2/V1).
 * Quasi-static spring-slider k (V2 - V) = sigma mu'. With u = phi - ln(V2/V*), w = psi + ln(V2/V*),
   w0 = V2/D_c and kappa = k V2/sigma, both laws linearise about steady sliding to
       w' = -w0 (u + w),   u' = (-kappa u - b w')/a,
   A = [[(b w0 - kappa)/a, b w0/a], [-w0, -w0]], tr A = (b w0 - kappa)/a - w0, det A = w0 kappa/a > 0.
   tr A = 0 gives k_c = sigma (b - a)/D_c, and there s = +- i sqrt(det A): omega = (V2/D_c) sqrt((b - a)/a)
-  (Ruina 1983; Rice & Ruina 1983, J. Appl. Mech. 50, 343: the critical stiffness and the period
-  2 pi (D_c/V) sqrt(a/(b - a)) of neutral oscillation). Stable (tr A < 0) for k > k_c.
+  (derived here; the critical stiffness is Ruina 1983's and Rice & Ruina 1983's, J. Appl. Mech. 50, 343,
+  where the neutral oscillation's period is 2 pi (D_c/V) sqrt(a/(b - a))). Stable (tr A < 0) for k > k_c.
 """
 import math
 

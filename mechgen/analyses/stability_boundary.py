@@ -18,7 +18,6 @@ divergence / flutter), reported under the scene's word for it when ``labels`` ma
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import brentq
 
 from mechgen.analyses import schema, summary
 from mechgen.analyses.operating_point import vector
@@ -109,6 +108,8 @@ def own_value(system, name: str) -> float:
 
 def run_stability_boundary(system, options: dict, context: dict) -> dict:
     """p_c with g(p_c) = 0 between the bracket's ends, and the verdict at the system's own parameter value."""
+    from scipy.optimize import brentq  # here, not at import: every scene loads the registry (startup budget)
+
     name, (low, high) = options["parameter"], options["bracket"]
     here = float(own_value(system, name))
     if options.get("about"):
