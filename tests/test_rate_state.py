@@ -233,3 +233,22 @@ def test_stability_boundary_refuses_bad_options_at_their_key(options, key):
     system = compiled()
     with pytest.raises(mechgen.InputError, match=key.replace(".", r"\.")):
         mechgen.analysis("stability_boundary", system, **{"parameter": "k", **options})
+
+
+@pytest.mark.parametrize("law, factor, settles", [("aging", 2.0, True), ("aging", 0.5, False),
+                                                  ("slip", 2.0, False), ("slip", 0.5, False)])
+def test_hard_case_spring_driven_step_of_a_million_settles_or_says_when_it_ran_away(law, factor, settles):
+    """D_c = 1e-9 m, V1 = 1e-9 -> V2 = 1e-3 m/s through the spring: at k = 2 k_c the aging law settles to steady
+    sliding (mu_ss(V2) to 1e-10); below k_c, and for the slip law even above it at so large a step (the slip law's
+    instability to large perturbations, cf. Gu, Rice, Ruina & Tse 1984, J. Mech. Phys. Solids 32, 167), the
+    quasi-static slider runs away and the run stops with exit 1 naming the time reached, never a hang."""
+    p = {**BASE, "D_c": 1e-9, "V1": 1e-9, "V2": 1e-3, "V_ref": 1e-6}
+    k_c = p["sigma"] * (p["b"] - p["a"]) / p["D_c"]
+    system = mechgen.compile("rate_state_slider", {**p, "law": law, "k": factor * k_c}, backend="c")
+    run = lambda: mechgen.simulate(system, t_end=1e-3, method="Radau", rtol=1e-10, atol=1e-12)  # noqa: E731
+    if settles:
+        out = run()
+        assert abs(out["velocity"] / p["V2"] - 1) < 1e-10 and abs(out["mu"] - mu_ss(p, p["V2"])) < 1e-10
+    else:
+        with pytest.raises(ConvergenceError, match=r"stopped at t = [0-9.e-]+ of t_end = 0.001 .*dphi/dt"):
+            run()
