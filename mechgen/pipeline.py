@@ -159,8 +159,8 @@ def all_kernels(model: Model) -> tuple[str, ...]:
         return LATTICE_KERNELS
     if model.is_field:
         return FIELD_KERNELS
-    if model.internals:
-        return LUMPED_KERNELS
+    if model.internals:  # a model of internal variables only (no coordinate) has no potential force
+        return tuple(k for k in LUMPED_KERNELS if k != "force" or model.coordinate_names)
     return tuple(k for k in LUMPED_KERNELS if not k.startswith("rates"))
 
 

@@ -251,7 +251,8 @@ def run_simulate(system, options: dict, context: dict) -> dict:
         q_end, v_end, ts, energies = traj.q[-1], traj.v[-1], traj.t, np.asarray(traj.energy)
         z_end = None
     else:
-        x0 = np.concatenate([q0, v0, np.zeros(system.m)])
+        start = declared_start(system)
+        x0 = np.concatenate([q0, v0, np.zeros(system.m) if start is None else start[2 * system.n:]])
         refuse_explicit_stiff(system, x0, t_end, method, budget)
         n_out = int(options.get("samples", 201))
         require(dense_bytes(n_out, 3 * (2 * system.n + system.m) + 6), f"{n_out} output samples", key="samples")

@@ -10,7 +10,8 @@ with ``free = "parameter"`` (solve for the parameter that holds an end value), `
 {lambda0 = 0.3}`` (this analysis's own values of numeric parameters, made free in the kernels) and
 ``shape = {loops = 2}`` (a start with this value of a shape output, from the starting guesses the
 model declares with it: each is solved by the analysis's method and form, the first whose measure
-equals the value is kept, else a ConvergenceError lists what the guesses gave).
+equals the value is kept, else a ConvergenceError lists what the guesses gave). Newton (a lumped model) takes
+``params`` too, and ``aliases = {name = "output"}`` (the output also reported as ``name``).
 
 ``max_seconds`` bounds Newton's wall time (default 600 s; exit 1 naming the iteration reached).
 
@@ -142,8 +143,8 @@ def check(ctx, base: str, options: dict) -> None:
     if "shape" in options and "bulge" in options:
         raise fail(ctx.file, f"{base}.bulge", "'shape' takes its starting guesses from the model; 'bulge' would be "
                    "ignored", "either shape or bulge")
-    if ("params" in options or "shape" in options) and newton_method:
-        raise fail(ctx.file, f"{base}.method", "params and shape are for a boundary-value steady state",
+    if "shape" in options and newton_method:
+        raise fail(ctx.file, f"{base}.method", "shape is for a boundary-value steady state",
                    "method = shooting, multiple_shooting or collocation")
     if ("hold" in options or options.get("stability") or "form" in options) and newton_method:
         raise fail(ctx.file, f"{base}.method", "hold, stability and form need a boundary-value steady state",
@@ -168,7 +169,7 @@ def needs(options: dict, *, internal: bool) -> set[str]:
 
 # --------------------------------------------------------------------------- Newton
 
-def _equilibrium_functions(system):
+def equilibrium_functions(system):
     """F(y) = [r(q, 0, 0, z); g(q, 0, z)] and dF/dy for y = (q, z)."""
     n = system.n
 
@@ -188,6 +189,15 @@ def _equilibrium_functions(system):
     return residual, jacobian
 
 
+def newton_aliases(out: dict, aliases: dict) -> dict:
+    """{alias: out[output]} for ``aliases = {alias = "output"}`` (an unknown output: SceneError at the key)."""
+    for alias, target in aliases.items():
+        if target not in out:
+            raise SceneError(f"aliases.{alias}: the steady state has no output {target!r}", key=f"aliases.{alias}",
+                             expected="one of: " + ", ".join(k for k in out if not k.startswith("_")))
+    return {alias: out[target] for alias, target in aliases.items()}
+
+
 def run_steady(system, options: dict, context: dict) -> dict:
     """Equilibrium r(q, 0, 0, z) = 0, g(q, 0, z) = 0 by Newton with the generated Jacobians.
 
@@ -202,8 +212,10 @@ def run_steady(system, options: dict, context: dict) -> dict:
         raise SceneError(f"model {system.metadata.model} fixes its ends at nonzero values: its steady state is "
                          "a boundary value problem in s", key="method",
                          expected="method = 'collocation', 'shooting' or 'multiple_shooting'")
+    if options.get("params"):
+        system = with_free_params(system, options["params"])
     y0 = np.concatenate([vector(system, options.get("guess")), np.zeros(system.m)])
-    residual, jacobian = _equilibrium_functions(system)
+    residual, jacobian = equilibrium_functions(system)
     res = newton(residual, jacobian, y0, tol=options.get("tol", 1e-10), max_iter=options.get("max_iter", 50),
                  budget=Budget("steady Newton iterations", seconds=float(options.get("max_seconds", DEFAULT_SECONDS))),
                  explain=lambda y: nonfinite_kernels(system, {"q": y[:system.n], "z": y[system.n:] if system.m else None}))
@@ -212,6 +224,7 @@ def run_steady(system, options: dict, context: dict) -> dict:
     if not system.is_lattice and not system.is_field:
         out["coordinates"] = {n: float(x) for n, x in zip(system.coordinates, q)}
     out.update(system.outputs(q, None, z if system.m else None))
+    out.update(newton_aliases(out, options.get("aliases", {})))
     if system.is_field:
         out["reactions"] = system.reactions(q)
         out.update(field_shapes(system, q[:, None], "deflection"))

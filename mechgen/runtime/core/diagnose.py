@@ -143,8 +143,11 @@ def explain_state(system, t: float, x) -> str:
         return ""
     names = list(getattr(system, "coordinates", []) or [])
     labels = ([f"d{c}/dt" for c in names] + [f"d({c}_dot)/dt" for c in names] if len(names) == n else
-              [f"dx[{i}]/dt" for i in range(2 * n)]) + [f"dz[{i}]/dt" for i in range(m)]
+              [f"dx[{i}]/dt" for i in range(2 * n)])
+    internal = list(getattr(getattr(system, "metadata", None), "internal", ()) or ())
+    labels += [f"d{c}/dt" for c in internal] if len(internal) == m else [f"dz[{i}]/dt" for i in range(m)]
     i = int(np.argmax(np.abs(rates)))
     diag = np.abs(M.diagonal() if hasattr(M, "diagonal") else np.diag(M))
-    return (f"the fastest rate there is {labels[i]} = {rates[i]:.3g} (the mass matrix's diagonal spans "
-            f"{diag.min():.3g} to {diag.max():.3g}) at " + inputs_text(system, state))
+    span = (f" (the mass matrix's diagonal spans {diag.min():.3g} to {diag.max():.3g})" if diag.size else
+            " (no coordinates: internal variables only)")
+    return f"the fastest rate there is {labels[i]} = {rates[i]:.3g}{span} at " + inputs_text(system, state)

@@ -349,7 +349,7 @@ class System:
             tan = self.call("tangent", q=q, v=v, a=a, z=z, t=t)
         else:
             raw = self.bound("tangent").evaluate(q=q, v=v, a=a, z=z, t=t)
-            tan = {k: raw[k].reshape(n, -1) for k in raw}
+            tan = {k: raw[k].reshape(n, m if k == "r_z" else n) for k in raw}
         blocks = [tan["r_q"], tan["r_v"]] + ([tan["r_z"]] if m else [])
         if self.is_lattice:
             rhs = sps.hstack(blocks).tocsc()
