@@ -165,3 +165,31 @@ def test_scene_with_cvodes(tmp_path):
     assert "energy_drift" in ok.stdout
     no = subprocess.run([sys.executable, "-m", "mechgen", "run", str(bad)], capture_output=True, text=True, timeout=120)
     assert no.returncode == 2 and "bad.toml" in no.stderr and "'method'" in no.stderr and "Traceback" not in no.stderr
+
+
+def test_rate_state_slider_agrees_with_radau_and_names_a_run_away():
+    """The quasi-static rate-and-state slider (two internal variables, no coordinate): mu after the velocity
+    step agrees with scipy's Radau on the C kernels (aging law, k = 1.2 k_c); the slip law's run-away at
+    k = 6e9 Pa/m (the velocity grows without bound, tests/test_rate_state.py) is a ConvergenceError located to
+    the part of t where Radau also stops, never a hang or silent garbage."""
+    import re
+
+    from mechgen.errors import ConvergenceError
+
+    values = {"law": "aging", "loading": "spring", "k": 6e9}
+    ours = mechgen.simulate(mechgen.compile("rate_state_slider", values, backend="casadi"), t_end=40.0,
+                            method="cvodes", rtol=1e-10, atol=1e-12, samples=2).outputs
+    ref = mechgen.simulate(mechgen.compile("rate_state_slider", values, backend="c"), t_end=40.0, method="Radau",
+                           rtol=1e-12, atol=1e-14, samples=2).outputs
+    assert ours["mu"] == pytest.approx(ref["mu"], abs=1e-8)
+    values["law"] = "slip"
+    with pytest.raises(ConvergenceError) as radau:
+        mechgen.simulate(mechgen.compile("rate_state_slider", values, backend="c"), t_end=40.0, method="Radau",
+                         rtol=1e-10, atol=1e-12, samples=2)
+    t_radau = float(re.search(r"stopped at t = ([0-9.e+-]+)", str(radau.value)).group(1))
+    with pytest.raises(ConvergenceError) as info:
+        mechgen.simulate(mechgen.compile("rate_state_slider", values, backend="casadi"), t_end=40.0,
+                         method="cvodes", rtol=1e-10, atol=1e-12, samples=2)
+    lo, hi = map(float, re.search(r"between t = ([0-9.e+-]+) and ([0-9.e+-]+)", str(info.value)).groups())
+    assert hi - lo <= 40.0 / 400 * 1.001 and lo - 0.1 <= t_radau <= hi + 0.1
+    assert "dphi/dt" in str(info.value)

@@ -10,12 +10,13 @@ inverse. CVODES integrates it with variable-order (1 to 5) BDF and Newton iterat
 Jacobian df/dx that CasADi differentiates from it; every step, Newton iteration and Jacobian
 evaluation runs in compiled code, so a stiff run costs what its steps cost and not the Python around them.
 
-The run is cut into :data:`CHUNKS` equal pieces of the sample grid (one integrator, reused: time
-enters as t0 + tau with t0 a parameter), so that the work budget's wall time and the progress bar are
-checked between pieces; ``max_steps`` bounds CVODES's steps within each piece (its ``max_num_steps``)
-and the steps of the whole run. A failure (too much work, a step below round-off, repeated Newton
-or error-test failures, a non-finite rate) ends the run with a ConvergenceError naming the piece of
-t it happened in, the CVODES flag, and what diagnose.explain_state finds at the piece's start.
+The run is cut into at least :data:`CHUNKS` equal pieces (one integrator, reused: time enters as
+t0 + tau with t0 a parameter), so that the work budget's wall time and the progress bar are checked
+between pieces; ``max_steps`` bounds CVODES's steps within each piece (its ``max_num_steps``) and the
+steps of the whole run. A failure (too much work, a step below round-off, repeated Newton or
+error-test failures, a non-finite rate) ends the run with a ConvergenceError naming the CVODES flag,
+the part of t it happened in (the failed piece re-run in :data:`LOCATE` parts: to 1/400 of t_end) and
+what diagnose.explain_state finds at that part's start (the fastest rate, a non-finite kernel output).
 
 Tolerances: CVODES's local error test ||e_i / (rtol |x_i| + atol)||_rms <= 1, the same form as scipy's.
 """
@@ -31,6 +32,8 @@ from mechgen.runtime.core.integrate import Trajectory
 
 #: the sample grid is integrated in this many pieces (budget and progress are checked between them)
 CHUNKS = 20
+#: a failed piece is re-run in this many parts to say where it failed
+LOCATE = 20
 #: the method's name in scenes and in integrate_cvodes' results
 NAME = "cvodes"
 
@@ -95,56 +98,70 @@ def integrate_cvodes(system, x0, t_end: float, *, t_eval, rtol: float = 1e-8, at
         raise ValueError("integrate_cvodes samples a uniform grid from t = 0")
     x_sym, t_sym, p_sym, f = first_order_expression(system)
     t0, tau = ca.MX.sym("t0"), ca.MX.sym("tau")
-    ode = ca.substitute(f, t_sym, t0 + tau)
-    intervals = t_eval.size - 1
-    per = max(1, -(-intervals // CHUNKS))  # intervals per piece
-    dt = float(t_eval[1] - t_eval[0])
+    dae = {"x": x_sym, "t": tau, "p": ca.vertcat(p_sym, t0), "ode": ca.substitute(f, t_sym, t0 + tau)}
+    sub = max(1, -(-CHUNKS // (t_eval.size - 1)))  # grid points per sample interval: at least CHUNKS pieces
+    h = float(t_eval[1] - t_eval[0]) / sub
+    intervals = (t_eval.size - 1) * sub
+    per = max(1, -(-intervals // CHUNKS))  # grid intervals per piece
     limit = budget.limit if budget is not None and budget.limit is not None else 100_000
     options = {"abstol": float(atol), "reltol": float(rtol), "max_num_steps": int(limit),
-               "disable_internal_warnings": True, "newton_scheme": "direct", "linear_solver": "csparse"}
-    integrators: dict[int, object] = {}
+               "disable_internal_warnings": True, "show_eval_warnings": False, "newton_scheme": "direct", "linear_solver": "csparse"}
+    integrators: dict = {}
 
-    def integrator(k: int):
-        if k not in integrators:
-            integrators[k] = ca.integrator("cvodes", "cvodes", {"x": x_sym, "t": tau, "p": ca.vertcat(p_sym, t0),
-                                                                "ode": ode}, 0.0, [dt * (i + 1) for i in range(k)],
-                                           options)
-        return integrators[k]
+    def integrator(k: int, step: float):
+        """CVODES from tau = 0 with outputs at step, 2 step, ... k step (built once per (k, step))."""
+        if (k, step) not in integrators:
+            integrators[k, step] = ca.integrator("cvodes", "cvodes", dae, 0.0, [step * (i + 1) for i in range(k)],
+                                                 options)
+        return integrators[k, step]
+
+    def advance(x, start: float, k: int, step: float):
+        """States at start + step, ..., start + k step (rows), and CVODES's statistics."""
+        F = integrator(k, step)
+        out = F(x0=x, p=np.concatenate([params, [start]]))
+        return np.asarray(out["xf"], float).reshape(x.size, k).T, F.stats()
+
+    def failure(exc: RuntimeError, x, start: float, span: float) -> Exception:
+        """The error of a piece that failed: located to one of LOCATE parts of it, diagnosed at that part's start."""
+        flag = _flag(str(exc))
+        step, t_a = span / LOCATE, start
+        for _ in range(LOCATE):
+            try:
+                x = advance(x, t_a, 1, step)[0][-1]
+            except RuntimeError:
+                break
+            t_a += step
+        where = f"between t = {t_a:.6g} and {t_a + step:.6g} of t_end = {float(t_end):.6g}"
+        if flag == "CV_TOO_MUCH_WORK":
+            return BudgetExceeded(f"{NAME} steps: more than max_steps = {limit:,} steps within {span:.3g} of t",
+                                  key=budget.key if budget is not None else "max_steps", reached=where)
+        why = explain(t_a, x) if explain is not None and np.all(np.isfinite(x)) else ""
+        return ConvergenceError(f"{NAME} failed {where} ({flag})" + (f"; {why}" if why else ""))
 
     params = np.asarray(system.params, float)
     x = np.asarray(x0, float).copy()
-    rows, steps, nfev, njev, done = [x.copy()], 0, 0, 0, 0
+    grid, steps, nfev, njev, done = [x.copy()], 0, 0, 0, 0
     with Progress(t_end, desc=desc, unit="t", enabled=progress) as bar:
         while done < intervals:
             k = min(per, intervals - done)
-            start = float(t_eval[done])
-            F = integrator(k)
+            start = done * h
             try:
-                out = F(x0=x, p=np.concatenate([params, [start]]))
+                block, stats = advance(x, start, k, h)
             except RuntimeError as exc:
-                end = float(t_eval[done + k])
-                why = explain(start, x) if explain is not None else ""
-                flag = _flag(str(exc))
-                where = f"between t = {start:.6g} and {end:.6g} of t_end = {float(t_end):.6g}"
-                if flag == "CV_TOO_MUCH_WORK":
-                    raise BudgetExceeded(f"{NAME} steps: more than max_steps = {limit:,} steps within one "
-                                         f"{k * dt:.3g} of t", key=budget.key if budget is not None else
-                                         "max_steps", reached=where) from exc
-                raise ConvergenceError(f"{NAME} failed {where} ({flag})" + (f"; {why}" if why else "")) from exc
-            stats = F.stats()
+                raise failure(exc, x, start, k * h) from exc
             steps += int(stats.get("nsteps", 0))
             nfev += int(stats.get("nfevals", 0))
             njev += int(stats.get("nlinsetups", 0))
-            block = np.asarray(out["xf"], float).reshape(x.size, k).T
             if not np.all(np.isfinite(block)):
-                raise KernelError(f"{NAME}: state became NaN/Inf between t = {start:.6g} and "
-                                  f"{float(t_eval[done + k]):.6g} of t_end = {float(t_end):.6g}")
-            rows.extend(block)
+                raise KernelError(f"{NAME}: state became NaN/Inf between t = {start:.6g} and {start + k * h:.6g} "
+                                  f"of t_end = {float(t_end):.6g}")
+            grid.extend(block)
             x = block[-1].copy()
             done += k
-            t_now = float(t_eval[done])
+            t_now = done * h
             if budget is not None:
                 budget.spend(int(stats.get("nsteps", 0)), lambda: f"t = {t_now:.6g} of t_end = {float(t_end):.6g}")
             bar.to(t_now)
-    return Trajectory(t_eval.copy(), np.array(rows), nfev=nfev, njev=njev, success=True,
+    rows = np.array(grid)[::sub]
+    return Trajectory(t_eval.copy(), rows, nfev=nfev, njev=njev, success=True,
                       message="CVODES reached the end of the integration interval.", steps=steps)
