@@ -52,6 +52,10 @@ REGISTRY: dict[str, Suite] = {s.name: s for s in (
           "restitution over 200 damping ratios for five contact laws against hand-written solve_ivp with events; "
           "work-precision per law and integrator", ("impacts.json", "impacts.md", "impacts.csv",
                                                     "impacts_work_precision.png")),
+    Suite("friction", "mechgen.bench.friction", "run_friction_benchmarks",
+          "rate-and-state spring-slider against hand-written solve_ivp Radau at equal accuracy; work-precision of "
+          "the velocity step per law and integrator", ("friction.json", "friction.md", "friction.csv",
+                                                        "friction_work_precision.png")),
     Suite("threads", "mechgen.bench.threads", "run_threads_benchmarks",
           "every shipped scene as a whole process, default environment against one BLAS thread (unpinned / pinned)",
           ("threads.json", "threads.md")),

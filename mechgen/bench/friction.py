@@ -1,0 +1,180 @@
+"""``mechgen bench friction``: rate-and-state friction, mechgen's runs against a hand-written solve_ivp.
+
+* **slider** - the quasi-static spring-slider of ``rate_state_slider`` (loading "spring", both laws) after a
+  load-point velocity step V1 -> V2 = 10 V1 at k = K_FACTOR k_c (a slowly decaying oscillation of the slip
+  rate over many decades of theta), mu at t_end: mechgen's ``simulate`` with CVODES on its CasADi kernels
+  and with scipy's Radau on its C kernels, against ``benchmarks/rate_state_handwritten.py`` (numpy
+  right-hand side, analytic Jacobian, ``solve_ivp`` Radau), over one tolerance ladder, in one run. The
+  reference is the hand-written Radau at rtol 1e-13 (checked against CVODES at 1e-13). Reported: error
+  against wall time per side and tolerance, and the ratio at equal accuracy (the least time each side
+  needs for an error below ACCURACY; target >= 5).
+* **work-precision** - the velocity step at imposed velocity (infinite stiffness), whose response has
+  closed forms (aging: theta(t) = D_c/V2 + (D_c/V1 - D_c/V2) exp(-V2 t/D_c); slip: ln(V2 theta/D_c) =
+  ln(V2/V1) exp(-V2 t/D_c)), per law and integrator over the ladder: error of mu(t_end) against wall time.
+* **user path** - ``mechgen run scenes/rate_state_slider.toml`` as a user runs it.
+
+Writes ``out/friction.{json,md,csv}`` and ``out/friction_work_precision.png``; ``quick``: one tolerance,
+one law, two integrators, one repeat (a smoke run).
+"""
+from __future__ import annotations
+
+import importlib.util
+import math
+import time
+from pathlib import Path
+
+from mechgen.bench.common import ROOT, environment, loglog_plot, user_path, user_path_markdown, write_csv, write_json, \
+    write_text
+
+LAWS = ("aging", "slip")
+#: the slider's parameters (the scene's): k_c = sigma (b - a) / D_c = 5e9 Pa/m
+PARAMS = {"a": 0.01, "b": 0.015, "D_c": 1e-5, "sigma": 1e7, "mu0": 0.6, "V1": 1e-6, "V2": 1e-5, "V_ref": 1e-6}
+K_FACTOR = 1.2
+#: t_end: 40 D_c / V2 (forty slip distances at the new velocity)
+T_END = 40 * PARAMS["D_c"] / PARAMS["V2"]
+#: the accuracy at which the two sides' times are compared (absolute error of mu at t_end)
+ACCURACY = 1e-8
+TARGET = 5.0
+
+
+def _baseline():
+    path = ROOT / "benchmarks" / "rate_state_handwritten.py"
+    spec = importlib.util.spec_from_file_location("rate_state_handwritten", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def k_critical() -> float:
+    """k_c = sigma (b - a) / D_c (Ruina 1983)."""
+    return PARAMS["sigma"] * (PARAMS["b"] - PARAMS["a"]) / PARAMS["D_c"]
+
+
+def _timed(fn, repeats: int = 3) -> tuple[float, object]:
+    """(least wall time of ``repeats`` calls, the last value)."""
+    best, value = math.inf, None
+    for _ in range(repeats):
+        start = time.perf_counter()
+        value = fn()
+        best = min(best, time.perf_counter() - start)
+    return best, value
+
+
+def slider_rows(law: str, rtols, hand, repeats: int = 3) -> tuple[list[dict], float]:
+    """The spring-slider at each tolerance, three ways (module doc), with errors against the reference."""
+    import mechgen
+
+    values = {**PARAMS, "k": K_FACTOR * k_critical(), "law": law, "loading": "spring"}
+    numeric = {k: v for k, v in values.items() if k not in ("law", "loading")}
+    reference = hand.mu_at_end(law, T_END, rtol=1e-13, atol=1e-15, **numeric)
+    systems = {"cvodes": mechgen.compile("rate_state_slider", values, backend="casadi"),
+               "Radau": mechgen.compile("rate_state_slider", values, backend="c")}
+    check = mechgen.simulate(systems["cvodes"], t_end=T_END, method="cvodes", rtol=1e-13, atol=1e-15).outputs["mu"]
+    rows = []
+    for rtol in rtols:
+        atol = rtol * 1e-2
+        for method, system in systems.items():
+            seconds, out = _timed(lambda: mechgen.simulate(system, t_end=T_END, method=method, rtol=rtol,
+                                                           atol=atol, samples=2).outputs, repeats)
+            rows.append({"law": law, "side": f"mechgen {method}", "rtol": rtol, "seconds": seconds,
+                         "error": abs(out["mu"] - reference)})
+        seconds, mu = _timed(lambda: hand.mu_at_end(law, T_END, rtol=rtol, atol=atol, **numeric), repeats)
+        rows.append({"law": law, "side": "hand-written Radau", "rtol": rtol, "seconds": seconds,
+                     "error": abs(mu - reference)})
+    return rows, abs(check - reference)
+
+
+def equal_accuracy(rows: list[dict], side: str) -> float | None:
+    """The least time of ``side`` with an error below ACCURACY (None: never reached on the ladder)."""
+    times = [r["seconds"] for r in rows if r["side"] == side and r["error"] <= ACCURACY]
+    return min(times) if times else None
+
+
+def step_exact(law: str) -> float:
+    """mu(t_end) after an imposed step V1 -> V2 (module doc's closed forms)."""
+    p = PARAMS
+    if law == "aging":
+        theta = p["D_c"] / p["V2"] + (p["D_c"] / p["V1"] - p["D_c"] / p["V2"]) * math.exp(-p["V2"] * T_END / p["D_c"])
+        log_state = math.log(p["V_ref"] * theta / p["D_c"])
+    else:
+        x = math.log(p["V2"] / p["V1"]) * math.exp(-p["V2"] * T_END / p["D_c"])
+        log_state = x - math.log(p["V2"] / p["V_ref"])
+    return p["mu0"] + p["a"] * math.log(p["V2"] / p["V_ref"]) + p["b"] * log_state
+
+
+def work_precision(laws, methods, rtols, repeats: int = 3) -> list[dict]:
+    """The imposed velocity step per law and integrator: error of mu(t_end) against wall time."""
+    import mechgen
+
+    rows = []
+    for law in laws:
+        exact = step_exact(law)
+        values = {**PARAMS, "k": k_critical(), "law": law, "loading": "imposed"}
+        for method in methods:
+            system = mechgen.compile("rate_state_slider", values, backend="casadi" if method == "cvodes" else "c")
+            for rtol in rtols:
+                seconds, out = _timed(lambda: mechgen.simulate(system, t_end=T_END, method=method, rtol=rtol,
+                                                               atol=rtol * 1e-2, samples=2).outputs, repeats)
+                rows.append({"law": law, "method": method, "rtol": rtol, "seconds": seconds,
+                             "error": abs(out["mu"] - exact)})
+    return rows
+
+
+def markdown(slider: list[dict], checks: dict, wp: list[dict], users: list[dict], env: dict) -> str:
+    lines = ["# Rate-and-state friction: mechgen against hand-written solve_ivp", "",
+             f"Quasi-static spring-slider, k = {K_FACTOR:g} k_c = {K_FACTOR * k_critical():.3g} Pa/m, load-point "
+             f"step {PARAMS['V1']:g} -> {PARAMS['V2']:g} m/s, mu at t_end = {T_END:g} s; reference: hand-written "
+             "Radau at rtol 1e-13 (CVODES at 1e-13 differs from it by "
+             + ", ".join(f"{law}: {d:.1e}" for law, d in checks.items()) + "). One run.", "",
+             "| law | side | rtol | wall time | abs. error of mu |", "|---|---|---|---|---|"]
+    lines += [f"| {r['law']} | {r['side']} | {r['rtol']:g} | {r['seconds'] * 1e3:.3f} ms | {r['error']:.2e} |"
+              for r in slider]
+    lines += ["", f"At equal accuracy (the least time for an error below {ACCURACY:g}; target ratio >= {TARGET:g}):",
+              "", "| law | mechgen cvodes | mechgen Radau (C kernels) | hand-written Radau | ratio hand / cvodes |",
+              "|---|---|---|---|---|"]
+    for law in dict.fromkeys(r["law"] for r in slider):
+        rows = [r for r in slider if r["law"] == law]
+        ours, radau, theirs = (equal_accuracy(rows, s) for s in ("mechgen cvodes", "mechgen Radau",
+                                                                   "hand-written Radau"))
+        show = lambda s: "not reached" if s is None else f"{s * 1e3:.3f} ms"  # noqa: E731
+        ratio = f"**{theirs / ours:.1f}**" if ours and theirs else "n/a"
+        lines.append(f"| {law} | {show(ours)} | {show(radau)} | {show(theirs)} | {ratio} |")
+    lines += ["", "## Work-precision: imposed velocity step against the closed forms", "",
+              "| law | method | rtol | wall time | abs. error of mu |", "|---|---|---|---|---|"]
+    lines += [f"| {r['law']} | {r['method']} | {r['rtol']:g} | {r['seconds'] * 1e3:.3f} ms | {r['error']:.2e} |"
+              for r in wp]
+    lines += ["", user_path_markdown(users), "", f"Environment: {env}"]
+    return "\n".join(lines) + "\n"
+
+
+def run_friction_benchmarks(out: Path, quick: bool = False) -> dict:
+    """Run the suite (see the module doc) and write its reports into ``out``."""
+    out = Path(out)
+    env = environment()
+    hand = _baseline()
+    laws = LAWS[:1] if quick else LAWS
+    rtols = (1e-6,) if quick else (1e-4, 1e-6, 1e-8, 1e-10, 1e-12)
+    repeats = 1 if quick else 3
+    slider, checks = [], {}
+    for law in laws:
+        rows, checks[law] = slider_rows(law, rtols, hand, repeats)
+        slider += rows
+    methods = ("cvodes", "Radau") if quick else ("cvodes", "Radau", "BDF", "LSODA", "DOP853")
+    wp = work_precision(laws, methods, rtols, repeats)
+    users = user_path([ROOT / "scenes" / "rate_state_slider.toml"], repeats=1 if quick else 3)
+    results = {"slider": slider, "reference_check": checks, "work_precision": wp, "user_path": users,
+               "environment": env, "accuracy": ACCURACY, "target": TARGET}
+    write_json(out / "friction.json", results)
+    columns = ("law", "side", "rtol", "seconds", "error")
+    write_csv(out / "friction.csv", [{"part": "slider", **{c: r[c] for c in columns}} for r in slider]
+              + [{"part": "step", **{c: r[c] for c in columns if c != "side"}, "side": f"mechgen {r['method']}"}
+                 for r in wp], header=["part", *columns])
+    write_text(out / "friction.md", markdown(slider, checks, wp, users, env))
+    series: dict = {}
+    for r in slider:
+        series.setdefault(f"slider {r['law']} {r['side']}", []).append((r["seconds"], r["error"], f"{r['rtol']:g}"))
+    for r in wp:
+        series.setdefault(f"step {r['law']} {r['method']}", []).append((r["seconds"], r["error"], f"{r['rtol']:g}"))
+    loglog_plot(out / "friction_work_precision.png", series, xlabel="wall time (s)", ylabel="abs. error of mu",
+                title="Rate-and-state friction: work-precision", floor=1e-16)
+    return results
