@@ -12,7 +12,8 @@ def test_quick_friction_benchmark_writes_reports(tmp_path):
     sides = {r["side"] for r in data["slider"]}
     assert sides == {"mechgen cvodes", "mechgen Radau", "hand-written Radau"}
     assert all(d < 1e-9 for d in data["reference_check"].values())  # two integrators agree at rtol 1e-13
-    assert all(r["error"] < 1e-6 for r in data["work_precision"])  # closed form (module doc), rtol 1e-6
+    # against the closed form (module doc) at rtol 1e-6: a global error within ten local tolerances
+    assert all(r["error"] < 10 * r["rtol"] for r in data["work_precision"])
     assert all(r["error"] < 1e-4 for r in data["slider"])
     text = (tmp_path / "friction.md").read_text()
     assert "At equal accuracy" in text and (tmp_path / "friction.csv").exists()
