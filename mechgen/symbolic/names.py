@@ -29,7 +29,7 @@ from mechgen.errors import ModelError
 
 _SYMBOLIC = Path(__file__).resolve().parent
 _IDENT = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,63}\Z")
-RESERVED = frozenset({"t", "pi", "e", "I", "E", "S", "oo", "nan", "zoo"})
+RESERVED = frozenset({"t", "pi", "e", "I", "S", "oo", "nan", "zoo"})
 #: C99/C11 keywords (a name is refused like a Python keyword: export builds C identifiers from names)
 C_KEYWORDS = frozenset("""auto break case char const continue default do double else enum extern float for goto if
 inline int long register restrict return short signed sizeof static struct switch typedef union unsigned void volatile
