@@ -199,7 +199,8 @@ def plot(plt, entry: dict, path) -> list:
     fig, ax = plt.subplots(figsize=(7, 4))
     amp = np.maximum(out["amplitude"], 1e-300)
     ax.semilogy(out["frequency"], amp, lw=0.8)
-    for i, f in enumerate(out["natural_frequencies"]):
+    shown = [f for f in out["natural_frequencies"] if f <= out["frequency"][-1]]
+    for i, f in enumerate(shown):
         ax.axvline(f, color="tab:red", ls="--", lw=0.7, label="natural frequencies" if i == 0 else None)
     f = np.asarray(out["frequency"])
     for i, p in enumerate(out["spectrum_peaks"]):
