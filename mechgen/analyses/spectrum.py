@@ -5,15 +5,17 @@ length): x(t) = x_0 + v t. It strikes at every ``spacing`` lambda (m, a corrugat
 i.e. at t_k = k lambda / v, with the impulse J(x_k) (N s; ``impulse``: a number or an expression of
 the contact position ``x`` and the parameters, e.g. "sin(2*pi*x/wavelength)"). About q = 0 the
 linear system M q'' + K q = sum_k J_k g(x_k) delta(t - t_k) (g(x): the reduced dofs of a unit point
-force on ``field`` at x; a lumped model's unit force on the coordinate ``input``) is projected on its
+force on ``field`` at x; a lumped model's unit force on the coordinate ``input``; only M and K are used:
+the model's own D and G are replaced by the modal damping, and q = 0 is taken to be a rest state) is projected on its
 lowest ``modes`` mass-normalised modes and given the modal damping ratio ``damping`` zeta (0 <= zeta
 < 1); each modal coordinate is then a sum of damped sines (mechgen.runtime.linear.impulses), sampled
 at ``sample_rate`` (Hz) up to ``t_end`` (s). The response u(t) = sum_n phi_n(observe) q_n(t) (the
 field at ``observe``, m, default a tenth of the length; or the coordinate ``output``, default
-``input``) is windowed (Hann) and Fourier transformed.
+``input``), or its rate with ``signal = "velocity"``, is windowed (Hann) and Fourier transformed.
 
 Outputs: ``natural_frequencies`` (Hz, of the retained modes), ``spectrum_peaks`` (Hz: the ``peaks``
-largest local maxima below ``f_max``, default 1.1 x the highest natural frequency, ascending),
+most prominent maxima of log amplitude below ``f_max``, default 1.1 x the highest natural frequency,
+at least ``separation`` bins apart, default 10; ascending),
 ``frequency_bin`` (Hz, 1 / record length), ``impulses`` (how many blows), ``impulse_rate`` (v / lambda, Hz:
 the blows' rate, whose harmonics the train's spectrum also shows while the contact runs), ``frequency`` and
 ``amplitude`` (the spectrum up to f_max; amplitude in the response's units), ``t`` and ``response``
