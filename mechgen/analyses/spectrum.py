@@ -19,7 +19,9 @@ at least ``separation`` bins apart, default 10; ascending),
 ``frequency_bin`` (Hz, 1 / record length), ``impulses`` (how many blows), ``impulse_rate`` (v / lambda, Hz:
 the blows' rate, whose harmonics the train's spectrum also shows while the contact runs), ``frequency`` and
 ``amplitude`` (the spectrum up to f_max; amplitude in the response's units), ``t`` and ``response``
-(the record, at most ``series`` points, evenly thinned, for plots).
+(the record, at most ``series`` points, evenly thinned, for plots); with ``reference`` (a list of
+frequencies in Hz, e.g. published ones) also ``reference_frequencies`` and ``frequency_ratio`` (ours / theirs,
+mode by mode).
 """
 from __future__ import annotations
 
@@ -65,6 +67,13 @@ def impulse(ctx, key: str, value: object) -> dict:
     return {"text": text, "values": {n: float(ctx.params[n]) for n in expr.names if n != "x"}}
 
 
+def frequencies_hz(ctx, key: str, value: object) -> list[float]:
+    """A non-empty list of frequencies > 0 (Hz), e.g. published natural frequencies to print beside ours."""
+    if not isinstance(value, list) or not value:
+        raise fail(ctx.file, key, f"value is {type_name(value)}", "a non-empty list of frequencies in Hz")
+    return [positive(ctx, f"{key}[{i}]", v) for i, v in enumerate(value, 1)]
+
+
 def field_name(ctx, key: str, value: object) -> str:
     """A string (checked against the system's fields when it runs)."""
     if not isinstance(value, str):
@@ -82,7 +91,8 @@ SCHEMA = {"speed": Option(positive, REQUIRED, "the sliding velocity in m/s (a nu
           "input": Option(coordinate), "output": Option(coordinate),
           "modes": Option(count, 8), "damping": Option(damping_ratio, 0.01),
           "peaks": Option(count, 4), "f_max": Option(positive), "series": Option(count, 2000),
-          "signal": Option(one_of("signal", SIGNALS), "displacement"), "separation": Option(count, 10)}
+          "signal": Option(one_of("signal", SIGNALS), "displacement"), "separation": Option(count, 10),
+          "reference": Option(frequencies_hz)}
 
 
 def check(ctx, base: str, options: dict) -> None:
@@ -183,7 +193,12 @@ def run_spectrum(system, options: dict, context: dict) -> dict:
     peaks = spectral_peaks(freq, amp, options["peaks"], f_max, options["separation"])
     shown = freq <= f_max
     step = max(1, samples // options["series"])
-    return {"natural_frequencies": [float(f) for f in f_n], "spectrum_peaks": peaks,
+    out = {"natural_frequencies": [float(f) for f in f_n]}
+    if options.get("reference"):
+        ref = options["reference"][:len(f_n)]
+        out.update({"reference_frequencies": list(ref),
+                    "frequency_ratio": [float(f / r) for f, r in zip(f_n, ref)]})
+    return {**out, "spectrum_peaks": peaks,
             "frequency_bin": float(freq[1] - freq[0]), "impulses": int(len(t_k)),
             "impulse_rate": options["speed"] / options["spacing"],
             "frequency": [float(f) for f in freq[shown]], "amplitude": [float(a) for a in amp[shown]],
