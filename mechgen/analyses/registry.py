@@ -26,6 +26,7 @@ MODULES = (
     "mechgen.analyses.impact",
     "mechgen.analyses.restitution",
     "mechgen.analyses.stability_boundary",
+    "mechgen.analyses.spectrum",
 )
 
 
