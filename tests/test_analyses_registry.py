@@ -57,7 +57,7 @@ def test_the_registry_lists_the_seven_kinds_each_with_a_function():
     # the seven of the refactor first, then kinds added since (response: tests/test_response.py, fit:
     # tests/test_fit.py; impact, restitution: tests/test_impacts.py)
     assert registry.kinds()[:len(KINDS)] == KINDS
-    assert registry.kinds()[len(KINDS):] == ("response", "fit", "impact", "restitution")
+    assert registry.kinds()[len(KINDS):] == ("response", "fit", "impact", "restitution", "periodic")
     for kind in KINDS:
         record = registry.get(kind)
         assert record.name == kind and record.schema and callable(record.run) and callable(record.summary)

@@ -25,6 +25,7 @@ MODULES = (
     "mechgen.analyses.fit",
     "mechgen.analyses.impact",
     "mechgen.analyses.restitution",
+    "mechgen.analyses.periodic",
 )
 
 
