@@ -75,8 +75,7 @@ def steady_period(system, x0, mode, period: float, options: dict, run: dict) -> 
                                 budget=budget_of(options, run["method"]), **run)
         if traj.terminated:
             raise ConvergenceError(f"periodic: the run ended at a terminal event, t = {traj.t_final:.6g} in mode "
-                                   f"{system.modes[traj.final_mode]}", key="period",
-                                   expected="a model without terminal events under a periodic drive")
+                                   f"{system.modes[traj.final_mode]} (a periodic drive needs a model without terminal events)")
         diffs = np.abs(np.diff(traj.x, axis=0))
         bound = floor + tol * np.abs(traj.x[1:])
         for k in range(1, count + 1):
@@ -85,8 +84,8 @@ def steady_period(system, x0, mode, period: float, options: dict, run: dict) -> 
         if count >= limit:
             raise ConvergenceError(f"periodic: no periodic steady state within {count} periods: at t = "
                                    f"{times[-1]:.6g} (mode {system.modes[int(traj.mode[-1])]}) the state differs "
-                                   f"from one period before by {np.max(diffs[-1]):.3g}", key="max_periods",
-                                   expected="more periods, a looser tolerance, or a drive that settles")
+                                   f"from one period before by {np.max(diffs[-1]):.3g} (key max_periods: more periods, a looser "
+                                   "tolerance, or a drive that settles)")
         count = min(2 * count, limit)
 
 
@@ -150,7 +149,7 @@ def run_periodic(system, options: dict, context: dict) -> dict:
     f1, x1 = 2 / period * np.sum(w * f * phase), 2 / period * np.sum(w * x * phase)
     if abs(x1) == 0:
         raise ConvergenceError(f"periodic: the displacement {disp!r} has no first harmonic over t = [{t0:.6g}, "
-                               f"{t1:.6g}]", key="displacement_output", expected="a displacement driven at the period")
+                               f"{t1:.6g}] (key displacement_output: a displacement driven at the period)")
     stiff = f1 / x1
     out = {"energy_per_cycle": float(np.sum(w * f * rate)), "equivalent_stiffness": float(stiff.real),
            "equivalent_damping": float(stiff.imag / omega), "steady_period": k, "periodicity_error": error,
