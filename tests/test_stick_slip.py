@@ -105,3 +105,22 @@ def test_no_steady_state_names_time_and_mode(system):
     with pytest.raises(ConvergenceError, match=r"no periodic steady state within 8 periods: at t = .* \(mode "):
         analysis("periodic", s, period=2 * math.pi / 1.37, force_output="friction_force",
                  displacement_output="tangential_displacement", max_periods=8)
+
+
+def test_scene_names_and_values(tmp_path):
+    """scenes/stick_slip_element.toml: the issue's output names, the Jenkins closed forms at its parameters."""
+    import json
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    scene = Path(__file__).resolve().parents[1] / "scenes" / "stick_slip_element.toml"
+    out = tmp_path / "r.json"
+    proc = subprocess.run([sys.executable, "-m", "mechgen", "run", str(scene), "--json", str(out)],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    result = json.loads(out.read_text())["analyses"][0]["outputs"]
+    w, k, c = jenkins(1.0, 0.3, 1.0, 1.0, 1.0)
+    assert result["energy_per_cycle"] == pytest.approx(w, rel=1e-8)
+    assert result["equivalent_stiffness"] == pytest.approx(k, rel=1e-8)
+    assert result["equivalent_damping"] == pytest.approx(c, rel=1e-8)
