@@ -21,6 +21,12 @@ displacement w (m) is the internal variable, the friction force f = k_u (u - w) 
   reset w = u (f = 0 at re-contact); a stick that would at once exceed mu n slips at once (the event
   loop's start-of-mode rule: the slip guard sits on zero moving in its direction).
 
+At a reversal (slip -> stick) the slip rate and the rate of |f| - mu n both vanish, so the stick
+mode's slip guard starts on its surface with a rate of round-off size, whose sign would decide at once
+between stick and a chattering return to slip; the reset of the slip -> stick guards moves w by
+64 ulps of |u| + |w| into stick (f changes by k_u times that: 1e-14 of mu n for k_u U ~ mu n), so the
+guard starts strictly inside and fires only on a real crossing.
+
 The run starts in ``stick`` at w(0) = U - mu n(0) / k_u (f(0) = mu n(0): the state at the reversal of
 the steady Jenkins cycle, so a constant-load contact is periodic from the first period).
 
@@ -104,12 +110,21 @@ def slip_backward(z, p, t):
     return friction(z, p, t) + p.mu * normal_load(p, t)
 
 
-@slip_positive.guard(to="stick", direction="falling")
+#: the slip -> stick reset moves w into the stick region by this many ulps of |u| + |w| (module doc)
+NUDGE = 64 * 2.220446049250313e-16
+
+
+def _nudge(z, p, t, sign):
+    """w + sign NUDGE (|u| + |w|): f a few ulps inside the stick cone."""
+    return {"w": z.w + sign * NUDGE * (sp.Abs(tangential(p, t)) + sp.Abs(z.w))}
+
+
+@slip_positive.guard(to="stick", direction="falling", reset=lambda z, p, t: _nudge(z, p, t, 1))
 def stop_forward(p, t):
     return _rate(p, t, 1)
 
 
-@slip_negative.guard(to="stick", direction="rising")
+@slip_negative.guard(to="stick", direction="rising", reset=lambda z, p, t: _nudge(z, p, t, -1))
 def stop_backward(p, t):
     return _rate(p, t, -1)
 

@@ -874,6 +874,78 @@ int mg_reset__0(const double *const *in, double *const *out, const long *sizes, 
     (void)sizes;
     const long len_in0 = 1;
     const long len_in1 = 1;
+    const long len_in2 = 1;
+    const long len_in3 = 1;
+    const long len_out0 = 3;
+    for (long b = 0; b < nbatch; ++b) {
+        const double *const in0 = in[0] + b * len_in0;
+        const double *const in1 = in[1] + b * len_in1;
+        const double *const in2 = in[2] + b * len_in2;
+        const double *const in3 = in[3] + b * len_in3;
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        {
+            const double g0 = in0[0];
+            const double g1 = in1[0];
+            const double g2 = in2[0];
+            const double g3 = in3[0];
+            out0[0] = g0;
+            out0[1] = g1;
+            out0[2] = g2 + 1.4210854715202004e-14*fabs(g2) + 1.4210854715202004e-14*fabs(cos(g3));
+        }
+    }
+    return 0;
+}
+
+/* reset__1: state after reset 1
+ *   in[0]  q: length 1 per state
+ *   in[1]  v: length 1 per state
+ *   in[2]  z: length 1 per state
+ *   in[3]  t: length 1 per state
+ *   in[4]  p: length 0
+ *   out[0] x: length 3 per state shape (3, 1)
+ */
+int mg_reset__1(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    const long len_in0 = 1;
+    const long len_in1 = 1;
+    const long len_in2 = 1;
+    const long len_in3 = 1;
+    const long len_out0 = 3;
+    for (long b = 0; b < nbatch; ++b) {
+        const double *const in0 = in[0] + b * len_in0;
+        const double *const in1 = in[1] + b * len_in1;
+        const double *const in2 = in[2] + b * len_in2;
+        const double *const in3 = in[3] + b * len_in3;
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        {
+            const double g0 = in0[0];
+            const double g1 = in1[0];
+            const double g2 = in2[0];
+            const double g3 = in3[0];
+            out0[0] = g0;
+            out0[1] = g1;
+            out0[2] = g2 - 1.4210854715202004e-14*fabs(g2) - 1.4210854715202004e-14*fabs(cos(g3));
+        }
+    }
+    return 0;
+}
+
+/* reset__2: state after reset 2
+ *   in[0]  q: length 1 per state
+ *   in[1]  v: length 1 per state
+ *   in[2]  z: length 1 per state
+ *   in[3]  t: length 1 per state
+ *   in[4]  p: length 0
+ *   out[0] x: length 3 per state shape (3, 1)
+ */
+int mg_reset__2(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    const long len_in0 = 1;
+    const long len_in1 = 1;
     const long len_in3 = 1;
     const long len_out0 = 3;
     for (long b = 0; b < nbatch; ++b) {
