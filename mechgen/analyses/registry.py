@@ -27,6 +27,7 @@ MODULES = (
     "mechgen.analyses.restitution",
     "mechgen.analyses.stability_boundary",
     "mechgen.analyses.spectrum",
+    "mechgen.analyses.periodic",
 )
 
 
