@@ -7,7 +7,8 @@ The public names (DESIGN.md, "the user's three jobs"), importable from ``mechgen
 * compiling it: ``compile(model, params=..., backend=...)`` -> an immutable compiled system
   (``with_params(**values)`` gives a new one);
 * one function per analysis kind, each returning a ``Result``: ``modes``, ``stability``,
-  ``steady``, ``continuation``, ``simulate``, ``sweep``, ``campbell``, ``fit``, ``impact``, ``restitution``;
+  ``steady``, ``continuation``, ``simulate``, ``sweep``, ``campbell``, ``fit``, ``impact``, ``restitution``,
+  ``periodic``, ``spectrum``, ``stability_boundary``;
   and ``analysis(kind, system,
   **options)`` for any registered kind by name (``response`` has no function of its own);
 * ``run(scene)``: a scene file (or a dict of its contents), built on the same functions;
@@ -40,6 +41,9 @@ _EXPORTS = {
     "fit": "mechgen.analyses.public",
     "impact": "mechgen.analyses.public",
     "restitution": "mechgen.analyses.public",
+    "periodic": "mechgen.analyses.public",
+    "spectrum": "mechgen.analyses.public",
+    "stability_boundary": "mechgen.analyses.public",
     "analysis": "mechgen.analyses.public",
     "MechgenError": "mechgen.errors",
     "InputError": "mechgen.errors",

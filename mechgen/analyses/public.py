@@ -164,6 +164,35 @@ def restitution(system, *, name: str | None = None, **options) -> Result:
     return _run("restitution", system, options, name)
 
 
+def periodic(system, *, name: str | None = None, **options) -> Result:
+    """The periodic steady state of a hybrid model under a periodic drive (mechgen.analyses.periodic).
+
+    Options: ``period`` (required), ``force_output``, ``displacement_output``, ``max_periods``,
+    ``tolerance``, ``nodes``, ``pieces`` and the integration keys. Outputs: ``energy_per_cycle``,
+    ``equivalent_stiffness``, ``equivalent_damping`` and the hysteresis loop of the detected period.
+    """
+    return _run("periodic", system, options, name)
+
+
+def spectrum(system, *, name: str | None = None, **options) -> Result:
+    """A travelling impulse train summed in modal coordinates and its Hann spectrum (mechgen.analyses.spectrum).
+
+    Options: ``speed``, ``spacing``, ``impulse`` (expressions of x and the parameters), ``start``, ``stop``,
+    ``modes``, ``damping``, ``observe`` or ``output``/``input``, ``t_end``, ``sample_rate``. Outputs:
+    ``natural_frequencies`` and ``spectrum_peaks`` (Hz), ``frequency_bin``, ``impulses``, ``impulse_rate``.
+    """
+    return _run("spectrum", system, options, name)
+
+
+def stability_boundary(system, *, name: str | None = None, **options) -> Result:
+    """Where the growth rate of the linearisation crosses zero in a parameter (mechgen.analyses.stability_boundary).
+
+    Options: ``parameter`` and ``bracket`` (required), ``labels``, the steady state's keys. Outputs:
+    ``<parameter>_critical``, ``frequency_critical``, ``crossing``, and ``verdict`` at the system's own value.
+    """
+    return _run("stability_boundary", system, options, name)
+
+
 def campbell(system, *, name: str | None = None, **options) -> Result:
     """A Campbell diagram over ``over = {"Omega": [speeds]}`` (a parameter left free in the kernels).
 
