@@ -15,5 +15,6 @@ def test_quick_friction_benchmark_writes_reports(tmp_path):
     # against the closed form (module doc) at rtol 1e-6: a global error within ten local tolerances
     assert all(r["error"] < 10 * r["rtol"] for r in data["work_precision"])
     assert all(r["error"] < 1e-4 for r in data["slider"])
+    assert all(r["error"] < 10 * r["rtol"] for r in data["hysteresis"])  # the Jenkins W (Griffin 1980)
     text = (tmp_path / "friction.md").read_text()
     assert "At equal accuracy" in text and (tmp_path / "friction.csv").exists()

@@ -54,7 +54,7 @@ REGISTRY: dict[str, Suite] = {s.name: s for s in (
                                                     "impacts_work_precision.png")),
     Suite("friction", "mechgen.bench.friction", "run_friction_benchmarks",
           "rate-and-state spring-slider against hand-written solve_ivp Radau at equal accuracy; work-precision of "
-          "the velocity step per law and integrator", ("friction.json", "friction.md", "friction.csv",
+          "the velocity step and of the stick-slip hysteresis energy per integrator", ("friction.json", "friction.md", "friction.csv",
                                                         "friction_work_precision.png")),
     Suite("threads", "mechgen.bench.threads", "run_threads_benchmarks",
           "every shipped scene as a whole process, default environment against one BLAS thread (unpinned / pinned)",

@@ -11,7 +11,11 @@
   closed forms (aging: theta(t) = D_c/V2 + (D_c/V1 - D_c/V2) exp(-V2 t/D_c); slip: ln(V2 theta/D_c) =
   ln(V2/V1) exp(-V2 t/D_c)), per law and integrator over the ladder: error of mu at t = 2 D_c/V2 (inside the
   transient) against wall time.
-* **user path** - ``mechgen run scenes/rate_state_slider.toml`` as a user runs it.
+* **hysteresis** - the stick-slip contact's energy per cycle in its detected periodic state against the Jenkins
+  closed form W = 4 mu N (U - mu N/k_u), per integrator (DOP853: the compiled event loop; RK45, Radau) over the
+  ladder: relative error against wall time.
+* **user path** - ``mechgen run scenes/rate_state_slider.toml`` and ``scenes/stick_slip_element.toml`` as a user
+  runs them.
 
 Writes ``out/friction.{json,md,csv}`` and ``out/friction_work_precision.png``; ``quick``: one tolerance,
 one law, two integrators, one repeat (a smoke run).
@@ -124,7 +128,31 @@ def work_precision(laws, methods, rtols, repeats: int = 3) -> list[dict]:
     return rows
 
 
-def markdown(slider: list[dict], checks: dict, wp: list[dict], users: list[dict], env: dict) -> str:
+#: the Jenkins element of the hysteresis work-precision: k_u, mu, N, U (omega = 1): W = 4 mu N (U - mu N / k_u)
+JENKINS = {"k_u": 1.0, "mu": 0.3, "N": 1.0, "amplitude": 1.0}
+
+
+def hysteresis_precision(methods, rtols, repeats: int = 3) -> list[dict]:
+    """The stick-slip contact's energy per cycle in its detected periodic state (``mechgen.periodic``) against the
+    Jenkins closed form (Griffin 1980), per integrator and tolerance: relative error against wall time."""
+    import mechgen
+
+    exact = 4 * JENKINS["mu"] * JENKINS["N"] * (JENKINS["amplitude"] - JENKINS["mu"] * JENKINS["N"] / JENKINS["k_u"])
+    system = mechgen.compile("stick_slip_contact", JENKINS)
+    rows = []
+    for method in methods:
+        for rtol in rtols:
+            seconds, out = _timed(lambda: mechgen.periodic(system, period=2 * math.pi, force_output="friction_force",
+                                                           displacement_output="tangential_displacement",
+                                                           method=method, rtol=rtol, atol=rtol * 1e-2).outputs,
+                                  repeats)
+            rows.append({"law": "jenkins", "method": method, "rtol": rtol, "seconds": seconds,
+                         "error": abs(out["energy_per_cycle"] - exact) / exact})
+    return rows
+
+
+def markdown(slider: list[dict], checks: dict, wp: list[dict], users: list[dict], env: dict,
+             hysteresis: list[dict] = ()) -> str:
     lines = ["# Rate-and-state friction: mechgen against hand-written solve_ivp", "",
              "Quasi-static spring-slider, k = " + ", ".join(f"{K_FACTOR[law]:g} k_c ({law})" for law in checks)
              + f", k_c = {k_critical():.3g} Pa/m, load-point "
@@ -149,6 +177,12 @@ def markdown(slider: list[dict], checks: dict, wp: list[dict], users: list[dict]
               "| law | method | rtol | wall time | abs. error of mu |", "|---|---|---|---|---|"]
     lines += [f"| {r['law']} | {r['method']} | {r['rtol']:g} | {r['seconds'] * 1e3:.3f} ms | {r['error']:.2e} |"
               for r in wp]
+    lines += ["", "## Work-precision: energy per cycle of the stick-slip contact (Jenkins limit)", "",
+              f"k_u = {JENKINS['k_u']:g}, mu = {JENKINS['mu']:g}, N = {JENKINS['N']:g}, U = {JENKINS['amplitude']:g}, "
+              "omega = 1: W = 4 mu N (U - mu N / k_u); the periodic state detected, then the loop integrated "
+              "(mechgen.periodic; DOP853 runs the compiled event loop).", "",
+              "| method | rtol | wall time | rel. error of W |", "|---|---|---|---|"]
+    lines += [f"| {r['method']} | {r['rtol']:g} | {r['seconds'] * 1e3:.3f} ms | {r['error']:.2e} |" for r in hysteresis]
     lines += ["", user_path_markdown(users), "", f"Environment: {env}"]
     return "\n".join(lines) + "\n"
 
@@ -167,20 +201,24 @@ def run_friction_benchmarks(out: Path, quick: bool = False) -> dict:
         slider += rows
     methods = ("cvodes", "Radau") if quick else ("cvodes", "Radau", "BDF", "LSODA", "DOP853")
     wp = work_precision(laws, methods, rtols, repeats)
-    users = user_path([ROOT / "scenes" / "rate_state_slider.toml"], repeats=1 if quick else 3)
-    results = {"slider": slider, "reference_check": checks, "work_precision": wp, "user_path": users,
-               "environment": env, "accuracy": ACCURACY, "target": TARGET}
+    hysteresis = hysteresis_precision(("DOP853",) if quick else ("DOP853", "RK45", "Radau"), rtols, repeats)
+    users = user_path([ROOT / "scenes" / "rate_state_slider.toml", ROOT / "scenes" / "stick_slip_element.toml"],
+                      repeats=1 if quick else 3)
+    results = {"slider": slider, "reference_check": checks, "work_precision": wp, "hysteresis": hysteresis,
+               "user_path": users, "environment": env, "accuracy": ACCURACY, "target": TARGET}
     write_json(out / "friction.json", results)
     columns = ("law", "side", "rtol", "seconds", "error")
     write_csv(out / "friction.csv", [{"part": "slider", **{c: r[c] for c in columns}} for r in slider]
               + [{"part": "step", **{c: r[c] for c in columns if c != "side"}, "side": f"mechgen {r['method']}"}
                  for r in wp], header=["part", *columns])
-    write_text(out / "friction.md", markdown(slider, checks, wp, users, env))
+    write_text(out / "friction.md", markdown(slider, checks, wp, users, env, hysteresis))
     series: dict = {}
     for r in slider:
         series.setdefault(f"slider {r['law']} {r['side']}", []).append((r["seconds"], r["error"], f"{r['rtol']:g}"))
     for r in wp:
         series.setdefault(f"step {r['law']} {r['method']}", []).append((r["seconds"], r["error"], f"{r['rtol']:g}"))
+    for r in hysteresis:
+        series.setdefault(f"hysteresis W {r['method']}", []).append((r["seconds"], r["error"], f"{r['rtol']:g}"))
     loglog_plot(out / "friction_work_precision.png", series, xlabel="wall time (s)", ylabel="abs. error of mu",
                 title="Rate-and-state friction: work-precision", floor=1e-16)
     return results
