@@ -102,3 +102,16 @@ def curves(plt, title: str, items: list[tuple[str, dict]], path: Path) -> bool:
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return True
+
+
+def loop(plt, x, force, path: Path, *, xlabel: str, title: str, style: str = "-") -> list[Path]:
+    """A force against displacement loop (an impact's hysteresis, a contact's cycle), one panel."""
+    fig, ax = plt.subplots(figsize=(5, 4))
+    ax.plot(x, force, style, ms=2)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("force")
+    ax.set_title(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return [path]

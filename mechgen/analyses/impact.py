@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mechgen.analyses import schema, summary
+from mechgen.analyses import figures, schema, summary
 from mechgen.analyses.operating_point import vector
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import ABSENT, REQUIRED, Option
@@ -154,15 +154,8 @@ def plot(plt, a: dict, path) -> list:
     out = a["outputs"]
     if "force_series" not in out:
         return []
-    fig, ax = plt.subplots(figsize=(5, 4))
-    ax.plot(out["penetration_series"], out["force_series"])
-    ax.set_xlabel("penetration")
-    ax.set_ylabel("force")
-    ax.set_title(f"{a['name']}: e = {out['restitution']:.4g}")
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return [path]
+    return figures.loop(plt, out["penetration_series"], out["force_series"], path, xlabel="penetration",
+                        title=f"{a['name']}: e = {out['restitution']:.4g}")
 
 
 def summary_lines(outputs: dict) -> list[str]:

@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mechgen.analyses import schema, summary
+from mechgen.analyses import figures, schema, summary
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import ABSENT, REQUIRED, Option
 from mechgen.errors import ConvergenceError, SceneError
@@ -165,15 +165,8 @@ def plot(plt, a: dict, path) -> list:
     out = a["outputs"]
     if "force_series" not in out:
         return []
-    fig, ax = plt.subplots(figsize=(5, 4))
-    ax.plot(out["displacement_series"], out["force_series"], ".-", ms=2)
-    ax.set_xlabel("displacement")
-    ax.set_ylabel("force")
-    ax.set_title(f"{a['name']}: W = {out['energy_per_cycle']:.4g}")
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return [path]
+    return figures.loop(plt, out["displacement_series"], out["force_series"], path, xlabel="displacement",
+                        title=f"{a['name']}: W = {out['energy_per_cycle']:.4g}", style=".-")
 
 
 def summary_lines(outputs: dict) -> list[str]:
