@@ -195,7 +195,9 @@ def casadi_kernels(module, spec: dict) -> dict[str, Kernel]:
                     o[b] = np.asarray(r).ravel()
             return 0
 
-        def function(sizes, builder=builder, built={}):  # noqa: B006 - one dict per kernel, by design
+        built: dict = {}  # casadi.Functions for symbolic use, apart from impl's (which carry slot ports)
+
+        def function(sizes, builder=builder, built=built):
             key = tuple(sorted(sizes.items()))
             if key not in built:
                 built[key] = builder(sizes, {})  # a kernel without integer slot ports (lumped)
