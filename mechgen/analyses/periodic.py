@@ -2,9 +2,12 @@
 
 The run starts at the model's declared initial state in its initial mode (``mode`` to choose) at t = 0
 and is integrated over P = 2, 4, 8, ... periods (up to ``max_periods``); the state x(kT) at the start
-of each period is compared with x((k-1)T): the steady period is the first [(k-1)T, kT] with
+of each period, with the loop's force and displacement outputs there (a model's state need not carry
+the drive's phase: a slipping contact's force is mu N at any phase), is compared with its value at
+(k-1)T: the steady period is the first [(k-1)T, kT] with
 
-    |x_i(kT) - x_i((k-1)T)| <= atol_periodic + tolerance |x_i(kT)|   for every entry i, same mode,
+    |y_i(kT) - y_i((k-1)T)| <= atol_periodic + tolerance |y_i(kT)|   for every entry i of y = (x, f, x_out),
+    in the same mode,
 
 else a ConvergenceError names the last time, mode and difference. Over that period, split at its
 events (where the outputs have kinks) and each smooth piece into ``pieces`` equal parts with ``nodes``
@@ -22,7 +25,7 @@ Gauss-Legendre points each, the force f = output ``force_output`` (N) and the di
         linear element has W = pi omega c_eq U^2).
 
 Outputs: ``energy_per_cycle``, ``equivalent_stiffness``, ``equivalent_damping``, ``steady_period``
-(k: the period [(k-1)T, kT] used), ``periodicity_error`` (max |x(kT) - x((k-1)T)|), ``cycle_events``
+(k: the period [(k-1)T, kT] used), ``periodicity_error`` (max |y(kT) - y((k-1)T)|: state and loop point), ``cycle_events``
 (the events of that period); with ``curve``, ``displacement_series`` and ``force_series`` (the loop).
 Integration keys as impact: ``method`` (DOP853), ``rtol`` (1e-12), ``atol`` (1e-14), ``max_steps``,
 ``max_seconds``, ``loop``; ``max_events`` and ``zeno_events`` as simulate.
@@ -61,14 +64,31 @@ def check(ctx, base: str, options: dict) -> None:
     hybrid_only(ctx, base, options)
 
 
+def loop_outputs(system, traj, names: tuple[str, str]) -> np.ndarray:
+    """The outputs ``names`` (force, displacement) at each sample of a hybrid trajectory, (samples, 2)."""
+    n, m = system.n, system.m
+    views, rows = {}, []
+    for ti, xi, mi in zip(traj.t, traj.x, traj.mode):
+        view = views.setdefault(int(mi), system.mode(int(mi)))
+        out = view.outputs(xi[:n], xi[n:2 * n], xi[2 * n:] if m else None, float(ti))
+        for name, key in zip(names, ("force_output", "displacement_output")):
+            if name not in out:
+                raise SceneError(f"model {system.metadata.model} has no output {name!r}", key=key,
+                                 expected="one of: " + ", ".join(out))
+        rows.append([out[names[0]], out[names[1]]])
+    return np.array(rows, dtype=float).reshape(-1, 2)
+
+
 def steady_period(system, x0, mode, period: float, options: dict, run: dict) -> tuple[int, float, object]:
-    """(k, error, trajectory): the first period [(k-1)T, kT] whose end state repeats its start (module doc)."""
+    """(k, error, trajectory): the first period [(k-1)T, kT] whose end state and loop point repeat its start
+    (module doc)."""
     from mechgen.analyses.simulate import budget_of
     from mechgen.analyses.simulate_hybrid import rules_of
 
     limit = int(options.get("max_periods", 64))
     tol, floor = float(options.get("tolerance", 1e-9)), float(options.get("atol_periodic", 1e-12))
     count = min(2, limit)
+    loop = (options.get("force_output", "force"), options.get("displacement_output", "displacement"))
     while True:
         times = period * np.arange(count + 1)
         traj = integrate_hybrid(system, x0, times[-1], mode=mode, t_eval=times, rules=rules_of(options),
@@ -76,8 +96,9 @@ def steady_period(system, x0, mode, period: float, options: dict, run: dict) -> 
         if traj.terminated:
             raise ConvergenceError(f"periodic: the run ended at a terminal event, t = {traj.t_final:.6g} in mode "
                                    f"{system.modes[traj.final_mode]} (a periodic drive needs a model without terminal events)")
-        diffs = np.abs(np.diff(traj.x, axis=0))
-        bound = floor + tol * np.abs(traj.x[1:])
+        y = np.hstack([traj.x, loop_outputs(system, traj, loop)])
+        diffs = np.abs(np.diff(y, axis=0))
+        bound = floor + tol * np.abs(y[1:])
         for k in range(1, count + 1):
             if np.all(diffs[k - 1] <= bound[k - 1]) and traj.mode[k] == traj.mode[k - 1]:
                 return k, float(np.max(diffs[k - 1])), traj
@@ -126,17 +147,8 @@ def run_periodic(system, options: dict, context: dict) -> dict:
     nodes, pieces = int(options.get("nodes", 16)), int(options.get("pieces", 4))
     t, w, part, xg = quadrature(breaks, nodes, pieces)
     again = integrate_hybrid(system, x0, t1, mode=mode, t_eval=t, rules=rules_of(options), **run)
-    views = {}
     force, disp = options.get("force_output", "force"), options.get("displacement_output", "displacement")
-    f, x = np.empty(t.size), np.empty(t.size)
-    for i, (ti, xi, mi) in enumerate(zip(again.t, again.x, again.mode)):
-        view = views.setdefault(int(mi), system.mode(int(mi)))
-        out = view.outputs(xi[:n], xi[n:2 * n], xi[2 * n:] if m else None, float(ti))
-        for name in (force, disp):
-            if name not in out:
-                raise SceneError(f"model {system.metadata.model} has no output {name!r}", key="force_output"
-                                 if name == force else "displacement_output", expected="one of: " + ", ".join(out))
-        f[i], x[i] = out[force], out[disp]
+    f, x = loop_outputs(system, again, (force, disp)).T
     # dx/dt on each part: derivative of the Legendre interpolant through its nodes
     rate = np.empty(t.size)
     for j in np.unique(part):

@@ -173,6 +173,8 @@ def check_hybrid(model) -> None:
             raise ModelError(f"guard name {g.name!r} is used twice in mode {g.source} of model {model.name}",
                              file=model.file, key=f"guard {g.name}", expected="one guard per name and mode")
         seen.add((g.source, g.name))
+    if not model.coordinate_names:  # internal variables only (a driven contact): no energies, no inertia
+        return
     common = any(f is not None for f in (model.kinetic_fn, model.potential_fn, model.dissipation_fn,
                                          model.forces_fn))
     for name, scope in model.mode_scopes.items():

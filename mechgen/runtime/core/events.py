@@ -30,6 +30,12 @@ closed form):
   |x| ~ A/2 (past zero a third of each period) steps of up to 2^12/3 ~ 1365 periods; a pair closer than
   that, or hidden between two samples where g sits at its extremes with zero slopes (aliasing), can be
   missed, and at the depth limit the zero found in an interval holding several may not be the first.
+  At the depth limit, an interval whose guard's cubic still dips through zero between two ends of its
+  tracked sign is split at the cubic's extremum (kept within [1/16, 15/16] of the interval), up to
+  :data:`DIP_DEPTH` more times: at 2^-12 of the step the cubic resolves g, and a narrow excursion past zero
+  is sampled where it is deepest (a stick 1e6 times longer than the slip: a slip of 1e-6 rad in steps of
+  0.1 rad, its guard past zero by 5e-13 of its scale, is found although it is 25 times narrower than
+  2^-12 of the step).
   A guard varying faster than the steps costs up to 2^13 evaluations per step; an ordinary one one.
 * **Location.** The zero is found by Brent's method on g along the dense output (to a few
   machine epsilons in t); the state there is integrated afresh from the step's start to that
@@ -66,6 +72,8 @@ from mechgen.runtime.core.integrate import IMPLICIT, METHODS
 LOOPS = ("auto", "python", "c")
 #: a suspicious interval of a step is halved at most this many times (2^-12 of the step)
 MAX_DEPTH = 12
+#: levels of splitting at a guard's cubic dip beyond MAX_DEPTH (module doc, "Missed events")
+DIP_DEPTH = 4
 EPS = float(np.finfo(float).eps)
 
 
@@ -212,6 +220,45 @@ def _suspicious(sign: np.ndarray, ga, da, gb, db, h: float, at_start: bool) -> b
         if _hermite(s, a, ra, b, rb, h)[0] > 0:
             return True
     return False
+
+
+def _dip(s: float, ga: float, da: float, gb: float, db: float, h: float) -> float | None:
+    """u in (0, 1) of the first interior extremum at which the cubic Hermite through (ga, h da), (gb, h db)
+    is past zero (sign -s) while both ends keep the sign s; None when it has none."""
+    if ga == 0.0 or gb == 0.0 or math.copysign(1.0, ga) != s or math.copysign(1.0, gb) != s:
+        return None
+    c1, c2, c3 = h * da, 3 * (gb - ga) - h * (2 * da + db), 2 * (ga - gb) + h * (da + db)
+    crit: list[float] = []
+    if c3 != 0.0:
+        disc = c2 * c2 - 3 * c1 * c3
+        if disc >= 0.0:
+            q = -(c2 + math.copysign(math.sqrt(disc), c2))
+            crit = [q / (3 * c3)] + ([c1 / q] if q != 0.0 else [])
+    elif c2 != 0.0:
+        crit = [-c1 / (2 * c2)]
+    for u in sorted(u for u in crit if 0.0 < u < 1.0):
+        value = ga + u * (c1 + u * (c2 + u * c3))
+        if value != 0.0 and math.copysign(1.0, value) != s:
+            return u
+    return None
+
+
+def split_point(sign: np.ndarray, ga, da, gb, db, ta: float, tb: float, depth: int) -> float | None:
+    """Where a suspicious interval [ta, tb] at ``depth`` is split (module doc, "Missed events"): the midpoint
+    above :data:`MAX_DEPTH`; below it, for up to :data:`DIP_DEPTH` more levels, the extremum of the first
+    guard whose cubic Hermite dips through zero between two ends of its tracked sign, kept within
+    [1/16, 15/16] of the interval; else None (not split)."""
+    if depth < MAX_DEPTH:
+        return 0.5 * (ta + tb)
+    if depth >= MAX_DEPTH + DIP_DEPTH:
+        return None
+    h = tb - ta
+    for k in range(len(sign)):
+        if sign[k] != 0.0:
+            u = _dip(float(sign[k]), float(ga[k]), float(da[k]), float(gb[k]), float(db[k]), h)
+            if u is not None:
+                return ta + min(max(u, 1.0 / 16), 15.0 / 16) * h
+    return None
 
 
 def _crossed(sign: np.ndarray, g: np.ndarray, directions: np.ndarray) -> np.ndarray:
@@ -430,8 +477,10 @@ def _scan(seg, dense, sign, a, b, t_start):
     stack = [(a, b, 0)]
     while stack:
         (ta, ga, da), (tb, gb, db), depth = stack.pop()
-        if depth < MAX_DEPTH and _suspicious(sign, ga, da, gb, db, tb - ta, ta == t_start):
-            tm = 0.5 * (ta + tb)
+        tm = None
+        if depth < MAX_DEPTH + DIP_DEPTH and _suspicious(sign, ga, da, gb, db, tb - ta, ta == t_start):
+            tm = split_point(sign, ga, da, gb, db, ta, tb, depth)
+        if tm is not None:
             gm, dm = seg.values(tm, dense(tm))
             stack.append(((tm, gm, dm), (tb, gb, db), depth + 1))
             stack.append(((ta, ga, da), (tm, gm, dm), depth + 1))

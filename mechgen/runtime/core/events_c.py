@@ -200,7 +200,7 @@ def _supported(system) -> str | None:
         if any(p not in names for p in PICKS[base]):
             return f"kernel {name} lacks the outputs {', '.join(PICKS[base])}"
     for i in range(len(system.modes)):
-        for kind in ("residual", "tangent") + (("rates",) if system.m else ()):
+        for kind in (("residual", "tangent") if system.n else ()) + (("rates",) if system.m else ()):
             if f"{kind}__{i}" not in system.kernels:
                 return f"mode {system.modes[i]} has no {kind} kernel"
         if system.guards(i) and f"guards__{i}" not in system.kernels:

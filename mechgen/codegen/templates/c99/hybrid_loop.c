@@ -30,7 +30,8 @@ typedef int (*mgh_fn)(const double *const *in, double *const *out, const long *s
 
 #define MGH_PORTS 8
 #define MGH_MAX_DEPTH 12
-#define MGH_STACK (MGH_MAX_DEPTH + 3)
+#define MGH_DIP_DEPTH 4
+#define MGH_STACK (MGH_MAX_DEPTH + MGH_DIP_DEPTH + 3)
 
 /* what a kernel input is */
 enum { MGH_IN_Q = 0, MGH_IN_V = 1, MGH_IN_A = 2, MGH_IN_Z = 3, MGH_IN_T = 4, MGH_IN_P = 5 };
@@ -296,12 +297,14 @@ static void fail_at(mgh_ctx *c, double t, const double *x)
         memcpy(c->S->err_x, x, (size_t)c->nx * sizeof(double));
 }
 
-/* f = dx/dt of mode `mode` at (t, x): (v, -M^-1 r(q, v, 0, z, t), rates) */
+/* f = dx/dt of mode `mode` at (t, x): (v, -M^-1 r(q, v, 0, z, t), rates); only the rates when n = 0 */
 static int rhs(mgh_ctx *c, long mode, double t, const double *x, double *f)
 {
     const mgh_mode *md = &c->P->modes[mode];
     long n = c->n, i;
     int rc;
+    if (n == 0)
+        goto rates;
     if ((rc = kcall(c, &md->residual, MGH_K_RESIDUAL, mode, x, NULL, t)) != 0)
         return rc;
     for (i = 0; i < n; ++i)
@@ -315,6 +318,7 @@ static int rhs(mgh_ctx *c, long mode, double t, const double *x, double *f)
     }
     memcpy(f, x + n, (size_t)n * sizeof(double));
     memcpy(f + n, c->b, (size_t)n * sizeof(double));
+rates:
     if (c->m) {
         if ((rc = kcall(c, &md->rates, MGH_K_RATES, mode, x, NULL, t)) != 0)
             return rc;
@@ -702,6 +706,50 @@ static long hermite_changes(double s, double ga, double da, double gb, double db
     return changes;
 }
 
+/* events.py _dip: u of the first interior extremum of the cubic Hermite past zero (sign -s) while both ends
+ * keep the sign s; -1 when there is none */
+static double hermite_dip(double s, double ga, double da, double gb, double db, double h)
+{
+    double u[2], cs[3], swap, value;
+    long nu, i;
+    if (ga == 0.0 || gb == 0.0 || sgn(ga) != s || sgn(gb) != s)
+        return -1.0;
+    nu = hermite_extrema(ga, da, gb, db, h, u, cs);
+    if (nu == 2 && u[1] < u[0]) {
+        swap = u[0];
+        u[0] = u[1];
+        u[1] = swap;
+    }
+    for (i = 0; i < nu; ++i) {
+        value = ga + u[i] * (cs[0] + u[i] * (cs[1] + u[i] * cs[2]));
+        if (value != 0.0 && sgn(value) != s)
+            return u[i];
+    }
+    return -1.0;
+}
+
+/* events.py split_point: the midpoint above MGH_MAX_DEPTH; below it, for MGH_DIP_DEPTH more levels, the
+ * extremum of the first guard whose cubic dips through zero between two ends of its tracked sign, within
+ * [1/16, 15/16] of the interval; else -INFINITY (not split) */
+static double split_point(const double *sign, const double *ga, const double *da, const double *gb,
+                          const double *db, long ng, double ta, double tb, long depth)
+{
+    long k;
+    double h = tb - ta, u;
+    if (depth < MGH_MAX_DEPTH)
+        return 0.5 * (ta + tb);
+    if (depth >= MGH_MAX_DEPTH + MGH_DIP_DEPTH)
+        return -INFINITY;
+    for (k = 0; k < ng; ++k) {
+        if (sign[k] == 0)
+            continue;
+        u = hermite_dip(sign[k], ga[k], da[k], gb[k], db[k], h);
+        if (u >= 0.0)
+            return ta + fmin(fmax(u, 1.0 / 16), 15.0 / 16) * h;
+    }
+    return -INFINITY;
+}
+
 /* events.py _suspicious: whether the interval of length h with ends (ga, da), (gb, db) must be halved ("Missed
  * events"): a guard of unchanged sign whose zero is within reach of either end at its rate, whose end rates
  * depart from the chord by as much as its distance from zero, or whose cubic dips through zero; a guard whose
@@ -855,8 +903,11 @@ static int scan(mgh_ctx *c, long mode, double *sign, double t0, double t1, long 
         memcpy(c->cb, slot + 2 * c->ng, (size_t)ng * sizeof(double));
         memcpy(c->cdb, slot + 3 * c->ng, (size_t)ng * sizeof(double));
         h = tb - ta;
-        if (depth < MGH_MAX_DEPTH && suspicious(sign, c->ca, c->cda, c->cb, c->cdb, ng, h, ta == c->S->t_start)) {
-            tm = 0.5 * (ta + tb);
+        tm = -INFINITY;
+        if (depth < MGH_MAX_DEPTH + MGH_DIP_DEPTH
+            && suspicious(sign, c->ca, c->cda, c->cb, c->cdb, ng, h, ta == c->S->t_start))
+            tm = split_point(sign, c->ca, c->cda, c->cb, c->cdb, ng, ta, tb, depth);
+        if (tm > -INFINITY) {
             dense_eval(c, tm, c->xm);
             if ((rc = rhs(c, mode, tm, c->xm, c->fm)) != 0)
                 return rc;
@@ -1115,18 +1166,19 @@ static int setup(mgh_ctx *c, const mgh_problem *P, mgh_state *S)
     memset(c, 0, sizeof(*c));
     c->P = P;
     c->S = S;
-    if (n < 1 || m < 0 || P->nmodes < 1 || P->modes == NULL || S->mode < 0 || S->mode >= P->nmodes
+    if (n < 0 || m < 0 || n + m < 1 || P->nmodes < 1 || P->modes == NULL || S->mode < 0 || S->mode >= P->nmodes
         || P->max_guards < 0 || (P->nresets > 0 && P->resets == NULL) || P->zeno_events < 0)
         return MGH_E_INPUT;
     for (i = 0; i < P->nmodes; ++i) {
         const mgh_mode *md = &P->modes[i];
-        if (check_kernel(&md->residual, 1) || check_kernel(&md->tangent, 1) || check_kernel(&md->rates, m > 0)
+        if (check_kernel(&md->residual, n > 0) || check_kernel(&md->tangent, n > 0) || check_kernel(&md->rates, m > 0)
             || check_kernel(&md->guards, md->nguards > 0) || md->nguards > P->max_guards || md->nguards < 0)
             return MGH_E_INPUT;
         for (j = 0; j < md->nguards; ++j)
             if (md->target[j] >= P->nmodes || md->reset[j] >= P->nresets || (!md->terminal[j] && md->target[j] < 0))
                 return MGH_E_INPUT;
-        if (md->tangent.out_len[md->tangent.pick[0]] != n * n || md->residual.out_len[md->residual.pick[0]] != n)
+        if (n > 0 && (md->tangent.out_len[md->tangent.pick[0]] != n * n
+                      || md->residual.out_len[md->residual.pick[0]] != n))
             return MGH_E_INPUT;
     }
     for (i = 0; i < P->nresets; ++i)

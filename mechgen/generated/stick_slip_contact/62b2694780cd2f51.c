@@ -5,129 +5,117 @@
 #include <math.h>
 
 /* residual__0: Lagrange residual r = M a - f
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
- *   in[2]  a: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  a: length 0 per state
  *   in[3]  z: length 1 per state
  *   in[4]  t: length 1 per state
  *   in[5]  p: length 0
- *   out[0] r: length 1 per state shape (1, 1)
+ *   out[0] r: length 0 per state shape (0, 1)
  */
 int mg_residual__0(const double *const *in, double *const *out, const long *sizes, long nbatch)
 {
     (void)sizes;
-    const long len_in2 = 1;
-    const long len_out0 = 1;
+    (void)in;
+    const long len_out0 = 0;
     for (long b = 0; b < nbatch; ++b) {
-        const double *const in2 = in[2] + b * len_in2;
         double *const out0 = out[0] + b * len_out0;
         for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
         {
-            const double g0 = in2[0];
-            out0[0] = g0;
         }
     }
     return 0;
 }
 
 /* residual__1: Lagrange residual r = M a - f
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
- *   in[2]  a: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  a: length 0 per state
  *   in[3]  z: length 1 per state
  *   in[4]  t: length 1 per state
  *   in[5]  p: length 0
- *   out[0] r: length 1 per state shape (1, 1)
+ *   out[0] r: length 0 per state shape (0, 1)
  */
 int mg_residual__1(const double *const *in, double *const *out, const long *sizes, long nbatch)
 {
     (void)sizes;
-    const long len_in2 = 1;
-    const long len_out0 = 1;
+    (void)in;
+    const long len_out0 = 0;
     for (long b = 0; b < nbatch; ++b) {
-        const double *const in2 = in[2] + b * len_in2;
         double *const out0 = out[0] + b * len_out0;
         for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
         {
-            const double g0 = in2[0];
-            out0[0] = g0;
         }
     }
     return 0;
 }
 
 /* residual__2: Lagrange residual r = M a - f
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
- *   in[2]  a: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  a: length 0 per state
  *   in[3]  z: length 1 per state
  *   in[4]  t: length 1 per state
  *   in[5]  p: length 0
- *   out[0] r: length 1 per state shape (1, 1)
+ *   out[0] r: length 0 per state shape (0, 1)
  */
 int mg_residual__2(const double *const *in, double *const *out, const long *sizes, long nbatch)
 {
     (void)sizes;
-    const long len_in2 = 1;
-    const long len_out0 = 1;
+    (void)in;
+    const long len_out0 = 0;
     for (long b = 0; b < nbatch; ++b) {
-        const double *const in2 = in[2] + b * len_in2;
         double *const out0 = out[0] + b * len_out0;
         for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
         {
-            const double g0 = in2[0];
-            out0[0] = g0;
         }
     }
     return 0;
 }
 
 /* residual__3: Lagrange residual r = M a - f
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
- *   in[2]  a: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  a: length 0 per state
  *   in[3]  z: length 1 per state
  *   in[4]  t: length 1 per state
  *   in[5]  p: length 0
- *   out[0] r: length 1 per state shape (1, 1)
+ *   out[0] r: length 0 per state shape (0, 1)
  */
 int mg_residual__3(const double *const *in, double *const *out, const long *sizes, long nbatch)
 {
     (void)sizes;
-    const long len_in2 = 1;
-    const long len_out0 = 1;
+    (void)in;
+    const long len_out0 = 0;
     for (long b = 0; b < nbatch; ++b) {
-        const double *const in2 = in[2] + b * len_in2;
         double *const out0 = out[0] + b * len_out0;
         for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
         {
-            const double g0 = in2[0];
-            out0[0] = g0;
         }
     }
     return 0;
 }
 
 /* tangent__0: Jacobians of the residual
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
- *   in[2]  a: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  a: length 0 per state
  *   in[3]  z: length 1 per state
  *   in[4]  t: length 1 per state
  *   in[5]  p: length 0
- *   out[0] r_q: length 1 per state shape (1, 1)
- *   out[1] r_v: length 1 per state shape (1, 1)
- *   out[2] r_a: length 1 per state shape (1, 1)
- *   out[3] r_z: length 1 per state shape (1, 1)
+ *   out[0] r_q: length 0 per state shape (0, 0)
+ *   out[1] r_v: length 0 per state shape (0, 0)
+ *   out[2] r_a: length 0 per state shape (0, 0)
+ *   out[3] r_z: length 0 per state shape (0, 1)
  */
 int mg_tangent__0(const double *const *in, double *const *out, const long *sizes, long nbatch)
 {
     (void)sizes;
     (void)in;
-    const long len_out0 = 1;
-    const long len_out1 = 1;
-    const long len_out2 = 1;
-    const long len_out3 = 1;
+    const long len_out0 = 0;
+    const long len_out1 = 0;
+    const long len_out2 = 0;
+    const long len_out3 = 0;
     for (long b = 0; b < nbatch; ++b) {
         double *const out0 = out[0] + b * len_out0;
         for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
@@ -138,32 +126,31 @@ int mg_tangent__0(const double *const *in, double *const *out, const long *sizes
         double *const out3 = out[3] + b * len_out3;
         for (long i = 0; i < len_out3; ++i) out3[i] = 0.0;
         {
-            out2[0] = 1.0;
         }
     }
     return 0;
 }
 
 /* tangent__1: Jacobians of the residual
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
- *   in[2]  a: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  a: length 0 per state
  *   in[3]  z: length 1 per state
  *   in[4]  t: length 1 per state
  *   in[5]  p: length 0
- *   out[0] r_q: length 1 per state shape (1, 1)
- *   out[1] r_v: length 1 per state shape (1, 1)
- *   out[2] r_a: length 1 per state shape (1, 1)
- *   out[3] r_z: length 1 per state shape (1, 1)
+ *   out[0] r_q: length 0 per state shape (0, 0)
+ *   out[1] r_v: length 0 per state shape (0, 0)
+ *   out[2] r_a: length 0 per state shape (0, 0)
+ *   out[3] r_z: length 0 per state shape (0, 1)
  */
 int mg_tangent__1(const double *const *in, double *const *out, const long *sizes, long nbatch)
 {
     (void)sizes;
     (void)in;
-    const long len_out0 = 1;
-    const long len_out1 = 1;
-    const long len_out2 = 1;
-    const long len_out3 = 1;
+    const long len_out0 = 0;
+    const long len_out1 = 0;
+    const long len_out2 = 0;
+    const long len_out3 = 0;
     for (long b = 0; b < nbatch; ++b) {
         double *const out0 = out[0] + b * len_out0;
         for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
@@ -174,32 +161,31 @@ int mg_tangent__1(const double *const *in, double *const *out, const long *sizes
         double *const out3 = out[3] + b * len_out3;
         for (long i = 0; i < len_out3; ++i) out3[i] = 0.0;
         {
-            out2[0] = 1.0;
         }
     }
     return 0;
 }
 
 /* tangent__2: Jacobians of the residual
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
- *   in[2]  a: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  a: length 0 per state
  *   in[3]  z: length 1 per state
  *   in[4]  t: length 1 per state
  *   in[5]  p: length 0
- *   out[0] r_q: length 1 per state shape (1, 1)
- *   out[1] r_v: length 1 per state shape (1, 1)
- *   out[2] r_a: length 1 per state shape (1, 1)
- *   out[3] r_z: length 1 per state shape (1, 1)
+ *   out[0] r_q: length 0 per state shape (0, 0)
+ *   out[1] r_v: length 0 per state shape (0, 0)
+ *   out[2] r_a: length 0 per state shape (0, 0)
+ *   out[3] r_z: length 0 per state shape (0, 1)
  */
 int mg_tangent__2(const double *const *in, double *const *out, const long *sizes, long nbatch)
 {
     (void)sizes;
     (void)in;
-    const long len_out0 = 1;
-    const long len_out1 = 1;
-    const long len_out2 = 1;
-    const long len_out3 = 1;
+    const long len_out0 = 0;
+    const long len_out1 = 0;
+    const long len_out2 = 0;
+    const long len_out3 = 0;
     for (long b = 0; b < nbatch; ++b) {
         double *const out0 = out[0] + b * len_out0;
         for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
@@ -210,32 +196,31 @@ int mg_tangent__2(const double *const *in, double *const *out, const long *sizes
         double *const out3 = out[3] + b * len_out3;
         for (long i = 0; i < len_out3; ++i) out3[i] = 0.0;
         {
-            out2[0] = 1.0;
         }
     }
     return 0;
 }
 
 /* tangent__3: Jacobians of the residual
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
- *   in[2]  a: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  a: length 0 per state
  *   in[3]  z: length 1 per state
  *   in[4]  t: length 1 per state
  *   in[5]  p: length 0
- *   out[0] r_q: length 1 per state shape (1, 1)
- *   out[1] r_v: length 1 per state shape (1, 1)
- *   out[2] r_a: length 1 per state shape (1, 1)
- *   out[3] r_z: length 1 per state shape (1, 1)
+ *   out[0] r_q: length 0 per state shape (0, 0)
+ *   out[1] r_v: length 0 per state shape (0, 0)
+ *   out[2] r_a: length 0 per state shape (0, 0)
+ *   out[3] r_z: length 0 per state shape (0, 1)
  */
 int mg_tangent__3(const double *const *in, double *const *out, const long *sizes, long nbatch)
 {
     (void)sizes;
     (void)in;
-    const long len_out0 = 1;
-    const long len_out1 = 1;
-    const long len_out2 = 1;
-    const long len_out3 = 1;
+    const long len_out0 = 0;
+    const long len_out1 = 0;
+    const long len_out2 = 0;
+    const long len_out3 = 0;
     for (long b = 0; b < nbatch; ++b) {
         double *const out0 = out[0] + b * len_out0;
         for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
@@ -246,15 +231,14 @@ int mg_tangent__3(const double *const *in, double *const *out, const long *sizes
         double *const out3 = out[3] + b * len_out3;
         for (long i = 0; i < len_out3; ++i) out3[i] = 0.0;
         {
-            out2[0] = 1.0;
         }
     }
     return 0;
 }
 
 /* rates__0: internal rates dz/dt
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
  *   in[2]  z: length 1 per state
  *   in[3]  t: length 1 per state
  *   in[4]  p: length 0
@@ -263,20 +247,23 @@ int mg_tangent__3(const double *const *in, double *const *out, const long *sizes
 int mg_rates__0(const double *const *in, double *const *out, const long *sizes, long nbatch)
 {
     (void)sizes;
-    (void)in;
+    const long len_in3 = 1;
     const long len_out0 = 1;
     for (long b = 0; b < nbatch; ++b) {
+        const double *const in3 = in[3] + b * len_in3;
         double *const out0 = out[0] + b * len_out0;
         for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
         {
+            const double g0 = in3[0];
+            out0[0] = -sin(g0);
         }
     }
     return 0;
 }
 
 /* rates__1: internal rates dz/dt
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
  *   in[2]  z: length 1 per state
  *   in[3]  t: length 1 per state
  *   in[4]  p: length 0
@@ -285,23 +272,20 @@ int mg_rates__0(const double *const *in, double *const *out, const long *sizes, 
 int mg_rates__1(const double *const *in, double *const *out, const long *sizes, long nbatch)
 {
     (void)sizes;
-    const long len_in3 = 1;
+    (void)in;
     const long len_out0 = 1;
     for (long b = 0; b < nbatch; ++b) {
-        const double *const in3 = in[3] + b * len_in3;
         double *const out0 = out[0] + b * len_out0;
         for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
         {
-            const double g0 = in3[0];
-            out0[0] = -sin(g0);
         }
     }
     return 0;
 }
 
 /* rates__2: internal rates dz/dt
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
  *   in[2]  z: length 1 per state
  *   in[3]  t: length 1 per state
  *   in[4]  p: length 0
@@ -310,23 +294,20 @@ int mg_rates__1(const double *const *in, double *const *out, const long *sizes, 
 int mg_rates__2(const double *const *in, double *const *out, const long *sizes, long nbatch)
 {
     (void)sizes;
-    const long len_in3 = 1;
+    (void)in;
     const long len_out0 = 1;
     for (long b = 0; b < nbatch; ++b) {
-        const double *const in3 = in[3] + b * len_in3;
         double *const out0 = out[0] + b * len_out0;
         for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
         {
-            const double g0 = in3[0];
-            out0[0] = -sin(g0);
         }
     }
     return 0;
 }
 
 /* rates__3: internal rates dz/dt
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
  *   in[2]  z: length 1 per state
  *   in[3]  t: length 1 per state
  *   in[4]  p: length 0
@@ -335,36 +316,33 @@ int mg_rates__2(const double *const *in, double *const *out, const long *sizes, 
 int mg_rates__3(const double *const *in, double *const *out, const long *sizes, long nbatch)
 {
     (void)sizes;
-    const long len_in3 = 1;
+    (void)in;
     const long len_out0 = 1;
     for (long b = 0; b < nbatch; ++b) {
-        const double *const in3 = in[3] + b * len_in3;
         double *const out0 = out[0] + b * len_out0;
         for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
         {
-            const double g0 = in3[0];
-            out0[0] = -sin(g0);
         }
     }
     return 0;
 }
 
 /* rates_tangent__0: Jacobians of the internal rates
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
  *   in[2]  z: length 1 per state
  *   in[3]  t: length 1 per state
  *   in[4]  p: length 0
- *   out[0] g_q: length 1 per state shape (1, 1)
- *   out[1] g_v: length 1 per state shape (1, 1)
+ *   out[0] g_q: length 0 per state shape (1, 0)
+ *   out[1] g_v: length 0 per state shape (1, 0)
  *   out[2] g_z: length 1 per state shape (1, 1)
  */
 int mg_rates_tangent__0(const double *const *in, double *const *out, const long *sizes, long nbatch)
 {
     (void)sizes;
     (void)in;
-    const long len_out0 = 1;
-    const long len_out1 = 1;
+    const long len_out0 = 0;
+    const long len_out1 = 0;
     const long len_out2 = 1;
     for (long b = 0; b < nbatch; ++b) {
         double *const out0 = out[0] + b * len_out0;
@@ -380,21 +358,21 @@ int mg_rates_tangent__0(const double *const *in, double *const *out, const long 
 }
 
 /* rates_tangent__1: Jacobians of the internal rates
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
  *   in[2]  z: length 1 per state
  *   in[3]  t: length 1 per state
  *   in[4]  p: length 0
- *   out[0] g_q: length 1 per state shape (1, 1)
- *   out[1] g_v: length 1 per state shape (1, 1)
+ *   out[0] g_q: length 0 per state shape (1, 0)
+ *   out[1] g_v: length 0 per state shape (1, 0)
  *   out[2] g_z: length 1 per state shape (1, 1)
  */
 int mg_rates_tangent__1(const double *const *in, double *const *out, const long *sizes, long nbatch)
 {
     (void)sizes;
     (void)in;
-    const long len_out0 = 1;
-    const long len_out1 = 1;
+    const long len_out0 = 0;
+    const long len_out1 = 0;
     const long len_out2 = 1;
     for (long b = 0; b < nbatch; ++b) {
         double *const out0 = out[0] + b * len_out0;
@@ -410,21 +388,21 @@ int mg_rates_tangent__1(const double *const *in, double *const *out, const long 
 }
 
 /* rates_tangent__2: Jacobians of the internal rates
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
  *   in[2]  z: length 1 per state
  *   in[3]  t: length 1 per state
  *   in[4]  p: length 0
- *   out[0] g_q: length 1 per state shape (1, 1)
- *   out[1] g_v: length 1 per state shape (1, 1)
+ *   out[0] g_q: length 0 per state shape (1, 0)
+ *   out[1] g_v: length 0 per state shape (1, 0)
  *   out[2] g_z: length 1 per state shape (1, 1)
  */
 int mg_rates_tangent__2(const double *const *in, double *const *out, const long *sizes, long nbatch)
 {
     (void)sizes;
     (void)in;
-    const long len_out0 = 1;
-    const long len_out1 = 1;
+    const long len_out0 = 0;
+    const long len_out1 = 0;
     const long len_out2 = 1;
     for (long b = 0; b < nbatch; ++b) {
         double *const out0 = out[0] + b * len_out0;
@@ -440,21 +418,21 @@ int mg_rates_tangent__2(const double *const *in, double *const *out, const long 
 }
 
 /* rates_tangent__3: Jacobians of the internal rates
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
  *   in[2]  z: length 1 per state
  *   in[3]  t: length 1 per state
  *   in[4]  p: length 0
- *   out[0] g_q: length 1 per state shape (1, 1)
- *   out[1] g_v: length 1 per state shape (1, 1)
+ *   out[0] g_q: length 0 per state shape (1, 0)
+ *   out[1] g_v: length 0 per state shape (1, 0)
  *   out[2] g_z: length 1 per state shape (1, 1)
  */
 int mg_rates_tangent__3(const double *const *in, double *const *out, const long *sizes, long nbatch)
 {
     (void)sizes;
     (void)in;
-    const long len_out0 = 1;
-    const long len_out1 = 1;
+    const long len_out0 = 0;
+    const long len_out1 = 0;
     const long len_out2 = 1;
     for (long b = 0; b < nbatch; ++b) {
         double *const out0 = out[0] + b * len_out0;
@@ -470,8 +448,8 @@ int mg_rates_tangent__3(const double *const *in, double *const *out, const long 
 }
 
 /* outputs__0: named outputs
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
  *   in[2]  z: length 1 per state
  *   in[3]  t: length 1 per state
  *   in[4]  p: length 0
@@ -487,7 +465,6 @@ int mg_rates_tangent__3(const double *const *in, double *const *out, const long 
 int mg_outputs__0(const double *const *in, double *const *out, const long *sizes, long nbatch)
 {
     (void)sizes;
-    const long len_in1 = 1;
     const long len_in2 = 1;
     const long len_in3 = 1;
     const long len_out0 = 1;
@@ -499,7 +476,6 @@ int mg_outputs__0(const double *const *in, double *const *out, const long *sizes
     const long len_out6 = 1;
     const long len_out7 = 1;
     for (long b = 0; b < nbatch; ++b) {
-        const double *const in1 = in[1] + b * len_in1;
         const double *const in2 = in[2] + b * len_in2;
         const double *const in3 = in[3] + b * len_in3;
         double *const out0 = out[0] + b * len_out0;
@@ -519,25 +495,21 @@ int mg_outputs__0(const double *const *in, double *const *out, const long *sizes
         double *const out7 = out[7] + b * len_out7;
         for (long i = 0; i < len_out7; ++i) out7[i] = 0.0;
         {
-            const double g0 = in1[0];
-            const double g1 = in2[0];
-            const double g2 = in3[0];
-            const double t0 = cos(g2);
-            const double t1 = (1.0/2.0)*(g0*g0);
-            out0[0] = -g1 + t0;
+            const double g0 = in2[0];
+            const double g1 = in3[0];
+            const double t0 = cos(g1);
+            out0[0] = g0;
             out1[0] = t0;
             out3[0] = 1.0;
-            out4[0] = g1;
-            out5[0] = t1;
-            out7[0] = t1;
+            out4[0] = -g0 + t0;
         }
     }
     return 0;
 }
 
 /* outputs__1: named outputs
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
  *   in[2]  z: length 1 per state
  *   in[3]  t: length 1 per state
  *   in[4]  p: length 0
@@ -553,7 +525,6 @@ int mg_outputs__0(const double *const *in, double *const *out, const long *sizes
 int mg_outputs__1(const double *const *in, double *const *out, const long *sizes, long nbatch)
 {
     (void)sizes;
-    const long len_in1 = 1;
     const long len_in2 = 1;
     const long len_in3 = 1;
     const long len_out0 = 1;
@@ -565,7 +536,6 @@ int mg_outputs__1(const double *const *in, double *const *out, const long *sizes
     const long len_out6 = 1;
     const long len_out7 = 1;
     for (long b = 0; b < nbatch; ++b) {
-        const double *const in1 = in[1] + b * len_in1;
         const double *const in2 = in[2] + b * len_in2;
         const double *const in3 = in[3] + b * len_in3;
         double *const out0 = out[0] + b * len_out0;
@@ -585,25 +555,21 @@ int mg_outputs__1(const double *const *in, double *const *out, const long *sizes
         double *const out7 = out[7] + b * len_out7;
         for (long i = 0; i < len_out7; ++i) out7[i] = 0.0;
         {
-            const double g0 = in1[0];
-            const double g1 = in2[0];
-            const double g2 = in3[0];
-            const double t0 = cos(g2);
-            const double t1 = (1.0/2.0)*(g0*g0);
-            out0[0] = -g1 + t0;
+            const double g0 = in2[0];
+            const double g1 = in3[0];
+            const double t0 = cos(g1);
+            out0[0] = g0;
             out1[0] = t0;
             out3[0] = 1.0;
-            out4[0] = g1;
-            out5[0] = t1;
-            out7[0] = t1;
+            out4[0] = -g0 + t0;
         }
     }
     return 0;
 }
 
 /* outputs__2: named outputs
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
  *   in[2]  z: length 1 per state
  *   in[3]  t: length 1 per state
  *   in[4]  p: length 0
@@ -619,7 +585,6 @@ int mg_outputs__1(const double *const *in, double *const *out, const long *sizes
 int mg_outputs__2(const double *const *in, double *const *out, const long *sizes, long nbatch)
 {
     (void)sizes;
-    const long len_in1 = 1;
     const long len_in2 = 1;
     const long len_in3 = 1;
     const long len_out0 = 1;
@@ -631,7 +596,6 @@ int mg_outputs__2(const double *const *in, double *const *out, const long *sizes
     const long len_out6 = 1;
     const long len_out7 = 1;
     for (long b = 0; b < nbatch; ++b) {
-        const double *const in1 = in[1] + b * len_in1;
         const double *const in2 = in[2] + b * len_in2;
         const double *const in3 = in[3] + b * len_in3;
         double *const out0 = out[0] + b * len_out0;
@@ -651,25 +615,21 @@ int mg_outputs__2(const double *const *in, double *const *out, const long *sizes
         double *const out7 = out[7] + b * len_out7;
         for (long i = 0; i < len_out7; ++i) out7[i] = 0.0;
         {
-            const double g0 = in1[0];
-            const double g1 = in2[0];
-            const double g2 = in3[0];
-            const double t0 = cos(g2);
-            const double t1 = (1.0/2.0)*(g0*g0);
-            out0[0] = -g1 + t0;
+            const double g0 = in2[0];
+            const double g1 = in3[0];
+            const double t0 = cos(g1);
+            out0[0] = g0;
             out1[0] = t0;
             out3[0] = 1.0;
-            out4[0] = g1;
-            out5[0] = t1;
-            out7[0] = t1;
+            out4[0] = -g0 + t0;
         }
     }
     return 0;
 }
 
 /* outputs__3: named outputs
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
  *   in[2]  z: length 1 per state
  *   in[3]  t: length 1 per state
  *   in[4]  p: length 0
@@ -685,7 +645,6 @@ int mg_outputs__2(const double *const *in, double *const *out, const long *sizes
 int mg_outputs__3(const double *const *in, double *const *out, const long *sizes, long nbatch)
 {
     (void)sizes;
-    const long len_in1 = 1;
     const long len_in2 = 1;
     const long len_in3 = 1;
     const long len_out0 = 1;
@@ -697,7 +656,6 @@ int mg_outputs__3(const double *const *in, double *const *out, const long *sizes
     const long len_out6 = 1;
     const long len_out7 = 1;
     for (long b = 0; b < nbatch; ++b) {
-        const double *const in1 = in[1] + b * len_in1;
         const double *const in2 = in[2] + b * len_in2;
         const double *const in3 = in[3] + b * len_in3;
         double *const out0 = out[0] + b * len_out0;
@@ -717,23 +675,20 @@ int mg_outputs__3(const double *const *in, double *const *out, const long *sizes
         double *const out7 = out[7] + b * len_out7;
         for (long i = 0; i < len_out7; ++i) out7[i] = 0.0;
         {
-            const double g0 = in1[0];
-            const double g1 = in2[0];
-            const double g2 = in3[0];
-            const double t0 = (1.0/2.0)*(g0*g0);
-            out1[0] = cos(g2);
-            out4[0] = g1;
-            out5[0] = t0;
-            out7[0] = t0;
+            const double g0 = in2[0];
+            const double g1 = in3[0];
+            const double t0 = cos(g1);
+            out1[0] = t0;
+            out4[0] = -g0 + t0;
         }
     }
     return 0;
 }
 
 /* guards__0: guards leaving mode 0 and their rates
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
- *   in[2]  a: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  a: length 0 per state
  *   in[3]  z: length 1 per state
  *   in[4]  t: length 1 per state
  *   in[5]  p: length 0
@@ -757,22 +712,21 @@ int mg_guards__0(const double *const *in, double *const *out, const long *sizes,
         {
             const double g0 = in3[0];
             const double g1 = in4[0];
-            const double t0 = cos(g1);
-            const double t1 = -sin(g1);
-            out0[0] = -g0 + t0 - 0.3;
-            out0[1] = -g0 + t0 + 0.3;
+            const double t0 = -sin(g1);
+            out0[0] = g0 - 0.3;
+            out0[1] = g0 + 0.3;
             out0[2] = 1.0;
-            out1[0] = t1;
-            out1[1] = t1;
+            out1[0] = t0;
+            out1[1] = t0;
         }
     }
     return 0;
 }
 
 /* guards__1: guards leaving mode 1 and their rates
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
- *   in[2]  a: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  a: length 0 per state
  *   in[3]  z: length 1 per state
  *   in[4]  t: length 1 per state
  *   in[5]  p: length 0
@@ -802,9 +756,9 @@ int mg_guards__1(const double *const *in, double *const *out, const long *sizes,
 }
 
 /* guards__2: guards leaving mode 2 and their rates
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
- *   in[2]  a: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  a: length 0 per state
  *   in[3]  z: length 1 per state
  *   in[4]  t: length 1 per state
  *   in[5]  p: length 0
@@ -834,9 +788,9 @@ int mg_guards__2(const double *const *in, double *const *out, const long *sizes,
 }
 
 /* guards__3: guards leaving mode 3 and their rates
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
- *   in[2]  a: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  a: length 0 per state
  *   in[3]  z: length 1 per state
  *   in[4]  t: length 1 per state
  *   in[5]  p: length 0
@@ -862,128 +816,161 @@ int mg_guards__3(const double *const *in, double *const *out, const long *sizes,
 }
 
 /* reset__0: state after reset 0
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
  *   in[2]  z: length 1 per state
  *   in[3]  t: length 1 per state
  *   in[4]  p: length 0
- *   out[0] x: length 3 per state shape (3, 1)
+ *   out[0] x: length 1 per state shape (1, 1)
  */
 int mg_reset__0(const double *const *in, double *const *out, const long *sizes, long nbatch)
 {
     (void)sizes;
-    const long len_in0 = 1;
-    const long len_in1 = 1;
-    const long len_in2 = 1;
-    const long len_in3 = 1;
-    const long len_out0 = 3;
+    (void)in;
+    const long len_out0 = 1;
     for (long b = 0; b < nbatch; ++b) {
-        const double *const in0 = in[0] + b * len_in0;
-        const double *const in1 = in[1] + b * len_in1;
-        const double *const in2 = in[2] + b * len_in2;
-        const double *const in3 = in[3] + b * len_in3;
         double *const out0 = out[0] + b * len_out0;
         for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
         {
-            const double g0 = in0[0];
-            const double g1 = in1[0];
-            const double g2 = in2[0];
-            const double g3 = in3[0];
-            out0[0] = g0;
-            out0[1] = g1;
-            out0[2] = g2 + 1.4210854715202004e-14*fabs(g2) + 1.4210854715202004e-14*fabs(cos(g3));
         }
     }
     return 0;
 }
 
 /* reset__1: state after reset 1
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
  *   in[2]  z: length 1 per state
  *   in[3]  t: length 1 per state
  *   in[4]  p: length 0
- *   out[0] x: length 3 per state shape (3, 1)
+ *   out[0] x: length 1 per state shape (1, 1)
  */
 int mg_reset__1(const double *const *in, double *const *out, const long *sizes, long nbatch)
 {
     (void)sizes;
-    const long len_in0 = 1;
-    const long len_in1 = 1;
     const long len_in2 = 1;
-    const long len_in3 = 1;
-    const long len_out0 = 3;
+    const long len_out0 = 1;
     for (long b = 0; b < nbatch; ++b) {
-        const double *const in0 = in[0] + b * len_in0;
-        const double *const in1 = in[1] + b * len_in1;
         const double *const in2 = in[2] + b * len_in2;
-        const double *const in3 = in[3] + b * len_in3;
         double *const out0 = out[0] + b * len_out0;
         for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
         {
-            const double g0 = in0[0];
-            const double g1 = in1[0];
-            const double g2 = in2[0];
-            const double g3 = in3[0];
-            out0[0] = g0;
-            out0[1] = g1;
-            out0[2] = g2 - 1.4210854715202004e-14*fabs(g2) - 1.4210854715202004e-14*fabs(cos(g3));
+            const double g0 = in2[0];
+            out0[0] = g0 - 1.4210854715202004e-14*fabs(g0) - 4.263256414560601e-15;
         }
     }
     return 0;
 }
 
 /* reset__2: state after reset 2
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
  *   in[2]  z: length 1 per state
  *   in[3]  t: length 1 per state
  *   in[4]  p: length 0
- *   out[0] x: length 3 per state shape (3, 1)
+ *   out[0] x: length 1 per state shape (1, 1)
  */
 int mg_reset__2(const double *const *in, double *const *out, const long *sizes, long nbatch)
 {
     (void)sizes;
-    const long len_in0 = 1;
-    const long len_in1 = 1;
-    const long len_in3 = 1;
-    const long len_out0 = 3;
+    (void)in;
+    const long len_out0 = 1;
     for (long b = 0; b < nbatch; ++b) {
-        const double *const in0 = in[0] + b * len_in0;
-        const double *const in1 = in[1] + b * len_in1;
-        const double *const in3 = in[3] + b * len_in3;
         double *const out0 = out[0] + b * len_out0;
         for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
         {
-            const double g0 = in0[0];
-            const double g1 = in1[0];
-            const double g2 = in3[0];
-            out0[0] = g0;
-            out0[1] = g1;
-            out0[2] = cos(g2);
+        }
+    }
+    return 0;
+}
+
+/* reset__3: state after reset 3
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  z: length 1 per state
+ *   in[3]  t: length 1 per state
+ *   in[4]  p: length 0
+ *   out[0] x: length 1 per state shape (1, 1)
+ */
+int mg_reset__3(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    const long len_in2 = 1;
+    const long len_out0 = 1;
+    for (long b = 0; b < nbatch; ++b) {
+        const double *const in2 = in[2] + b * len_in2;
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        {
+            const double g0 = in2[0];
+            out0[0] = g0 + 1.4210854715202004e-14*fabs(g0) + 4.263256414560601e-15;
+        }
+    }
+    return 0;
+}
+
+/* reset__4: state after reset 4
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  z: length 1 per state
+ *   in[3]  t: length 1 per state
+ *   in[4]  p: length 0
+ *   out[0] x: length 1 per state shape (1, 1)
+ */
+int mg_reset__4(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    (void)in;
+    const long len_out0 = 1;
+    for (long b = 0; b < nbatch; ++b) {
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        {
+        }
+    }
+    return 0;
+}
+
+/* reset__5: state after reset 5
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  z: length 1 per state
+ *   in[3]  t: length 1 per state
+ *   in[4]  p: length 0
+ *   out[0] x: length 1 per state shape (1, 1)
+ */
+int mg_reset__5(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    (void)in;
+    const long len_out0 = 1;
+    for (long b = 0; b < nbatch; ++b) {
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        {
         }
     }
     return 0;
 }
 
 /* initial: the declared initial state (q, v, z)
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
  *   in[2]  z: length 1 per state
  *   in[3]  t: length 1 per state
  *   in[4]  p: length 0
- *   out[0] x: length 3 per state shape (3, 1)
+ *   out[0] x: length 1 per state shape (1, 1)
  */
 int mg_initial(const double *const *in, double *const *out, const long *sizes, long nbatch)
 {
     (void)sizes;
     (void)in;
-    const long len_out0 = 3;
+    const long len_out0 = 1;
     for (long b = 0; b < nbatch; ++b) {
         double *const out0 = out[0] + b * len_out0;
         for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
         {
-            out0[2] = 0.7;
+            out0[0] = 0.3;
         }
     }
     return 0;
