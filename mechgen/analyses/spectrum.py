@@ -4,8 +4,11 @@ A contact point moves at ``speed`` v (m/s) from ``start`` x_0 to ``stop`` (m; de
 length): x(t) = x_0 + v t. It strikes at every ``spacing`` lambda (m, a corrugation's wavelength),
 i.e. at t_k = k lambda / v, with the impulse J(x_k) (N s; ``impulse``: a number or an expression of
 the contact position ``x`` and the parameters, e.g. "sin(2*pi*x/wavelength)"). About q = 0 the
-linear system M q'' + K q = sum_k J_k g(x_k) delta(t - t_k) (g(x): the reduced dofs of a unit point
-force on ``field`` at x; a lumped model's unit force on the coordinate ``input``; only M and K are used:
+linear system M q'' + K q = sum_k (J_k g(x_k) + C_k g'(x_k)) delta(t - t_k) (g(x): the reduced dofs of a
+unit point force on ``field`` at x; g'(x), those of a unit point couple, the slope row; C_k the angular
+impulse ``couple``, N m s, an expression of x like ``impulse``: a tangential impulse J_t at a distance e
+from the neutral axis, an interface off the axis, is the couple e J_t; a lumped model's unit force on the
+coordinate ``input``; only M and K are used:
 the model's own D and G are replaced by the modal damping, and q = 0 is taken to be a rest state) is projected on its
 lowest ``modes`` mass-normalised modes and given the modal damping ratio ``damping`` zeta (0 <= zeta
 < 1); each modal coordinate is then a sum of damped sines (mechgen.runtime.linear.impulses), sampled
@@ -86,6 +89,7 @@ SCHEMA = {"speed": Option(positive, REQUIRED, "the sliding velocity in m/s (a nu
           "t_end": Option(positive, REQUIRED, "the record length in s"),
           "sample_rate": Option(positive, REQUIRED, "samples per second (Hz), above twice the highest mode's"),
           "impulse": Option(impulse, {"text": "1", "values": {}}),
+          "couple": Option(impulse),
           "start": Option(number, 0.0), "stop": Option(number),
           "field": Option(field_name), "observe": Option(number),
           "input": Option(coordinate), "output": Option(coordinate),
@@ -111,6 +115,9 @@ def check(ctx, base: str, options: dict) -> None:
         for key in ("field", "observe"):
             if key in options:
                 raise fail(ctx.file, f"{base}.{key}", f"'{key}' is for a continuum", "input and output coordinates")
+        if "couple" in options:
+            raise fail(ctx.file, f"{base}.couple", "'couple' (an angular impulse on the field's slope) is for a "
+                       "continuum", "impulse alone for a lumped model")
     samples = options["t_end"] * options["sample_rate"]
     top = ctx.limits.get(SAMPLES_LIMIT, LIMITS[SAMPLES_LIMIT])
     if samples > top:
@@ -138,8 +145,9 @@ def _blows(system, options: dict) -> tuple[np.ndarray, np.ndarray]:
     return t[keep], x[keep]
 
 
-def _loads(system, options: dict, x: np.ndarray):
-    """Columns g(x_k) (reduced generalized force of a unit point force) and the observation row c (u = c q)."""
+def _loads(system, options: dict, x: np.ndarray, order: int = 0):
+    """Columns g(x_k) (reduced generalized force of a unit point force; with ``order`` 1, of a unit point
+    couple: the slope row) and the observation row c (u = c q)."""
     if not system.is_field:
         names = list(system.coordinates)
         g = np.zeros((system.n, len(x)))
@@ -157,7 +165,8 @@ def _loads(system, options: dict, x: np.ndarray):
             raise InputError(f"{key} = {where:g} m is outside the field [0, {length:g}]", key=key,
                              expected="a position along the field in m")
     red = system.reduction
-    g = np.column_stack([red.vector(disc.row(field, 0, float(p))) for p in x]) if len(x) else np.zeros((system.n, 0))
+    g = (np.column_stack([red.vector(disc.row(field, order, float(p))) for p in x]) if len(x)
+         else np.zeros((system.n, 0)))
     c = red.vector(disc.row(field, 0, float(options.get("observe", 0.1 * length))))
     return g, c
 
@@ -182,6 +191,10 @@ def run_spectrum(system, options: dict, context: dict) -> dict:
     J = np.array([magnitude.evaluate({**options["impulse"]["values"], "x": float(x)}) for x in x_k])
     g, c = _loads(system, options, x_k)
     P = phi.T @ (g * J)                     # generalized modal impulses, N s per unit modal coordinate
+    if options.get("couple") is not None:   # angular impulses on the slope row
+        turning = parse_expression(options["couple"]["text"], key="couple")
+        C = np.array([turning.evaluate({**options["couple"]["values"], "x": float(x)}) for x in x_k])
+        P = P + phi.T @ (_loads(system, options, x_k, order=1)[0] * C)
     samples = int(round(t_end * rate))
     dt = 1.0 / rate
     u = np.zeros(samples)
