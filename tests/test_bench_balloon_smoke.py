@@ -8,6 +8,7 @@ import json
 import pytest
 
 from mechgen.bench.balloon import POINTS, STOP, run_balloon_benchmarks
+from bench_reports import check_standard_reports
 
 
 @pytest.mark.slow
@@ -16,6 +17,7 @@ def test_quick_balloon_benchmark_writes_reports(tmp_path, capsys):
     result = run_balloon_benchmarks(tmp_path, quick=True)
     data = json.loads((tmp_path / "balloon_branch.json").read_text())
     md = (tmp_path / "balloon_branch.md").read_text()
+    check_standard_reports(tmp_path, "balloon")
     assert md.startswith("# Ballooning string benchmark") and "baseline / mechgen" in md
     assert data["quick"] is True and result["quick"] is True
     refs = data["references"]

@@ -9,6 +9,7 @@ import importlib.util
 import json
 
 from mechgen.bench.beam import run_field_benchmarks
+from bench_reports import check_standard_reports
 
 
 def test_quick_field_benchmark_writes_reports(tmp_path, capsys):
@@ -19,6 +20,7 @@ def test_quick_field_benchmark_writes_reports(tmp_path, capsys):
     hermite = [float(r["max_rel_error"]) for r in rows if r["discretisation"] == "hermite"]
     assert hermite == sorted(hermite, reverse=True)  # refinement helps on the quick ladder
     assert min(float(r["max_rel_error"]) for r in rows if r["discretisation"] == "beam") < 1e-10
+    check_standard_reports(tmp_path, "beam", ratios=importlib.util.find_spec("skfem") is not None)
     assembly = json.loads((tmp_path / "beam_assembly.json").read_text())
     assert assembly["elements"] == 2000 and assembly["checks"]["mechgen_vs_closed_form"] < 1e-12
     assert "mechgen linear()" in assembly["seconds"]

@@ -4,6 +4,7 @@ reference against CVODES at the same tight tolerance)."""
 import json
 
 from mechgen.cli import main
+from bench_reports import check_standard_reports
 
 
 def test_quick_friction_benchmark_writes_reports(tmp_path):
@@ -18,3 +19,4 @@ def test_quick_friction_benchmark_writes_reports(tmp_path):
     assert all(r["error"] < 10 * r["rtol"] for r in data["hysteresis"])  # the Jenkins W (Griffin 1980)
     text = (tmp_path / "friction.md").read_text()
     assert "At equal accuracy" in text and (tmp_path / "friction.csv").exists()
+    check_standard_reports(tmp_path, "friction")

@@ -3,6 +3,7 @@ asserted; the errors it reports are checked against the closed forms' accuracy).
 import json
 
 from mechgen.cli import main
+from bench_reports import check_standard_reports
 
 
 def test_quick_impact_benchmark_writes_reports(tmp_path):
@@ -13,3 +14,4 @@ def test_quick_impact_benchmark_writes_reports(tmp_path):
     assert all(r["mechgen_error"] < 1e-8 for r in data["sweep"])  # the closed forms (tests/impact_reference.py)
     assert all(r["ratio"] == r["handwritten_s"] / r["mechgen_s"] for r in data["sweep"])
     assert "ratio" in (tmp_path / "impacts.md").read_text()
+    check_standard_reports(tmp_path, "impacts")

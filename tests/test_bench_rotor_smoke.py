@@ -8,6 +8,7 @@ import json
 import pytest
 
 from mechgen.bench.rotor import COUNT, TOL, run_rotor_benchmarks
+from bench_reports import check_standard_reports
 
 HAVE_ROSS = importlib.util.find_spec("ross") is not None
 
@@ -18,6 +19,7 @@ def test_quick_rotor_benchmark_writes_reports(tmp_path, capsys):
     result = run_rotor_benchmarks(tmp_path, quick=True)
     data = json.loads((tmp_path / "rotor_campbell.json").read_text())
     md = (tmp_path / "rotor_campbell.md").read_text()
+    check_standard_reports(tmp_path, "rotor", ratios=importlib.util.find_spec("ross") is not None)
     assert md.startswith("# Rotor Campbell benchmark")
     assert data["quick"] is True and result["quick"] is True
     camp = data["campbell"]

@@ -22,6 +22,17 @@ class Suite:
     function: str
     summary: str
     writes: tuple[str, ...] = ()
+    #: the other tools the suite times against (packages are optional extras; hand-written baselines live in
+    #: benchmarks/)
+    peers: tuple[str, ...] = ()
+    #: whether the suite writes the harness's standard reports (common.suite_report)
+    standard: bool = True
+
+    @property
+    def reports(self) -> tuple[str, ...]:
+        """Every file the suite writes: the standard three, then its own."""
+        own = tuple(f"{self.name}_{tail}" for tail in ("work_precision.csv", "work_precision.png", "ratios.json"))
+        return (own if self.standard else ()) + tuple(w for w in self.writes if w not in own)
 
     def run(self, out: Path, quick: bool = False) -> dict:
         """Run the suite (importing its module now) and return its results."""
@@ -32,33 +43,36 @@ class Suite:
 REGISTRY: dict[str, Suite] = {s.name: s for s in (
     Suite("fpu", "mechgen.bench.fpu", "run_fpu_benchmarks",
           "FPU chain kernels: generated C against hand C, numpy, sympy.lambdify, CasADi; call overhead, build and "
-          "scene start times", ("fpu_kernels.csv", "fpu_kernels.json", "fpu_kernels.md")),
+          "scene start times", ("fpu_kernels.csv", "fpu_kernels.json", "fpu_kernels.md"),
+          peers=("hand-written C", "numpy", "sympy.lambdify", "CasADi"), standard=False),
     Suite("beam", "mechgen.bench.beam", "run_field_benchmarks",
           "clamped-free beam: work against precision of four discretisations, assembly against scikit-fem; the "
           "continua scenes unpinned against pinned",
           ("beam_work_precision.csv", "beam_work_precision.md", "beam_work_precision.png", "beam_assembly.json",
-           "beam_assembly.md", "beam_user_path.json", "beam_user_path.md")),
+           "beam_assembly.md", "beam_user_path.json", "beam_user_path.md"), peers=("scikit-fem",)),
     Suite("rotor", "mechgen.bench.rotor", "run_rotor_benchmarks",
           "Campbell diagrams of ROSS's example rotor, mechgen against ROSS, pinned and as a user runs both", ("rotor_campbell.json",
-                                                                              "rotor_campbell.md")),
+                                                                              "rotor_campbell.md"), peers=("ROSS",)),
     Suite("balloon", "mechgen.bench.balloon", "run_balloon_benchmarks",
           "the ballooning string's branch with stability against a hand-written scipy baseline",
-          ("balloon_branch.json", "balloon_branch.md")),
+          ("balloon_branch.json", "balloon_branch.md"), peers=("hand-written scipy shooting (benchmarks/)",)),
     Suite("startup", "mechgen.bench.startup", "run_startup_benchmarks",
           "whole-process start of a cached scene (laval_rotor, beam_modes): median wall time and import share, "
           "unpinned against pinned",
-          ("startup.json", "startup.md")),
+          ("startup.json", "startup.md"), standard=False),
     Suite("impacts", "mechgen.bench.impacts", "run_impact_benchmarks",
           "restitution over 200 damping ratios for five contact laws against hand-written solve_ivp with events; "
           "work-precision per law and integrator", ("impacts.json", "impacts.md", "impacts.csv",
-                                                    "impacts_work_precision.png")),
+                                                    "impacts_work_precision.png"),
+          peers=("hand-written solve_ivp with events (benchmarks/)",)),
     Suite("friction", "mechgen.bench.friction", "run_friction_benchmarks",
           "rate-and-state spring-slider against hand-written solve_ivp Radau at equal accuracy; work-precision of "
           "the velocity step and of the stick-slip hysteresis energy per integrator", ("friction.json", "friction.md", "friction.csv",
-                                                        "friction_work_precision.png")),
+                                                        "friction_work_precision.png"),
+          peers=("hand-written solve_ivp Radau (benchmarks/)",)),
     Suite("threads", "mechgen.bench.threads", "run_threads_benchmarks",
           "every shipped scene as a whole process, default environment against one BLAS thread (unpinned / pinned)",
-          ("threads.json", "threads.md")),
+          ("threads.json", "threads.md"), standard=False),
 )}
 
 #: the suite names (``mechgen bench`` with none runs them all)
@@ -68,8 +82,8 @@ SUITES = tuple(REGISTRY)
 def suite_lines() -> list[str]:
     """One line per suite: its name, what it measures and the reports it writes (``mechgen bench --list``)."""
     width = max(len(name) for name in REGISTRY)
-    return [f"{s.name:{width}s}  {s.summary}" + (f" -> {', '.join(s.writes)}" if s.writes else "")
-            for s in REGISTRY.values()]
+    return [f"{s.name:{width}s}  {s.summary}" + (f"; peers: {', '.join(s.peers)}" if s.peers else "")
+            + (f" -> {', '.join(s.reports)}" if s.reports else "") for s in REGISTRY.values()]
 
 
 def run_benchmarks(models_: list[str] | None = None, *, out: Path, quick: bool = False) -> dict:

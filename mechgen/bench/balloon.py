@@ -46,8 +46,8 @@ from pathlib import Path
 
 import numpy as np
 
-from mechgen.bench.common import (ROOT, blas_info, blas_threads, environment, user_path, user_path_markdown,
-                                  write_json, write_text)
+from mechgen.bench.common import (ROOT, blas_info, blas_threads, environment, suite_report, user_path,
+                                  user_path_markdown, write_json, write_text)
 from mechgen.bench.common import timed as _timed  # the local name the suite's steps use
 
 SCENE = ROOT / "scenes" / "balloon_branches.toml"
@@ -395,6 +395,16 @@ def run_balloon_benchmarks(out: Path, quick: bool = False) -> dict:
     res["user_path"] = user_path([ROOT / "scenes" / (QUICK_USER_SCENE if quick else USER_SCENE)],
                                  repeats=1 if quick else 3, warm=not quick)
     env["loadavg_after"] = list(os.getloadavg())
+    rows, eq = res["work_precision"]["branch"], res["headline"]["equal_accuracy"]
+    suite_report(out, "balloon", [{"series": r["tool"], "setting": r["setting"], "seconds": r["per_point_s"],
+                                   "error": r["p_e_min_error"]} for r in rows],
+                 reference=res["references"]["source"], error="rel. error of p_e,min along the branch",
+                 time="seconds per branch point (with stability)", title="Ballooning string: work-precision",
+                 ratios=[{"peer": "hand-written scipy baseline (DOP853 shooting)",
+                          "ours_s": res["headline"]["mechgen"]["per_point_median_s"],
+                          "peer_s": eq["baseline_per_point_s"],
+                          "condition": f"equal accuracy in p_e,min (baseline rtol {eq['baseline_rtol']:g}: "
+                                       f"{eq['baseline_p_e_min_error']:.1e}, mechgen {eq['mechgen_p_e_min_error']:.1e})"}])
     write_json(out / "balloon_branch.json", res, indent=1)
     table = report_markdown(res)
     write_text(out / "balloon_branch.md", table + "\n")

@@ -48,7 +48,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mechgen.bench.common import (ROOT, loglog_plot, repeat_times, user_path, user_path_markdown, write_csv,
+from mechgen.bench.common import (ROOT, repeat_times, suite_report, user_path, user_path_markdown,
                                   write_json, write_text)
 
 MODEL = "euler_bernoulli_beam"
@@ -147,15 +147,18 @@ def work_precision(ladders: dict, *, repeats: int = 5, backend: str = "c") -> li
     return rows
 
 
-def _write_work_precision(rows: list[dict], out: Path, exact: np.ndarray) -> list[Path]:
-    files = [out / "beam_work_precision.csv", out / "beam_work_precision.md"]
-    write_csv(files[0], ([r["discretisation"], r["size"], r["unknowns"], f"{r['max_rel_error']:.6e}",
-                          f"{r['seconds']:.6e}", f"{r['median_seconds']:.6e}", r["backend"]] for r in rows),
-              header=["discretisation", "size", "unknowns", "max_rel_error", "seconds", "median_seconds", "backend"])
-    write_text(files[1], work_precision_markdown(rows, exact))
-    png = out / "beam_work_precision.png"
-    if _plot_work_precision(rows, png):
-        files.append(png)
+def _write_work_precision(rows: list[dict], out: Path, exact: np.ndarray, ratios: list[dict]) -> list[Path]:
+    """The harness's standard reports (beam_work_precision.csv with the beam's own columns too, .png,
+    beam_ratios.json) and the markdown table."""
+    points = [{"series": r["discretisation"], "setting": f"N {r['size']}", "seconds": r["seconds"],
+               "error": r["max_rel_error"], **{k: r[k] for k in ("discretisation", "size", "unknowns", "max_rel_error",
+                                                                  "median_seconds", "backend")}} for r in rows]
+    files = suite_report(out, "beam", points,
+                         reference=f"exact clamped-free roots of cos(bL) cosh(bL) = -1 (first {COUNT} frequencies)",
+                         error="max relative error, first five frequencies",
+                         time="full solve wall time [s] (warm compile + linear() + modes(5))",
+                         title="Clamped-free Euler-Bernoulli beam: work-precision", ratios=ratios, floor=PLOT_FLOOR)
+    files.append(write_text(out / "beam_work_precision.md", work_precision_markdown(rows, exact)))
     return files
 
 
@@ -173,15 +176,6 @@ def work_precision_markdown(rows: list[dict], exact: np.ndarray) -> str:
         lines.append(f"| {r['discretisation']} | {r['size']} | {r['unknowns']} | {r['max_rel_error']:.2e} | "
                      f"{r['seconds']:.2e} | {r['median_seconds']:.2e} |")
     return "\n".join(lines) + "\n"
-
-
-def _plot_work_precision(rows: list[dict], path: Path) -> bool:
-    """Error against time, log-log, one line per discretisation (False when matplotlib is missing)."""
-    series = {disc: [(r["seconds"], r["max_rel_error"], r["size"]) for r in rows if r["discretisation"] == disc]
-              for disc in dict.fromkeys(r["discretisation"] for r in rows)}
-    return loglog_plot(path, series, xlabel="full solve wall time [s] (warm compile + linear() + modes(5))",
-                       ylabel="max relative error, first five frequencies",
-                       title="Clamped-free Euler-Bernoulli beam: work-precision", floor=PLOT_FLOOR)
 
 
 # -- assembly against scikit-fem ----------------------------------------------------
@@ -318,14 +312,23 @@ def run_field_benchmarks(out: Path, quick: bool = False) -> dict:
         assembly = assembly_comparison(ASSEMBLY_ELEMENTS, repeats=3 if quick else 7, min_time=0.0 if quick else 0.05)
     users = user_path([ROOT / "scenes" / name for name in (USER_SCENES[:1] if quick else USER_SCENES)],
                       repeats=1 if quick else 3, warm=not quick)
-    files = _write_work_precision(rows, out, exact)
     write_json(out / "beam_assembly.json", assembly)
     write_text(out / "beam_assembly.md", assembly_markdown(assembly))
     users_md = user_path_markdown(users, "The continua scenes as a user runs them")
     write_json(out / "beam_user_path.json", users)
     write_text(out / "beam_user_path.md", users_md + "\n")
-    files += [out / "beam_assembly.json", out / "beam_assembly.md", out / "beam_user_path.json",
-              out / "beam_user_path.md"]
+    files = [out / "beam_assembly.json", out / "beam_assembly.md", out / "beam_user_path.json",
+             out / "beam_user_path.md"]
+    t = assembly["seconds"]
+    ratios = [{"peer": "scikit-fem asm(M)+asm(K)", "ours_s": t[ours], "peer_s": t["skfem asm(M)+asm(K)"],
+               "condition": f"{ours}: the same Hermite M and K, {assembly['elements']} elements (checked equal)"}
+              for ours in ("mechgen linear()", "mechgen assembly only (M, K)")
+              if ours in t and "skfem asm(M)+asm(K)" in t]
+    if "skfem MeshLine+Basis+asm" in t:
+        ratios.append({"peer": "scikit-fem MeshLine+Basis+asm", "ours_s": t["mechgen refined(N).linear()"],
+                       "peer_s": t["skfem MeshLine+Basis+asm"],
+                       "condition": f"from scratch at {assembly['elements']} elements"})
+    files = _write_work_precision(rows, out, exact, ratios) + files
     print(work_precision_markdown(rows, exact))
     print(assembly_markdown(assembly))
     print(users_md)

@@ -13,7 +13,11 @@ Timing (each function states what it measures):
 Fairness: :func:`blas_threads` limits BLAS/OpenMP threads for every tool alike, :func:`blas_info` records
 them, :func:`environment` records the machine and the load average. Reports: :func:`write_csv`,
 :func:`write_json` and :func:`write_text` write atomically (a reader never sees half a file);
-:func:`loglog_plot` draws a work-precision diagram (time against error, log-log).
+:func:`loglog_plot` draws a work-precision diagram (time against error, log-log); :func:`suite_report`
+writes the three reports every work-precision suite has, in one format: ``<suite>_work_precision.csv``,
+``<suite>_work_precision.png`` (the reference named on the plot and in every CSV row) and
+``<suite>_ratios.json`` (wall-time ratios against the suite's peers, each with the condition it was
+measured at).
 """
 from __future__ import annotations
 
@@ -300,3 +304,42 @@ def loglog_plot(path: Path, series: dict, *, xlabel: str, ylabel: str, title: st
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return True
+
+
+def suite_report(out: Path, suite: str, points: Iterable[dict], *, reference: str, error: str, time: str,
+                 title: str, ratios: Iterable[dict] = (), floor: float = 1e-16) -> list[Path]:
+    """The harness's standard reports of suite ``suite`` in ``out`` (the files it wrote):
+
+    * ``<suite>_work_precision.csv``: one row per point, columns series, setting, seconds, error, reference
+      (``points``: dicts with keys series, setting, seconds, error; ``error`` measured against ``reference``),
+      then any further keys of the points as more columns;
+    * ``<suite>_work_precision.png``: error against seconds, log-log, one line per series, the reference
+      named in the title (skipped without matplotlib);
+    * ``<suite>_ratios.json``: {suite, reference, error, time, ratios}, each ratio a dict with peer (the other
+      tool), ours_s and peer_s (seconds, one run, same machine), ratio = peer_s / ours_s (> 1: we are faster)
+      and condition (what was held equal: the accuracy, the problem size).
+    """
+    out = Path(out)
+    base = ["series", "setting", "seconds", "error", "reference"]
+    rows, extra = [], {}
+    for p in points:
+        rows.append({**p, "series": str(p["series"]), "setting": str(p["setting"]), "seconds": float(p["seconds"]),
+                     "error": float(p["error"]), "reference": reference})
+        extra.update(dict.fromkeys(k for k in p if k not in base))
+    files = [write_csv(out / f"{suite}_work_precision.csv", [{k: r.get(k, "") for k in base + list(extra)}
+                                                               for r in rows], header=base + list(extra))]
+    series: dict = {}
+    for r in rows:
+        series.setdefault(r["series"], []).append((r["seconds"], r["error"], r["setting"]))
+    png = out / f"{suite}_work_precision.png"
+    if rows and loglog_plot(png, series, xlabel=time, ylabel=error, title=f"{title}\nreference: {reference}",
+                            floor=floor):
+        files.append(png)
+    table = []
+    for r in ratios:
+        ours, theirs = float(r["ours_s"]), float(r["peer_s"])
+        table.append({"peer": str(r["peer"]), "ours_s": ours, "peer_s": theirs,
+                      "ratio": theirs / ours if ours > 0 else float("inf"), "condition": str(r["condition"])})
+    files.append(write_json(out / f"{suite}_ratios.json", {"suite": suite, "reference": reference, "error": error,
+                                                          "time": time, "ratios": table}))
+    return files

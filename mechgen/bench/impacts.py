@@ -23,8 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
-from mechgen.bench.common import ROOT, environment, loglog_plot, user_path, user_path_markdown, write_csv, write_json, \
-    write_text
+from mechgen.bench.common import (ROOT, environment, suite_report, user_path, user_path_markdown,
+                                  write_csv, write_json, write_text)
 
 LAWS = ("kelvin_voigt", "modified_kelvin_voigt", "maxwell", "standard_linear", "hunt_crossley")
 #: the hand-written baseline's name of each law
@@ -172,10 +172,14 @@ def run_impact_benchmarks(out: Path, quick: bool = False) -> dict:
     write_json(out / "impacts.json", results)
     write_csv(out / "impacts.csv", wp)
     write_text(out / "impacts.md", markdown(sweeps, wp, users, env))
-    series = {}
-    for r in wp:
-        series.setdefault(f"{r['law']} {r['method']}", []).append((r["seconds_per_impact"], r["error"],
-                                                                   f"{r['rtol']:g}"))
-    loglog_plot(out / "impacts_work_precision.png", series, xlabel="seconds per impact",
-                ylabel="relative error of e", title="Compliant impacts: work-precision (zeta = 0.3)", floor=1e-16)
+    suite_report(out, "impacts", [{"series": f"{r['law']} {r['method']}", "setting": f"rtol {r['rtol']:g}",
+                                   "seconds": r["seconds_per_impact"], "error": r["error"]} for r in wp],
+                 reference="closed-form restitution of each law (tests/impact_reference.py)",
+                 error="relative error of e (zeta = 0.3)", time="seconds per impact",
+                 title="Compliant impacts: work-precision",
+                 ratios=[{"peer": f"hand-written solve_ivp with events ({r['law']})", "ours_s": r["mechgen_s"],
+                          "peer_s": r["handwritten_s"],
+                          "condition": f"{r['impacts']} zeta values, {r['method']} at rtol {r['rtol']:g}, same "
+                                       f"tolerances (abs. error of e: ours {r['mechgen_abs_error']:.2g}, theirs "
+                                       f"{r['handwritten_abs_error']:.2g})"} for r in sweeps])
     return results

@@ -70,8 +70,8 @@ from pathlib import Path
 
 import numpy as np
 
-from mechgen.bench.common import (ROOT, blas_info, blas_threads, environment, user_path, user_path_markdown,
-                                  write_json, write_text)
+from mechgen.bench.common import (ROOT, blas_info, blas_threads, environment, suite_report, user_path,
+                                  user_path_markdown, write_json, write_text)
 from mechgen.bench.common import timed as _timed  # the local name the suite's steps use
 
 SCENE = ROOT / "scenes" / "ross_example_rotor.toml"
@@ -646,6 +646,17 @@ def run_rotor_benchmarks(out: Path, quick: bool = False) -> dict:
     res["configurations"] = user_configurations(len(speeds), repeats, with_ross=not quick)
     res["user_path"] = user_path([SCENE], repeats=repeats, warm=not quick)
     env["loadavg_after"] = list(os.getloadavg())
+    wp = res["work_precision"]
+    ratios = []
+    if "ross" in ct:
+        ratios.append({"peer": f"ROSS {env.get('ross')} run_campbell", "ours_s": ct["mechgen_tracking"]["median_s"],
+                       "peer_s": ct["ross"]["median_s"],
+                       "condition": f"the same rotor and {ct['speeds']} speeds, BLAS pinned to 1 thread, Campbell "
+                                    f"diagrams equal to {ct['campbell_max_rel_diff']:.1e} relative"})
+    suite_report(out, "rotor", [{"series": r["method"], "setting": f"N {r['N']}", "seconds": r["seconds_per_speed"],
+                                 "error": r["max_rel_error"]} for r in wp["rows"]],
+                 reference=wp["reference"]["method"], error="max rel. error of the frequencies",
+                 time="seconds per speed", title="ROSS example rotor: work-precision", ratios=ratios)
     write_json(out / "rotor_campbell.json", res, indent=1)
     table = report_markdown(res)
     write_text(out / "rotor_campbell.md", table + "\n")
