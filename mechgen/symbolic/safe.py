@@ -53,7 +53,10 @@ class SafeFunctionBase(sp.Function):
         exact, dps = sp.Rational(x), prec_to_dps(prec)
         if abs(exact) < cls._below:
             return sp.Float(sp.Add(*[c * exact**k for k, c in enumerate(cls._coeffs)]).evalf(dps + 5), dps)
-        return sp.Float(cls._closed.xreplace({_X: exact}).evalf(dps + 20), dps)
+        value = cls._closed.xreplace({_X: exact}).evalf(dps + 20)
+        # outside the function's domain (a log of a negative number, a pole) the value stays complex or zoo,
+        # which the specialisation refuses naming the parameter (mechgen.symbolic.finite)
+        return sp.Float(value, dps) if value.is_real and value.is_finite else value
 
     def fdiff(self, argindex=1):
         return derivative_of(type(self))(self.args[0])
