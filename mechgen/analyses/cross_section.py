@@ -36,8 +36,12 @@ def _values(system) -> str:
 def checked_stiffness(system) -> np.ndarray:
     """K (6 x 6) of the system's section: finite, symmetric to round-off and positive definite, else an
     InputError naming the parameters (key ``params``)."""
-    K = np.asarray(system.call("section", check=False)["K"], dtype=float).reshape(6, 6)
     model = system.metadata.model
+    if "section" not in system.kernels:
+        raise InputError(f"model {model} declares no cross-section (the cross_section analysis needs one)",
+                         key="kind", expected="a model with @model.section_stiffness, or another analysis kind")
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):  # a bad section is reported below
+        K = np.asarray(system.call("section", check=False)["K"], dtype=float).reshape(6, 6)
     if not np.all(np.isfinite(K)):
         bad = [f"K[{STRAINS[i]},{STRAINS[j]}]" for i, j in zip(*np.nonzero(~np.isfinite(K)))]
         raise InputError(f"the section stiffness of model {model} is not finite ({', '.join(bad[:4])}) at "

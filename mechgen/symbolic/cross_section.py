@@ -124,8 +124,8 @@ def stiffness_density(lam, mu, a2, a3, kappa0, tau0, *, condense: bool = True,
 
 # -- integrals over the section -----------------------------------------------------------------------------
 
-_SERIES_BELOW = sp.Rational(1, 8)
-_SERIES_TERMS = 40
+_SERIES_BELOW = sp.Rational(1, 4)
+_SERIES_TERMS = 64
 _H = sp.Symbol("h", real=True)
 _U = sp.Symbol("u", positive=True)
 
@@ -149,7 +149,7 @@ def _f_coeffs(m: int, n: int) -> list:
 
 
 def section_moment(m: int, n: int) -> type:
-    """The SafeFunction F_mn(h) = int_{-1}^{1} y^m (1 - h y)^-n dy (series for |h| < 1/8, closed form above)."""
+    """The SafeFunction F_mn(h) = int_{-1}^{1} y^m (1 - h y)^-n dy (series for |h| < 1/4, closed form above)."""
     return safe_function(f"section_F{m}_{n}", sp.Lambda(_H, _f_closed(m, n)), _f_coeffs(m, n), _SERIES_BELOW)
 
 
