@@ -196,3 +196,43 @@ def test_frenet_frame_of_a_circle_and_a_straight_line():
     assert fr.twist == sp.Matrix([1, 0, 0, 0, 0, 1 / r])              # f0 = [e1; e3/r] (slide 22)
     with pytest.raises(ValueError, match="straight"):
         L.frenet_serret(sp.Matrix([a, 2 * a, 0]), a)
+
+
+@pytest.mark.parametrize("backend", ["c", "numpy"])
+def test_a_compiled_kernel_of_the_exponential_and_its_jacobian_is_exact_at_and_near_zero(backend):
+    # a lumped model whose outputs are entries of exp(hat w) and J_l(w) and whose potential holds them
+    # (so the residual differentiates the angle functions): C through the real pipeline (lower, CSE, print)
+    from mechgen import Model, Param, compile as build
+
+    model = Model("exp_probe", file=None)
+    model.params(Param("k", 1.0, "N m"))
+    model.coordinates("w0", "w1", "w2")
+
+    @model.potential
+    def potential(q, p):
+        return p.k * (3 - L.exp_so3([q.w0, q.w1, q.w2]).trace())   # tr R = 1 + 2 cos t: V = 2 k (1 - cos t)
+
+    def entry(fn, i, j):
+        return lambda q: fn([q.w0, q.w1, q.w2])[i, j]
+
+    for i in range(3):
+        for j in range(3):
+            model.output(f"R{i}{j}", entry(L.exp_so3, i, j))
+            model.output(f"J{i}{j}", entry(L.jac_left_so3, i, j))
+    system = build(model, backend=backend, kernels={"outputs", "linear", "residual"})
+    for theta in (0.0, 1e-300, 1e-9, 0.3, 0.999999, 1.000001, 2.0):
+        w = _point(theta, seed=7)
+        out = system.outputs(w)
+        R = np.array([[out[f"R{i}{j}"] for j in range(3)] for i in range(3)])
+        J = np.array([[out[f"J{i}{j}"] for j in range(3)] for i in range(3)])
+        np.testing.assert_allclose(R, num.exp_so3(w), rtol=0, atol=2e-15)
+        np.testing.assert_allclose(J, num.jac_left_so3(w), rtol=0, atol=2e-15)
+        # V = 2 k (1 - cos t), t = |w|: its Hessian is 2 k I at w = 0 (k = 1), finite everywhere
+        K = system.linear(w)["K"]
+        assert np.all(np.isfinite(K))
+        if theta < 1e-8:
+            np.testing.assert_allclose(K, 2.0 * np.eye(3), rtol=0, atol=1e-15)
+        elif theta > 0.1:   # grad V = 2 k sinc(t) w: Hessian 2 k (sinc I + (t cos t - sin t)/t^3 w w^T)
+            t = theta
+            ref = 2.0 * (math.sin(t) / t * np.eye(3) + (t * math.cos(t) - math.sin(t)) / t**3 * np.outer(w, w))
+            np.testing.assert_allclose(K, ref, rtol=0, atol=1e-14)
