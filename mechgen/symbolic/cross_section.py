@@ -30,6 +30,7 @@ Units: lam, mu in Pa, lengths in m; K_uu in N, K_uw in N m, K_ww in N m^2.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import sympy as sp
 
@@ -56,7 +57,7 @@ def Square(b) -> Rectangle:  # noqa: N802 - a constructor
 
 @dataclass(frozen=True)
 class Circle:
-    """A solid circular section of radius ``radius`` centred on the reference curve (straight rods only)."""
+    """A solid circular section of radius ``radius`` centred on the reference curve."""
 
     radius: object
 
@@ -148,6 +149,7 @@ def _f_coeffs(m: int, n: int) -> list:
             for k in range(_SERIES_TERMS)]
 
 
+@lru_cache(maxsize=None)
 def section_moment(m: int, n: int) -> type:
     """The SafeFunction F_mn(h) = int_{-1}^{1} y^m (1 - h y)^-n dy (series for |h| < 1/4, closed form above)."""
     return safe_function(f"section_F{m}_{n}", sp.Lambda(_H, _f_closed(m, n)), _f_coeffs(m, n), _SERIES_BELOW)
@@ -158,30 +160,77 @@ def _z_moment(q: int):
     return sp.Rational(2, q + 1) if q % 2 == 0 else sp.Integer(0)
 
 
-def _integrate_rectangle(expr: sp.Expr, rect: Rectangle, kappa0) -> sp.Expr:
-    """int over the rectangle of expr(a2, a3), a rational function whose denominator is a power of
-    (1 - kappa0 a2): monomials y^m z^q (1 - h y)^-n with a2 = w2/2 y, a3 = w3/2 z, h = kappa0 w2/2."""
-    h2, h3 = sp.sympify(rect.width2) / 2, sp.sympify(rect.width3) / 2
+def _disk_moment(a: int, b: int):
+    """int over the unit disk of y^a z^b = 2 G((a+1)/2) G((b+1)/2) / ((a+b+2) G((a+b)/2 + 1)) for even a, b,
+    = 2 pi (a-1)!! (b-1)!! / (2^((a+b)/2) (a+b+2) ((a+b)/2)!)."""
+    if a % 2 or b % 2:
+        return sp.Integer(0)
+    half = (a + b) // 2
+    return (2 * sp.pi * sp.factorial2(a - 1) * sp.factorial2(b - 1)
+            / (sp.Integer(2) ** half * (a + b + 2) * sp.factorial(half)))
+
+
+def _theta_power(e: int) -> sp.Expr:
+    """T_e(h) = int_0^pi (1 - h cos t)^e dt: a polynomial for e >= 0, pi s^e P_(-e-1)(1/s) for e < 0
+    (s = sqrt(1 - h^2), P_n Legendre; Gradshteyn & Ryzhik 3.661)."""
+    if e >= 0:
+        return sum(sp.binomial(e, l) * (-_H) ** l * (sp.pi * sp.binomial(l, l // 2) / 2**l if l % 2 == 0 else 0)
+                   for l in range(e + 1))
+    s = sp.sqrt(1 - _H**2)
+    return sp.pi * s**e * sp.legendre(-e - 1, 1 / s)
+
+
+def _g_closed(m: int, q: int, n: int) -> sp.Expr:
+    """G_mqn(h) = int over the unit disk of y^m z^q (1 - h y)^-n, even q: with y = cos t, after the z integral,
+    2/(q+1) int_0^pi P(cos t) (1 - h cos t)^-n dt, P(c) = c^m (1 - c^2)^((q+2)/2), and c^j = ((1 - u)/h)^j,
+    u = 1 - h c, reduces each power to T_e (valid for |h| < 1)."""
+    c = sp.Symbol("c")
+    poly = sp.Poly(sp.expand(c**m * (1 - c**2) ** ((q + 2) // 2)), c)
+    total = sp.Integer(0)
+    for (j,), pj in poly.terms():
+        total += pj * _H ** (-j) * sum(sp.binomial(j, i) * (-1) ** i * _theta_power(i - n) for i in range(j + 1))
+    return 2 * total / (q + 1)
+
+
+@lru_cache(maxsize=None)
+def disk_moment(m: int, q: int, n: int) -> type:
+    """The SafeFunction G_mqn(h) = int over the unit disk of y^m z^q (1 - h y)^-n (series for |h| < 1/2 with
+    coefficients binom(n+k-1, k) int y^(m+k) z^q, closed form above)."""
+    coeffs = [sp.binomial(n + k - 1, k) * _disk_moment(m + k, q) for k in range(_SERIES_TERMS)]
+    return safe_function(f"section_G{m}_{q}_{n}", sp.Lambda(_H, _g_closed(m, q, n)), coeffs, sp.Rational(1, 2))
+
+
+def _rectangle_moment(m: int, q: int, n: int, h: sp.Expr) -> sp.Expr:
+    """int over the square [-1, 1]^2 of y^m z^q (1 - h y)^-n."""
+    zq = _z_moment(q)
+    if zq == 0:
+        return sp.Integer(0)
+    return zq * (_z_moment(m) if n == 0 else section_moment(m, n)(h))
+
+
+def _circle_moment(m: int, q: int, n: int, h: sp.Expr) -> sp.Expr:
+    """int over the unit disk of y^m z^q (1 - h y)^-n."""
+    if q % 2:
+        return sp.Integer(0)
+    return _disk_moment(m, q) if n == 0 else disk_moment(m, q, n)(h)
+
+
+def _integrate(expr: sp.Expr, half2, half3, kappa0, moment) -> sp.Expr:
+    """int over the section of expr(a2, a3), a rational function whose denominator is a power of
+    (1 - kappa0 a2): with a2 = half2 y, a3 = half3 z and h = kappa0 half2, a sum of monomials
+    y^m z^q (1 - h y)^-n, each integrated over the unit section by ``moment(m, q, n, h)``."""
     y, z = sp.symbols("y z", real=True)
-    e = sp.cancel(sp.together(expr.xreplace({A2: h2 * y, A3: h3 * z})))
+    e = sp.cancel(sp.together(expr.xreplace({A2: half2 * y, A3: half3 * z})))
     if e == 0:
         return sp.Integer(0)
     num, den = sp.fraction(e)
     h = sp.Symbol("h_", real=True)
-    den = sp.factor(den.subs(kappa0, 2 * h / sp.sympify(rect.width2)) if kappa0 != 0 else den)
-    base_n, const = _power_of_one_minus(den, h, y)
+    to_h = {kappa0: h / half2} if kappa0 != 0 else {}
+    base_n, const = _power_of_one_minus(sp.factor(den.subs(to_h)), h, y)
     total = sp.Integer(0)
-    num = sp.expand(num.subs(kappa0, 2 * h / sp.sympify(rect.width2)) if kappa0 != 0 else num)
-    for (m, q), coeff in sp.Poly(num, y, z).terms():
-        zq = _z_moment(q)
-        if zq == 0:
-            continue
-        if base_n == 0:
-            ym = _z_moment(m)
-        else:
-            ym = section_moment(m, base_n)(kappa0 * h2)
-        total += coeff.subs(h, kappa0 * h2) * zq * ym
-    return sp.factor_terms(total * h2 * h3 / const)
+    for (m, q), coeff in sp.Poly(sp.expand(num.subs(to_h)), y, z).terms():
+        total += coeff.subs(h, kappa0 * half2) * moment(m, q, base_n, kappa0 * half2)
+    return sp.factor_terms(total * half2 * half3 / const)
 
 
 def _power_of_one_minus(den: sp.Expr, h: sp.Symbol, y: sp.Symbol) -> tuple[int, sp.Expr]:
@@ -195,23 +244,15 @@ def _power_of_one_minus(den: sp.Expr, h: sp.Symbol, y: sp.Symbol) -> tuple[int, 
     return int(n), c
 
 
-def _integrate_circle(expr: sp.Expr, circle: Circle) -> sp.Expr:
-    """int over the disk of a polynomial in (a2, a3), in polar coordinates."""
-    rho, phi = sp.symbols("rho phi", nonnegative=True)
-    R = sp.sympify(circle.radius)
-    e = sp.expand(expr.xreplace({A2: rho * sp.cos(phi), A3: rho * sp.sin(phi)}) * rho)
-    return sp.simplify(sp.integrate(sp.integrate(e, (phi, 0, 2 * sp.pi)), (rho, 0, R)))
-
-
 def cross_section_stiffness(lam, mu, section, kappa0=0, tau0=0, *, condense: bool = True,
                             measure: str = "parametric") -> sp.Matrix:
     """K = int_A D^T C D dA (6 x 6, ordered [K_uu, K_uw; K_wu, K_ww]) of a section of a rod whose reference
     curve has curvature kappa0 and torsion tau0 (1/m), from the Lame constants lam, mu (Pa).
 
-    ``section``: a :class:`Rectangle` (any kappa0; tau0 = 0) or a :class:`Circle` (straight rods). The
-    integrals over the rectangle are exact: monomials over powers of (1 - kappa0 a2) give the
-    :func:`section_moment` functions F_mn(kappa0 w2/2), finite and accurate at kappa0 = 0, defined for
-    |kappa0| w2/2 < 1 (the section does not reach the centre of curvature). See the module docstring for
+    ``section``: a :class:`Rectangle` or a :class:`Circle` (tau0 = 0). The integrals are exact: monomials over
+    powers of (1 - kappa0 a2) give the :func:`section_moment` functions F_mn(kappa0 w2/2) (rectangle) or the
+    :func:`disk_moment` functions G_mqn(kappa0 R) (circle), finite and accurate at kappa0 = 0, defined for
+    |kappa0| w2/2 < 1 or |kappa0| R < 1 (the section does not reach the centre of curvature). See the module docstring for
     ``condense`` and ``measure``. A pre-twisted or helical reference (tau0 != 0) has no closed form here:
     integrate :func:`stiffness_density` numerically.
     """
@@ -221,13 +262,13 @@ def cross_section_stiffness(lam, mu, section, kappa0=0, tau0=0, *, condense: boo
     kappa0 = sp.sympify(kappa0)
     k = sp.Symbol("k_", real=True)  # a plain symbol while integrating, substituted at the end
     dens = stiffness_density(_LAM, _MU, A2, A3, k if kappa0 != 0 else 0, 0, condense=condense, measure=measure)
+    kk = k if kappa0 != 0 else sp.Integer(0)
     if isinstance(section, Rectangle):
-        K = dens.applyfunc(lambda e: _integrate_rectangle(e, section, k) if kappa0 != 0
-                           else _integrate_rectangle(e, section, 0))
+        half2, half3, moment = sp.sympify(section.width2) / 2, sp.sympify(section.width3) / 2, _rectangle_moment
     elif isinstance(section, Circle):
-        if kappa0 != 0:
-            raise NotImplementedError("a circular section is integrated for a straight rod (kappa0 = 0) only")
-        K = dens.applyfunc(lambda e: _integrate_circle(e, section))
+        half2 = half3 = sp.sympify(section.radius)
+        moment = _circle_moment
     else:
         raise TypeError(f"unknown section {section!r}: a Rectangle, Square or Circle")
+    K = dens.applyfunc(lambda e: _integrate(e, half2, half3, kk, moment))
     return K.xreplace({k: kappa0, _LAM: sp.sympify(lam), _MU: sp.sympify(mu)})

@@ -95,11 +95,11 @@ SafeFunction = SafeFunctionBase
 
 def safe_function(name: str, closed: sp.Lambda, coeffs, below) -> type:
     """The SafeFunction class ``name`` with closed form ``closed`` (a one-argument Lambda), Taylor coefficients
-    ``coeffs`` (exact numbers, c_0 first) and series interval |x| < ``below``; made once per name."""
+    ``coeffs`` (exact sympy numbers, c_0 first) and series interval |x| < ``below``; made once per name."""
     if name in _REGISTRY:
         return _REGISTRY[name]
-    cls = type(name, (SafeFunctionBase,), {"_closed": closed(_X), "_coeffs": tuple(sp.nsimplify(c) for c in coeffs),
-                                       "_below": sp.nsimplify(below), "_base": name, "_order": 0})
+    cls = type(name, (SafeFunctionBase,), {"_closed": closed(_X), "_coeffs": tuple(sp.sympify(c) for c in coeffs),
+                                       "_below": sp.sympify(below), "_base": name, "_order": 0})
     _REGISTRY[name] = cls
     return cls
 
