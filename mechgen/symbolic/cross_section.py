@@ -25,6 +25,11 @@ f = vee6(H^-1 H') = f0 + eps, eps = (u-strains: extension, shears; w-strains: tw
 Straight rod (kappa0 = tau0 = 0, section centred on the curve, principal axes n0, b0):
 K = diag(E A, mu A, mu A, mu I_p, E I_2, E I_3) with I_2 = int a3^2 dA, I_3 = int a2^2 dA, I_p = I_2 + I_3:
 no shear correction factor (shear area = A) and torsion by the polar moment (no warping; exact for a circle).
+A curved rod (kappa0 != 0) couples extension with bending about b0 and shear along b0 with twist:
+K[u1, w3] = -E int a2 dA/(1 - a2 kappa0)^2 and K[u3, w1] = mu int a2 dA/(1 - a2 kappa0)^2 (the seed's c3 terms).
+With tau0 != 0 the condensed C (``constitutive_matrix``, ``stiffness_density``) has shear-extension couplings
+of order a tau0; it is not the seed's slide-17 C, whose extracted text is garbled there (the two agree at
+tau0 = 0), and :func:`cross_section_stiffness` integrates tau0 = 0 only.
 Units: lam, mu in Pa, lengths in m; K_uu in N, K_uw in N m, K_ww in N m^2.
 """
 from __future__ import annotations
