@@ -19,7 +19,7 @@ from mechgen.analyses.schema import OptionContext, validate
 from mechgen.errors import InputError
 
 __all__ = ["analysis", "campbell", "continuation", "fit", "impact", "modes", "restitution", "simulate", "stability",
-           "steady", "sweep"]
+           "steady", "sweep", "cross_section"]
 
 
 def _model_info(system):
@@ -191,6 +191,16 @@ def stability_boundary(system, *, name: str | None = None, **options) -> Result:
     ``<parameter>_critical``, ``frequency_critical``, ``crossing``, and ``verdict`` at the system's own value.
     """
     return _run("stability_boundary", system, options, name)
+
+
+def cross_section(system, *, name: str | None = None, **options) -> Result:
+    """The stiffness K (6 x 6, [K_uu, K_uw; K_wu, K_ww]) of the rod section a model declares with
+    ``@model.section_stiffness``, at the system's parameters (mechgen.analyses.cross_section).
+
+    No options. Outputs: ``K`` and its ``eigenvalues``; a K that is not finite or not positive definite
+    raises an InputError naming the parameters.
+    """
+    return _run("cross_section", system, options, name)
 
 
 def campbell(system, *, name: str | None = None, **options) -> Result:

@@ -28,6 +28,7 @@ MODULES = (
     "mechgen.analyses.stability_boundary",
     "mechgen.analyses.spectrum",
     "mechgen.analyses.periodic",
+    "mechgen.analyses.cross_section",
 )
 
 

@@ -9,6 +9,7 @@ Kernel names and what they compute (n coordinates, m internal variables):
 * ``rates``     dz/dt = g(q, v, z, t)                  -> g[m]
 * ``rates_tangent``                                    -> g_q[m*n], g_v[m*n], g_z[m*m]
 * ``outputs``   declared outputs and energies          -> one port of length 1 each
+* ``section``   the declared section stiffness K(p)    -> K[36] (6 x 6, symmetric; Model.section_stiffness)
 
 A hybrid model (mechgen.symbolic.hybrid) has each of these per mode i, named ``<kernel>__i``, and
 
@@ -21,9 +22,10 @@ import sympy as sp
 
 from mechgen.codegen.ir import KernelIR, Port, fixed
 from mechgen.codegen.lower import canonical_block, dense_writes, kernel
+from mechgen.errors import ModelError
 from mechgen.symbolic.derive import LumpedEquations
 
-LUMPED_KERNELS = ("residual", "tangent", "linear", "force", "rates", "rates_tangent", "outputs")
+LUMPED_KERNELS = ("residual", "tangent", "linear", "force", "rates", "rates_tangent", "outputs", "section")
 
 
 def _inputs(eqs: LumpedEquations, with_accel: bool = True) -> tuple[list[Port], list]:
@@ -88,4 +90,10 @@ def lower_lumped(eqs: LumpedEquations, name: str, *, cse: bool = True) -> Kernel
     if name == "outputs":
         mats = {k: sp.Matrix([[e]]) for k, e in eqs.outputs.items()}
         return _matrix_kernel(eqs, name, "named outputs", mats, accel=False, cse=cse)
+    if name == "section":
+        if eqs.section is None:
+            raise ModelError(f"model {eqs.model} declares no section stiffness", key="section_stiffness",
+                             expected="a model with @model.section_stiffness (the cross_section analysis)")
+        return _matrix_kernel(eqs, name, "cross-section stiffness K (6 x 6)", {"K": eqs.section}, accel=False,
+                              cse=cse, symmetric=("K",))
     raise KeyError(name)

@@ -126,6 +126,10 @@ class CPrinter(_Numbers, C99CodePrinter):
         x, n = (self._print(a) for a in expr.args)
         return f"pow(fabs({x}), {n})"
 
+    def _print_SafeFunctionBase(self, expr):
+        """A function with a finite limit (mechgen.symbolic.safe): its series | closed-form Piecewise."""
+        return self._print(expr.lowered())
+
 
 class NumpyPrinter(_Numbers, PythonCodePrinter):
     """Printer for vectorised numpy code (module imported as ``np``)."""
@@ -177,12 +181,33 @@ class NumpyPrinter(_Numbers, PythonCodePrinter):
     def _print_Pi(self, expr):
         return f"{self._module}.pi"
 
+    def _print_SafeFunctionBase(self, expr):
+        """A function with a finite limit (mechgen.symbolic.safe): its series | closed-form Piecewise."""
+        return self._print(expr.lowered())
+
+    _IF = "np.where"
+
+    def _print_Piecewise(self, expr):
+        """Elementwise: np.where(c1, e1, np.where(c2, e2, ...)) (CasADi: ca.if_else); the last condition is True."""
+        *pieces, (last, cond) = expr.args
+        if cond != sp.true:
+            raise NotImplementedError("a Piecewise without a final True branch has no value everywhere")
+        text = self._print(last)
+        for e, c in reversed(pieces):
+            text = f"{self._IF}({self._print(c)}, {self._print(e)}, {text})"
+        return text
+
+    def _print_Relational(self, expr):
+        lhs, rhs = (self.parenthesize(a, 40) for a in (expr.lhs, expr.rhs))
+        return f"({lhs} {expr.rel_op} {rhs})"
+
 
 class CasadiPrinter(NumpyPrinter):
     """Printer for CasADi SX construction code (module imported as ``ca``; numpy as ``np``, whose ``np.inf`` and
     ``np.nan`` are the non-finite constants)."""
 
     _module = "ca"
+    _IF = "ca.if_else"
     _np_names = {"asin": "asin", "acos": "acos", "atan": "atan", "atan2": "atan2", "Abs": "fabs",
                  "Max": "fmax", "Min": "fmin", "sign": "sign"}
 

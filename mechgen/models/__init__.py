@@ -30,7 +30,8 @@ from mechgen.errors import InputError, ModelError
 BUILTIN = ("balloon_string", "euler_bernoulli_beam", "follower_column", "fpu_chain", "laval_rotor", "moving_string",
            "spinning_shaft", "rotating_string", "spring_pendulum", "timoshenko_beam", "viscoelastic_impact",
            "ogive_penetration", "rate_state_slider", "rate_state_inertial", "friction_beam",
-           "stick_slip_contact")
+           "stick_slip_contact",
+           "curved_beam_stiffness")
 HERE = Path(__file__).resolve().parent
 #: the entry-point group installed packages register their models under (value ``module:attribute``)
 ENTRY_POINT_GROUP = "mechgen.models"

@@ -21,6 +21,9 @@ def _lumped(eqs) -> list[str]:
     for name, mat in eqs.linear_matrices().items():
         lines.append(f"{name} =")
         lines += ["  " + line for line in sp.pretty(sp.simplify(mat.subs(rest)), use_unicode=False).splitlines()]
+    if getattr(eqs, "section", None) is not None:
+        lines += ["", "cross-section stiffness K (Model.section_stiffness; [K_uu, K_uw; K_wu, K_ww]):"]
+        lines += [f"  K[{i},{j}] = {eqs.section[i, j]}" for i in range(6) for j in range(i, 6) if eqs.section[i, j] != 0]
     return lines
 
 
@@ -59,6 +62,9 @@ def _field(eqs) -> list[str]:
     for name, mat in local.linear_matrices().items():
         lines.append(f"{name.lower()} =")
         lines += ["  " + line for line in sp.pretty(sp.simplify(mat.subs(rest)), use_unicode=False).splitlines()]
+    if getattr(eqs, "section", None) is not None:
+        lines += ["", "cross-section stiffness K (Model.section_stiffness; [K_uu, K_uw; K_wu, K_ww]):"]
+        lines += [f"  K[{i},{j}] = {eqs.section[i, j]}" for i in range(6) for j in range(i, 6) if eqs.section[i, j] != 0]
     return lines
 
 

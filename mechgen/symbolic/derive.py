@@ -50,6 +50,8 @@ class LumpedEquations:
     position: tuple[sp.Symbol, ...] = ()
     #: the declared initial state (mechgen.symbolic.initial), None when the model declares none
     initial: sp.Matrix | None = None
+    #: the declared cross-section stiffness K (6 x 6, Model.section_stiffness), None when the model declares none
+    section: sp.Matrix | None = None
 
     @property
     def t(self) -> sp.Symbol:
@@ -161,4 +163,24 @@ def derive_lumped(model: Model, spec: Specialization, mode: str | None = None) -
         kinetic=T, potential=V, residual=sp.Matrix(res) if res else sp.zeros(0, 1),
         rates=sp.Matrix(rates) if rates else sp.zeros(0, 1), outputs=outputs,
         initial=initial_column(model, p_ns, names, tuple(i.name for i in model.internals)),
+        section=_section(model, p_ns),
     )
+
+
+def _section(model: Model, p_ns) -> sp.Matrix | None:
+    """The declared section stiffness K(p) as a symmetric 6 x 6 Matrix (Model.section_stiffness), or None."""
+    if model.section_fn is None:
+        return None
+    raw = call_declared(model.section_fn, p=p_ns)
+    try:
+        K = sp.Matrix(raw)
+    except (TypeError, ValueError, sp.SympifyError):
+        K = None
+    if K is None or K.shape != (6, 6):
+        raise ModelError(f"section_stiffness of model {model.name} returned {type(raw).__name__}",
+                         file=model.file, key="section_stiffness", expected="a 6 x 6 matrix of the parameters")
+    K = K.applyfunc(lambda e: _scalar(e, "section_stiffness", model))
+    if any(sp.simplify(K[i, j] - K[j, i]) != 0 for i in range(6) for j in range(i)):
+        raise ModelError(f"section_stiffness of model {model.name} is not symmetric", file=model.file,
+                         key="section_stiffness", expected="K = K^T (a stiffness derived from an energy)")
+    return K

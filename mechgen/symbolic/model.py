@@ -284,6 +284,8 @@ class Model:
         self.mode_scopes: dict = {}
         self.initial_mode: str | None = None
         self.guards: list = []
+        #: the declared cross-section stiffness K(p) (6 x 6), or None (:meth:`section_stiffness`)
+        self.section_fn: Callable | None = None
 
     # -- declarations ---------------------------------------------------
     def params(self, *params: Param) -> Namespace:
@@ -332,6 +334,17 @@ class Model:
             raise ModelError(f"output name {name!r} is already used in model {self.name}", file=self.file, key=name,
                              expected="a name not yet declared")
         self.shape_outputs.append(ShapeOutput(name, fn, start, doc))
+
+    def section_stiffness(self, fn: Callable) -> Callable:
+        """Declare a rod cross-section's stiffness K(p): a 6 x 6 symmetric matrix of the parameters, ordered
+        [K_uu, K_uw; K_wu, K_ww] (twist order (v, w), mechgen.symbolic.liegroup), e.g. from
+        :func:`mechgen.symbolic.cross_section.cross_section_stiffness`. The ``section`` kernel evaluates it
+        and the ``cross_section`` analysis reports it (N, N m, N m^2)."""
+        if self.section_fn is not None:
+            raise ModelError(f"model {self.name} declares its section stiffness twice", file=self.file,
+                             key="section_stiffness", expected="one section_stiffness declaration")
+        self.section_fn = fn
+        return fn
 
     def chain(self, coordinate: str, *, sites: str, ends: str = "fixed") -> None:
         """Declare a lattice of identical sites; ``sites`` names a size parameter."""
