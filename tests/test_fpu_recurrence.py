@@ -91,7 +91,8 @@ def beta_recurrence(N: int, S: float, dt: float = 0.2) -> float:
 
 
 def test_fpu_beta_recurrence_scales_with_n_cubed_at_fixed_s():
-    """Pace, Reiss & Campbell 2019 (Chaos 29, 113107): at fixed S = E beta (N+1), the recurrence time scales as
+    """Pace, Reiss & Campbell 2019 (Chaos 29, 113107; arXiv:1908.00564, abstract: "T_r = t_r/(N+1)^3 depends, for
+    large N, only on the parameter S = E beta (N+1)"): at fixed S = E beta (N+1), the recurrence time scales as
     (N+1)^3, t_r / (N+1)^3 = F(S). Measured here at S = 4: 0.2805, 0.2859, 0.2878 for N = 15, 31, 63 (the
     discreteness correction shrinks about 4x per doubling of N)."""
     scaled = [beta_recurrence(N, 4.0) for N in (15, 31, 63)]

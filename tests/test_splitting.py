@@ -108,3 +108,28 @@ def test_c_loop_energy_bounded_over_a_million_steps():
         assert err.max() < dt ** METHODS[name].order, (name, err.max())
         tenth = len(err) // 10
         assert abs(err[-tenth:].mean() - err[:tenth].mean()) < 0.2 * err.max(), name
+
+
+def test_without_a_compiler_the_numpy_stepper_runs(monkeypatch, tmp_path):
+    from mechgen.codegen import build
+    from mechgen.errors import CompilerUnavailable
+    from mechgen.runtime.core import symplectic_c
+
+    system = mechgen.compile("fpu_chain", {"N": 6, "alpha": 0.25}, kernels=["force", "outputs"])  # compiler works
+    q0 = np.linspace(0.1, 0.6, 6)
+    reference = evolve(system.force, q0, np.zeros(6), 0.1, 50, "yoshida4")[0]
+    monkeypatch.setenv("CC", "/nonexistent/cc")
+    monkeypatch.setenv("MECHGEN_CACHE", str(tmp_path))  # an empty cache: the loop library is not there built
+    build.reset_compiler_cache()
+    symplectic_c.forget_library()
+    try:
+        assert "cannot be built" in symplectic_c.c_unavailable(system)
+        q, _, _, used = symplectic_c.evolve_system(system, q0, np.zeros(6), 0.1, 50, "yoshida4")
+        assert used == "numpy" and np.array_equal(q, reference)
+        with pytest.raises(CompilerUnavailable):
+            symplectic_c.evolve_system(system, q0, np.zeros(6), 0.1, 50, "yoshida4", loop="c")
+    finally:
+        monkeypatch.undo()
+        build.reset_compiler_cache()
+        symplectic_c.forget_library()
+    assert symplectic_c.c_unavailable(system) is None
