@@ -66,6 +66,8 @@ COMPILING = (f"{os.sep}mechgen{os.sep}symbolic{os.sep}", f"{os.sep}mechgen{os.se
 # simulations, coarser meshes), so that a few hundred cases fit in a CI minute. Paths as in ``get_path``.
 CHEAP = {
     "fpu_chain": {("params", "N"): 8, ("analysis", 1, "t_end"): 20.0},
+    "fpu_recurrence": {("analysis", 0, "t_end"): 200.0},
+    "fpu_large": {("params", "N"): 1000, ("analysis", 0, "t_end"): 10.0},
     "spring_pendulum": {("analysis", 2, "t_end"): 2.0},
     "laval_rotor": {("analysis", 1, "over", "Omega", "num"): 4},
     "beam_modes": {("params", "N"): 4},

@@ -19,7 +19,7 @@ from mechgen.analyses.schema import OptionContext, validate
 from mechgen.errors import InputError
 
 __all__ = ["analysis", "campbell", "continuation", "fit", "impact", "modes", "restitution", "simulate", "stability",
-           "steady", "sweep", "cross_section"]
+           "steady", "sweep", "cross_section", "symplectic"]
 
 
 def _model_info(system):
@@ -263,3 +263,14 @@ def sweep(system, analysis: str = "modes", grid: Mapping[str, Any] | None = None
     table = {"over": grid, "analysis": {"kind": analysis, **inner_options}, "workers": workers,
              "progress": progress}
     return _run("sweep", system, table, name)
+
+
+def symplectic(system, *, name: str | None = None, **options) -> Result:
+    """A chain run by a splitting method with the time loop in C (mechgen.analyses.symplectic).
+
+    Options: ``integrator`` (leapfrog, yoshida4, yoshida6, aba864), ``dt``, ``t_end`` (required), ``stride``,
+    ``initial_mode``, ``amplitude``, ``modes``, ``loop``, ``max_steps``. Outputs: ``energy_error``,
+    ``steps_per_second``, ``bandwidth_fraction``, and for fixed ends ``recurrence_periods``,
+    ``recurrence_fraction``, ``t`` and ``mode_energies_series``.
+    """
+    return _run("symplectic", system, options, name)

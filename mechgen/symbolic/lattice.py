@@ -83,7 +83,8 @@ def derive_lattice(model: Model, spec: Specialization) -> LatticeEquations:
         return as_expr(call_declared(fn, p=p_ns, **kw), fn.__name__, model) if fn else zero
 
     return LatticeEquations(
-        model=model.name, coordinate=name, sites=chain.sites, ends=chain.ends,
+        model=model.name, coordinate=name, sites=chain.sites,
+        ends=chain.ends if chain.ends in ("fixed", "periodic") else str(spec.values[chain.ends]),
         site_q=q, site_v=v, site_a=a, bond_q=(qa, qb), params=free, param_names=tuple(s.name for s in free),
         site_kinetic=local(model.site_kinetic_fn, s=site),
         site_potential=local(model.site_potential_fn, s=site),

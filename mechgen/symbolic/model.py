@@ -347,11 +347,17 @@ class Model:
         return fn
 
     def chain(self, coordinate: str, *, sites: str, ends: str = "fixed") -> None:
-        """Declare a lattice of identical sites; ``sites`` names a size parameter."""
+        """Declare a lattice of identical sites; ``sites`` names a size parameter.
+
+        ``ends`` is ``"fixed"``, ``"periodic"`` or the name of a choice parameter among those two (the
+        scene picks the ends; the one bond energy serves both).
+        """
         self._claim(coordinate, "coordinate")
         if ends not in ("fixed", "periodic"):
-            raise ModelError(f"unknown chain ends {ends!r}", file=self.file, key="chain.ends",
-                             expected="'fixed' or 'periodic'")
+            choice = next((p for p in self.param_list if p.name == ends), None)
+            if choice is None or not choice.is_choice or not set(choice.choices) <= {"fixed", "periodic"}:
+                raise ModelError(f"unknown chain ends {ends!r}", file=self.file, key="chain.ends",
+                                 expected="'fixed', 'periodic' or a choice parameter among them")
         prm = self.param(sites)
         if not prm.size:
             raise ModelError(f"chain sites parameter {sites!r} is not a size parameter", file=self.file,
