@@ -29,6 +29,7 @@ MODULES = (
     "mechgen.analyses.spectrum",
     "mechgen.analyses.periodic",
     "mechgen.analyses.cross_section",
+    "mechgen.analyses.rod_statics",
 )
 
 
