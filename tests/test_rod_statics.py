@@ -235,6 +235,6 @@ def test_unconstrained_ends_and_a_failed_path(tmp_path, capsys):
         assert "analysis[1].tip" in capsys.readouterr().err
     scene = tmp_path / "stuck.toml"
     scene.write_text(text.replace('tip_torque = [0.0, 0.0, "4 * pi * EI / L"]', "tip_force = [0.0, -1.0, 0.0]")
-                     .replace("steps = 10", "steps = 2\ntol = 1e-300"))
+                     .replace("steps = 10", "steps = 2\ntol = 1e-300\nmin_step = 0.1").replace("elements = 40", "elements = 4"))
     assert main(["run", str(scene)]) == 1
     assert "last load reached" in capsys.readouterr().err

@@ -10,6 +10,7 @@ Scene keys: ``method`` (shooting: RKMK4, order 4; collocation: Lie-group midpoin
 (or ``N``: RKMK4 steps or collocation elements, default 40), ``base``/``tip`` (clamped, pinned, free;
 default clamped/free), ``tip_force``, ``tip_torque`` ([x, y, z], N and N m; numbers or expressions of the
 parameters), ``steps`` (initial continuation steps, default 10), ``tol`` (scaled Newton residual, 1e-10),
+``min_step`` (the smallest load step before giving up, 1e-4),
 ``bending_axis`` (x, y or z: the axis ``tip_rotation`` turns about, default z).
 
 Outputs: ``tip_position`` ([x, y, z], m), ``tip_rotation`` (rad about the bending axis, unwrapped: an end
@@ -60,6 +61,7 @@ SCHEMA = {
     "tip_torque": Option(_vector3, [0.0, 0.0, 0.0]),
     "steps": Option(lambda ctx, key, v: schema.int_at_least(ctx, key, v, 1), 10),
     "tol": Option(schema.positive, 1e-10),
+    "min_step": Option(schema.positive, 1e-4),
     "bending_axis": Option(schema.one_of("axis", tuple(AXES)), "z"),
 }
 
@@ -134,7 +136,7 @@ def run_rod_statics(system, options: dict, context: dict) -> dict:
     """Solve along the load path; the final state's tip pose and fields, and the branch."""
     rod = rod_of(system, options)
     path = solve_statics(rod, method=options["method"], elements=options["elements"], steps=options["steps"],
-                         tol=options["tol"])
+                         tol=options["tol"], min_step=options["min_step"])
     final, axis = path.final, AXES[options["bending_axis"]]
     rows = lambda a: [[float(x) + 0.0 for x in row] for row in a]  # noqa: E731
     return {"tip_position": [float(x) + 0.0 for x in final.H[-1, :3, 3]],
