@@ -238,3 +238,88 @@ def test_unconstrained_ends_and_a_failed_path(tmp_path, capsys):
                      .replace("steps = 10", "steps = 2\ntol = 1e-300\nmin_step = 0.1").replace("elements = 40", "elements = 4"))
     assert main(["run", str(scene)]) == 1
     assert "last load reached" in capsys.readouterr().err
+
+
+# --------------------------------------------------------------------------- 3D, many turns, the declaration
+
+@pytest.mark.parametrize("method", ["shooting", "collocation"])
+def test_oblique_end_torque_on_an_isotropic_rod_gives_the_exact_helix(method):
+    """GJ = EI, no force: the spatial moment M is constant and the section turns about it at M/EI, so
+    f = (e1, M/EI) everywhere and H(L) = exp(L hat6 f) (the body moment R^T M = M)."""
+    from mechgen.runtime.rods.liegroup import exp_se3
+
+    EI, L = 1.5, 2.0
+    M = np.array([2.0, 0.5, -3.0])
+    st = solve_statics(Rod(L, stiffness(EA=1e3, GA=1e3, GJ=EI, EI=EI), tip_torque=M), method=method, elements=16,
+                       steps=4).final
+    expect = exp_se3(st.s[:, None] * np.concatenate([[1.0, 0.0, 0.0], M / EI]))
+    assert np.max(np.abs(st.H - expect)) < 1e-10
+
+
+@pytest.mark.parametrize("method", ["shooting", "collocation"])
+def test_twenty_full_turns_keep_the_rotations_orthonormal(method):
+    """tau L/EI = 40 pi (issue 15 item 6): the arc closes on itself 20 times; R^T R = I to 1e-12 at every node."""
+    k = 40 * math.pi
+    rod = Rod(1.0, stiffness(EA=1e4, GA=1e4), tip_torque=np.array([0.0, 0.0, k]))
+    st = solve_statics(rod, method=method, elements=400, steps=1).final
+    assert orthonormality_error(st.H[:, :3, :3]) < 1e-12
+    assert abs(turning_angle(st.H, (0, 0, 1)) - k) < 1e-9 and np.max(np.abs(st.H[-1, :3, 3])) < 1e-10
+
+
+CURVED = '''"""A curved rod in a few lines: the arc of radius r with the curved-beam section (seed 001)."""
+from mechgen.symbolic.cross_section import Square, cross_section_stiffness
+from mechgen.symbolic.model import Model
+from mechgen.symbolic.params import Param
+
+model = Model("curved_rod", doc=__doc__, file=__file__)
+model.params(Param("r", 0.5, "m"), Param("b", 0.1, "m"), Param("lam", 2.0e6, "Pa"), Param("mu", 1.0e6, "Pa"),
+             Param("L", 1.0, "m"))
+
+
+@model.section_stiffness
+def stiffness(p):
+    return cross_section_stiffness(p.lam, p.mu, Square(p.b), kappa0=1 / p.r)
+
+
+model.rod(length=lambda p: p.L, f0=lambda p: (1, 0, 0, 0, 0, 1 / p.r))
+'''
+
+
+def test_a_user_rod_on_a_declared_curved_section(tmp_path):
+    """The rod's K is the section's (with the extension-bending coupling K[u1, w3]); an end torque tau about z
+    keeps n = 0 and m = (0, 0, tau), so f = f0 + K^-1 sigma is constant and H(L) = exp(L hat6 f)."""
+    from mechgen.runtime.rods.liegroup import exp_se3
+
+    path = tmp_path / "curved_rod.py"
+    path.write_text(CURVED)
+    system = mechgen.compile(str(path), backend="numpy")
+    K = np.asarray(mechgen.cross_section(system)["K"])
+    assert K[0, 5] != 0.0
+    out = system.call("rod", f=np.array([[1.1, 0.01, 0, 0, 0.02, 2.3]]), r=np.zeros((1, 3)))
+    eps = np.array([0.1, 0.01, 0, 0, 0.02, 2.3 - 2.0])
+    assert np.allclose(out["sigma"][0], K @ eps, rtol=1e-13) and np.allclose(out["C"][0], K.ravel())
+    assert abs(out["W"][0, 0] - eps @ K @ eps / 2) < 1e-12 * abs(eps @ K @ eps)
+    tau = -0.3 * K[5, 5]
+    for method in ("shooting", "collocation"):
+        res = mechgen.rod_statics(system, tip_torque=[0.0, 0.0, tau], elements=10, method=method)
+        f = np.array([1.0, 0, 0, 0, 0, 2.0]) + np.linalg.solve(K, [0, 0, 0, 0, 0, tau])
+        assert np.allclose(res["tip_position"], exp_se3(f)[:3, 3], atol=1e-11)
+        assert np.allclose(np.array(res["strain"]), np.tile(f - [1, 0, 0, 0, 0, 2.0], (11, 1)), atol=1e-12)
+
+
+def test_rod_declarations_that_cannot_work_are_model_errors():
+    from mechgen.errors import ModelError
+    from mechgen.symbolic.model import Model
+    from mechgen.symbolic.params import Param
+    from mechgen.symbolic.rod import rod_stiffness
+
+    model = Model("twice", file=__file__)
+    model.params(Param("EI", 1.0, "N m^2"))
+    model.rod(stiffness=lambda p: rod_stiffness(1.0, 1.0, 1.0, p.EI))
+    with pytest.raises(ModelError, match="declares its rod twice"):
+        model.rod()
+    bare = Model("bare", file=__file__)
+    bare.params(Param("EI", 1.0, "N m^2"))
+    bare.rod(length=lambda p: p.EI)
+    with pytest.raises(ModelError, match="no 6 x 6 stiffness"):
+        mechgen.compile(bare, backend="numpy")
