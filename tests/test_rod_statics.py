@@ -323,3 +323,15 @@ def test_rod_declarations_that_cannot_work_are_model_errors():
     bare.rod(length=lambda p: p.EI)
     with pytest.raises(ModelError, match="no 6 x 6 stiffness"):
         mechgen.compile(bare, backend="numpy")
+
+
+def test_at_pl2_ei_100_the_path_stays_on_the_hanging_branch():
+    """PL^2/EI = 100: Newton from a coarse load step can converge to a looped elastica (another equilibrium);
+    the continuation refuses such jumps, so the answer is Bisshopp-Drucker's (within O(h^2) = 1e-4 at N = 80)."""
+    assert tip_error(100.0, "collocation", 80) < 1.2e-4
+
+
+@pytest.mark.slow
+def test_at_pl2_ei_100_shooting_also_stays_on_the_branch():
+    """The same by RKMK4 shooting (ill-conditioned here: ~exp(sqrt(100)) sensitivity, about 12 s)."""
+    assert tip_error(100.0, "shooting", 40) < 2e-6

@@ -6,7 +6,9 @@ sigma = K (f - f0), with the ``rod`` kernel's K, f0, length L and distributed sp
 centrifugal). The tip force and torque are dead loads in the spatial frame. The load (tip wrench and
 distributed load together) is applied by continuation in a factor lam from 0 to 1.
 
-Scene keys: ``method`` (shooting: RKMK4, order 4; collocation: Lie-group midpoint, order 2), ``elements``
+Scene keys: ``method`` (collocation, the default: Lie-group midpoint, order 2, robust at any load;
+shooting: RKMK4, order 4, but single shooting's sensitivity grows like exp(L sqrt(P/EI)): it stalls
+beyond PL^2/EI ~ 100 - 1000 and is slow there), ``elements``
 (or ``N``: RKMK4 steps or collocation elements, default 40), ``base``/``tip`` (clamped, pinned, free;
 default clamped/free), ``tip_force``, ``tip_torque`` ([x, y, z], N and N m; numbers or expressions of the
 parameters), ``steps`` (initial continuation steps, default 10), ``tol`` (scaled Newton residual, 1e-10),
@@ -47,19 +49,32 @@ def _vector3(ctx, key: str, value: object) -> list[float]:
     return [schema.number(ctx, f"{key}[{i}]", v) for i, v in enumerate(value, 1)]
 
 
-def _elements(ctx, key: str, value: object) -> int:
-    return schema.int_at_least(ctx, key, value, 2)
+MAX_ELEMENTS = 100_000   # the collocation's FD Jacobian holds 24 (N + 1) poses: ~300 MB at this size
+MAX_STEPS = 10_000
+
+
+def _bounded(low: int, high: int):
+    def check(ctx, key: str, value: object) -> int:
+        n = schema.int_at_least(ctx, key, value, low)
+        if n > high:
+            raise fail(ctx.file, key, f"value {n} is above {high}", f"an integer from {low} to {high}")
+        return n
+
+    return check
+
+
+_elements = _bounded(2, MAX_ELEMENTS)
 
 
 SCHEMA = {
-    "method": Option(schema.one_of("rod statics method", ("shooting", "collocation")), "shooting"),
+    "method": Option(schema.one_of("rod statics method", ("collocation", "shooting")), "collocation"),
     "elements": Option(_elements),
     "N": Option(_elements),
     "base": Option(schema.one_of("end condition", ENDS), "clamped"),
     "tip": Option(schema.one_of("end condition", ENDS), "free"),
     "tip_force": Option(_vector3, [0.0, 0.0, 0.0]),
     "tip_torque": Option(_vector3, [0.0, 0.0, 0.0]),
-    "steps": Option(lambda ctx, key, v: schema.int_at_least(ctx, key, v, 1), 10),
+    "steps": Option(_bounded(1, MAX_STEPS), 10),
     "tol": Option(schema.positive, 1e-10),
     "min_step": Option(schema.positive, 1e-4),
     "bending_axis": Option(schema.one_of("axis", tuple(AXES)), "z"),

@@ -204,43 +204,37 @@ def _shoot_residual(rod: Rod, z: np.ndarray, steps: int, lam: float) -> np.ndarr
     return np.concatenate([base_residual(rod, H0, sigma0), tip_residual(rod, HL, sL, lam)], axis=-1)
 
 
-def _newton(residual_and_jacobian, z, *, tol: float, max_iter: int, solve=np.linalg.solve, update=None):
-    """Damped Newton: halve the step until |r| decreases. Returns (z, iterations) or None."""
+def _newton(residual_and_jacobian, z, *, tol: float, max_iter: int, solve=np.linalg.solve, update=None,
+            contraction: float = 0.5):
+    """Newton with full steps that must contract: |dz_k| <= contraction |dz_(k-1)|, else None (a continuation
+    step then halves: a Newton iteration that wanders, or a damped one, can land on another branch of
+    equilibria, e.g. a looped elastica). Returns (z, iterations) or None."""
     update = update or (lambda z, dz: z + dz)
-    r, J = residual_and_jacobian(z)
-    norm = np.linalg.norm(r)
-    for it in range(1, max_iter + 1):
+    last = np.inf
+    for it in range(max_iter + 1):
+        r, J = residual_and_jacobian(z)
+        norm = np.linalg.norm(r)
         if not np.isfinite(norm):
             return None
         if norm < tol:
-            return z, it - 1
+            return z, it
+        if it == max_iter:
+            return None
         try:
             dz = -solve(J, r)
         except (np.linalg.LinAlgError, RuntimeError):
             return None
-        if not np.all(np.isfinite(dz)):
+        size = np.linalg.norm(dz)
+        if not np.isfinite(size) or size > contraction * last:
             return None
-        step = 1.0
-        while step > 1e-4:
-            trial = update(z, step * dz)
-            r_t, J_t = residual_and_jacobian(trial, jacobian=False)
-            n_t = np.linalg.norm(r_t)
-            if np.isfinite(n_t) and n_t < (1 - 1e-4 * step) * norm or n_t < tol:
-                break
-            step *= 0.5
-        else:
-            return None
-        z = trial
-        r, J = residual_and_jacobian(z)
-        norm = np.linalg.norm(r)
-    return (z, max_iter) if norm < tol else None
+        last = size
+        z = update(z, dz)
+    return None
 
 
 def shoot(rod: Rod, steps: int, lam: float, z0: np.ndarray, *, tol: float = 1e-10, max_iter: int = 30):
     """Newton on the scaled base unknowns at load factor lam: (z, iterations), or None without convergence."""
-    def rj(z, jacobian=True):
-        if not jacobian:
-            return _shoot_residual(rod, z, steps, lam), None
+    def rj(z):
         d = 1e-7 * np.maximum(1.0, np.abs(z))
         batch = np.vstack([z, z + np.diag(d)])
         r = _shoot_residual(rod, batch, steps, lam)
@@ -322,10 +316,10 @@ def collocate(rod: Rod, guess: Solution, lam: float, *, tol: float = 1e-10, max_
     def state(z):
         return _perturbed(rod, base[0], base[1], z.reshape(n + 1, 12))
 
-    def rj(z, jacobian=True):
+    def rj(z):
         H, sigma = state(z)
         r = _collocation_residual(rod, H, sigma, lam)
-        return r, (_collocation_jacobian(rod, H, sigma, lam, r) if jacobian else None)
+        return r, _collocation_jacobian(rod, H, sigma, lam, r)
 
     def update(z, dz):
         # increments compose on the right of the current poses: re-base them so that exp stays small
@@ -377,8 +371,9 @@ class Path:
 
 def solve_statics(rod: Rod, *, method: str = "shooting", elements: int = 40, steps: int = 10,
                   min_step: float = 1e-4, tol: float = 1e-10, progress: Callable | None = None) -> Path:
-    """Continuation in the load factor lam from 0 to 1 in ``steps`` initial steps (halved on a failure,
-    grown by 1.5 after a solve in <= 4 Newton iterations, at most 2/steps). ``elements``: RKMK4 steps of
+    """Continuation in the load factor lam from 0 to 1 in ``steps`` initial steps (halved on a failure or a
+    jump off the branch (:func:`_smooth`), grown by 1.5 after a solve in <= 4 Newton iterations, at most
+    2/steps). ``elements``: RKMK4 steps of
     the shooting, or collocation elements. ConvergenceError names the last load factor reached."""
     check_ends(rod.base, rod.tip)
     if method not in ("shooting", "collocation"):
@@ -394,10 +389,12 @@ def solve_statics(rod: Rod, *, method: str = "shooting", elements: int = 40, ste
     else:
         states = [straight(rod, elements)]
         prev = None
+    rate = None
     while lam < 1.0:
         target = min(1.0, lam + dlam)
         if method == "shooting":
             guess = z if prev is None else z + (z - prev[0]) * (target - lam) / (lam - prev[1])
+            prev_back = prev
             out = shoot(rod, elements, target, guess, tol=tol)
             ok = out is not None
             if ok:
@@ -410,18 +407,42 @@ def solve_statics(rod: Rod, *, method: str = "shooting", elements: int = 40, ste
             if ok:
                 states.append(sol)
                 iters = sol.iterations
+        if ok and not _smooth(states, target - lam, rate):
+            states.pop()
+            if method == "shooting":
+                z, prev = prev[0], prev_back
+            ok = False
         if not ok:
             dlam *= 0.5
             if dlam < min_step:
                 raise ConvergenceError(f"rod statics ({method}) did not converge beyond load factor {lam:.6g} "
-                                       f"(the last load reached; step below {min_step:g})")
+                                       f"(the last load reached; step below {min_step:g}: Newton failed or left "
+                                       "the branch)")
             continue
+        rate = _change(states[-2], states[-1]) / (target - lam)
         lam = target
         if progress is not None:
             progress(lam)
         if iters <= 4:
             dlam = min(1.5 * dlam, dmax)
     return Path(tuple(states))
+
+
+def _change(a: Solution, b: Solution) -> float:
+    """The largest move of a node between two states, in units of L (poses compared at the same nodes)."""
+    L = a.s[-1]
+    if a.H.shape != b.H.shape:
+        return 0.0
+    return float(np.max(np.linalg.norm(b.H[:, :3, 3] - a.H[:, :3, 3], axis=-1)) / L)
+
+
+def _smooth(states: list, dlam: float, rate: float | None) -> bool:
+    """Whether the newest state follows the branch: its nodes moved at most 3 times as far per unit load as
+    over the previous step (plus 2 % of L). A larger move is a jump to another branch of equilibria (shooting
+    is ill-conditioned at large loads, and Newton may converge to a looped elastica); the step is halved."""
+    if rate is None:
+        return True
+    return _change(states[-2], states[-1]) <= 3.0 * rate * dlam + 0.02
 
 
 # --------------------------------------------------------------------------- measures
