@@ -335,3 +335,16 @@ def test_at_pl2_ei_100_the_path_stays_on_the_hanging_branch():
 def test_at_pl2_ei_100_shooting_also_stays_on_the_branch():
     """The same by RKMK4 shooting (ill-conditioned here: ~exp(sqrt(100)) sensitivity, about 12 s)."""
     assert tip_error(100.0, "shooting", 40) < 2e-6
+
+
+def test_the_model_gravity_load_gives_the_timoshenko_cantilever_under_its_own_weight(capsys):
+    """q = rhoA g per length, small: tip deflection q L^4/(8 EI) + q L^2/(2 GA) (Timoshenko beam theory)."""
+    EI, GA, L, rhoA, g = 2.0, 40.0, 1.5, 1e-3, 9.81
+    system = mechgen.compile("cosserat_rod", params={"EI": EI, "GA": GA, "L": L, "rhoA": rhoA, "g_y": -g,
+                                                     "EA": 1e6, "GJ": 1.0}, backend="numpy")
+    res = mechgen.rod_statics(system, elements=200, steps=1)
+    q = rhoA * g
+    expect = q * L**4 / (8 * EI) + q * L**2 / (2 * GA)
+    assert abs(-res["tip_position"][1] / expect - 1) < 3e-5     # O(h^2) of the collocation at N = 200
+    assert main(["show", "cosserat_rod"]) == 0
+    assert "omega**2*r_1*rhoA" in capsys.readouterr().out
