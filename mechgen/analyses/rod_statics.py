@@ -182,6 +182,10 @@ def plot(plt, a: dict, path: Path) -> list[Path]:
         last = k == len(branch) - 1
         ax.plot(xyz[:, 0], xyz[:, 1], xyz[:, 2], color="k" if last else "tab:blue", lw=2 if last else 0.8,
                 alpha=1.0 if last else 0.4)
+    pts = np.concatenate([np.asarray(p["shape"]) for p in branch])
+    centre, half = (pts.max(0) + pts.min(0)) / 2, max(float(np.max(pts.max(0) - pts.min(0))) / 2, 1e-12)
+    for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre):   # equal scales: arcs look round
+        setter(c - half, c + half)
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     ax.set_zlabel("z (m)")
