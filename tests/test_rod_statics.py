@@ -192,6 +192,9 @@ def test_rotating_beam_axial_force_against_the_closed_form(tmp_path, capsys):
     assert np.max(np.abs(N - small)) < 0.5 * (k * L) ** 2 * np.max(small)
     strain = np.array(out["strain"])[:, 0]
     assert np.max(np.abs(strain - exact / EA)) < 1e-10
+    eta = np.array(out["velocity"])       # section velocity omega x r: (0, omega x(s), 0), spin (0, 0, omega)
+    assert np.max(np.abs(eta[:, 1] - omega * np.sin(k * s) / (k * math.cos(k * L)))) < 1e-8
+    assert np.max(np.abs(eta[:, [0, 2, 3, 4]])) < 1e-12 and np.allclose(eta[:, 5], omega, rtol=1e-14)
 
 
 def test_end_torque_scene_and_python_function_agree(tmp_path, capsys):
@@ -235,7 +238,8 @@ def test_unconstrained_ends_and_a_failed_path(tmp_path, capsys):
         assert "analysis[1].tip" in capsys.readouterr().err
     scene = tmp_path / "stuck.toml"
     scene.write_text(text.replace('tip_torque = [0.0, 0.0, "4 * pi * EI / L"]', "tip_force = [0.0, -1.0, 0.0]")
-                     .replace("steps = 10", "steps = 2\ntol = 1e-300\nmin_step = 0.1").replace("elements = 40", "elements = 4"))
+                     .replace("steps = 10", "steps = 2\ntol = 1e-300\nmin_step = 0.1")
+                     .replace("elements = 40", "elements = 4"))
     assert main(["run", str(scene)]) == 1
     assert "last load reached" in capsys.readouterr().err
 

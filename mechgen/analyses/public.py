@@ -208,9 +208,10 @@ def rod_statics(system, *, name: str | None = None, **options) -> Result:
     the origin), by load continuation (mechgen.analyses.rod_statics).
 
     Options: ``method`` (shooting, collocation), ``elements`` (or ``N``), ``base``, ``tip`` (clamped, pinned,
-    free), ``tip_force``, ``tip_torque`` ([x, y, z], spatial, dead), ``steps``, ``tol``, ``min_step``, ``bending_axis``.
+    free), ``tip_force``, ``tip_torque`` ([x, y, z], spatial, dead), ``steps``, ``tol``, ``min_step``,
+    ``bending_axis``, ``frame_rate``.
     Outputs: ``tip_position``, ``tip_rotation``, ``tip_orientation``, ``s``, ``shape``, ``strain``,
-    ``stress_resultant``, ``branch`` (the tip pose per load step), ``orthonormality_error``.
+    ``stress_resultant``, ``branch`` (the tip pose per load step), ``velocity``, ``orthonormality_error``.
     """
     return _run("rod_statics", system, options, name)
 

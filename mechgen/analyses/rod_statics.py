@@ -13,13 +13,15 @@ beyond PL^2/EI ~ 100 - 1000 and is slow there), ``elements``
 default clamped/free), ``tip_force``, ``tip_torque`` ([x, y, z], N and N m; numbers or expressions of the
 parameters), ``steps`` (initial continuation steps, default 10), ``tol`` (scaled Newton residual, 1e-10),
 ``min_step`` (the smallest load step before giving up, 1e-4),
-``bending_axis`` (x, y or z: the axis ``tip_rotation`` turns about, default z).
+``bending_axis`` (x, y or z: the axis ``tip_rotation`` turns about, default z), ``frame_rate`` ([x, y, z],
+rad/s: the rate of the frame the state is steady in, for ``velocity``; default 0).
 
 Outputs: ``tip_position`` ([x, y, z], m), ``tip_rotation`` (rad about the bending axis, unwrapped: an end
 torque tau gives tau L/EI even beyond 2 pi), ``tip_orientation`` (3 x 3), ``s`` (nodes), ``shape``
 (centre line, n x 3), ``strain`` (eps = f - f0, n x 6: u1 u2 u3 w1 w2 w3), ``stress_resultant`` (sigma = (n, m)
 in the section frame, n x 6: N, N m), ``branch`` (per load step: ``load`` factor, ``tip_force``,
-``tip_torque``, ``tip_position``, ``tip_rotation``, ``shape``), ``orthonormality_error`` (max |R^T R - I|),
+``tip_torque``, ``tip_position``, ``tip_rotation``, ``shape``), ``velocity`` (eta = (R^T (Omega x r), R^T Omega),
+n x 6, m/s and rad/s in the section frame), ``orthonormality_error`` (max |R^T R - I|),
 ``iterations`` (Newton, last step). Bad input (exit 2): K not symmetric positive definite (key ``params``),
 L <= 0 (``params.L``), ends that leave the rod free to move rigidly (``<analysis>.tip``). A load path that
 does not converge is a ConvergenceError naming the last load factor reached (exit 1).
@@ -78,6 +80,7 @@ SCHEMA = {
     "tol": Option(schema.positive, 1e-10),
     "min_step": Option(schema.positive, 1e-4),
     "bending_axis": Option(schema.one_of("axis", tuple(AXES)), "z"),
+    "frame_rate": Option(_vector3, [0.0, 0.0, 0.0]),
 }
 
 
@@ -161,7 +164,16 @@ def run_rod_statics(system, options: dict, context: dict) -> dict:
             "strain": rows(final.f - rod.f0), "stress_resultant": rows(final.sigma),
             "branch": [_point(rod, st, axis) for st in path.states],
             "orthonormality_error": orthonormality_error(final.H[:, :3, :3]),
+            "velocity": rows(_velocity(final.H, np.array(options["frame_rate"], dtype=float))),
             "iterations": int(final.iterations), "method": options["method"], "elements": int(options["elements"])}
+
+
+def _velocity(H: np.ndarray, omega: np.ndarray) -> np.ndarray:
+    """The sections' velocity twists eta = (R^T (Omega x r), R^T Omega) (section frame) of a state held steady
+    in a frame turning at Omega about the origin (a rotating beam's centrifugal load comes with it)."""
+    R, r = H[:, :3, :3], H[:, :3, 3]
+    Rt = np.swapaxes(R, -1, -2)
+    return np.concatenate([np.einsum("nij,nj->ni", Rt, np.cross(omega, r)), np.einsum("nij,j->ni", Rt, omega)], axis=1)
 
 
 def lines(outputs: dict) -> list[str]:
