@@ -159,9 +159,10 @@ def all_kernels(model: Model) -> tuple[str, ...]:
         return LATTICE_KERNELS
     if model.is_field:
         return FIELD_KERNELS
-    lumped = tuple(k for k in LUMPED_KERNELS if k != "section" or model.section_fn is not None)
-    if not model.coordinate_names and not model.internals:  # no state: a section's stiffness and the outputs
-        return tuple(k for k in lumped if k in ("outputs", "section"))
+    lumped = tuple(k for k in LUMPED_KERNELS if (k != "section" or model.section_fn is not None)
+                   and (k != "rod" or model.rod_spec is not None))
+    if not model.coordinate_names and not model.internals:  # no state: a section's stiffness, a rod, the outputs
+        return tuple(k for k in lumped if k in ("outputs", "section", "rod"))
     if model.internals:  # a model of internal variables only (no coordinate) has no potential force
         return tuple(k for k in lumped if k != "force" or model.coordinate_names)
     return tuple(k for k in lumped if not k.startswith("rates"))

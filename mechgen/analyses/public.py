@@ -19,7 +19,7 @@ from mechgen.analyses.schema import OptionContext, validate
 from mechgen.errors import InputError
 
 __all__ = ["analysis", "campbell", "continuation", "fit", "impact", "modes", "restitution", "simulate", "stability",
-           "steady", "sweep", "cross_section", "symplectic"]
+           "steady", "sweep", "cross_section", "symplectic", "rod_statics"]
 
 
 def _model_info(system):
@@ -201,6 +201,19 @@ def cross_section(system, *, name: str | None = None, **options) -> Result:
     raises an InputError naming the parameters.
     """
     return _run("cross_section", system, options, name)
+
+
+def rod_statics(system, *, name: str | None = None, **options) -> Result:
+    """The static equilibrium of the Cosserat rod a model declares with ``Model.rod`` (initially along x from
+    the origin), by load continuation (mechgen.analyses.rod_statics).
+
+    Options: ``method`` (shooting, collocation), ``elements`` (or ``N``), ``base``, ``tip`` (clamped, pinned,
+    free), ``tip_force``, ``tip_torque`` ([x, y, z], spatial, dead), ``steps``, ``tol``, ``min_step``,
+    ``bending_axis``, ``frame_rate``.
+    Outputs: ``tip_position``, ``tip_rotation``, ``tip_orientation``, ``s``, ``shape``, ``strain``,
+    ``stress_resultant``, ``branch`` (the tip pose per load step), ``velocity``, ``orthonormality_error``.
+    """
+    return _run("rod_statics", system, options, name)
 
 
 def campbell(system, *, name: str | None = None, **options) -> Result:

@@ -30,6 +30,7 @@ MODULES = (
     "mechgen.analyses.periodic",
     "mechgen.analyses.cross_section",
     "mechgen.analyses.symplectic",
+    "mechgen.analyses.rod_statics",
 )
 
 

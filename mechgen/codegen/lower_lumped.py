@@ -10,6 +10,8 @@ Kernel names and what they compute (n coordinates, m internal variables):
 * ``rates_tangent``                                    -> g_q[m*n], g_v[m*n], g_z[m*m]
 * ``outputs``   declared outputs and energies          -> one port of length 1 each
 * ``section``   the declared section stiffness K(p)    -> K[36] (6 x 6, symmetric; Model.section_stiffness)
+* ``rod``       a declared rod's local pieces at (f, r) -> sigma[6], C[36], W[1], f0[6], g[6], g_r[18], L[1]
+                (Model.rod, mechgen.symbolic.rod: sigma = K (f - f0), the spatial load wrench g(r); batched)
 
 A hybrid model (mechgen.symbolic.hybrid) has each of these per mode i, named ``<kernel>__i``, and
 
@@ -25,7 +27,7 @@ from mechgen.codegen.lower import canonical_block, dense_writes, kernel
 from mechgen.errors import ModelError
 from mechgen.symbolic.derive import LumpedEquations
 
-LUMPED_KERNELS = ("residual", "tangent", "linear", "force", "rates", "rates_tangent", "outputs", "section")
+LUMPED_KERNELS = ("residual", "tangent", "linear", "force", "rates", "rates_tangent", "outputs", "section", "rod")
 
 
 def _inputs(eqs: LumpedEquations, with_accel: bool = True) -> tuple[list[Port], list]:
@@ -96,4 +98,25 @@ def lower_lumped(eqs: LumpedEquations, name: str, *, cse: bool = True) -> Kernel
                              expected="a model with @model.section_stiffness (the cross_section analysis)")
         return _matrix_kernel(eqs, name, "cross-section stiffness K (6 x 6)", {"K": eqs.section}, accel=False,
                               cse=cse, symmetric=("K",))
+    if name == "rod":
+        return _rod_kernel(eqs, cse)
     raise KeyError(name)
+
+
+def _rod_kernel(eqs: LumpedEquations, cse: bool) -> KernelIR:
+    """sigma, C, W, f0, g, g_r of the declared rod at a batch of (f, r)."""
+    rod = eqs.rod
+    if rod is None:
+        raise ModelError(f"model {eqs.model} declares no rod", key="rod",
+                         expected="a model with Model.rod(...) (the rod_statics analysis)")
+    inputs = [Port("f", fixed(6), doc="deformation twist (nu, kappa)"), Port("r", fixed(3), doc="centre-line point"),
+              Port("p", fixed(len(eqs.params)), batched=False)]
+    gathers = [(s, "f", i, False) for i, s in enumerate(rod.f)] + [(s, "r", i, False) for i, s in enumerate(rod.r)]
+    gathers += [(s, "p", i, False) for i, s in enumerate(eqs.params)]
+    mats = {"sigma": rod.sigma, "C": rod.C, "W": sp.Matrix([[rod.energy]]), "f0": rod.f0, "g": rod.load,
+            "g_r": rod.load_r, "L": sp.Matrix([[rod.length]])}
+    outputs = [Port(k, fixed(m.rows * m.cols), shape=(m.rows, m.cols), symmetric=k == "C") for k, m in mats.items()]
+    writes = [w for k, m in mats.items() for w in dense_writes(k, m)]
+    block = canonical_block(gathers, writes, cse=cse, model=eqs.model)
+    return kernel("rod", "Cosserat rod: stress resultant, tangent, energy density, load", inputs, outputs, [block],
+                  meta=_meta(eqs))

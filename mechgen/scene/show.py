@@ -24,6 +24,11 @@ def _lumped(eqs) -> list[str]:
     if getattr(eqs, "section", None) is not None:
         lines += ["", "cross-section stiffness K (Model.section_stiffness; [K_uu, K_uw; K_wu, K_ww]):"]
         lines += [f"  K[{i},{j}] = {eqs.section[i, j]}" for i in range(6) for j in range(i, 6) if eqs.section[i, j] != 0]
+    rod = getattr(eqs, "rod", None)
+    if rod is not None:
+        lines += ["", "Cosserat rod (Model.rod; sigma = K (f - f0), f = vee6(H^-1 H') = (nu, kappa)):",
+                  f"  L = {rod.length}", f"  f0 = {list(rod.f0)}",
+                  f"  distributed load (spatial force, torque per length at r = (r_1, r_2, r_3)) = {list(rod.load)}"]
     return lines
 
 

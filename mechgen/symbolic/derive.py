@@ -24,6 +24,7 @@ from mechgen.errors import ModelError
 from mechgen.symbolic.model import Model, as_expr, call_declared
 from mechgen.symbolic.initial import initial_column
 from mechgen.symbolic.params import Namespace
+from mechgen.symbolic.rod import derive_rod
 from mechgen.symbolic.specialize import Specialization, param_namespace
 
 TIME = sp.Symbol("t", real=True)
@@ -52,6 +53,8 @@ class LumpedEquations:
     initial: sp.Matrix | None = None
     #: the declared cross-section stiffness K (6 x 6, Model.section_stiffness), None when the model declares none
     section: sp.Matrix | None = None
+    #: the declared rod's local pieces (mechgen.symbolic.rod.RodPieces, Model.rod), None when none is declared
+    rod: object = None
 
     @property
     def t(self) -> sp.Symbol:
@@ -163,7 +166,8 @@ def derive_lumped(model: Model, spec: Specialization, mode: str | None = None) -
         kinetic=T, potential=V, residual=sp.Matrix(res) if res else sp.zeros(0, 1),
         rates=sp.Matrix(rates) if rates else sp.zeros(0, 1), outputs=outputs,
         initial=initial_column(model, p_ns, names, tuple(i.name for i in model.internals)),
-        section=_section(model, p_ns),
+        section=(section := _section(model, p_ns)),
+        rod=derive_rod(model, p_ns, section, free),
     )
 
 

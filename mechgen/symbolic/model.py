@@ -286,6 +286,8 @@ class Model:
         self.guards: list = []
         #: the declared cross-section stiffness K(p) (6 x 6), or None (:meth:`section_stiffness`)
         self.section_fn: Callable | None = None
+        #: the declared Cosserat rod (mechgen.symbolic.rod.RodSpec), or None (:meth:`rod`)
+        self.rod_spec = None
 
     # -- declarations ---------------------------------------------------
     def params(self, *params: Param) -> Namespace:
@@ -345,6 +347,30 @@ class Model:
                              key="section_stiffness", expected="one section_stiffness declaration")
         self.section_fn = fn
         return fn
+
+    def rod(self, *, length: Callable | None = None, stiffness: Callable | None = None, f0: Callable | None = None,
+            load: Callable | None = None, doc: str = "") -> None:
+        """Declare a geometrically exact (Cosserat) rod with strain energy 1/2 int (f - f0)^T K (f - f0) ds,
+        f = vee6(H^-1 H') = (nu, kappa) (mechgen.symbolic.rod).
+
+        ``length(p)``: the reference length L (m; default 1), e.g. ``lambda p: p.L``.
+        ``stiffness(p)``: K (6 x 6, [K_uu, K_uw; K_wu, K_ww]), e.g.
+        ``lambda p: rod_stiffness(p.EA, p.GA, p.GJ, p.EI)``; None uses the declared section
+        (:meth:`section_stiffness`); a given one also serves as the section (the cross_section analysis).
+        ``f0(p)``: the reference twist (6; default (1, 0, 0, 0, 0, 0), straight along the first section axis).
+        ``load(r, p)``: the distributed wrench per unit length in the spatial frame at the centre-line point
+        ``r`` (``r.x``, ``r.y``, ``r.z``): 3 force components (N/m) or 6 (force, torque N m/m).
+        The ``rod`` kernel evaluates sigma = K (f - f0), C = d sigma/df, W, f0, the load and d load/dr;
+        the ``rod_statics`` analysis solves the rod's equilibrium.
+        """
+        from mechgen.symbolic.rod import RodSpec
+
+        if self.rod_spec is not None:
+            raise ModelError(f"model {self.name} declares its rod twice", file=self.file, key="rod",
+                             expected="one rod declaration")
+        if stiffness is not None and self.section_fn is None:
+            self.section_fn = stiffness
+        self.rod_spec = RodSpec(stiffness, f0, load, length, doc)
 
     def chain(self, coordinate: str, *, sites: str, ends: str = "fixed") -> None:
         """Declare a lattice of identical sites; ``sites`` names a size parameter.
