@@ -255,13 +255,17 @@ def fit(system, *, name: str | None = None, **options) -> Result:
 
 
 def sweep(system, analysis: str = "modes", grid: Mapping[str, Any] | None = None, *, name: str | None = None,
-          workers: int = 0, progress: bool = False, **inner_options) -> Result:
+          workers: int = 0, progress: bool = False, executor: str | None = None, scheduler: str | None = None,
+          on_error: str = "record", **inner_options) -> Result:
     """``analysis`` (modes, stability, steady or simulate, with ``inner_options``) at every point of ``grid``.
 
     ``grid`` maps each parameter (free in the kernels) to its values or {start, stop, num}; several
     parameters give their cartesian product, the first outermost. Each point runs on a new system
-    with the point's values (``system`` is not changed). ``workers`` > 1 runs points in local
-    processes (the system must then pickle; a scene's sweep compiles in each process instead);
+    with the point's values (``system`` is not changed). ``executor``: "serial", "processes"
+    (``workers`` local processes) or "dask" (a LocalCluster of ``workers`` processes, or the running
+    ``scheduler`` at "tcp://host:port"); left out, ``workers`` > 1 means processes (the system must then
+    pickle; a scene's sweep compiles in each process instead). ``on_error``: "record" (a failed point's
+    error in ``status``, the sweep goes on) or "raise";
     ``progress`` draws a bar on stderr (off by default here, on in scenes). Outputs: ``grid`` (the
     points) and one list per output of the inner analysis. Keywords other than these go to the inner
     analysis (``max_seconds`` there is each point's budget); the sweep's own wall-time budget is the
@@ -274,7 +278,11 @@ def sweep(system, analysis: str = "modes", grid: Mapping[str, Any] | None = None
                          expected="one of: " + ", ".join(k for k in kinds() if get(k).sweepable))
     _check_keys("sweep", analysis, inner_options)
     table = {"over": grid, "analysis": {"kind": analysis, **inner_options}, "workers": workers,
-             "progress": progress}
+             "progress": progress, "on_error": on_error}
+    if executor is not None:
+        table["executor"] = executor
+    if scheduler is not None:
+        table["scheduler"] = scheduler
     return _run("sweep", system, table, name)
 
 

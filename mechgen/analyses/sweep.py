@@ -2,13 +2,20 @@
 
 Scene keys: ``over`` (parameter = [values] or {start, stop, num}; several parameters give their
 cartesian product, the first outermost; at most 10^6 points), ``analysis`` (a table with the inner
-``kind``: modes, stability, steady or simulate, and its keys), ``workers`` (local processes; 0 or 1:
-serial), ``progress`` (a bar with the remaining time on stderr when it is a terminal and the sweep
+``kind``: modes, stability, steady or simulate, and its keys), ``executor`` (``serial``, ``processes``
+or ``dask``; left out: processes when ``workers`` > 1, else serial), ``workers`` (local processes, or
+the workers of the Dask LocalCluster started for the run; 0: two), ``scheduler`` (with dask: a running
+scheduler's address, ``tcp://host:port``, instead of a LocalCluster), ``on_error`` (``record``, the
+default: a failed point gets its error in ``status`` and None outputs and the sweep goes on; ``raise``:
+the first failure stops the sweep), ``progress`` (a bar with the remaining time on stderr when it is a terminal and the sweep
 lasts over 2 s) and ``max_seconds`` (the wall-time budget, default 600: the time of the whole grid
 is estimated from its first points and a sweep that would take longer is refused once the estimate
 is 2 s old, naming the estimate, the points done and the key). Outputs: ``grid`` (the points, a
-list of {parameter: value}) plus one list per output of the inner analysis, in grid order. An inner
-analysis keeps its own budget (``analysis.max_steps`` ...), per point.
+list of {parameter: value}) plus one list per output of the inner analysis, in grid order, ``status``
+(per point: ``ok`` or ``failed: <error>``), ``failed`` (their count), ``retried`` (the points run again
+after a Dask worker was lost: each is still in the results once), ``executor`` and ``tasks`` (what the
+executor ran: points, or Dask chunks of at least ~0.5 s of work). An inner analysis keeps its own budget
+(``analysis.max_steps`` ...), per point.
 """
 from __future__ import annotations
 
@@ -20,8 +27,8 @@ from mechgen.analyses.parameters import with_free_params
 from mechgen.analyses.registry import AnalysisKind, get, kinds, register
 from mechgen.analyses.schema import ABSENT, REQUIRED, AnalysisSpec, Option
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget
-from mechgen.runtime.core.sweep import sweep
-from mechgen.scene.values import fail, type_name
+from mechgen.runtime.core.sweep import EXECUTORS, ON_ERROR, OK, SweepExecutor, sweep_points
+from mechgen.scene.values import fail, show, type_name
 
 
 def _inner(ctx, key: str, value: object) -> AnalysisSpec:
@@ -38,15 +45,28 @@ def _workers(ctx, key: str, value: object) -> int:
     return schema.int_at_least(ctx, key, value, 0)
 
 
+def _scheduler(ctx, key: str, value: object) -> str:
+    """A Dask scheduler's address: tcp://host:port (or tls://, inproc://)."""
+    if not isinstance(value, str) or "://" not in value or len(value) > 500 or not value.isprintable():
+        raise fail(ctx.file, key, f"value is {show(value)}",
+                   "a Dask scheduler address such as \"tcp://127.0.0.1:8786\"")
+    return value
+
+
 SCHEMA = {"over": Option(schema.over, REQUIRED, "a table: parameter = [values] or {start, stop, num}"),
           "analysis": Option(_inner, REQUIRED, "a table with kind and its options"),
           "workers": Option(_workers, 0), "progress": Option(schema.boolean, True),
-          "max_seconds": Option(schema.positive, ABSENT)}
+          "max_seconds": Option(schema.positive, ABSENT),
+          "executor": Option(schema.one_of("executor", EXECUTORS), ABSENT),
+          "scheduler": Option(_scheduler, ABSENT), "on_error": Option(schema.one_of("on_error", ON_ERROR), "record")}
 
 
 def check(ctx, base: str, options: dict) -> None:
-    """Adds ``grid``: the cartesian product of ``over``."""
+    """Adds ``grid``: the cartesian product of ``over``; a ``scheduler`` needs ``executor = "dask"``."""
     options["grid"] = schema.grid(options["over"])
+    if "scheduler" in options and options.get("executor") != "dask":
+        raise fail(ctx.file, f"{base}.scheduler", "a scheduler without executor = \"dask\"",
+                   "executor = \"dask\" beside scheduler, or no scheduler")
 
 
 def frees(options: dict) -> list[str]:
@@ -68,11 +88,19 @@ def _at_point(task: tuple) -> dict:
     return public(get(kind).run(with_free_params(system, point, key="grid"), options, {}))
 
 
-def collect(grid: list[dict], results: list[dict]) -> dict:
-    """{"grid": grid, output: [value at each point]} (the outputs of the first point)."""
+def collect(grid: list[dict], results: list, status: list | None = None, retried: list | None = None) -> dict:
+    """{"grid": grid, output: [value at each point] (None where the point failed), "status": ["ok" or
+    "failed: ..."], "retried": [the points run again after their worker was lost]} (the outputs of the
+    first point that succeeded)."""
     out: dict = {"grid": grid}
-    for key in results[0] if results else []:
-        out[key] = [r.get(key) for r in results]
+    first = next((r for r in results if r is not None), {})
+    for key in first:
+        out[key] = [None if r is None else r.get(key) for r in results]
+    if status is not None:
+        out["status"] = list(status)
+        out["failed"] = sum(s != OK for s in status)
+    if retried is not None:
+        out["retried"] = [grid[i] for i in retried]
     return out
 
 
@@ -102,9 +130,13 @@ def run_sweep(system, options: dict, context: dict) -> dict:
     points = context.get(POINTS) or PointRunner(_at_point, lambda kind, opts, point: (system, kind, opts, point))
     tasks = Tasks(points, inner.kind, dict(inner.options), options["grid"])
     budget = Budget(f"sweep of {inner.kind}", unit="points", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
-    results = sweep(points.evaluate, tasks, workers=options.get("workers", 0), progress=options.get("progress", True),
-                    desc=context.get(NAME, "sweep"), budget=budget, labels=options["grid"])
-    return collect(options["grid"], results)
+    executor = SweepExecutor.of(options.get("executor"), options.get("workers", 0), options.get("scheduler"))
+    run = sweep_points(points.evaluate, tasks, executor=executor, progress=options.get("progress", True),
+                       desc=context.get(NAME, "sweep"), budget=budget, labels=options["grid"],
+                       on_error=options.get("on_error", "record"))
+    out = collect(options["grid"], run.results, run.status, run.retried)
+    out["executor"], out["tasks"] = executor.kind, run.tasks
+    return out
 
 
 def summary_lines(outputs: dict) -> list[str]:
@@ -128,6 +160,8 @@ def plot(plt, a: dict, path: Path) -> list[Path]:
     verdicts = a["outputs"].get("verdict") or ["stable"] * len(x)
     colours = figures.VERDICT_COLOURS
     for xi, freqs, verdict in zip(x, a["outputs"].get("frequencies", []), verdicts):
+        if freqs is None:  # a failed point
+            continue
         ax.plot([xi] * len(freqs), freqs, ".", color=colours.get(verdict, "k"), ms=3)
     if name == "Omega" and x and isinstance(x[0], (int, float)):
         ax.plot([min(x), max(x)], [min(x), max(x)], "r--", lw=1, label="1x (synchronous)")
@@ -136,7 +170,7 @@ def plot(plt, a: dict, path: Path) -> list[Path]:
     ax.set_title(f"{a['name']}: frequencies vs {name}" + (" (red: flutter, blue: divergence, orange: unconverged)"
                                                           if growth else ""), fontsize=9)
     if growth:
-        axes[1, 0].plot(x, growth, "o-", ms=3)
+        axes[1, 0].plot(x, [float("nan") if g is None else g for g in growth], "o-", ms=3)
         axes[1, 0].axhline(0.0, color="0.6", lw=0.5)
         axes[1, 0].set_ylabel("growth rate max Re s")
     axes[-1, 0].set_xlabel(name)

@@ -1,85 +1,181 @@
-"""Run one function over a list of parameter points, serially or in local processes.
+"""Run one function over a list of parameter points: serially, in local processes, or on Dask.
 
 Order is preserved; a tqdm progress bar with the remaining time goes to stderr when it is a
-terminal and the sweep lasts over 2 s (mechgen.runtime.core.budget.Progress). An exception at a
-point is re-raised naming that point. A :class:`~mechgen.runtime.core.budget.Budget` bounds the
-wall time: after each point the time for all of them is estimated from the points done
-(elapsed * total / done) and the sweep is refused as soon as that estimate, trusted after 2 s,
-exceeds the budget; an inner analysis's spent budget is re-raised with the point and its key
-under ``inner`` (``analysis.max_steps``).
+terminal and the sweep lasts over 2 s (mechgen.runtime.core.budget.Progress). A
+:class:`~mechgen.runtime.core.budget.Budget` bounds the wall time: after each point (or chunk) the
+time for all of them is estimated from the points done (elapsed * total / done) and the sweep is
+refused as soon as that estimate, trusted after 2 s, exceeds the budget; an inner analysis's spent
+budget is re-raised with the point and its key under ``inner`` (``analysis.max_steps``).
+
+A point whose function fails is, with ``on_error = "record"``, recorded (its result None, its
+status ``"failed: <message>"``) and the sweep goes on; a user's mistake (an
+:class:`~mechgen.errors.InputError`) and a spent budget still stop the sweep, and so does a sweep
+none of whose points succeeded (the first failure, naming its point). With ``on_error = "raise"``
+the first failure stops the sweep, naming the point.
+
+Executors (:class:`SweepExecutor`): ``serial``; ``processes`` (``workers`` local processes, BLAS on
+one thread each); ``dask`` (mechgen.runtime.core.dask_sweep: chunks of points on a
+``dask.distributed`` cluster). Each point's result depends only on the point: the executors give the
+same numbers (tests/test_sweep_executors.py).
 """
 from __future__ import annotations
 
-from mechgen.errors import MechgenError
+from dataclasses import dataclass, field
+
+from mechgen.errors import InputError, MechgenError
 from mechgen.runtime.core.budget import Budget, BudgetExceeded, Progress
 from mechgen.runtime.core.threads import single_thread_worker
+
+EXECUTORS = ("serial", "processes", "dask")
+ON_ERROR = ("record", "raise")
+#: a point's status when its function returned
+OK = "ok"
 
 
 class SweepError(MechgenError):
     """A sweep point failed; the message names the point."""
 
 
+@dataclass(frozen=True)
+class SweepExecutor:
+    """Where the points run: ``kind`` (serial | processes | dask), ``workers`` (processes, or Dask
+    workers of a LocalCluster started for the run; 0: two), ``scheduler`` (a running Dask
+    scheduler's address, ``tcp://host:port``; None: a LocalCluster on the loopback for this sweep),
+    ``chunk_seconds`` (the work a Dask task carries at least, from the first point's time: Dask's
+    per-task overhead is 0.2-1 ms)."""
+
+    kind: str = "serial"
+    workers: int = 0
+    scheduler: str | None = None
+    chunk_seconds: float = 0.5
+
+    def __post_init__(self) -> None:
+        if self.kind not in EXECUTORS:
+            raise InputError(f"unknown executor {self.kind!r}", key="executor", expected=" | ".join(EXECUTORS))
+
+    @classmethod
+    def of(cls, kind: str | None, workers: int = 0, scheduler: str | None = None) -> "SweepExecutor":
+        """The executor a sweep's keys name; no ``executor`` key: processes when ``workers`` > 1, else serial."""
+        if kind is None:
+            kind = "processes" if workers > 1 else "serial"
+        return cls(kind, int(workers), scheduler)
+
+
+@dataclass
+class SweepRun:
+    """A sweep's outcome: ``results[i]`` (None where point i failed), ``status[i]`` (``"ok"`` or
+    ``"failed: ..."``), ``retried`` (indices of points run again after their worker was lost),
+    ``tasks`` (the tasks the executor ran: points, or Dask chunks)."""
+
+    results: list
+    status: list
+    retried: list = field(default_factory=list)
+    tasks: int = 0
+
+
 def sweep(func, points: list, *, workers: int = 0, progress: bool = True, desc: str = "sweep",
           budget: Budget | None = None, inner: str = "analysis", labels=None) -> list:
     """[func(point) for point in points], with ``workers`` > 1 local processes, under ``budget``; ``labels[i]``
-    names point i in messages (default: the point, or the last dict of a task tuple)."""
-    results: list = [None] * len(points)
+    names point i in messages (default: the point, or the last dict of a task tuple). The first failure stops
+    the sweep (SweepError naming the point)."""
+    run = sweep_points(func, points, executor=SweepExecutor.of(None, workers), progress=progress, desc=desc,
+                       budget=budget, inner=inner, labels=labels, on_error="raise")
+    return run.results
+
+
+def sweep_points(func, points, *, executor: SweepExecutor | None = None, progress: bool = True,
+                 desc: str = "sweep", budget: Budget | None = None, inner: str = "analysis", labels=None,
+                 on_error: str = "record") -> SweepRun:
+    """``func`` at every point on ``executor`` (module docstring): a :class:`SweepRun` in point order."""
+    executor = executor or SweepExecutor()
+    if on_error not in ON_ERROR:
+        raise InputError(f"unknown on_error {on_error!r}", key="on_error", expected=" | ".join(ON_ERROR))
+    record = on_error == "record"
     total = len(points)
+    run = SweepRun([None] * total, [None] * total)
 
     def label(i: int):
         return labels[i] if labels is not None else points[i]
 
-    def done(i: int) -> None:
-        if budget is not None:
-            budget.project(i + 1, total, lambda: f"{i + 1:,} of {total:,} points")
+    def store(i: int, outcome: tuple) -> None:
+        """Keep point i's (status, value), or raise its failure (on_error = raise)."""
+        run.status[i], run.results[i] = outcome
 
     with Progress(total, desc=desc, unit="point", enabled=progress) as bar:
-        if workers <= 1:
-            for i, point in enumerate(points):
-                results[i] = _call(func, point, inner, label(i))
-                bar.update()
-                done(i)
-            return results
-        from concurrent.futures import ProcessPoolExecutor
+        def done(count: int) -> None:
+            bar.update(count)
+            if budget is not None:
+                finished = sum(s is not None for s in run.status)
+                budget.project(finished, total, lambda: f"{finished:,} of {total:,} points")
 
-        pool = ProcessPoolExecutor(max_workers=workers, initializer=single_thread_worker)
-        try:
-            futures = [pool.submit(func, point) for point in points]
-            for i, fut in enumerate(futures):
-                try:
-                    results[i] = fut.result()
-                except BudgetExceeded as exc:
-                    raise _inner(exc, label(i), inner) from exc
-                except MechgenError:
-                    raise
-                except Exception as exc:  # re-raised with the point named
-                    raise SweepError(f"sweep point {_describe(label(i))} failed: {exc}") from exc
-                bar.update()
-                done(i)
-        finally:
-            pool.shutdown(wait=True, cancel_futures=True)
-    return results
+        if executor.kind == "dask":
+            from mechgen.runtime.core.dask_sweep import run_on_dask
+
+            run.retried, run.tasks = run_on_dask(func, points, executor, store, done, label, inner, record)
+        elif executor.kind == "processes" and executor.workers > 1:
+            _run_processes(func, points, executor.workers, store, done, label, inner, record)
+            run.tasks = total
+        else:
+            for i in range(total):
+                store(i, guarded(func, points[i], inner, label(i), record))
+                done(1)
+            run.tasks = total
+    if total and all(s != OK for s in run.status):
+        first = run.status[0][len("failed: "):]
+        raise SweepError(f"every sweep point failed; the first, {describe(label(0))}: {first}")
+    return run
 
 
-def _inner(exc: BudgetExceeded, point, inner: str) -> BudgetExceeded:
+def _run_processes(func, points, workers: int, store, done, label, inner: str, record: bool) -> None:
+    from concurrent.futures import ProcessPoolExecutor
+
+    pool = ProcessPoolExecutor(max_workers=workers, initializer=single_thread_worker)
+    try:
+        futures = [pool.submit(guarded, func, point, inner, None, record) for point in points]
+        for i, fut in enumerate(futures):
+            try:
+                outcome = fut.result()
+            except BudgetExceeded as exc:
+                raise inner_budget(exc, label(i), inner) from exc
+            except SweepError as exc:  # raised in the worker, which knew the task, not its label
+                raise SweepError(f"sweep point {describe(label(i))} failed: {exc}") from exc
+            store(i, outcome)
+            done(1)
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+def guarded(func, point, inner: str, label, record: bool = True) -> tuple:
+    """("ok", func(point)), or with ``record`` ("failed: <message>", None) for a failed computation. A
+    user's mistake (InputError) and a spent budget (named with the point when ``label`` is given) are
+    raised; without ``record`` so is every failure (a MechgenError as it is, another named with the point)."""
+    try:
+        return OK, func(point)
+    except BudgetExceeded as exc:
+        if label is None:
+            raise
+        raise inner_budget(exc, label, inner) from exc
+    except InputError:
+        raise
+    except MechgenError as exc:
+        if not record:
+            raise
+        return f"failed: {type(exc).__name__}: {exc}", None
+    except Exception as exc:  # recorded, or raised with the point named
+        if not record:  # in a worker (no label) the driver names the point
+            raise SweepError(f"sweep point {describe(label)} failed: {exc}" if label is not None else str(exc)) from exc
+        return f"failed: {type(exc).__name__}: {exc}", None
+
+
+def inner_budget(exc: BudgetExceeded, point, inner: str) -> BudgetExceeded:
     """An inner analysis's spent budget, with the point and its key under ``inner``."""
-    reached = f"{exc.reached} at sweep point {_describe(point)}" if exc.reached else f"sweep point {_describe(point)}"
+    reached = f"{exc.reached} at sweep point {describe(point)}" if exc.reached else f"sweep point {describe(point)}"
     return BudgetExceeded(exc.message, key=f"{inner}.{exc.key}" if exc.key else None, reached=reached,
                           analysis=exc.analysis)
 
 
-def _call(func, point, inner: str, label):
-    try:
-        return func(point)
-    except BudgetExceeded as exc:
-        raise _inner(exc, label, inner) from exc
-    except MechgenError:
-        raise
-    except Exception as exc:  # re-raised with the point named
-        raise SweepError(f"sweep point {_describe(label)} failed: {exc}") from exc
-
-
-def _describe(point) -> str:
+def describe(point) -> str:
+    """A point as messages show it (the last dict of a task tuple: the grid point)."""
     if isinstance(point, tuple) and point and isinstance(point[-1], dict):
         point = point[-1]
     return repr(point)
