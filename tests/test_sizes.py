@@ -30,11 +30,14 @@ GIB = 2**30
 EPS = np.finfo(float).eps
 
 # One analysis of rotating_string with lagrange1 elements in a fresh process; prints its frequencies,
-# the wall time of the analysis and the peak resident memory (ru_maxrss, KiB on Linux).
+# the wall time of the analysis and the peak resident memory (VmHWM of /proc/self/status:
+# ru_maxrss would carry over the forking test process's resident set).
 SCRIPT = textwrap.dedent("""
     import json, resource, sys, time
     from threadpoolctl import threadpool_limits
     import mechgen
+    def peak_rss():  # this process's own high-water mark (VmHWM, kB); ru_maxrss keeps a forked parent's
+        return next(int(l.split()[1]) for l in open("/proc/self/status") if l.startswith("VmHWM")) * 1024
     N, kind, omega = int(sys.argv[1]), sys.argv[2], float(sys.argv[3])
     system = mechgen.compile("rotating_string", {"P": 1.0, "rhoA": 1.0, "L": 1.0, "Omega": omega,
                              "discretisation": "lagrange1", "N": N}, kernels=["linear"])
@@ -44,7 +47,7 @@ SCRIPT = textwrap.dedent("""
         result = getattr(mechgen, kind)(system, **options)
         seconds = time.perf_counter() - clock
     print(json.dumps({"frequencies": result.outputs["frequencies"], "seconds": seconds, "n": system.n,
-                      "maxrss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024}))
+                      "maxrss": peak_rss()}))
 """)
 
 
