@@ -20,6 +20,7 @@
 """
 from __future__ import annotations
 
+import itertools
 import math
 import os
 import time
@@ -126,7 +127,7 @@ def _stream(client, func, points, size: int, workers: int, store, done, label, i
     pending = iter(range(len(bounds)))
     futures = as_completed()
     owner: dict = {}
-    for index in _take(pending, IN_FLIGHT * workers):
+    for index in itertools.islice(pending, IN_FLIGHT * workers):
         fut = submit(index)
         owner[fut.key] = index
         futures.add(fut)
@@ -151,7 +152,7 @@ def _stream(client, func, points, size: int, workers: int, store, done, label, i
                 raise SweepError(f"sweep point {describe(label(lo + offset))} failed: {outcome[0][len('failed: '):]}")
             store(lo + offset, outcome)
         done(hi - lo)
-        for nxt in _take(pending, 1):
+        for nxt in itertools.islice(pending, 1):
             again = submit(nxt)
             owner[again.key] = nxt
             futures.add(again)
@@ -159,14 +160,4 @@ def _stream(client, func, points, size: int, workers: int, store, done, label, i
     retried = sorted(i for index, count in starts.items() if count > 1 or resubmitted[index]
                      for i in range(*bounds[index]))
     return retried, len(bounds) + sum(resubmitted.values())
-
-
-def _take(iterator, count: int) -> list:
-    out = []
-    for _ in range(count):
-        nxt = next(iterator, None)
-        if nxt is None:
-            break
-        out.append(nxt)
-    return out
 

@@ -102,10 +102,13 @@ def sweep_points(func, points, *, executor: SweepExecutor | None = None, progres
         run.status[i], run.results[i] = outcome
 
     with Progress(total, desc=desc, unit="point", enabled=progress) as bar:
+        finished = 0
+
         def done(count: int) -> None:
+            nonlocal finished
+            finished += count
             bar.update(count)
             if budget is not None:
-                finished = sum(s is not None for s in run.status)
                 budget.project(finished, total, lambda: f"{finished:,} of {total:,} points")
 
         if executor.kind == "dask":
