@@ -109,3 +109,13 @@ def test_runtime_campbell_refuses_reduced_on_dask_and_runs_auto_exact():
     for w, row in zip(speeds, res.frequencies):
         root = np.sqrt(w**2 / 16 + 1)
         np.testing.assert_allclose(sorted(row), sorted([root - w / 4, root + w / 4]), rtol=1e-12)
+
+
+def test_an_input_error_from_a_worker_keeps_its_key():
+    import pickle
+
+    from mechgen.errors import SceneError
+
+    err = pickle.loads(pickle.dumps(SceneError("bad", file="a.toml", key="analysis[1].count", expected="1")))
+    assert type(err) is SceneError and (err.file, err.key, err.expected) == ("a.toml", "analysis[1].count", "1")
+    assert str(err) == "in a.toml at key 'analysis[1].count': bad; expected 1."
