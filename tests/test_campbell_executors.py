@@ -84,6 +84,11 @@ def test_reduced_method_is_refused_on_a_parallel_executor(tmp_path, capsys):
     assert str(path) in err and "analysis[1].executor" in err and "reduced" in err
     with pytest.raises(InputError, match="executor"):
         mechgen.run(scene, backend="numpy")
+    # workers > 1 without an executor means processes: refused at workers
+    path.write_text(text + '[[analysis]]\nname = "c"\nkind = "campbell"\nover = { Omega = [0.0, 500.0] }\n'
+                    'method = "reduced"\nworkers = 2\n')
+    assert main(["run", str(path), "--backend", "numpy"]) == 2
+    assert "analysis[1].workers" in capsys.readouterr().err
     # a scheduler without executor = "dask" is refused as in sweep
     path.write_text(text + '[[analysis]]\nname = "c"\nkind = "campbell"\nover = { Omega = [0.0, 500.0] }\n'
                     'scheduler = "tcp://127.0.0.1:1"\n')
