@@ -268,11 +268,11 @@ def test_compiled_elements_match_the_numpy_reference_including_near_pi(monkeypat
     st.R = st.R @ exp_so3(0.9 * rng.normal(size=(9, 3)))
     st.R[3] = st.R[2] @ exp_so3(np.array([0.0, 3.1, 0.2]))
     z = 0.3 * rng.normal(size=(5, 9, 6))
-    assert dynamics._library() is not None
+    assert dynamics.element_library() is not None
     for c, n in zip(d.weighted_internal(st, z), d.weighted_internal(st, z, compiled=False)):
         assert np.max(np.abs(c - n)) <= 1e-13 * np.max(np.abs(n))
     bb = body(tip_force=(0.0, 1e-2, 0.0), EA=1e4, GA=1e4, rhoI=1e-4, rhoJ=2e-4)
     run = lambda: simulate(Discrete(bb, 10), reference_state(bb, 10), dt=0.01, t_end=0.3).final.x  # noqa: E731
     compiled = run()
-    monkeypatch.setattr(dynamics, "_library", lambda: None)
+    monkeypatch.setattr(dynamics, "element_library", lambda: None)
     assert np.max(np.abs(run() - compiled)) < 1e-12

@@ -74,7 +74,7 @@ SOURCE = Path(__file__).resolve().parent.parent.parent / "codegen" / "templates"
 
 
 @lru_cache(maxsize=1)
-def _library():
+def element_library():
     """The loaded rod-element library, or None (no compiler: the numpy path runs; one log line)."""
     from mechgen.codegen.build import load_shared
     from mechgen.errors import BuildError, CompilerUnavailable
@@ -92,7 +92,7 @@ def _library():
 
 def forget_library() -> None:
     """Forget the loaded (or refused) library (tests change CC)."""
-    _library.cache_clear()
+    element_library.cache_clear()
 
 
 @dataclass(frozen=True)
@@ -239,7 +239,7 @@ class Discrete:
         forces and moments: in C (codegen/templates/c99/rod_elements.c, the same operations) when a compiler
         is there, else numpy (:meth:`internal`)."""
         al = self.body.alpha
-        lib = _library() if compiled else None
+        lib = element_library() if compiled else None
         if lib is None:
             xm = st.x + al * z[..., :3]
             Rm = st.R @ exp_so3(al * z[..., 3:])
