@@ -1,0 +1,539 @@
+"""``mechgen bench rods``: the geometrically exact (Cosserat) rod, mechgen against PyElastica (issue 15).
+
+Peer: PyElastica (``pyelastica==1.0.0``, the pin in pyproject's ``bench`` extra; :data:`PYELASTICA_PIN`),
+its ``CosseratRod.straight_rod`` with ``OneEndFixedBC`` (node 0 and element 0's directors held),
+``EndpointForces`` (a dead tip force, ramp time 1e-300 s: a step load) and, for the static limit,
+``AnalyticalLinearDamper(uniform_damping_constant=c)`` (v and omega multiplied by exp(-c dt) after each
+step), stepped by its ``PositionVerlet``. Without pyelastica the PyElastica parts are skipped with a message
+(``"pyelastica": "skipped: ..."`` in the results) and mechgen's parts still run.
+
+Mapping (PyElastica 1.0.0, ``elastica/rod/factory_function.py``; a solid disc of radius r, density rho,
+Young's modulus E, shear modulus G): A = pi r^2, I = A^2/(4 pi) = pi r^4/4 about each bending axis,
+J = 2 I (polar);
+
+    EA = E A,  GA = alpha_c G A,  GJ = G J,  EI = E I  (N, N, N m^2, N m^2),
+    rhoA = rho A (kg/m),  rhoI = rho I,  rhoJ = rho J (kg m: PyElastica's mass second moment of inertia of an
+    element is diag(I, I, 2I) rho dl),
+
+with PyElastica's shear coefficient alpha_c = 27/28 (1.0.0: "best correlation for Poisson ratio 0.5,
+Kaneko 1975"; the 0.2 releases used 4/3). The suite does not trust this note: it builds a PyElastica rod
+and reads alpha_c = S_11/(G A) and the mass second moment back from it (``pyelastica.alpha_c`` and
+``pyelastica.mass_second_moment_over_rho_dl`` in the results).
+
+Parts:
+
+* **static** - the cantilever under a dead tip load P perpendicular to it, P L^2/EI = 10, rod along +x:
+  tip displacement error against wall time over each discretisation ladder: mechgen's ``rod_statics`` by
+  Lie-group midpoint collocation (elements 10 .. 640, order 2) and by RKMK4 shooting (steps 5 .. 160, order
+  4), and PyElastica's static limit (a damped run until max |v| < REST_TOL m/s) over n_elem 10 .. 160 at
+  its stable dt. All three solve the same extensible, shearable rod (PyElastica's section:
+  EA/EI = 4/r^2 = 4e4, GA/EI = 1.29e4 at r = 0.01). Reference: mechgen RKMK4 shooting of that rod at
+  REFERENCE_STEPS steps (its own distance to half the steps is reported). The reference solver is
+  validated independently: Bisshopp & Drucker's elliptic-integral solution of the inextensible
+  cantilever (Q. Appl. Math. 3 (1945) 272; :func:`elastica`, scipy's ellipk/ellipkinc/ellipe/ellipeinc and
+  a root solve) reproduces Mattiasson's table (Int. J. Numer. Meth. Eng. 17 (1981) 145, PL^2/EI = 10:
+  (L - x)/L = 0.55500, y/L = -0.81061), and mechgen's shooting of a nearly inextensible rod (EA/EI = GA/EI
+  = 1e8) matches it. Error: max(|x - x_ref|, |y - y_ref|)/L of the tip.
+* **dynamic** (needs ``mechgen.rod_dynamics``): the same cantilever released from straight under a step tip
+  load (P L^2/EI = DYN_LOAD), undamped, to DYN_T_END: the tip trajectory of each side at the same
+  resolution N, each against a converged reference (mechgen's finest run: DYN_REF_ELEMENTS elements, its
+  smallest dt), error = max over the run of |tip - tip_ref| / max |tip deflection|; the two sides'
+  agreement with each other by the same measure; the wall-time ratio at matched accuracy (mechgen's
+  largest dt on its ladder whose error is at most PyElastica's at PyElastica's stable dt).
+* **stiff** (needs ``mechgen.rod_dynamics``): E (and G) 100 times larger: PyElastica's explicit step must
+  stay below dl sqrt(rho/max(E, G)) (and the section's shear-rotation mode, 2/omega_rot, omega_rot =
+  sqrt(alpha_c G A/(rho I))); it is run at 0.5 and at STIFF_OVER times that limit (the second blows up:
+  non-finite or |tip| > 10 L), while mechgen's implicit step runs at dt far above it.
+
+Timing: one BLAS thread for both (common.blas_threads); PyElastica's numba functions compiled by an untimed
+warm-up run first (its seconds reported); a PyElastica time is its stepping loop, a mechgen time the whole
+public call (``mechgen.rod_statics`` / ``mechgen.rod_dynamics``: set-up and solve) on a compiled system,
+the best of REPEATS runs after a warm-up (one run in quick mode). Writes ``rods_work_precision.{csv,png}``,
+``rods_ratios.json`` (ratio = PyElastica seconds / mechgen seconds at the condition stated) and
+``rods.json``, ``rods.md``; ``quick``: tiny ladders (< 20 s once numba's cache is warm).
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from mechgen.bench.common import best_time, blas_threads, environment, suite_report, write_json, write_text
+
+#: the PyElastica release the suite was written and measured against (pyproject's bench extra)
+PYELASTICA_PIN = "1.0.0"
+#: PyElastica 1.0.0's shear coefficient (elastica/rod/factory_function.py); the suite measures it too
+ALPHA_C_PIN = 27.0 / 28.0
+#: Mattiasson (1981), table 1, at P L^2/EI = 10: (L - x)/L, y/L (tip load along -y)
+MATTIASSON_10 = (0.55500, -0.81061)
+#: the static load P L^2/EI
+STATIC_LOAD = 10.0
+#: PyElastica's static limit: run (damped) until max |v| < REST_TOL (m/s), at most REST_T_MAX (s)
+REST_TOL = 1e-9
+REST_T_MAX = 60.0
+#: PyElastica's damping for the static limit (1/s; about twice the loaded rod's first frequency)
+REST_DAMPING = 10.0
+#: the dynamic step load P L^2/EI, the run's length (s; the first period of the unloaded rod is 1.79 s)
+DYN_LOAD = 2.0
+DYN_T_END = 1.0
+DYN_REF_ELEMENTS = 160
+#: the stiff case: E and G times STIFF_FACTOR; PyElastica also run at STIFF_OVER times its stable limit
+STIFF_FACTOR = 100.0
+STIFF_OVER = 2.0
+#: the speed target at matched accuracy (issue 15)
+TARGET = 5.0
+
+
+@dataclass(frozen=True)
+class Section:
+    """A solid circular rod of length L (m), radius r (m), density rho (kg/m^3), moduli E, G (Pa)."""
+
+    L: float
+    r: float
+    rho: float
+    E: float
+    G: float
+
+    @property
+    def A(self) -> float:
+        return math.pi * self.r ** 2
+
+    @property
+    def I(self) -> float:  # noqa: E743 (the second moment of area, m^4)
+        return self.A ** 2 / (4 * math.pi)
+
+    def params(self, alpha_c: float = ALPHA_C_PIN) -> dict:
+        """mechgen's ``cosserat_rod`` parameters of this section (the mapping in the module doc)."""
+        A, I = self.A, self.I
+        return {"L": self.L, "EA": self.E * A, "GA": alpha_c * self.G * A, "GJ": self.G * 2 * I, "EI": self.E * I,
+                "rhoA": self.rho * A, "rhoI": self.rho * I, "rhoJ": self.rho * 2 * I}
+
+    def stable_dt(self, n: int, alpha_c: float = ALPHA_C_PIN) -> float:
+        """PyElastica's explicit limit (s): min(dl sqrt(rho/max(E, G)), 2/omega_rot), omega_rot = sqrt(alpha_c G
+        A/(rho I)) the element's shear-rotation frequency (independent of dl: it binds when dl > ~r)."""
+        wave = self.L / n * math.sqrt(self.rho / max(self.E, self.G))
+        rot = 2.0 / math.sqrt(alpha_c * self.G * self.A / (self.rho * self.I))
+        return min(wave, rot)
+
+
+def base_section(stiff: float = 1.0) -> Section:
+    """L = 1 m, r = 0.01 m, EI = stiff N m^2, rhoA = 1 kg/m, G = E/3 (PyElastica's default, nu = 0.5)."""
+    r = 0.01
+    A, I = math.pi * r ** 2, math.pi * r ** 4 / 4
+    E = stiff / I
+    return Section(L=1.0, r=r, rho=1.0 / A, E=E, G=E / 3)
+
+
+# -- the elliptic-integral reference ----------------------------------------------------------------------------
+def elastica(alpha: float) -> tuple[float, float, float]:
+    """Bisshopp & Drucker's inextensible cantilever under a dead tip load P (alpha = P L^2/EI):
+    ((L - x)/L, y/L (along the load), tip angle phi) with sqrt(alpha) = K(k) - F(psi0, k), k^2 = (1 + sin phi)/2,
+    sin psi0 = 1/(k sqrt 2), x/L = sqrt(2 sin phi/alpha), y/L = 1 - 2 (E(k) - E(psi0, k))/sqrt(alpha)."""
+    from scipy.optimize import brentq
+    from scipy.special import ellipe, ellipeinc, ellipk, ellipkinc
+
+    def gap(phi):
+        m = (1 + math.sin(phi)) / 2
+        return ellipk(m) - ellipkinc(math.asin(1 / math.sqrt(2 * m)), m) - math.sqrt(alpha)
+
+    phi = brentq(gap, 1e-12, math.pi / 2 - 1e-13, xtol=1e-15)
+    m = (1 + math.sin(phi)) / 2
+    psi0 = math.asin(1 / math.sqrt(2 * m))
+    x = math.sqrt(2 * math.sin(phi) / alpha)
+    y = 1 - 2 / math.sqrt(alpha) * (ellipe(m) - ellipeinc(psi0, m))
+    return 1 - x, y, phi
+
+
+# -- PyElastica ---------------------------------------------------------------------------------------------------
+def pyelastica_version() -> str | None:
+    """The installed pyelastica's version, or None."""
+    try:
+        from importlib.metadata import PackageNotFoundError, version
+        return version("pyelastica")
+    except PackageNotFoundError:
+        return None
+
+
+def _elastica():
+    import elastica as ea
+    from elastica.timestepper.symplectic_steppers import PositionVerlet
+
+    class Simulator(ea.BaseSystemCollection, ea.Constraints, ea.Forcing, ea.Damping):
+        pass
+
+    return ea, Simulator, PositionVerlet
+
+
+def pyelastica_rod(sec: Section, n: int):
+    """A straight PyElastica rod from the origin along +x (normal +z), n elements."""
+    ea, _, _ = _elastica()
+    return ea.CosseratRod.straight_rod(n, np.zeros(3), np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 1.0]),
+                                       sec.L, sec.r, sec.rho, youngs_modulus=sec.E, shear_modulus=sec.G)
+
+
+def pyelastica_section_check(sec: Section) -> dict:
+    """alpha_c = S_11/(G A) and the mass second moment / (rho dl) (expected diag(I, I, 2I)) read back from a
+    PyElastica rod, with PyElastica's EA, EI, GJ against the mapping's."""
+    rod = pyelastica_rod(sec, 4)
+    dl = sec.L / 4
+    S, B, Jm = rod.shear_matrix[:, :, 0], rod.bend_matrix[:, :, 0], rod.mass_second_moment_of_inertia[:, :, 0]
+    p = sec.params(S[0, 0] / (sec.G * sec.A))
+    return {"alpha_c": float(S[0, 0] / (sec.G * sec.A)), "EA_rel_diff": float(S[2, 2] / p["EA"] - 1),
+            "EI_rel_diff": float(B[0, 0] / p["EI"] - 1), "GJ_rel_diff": float(B[2, 2] / p["GJ"] - 1),
+            "mass_second_moment_over_rho_dl": [float(Jm[i, i] / (sec.rho * dl)) for i in range(3)],
+            "I": sec.I, "J": 2 * sec.I}
+
+
+def pyelastica_cantilever(sec: Section, n: int, *, tip_force, dt: float, t_end: float, damping: float = 0.0,
+                          save_every: int = 1, rest_tol: float | None = None, check_every: int = 500) -> dict:
+    """PyElastica's clamped cantilever (``OneEndFixedBC`` at node 0, tip force on the last node) stepped by
+    PositionVerlet at dt (s) to t_end (s), or, with ``rest_tol``, until max |v| < rest_tol (m/s; checked every
+    ``check_every`` steps). Returns t (s), tip_trajectory ([x, y, z] every ``save_every`` steps, m),
+    tip_position, wall_s (the stepping loop), steps, blew_up (non-finite or |tip| > 10 L) and t_blew_up."""
+    ea, Simulator, PositionVerlet = _elastica()
+    sim = Simulator()
+    rod = pyelastica_rod(sec, n)
+    sim.append(rod)
+    sim.constrain(rod).using(ea.OneEndFixedBC, constrained_position_idx=(0,), constrained_director_idx=(0,))
+    sim.add_forcing_to(rod).using(ea.EndpointForces, np.zeros(3), np.array(tip_force, dtype=float),
+                                  ramp_up_time=1e-300)
+    if damping > 0:
+        sim.dampen(rod).using(ea.AnalyticalLinearDamper, uniform_damping_constant=damping, time_step=dt)
+    sim.finalize()
+    stepper = PositionVerlet()
+    steps = int(round(t_end / dt))
+    t, dt64 = np.float64(0.0), np.float64(dt)
+    ts, traj = [0.0], [rod.position_collection[:, -1].copy()]
+    blew = None
+    start = time.perf_counter()
+    k = 0
+    while k < steps:
+        t = stepper.step(sim, t, dt64)
+        k += 1
+        if k % save_every == 0:
+            ts.append(float(t))
+            traj.append(rod.position_collection[:, -1].copy())
+        if k % check_every == 0:
+            tip = rod.position_collection[:, -1]
+            if not np.all(np.isfinite(tip)) or np.max(np.abs(tip)) > 10 * sec.L:
+                blew = float(t)
+                break
+            if rest_tol is not None and np.max(np.abs(rod.velocity_collection)) < rest_tol:
+                break
+    wall = time.perf_counter() - start
+    tip = rod.position_collection[:, -1].copy()
+    if blew is None and (not np.all(np.isfinite(tip)) or np.max(np.abs(tip)) > 10 * sec.L):
+        blew = float(t)
+    return {"t": ts, "tip_trajectory": np.array(traj), "tip_position": tip, "wall_s": wall, "steps": k, "dt": dt,
+            "blew_up": blew is not None, "t_blew_up": blew,
+            "max_speed": float(np.max(np.abs(rod.velocity_collection)))}
+
+
+def pyelastica_warmup() -> float:
+    """Seconds of a tiny untimed PyElastica run (numba compiles or loads its cache)."""
+    start = time.perf_counter()
+    pyelastica_cantilever(base_section(), 4, tip_force=[0.0, -1.0, 0.0], dt=1e-5, t_end=1e-4, damping=1.0,
+                          check_every=5)
+    return time.perf_counter() - start
+
+
+# -- mechgen ------------------------------------------------------------------------------------------------------
+def _system(params: dict):
+    """The compiled ``cosserat_rod`` (C backend) at ``params``; rhoI, rhoJ left out where the model has none
+    (before rod dynamics: statics need no inertia)."""
+    import mechgen
+
+    known = {p.name for p in mechgen.load_model("cosserat_rod").param_list}
+    return mechgen.compile("cosserat_rod", params={k: v for k, v in params.items() if k in known}, backend="c")
+
+
+def _timed_best(fn, repeats: int):
+    out = {}
+
+    def call():
+        out["res"] = fn()
+
+    return best_time(call, min_time=0.0, repeats=repeats), out["res"]
+
+
+def _tip_error(tip, ref, L: float) -> float:
+    return float(max(abs(tip[0] - ref[0]), abs(tip[1] - ref[1]))) / L
+
+
+def static_study(quick: bool, repeats: int, have_elastica: bool) -> dict:
+    """The static part (module doc): rows of mechgen and PyElastica tip errors against wall time."""
+    import mechgen
+
+    sec = base_section()
+    P = STATIC_LOAD * sec.params()["EI"] / sec.L ** 2
+    force = [0.0, -P, 0.0]
+    system = _system(sec.params())
+
+    def statics(method, n, sys_=system):
+        return mechgen.rod_statics(sys_, tip_force=force, elements=n, method=method, steps=5)["tip_position"]
+
+    ref_steps = 40 if quick else 320
+    ref = statics("shooting", ref_steps)
+    half = statics("shooting", ref_steps // 2)
+    # validation of the reference solver: the elliptic solution against Mattiasson, and mechgen's shooting of
+    # a nearly inextensible rod against the elliptic solution
+    u, v, phi = elastica(STATIC_LOAD)
+    stiff_sys = _system({"L": 1.0, "EI": 1.0, "GJ": 1.0, "EA": 1e8, "GA": 1e8})
+    inext = mechgen.rod_statics(stiff_sys, tip_force=[0.0, -STATIC_LOAD, 0.0], elements=20 if quick else 80,
+                                method="shooting", steps=5)["tip_position"]
+    validation = {"elliptic_(L-x)/L": u, "elliptic_y/L": -v, "elliptic_tip_angle": phi,
+                  "mattiasson_10": list(MATTIASSON_10),
+                  "elliptic_minus_mattiasson": [u - MATTIASSON_10[0], -v - MATTIASSON_10[1]],
+                  "mechgen_shooting_EA_GA_1e8_minus_elliptic": [1 - inext[0] - u, inext[1] + v],
+                  "reference_minus_elliptic": [1 - ref[0] - u, ref[1] + v],
+                  "reference_self_convergence": _tip_error(ref, half, sec.L)}
+    rows = []
+    ladders = {"collocation": (10, 20, 40) if quick else (10, 20, 40, 80, 160, 320, 640),
+               "shooting": (5, 10) if quick else (5, 10, 20, 40, 80, 160)}
+    for method, ns in ladders.items():
+        for n in ns:
+            seconds, tip = _timed_best(lambda: statics(method, n), repeats)
+            rows.append({"side": f"mechgen {method}", "n": n, "seconds": seconds,
+                         "error": _tip_error(tip, ref, sec.L), "tip": list(tip)})
+    pyel = []
+    if have_elastica:
+        for n in ((10, 20) if quick else (10, 20, 40, 80, 160)):
+            dt = 0.5 * sec.stable_dt(n)
+            run = pyelastica_cantilever(sec, n, tip_force=force, dt=dt, t_end=REST_T_MAX, damping=REST_DAMPING,
+                                        rest_tol=REST_TOL)
+            pyel.append({"side": "PyElastica static limit", "n": n, "seconds": run["wall_s"],
+                         "error": _tip_error(run["tip_position"], ref, sec.L), "tip": list(run["tip_position"]),
+                         "dt": dt, "steps": run["steps"], "t_rest": run["steps"] * dt,
+                         "max_speed_end": run["max_speed"], "blew_up": run["blew_up"]})
+    return {"section": sec.__dict__, "params": sec.params(), "tip_force": force, "reference_steps": ref_steps,
+            "reference_tip": list(ref), "validation": validation, "rows": rows + pyel,
+            "orders": {side: _orders([r for r in rows + pyel if r["side"] == side])
+                       for side in dict.fromkeys(r["side"] for r in rows + pyel)}}
+
+
+def _orders(rows: list[dict]) -> list[float]:
+    """Observed orders log2(e(n)/e(2n)) along a doubling ladder."""
+    return [math.log(a["error"] / b["error"]) / math.log(b["n"] / a["n"])
+            for a, b in zip(rows, rows[1:]) if a["error"] > 0 and b["error"] > 0]
+
+
+# -- dynamics -----------------------------------------------------------------------------------------------------
+def _dynamics_available() -> bool:
+    import mechgen
+
+    return hasattr(mechgen, "rod_dynamics")
+
+
+def _mechgen_dynamic(system, n: int, dt: float, t_end: float, force, save_every: int = 1) -> dict:
+    import mechgen
+
+    res = mechgen.rod_dynamics(system, elements=n, dt=dt, t_end=t_end, tip_force=force, damping=0.0,
+                               save_every=save_every)
+    return {"t": np.asarray(res.outputs["t"], dtype=float),
+            "tip_trajectory": np.asarray(res.outputs["tip_trajectory"], dtype=float),
+            "energy_error": float(np.max(np.abs(np.asarray(res.outputs["energy_error"], dtype=float)))),
+            "orthonormality_error": float(np.max(res.outputs["orthonormality_error"]))}
+
+
+def _traj_error(t, tip, t_ref, tip_ref, scale: float) -> float:
+    """max over the run of |tip(t) - tip_ref(t)| / scale, the reference interpolated linearly onto t."""
+    ref = np.stack([np.interp(t, t_ref, tip_ref[:, i]) for i in range(3)], axis=1)
+    return float(np.max(np.linalg.norm(tip - ref, axis=1))) / scale
+
+
+def dynamic_study(quick: bool, repeats: int, have_elastica: bool) -> dict:
+    """The dynamic part (module doc)."""
+    sec = base_section()
+    params = sec.params()
+    system = _system(params)
+    P = DYN_LOAD * params["EI"] / sec.L ** 2
+    force = [0.0, -P, 0.0]
+    t_end = 0.25 if quick else DYN_T_END
+    n = 10 if quick else 20
+    ref_n = 40 if quick else DYN_REF_ELEMENTS
+    dts = (t_end / 20, t_end / 40) if quick else tuple(t_end / k for k in (25, 50, 100, 200, 400, 800))
+    ref_dt = dts[-1] / 2
+    ref = _mechgen_dynamic(system, ref_n, ref_dt, t_end, force)
+    half = _mechgen_dynamic(system, ref_n // 2, ref_dt, t_end, force)
+    t_ref, tip_ref = ref["t"], ref["tip_trajectory"]
+    scale = float(np.max(np.linalg.norm(tip_ref - tip_ref[0], axis=1)))
+    rows = []
+    for dt in dts:
+        seconds, run = _timed_best(lambda: _mechgen_dynamic(system, n, dt, t_end, force), repeats)
+        rows.append({"side": f"mechgen N={n}", "n": n, "dt": dt, "seconds": seconds,
+                     "error": _traj_error(run["t"], run["tip_trajectory"], t_ref, tip_ref, scale),
+                     "energy_error": run["energy_error"], "orthonormality_error": run["orthonormality_error"],
+                     "_run": run})
+    out = {"section": sec.__dict__, "params": params, "tip_force": force, "t_end": t_end, "elements": n,
+           "reference": {"elements": ref_n, "dt": ref_dt, "max_tip_deflection": scale,
+                         "self_convergence_half_elements": _traj_error(half["t"], half["tip_trajectory"], t_ref,
+                                                                       tip_ref, scale)}}
+    if have_elastica:
+        dt = 0.5 * sec.stable_dt(n)
+        stride = max(1, int(round(dts[-1] / dt)))
+        peer = pyelastica_cantilever(sec, n, tip_force=force, dt=dt, t_end=t_end, save_every=stride)
+        perr = _traj_error(np.asarray(peer["t"]), peer["tip_trajectory"], t_ref, tip_ref, scale)
+        prow = {"side": f"PyElastica N={n}", "n": n, "dt": dt, "seconds": peer["wall_s"], "error": perr,
+                "steps": peer["steps"], "blew_up": peer["blew_up"]}
+        for r in rows:
+            run = r["_run"]
+            r["agreement_with_pyelastica"] = _traj_error(np.asarray(peer["t"]), peer["tip_trajectory"], run["t"],
+                                                         run["tip_trajectory"], scale)
+        matched = [r for r in rows if r["error"] <= perr]
+        best = max(matched, key=lambda r: r["dt"]) if matched else None
+        out["pyelastica"] = prow
+        out["matched"] = None if best is None else {
+            "mechgen_dt": best["dt"], "mechgen_error": best["error"], "mechgen_s": best["seconds"],
+            "pyelastica_dt": dt, "pyelastica_error": perr, "pyelastica_s": peer["wall_s"],
+            "ratio": peer["wall_s"] / best["seconds"], "dt_ratio": best["dt"] / dt}
+        rows.append(prow)
+    for r in rows:
+        r.pop("_run", None)
+    out["rows"] = rows
+    return out
+
+
+def stiff_study(quick: bool, repeats: int, have_elastica: bool) -> dict:
+    """The stiff part (module doc): E, G x STIFF_FACTOR."""
+    sec = base_section(STIFF_FACTOR)
+    params = sec.params()
+    system = _system(params)
+    P = DYN_LOAD * params["EI"] / sec.L ** 2
+    force = [0.0, -P, 0.0]
+    n = 10 if quick else 20
+    t_end = 0.05 if quick else 0.2
+    limit = sec.stable_dt(n)
+    out = {"section": sec.__dict__, "params": params, "elements": n, "t_end": t_end, "pyelastica_limit_dt": limit,
+           "wave_limit_dt": sec.L / n * math.sqrt(sec.rho / max(sec.E, sec.G))}
+    dts = (t_end / 10, t_end / 20) if quick else (t_end / 20, t_end / 40, t_end / 80)
+    ref = _mechgen_dynamic(system, n, dts[-1] / 4, t_end, force)
+    scale = float(np.max(np.linalg.norm(ref["tip_trajectory"] - ref["tip_trajectory"][0], axis=1)))
+    rows = []
+    for dt in dts:
+        seconds, run = _timed_best(lambda: _mechgen_dynamic(system, n, dt, t_end, force), repeats)
+        rows.append({"side": f"stiff mechgen N={n}", "n": n, "dt": dt, "dt_over_pyelastica_limit": dt / limit,
+                     "seconds": seconds, "energy_error": run["energy_error"],
+                     "error": _traj_error(run["t"], run["tip_trajectory"], ref["t"], ref["tip_trajectory"], scale)})
+    out["reference"] = {"elements": n, "dt": dts[-1] / 4, "max_tip_deflection": scale,
+                        "note": "the same N (time error only)"}
+    if have_elastica:
+        peer = []
+        for factor in (0.5, STIFF_OVER):
+            dt = factor * limit
+            t_run = t_end if factor < 1 else min(t_end, 2000 * dt)
+            run = pyelastica_cantilever(sec, n, tip_force=force, dt=dt, t_end=t_run,
+                                        save_every=max(1, int(round(dts[-1] / dt))), check_every=20)
+            err = None if run["blew_up"] else _traj_error(np.asarray(run["t"]), run["tip_trajectory"], ref["t"],
+                                                          ref["tip_trajectory"], scale)
+            peer.append({"side": f"stiff PyElastica N={n}", "n": n, "dt": dt, "dt_over_limit": factor,
+                         "seconds": run["wall_s"], "steps": run["steps"], "blew_up": run["blew_up"],
+                         "t_blew_up": run["t_blew_up"], "t_run": t_run, "error": err})
+        out["pyelastica"] = peer
+    out["rows"] = rows
+    return out
+
+
+# -- the suite ------------------------------------------------------------------------------------------------------
+def markdown(results: dict) -> str:
+    """The suite's report as Markdown tables."""
+    st = results["static"]
+    pe = results["pyelastica"]
+    lines = ["# Cosserat rod: mechgen against PyElastica", "",
+             f"PyElastica: {pe if isinstance(pe, str) else 'pyelastica ' + pe['version'] + ', alpha_c = ' + format(pe['alpha_c'], '.6g')}",
+             "", "## Static tip load, P L^2/EI = 10", "",
+             f"Reference: mechgen RKMK4 shooting, {st['reference_steps']} steps, of the same extensible rod "
+             f"(EA = {st['params']['EA']:.4g} N, GA = {st['params']['GA']:.4g} N, EI = {st['params']['EI']:.4g} N m^2); "
+             f"self-convergence {st['validation']['reference_self_convergence']:.1e}; elliptic minus Mattiasson "
+             f"{max(map(abs, st['validation']['elliptic_minus_mattiasson'])):.1e}; mechgen (EA = GA = 1e8 EI) minus "
+             f"elliptic {max(map(abs, st['validation']['mechgen_shooting_EA_GA_1e8_minus_elliptic'])):.1e}.", "",
+             "| side | n | seconds | error / L |", "|---|---|---|---|"]
+    lines += [f"| {r['side']} | {r['n']} | {r['seconds']:.3g} | {r['error']:.2e} |" for r in st["rows"]]
+    lines += ["", "Observed orders: " + "; ".join(f"{k}: {', '.join(f'{o:.2f}' for o in v)}"
+                                                 for k, v in st["orders"].items())]
+    for key, title in (("dynamic", "Dynamic step load"), ("stiff", "Stiff rod (E x 100)")):
+        part = results[key]
+        lines += ["", f"## {title}", ""]
+        if isinstance(part, str):
+            lines.append(part)
+            continue
+        lines += ["| side | N | dt (s) | seconds | error | agreement with PyElastica |", "|---|---|---|---|---|---|"]
+        for r in part["rows"] + (part.get("pyelastica") if isinstance(part.get("pyelastica"), list) else []):
+            err = "blew up" if r.get("blew_up") else f"{r['error']:.2e}"
+            agree = r.get("agreement_with_pyelastica")
+            lines.append(f"| {r['side']} | {r['n']} | {r['dt']:.3g} | {r['seconds']:.3g} | {err} | "
+                         f"{'' if agree is None else format(agree, '.2e')} |")
+        if part.get("matched"):
+            m = part["matched"]
+            lines += ["", f"Matched accuracy: mechgen dt {m['mechgen_dt']:.3g} s (error {m['mechgen_error']:.2e}, "
+                          f"{m['mechgen_s']:.3g} s) against PyElastica dt {m['pyelastica_dt']:.3g} s (error "
+                          f"{m['pyelastica_error']:.2e}, {m['pyelastica_s']:.3g} s): ratio {m['ratio']:.2f} "
+                          f"(target {TARGET:g})."]
+    return "\n".join(lines) + "\n"
+
+
+def run_rods_benchmarks(out: Path, quick: bool = False) -> dict:
+    """Run the suite (see the module doc) and write its reports into ``out``."""
+    out = Path(out)
+    version = pyelastica_version()
+    have = version is not None
+    env = environment(pyelastica=version)
+    repeats = 1 if quick else 3
+    results: dict = {"quick": quick, "environment": env, "target": TARGET}
+    with blas_threads(1):
+        if have:
+            warm = pyelastica_warmup()
+            results["pyelastica"] = {"version": version, "pin": PYELASTICA_PIN, "jit_warmup_s": warm,
+                                     **pyelastica_section_check(base_section())}
+        else:
+            results["pyelastica"] = "skipped: pyelastica is not installed (pip install pyelastica==" \
+                                    f"{PYELASTICA_PIN}, or the bench extra)"
+        results["static"] = static_study(quick, repeats, have)
+        if _dynamics_available():
+            results["dynamic"] = dynamic_study(quick, repeats, have)
+            results["stiff"] = stiff_study(quick, repeats, have)
+        else:
+            results["dynamic"] = results["stiff"] = "skipped: mechgen.rod_dynamics is not available"
+    env["loadavg_after"] = list(__import__("os").getloadavg())
+    points = [{"series": f"static: {r['side']}", "setting": f"n={r['n']}", "seconds": r["seconds"],
+               "error": r["error"]} for r in results["static"]["rows"]]
+    ratios = []
+    st_rows = results["static"]["rows"]
+    peer_rows = [r for r in st_rows if r["side"].startswith("PyElastica")]
+    if peer_rows:
+        finest = peer_rows[-1]
+        ours = [r for r in st_rows if r["side"] == "mechgen collocation" and r["error"] <= finest["error"]]
+        if ours:
+            coarsest = ours[0] is next(r for r in st_rows if r["side"] == "mechgen collocation")
+            ratios.append({"peer": "PyElastica (static limit)", "ours_s": ours[0]["seconds"], "peer_s": finest["seconds"],
+                           "condition": f"static tip error <= {finest['error']:.2e} L: PyElastica n_elem "
+                                        f"{finest['n']} (damped run to rest: it has no static solver), mechgen "
+                                        f"collocation {ours[0]['n']} elements (error {ours[0]['error']:.2e})"
+                                        + ("; mechgen's coarsest point already meets it: a lower bound" if coarsest
+                                           else "")})
+    for key in ("dynamic", "stiff"):
+        part = results[key]
+        if isinstance(part, str):
+            continue
+        for r in part["rows"] + (part["pyelastica"] if isinstance(part.get("pyelastica"), list) else
+                                 [part["pyelastica"]] if "pyelastica" in part else []):
+            if r.get("error") is not None:
+                points.append({"series": f"{key}: {r['side']}", "setting": f"dt={r['dt']:.3g}",
+                               "seconds": r["seconds"], "error": r["error"]})
+        if part.get("matched"):
+            m = part["matched"]
+            ratios.append({"peer": "PyElastica (dynamic)", "ours_s": m["mechgen_s"], "peer_s": m["pyelastica_s"],
+                           "condition": f"matched accuracy at N = {part['elements']}: max tip error over the run "
+                                        f"{m['mechgen_error']:.2e} (mechgen dt {m['mechgen_dt']:.3g} s) <= "
+                                        f"{m['pyelastica_error']:.2e} (PyElastica dt {m['pyelastica_dt']:.3g} s)"})
+    results["ratios"] = ratios
+    suite_report(out, "rods", points,
+                 reference="static: mechgen RKMK4 shooting of the same rod, finest (validated against Bisshopp-"
+                           "Drucker / Mattiasson); dynamic: mechgen's finest run",
+                 error="tip error / L (static); max over the run / max tip deflection (dynamic)",
+                 time="wall time (s)", title="Cosserat cantilever: mechgen against PyElastica", ratios=ratios)
+    write_json(out / "rods.json", results)
+    write_text(out / "rods.md", markdown(results))
+    return results
