@@ -43,7 +43,7 @@ Parts:
 * **stiff** (needs ``mechgen.rod_dynamics``): E (and G) 100 times larger: PyElastica's explicit step must
   stay below dl sqrt(rho/max(E, G)) (and the section's shear-rotation mode, 2/omega_rot, omega_rot =
   sqrt(alpha_c G A/(rho I))); it is run at 0.5 and at STIFF_OVER times that limit (the second blows up:
-  non-finite or |tip| > 10 L), while mechgen's implicit step runs at dt far above it.
+  non-finite or |tip| > 1.5 L), while mechgen's implicit step runs at dt far above it.
 
 Timing: one BLAS thread for both (common.blas_threads); PyElastica's numba functions compiled by an untimed
 warm-up run first (its seconds reported); a PyElastica time is its stepping loop, a mechgen time the whole
@@ -192,7 +192,7 @@ def pyelastica_cantilever(sec: Section, n: int, *, tip_force, dt: float, t_end: 
     """PyElastica's clamped cantilever (``OneEndFixedBC`` at node 0, tip force on the last node) stepped by
     PositionVerlet at dt (s) to t_end (s), or, with ``rest_tol``, until max |v| < rest_tol (m/s; checked every
     ``check_every`` steps). Returns t (s), tip_trajectory ([x, y, z] every ``save_every`` steps, m),
-    tip_position, wall_s (the stepping loop), steps, blew_up (non-finite or |tip| > 10 L) and t_blew_up."""
+    tip_position, wall_s (the stepping loop), steps, blew_up (non-finite or |tip| > BLOWN L) and t_blew_up."""
     ea, Simulator, PositionVerlet = _elastica()
     sim = Simulator()
     rod = pyelastica_rod(sec, n)
@@ -218,18 +218,39 @@ def pyelastica_cantilever(sec: Section, n: int, *, tip_force, dt: float, t_end: 
             traj.append(rod.position_collection[:, -1].copy())
         if k % check_every == 0:
             tip = rod.position_collection[:, -1]
-            if not np.all(np.isfinite(tip)) or np.max(np.abs(tip)) > 10 * sec.L:
+            if not np.all(np.isfinite(tip)) or np.linalg.norm(tip) > BLOWN * sec.L:
                 blew = float(t)
                 break
             if rest_tol is not None and np.max(np.abs(rod.velocity_collection)) < rest_tol:
                 break
     wall = time.perf_counter() - start
     tip = rod.position_collection[:, -1].copy()
-    if blew is None and (not np.all(np.isfinite(tip)) or np.max(np.abs(tip)) > 10 * sec.L):
+    if blew is None and (not np.all(np.isfinite(tip)) or np.linalg.norm(tip) > BLOWN * sec.L):
         blew = float(t)
     return {"t": ts, "tip_trajectory": np.array(traj), "tip_position": tip, "wall_s": wall, "steps": k, "dt": dt,
             "blew_up": blew is not None, "t_blew_up": blew,
             "max_speed": float(np.max(np.abs(rod.velocity_collection)))}
+
+
+#: a run has blown up when its tip is farther than BLOWN x L from the clamp (an intact rod's is within ~L)
+BLOWN = 1.5
+#: the factors of Section.stable_dt tried by :func:`stable_runs`
+DT_FACTORS = (0.5, 0.7, 1.0, 1.4, 2.0, 2.8, 4.0)
+
+
+def stable_runs(sec: Section, n: int, force, t_end: float, save_dt: float) -> list[dict]:
+    """PyElastica's runs to t_end at dt = DT_FACTORS x Section.stable_dt(n), up to and including the first that
+    blows up (each a :func:`pyelastica_cantilever` result with its ``factor``)."""
+    limit = sec.stable_dt(n)
+    runs = []
+    for factor in DT_FACTORS:
+        dt = factor * limit
+        run = pyelastica_cantilever(sec, n, tip_force=force, dt=dt, t_end=t_end,
+                                    save_every=max(1, int(round(save_dt / dt))), check_every=20)
+        runs.append({**run, "factor": factor})
+        if run["blew_up"]:
+            break
+    return runs
 
 
 def pyelastica_warmup() -> float:
@@ -372,10 +393,19 @@ def dynamic_study(quick: bool, repeats: int, have_elastica: bool) -> dict:
                          "self_convergence_half_elements": _traj_error(half["t"], half["tip_trajectory"], t_ref,
                                                                        tip_ref, scale)}}
     if have_elastica:
-        dt = 0.5 * sec.stable_dt(n)
-        stride = max(1, int(round(dts[-1] / dt)))
-        peer = pyelastica_cantilever(sec, n, tip_force=force, dt=dt, t_end=t_end, save_every=stride)
-        perr = _traj_error(np.asarray(peer["t"]), peer["tip_trajectory"], t_ref, tip_ref, scale)
+        # the peer's dt, generous to it: the largest on the ladder that neither blows up nor has an error over
+        # 1.1 x that of the smallest dt tried (an accuracy not yet spoiled by the step)
+        runs = stable_runs(sec, n, force, t_end, dts[-1])
+        for run in runs:
+            run["error"] = None if run["blew_up"] else _traj_error(np.asarray(run["t"]), run["tip_trajectory"],
+                                                                     t_ref, tip_ref, scale)
+        ok = [run for run in runs if run["error"] is not None and run["error"] <= 1.1 * runs[0]["error"]]
+        if not ok:
+            raise RuntimeError(f"PyElastica blew up at every dt tried down to {runs[0]['dt']:.3g} s")
+        peer = max(ok, key=lambda run: run["dt"])
+        dt, perr = peer["dt"], peer["error"]
+        out["pyelastica_dt_search"] = [{"dt": run["dt"], "factor": run["factor"], "blew_up": run["blew_up"],
+                                        "error": run["error"], "seconds": run["wall_s"]} for run in runs]
         prow = {"side": f"PyElastica N={n}", "n": n, "dt": dt, "seconds": peer["wall_s"], "error": perr,
                 "steps": peer["steps"], "blew_up": peer["blew_up"]}
         for r in rows:
@@ -408,7 +438,7 @@ def stiff_study(quick: bool, repeats: int, have_elastica: bool) -> dict:
     limit = sec.stable_dt(n)
     out = {"section": sec.__dict__, "params": params, "elements": n, "t_end": t_end, "pyelastica_limit_dt": limit,
            "wave_limit_dt": sec.L / n * math.sqrt(sec.rho / max(sec.E, sec.G))}
-    dts = (t_end / 10, t_end / 20) if quick else (t_end / 20, t_end / 40, t_end / 80)
+    dts = (t_end / 10, t_end / 20) if quick else tuple(t_end / k for k in (20, 40, 80, 160, 320))
     ref = _mechgen_dynamic(system, n, dts[-1] / 4, t_end, force)
     scale = float(np.max(np.linalg.norm(ref["tip_trajectory"] - ref["tip_trajectory"][0], axis=1)))
     rows = []
@@ -421,7 +451,8 @@ def stiff_study(quick: bool, repeats: int, have_elastica: bool) -> dict:
                         "note": "the same N (time error only)"}
     if have_elastica:
         peer = []
-        for factor in (0.5, STIFF_OVER):
+        wave = out["wave_limit_dt"]
+        for factor in (0.5, STIFF_OVER) + ((wave / limit,) if wave > STIFF_OVER * limit else ()):
             dt = factor * limit
             t_run = t_end if factor < 1 else min(t_end, 2000 * dt)
             run = pyelastica_cantilever(sec, n, tip_force=force, dt=dt, t_end=t_run,
@@ -429,6 +460,7 @@ def stiff_study(quick: bool, repeats: int, have_elastica: bool) -> dict:
             err = None if run["blew_up"] else _traj_error(np.asarray(run["t"]), run["tip_trajectory"], ref["t"],
                                                           ref["tip_trajectory"], scale)
             peer.append({"side": f"stiff PyElastica N={n}", "n": n, "dt": dt, "dt_over_limit": factor,
+                         "dt_over_wave_limit": dt / wave,
                          "seconds": run["wall_s"], "steps": run["steps"], "blew_up": run["blew_up"],
                          "t_blew_up": run["t_blew_up"], "t_run": t_run, "error": err})
         out["pyelastica"] = peer
