@@ -8,7 +8,7 @@ The public names (DESIGN.md, "the user's three jobs"), importable from ``mechgen
   (``with_params(**values)`` gives a new one);
 * one function per analysis kind, each returning a ``Result``: ``modes``, ``stability``,
   ``steady``, ``continuation``, ``simulate``, ``sweep``, ``campbell``, ``fit``, ``impact``, ``restitution``,
-  ``periodic``, ``spectrum``, ``stability_boundary``, ``cross_section``, ``symplectic``, ``rod_statics``;
+  ``periodic``, ``spectrum``, ``stability_boundary``, ``cross_section``, ``symplectic``, ``rod_statics``, ``rod_dynamics``;
   and ``analysis(kind, system,
   **options)`` for any registered kind by name (``response`` has no function of its own);
 * ``run(scene)``: a scene file (or a dict of its contents), built on the same functions;
@@ -47,6 +47,7 @@ _EXPORTS = {
     "cross_section": "mechgen.analyses.public",
     "symplectic": "mechgen.analyses.public",
     "rod_statics": "mechgen.analyses.public",
+    "rod_dynamics": "mechgen.analyses.public",
     "analysis": "mechgen.analyses.public",
     "MechgenError": "mechgen.errors",
     "InputError": "mechgen.errors",

@@ -59,7 +59,7 @@ def test_the_registry_lists_the_seven_kinds_each_with_a_function():
     assert registry.kinds()[:len(KINDS)] == KINDS
     assert registry.kinds()[len(KINDS):] == ("response", "fit", "impact", "restitution", "stability_boundary", "spectrum",
                                                     "periodic",
-                                                    "cross_section", "symplectic", "rod_statics")
+                                                    "cross_section", "symplectic", "rod_statics", "rod_dynamics")
     for kind in KINDS:
         record = registry.get(kind)
         assert record.name == kind and record.schema and callable(record.run) and callable(record.summary)

@@ -19,7 +19,8 @@ from mechgen.analyses.schema import OptionContext, validate
 from mechgen.errors import InputError
 
 __all__ = ["analysis", "campbell", "continuation", "fit", "impact", "modes", "restitution", "simulate", "stability",
-           "steady", "sweep", "cross_section", "symplectic", "rod_statics"]
+           "steady", "sweep", "cross_section", "symplectic", "rod_statics",
+           "rod_dynamics"]
 
 
 def _model_info(system):
@@ -214,6 +215,21 @@ def rod_statics(system, *, name: str | None = None, **options) -> Result:
     ``stress_resultant``, ``branch`` (the tip pose per load step), ``velocity``, ``orthonormality_error``.
     """
     return _run("rod_statics", system, options, name)
+
+
+def rod_dynamics(system, *, name: str | None = None, **options) -> Result:
+    """The motion of the Cosserat rod a model declares with ``Model.rod(..., inertia=...)`` (initially along
+    x from the origin, at rest or moving rigidly), loads applied at t = 0: N two-node SO(3) x R^3 elements and
+    the implicit Lie-group midpoint step (mechgen.analyses.rod_dynamics).
+
+    Options: ``dt``, ``t_end`` (required, s), ``elements`` (or ``N``), ``base``, ``tip``, ``tip_force``,
+    ``tip_torque``, ``damping`` (1/s), ``initial_velocity``, ``initial_angular_velocity``, ``save_every``,
+    ``shape_every``, ``tol``, ``bending_axis``.
+    Outputs: ``t``, ``tip_trajectory``, ``tip_rotations``, ``tip_position``, ``tip_rotation``, ``energy``,
+    ``work``, ``energy_error``, ``orthonormality_error``, ``shape``, ``shapes``, ``strain``, ``stress_resultant``,
+    ``steps``, ``newton_iterations``.
+    """
+    return _run("rod_dynamics", system, options, name)
 
 
 def campbell(system, *, name: str | None = None, **options) -> Result:

@@ -31,6 +31,7 @@ MODULES = (
     "mechgen.analyses.cross_section",
     "mechgen.analyses.symplectic",
     "mechgen.analyses.rod_statics",
+    "mechgen.analyses.rod_dynamics",
 )
 
 

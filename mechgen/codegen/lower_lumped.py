@@ -10,7 +10,7 @@ Kernel names and what they compute (n coordinates, m internal variables):
 * ``rates_tangent``                                    -> g_q[m*n], g_v[m*n], g_z[m*m]
 * ``outputs``   declared outputs and energies          -> one port of length 1 each
 * ``section``   the declared section stiffness K(p)    -> K[36] (6 x 6, symmetric; Model.section_stiffness)
-* ``rod``       a declared rod's local pieces at (f, r) -> sigma[6], C[36], W[1], f0[6], g[6], g_r[18], L[1]
+* ``rod``       a declared rod's local pieces at (f, r) -> sigma[6], C[36], W[1], f0[6], g[6], g_r[18], L[1], M[36]
                 (Model.rod, mechgen.symbolic.rod: sigma = K (f - f0), the spatial load wrench g(r); batched)
 
 A hybrid model (mechgen.symbolic.hybrid) has each of these per mode i, named ``<kernel>__i``, and
@@ -104,7 +104,7 @@ def lower_lumped(eqs: LumpedEquations, name: str, *, cse: bool = True) -> Kernel
 
 
 def _rod_kernel(eqs: LumpedEquations, cse: bool) -> KernelIR:
-    """sigma, C, W, f0, g, g_r of the declared rod at a batch of (f, r)."""
+    """sigma, C, W, f0, g, g_r, L and the mass per length M of the declared rod at a batch of (f, r)."""
     rod = eqs.rod
     if rod is None:
         raise ModelError(f"model {eqs.model} declares no rod", key="rod",
@@ -114,8 +114,9 @@ def _rod_kernel(eqs: LumpedEquations, cse: bool) -> KernelIR:
     gathers = [(s, "f", i, False) for i, s in enumerate(rod.f)] + [(s, "r", i, False) for i, s in enumerate(rod.r)]
     gathers += [(s, "p", i, False) for i, s in enumerate(eqs.params)]
     mats = {"sigma": rod.sigma, "C": rod.C, "W": sp.Matrix([[rod.energy]]), "f0": rod.f0, "g": rod.load,
-            "g_r": rod.load_r, "L": sp.Matrix([[rod.length]])}
-    outputs = [Port(k, fixed(m.rows * m.cols), shape=(m.rows, m.cols), symmetric=k == "C") for k, m in mats.items()]
+            "g_r": rod.load_r, "L": sp.Matrix([[rod.length]]), "M": rod.M}
+    outputs = [Port(k, fixed(m.rows * m.cols), shape=(m.rows, m.cols), symmetric=k in ("C", "M"))
+               for k, m in mats.items()]
     writes = [w for k, m in mats.items() for w in dense_writes(k, m)]
     block = canonical_block(gathers, writes, cse=cse, model=eqs.model)
     return kernel("rod", "Cosserat rod: stress resultant, tangent, energy density, load", inputs, outputs, [block],

@@ -12,13 +12,16 @@ centrifugal force:
 
     q = rhoA (g_x, g_y, g_z) + rhoA omega^2 (x, y, 0)    (N/m),   l = 0.
 
-SI units: EA, GA in N, GJ, EI in N m^2, rhoA in kg/m, g in m/s^2, omega in rad/s. The ``rod_statics``
-analysis takes the ends, the tip force and torque and the discretisation; the ``cross_section`` analysis
-reports K.
+The kinetic energy is 1/2 int eta^T M eta ds with the velocity twist eta = (R^T r_t, omega) and
+M = diag(rhoA, rhoA, rhoA, rhoJ, rhoI, rhoI) (the ``rod_dynamics`` analysis; a rod at rest in statics needs none).
+
+SI units: EA, GA in N, GJ, EI in N m^2, rhoA in kg/m, rhoI, rhoJ in kg m, g in m/s^2, omega in rad/s. The
+``rod_statics`` analysis takes the ends, the tip force and torque and the discretisation; ``rod_dynamics``
+the ends, loads, time step and damping; the ``cross_section`` analysis reports K.
 """
 from mechgen.symbolic.model import Model
 from mechgen.symbolic.params import Param
-from mechgen.symbolic.rod import rod_stiffness
+from mechgen.symbolic.rod import rod_inertia, rod_stiffness
 
 model = Model("cosserat_rod", doc=__doc__, file=__file__)
 model.params(
@@ -28,6 +31,8 @@ model.params(
     Param("GJ", 1.0, "N m^2", "torsional stiffness"),
     Param("EI", 1.0, "N m^2", "bending stiffness (both directions)"),
     Param("rhoA", 0.0, "kg/m", "mass per unit length"),
+    Param("rhoI", 0.0, "kg m", "rotational inertia per unit length about each bending axis (rho I)"),
+    Param("rhoJ", 0.0, "kg m", "polar rotational inertia per unit length (rho J)"),
     Param("g_x", 0.0, "m/s^2", "gravity, x component"),
     Param("g_y", 0.0, "m/s^2", "gravity, y component"),
     Param("g_z", 0.0, "m/s^2", "gravity, z component"),
@@ -40,4 +45,5 @@ def _load(r, p):
     return (p.rhoA * p.g_x + c * r.x, p.rhoA * p.g_y + c * r.y, p.rhoA * p.g_z)
 
 
-model.rod(length=lambda p: p.L, stiffness=lambda p: rod_stiffness(p.EA, p.GA, p.GJ, p.EI), load=_load)
+model.rod(length=lambda p: p.L, stiffness=lambda p: rod_stiffness(p.EA, p.GA, p.GJ, p.EI), load=_load,
+          inertia=lambda p: rod_inertia(p.rhoA, p.rhoJ, p.rhoI))

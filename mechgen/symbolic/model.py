@@ -349,7 +349,7 @@ class Model:
         return fn
 
     def rod(self, *, length: Callable | None = None, stiffness: Callable | None = None, f0: Callable | None = None,
-            load: Callable | None = None, doc: str = "") -> None:
+            load: Callable | None = None, inertia: Callable | None = None, doc: str = "") -> None:
         """Declare a geometrically exact (Cosserat) rod with strain energy 1/2 int (f - f0)^T K (f - f0) ds,
         f = vee6(H^-1 H') = (nu, kappa) (mechgen.symbolic.rod).
 
@@ -360,8 +360,10 @@ class Model:
         ``f0(p)``: the reference twist (6; default (1, 0, 0, 0, 0, 0), straight along the first section axis).
         ``load(r, p)``: the distributed wrench per unit length in the spatial frame at the centre-line point
         ``r`` (``r.x``, ``r.y``, ``r.z``): 3 force components (N/m) or 6 (force, torque N m/m).
-        The ``rod`` kernel evaluates sigma = K (f - f0), C = d sigma/df, W, f0, the load and d load/dr;
-        the ``rod_statics`` analysis solves the rod's equilibrium.
+        ``inertia(p)``: the mass per unit length M (6 x 6, kinetic energy 1/2 int eta^T M eta ds), e.g.
+        ``lambda p: rod_inertia(p.rhoA, p.rhoJ, p.rhoI)`` (kg/m, kg m); needed by ``rod_dynamics``.
+        The ``rod`` kernel evaluates sigma = K (f - f0), C = d sigma/df, W, f0, the load and d load/dr, L
+        and M; the ``rod_statics`` analysis solves the rod's equilibrium, ``rod_dynamics`` its motion.
         """
         from mechgen.symbolic.rod import RodSpec
 
@@ -370,7 +372,7 @@ class Model:
                              expected="one rod declaration")
         if stiffness is not None and self.section_fn is None:
             self.section_fn = stiffness
-        self.rod_spec = RodSpec(stiffness, f0, load, length, doc)
+        self.rod_spec = RodSpec(stiffness, f0, load, length, doc, inertia)
 
     def chain(self, coordinate: str, *, sites: str, ends: str = "fixed") -> None:
         """Declare a lattice of identical sites; ``sites`` names a size parameter.

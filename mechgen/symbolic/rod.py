@@ -23,7 +23,7 @@ kernel evaluates them at a batch of points; mechgen.runtime.rods.statics integra
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Callable
 
 import sympy as sp
@@ -43,6 +43,15 @@ def rod_stiffness(EA, GA, GJ, EI, *, GA3=None, EI3=None) -> sp.Matrix:  # noqa: 
     return sp.diag(EA, GA, GA3, GJ, EI, EI3)
 
 
+def rod_inertia(rhoA, rhoJ, rhoI, *, rhoI3=None) -> sp.Matrix:  # noqa: N803 - the issue's names
+    """The mass per unit length M = diag(rhoA, rhoA, rhoA, rhoJ, rhoI2, rhoI3) of a section whose mass centre
+    is on the centre line, on its principal axes: kinetic energy 1/2 int eta^T M eta ds with the velocity twist
+    eta = (R^T r_t, omega) (seed 001, slide 24). rhoA in kg/m; rhoJ = rho J (polar) and rhoI = rho I (each
+    bending axis, unless ``rhoI3`` is given) in kg m."""
+    rhoI3 = rhoI if rhoI3 is None else rhoI3
+    return sp.diag(rhoA, rhoA, rhoA, rhoJ, rhoI, rhoI3)
+
+
 @dataclass(frozen=True)
 class RodSpec:
     """A declared rod (Model.rod): the stiffness K(p) (None: the declared section), the reference twist
@@ -53,12 +62,14 @@ class RodSpec:
     load: Callable | None
     length: Callable | None = None
     doc: str = ""
+    inertia: Callable | None = None
 
 
 @dataclass(frozen=True)
 class RodPieces:
     """The derived local pieces: symbols f (6) and r (3); W, sigma (6), C (6 x 6), the reference twist f0 (6),
-    the spatial load wrench g (6) and dg/dr (6 x 3)."""
+    the spatial load wrench g (6) and dg/dr (6 x 3), the length and the mass per length M (6 x 6; zero when
+    the rod declares no inertia)."""
 
     f: tuple[sp.Symbol, ...]
     r: tuple[sp.Symbol, ...]
@@ -69,6 +80,7 @@ class RodPieces:
     load: sp.Matrix
     load_r: sp.Matrix
     length: sp.Expr = sp.Integer(1)
+    M: sp.Matrix = field(default_factory=lambda: sp.zeros(6, 6))
 
 
 STRAIN_SYMBOLS = tuple(sp.Symbol(f"f_{c}", real=True) for c in COMPONENTS)
@@ -128,4 +140,12 @@ def derive_rod(model, p_ns, K: sp.Matrix | None, params: tuple[sp.Symbol, ...]) 
         load = _vector(raw, 6, "load", model, allowed | set(r))
     length = sp.Integer(1) if spec.length is None else \
         _vector([call_declared(spec.length, p=p_ns)], 1, "length", model, allowed)[0]
-    return RodPieces(f, r, W, sigma, C, f0, load, load.jacobian(sp.Matrix(r)), length)
+    M = sp.zeros(6, 6)
+    if spec.inertia is not None:
+        M = sp.Matrix(call_declared(spec.inertia, p=p_ns))
+        stray = set().union(*(e.free_symbols for e in M)) - allowed if M.shape == (6, 6) else set()
+        if M.shape != (6, 6) or stray or any(sp.simplify(M[i, j] - M[j, i]) != 0 for i in range(6) for j in range(i)):
+            raise ModelError(f"the rod inertia of model {model.name} is not a symmetric 6 x 6 matrix of the "
+                             "parameters", file=model.file, key="rod.inertia",
+                             expected="inertia=lambda p: rod_inertia(p.rhoA, p.rhoJ, p.rhoI)")
+    return RodPieces(f, r, W, sigma, C, f0, load, load.jacobian(sp.Matrix(r)), length, M)

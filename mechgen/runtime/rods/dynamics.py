@@ -1,0 +1,504 @@
+"""Dynamics of a geometrically exact (Cosserat) rod: nodal SO(3) x R^3 elements, a Lie-group midpoint step.
+
+Spatial discretisation (conventions of mechgen.runtime.rods.liegroup and .statics; seed 001, Grazioso).
+N two-node elements of reference length h = L/N; node i carries a position x_i (spatial, m) and a rotation
+R_i (section frame -> spatial). Element e joins nodes i = e and i + 1:
+
+    Psi_e = log(R_i^T R_{i+1}),   R_e = R_i exp(Psi_e/2),   kappa_e = Psi_e/h,   nu_e = R_e^T (x_{i+1} - x_i)/h,
+
+so f_e = (nu_e, kappa_e) is the deformation twist at the element's midpoint to O(h^2), objective (invariant
+under a rigid motion) and exactly f0 on the reference configuration of a straight rod. The strain energy is
+the midpoint rule of the continuum one, V = sum_e h/2 (f_e - f0)^T K (f_e - f0), with sigma_e = (n_e, m_e)
+= K (f_e - f0). Its exact variation, with dx_i and body rotations R_i -> R_i exp(hat w_i), is
+
+    dPsi_e = J_r(Psi_e)^-1 w_{i+1} - J_l(Psi_e)^-1 w_i,
+    dV = sum_e (R_e n_e).(dx_{i+1} - dx_i) + a_e.(exp(Psi_e/2)^T w_i) + c_e.dPsi_e,
+    a_e = h n_e x nu_e,   c_e = m_e + J_r(Psi_e/2)^T a_e / 2,
+
+which gives the nodal internal forces F_i = -dV/dx_i (spatial, N) and body moments M_i = -dV/dw_i (N m).
+The kinetic energy is lumped at the nodes with the mass per length M = diag(rhoA I_3, J_rho) (kg/m, kg m):
+m_i = rhoA w_i, J_i = J_rho w_i with the nodal lengths w_i = h (h/2 at the ends),
+
+    T = sum_i 1/2 m_i |v_i|^2 + 1/2 omega_i^T J_i omega_i      (omega_i: body angular velocity, rad/s).
+
+Equations of motion per node: m_i v_i' = F_i + F_ext,i - c m_i v_i, J_i omega_i' + omega_i x J_i omega_i =
+M_i + M_ext,i - c J_i omega_i (c: mass-proportional damping, 1/s). External loads: the distributed spatial
+wrench q(x) (force, torque per length) lumped at the nodes (w_i q(x_i), the torque taken to the body frame),
+a dead tip force F and torque T (spatial) on the last node.
+
+Time step (implicit midpoint on SO(3) x R^3, order 2, A-stable on the linearisation): unknown increments
+dx_i and theta_i (body frame) with
+
+    x^{n+1} = x^n + dx,  R^{n+1} = R^n exp(hat theta),  v_mid = dx/dt,  omega_mid = theta/dt,
+    v^{n+1} = 2 v_mid - v^n,  omega^{n+1} = 2 omega_mid - omega^n,
+
+the equations of motion imposed at the midpoint configuration (x^n + dx/2, R^n exp(theta/2)) with the rates
+(v^{n+1} - v^n)/dt and the midpoint velocities. The midpoint rule does not damp modes with omega dt >> 1 (its
+amplification tends to -1): stiff shear and axial modes, once excited by a sudden load, ring. RodBody.alpha
+> 1/2 turns the step into the theta-method on the group (configuration x^n + alpha dx, R^n exp(alpha theta);
+v^{n+1} = (v_mid - (1 - alpha) v^n)/alpha; order 1; alpha = 1 backward Euler), which damps them: for
+dynamic relaxation to a static state, or a stiff transient where the high modes are not wanted. Rotations are only ever multiplied by exponentials (never
+integrated as angles or quaternions), so they stay orthonormal to round-off over any number of turns.
+Kinetic energy of the rotation is conserved exactly by the gyroscopic term (omega_mid . omega_mid x J
+omega_mid = 0); for the elastic energy the step is second-order (energy error O(dt^2), bounded, no drift).
+The coupled increments are found by Newton's method on a banded system (node-major order, bandwidth 11)
+whose Jacobian is taken by finite differences over three colours of nodes and kept over steps while the
+iteration contracts fast (simplified Newton); a step that does not converge is split in two, down to 2^-12
+of dt, before a ConvergenceError names the time reached.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.linalg import lapack
+
+from mechgen.errors import ConvergenceError
+from mechgen.runtime.rods.liegroup import exp_so3, hat3, jac_left_so3, jac_left_so3_inv, log_so3
+from mechgen.runtime.rods.statics import Rod
+
+ENDS = ("clamped", "pinned", "free")
+#: band half-width of the node-major Jacobian: a node's 6 equations reach the 6 unknowns of each neighbour
+BAND = 11
+MAX_SPLITS = 12
+#: simplified Newton's largest accepted contraction rate before the Jacobian is taken again
+REFRESH = 0.2
+
+
+@dataclass(frozen=True)
+class RodBody:
+    """A rod with its mass per length: the statics Rod (L, K, f0, loads, ends) and M = diag(rhoA I, J_rho)
+    (6 x 6, kg/m and kg m), the mass-proportional damping c (1/s)."""
+
+    rod: Rod
+    M: np.ndarray
+    damping: float = 0.0
+    #: the step's weight alpha in [1/2, 1]: 1/2 the midpoint rule (energy-conserving, order 2), above it the
+    #: theta-method's numerical dissipation of the stiff modes (order 1), 1 backward Euler
+    alpha: float = 0.5
+
+    @property
+    def rhoA(self) -> float:
+        return float(self.M[0, 0])
+
+    @property
+    def J_rho(self) -> np.ndarray:
+        return np.asarray(self.M[3:, 3:], dtype=float)
+
+
+def check_inertia(M: np.ndarray) -> str | None:
+    """None when M = diag(rhoA I_3, J) with rhoA > 0 and J symmetric positive definite; else what is wrong."""
+    M = np.asarray(M, dtype=float)
+    if M.shape != (6, 6) or not np.all(np.isfinite(M)):
+        return "the mass per length M is not a finite 6 x 6 matrix"
+    if np.any(M[:3, 3:] != 0.0) or np.any(M[3:, :3] != 0.0):
+        return "M couples translation and rotation (a section whose mass centre is off the centre line)"
+    rhoA = M[0, 0]
+    if not rhoA > 0.0 or np.max(np.abs(M[:3, :3] - rhoA * np.eye(3))) > 1e-12 * rhoA:
+        return f"the translational mass per length is not rhoA I with rhoA > 0 (M_uu = {M[:3, :3].tolist()})"
+    J = M[3:, 3:]
+    if np.max(np.abs(J - J.T)) > 1e-12 * np.max(np.abs(J)) or np.linalg.eigvalsh(J)[0] <= 0.0:
+        return f"the rotational inertia per length J is not symmetric positive definite (J = {J.tolist()})"
+    return None
+
+
+@dataclass
+class State:
+    """Nodal positions x (n, 3), rotations R (n, 3, 3), velocities v (n, 3), body angular velocities w (n, 3)."""
+
+    x: np.ndarray
+    R: np.ndarray
+    v: np.ndarray
+    w: np.ndarray
+
+    def copy(self) -> "State":
+        return State(self.x.copy(), self.R.copy(), self.v.copy(), self.w.copy())
+
+
+def reference_state(body: RodBody, elements: int) -> State:
+    """The reference configuration at rest: nodes at H(s) = exp(s hat6 f0) (straight along x for the default f0)."""
+    from mechgen.runtime.rods.liegroup import exp_se3
+
+    s = np.linspace(0.0, body.rod.L, elements + 1)
+    H = exp_se3(s[:, None] * body.rod.f0[None, :])
+    n = elements + 1
+    return State(H[:, :3, 3].copy(), H[:, :3, :3].copy(), np.zeros((n, 3)), np.zeros((n, 3)))
+
+
+def _cross(a, b):
+    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1], a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
+
+
+def _mv(A, b):
+    return np.einsum("...ij,...j->...i", A, b)
+
+
+def _mtv(A, b):
+    return np.einsum("...ji,...j->...i", A, b)
+
+
+@dataclass(frozen=True)
+class Discrete:
+    """The discretised rod: h, nodal lengths, masses and inertias, fixed degrees of freedom (n, 6)."""
+
+    body: RodBody
+    elements: int
+    base: str = "clamped"
+    tip: str = "free"
+    h: float = field(init=False)
+    weights: np.ndarray = field(init=False)
+    fixed: np.ndarray = field(init=False)
+
+    def __post_init__(self):
+        n = self.elements + 1
+        h = self.body.rod.L / self.elements
+        wts = np.full(n, h)
+        wts[0] = wts[-1] = h / 2
+        fixed = np.zeros((n, 6), dtype=bool)
+        for node, end in ((0, self.base), (-1, self.tip)):
+            if end not in ENDS:
+                raise ValueError(f"unknown end {end!r}: one of {', '.join(ENDS)}")
+            if end in ("clamped", "pinned"):
+                fixed[node, :3] = True
+            if end == "clamped":
+                fixed[node, 3:] = True
+        object.__setattr__(self, "h", h)
+        object.__setattr__(self, "weights", wts)
+        object.__setattr__(self, "fixed", fixed)
+
+    # ------------------------------------------------------------------ energy and forces
+    # Every array below may carry leading batch axes (..., n, 3): the finite-difference Jacobian evaluates
+    # all 18 perturbed residuals in one call.
+    def strains(self, x: np.ndarray, R: np.ndarray):
+        """Per element: Psi (..., N, 3), the midpoint rotation R_e (..., N, 3, 3), the twist f_e (..., N, 6)."""
+        Ri = R[..., :-1, :, :]
+        Psi = log_so3(np.swapaxes(Ri, -1, -2) @ R[..., 1:, :, :])
+        Re = Ri @ exp_so3(0.5 * Psi)
+        nu = _mtv(Re, x[..., 1:, :] - x[..., :-1, :]) / self.h
+        return Psi, Re, np.concatenate([nu, Psi / self.h], axis=-1)
+
+    def elastic_energy(self, x: np.ndarray, R: np.ndarray) -> float:
+        """V = sum_e h/2 (f_e - f0)^T K (f_e - f0) (J)."""
+        eps = self.strains(x, R)[2] - self.body.rod.f0
+        return float(0.5 * self.h * np.einsum("ei,ij,ej->", eps, self.body.rod.K, eps))
+
+    def internal(self, x: np.ndarray, R: np.ndarray):
+        """Nodal internal forces F (..., n, 3, spatial) and body moments Mb (..., n, 3): minus the exact
+        gradient of V; and the elements' stress resultants sigma (..., N, 6)."""
+        h, K = self.h, self.body.rod.K
+        Psi, Re, f = self.strains(x, R)
+        sigma = (f - self.body.rod.f0) @ K
+        n_, m_ = sigma[..., :3], sigma[..., 3:]
+        Fe = _mv(Re, n_)
+        F = np.zeros_like(x)
+        F[..., :-1, :] += Fe
+        F[..., 1:, :] -= Fe
+        a = h * _cross(n_, f[..., :3])
+        c = m_ + 0.5 * _mtv(jac_left_so3(-0.5 * Psi), a)          # J_r(Psi/2)^T a / 2
+        Rh = np.swapaxes(R[..., :-1, :, :], -1, -2) @ Re           # exp(Psi/2)
+        Jl_inv = jac_left_so3_inv(Psi)
+        Jr_inv = Jl_inv + hat3(Psi)                                # J_r^-1 = J_l^-1(-Psi) = I + W/2 + b W^2
+        Mb = np.zeros_like(x)
+        Mb[..., :-1, :] -= _mv(Rh, a) - _mtv(Jl_inv, c)            # -dV/dw_i
+        Mb[..., 1:, :] -= _mtv(Jr_inv, c)                          # -dV/dw_{i+1}
+        return F, Mb, sigma
+
+    def external(self, x: np.ndarray, R: np.ndarray):
+        """Lumped distributed load and the dead tip wrench: nodal spatial forces and body moments."""
+        rod = self.body.rod
+        F = np.zeros_like(x)
+        Mb = np.zeros_like(x)
+        if rod.load is not None:
+            g = np.asarray(rod.load(x.reshape(-1, 3)), dtype=float).reshape(x.shape[:-1] + (6,))
+            g = g * self.weights[:, None]
+            F += g[..., :3]
+            Mb += _mtv(R, g[..., 3:])
+        F[..., -1, :] += rod.tip_force
+        Mb[..., -1, :] += _mtv(R[..., -1, :, :], rod.tip_torque)
+        return F, Mb
+
+    def kinetic_energy(self, v: np.ndarray, w: np.ndarray) -> float:
+        """T = sum_i m_i |v_i|^2/2 + w_i^T J_i w_i/2 (J)."""
+        J = self.body.J_rho
+        return float(0.5 * np.sum(self.weights * (self.body.rhoA * np.sum(v * v, axis=1)
+                                                  + np.einsum("ni,ij,nj->n", w, J, w))))
+
+    # ------------------------------------------------------------------ the midpoint step
+    def residual(self, st: State, z: np.ndarray, dt: float):
+        """Midpoint equations at increments z = (dx, theta) (..., n, 6); also the external wrench there."""
+        dx, th = z[..., :3], z[..., 3:]
+        al = self.body.alpha
+        xm = st.x + al * dx
+        Rm = st.R @ exp_so3(al * th)
+        F, Mb, _ = self.internal(xm, Rm)
+        Fx, Mx = self.external(xm, Rm)
+        c = self.body.damping
+        vm, wm = dx / dt, th / dt
+        m = self.body.rhoA * self.weights[:, None]
+        Jw = wm @ self.body.J_rho.T
+        rt = m * ((vm - st.v) / (al * dt) + c * vm) - F - Fx
+        rr = self.weights[:, None] * (((wm - st.w) / (al * dt) + c * wm) @ self.body.J_rho.T + _cross(wm, Jw)) - Mb - Mx
+        r = np.concatenate([rt, rr], axis=-1)
+        r[..., self.fixed] = (z * self._fixed_scale(dt))[..., self.fixed]
+        return r, Fx, Mx
+
+    def _fixed_scale(self, dt: float) -> np.ndarray:
+        """Rows of fixed degrees of freedom: z itself, scaled like the inertia rows (m / (alpha dt^2))."""
+        m = self.body.rhoA * self.h / (self.body.alpha * dt**2)
+        j = float(np.max(np.diag(self.body.J_rho))) * self.h / (self.body.alpha * dt**2)
+        return np.concatenate([np.full(3, m), np.full(3, j)])
+
+    def _band_pattern(self):
+        """Index arrays of the colour-grouped finite differences: perturbation b = 6 colour + k moves unknown k
+        of the nodes p = colour mod 3; entry (b, q, a) of its residual change is J[6q + a, 6p + k]."""
+        n = self.elements + 1
+        b, q, a, p = [], [], [], []
+        for colour in range(3):
+            for k in range(6):
+                for node in range(colour, n, 3):
+                    for nb in (node - 1, node, node + 1):
+                        if 0 <= nb < n:
+                            for row in range(6):
+                                b.append(6 * colour + k), q.append(nb), a.append(row), p.append(node)
+        b, q, a, p = map(np.asarray, (b, q, a, p))
+        k = b % 6
+        col = 6 * p + k
+        return b, q, a, p, k, col, 2 * BAND + 6 * q + a - col
+
+    def jacobian_band(self, st: State, z: np.ndarray, dt: float, r0: np.ndarray) -> np.ndarray:
+        """The residual's Jacobian in LAPACK band storage (3 BAND + 1 rows), by forward differences over three
+        colours of nodes (a node's residual depends on its neighbours only), all 18 in one batched call."""
+        n = z.shape[0]
+        pattern = self.__dict__.get("_pattern")
+        if pattern is None:
+            pattern = self._band_pattern()
+            object.__setattr__(self, "_pattern", pattern)
+        b, q, a, p, k, col, row = pattern
+        scale = np.concatenate([np.full(3, self.h), np.ones(3)])
+        eps = 1e-7 * (scale[None, :] + np.abs(z))                      # (n, 6)
+        Z = np.broadcast_to(z, (18, n, 6)).copy()
+        for colour in range(3):
+            nodes = np.arange(colour, n, 3)
+            for kk in range(6):
+                Z[6 * colour + kk, nodes, kk] += eps[nodes, kk]
+        dR = self.residual(st, Z, dt)[0] - r0
+        ab = np.zeros((3 * BAND + 1, 6 * n))
+        ab[row, col] = dR[b, q, a] / eps[p, k]
+        return ab
+
+
+@dataclass
+class Trajectory:
+    """Saved times t, states (tip position, energies), the work of the loads and damping, the final state."""
+
+    t: list = field(default_factory=list)
+    tip: list = field(default_factory=list)
+    tip_rotation: list = field(default_factory=list)
+    energy: list = field(default_factory=list)
+    work: list = field(default_factory=list)
+    shapes: list = field(default_factory=list)
+    final: State | None = None
+    steps: int = 0
+    newton_iterations: int = 0
+    jacobians: int = 0
+    splits: int = 0
+
+
+class _Solver:
+    """Newton on the midpoint equations with a factorised band Jacobian kept across steps."""
+
+    def __init__(self, disc: Discrete, tol: float, max_iter: int):
+        self.disc, self.tol, self.max_iter = disc, tol, max_iter
+        self.lu = None
+        self.dt = None
+        self.iterations = 0
+        self.jacobians = 0
+        size = 6 * (disc.elements + 1)
+        self.scale = np.tile(np.concatenate([np.full(3, disc.body.rod.L), np.ones(3)]), size // 6)
+
+    def _factor(self, st: State, z: np.ndarray, dt: float, r0: np.ndarray) -> None:
+        ab = self.disc.jacobian_band(st, z, dt, r0)
+        lu, piv, info = lapack.dgbtrf(ab, BAND, BAND)
+        if info != 0:
+            raise ConvergenceError(f"the rod's step Jacobian is singular (LAPACK dgbtrf info {info})")
+        self.lu, self.piv, self.dt = lu, piv, dt
+        self.jacobians += 1
+
+    def _solve(self, r: np.ndarray) -> np.ndarray:
+        self.iterations += 1
+        return lapack.dgbtrs(self.lu, BAND, BAND, -r.ravel(), self.piv)[0].reshape(r.shape)
+
+    def _norm(self, dz: np.ndarray) -> float:
+        return float(np.max(np.abs(dz.ravel()) / self.scale))
+
+    def step(self, st: State, dt: float, z0: np.ndarray):
+        """The converged increments z and the midpoint external wrench, or None when Newton fails.
+
+        Damped Newton with the natural monotonicity test (Deuflhard): a step lam dz is accepted when the
+        next correction, J^-1 r(z + lam dz) with the same Jacobian, is at most (1 - lam/4) |dz|; else lam is
+        halved (down to 1/64). The kept Jacobian is taken again at the current iterate when the corrections
+        contract slower than REFRESH; converged when the estimated error after the last correction,
+        |dz| rate/(1 - rate), is below tol (units of L and rad)."""
+        z = z0.copy()
+        r, Fx, Mx = self.disc.residual(st, z, dt)
+        fresh = self.lu is None or self.dt != dt
+        if fresh:
+            self._factor(st, z, dt, r)
+        dz = self._solve(r)
+        size = self._norm(dz)
+        if not np.isfinite(size):
+            self.lu = None
+            return None
+        if size < 0.01 * self.tol:
+            return z, Fx, Mx
+        for _ in range(self.max_iter):
+            lam = 1.0
+            while True:
+                zt = z + lam * dz
+                rt, Fxt, Mxt = self.disc.residual(st, zt, dt)
+                dzt = self._solve(rt)
+                new = self._norm(dzt)
+                if np.isfinite(new) and new <= (1.0 - lam / 4.0) * size:
+                    break
+                lam *= 0.5
+                if lam < 1.0 / 64.0:
+                    break
+            if lam < 1.0 / 64.0:
+                if fresh:
+                    break
+                self._factor(st, z, dt, r)                 # a stale Jacobian: take it again here
+                fresh = True
+                dz = self._solve(r)
+                size = self._norm(dz)
+                continue
+            z, r, Fx, Mx = zt, rt, Fxt, Mxt
+            rate = new / max(size, 1e-300)
+            if lam == 1.0 and (new < 0.01 * self.tol or (rate < 1.0 and new * rate / (1.0 - rate) < self.tol)):
+                # the last correction is taken (its size bounds the error of z); the wrench of the loads is
+                # the one at z, off by O(|dzt|)
+                return z + dzt, Fx, Mx
+            if rate > REFRESH and not fresh:
+                self._factor(st, z, dt, r)
+                fresh = True
+                dzt = self._solve(r)
+                new = self._norm(dzt)
+            dz, size = dzt, new
+        self.lu = None
+        return None
+
+
+def advance(disc: Discrete, st: State, z: np.ndarray, dt: float, Fx, Mx) -> tuple[State, float]:
+    """The state after increments z, and the work of the external loads and damping over the step (J)."""
+    dx, th = z[:, :3], z[:, 3:]
+    vm, wm = dx / dt, th / dt
+    c = disc.body.damping
+    m = disc.body.rhoA * disc.weights
+    work = float(np.sum(Fx * dx) + np.sum(Mx * th))
+    if c:
+        work -= c * float(np.sum(m * np.sum(vm * dx, axis=1))
+                          + np.sum(disc.weights * np.einsum("ni,ij,nj->n", th, disc.body.J_rho, wm)))
+    al = disc.body.alpha
+    new = State(st.x + dx, st.R @ exp_so3(th), (vm - (1.0 - al) * st.v) / al, (wm - (1.0 - al) * st.w) / al)
+    return new, work
+
+
+def simulate(disc: Discrete, state: State, *, dt: float, t_end: float, save_every: int = 1,
+             shape_every: int = 0, tol: float = 1e-10, max_iter: int = 40, axis=(0.0, 0.0, 1.0)) -> Trajectory:
+    """March the midpoint step from ``state`` at t = 0 to ``t_end`` with steps ``dt`` (s), saving every
+    ``save_every`` steps (and the shape every ``shape_every`` saves, 0: never; the final one always)."""
+    from mechgen.runtime.rods.statics import turning_angle
+
+    steps = max(int(np.ceil(t_end / dt - 1e-9)), 0)
+    solver = _Solver(disc, tol, max_iter)
+    out = Trajectory()
+    st = state.copy()
+    work = 0.0
+    axis = np.asarray(axis, dtype=float)
+
+    def record(t: float, saves: int):
+        out.t.append(t)
+        out.tip.append(st.x[-1].copy())
+        H = np.zeros((len(st.x), 4, 4))
+        H[:, :3, :3], H[:, :3, 3] = st.R, st.x
+        out.tip_rotation.append(turning_angle(H, axis))
+        out.energy.append(disc.kinetic_energy(st.v, st.w) + disc.elastic_energy(st.x, st.R))
+        out.work.append(work)
+        if shape_every and saves % shape_every == 0:
+            out.shapes.append(st.x.copy())
+
+    record(0.0, 0)
+    z_prev = z_prev2 = None
+    for k in range(1, steps + 1):
+        h = min(dt, t_end - (k - 1) * dt)
+        if z_prev is None:
+            z0 = np.concatenate([h * st.v, h * st.w], axis=1)
+        elif z_prev2 is None or h != dt:
+            z0 = z_prev * (h / dt)
+        else:
+            z0 = 2.0 * z_prev - z_prev2        # linear extrapolation of the increments: O(dt^3) off
+        z_prev2 = z_prev
+        st, dw, z_prev = _step_split(disc, solver, st, h, z0, out, (k - 1) * dt)
+        work += dw
+        out.steps += 1
+        if k % save_every == 0 or k == steps:
+            record(min(k * dt, t_end), k // save_every)
+    out.final = st
+    out.newton_iterations, out.jacobians = solver.iterations, solver.jacobians
+    if shape_every and (not out.shapes or out.shapes[-1] is not st.x):
+        out.shapes.append(st.x.copy())
+    return out
+
+
+def _step_split(disc, solver, st, dt, z0, out, t, depth: int = 0):
+    """One step of dt, split in halves (recursively) when Newton does not converge."""
+    got = solver.step(st, dt, z0)
+    if got is not None:
+        z, Fx, Mx = got
+        new, work = advance(disc, st, z, dt, Fx, Mx)
+        return new, work, z
+    if depth >= MAX_SPLITS:
+        raise ConvergenceError(f"the rod's midpoint step did not converge at t = {t:.6g} s even with the step "
+                               f"split {MAX_SPLITS} times (dt = {dt:.3g} s)")
+    out.splits += 1
+    half = 0.5 * dt
+    mid, w1, z1 = _step_split(disc, solver, st, half, 0.5 * z0, out, t, depth + 1)
+    end, w2, z2 = _step_split(disc, solver, mid, half, z1, out, t + half, depth + 1)
+    return end, w1 + w2, 2.0 * z2
+
+
+def linear_frequencies(disc: Discrete, count: int = 6, eps: float = 1e-4) -> np.ndarray:
+    """The lowest ``count`` natural frequencies (rad/s) of small motions about the reference configuration:
+    the tangent stiffness -d(F, Mb)/d(x, w) by central differences, against the lumped mass, fixed degrees of
+    freedom removed (a dense symmetric eigenproblem: for tests and moderate N)."""
+    from scipy.linalg import eigh
+
+    st = reference_state(disc.body, disc.elements)
+    n = disc.elements + 1
+    free = ~disc.fixed.ravel()
+
+    def forces(dq: np.ndarray) -> np.ndarray:
+        dq = dq.reshape(n, 6)
+        F, Mb, _ = disc.internal(st.x + dq[:, :3], st.R @ exp_so3(dq[:, 3:]))
+        return np.concatenate([F, Mb], axis=1).ravel()
+
+    size = 6 * n
+    Kt = np.zeros((size, size))
+    for j in range(size):
+        e = np.zeros(size)
+        e[j] = eps
+        Kt[:, j] = -(forces(e) - forces(-e)) / (2 * eps)
+    Kt = 0.5 * (Kt + Kt.T)
+    mass = np.zeros((n, 6, 6))
+    mass[:, :3, :3] = disc.body.rhoA * np.eye(3)
+    mass[:, 3:, 3:] = disc.body.J_rho
+    mass *= disc.weights[:, None, None]
+    Mfull = np.zeros((size, size))
+    for i in range(n):
+        Mfull[6 * i:6 * i + 6, 6 * i:6 * i + 6] = mass[i]
+    lam = eigh(Kt[np.ix_(free, free)], Mfull[np.ix_(free, free)], eigvals_only=True)
+    return np.sqrt(np.clip(lam, 0.0, None))[:count]
+
+
+__all__ = ["RodBody", "Discrete", "State", "Trajectory", "reference_state", "simulate", "advance",
+           "linear_frequencies", "check_inertia", "ENDS", "BAND"]
