@@ -46,3 +46,17 @@ def test_quick_run_writes_the_reports(tmp_path):
         peer = [r for r in st["rows"] if r["side"] == "PyElastica static limit"]
         assert peer and not any(r["blew_up"] for r in peer) and all(r["max_speed_end"] < 1e-9 for r in peer)
         assert ratios["ratios"] and all(r["ratio"] > 0 for r in ratios["ratios"])
+    dyn, stiff = res["dynamic"], res["stiff"]
+    assert not isinstance(dyn, str) and not isinstance(stiff, str)
+    assert all(r["orthonormality_error"] < 1e-12 for r in dyn["rows"])
+    # mechgen's coarse runs lie within 3 % of the tip deflection of its fine reference (N = 40 vs 10 here)
+    assert all(r["error"] < 3e-2 for r in dyn["rows"])
+    assert all(r["error"] < 1e-2 and r["dt_over_pyelastica_limit"] > 100 for r in stiff["rows"])
+    if importlib.util.find_spec("elastica") is not None:
+        # the two codes' trajectories agree to PyElastica's first-order discretisation error (2.2 % at N = 10),
+        # and PyElastica refined to N = 20 moves toward mechgen's reference
+        assert all(r["agreement_with_pyelastica"] < 3e-2 for r in dyn["rows"])
+        peers = dyn["pyelastica"]
+        assert peers[1]["error"] < peers[0]["error"] < 3e-2
+        stable, over = stiff["pyelastica"][:2]
+        assert not stable["blew_up"] and over["blew_up"] and over["dt_over_limit"] == 2.0
