@@ -34,12 +34,20 @@ Parts:
   a root solve) reproduces Mattiasson's table (Int. J. Numer. Meth. Eng. 17 (1981) 145, PL^2/EI = 10:
   (L - x)/L = 0.55500, y/L = -0.81061), and mechgen's shooting of a nearly inextensible rod (EA/EI = GA/EI
   = 1e8) matches it. Error: max(|x - x_ref|, |y - y_ref|)/L of the tip.
-* **dynamic** (needs ``mechgen.rod_dynamics``): the same cantilever released from straight under a step tip
-  load (P L^2/EI = DYN_LOAD), undamped, to DYN_T_END: the tip trajectory of each side at the same
-  resolution N, each against a converged reference (mechgen's finest run: DYN_REF_ELEMENTS elements, its
-  smallest dt), error = max over the run of |tip - tip_ref| / max |tip deflection|; the two sides'
-  agreement with each other by the same measure; the wall-time ratio at matched accuracy (mechgen's
-  largest dt on its ladder whose error is at most PyElastica's at PyElastica's stable dt).
+* **dynamic** (``mechgen.rod_dynamics``; skipped with a message where it is missing): the same cantilever
+  released from straight under a step tip load (P L^2/EI = DYN_LOAD), undamped, to DYN_T_END. Error of a
+  run: max over the run of |tip(t) - tip_ref(t)| / max |tip deflection of the reference|, the reference
+  being mechgen's finest run (DYN_REF_ELEMENTS elements, half its smallest dt; its distance to half the
+  elements is reported). mechgen runs over N x dt ladders (implicit midpoint, dt from t_end/25), PyElastica
+  over an N ladder, each N at its largest dt on DT_FACTORS x Section.stable_dt that neither blows up nor
+  loses accuracy (error <= 1.1 x that at the smallest factor; generous to the peer). Reported: the two
+  codes' agreement at the same N (the same measure); the ratio at the same resolution (mechgen's fastest
+  dt at N = ``elements`` whose error is at most PyElastica's there) and at matched accuracy across
+  resolutions (each side's least time for an error at most PyElastica's finest).
+* **gravity**: the same comparison for scenes/rod_dynamics.toml's soft rod (L = 1 m, r = 2.5 cm, rho = 1000
+  kg/m^3, E = 10 MPa, G = E/3) released under gravity (9.81 m/s^2 along -y) to GRAVITY_T_END, N = 40 as in
+  the scene, with PyElastica's GravityForces; GA = alpha_c G A with PyElastica's alpha_c on both sides (the
+  scene's comment says 4/3, PyElastica 1.0.0 has 27/28).
 * **stiff** (needs ``mechgen.rod_dynamics``): E (and G) 100 times larger: PyElastica's explicit step must
   stay below dl sqrt(rho/max(E, G)) (and the section's shear-rotation mode, 2/omega_rot, omega_rot =
   sqrt(alpha_c G A/(rho I))); it is run at 0.5 and at STIFF_OVER times that limit (the second blows up:
@@ -50,7 +58,8 @@ warm-up run first (its seconds reported); a PyElastica time is its stepping loop
 public call (``mechgen.rod_statics`` / ``mechgen.rod_dynamics``: set-up and solve) on a compiled system,
 the best of REPEATS runs after a warm-up (one run in quick mode). Writes ``rods_work_precision.{csv,png}``,
 ``rods_ratios.json`` (ratio = PyElastica seconds / mechgen seconds at the condition stated) and
-``rods.json``, ``rods.md``; ``quick``: tiny ladders (< 20 s once numba's cache is warm).
+``rods.json``, ``rods.md``; ``quick``: tiny ladders (about 13 s once numba's cache is warm; numba's
+first compilation of PyElastica adds about 10 s once).
 """
 from __future__ import annotations
 
@@ -80,9 +89,14 @@ REST_DAMPING = 10.0
 DYN_LOAD = 2.0
 DYN_T_END = 1.0
 DYN_REF_ELEMENTS = 160
+#: the gravity case (scenes/rod_dynamics.toml): g (m/s^2) along -y, run length (s)
+GRAVITY = 9.81
+GRAVITY_T_END = 2.0
 #: the stiff case: E and G times STIFF_FACTOR; PyElastica also run at STIFF_OVER times its stable limit
 STIFF_FACTOR = 100.0
 STIFF_OVER = 2.0
+#: the stiff case's time comparison: mechgen's fastest run within this error of its own same-N reference
+STIFF_ACCURACY = 1e-2
 #: the speed target at matched accuracy (issue 15)
 TARGET = 5.0
 
@@ -188,8 +202,10 @@ def pyelastica_section_check(sec: Section) -> dict:
 
 
 def pyelastica_cantilever(sec: Section, n: int, *, tip_force, dt: float, t_end: float, damping: float = 0.0,
-                          save_every: int = 1, rest_tol: float | None = None, check_every: int = 500) -> dict:
-    """PyElastica's clamped cantilever (``OneEndFixedBC`` at node 0, tip force on the last node) stepped by
+                          save_every: int = 1, rest_tol: float | None = None, check_every: int = 500,
+                          gravity=(0.0, 0.0, 0.0)) -> dict:
+    """PyElastica's clamped cantilever (``OneEndFixedBC`` at node 0, tip force on the last node, ``GravityForces``
+    with ``gravity`` (m/s^2) where it is not zero) stepped by
     PositionVerlet at dt (s) to t_end (s), or, with ``rest_tol``, until max |v| < rest_tol (m/s; checked every
     ``check_every`` steps). Returns t (s), tip_trajectory ([x, y, z] every ``save_every`` steps, m),
     tip_position, wall_s (the stepping loop), steps, blew_up (non-finite or |tip| > BLOWN L) and t_blew_up."""
@@ -200,6 +216,8 @@ def pyelastica_cantilever(sec: Section, n: int, *, tip_force, dt: float, t_end: 
     sim.constrain(rod).using(ea.OneEndFixedBC, constrained_position_idx=(0,), constrained_director_idx=(0,))
     sim.add_forcing_to(rod).using(ea.EndpointForces, np.zeros(3), np.array(tip_force, dtype=float),
                                   ramp_up_time=1e-300)
+    if any(gravity):
+        sim.add_forcing_to(rod).using(ea.GravityForces, acc_gravity=np.array(gravity, dtype=float))
     if damping > 0:
         sim.dampen(rod).using(ea.AnalyticalLinearDamper, uniform_damping_constant=damping, time_step=dt)
     sim.finalize()
@@ -238,7 +256,7 @@ BLOWN = 1.5
 DT_FACTORS = (0.5, 0.7, 1.0, 1.4, 2.0, 2.8, 4.0)
 
 
-def stable_runs(sec: Section, n: int, force, t_end: float, save_dt: float) -> list[dict]:
+def stable_runs(sec: Section, n: int, force, t_end: float, save_dt: float, gravity=(0.0, 0.0, 0.0)) -> list[dict]:
     """PyElastica's runs to t_end at dt = DT_FACTORS x Section.stable_dt(n), up to and including the first that
     blows up (each a :func:`pyelastica_cantilever` result with its ``factor``)."""
     limit = sec.stable_dt(n)
@@ -246,7 +264,7 @@ def stable_runs(sec: Section, n: int, force, t_end: float, save_dt: float) -> li
     for factor in DT_FACTORS:
         dt = factor * limit
         run = pyelastica_cantilever(sec, n, tip_force=force, dt=dt, t_end=t_end,
-                                    save_every=max(1, int(round(save_dt / dt))), check_every=20)
+                                    save_every=max(1, int(round(save_dt / dt))), check_every=20, gravity=gravity)
         runs.append({**run, "factor": factor})
         if run["blew_up"]:
             break
@@ -371,18 +389,32 @@ def _fastest(rows: list[dict], bound: float) -> dict | None:
     return min(ok, key=lambda r: r["seconds"]) if ok else None
 
 
-def dynamic_study(quick: bool, repeats: int, have_elastica: bool) -> dict:
+def scene_section() -> Section:
+    """scenes/rod_dynamics.toml's soft rod: L = 1 m, r = 2.5 cm, rho = 1000 kg/m^3, E = 10 MPa, G = E/3."""
+    return Section(L=1.0, r=0.025, rho=1000.0, E=1.0e7, G=1.0e7 / 3)
+
+
+def dynamic_study(quick: bool, repeats: int, have_elastica: bool, case: str = "tip_load") -> dict:
     """The dynamic part (module doc): mechgen over N x dt ladders, PyElastica over an N ladder at its largest
     unspoiled stable dt; the same-resolution comparison at N = ``elements`` and the matched-accuracy one
-    across resolutions (target: PyElastica's finest error)."""
-    sec = base_section()
-    params = sec.params()
+    across resolutions (target: PyElastica's finest error). ``case``: "tip_load" (base_section, a step tip
+    load P L^2/EI = DYN_LOAD, DYN_T_END, N = 20) or "gravity" (scenes/rod_dynamics.toml's rod released under
+    g = 9.81 m/s^2 along -y, to 2 s, N = 40 as in the scene)."""
+    if case == "gravity":
+        sec = scene_section()
+        params = {**sec.params(), "g_y": -GRAVITY}
+        force, gravity = [0.0, 0.0, 0.0], (0.0, -GRAVITY, 0.0)
+        t_end = 0.5 if quick else GRAVITY_T_END
+        n = 10 if quick else 40
+        ours_n = (10,) if quick else (10, 20, 40)
+    else:
+        sec = base_section()
+        params = sec.params()
+        force, gravity = [0.0, -DYN_LOAD * params["EI"] / sec.L ** 2, 0.0], (0.0, 0.0, 0.0)
+        t_end = 0.25 if quick else DYN_T_END
+        n = 10 if quick else 20
+        ours_n = (10,) if quick else (10, 20, 40)
     system = _system(params)
-    P = DYN_LOAD * params["EI"] / sec.L ** 2
-    force = [0.0, -P, 0.0]
-    t_end = 0.25 if quick else DYN_T_END
-    n = 10 if quick else 20
-    ours_n = (10,) if quick else (10, 20, 40)
     peer_n = (10, 20) if quick else (20, 40, 80, 160)
     ref_n = 40 if quick else DYN_REF_ELEMENTS
     dts = (t_end / 20, t_end / 40) if quick else tuple(t_end / k for k in (25, 50, 100, 200, 400, 800))
@@ -402,7 +434,8 @@ def dynamic_study(quick: bool, repeats: int, have_elastica: bool) -> dict:
                          "energy_error": run["energy_error"], "orthonormality_error": run["orthonormality_error"]})
             if m == n:
                 runs_at_n[dt] = run
-    out = {"section": sec.__dict__, "params": params, "tip_force": force, "t_end": t_end, "elements": n,
+    out = {"case": case, "section": sec.__dict__, "params": params, "tip_force": force, "gravity": list(gravity),
+           "t_end": t_end, "elements": n,
            "reference": {"elements": ref_n, "dt": ref_dt, "max_tip_deflection": scale,
                          "self_convergence_half_elements": _traj_error(half["t"], half["tip_trajectory"], t_ref,
                                                                        tip_ref, scale)}}
@@ -411,7 +444,7 @@ def dynamic_study(quick: bool, repeats: int, have_elastica: bool) -> dict:
         for m in peer_n:
             # the peer's dt, generous to it: the largest on the ladder that neither blows up nor has an error
             # over 1.1 x that of the smallest dt tried (an accuracy not yet spoiled by the step)
-            runs = stable_runs(sec, m, force, t_end, dts[-1])
+            runs = stable_runs(sec, m, force, t_end, dts[-1], gravity)
             for run in runs:
                 run["error"] = None if run["blew_up"] else _traj_error(np.asarray(run["t"]), run["tip_trajectory"],
                                                                          t_ref, tip_ref, scale)
@@ -428,6 +461,7 @@ def dynamic_study(quick: bool, repeats: int, have_elastica: bool) -> dict:
                 same_run = peer
         out["pyelastica_dt_search"] = searches
         out["pyelastica"] = peers
+        out["pyelastica_orders"] = _orders(peers)
         if same_run is not None:
             for r in rows:
                 if r["n"] == n:
@@ -490,6 +524,12 @@ def stiff_study(quick: bool, repeats: int, have_elastica: bool) -> dict:
                          "seconds": run["wall_s"], "steps": run["steps"], "blew_up": run["blew_up"],
                          "t_blew_up": run["t_blew_up"], "t_run": t_run, "error": err})
         out["pyelastica"] = peer
+        ours = _fastest(rows, STIFF_ACCURACY)
+        if ours is not None and not peer[0]["blew_up"]:
+            out["times"] = {"mechgen_dt": ours["dt"], "mechgen_s": ours["seconds"], "mechgen_error": ours["error"],
+                            "pyelastica_dt": peer[0]["dt"], "pyelastica_s": peer[0]["seconds"],
+                            "pyelastica_error": peer[0]["error"], "ratio": peer[0]["seconds"] / ours["seconds"],
+                            "dt_ratio": ours["dt"] / peer[0]["dt"]}
     out["rows"] = rows
     return out
 
@@ -511,7 +551,8 @@ def markdown(results: dict) -> str:
     lines += [f"| {r['side']} | {r['n']} | {r['seconds']:.3g} | {r['error']:.2e} |" for r in st["rows"]]
     lines += ["", "Observed orders: " + "; ".join(f"{k}: {', '.join(f'{o:.2f}' for o in v)}"
                                                  for k, v in st["orders"].items())]
-    for key, title in (("dynamic", "Dynamic step load"), ("stiff", "Stiff rod (E x 100)")):
+    for key, title in (("dynamic", "Dynamic step tip load"), ("gravity", "Released under gravity (scenes/rod_dynamics.toml's rod)"),
+                       ("stiff", "Stiff rod (E x 100)")):
         part = results[key]
         lines += ["", f"## {title}", ""]
         if isinstance(part, str):
@@ -523,6 +564,13 @@ def markdown(results: dict) -> str:
             agree = r.get("agreement_with_pyelastica")
             lines.append(f"| {r['side']} | {r['n']} | {r['dt']:.3g} | {r['seconds']:.3g} | {err} | "
                          f"{'' if agree is None else format(agree, '.2e')} |")
+        if part.get("pyelastica_orders"):
+            lines += ["", "PyElastica's observed orders in N: " + ", ".join(f"{o:.2f}" for o in part["pyelastica_orders"])]
+        if part.get("times"):
+            m = part["times"]
+            lines += ["", f"mechgen's fastest dt with a time error <= {STIFF_ACCURACY:g}: {m['mechgen_dt']:.3g} s "
+                          f"({m['dt_ratio']:.0f} x PyElastica's dt {m['pyelastica_dt']:.3g} s), {m['mechgen_s']:.3g} s "
+                          f"against PyElastica's {m['pyelastica_s']:.3g} s (ratio {m['ratio']:.2f}, not at equal accuracy)."]
         if part.get("same_resolution"):
             m = part["same_resolution"]
             lines += ["", f"Same resolution N = {m['elements']}: mechgen's fastest run with an error <= PyElastica's, "
@@ -558,9 +606,11 @@ def run_rods_benchmarks(out: Path, quick: bool = False) -> dict:
         results["static"] = static_study(quick, repeats, have)
         if _dynamics_available():
             results["dynamic"] = dynamic_study(quick, repeats, have)
+            results["gravity"] = dynamic_study(quick, repeats, have, case="gravity")
             results["stiff"] = stiff_study(quick, repeats, have)
         else:
-            results["dynamic"] = results["stiff"] = "skipped: mechgen.rod_dynamics is not available"
+            results["dynamic"] = results["gravity"] = results["stiff"] = \
+                "skipped: mechgen.rod_dynamics is not available"
     env["loadavg_after"] = list(__import__("os").getloadavg())
     points = [{"series": f"static: {r['side']}", "setting": f"n={r['n']}", "seconds": r["seconds"],
                "error": r["error"]} for r in results["static"]["rows"]]
@@ -578,7 +628,7 @@ def run_rods_benchmarks(out: Path, quick: bool = False) -> dict:
                                         f"collocation {ours[0]['n']} elements (error {ours[0]['error']:.2e})"
                                         + ("; mechgen's coarsest point already meets it: a lower bound" if coarsest
                                            else "")})
-    for key in ("dynamic", "stiff"):
+    for key in ("dynamic", "gravity", "stiff"):
         part = results[key]
         if isinstance(part, str):
             continue
@@ -589,13 +639,22 @@ def run_rods_benchmarks(out: Path, quick: bool = False) -> dict:
                                "seconds": r["seconds"], "error": r["error"]})
         if part.get("same_resolution"):
             m = part["same_resolution"]
-            ratios.append({"peer": "PyElastica (dynamic, same N)", "ours_s": m["mechgen_s"], "peer_s": m["pyelastica_s"],
+            ratios.append({"peer": f"PyElastica ({key}, same N)", "ours_s": m["mechgen_s"], "peer_s": m["pyelastica_s"],
                            "condition": f"same resolution N = {m['elements']}, mechgen's fastest dt with a max tip error "
                                         f"over the run {m['mechgen_error']:.2e} (dt {m['mechgen_dt']:.3g} s) <= "
                                         f"PyElastica's {m['pyelastica_error']:.2e} (dt {m['pyelastica_dt']:.3g} s)"})
+        if part.get("times"):
+            m = part["times"]
+            ratios.append({"peer": "PyElastica (stiff)", "ours_s": m["mechgen_s"], "peer_s": m["pyelastica_s"],
+                           "condition": f"stiff rod (E x {STIFF_FACTOR:g}), N = {part['elements']}: mechgen's fastest "
+                                        f"dt ({m['mechgen_dt']:.3g} s, {m['dt_ratio']:.0f} x PyElastica's) with a time "
+                                        f"error <= {STIFF_ACCURACY:g} against its own dt/4 run; PyElastica at 0.5 x its "
+                                        f"limit (dt {m['pyelastica_dt']:.3g} s; its difference from that run "
+                                        f"{m['pyelastica_error']:.2e}, spatial discretisation included): not an "
+                                        "equal-accuracy ratio"})
         if part.get("matched"):
             m = part["matched"]
-            ratios.append({"peer": "PyElastica (dynamic, matched accuracy)", "ours_s": m["mechgen_s"],
+            ratios.append({"peer": f"PyElastica ({key}, matched accuracy)", "ours_s": m["mechgen_s"],
                            "peer_s": m["pyelastica_s"],
                            "condition": f"each side's least time for a max tip error <= {m['target_error']:.2e} "
                                         f"(PyElastica's finest): mechgen N = {m['mechgen_n']}, dt {m['mechgen_dt']:.3g} s; "
