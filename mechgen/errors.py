@@ -30,6 +30,10 @@ class InputError(MechgenError):
         self.expected = expected
         super().__init__(self.paragraph())
 
+    def __reduce__(self):
+        """Pickled with its parts, so that one raised in a worker process keeps its file, key and expected."""
+        return _restore, (type(self), self.message, self.file, self.key, self.expected)
+
     def paragraph(self) -> str:
         """The one-paragraph message the CLI prints."""
         where = []
@@ -43,6 +47,11 @@ class InputError(MechgenError):
         if self.expected:
             text += f"; expected {self.expected}"
         return text + "."
+
+
+def _restore(cls, message: str, file: str | None, key: str | None, expected: str | None) -> InputError:
+    """An InputError (or subclass) from its pickled parts."""
+    return cls(message, file=file, key=key, expected=expected)
 
 
 class SceneError(InputError):

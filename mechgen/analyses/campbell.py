@@ -5,9 +5,15 @@ whirl frequency crosses a multiple of the speed. Scene keys: ``over`` (one numer
 or more increasing values), ``count`` (modes; left out: min(8, the system's degrees of freedom), a count written larger than
 that is refused), ``multiples`` (of the speed, default [1]),
 ``method`` (auto, exact, reduced), ``about`` and ``at`` (the operating point), ``max_seconds`` (the wall-time
-budget, default 600 s: the exact path refuses once its first speeds project past it; exit 1). Outputs: ``speeds``,
-``frequencies`` and ``whirl`` and ``log_dec`` (one row per speed), ``critical_speeds``, ``parameter``,
-``method`` and ``exact_solves``.
+budget, default 600 s: the exact path refuses once its first speeds project past it; exit 1), and where the
+per-speed eigen-solves run, as for ``sweep``: ``executor`` (``serial``, ``processes`` or ``dask``; left out:
+processes when ``workers`` > 1, else serial), ``workers``, ``scheduler`` (with dask: a running scheduler's
+address). On a parallel executor every speed is solved exactly (full size; the speeds are independent: their
+matrices are assembled here, the solves are distributed, in Dask chunks of at least ~0.5 s of work) and the
+modes are tracked here afterwards, so the result is the serial exact one; ``method = "reduced"`` (whose basis
+grows from speed to speed) is refused there, and ``auto`` means exact. Outputs: ``speeds``, ``frequencies`` and
+``whirl`` and ``log_dec`` (one row per speed), ``critical_speeds``, ``parameter``, ``method``, ``exact_solves``
+and ``executor``.
 """
 from __future__ import annotations
 
@@ -22,6 +28,7 @@ from mechgen.analyses.schema import ABSENT, REQUIRED, Option
 from mechgen.analyses.whirl import SPARSE_N, whirl_stations
 from mechgen.errors import SceneError
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget
+from mechgen.runtime.core.sweep import SweepExecutor
 from mechgen.runtime.linear.campbell import CampbellOptions, campbell, critical_speeds, fit_speed_polynomial
 from mechgen.scene.values import fail, is_choice, join, param_info, type_name
 
@@ -49,7 +56,23 @@ SCHEMA = {"over": Option(_speeds, REQUIRED, "a table: parameter = [values] or {s
           "count": Option(schema.count), "multiples": Option(_multiples, [1.0]),
           "method": Option(schema.one_of("campbell method", ("auto", "exact", "reduced"))),
           "about": Option(schema.about), "at": Option(schema.coordinate_table),
-          "max_seconds": Option(schema.positive, ABSENT)}
+          "max_seconds": Option(schema.positive, ABSENT), **schema.executor_options()}
+
+
+def _executor(options: dict) -> SweepExecutor:
+    return SweepExecutor.of(options.get("executor"), options.get("workers", 0), options.get("scheduler"))
+
+
+def check(ctx, base: str, options: dict) -> None:
+    """A ``scheduler`` needs ``executor = "dask"``; ``method = "reduced"`` runs serially only."""
+    schema.check_executor(ctx, base, options)
+    kind = _executor(options).kind
+    if options.get("method") == "reduced" and kind != "serial":
+        key = join(base, "executor" if "executor" in options else "workers")
+        raise fail(ctx.file, key, f"method = \"reduced\" carries its reduced basis from speed to speed and cannot "
+                   f"run on the {kind} executor",
+                   "executor = \"serial\" with method = \"reduced\", or method = \"exact\" (or \"auto\", which "
+                   "solves every speed exactly on a parallel executor)")
 
 
 def needs(options: dict, *, internal: bool) -> set[str]:
@@ -118,8 +141,9 @@ def run_campbell(system, options: dict, context: dict) -> dict:
     matrices_at = assembled_at if poly is None else poly.combined({"M": ("M",), "C": ("D", "G"), "K": ("K",)})
     budget = Budget(f"campbell over {name}", unit="speeds",
                     seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
+    executor = _executor(options)
     res = campbell(matrices_at, speeds, count, CampbellOptions(sparse=sparse, method=options.get("method", "auto"),
-                                                                budget=budget),
+                                                                budget=budget, executor=executor),
                    x_index=stations[0], y_index=stations[1])
     crit = critical_speeds(res, options.get("multiples", [1.0]), refine=matrices_at, sparse=sparse)
     freqs = np.asarray(res.frequencies)
@@ -128,7 +152,7 @@ def run_campbell(system, options: dict, context: dict) -> dict:
             "critical_speeds": [{"mode": int(c["mode"]) + 1, "multiple": float(c["multiple"]),
                                  "speed": float(c["speed"]), "frequency": float(c["frequency"]), "whirl": c["whirl"]}
                                 for c in crit],
-            "parameter": name, "method": res.method, "exact_solves": int(res.exact_solves)}
+            "parameter": name, "method": res.method, "exact_solves": int(res.exact_solves), "executor": executor.kind}
 
 
 def summary_lines(outputs: dict) -> list[str]:
@@ -164,4 +188,4 @@ def plot(plt, a: dict, path: Path) -> list[Path]:
     return [path]
 
 
-register(AnalysisKind("campbell", SCHEMA, run_campbell, needs, summary_lines, frees=frees, plot=plot))
+register(AnalysisKind("campbell", SCHEMA, run_campbell, needs, summary_lines, check=check, frees=frees, plot=plot))

@@ -236,8 +236,11 @@ def campbell(system, *, name: str | None = None, **options) -> Result:
     """A Campbell diagram over ``over = {"Omega": [speeds]}`` (a parameter left free in the kernels).
 
     Options: ``over`` (required; values or {start, stop, num}), ``count``, ``multiples``, ``method``,
-    ``about``, ``at``. Outputs: ``speeds``, ``frequencies``, ``whirl``, ``log_dec`` (one row per speed),
-    ``critical_speeds``.
+    ``about``, ``at``, ``max_seconds``, and where the per-speed eigen-solves run: ``executor`` ("serial",
+    "processes" or "dask"), ``workers``, ``scheduler`` (as for :func:`sweep`; a parallel executor solves every
+    speed exactly and gives the serial exact result; ``method="reduced"`` runs serially only). Outputs:
+    ``speeds``, ``frequencies``, ``whirl``, ``log_dec`` (one row per speed), ``critical_speeds``, ``method``,
+    ``exact_solves``, ``executor``.
     """
     return _run("campbell", system, options, name)
 

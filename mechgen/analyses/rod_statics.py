@@ -44,7 +44,8 @@ from mechgen.scene.values import fail, show, type_name
 AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
 
 
-def _vector3(ctx, key: str, value: object) -> list[float]:
+def vector3(ctx, key: str, value: object) -> list[float]:
+    """A scene's [x, y, z] (numbers or expressions of the parameters; spatial frame)."""
     if not isinstance(value, list) or len(value) != 3:
         raise fail(ctx.file, key, f"value is {show(value) if isinstance(value, list) else type_name(value)}",
                    "an array of 3 numbers [x, y, z] (spatial frame)")
@@ -74,13 +75,13 @@ SCHEMA = {
     "N": Option(_elements),
     "base": Option(schema.one_of("end condition", ENDS), "clamped"),
     "tip": Option(schema.one_of("end condition", ENDS), "free"),
-    "tip_force": Option(_vector3, [0.0, 0.0, 0.0]),
-    "tip_torque": Option(_vector3, [0.0, 0.0, 0.0]),
+    "tip_force": Option(vector3, [0.0, 0.0, 0.0]),
+    "tip_torque": Option(vector3, [0.0, 0.0, 0.0]),
     "steps": Option(_bounded(1, MAX_STEPS), 10),
     "tol": Option(schema.positive, 1e-10),
     "min_step": Option(schema.positive, 1e-4),
     "bending_axis": Option(schema.one_of("axis", tuple(AXES)), "z"),
-    "frame_rate": Option(_vector3, [0.0, 0.0, 0.0]),
+    "frame_rate": Option(vector3, [0.0, 0.0, 0.0]),
 }
 
 

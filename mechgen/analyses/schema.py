@@ -316,3 +316,36 @@ def no_check(ctx: OptionContext, base: str, options: dict) -> None:
 
 #: the options of the linear analyses (modes, stability): where to linearise and how many modes
 LINEAR_OPTIONS = {"about": Option(about), "at": Option(coordinate_table), "count": Option(count)}
+
+
+# ------------------------------------------------------------------------ where a grid's points run
+
+
+def workers(ctx: OptionContext, key: str, value: object) -> int:
+    """A count of worker processes (local processes, or the Dask LocalCluster's workers); 0: the default, two."""
+    return int_at_least(ctx, key, value, 0)
+
+
+def scheduler(ctx: OptionContext, key: str, value: object) -> str:
+    """A Dask scheduler's address: tcp://host:port (or tls://, inproc://)."""
+    if not isinstance(value, str) or "://" not in value or len(value) > 500 or not value.isprintable():
+        raise fail(ctx.file, key, f"value is {show(value)}",
+                   "a Dask scheduler address such as \"tcp://127.0.0.1:8786\"")
+    return value
+
+
+def executor_options() -> dict[str, Option]:
+    """The keys of a kind whose independent points run on an executor (mechgen.runtime.core.sweep.SweepExecutor):
+    ``executor`` (serial | processes | dask; left out: processes when ``workers`` > 1, else serial),
+    ``workers`` (0: two) and ``scheduler`` (with dask: a running scheduler instead of a LocalCluster)."""
+    from mechgen.runtime.core.sweep import EXECUTORS
+
+    return {"executor": Option(one_of("executor", EXECUTORS), ABSENT), "workers": Option(workers, 0),
+            "scheduler": Option(scheduler, ABSENT)}
+
+
+def check_executor(ctx: OptionContext, base: str, options: dict) -> None:
+    """A ``scheduler`` needs ``executor = "dask"``."""
+    if "scheduler" in options and options.get("executor") != "dask":
+        raise fail(ctx.file, join(base, "scheduler"), "a scheduler without executor = \"dask\"",
+                   "executor = \"dask\" beside scheduler, or no scheduler")

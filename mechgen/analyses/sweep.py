@@ -27,8 +27,8 @@ from mechgen.analyses.parameters import with_free_params
 from mechgen.analyses.registry import AnalysisKind, get, kinds, register
 from mechgen.analyses.schema import ABSENT, REQUIRED, AnalysisSpec, Option
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget
-from mechgen.runtime.core.sweep import EXECUTORS, ON_ERROR, OK, SweepExecutor, sweep_points
-from mechgen.scene.values import fail, show, type_name
+from mechgen.runtime.core.sweep import ON_ERROR, OK, SweepExecutor, sweep_points
+from mechgen.scene.values import fail, type_name
 
 
 def _inner(ctx, key: str, value: object) -> AnalysisSpec:
@@ -41,32 +41,16 @@ def _inner(ctx, key: str, value: object) -> AnalysisSpec:
     return AnalysisSpec(ctx.current, kind, options)
 
 
-def _workers(ctx, key: str, value: object) -> int:
-    return schema.int_at_least(ctx, key, value, 0)
-
-
-def _scheduler(ctx, key: str, value: object) -> str:
-    """A Dask scheduler's address: tcp://host:port (or tls://, inproc://)."""
-    if not isinstance(value, str) or "://" not in value or len(value) > 500 or not value.isprintable():
-        raise fail(ctx.file, key, f"value is {show(value)}",
-                   "a Dask scheduler address such as \"tcp://127.0.0.1:8786\"")
-    return value
-
-
 SCHEMA = {"over": Option(schema.over, REQUIRED, "a table: parameter = [values] or {start, stop, num}"),
           "analysis": Option(_inner, REQUIRED, "a table with kind and its options"),
-          "workers": Option(_workers, 0), "progress": Option(schema.boolean, True),
-          "max_seconds": Option(schema.positive, ABSENT),
-          "executor": Option(schema.one_of("executor", EXECUTORS), ABSENT),
-          "scheduler": Option(_scheduler, ABSENT), "on_error": Option(schema.one_of("on_error", ON_ERROR), "record")}
+          "progress": Option(schema.boolean, True), "max_seconds": Option(schema.positive, ABSENT),
+          **schema.executor_options(), "on_error": Option(schema.one_of("on_error", ON_ERROR), "record")}
 
 
 def check(ctx, base: str, options: dict) -> None:
     """Adds ``grid``: the cartesian product of ``over``; a ``scheduler`` needs ``executor = "dask"``."""
     options["grid"] = schema.grid(options["over"])
-    if "scheduler" in options and options.get("executor") != "dask":
-        raise fail(ctx.file, f"{base}.scheduler", "a scheduler without executor = \"dask\"",
-                   "executor = \"dask\" beside scheduler, or no scheduler")
+    schema.check_executor(ctx, base, options)
 
 
 def frees(options: dict) -> list[str]:

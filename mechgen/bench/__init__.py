@@ -77,6 +77,10 @@ REGISTRY: dict[str, Suite] = {s.name: s for s in (
     Suite("threads", "mechgen.bench.threads", "run_threads_benchmarks",
           "every shipped scene as a whole process, default environment against one BLAS thread (unpinned / pinned)",
           ("threads.json", "threads.md"), standard=False),
+    Suite("sweep", "mechgen.bench.sweep", "run_sweep_benchmarks",
+          "a 10^4-point Laval rotor stability sweep on the serial, local-process and Dask executors (2 workers): wall "
+          "time, overhead per point, dask / processes", ("sweep.json", "sweep.md"),
+          peers=("local processes (concurrent.futures)", "dask.distributed LocalCluster")),
 )}
 
 #: the suite names (``mechgen bench`` with none runs them all)
@@ -98,7 +102,7 @@ def run_benchmarks(models_: list[str] | None = None, *, out: Path, quick: bool =
     (:mod:`mechgen.bench.rotor`); ``balloon``: the ballooning string's branch with stability against a
     hand-written scipy baseline (:mod:`mechgen.bench.balloon`); ``startup``: whole-process start of cached
     scenes (:mod:`mechgen.bench.startup`); ``threads``: every shipped scene unpinned against pinned
-    (:mod:`mechgen.bench.threads`). Every suite also times its scenes as a user runs them (default
+    (:mod:`mechgen.bench.threads`); ``sweep``: a Laval rotor sweep on each executor (:mod:`mechgen.bench.sweep`). Every suite also times its scenes as a user runs them (default
     environment) beside its pinned figures. Returns {suite: its results}.
     """
     from mechgen.errors import InputError

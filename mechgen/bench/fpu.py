@@ -1,14 +1,27 @@
 """``mechgen bench fpu``: speed of generated kernels against hand-written and library baselines.
 
 FPU chain (bond force f(r) = gamma r + alpha r^2 + beta r^3, fixed ends): the force
-F = -dV/du and its sparse (tridiagonal) stiffness K = dF/du... as CSR data, at N = 64,
-1024, 16384 and for a batch of 10 000 states, computed by
+F = -dV/du and its sparse (tridiagonal) stiffness K = dF/du... as CSR data, on the ladder
+N = 64, 256, 1024, 4096, 16384, 65536, 262144, 10^6 (quick: 64, 256) and for a batch of 10 000 states
+at N = 4096 (quick: 100 at N = 64), computed by
 
 * generated C (mechgen, prepared call),
 * a hand-written C loop (benchmarks/hand_fpu.c) built with the same flags and called the same way,
+* a hand-written numba loop (the same loop as the hand C, ``@numba.njit``; the ``bench`` extra; skipped
+  with a note in the reports when numba is not importable),
 * hand-written vectorised numpy,
 * ``sympy.lambdify`` of the whole-chain expressions (N <= 1024; expanding bigger chains takes minutes),
-* a CasADi SX ``Function`` of the whole chain (vectorised SX operations).
+* a CasADi SX ``Function`` of the whole chain (vectorised SX operations; N <= 16384: building the SX graph
+  of a bigger chain takes longer than the rest of the benchmark).
+
+Memory bandwidth (measured in the same run): the batched force moves 16 N B bytes per call (u read, F
+written: 8 bytes per double); its achieved fraction of the bound is (16 N B / t) / bw_copy(N B), bw_copy(n)
+the bandwidth of a numpy copy of n doubles (16 n bytes over its best time of 5,
+:func:`mechgen.analyses.symplectic.copy_bandwidth`). The leapfrog step of the C time loop
+(mechgen.runtime.core.symplectic_c, ``scenes/fpu_large.toml``: N = 10^6 FPU-beta, 2000 steps; quick: 10^5,
+100 steps) reports its own ``bandwidth_fraction`` the same way (bytes a step moves,
+:func:`mechgen.analyses.symplectic.bytes_per_step`). Target (issue 16): within 2x of the bound, a
+fraction >= 0.5.
 
 Also: the Python-level overhead of a prepared call of a small kernel, derivation +
 generation + compile time (first run with an empty cache, and cached, each in a
@@ -23,6 +36,7 @@ of 3 (``user_path`` in ``fpu_kernels.json``, a table in ``fpu_kernels.md``; :fun
 from __future__ import annotations
 
 import time
+import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -31,12 +45,23 @@ from mechgen.bench.common import (ROOT, best_time, empty_cache, in_fresh_process
                                   write_csv, write_json, write_text)
 
 __all__ = ["best_time", "empty_cache", "numpy_force", "numpy_stiffness", "fpu_system", "kernel_rows",
-           "call_overhead", "build_times", "scene_start", "report_markdown", "run_fpu_benchmarks"]
+           "numba_kernels", "batch_bandwidth", "leapfrog_bandwidth", "ratio_table", "call_overhead", "build_times",
+           "scene_start", "report_markdown", "run_fpu_benchmarks"]
 
 GAMMA, ALPHA, BETA = 1.0, 0.25, 0.1
 HAND_C = ROOT / "benchmarks" / "hand_fpu.c"
 #: the scene timed as a user runs it
 USER_SCENE = "fpu_chain.toml"
+#: the N ladder of the force and stiffness timings (full, quick)
+LADDER, QUICK_LADDER = (64, 256, 1024, 4096, 16384, 65536, 262144, 1_000_000), (64, 256)
+#: the batched force: (N, states), full and quick
+BATCH, QUICK_BATCH = (4096, 10_000), (64, 100)
+#: the largest N of the whole-chain CasADi SX functions
+CASADI_MAX = 16384
+#: the leapfrog run: (N, t_end at dt = 0.05), full and quick
+LEAPFROG, QUICK_LEAPFROG = (1_000_000, 100.0), (100_000, 5.0)
+#: the issue's targets: generated / hand C at most, lambdify / generated at least (N >= 1024), bandwidth share
+GEN_HAND_TARGET, LAMBDIFY_TARGET, BANDWIDTH_TARGET = 1.3, 100.0, 0.5
 
 
 def numpy_force(u: np.ndarray) -> np.ndarray:
@@ -113,15 +138,58 @@ def _casadi_force(n: int):
     return F, K
 
 
+def numba_kernels():
+    """(force, stiffness, None) as hand-written numba loops - the loops of benchmarks/hand_fpu.c, u of shape
+    (states, N), outputs written in place - or (None, None, why) when numba is not importable."""
+    try:
+        import numba
+    except ImportError as exc:
+        return None, None, f"numba is not importable ({exc}): pip install 'mechgen[bench]'"
+
+    @numba.njit(cache=False)
+    def force(u, g, a, b, F):  # F_i = f(u_{i+1} - u_i) - f(u_i - u_{i-1}), u_0 = u_{N+1} = 0
+        nb, n = u.shape
+        for s in range(nb):
+            left = u[s, 0] * (g + u[s, 0] * (a + u[s, 0] * b))
+            for i in range(n):
+                r = (u[s, i + 1] if i + 1 < n else 0.0) - u[s, i]
+                right = r * (g + r * (a + r * b))
+                F[s, i] = right - left
+                left = right
+
+    @numba.njit(cache=False)
+    def stiffness(u, g, a, b, K):  # CSR data of K = -dF/du, rows ascending, k(r) = f'(r)
+        n = u.shape[0]
+        left = g + u[0] * (2.0 * a + 3.0 * b * u[0])
+        p = 0
+        for i in range(n):
+            r = (u[i + 1] if i + 1 < n else 0.0) - u[i]
+            right = g + r * (2.0 * a + 3.0 * b * r)
+            if i > 0:
+                K[p] = -left
+                p += 1
+            K[p] = left + right
+            p += 1
+            if i + 1 < n:
+                K[p] = -right
+                p += 1
+            left = right
+
+    return force, stiffness, None
+
+
 def _row(rows: list, method: str, quantity: str, n: int, batch: int, seconds: float) -> None:
     rows.append({"method": method, "quantity": quantity, "N": n, "batch": batch, "seconds": seconds})
 
 
-def kernel_rows(sizes, batch_n: int, batch: int, lambdify_max: int) -> list[dict]:
-    """Time every method for the force and the stiffness; checks agreement first."""
+def kernel_rows(sizes, batch_n: int, batch: int, lambdify_max: int, casadi_max: int = CASADI_MAX,
+                numba: bool = True) -> list[dict]:
+    """Time every method for the force and the stiffness; checks agreement first. ``numba``: time the numba
+    loops too (when importable)."""
     from mechgen.codegen.build import load_shared
 
     lib = load_shared(HAND_C.read_text(), stem="hand_fpu")
+    nb_force, nb_stiff, _ = numba_kernels() if numba else (None, None, None)
     rows: list = []
     rng = np.random.default_rng(0)
     for n, nb in [(n, 1) for n in sizes] + [(batch_n, batch)]:
@@ -137,11 +205,16 @@ def kernel_rows(sizes, batch_n: int, batch: int, lambdify_max: int) -> list[dict
         _row(rows, "generated C", "force", n, nb, best_time(gen))
         _row(rows, "hand C -O3", "force", n, nb, best_time(hand))
         _row(rows, "numpy", "force", n, nb, best_time(lambda: numpy_force(u)))
-        F, Kc = _casadi_force(n)
-        if nb == 1:
+        if nb_force is not None:
+            f_nb = np.zeros((nb, n))
+            nb_force(u, GAMMA, ALPHA, BETA, f_nb)
+            assert np.allclose(f_nb, ref, rtol=1e-12, atol=1e-15)
+            _row(rows, "numba", "force", n, nb, best_time(lambda: nb_force(u, GAMMA, ALPHA, BETA, f_nb)))
+        F, Kc = _casadi_force(n) if n <= casadi_max and n * nb <= 1_000_000 else (None, None)
+        if F is not None and nb == 1:
             assert np.allclose(np.asarray(F(u1)).ravel(), ref[0], rtol=1e-12, atol=1e-15)
             _row(rows, "casadi SX", "force", n, nb, best_time(lambda: F(u1)))
-        else:
+        elif F is not None:
             Fm = F.map(nb)
             _row(rows, "casadi SX map", "force", n, nb, best_time(lambda: Fm(u.T)))
         if n <= lambdify_max and nb == 1:
@@ -160,8 +233,60 @@ def kernel_rows(sizes, batch_n: int, batch: int, lambdify_max: int) -> list[dict
             _row(rows, "generated C", "stiffness", n, 1, best_time(k_gen))
             _row(rows, "hand C -O3", "stiffness", n, 1, best_time(k_hand))
             _row(rows, "numpy", "stiffness", n, 1, best_time(lambda: numpy_stiffness(u1)))
-            _row(rows, "casadi SX", "stiffness", n, 1, best_time(lambda: Kc(u1)))
+            if nb_stiff is not None:
+                k_nb = np.zeros(3 * n - 2)
+                nb_stiff(u1, GAMMA, ALPHA, BETA, k_nb)
+                assert np.allclose(k_nb, ref_k, rtol=1e-12)
+                _row(rows, "numba", "stiffness", n, 1, best_time(lambda: nb_stiff(u1, GAMMA, ALPHA, BETA, k_nb)))
+            if Kc is not None:
+                _row(rows, "casadi SX", "stiffness", n, 1, best_time(lambda: Kc(u1)))
     return rows
+
+
+def batch_bandwidth(rows: list, batch_n: int, batch: int) -> dict:
+    """The batched force's achieved share of the memory-bandwidth bound, per method timed on it (generated C,
+    hand C, numba, numpy): (16 N B bytes / its seconds) / bw_copy(N B) (module docstring), bw_copy measured now."""
+    from mechgen.analyses.symplectic import copy_bandwidth
+
+    moved = 16.0 * batch_n * batch
+    bw = copy_bandwidth(batch_n * batch)
+    shares = {r["method"]: moved / r["seconds"] / bw for r in rows
+              if (r["quantity"], r["N"], r["batch"]) == ("force", batch_n, batch) and r["method"] in
+              ("generated C", "hand C -O3", "numba", "numpy")}
+    return {"N": batch_n, "states": batch, "bytes_per_call": moved, "copy_bandwidth_GBps": bw / 1e9,
+            "fraction": shares, "target": BANDWIDTH_TARGET}
+
+
+def leapfrog_bandwidth(n: int, t_end: float) -> dict:
+    """The leapfrog's steps per second and share of the bandwidth bound in the C time loop: scenes/fpu_large.toml
+    (FPU-beta, fixed ends, dt = 0.05) at N = ``n`` to ``t_end``, as the symplectic analysis reports them."""
+    import mechgen
+
+    scene = tomllib.loads((ROOT / "scenes" / "fpu_large.toml").read_text())
+    scene["params"]["N"] = int(n)
+    (analysis,) = scene["analysis"]
+    analysis["t_end"] = float(t_end)
+    analysis["stride"] = min(int(analysis.get("stride", 500)), int(round(t_end / analysis["dt"])))
+    out = mechgen.run(scene)["analyses"][0]["outputs"]
+    return {"N": int(n), "steps": out["steps"], "loop": out["loop"], "steps_per_second": out["steps_per_second"],
+            "energy_error": out["energy_error"], "fraction": out["bandwidth_fraction"], "target": BANDWIDTH_TARGET}
+
+
+def ratio_table(rows: list) -> list[dict]:
+    """Per quantity, N and batch: generated C / hand C (target <= GEN_HAND_TARGET), and lambdify, numba, numpy,
+    CasADi over generated C (> 1: generated C is faster); None where a method was not timed."""
+    out = []
+    for q, n, b in sorted({(r["quantity"], r["N"], r["batch"]) for r in rows}, key=lambda k: (k[0], k[2], k[1])):
+        hand = _ratio(rows, "hand C -O3", q, n, b, "generated C")
+        cas = _ratio(rows, "casadi SX", q, n, b, "generated C") or _ratio(rows, "casadi SX map", q, n, b,
+                                                                          "generated C")
+        gen_hand = None if hand is None else 1.0 / hand
+        out.append({"quantity": q, "N": n, "batch": b, "gen_over_hand_c": gen_hand,
+                    "within_gen_hand_target": None if gen_hand is None else gen_hand <= GEN_HAND_TARGET,
+                    "lambdify_over_gen": _ratio(rows, "sympy.lambdify", q, n, b, "generated C"),
+                    "numba_over_gen": _ratio(rows, "numba", q, n, b, "generated C"),
+                    "numpy_over_gen": _ratio(rows, "numpy", q, n, b, "generated C"), "casadi_over_gen": cas})
+    return out
 
 
 def call_overhead() -> dict:
@@ -244,10 +369,25 @@ def _ratio(rows, method, quantity, n, batch, base) -> float | None:
     return None if a is None or b is None else a / b
 
 
+def bandwidth_markdown(batched: dict, leapfrog: dict, numba_note: str | None) -> list[str]:
+    """The bandwidth lines (and why numba is missing, if it is)."""
+    shares = ", ".join(f"{m} {f:.2f}" for m, f in batched["fraction"].items())
+    lines = ["", f"batched force, {batched['states']:,} states at N = {batched['N']:,} "
+             f"({batched['bytes_per_call'] / 1e6:.0f} MB moved per call; numpy copy of the same size "
+             f"{batched['copy_bandwidth_GBps']:.2f} GB/s): share of the bandwidth bound {shares} "
+             f"(target >= {BANDWIDTH_TARGET:g})",
+             f"leapfrog step, C time loop ({leapfrog['loop']}), N = {leapfrog['N']:,}, {leapfrog['steps']:,} steps: "
+             f"{leapfrog['steps_per_second']:.1f} steps/s, share of the bandwidth bound {leapfrog['fraction']:.2f} "
+             f"(target >= {BANDWIDTH_TARGET:g}), energy error {leapfrog['energy_error']:.1e}"]
+    if numba_note:
+        lines.append(f"numba: not timed - {numba_note}")
+    return lines
+
+
 def report_markdown(rows, overhead, builds, start) -> str:
     """The summary table with the issue's targets."""
-    lines = ["| quantity | N | batch | generated C | hand C | gen/hand (target <= 1.3) | numpy/gen | "
-             "lambdify/gen (target >= 100 at N >= 1024) | casadi/gen |", "|---|---|---|---|---|---|---|---|---|"]
+    lines = ["| quantity | N | batch | generated C | hand C | gen/hand (target <= 1.3) | numba/gen | numpy/gen | "
+             "lambdify/gen (target >= 100 at N >= 1024) | casadi/gen |", "|---|---|---|---|---|---|---|---|---|---|"]
     keys = sorted({(r["quantity"], r["N"], r["batch"]) for r in rows}, key=lambda k: (k[0], k[2], k[1]))
     for q, n, b in keys:
         gen = next(r["seconds"] for r in rows if (r["method"], r["quantity"], r["N"], r["batch"]) ==
@@ -262,6 +402,7 @@ def report_markdown(rows, overhead, builds, start) -> str:
                        ("hand C -O3", q, n, b)), None)
         lines.append(f"| {q} | {n} | {b} | {gen * 1e6:.2f} us | "
                      f"{'-' if hand_s is None else f'{hand_s * 1e6:.2f} us'} | {fmt(gh)} | "
+                     f"{fmt(_ratio(rows, 'numba', q, n, b, 'generated C'))} | "
                      f"{fmt(_ratio(rows, 'numpy', q, n, b, 'generated C'))} | {fmt(lam)} | {fmt(cas)} |")
     lines.append("")
     lines.append(f"prepared call of a 4-DOF kernel: {overhead['single_call_ns']:.0f} ns per call, kernel "
@@ -278,18 +419,26 @@ def report_markdown(rows, overhead, builds, start) -> str:
 
 def run_fpu_benchmarks(*, out: Path, quick: bool = False) -> dict:
     """Run the FPU benchmark and write ``out/fpu_kernels.{csv,json,md}``."""
-    sizes = (64, 256) if quick else (64, 1024, 16384)
-    batch = (64, 100) if quick else (64, 10_000)
+    sizes = QUICK_LADDER if quick else LADDER
+    batch = QUICK_BATCH if quick else BATCH
+    numba_note = numba_kernels()[2]
     rows = kernel_rows(sizes, batch[0], batch[1], lambdify_max=256 if quick else 1024)
+    batched = batch_bandwidth(rows, *batch)
+    leapfrog = leapfrog_bandwidth(*(QUICK_LEAPFROG if quick else LEAPFROG))
+    ratios = ratio_table(rows)
     overhead = call_overhead()
     builds = build_times((8, 100_000) if not quick else (8, 1000))
     start = scene_start(ROOT / "scenes" / "spring_pendulum.toml")
     users = user_path([ROOT / "scenes" / USER_SCENE], repeats=1 if quick else 3, warm=not quick)
     out = Path(out)
     write_csv(out / "fpu_kernels.csv", rows)
-    result = {"kernels": rows, "call_overhead": overhead, "builds": builds, "scene_start": start, "user_path": users}
+    result = {"kernels": rows, "ratios": ratios, "batched_force_bandwidth": batched, "leapfrog_bandwidth": leapfrog,
+              "numba": numba_note or "timed", "call_overhead": overhead, "builds": builds, "scene_start": start,
+              "user_path": users}
     write_json(out / "fpu_kernels.json", result)
-    table = report_markdown(rows, overhead, builds, start) + "\n\n" + user_path_markdown(users, "The scene as a user runs it")
+    table = (report_markdown(rows, overhead, builds, start) + "\n".join([""] + bandwidth_markdown(batched, leapfrog,
+                                                                                                 numba_note))
+             + "\n\n" + user_path_markdown(users, "The scene as a user runs it"))
     write_text(out / "fpu_kernels.md", table + "\n")
     print(table)
     print(f"\nwrote {out / 'fpu_kernels.csv'}, {out / 'fpu_kernels.json'}, {out / 'fpu_kernels.md'}")

@@ -41,7 +41,7 @@ class SweepExecutor:
     """Where the points run: ``kind`` (serial | processes | dask), ``workers`` (processes, or Dask
     workers of a LocalCluster started for the run; 0: two), ``scheduler`` (a running Dask
     scheduler's address, ``tcp://host:port``; None: a LocalCluster on the loopback for this sweep),
-    ``chunk_seconds`` (the work a Dask task carries at least, from the first point's time: Dask's
+    ``chunk_seconds`` (the work a Dask task carries at least, from a warm point's time: Dask's
     per-task overhead is 0.2-1 ms)."""
 
     kind: str = "serial"

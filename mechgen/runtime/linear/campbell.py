@@ -449,6 +449,12 @@ class CampbellOptions(Options):
         mac_min: the smallest MAC of a curve to the previous speed that a reduced speed may have.
         budget: a :class:`mechgen.runtime.core.budget.Budget` checked at every speed's solve (None: none);
             the exact path projects the whole diagram's time from its first speeds.
+        executor: where the exact path's per-speed eigen-solves run, a
+            :class:`mechgen.runtime.core.sweep.SweepExecutor` (None: serial, here). The solves are
+            independent (each speed's matrices are assembled here and sent with its task); the tracking
+            runs here afterwards on the same candidates, so every executor gives the serial result. The
+            reduced path carries its basis from speed to speed and runs here only: with a parallel
+            executor, 'auto' takes the exact path and 'reduced' is refused (InputError at ``executor``).
     """
 
     sparse: bool | None = None
@@ -461,6 +467,7 @@ class CampbellOptions(Options):
     residual_tol: float = 1e-9
     mac_min: float = 0.8
     budget: object = None
+    executor: object = None
 
 
 def campbell(matrices_at, speeds, count: int, options: CampbellOptions | None = None, *, x_index, y_index,
@@ -485,6 +492,12 @@ def campbell(matrices_at, speeds, count: int, options: CampbellOptions | None = 
     cluster_tol, planar_tol, method = opts.cluster_tol, opts.planar_tol, opts.method
     residual_tol, mac_min, budget = opts.residual_tol, opts.mac_min, opts.budget
     _check_method(method)
+    parallel = opts.executor is not None and opts.executor.kind != "serial"
+    if parallel and method == "reduced":
+        raise InputError(f"method 'reduced' carries its basis from speed to speed and cannot run on executor "
+                         f"{opts.executor.kind!r}", key="executor",
+                         expected="executor 'serial' for method 'reduced', or method 'exact' (or 'auto': exact "
+                                  "solves at every speed on a parallel executor)")
     speeds = np.asarray(speeds, dtype=float)
     if speeds.ndim != 1 or speeds.size == 0 or not np.all(np.isfinite(speeds)):
         raise InputError("speeds must be a non-empty list of finite numbers", key="speeds",
@@ -510,7 +523,7 @@ def campbell(matrices_at, speeds, count: int, options: CampbellOptions | None = 
     if method == "reduced" and (poly is None or not {"M", "C", "K"} <= set(poly.terms)):
         raise InputError("method 'reduced' needs the matrices as a SpeedPolynomial with keys M, C, K",
                          key="matrices_at", expected="fit_speed_polynomial(...) or method='exact'")
-    reduced = poly is not None and {"M", "C", "K"} <= set(poly.terms) and (
+    reduced = not parallel and poly is not None and {"M", "C", "K"} <= set(poly.terms) and (
         method == "reduced" or (method == "auto" and S >= REDUCED_MIN_SPEEDS and n >= REDUCED_MIN_RATIO * m))
     track = dict(x_index=x_index, y_index=y_index, freq_weight=freq_weight, cluster_tol=cluster_tol,
                  planar_tol=planar_tol)
@@ -518,6 +531,11 @@ def campbell(matrices_at, speeds, count: int, options: CampbellOptions | None = 
     if reduced:
         eig, shp, mac, model, n_exact = _campbell_reduced(poly, speeds, count, m, n, sparse, sigma, first,
                                                           residual_tol, mac_min, track, budget)
+    elif parallel:
+        found = solve_speeds(matrices_at, first, speeds, (n, m, count, sparse, sigma), opts.executor, budget)
+        eig, shp, mac, _ = _track(speeds, [dm.eigenvalues for dm in found], [dm.shapes for dm in found], count,
+                                  **track)
+        n_exact = S
     else:
         found = []
         for i, w in enumerate(speeds):
@@ -540,6 +558,37 @@ def campbell(matrices_at, speeds, count: int, options: CampbellOptions | None = 
         y_index=tuple(np.atleast_1d(y_index).tolist()), candidates=m,
         method="reduced" if reduced else "exact", exact_solves=n_exact,
         basis_size=0 if model is None else model.size, reduced=model)
+
+
+class SpeedTasks:
+    """The exact path's per-speed tasks for :func:`speed_modes`, made when a speed is reached:
+    (matrices at the speed, the speed, n, m, count, sparse, sigma); speed 0 reuses the matrices already built."""
+
+    def __init__(self, matrices_at, first: dict, speeds, solve: tuple) -> None:
+        self.matrices_at, self.first, self.speeds, self.solve = matrices_at, first, speeds, solve
+
+    def __len__(self) -> int:
+        return len(self.speeds)
+
+    def __getitem__(self, i: int) -> tuple:
+        w = float(self.speeds[i])
+        return (self.first if i == 0 else self.matrices_at(w), w, *self.solve)
+
+
+def speed_modes(task: tuple) -> DampedModes:
+    """The candidate damped modes of one speed (a :class:`SpeedTasks` task); module level: it runs in workers."""
+    return _modes_at(*task)
+
+
+def solve_speeds(matrices_at, first: dict, speeds, solve: tuple, executor, budget=None) -> list:
+    """The DampedModes of every speed on ``executor`` (mechgen.runtime.core.sweep.sweep_points: local
+    processes or Dask chunks), in speed order; the first failure stops the diagram (naming the speed)."""
+    from mechgen.runtime.core.sweep import sweep_points
+
+    run = sweep_points(speed_modes, SpeedTasks(matrices_at, first, speeds, solve), executor=executor,
+                       desc="campbell", budget=budget, inner="campbell",
+                       labels=[{"speed": float(w)} for w in speeds], on_error="raise")
+    return run.results
 
 
 def _campbell_reduced(poly, speeds, count, m, n, sparse, sigma, first, residual_tol, mac_min, track, budget=None):

@@ -48,7 +48,11 @@ of dt, before a ConvergenceError names the time reached.
 """
 from __future__ import annotations
 
+import ctypes
+import logging
 from dataclasses import dataclass, field
+from functools import lru_cache
+from pathlib import Path
 
 import numpy as np
 from scipy.linalg import lapack
@@ -60,9 +64,35 @@ from mechgen.runtime.rods.statics import Rod
 ENDS = ("clamped", "pinned", "free")
 #: band half-width of the node-major Jacobian: a node's 6 equations reach the 6 unknowns of each neighbour
 BAND = 11
+log = logging.getLogger("mechgen")
 MAX_SPLITS = 12
 #: simplified Newton's largest accepted contraction rate before the Jacobian is taken again
 REFRESH = 0.2
+
+
+SOURCE = Path(__file__).resolve().parent.parent.parent / "codegen" / "templates" / "c99" / "rod_elements.c"
+
+
+@lru_cache(maxsize=1)
+def _library():
+    """The loaded rod-element library, or None (no compiler: the numpy path runs; one log line)."""
+    from mechgen.codegen.build import load_shared
+    from mechgen.errors import BuildError, CompilerUnavailable
+
+    try:
+        lib = load_shared(SOURCE.read_text(encoding="utf-8"), stem="mgrod", ldflags=("-lm",), symbols=("mgr_internal",))
+    except (CompilerUnavailable, BuildError, OSError) as exc:
+        log.info("C rod elements unavailable (%s): numpy forces", exc)
+        return None
+    c_long, c_double, c_void_p = ctypes.c_long, ctypes.c_double, ctypes.c_void_p
+    lib.mgr_internal.argtypes = [c_long, c_long, c_double, c_double] + [c_void_p] * 9
+    lib.mgr_internal.restype = ctypes.c_int
+    return lib
+
+
+def forget_library() -> None:
+    """Forget the loaded (or refused) library (tests change CC)."""
+    _library.cache_clear()
 
 
 @dataclass(frozen=True)
@@ -204,6 +234,35 @@ class Discrete:
         Mb[..., 1:, :] -= _mtv(Jr_inv, c)                          # -dV/dw_{i+1}
         return F, Mb, sigma
 
+    def weighted_internal(self, st: State, z: np.ndarray, *, compiled: bool = True):
+        """The configuration x + alpha dx, R exp(alpha theta) at increments z (..., n, 6) and its internal
+        forces and moments: in C (codegen/templates/c99/rod_elements.c, the same operations) when a compiler
+        is there, else numpy (:meth:`internal`)."""
+        al = self.body.alpha
+        lib = _library() if compiled else None
+        if lib is None:
+            xm = st.x + al * z[..., :3]
+            Rm = st.R @ exp_so3(al * z[..., 3:])
+            F, Mb, _ = self.internal(xm, Rm)
+            return xm, Rm, F, Mb
+        zc = np.ascontiguousarray(z, dtype=float)
+        lead = zc.shape[:-1]
+        batch = int(np.prod(lead[:-1])) if len(lead) > 1 else 1
+        x = np.ascontiguousarray(st.x, dtype=float)
+        R = np.ascontiguousarray(st.R, dtype=float)
+        xm = np.empty(lead + (3,))
+        Rm = np.empty(lead + (3, 3))
+        F = np.empty(lead + (3,))
+        Mb = np.empty(lead + (3,))
+        K = self.__dict__.get("_Kc")
+        if K is None:
+            K = np.ascontiguousarray(self.body.rod.K, dtype=float)
+            object.__setattr__(self, "_Kc", K)
+            object.__setattr__(self, "_f0c", np.ascontiguousarray(self.body.rod.f0, dtype=float))
+        lib.mgr_internal(batch, lead[-1], self.h, al, K.ctypes.data, self._f0c.ctypes.data, x.ctypes.data,
+                         R.ctypes.data, zc.ctypes.data, xm.ctypes.data, Rm.ctypes.data, F.ctypes.data, Mb.ctypes.data)
+        return xm, Rm, F, Mb
+
     def external(self, x: np.ndarray, R: np.ndarray):
         """Lumped distributed load and the dead tip wrench: nodal spatial forces and body moments."""
         rod = self.body.rod
@@ -229,9 +288,7 @@ class Discrete:
         """Midpoint equations at increments z = (dx, theta) (..., n, 6); also the external wrench there."""
         dx, th = z[..., :3], z[..., 3:]
         al = self.body.alpha
-        xm = st.x + al * dx
-        Rm = st.R @ exp_so3(al * th)
-        F, Mb, _ = self.internal(xm, Rm)
+        xm, Rm, F, Mb = self.weighted_internal(st, z)
         Fx, Mx = self.external(xm, Rm)
         c = self.body.damping
         vm, wm = dx / dt, th / dt

@@ -60,17 +60,23 @@ def _closed(name: str, t: np.ndarray) -> np.ndarray:
     return (2.0 * t - 3.0 * np.sin(t) + t * np.cos(t)) / (2.0 * t**5)
 
 
-def _terms(name: str, t_max: float) -> int:
-    """How many series terms reach round-off for every angle up to t_max (< 1): the first neglected term
-    c_m t^(2m) below 1e-18 of the function's value (>= 1/24 for a3, a4 near 0; the table's terms fall fast)."""
+def _limits(name: str) -> list[float]:
+    """For m = 1 … 12 terms, the largest angle whose first neglected term c_m t^(2m) is below 1e-18 of the
+    function's value at 0 (|c_0|; the functions stay within a factor 2 of it for t < 1)."""
     coeffs = _SERIES[name]
-    x = t_max * t_max
-    power = 1.0
-    for m, c in enumerate(coeffs):
-        if abs(c) * power < 1e-18 * abs(coeffs[0]):
-            return max(m, 1)
-        power *= x
-    return len(coeffs)
+    return [(1e-18 * abs(coeffs[0]) / abs(coeffs[m])) ** (1.0 / (2 * m)) if m < len(coeffs) else math.inf
+            for m in range(1, len(coeffs) + 1)]
+
+
+_LIMITS = {name: _limits(name) for name in _SERIES}
+
+
+def _terms(name: str, t_max: float) -> int:
+    """How many series terms reach round-off for every angle up to t_max (< 1)."""
+    for m, limit in enumerate(_LIMITS[name], 1):
+        if t_max <= limit:
+            return m
+    return len(_SERIES[name])
 
 
 def _series(name: str, t: np.ndarray) -> np.ndarray:

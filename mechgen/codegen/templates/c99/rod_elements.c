@@ -1,0 +1,162 @@
+/* Internal forces of the two-node SO(3) x R^3 Cosserat rod elements at the step's weighted configuration.
+ *
+ * The same operations as mechgen/runtime/rods/dynamics.py (Discrete.residual's configuration and
+ * Discrete.internal; angle functions as mechgen/runtime/rods/liegroup.py: series below 1 rad, closed forms
+ * above): for each of `batch` increments z (n nodes x 6: dx, theta)
+ *
+ *   xm_i = x_i + alpha dx_i,   Rm_i = R_i exp(alpha theta_i),
+ *   Psi_e = log(Rm_i^T Rm_{i+1}),  Re = Rm_i exp(Psi_e/2),  nu = Re^T (xm_{i+1} - xm_i)/h,  kappa = Psi_e/h,
+ *   sigma = K ((nu, kappa) - f0),  F_i += Re n,  F_{i+1} -= Re n,
+ *   a = h n x nu,  c = m + J_r(Psi/2)^T a/2,
+ *   Mb_i -= exp(Psi/2) a - J_l(Psi)^-T c,   Mb_{i+1} -= J_r(Psi)^-T c,
+ *
+ * writing xm (batch, n, 3), Rm (batch, n, 3, 3), F and Mb (batch, n, 3): spatial forces (N) and body moments
+ * (N m), minus the exact gradient of V = sum_e h/2 (f_e - f0)^T K (f_e - f0). Row-major 3 x 3 matrices.
+ */
+#include <math.h>
+#include <string.h>
+
+#define TERMS 12
+
+static double fact(int n) { double f = 1.0; for (int i = 2; i <= n; ++i) f *= i; return f; }
+
+/* sum_m (-1)^m t^(2m) / (2m + k)!  (k = 1: sin t/t, 2: (1 - cos t)/t^2, 3: (t - sin t)/t^3) */
+static double series(double t, int k) {
+    double t2 = t * t, acc = 0.0;
+    for (int m = TERMS - 1; m >= 0; --m) acc = acc * t2 + ((m % 2) ? -1.0 : 1.0) / fact(2 * m + k);
+    return acc;
+}
+
+static double sinc_(double t) { return t < 1.0 ? series(t, 1) : sin(t) / t; }
+static double a1_(double t) { return t < 1.0 ? series(t, 2) : (1.0 - cos(t)) / (t * t); }
+static double a2_(double t) { return t < 1.0 ? series(t, 3) : (t - sin(t)) / (t * t * t); }
+
+/* (1 - (t/2) cot(t/2))/t^2 = sum_n |B_2n| t^(2n-2)/(2n)! below 1 rad */
+static double binv_(double t) {
+    static const double B[TERMS] = {1.0 / 6, 1.0 / 30, 1.0 / 42, 1.0 / 30, 5.0 / 66, 691.0 / 2730, 7.0 / 6,
+                                    3617.0 / 510, 43867.0 / 798, 174611.0 / 330, 854513.0 / 138,
+                                    236364091.0 / 2730};
+    if (t >= 1.0) return (1.0 - t * sin(t) / (2.0 * (1.0 - cos(t)))) / (t * t);
+    double t2 = t * t, acc = 0.0;
+    for (int n = TERMS - 1; n >= 0; --n) acc = acc * t2 + B[n] / fact(2 * n + 2);
+    return acc;
+}
+
+static double norm3(const double *w) { return sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]); }
+
+static void hat(const double *w, double *W) {
+    W[0] = 0.0;   W[1] = -w[2]; W[2] = w[1];
+    W[3] = w[2];  W[4] = 0.0;   W[5] = -w[0];
+    W[6] = -w[1]; W[7] = w[0];  W[8] = 0.0;
+}
+
+/* exp(hat w) = cos t I + sinc(t) hat w + a1(t) w w^T */
+static void exp3(const double *w, double *E) {
+    double t = norm3(w), s = sinc_(t), a = a1_(t), c = cos(t), W[9];
+    hat(w, W);
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) E[3 * i + j] = a * w[i] * w[j] + s * W[3 * i + j] + (i == j ? c : 0.0);
+}
+
+/* I + p hat w + q hat(w)^2, hat(w)^2 = w w^T - t^2 I */
+static void poly3(const double *w, double p, double q, double *J) {
+    double t2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2], W[9];
+    hat(w, W);
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            J[3 * i + j] = (i == j ? 1.0 - q * t2 : 0.0) + p * W[3 * i + j] + q * w[i] * w[j];
+}
+
+/* w with exp(hat w) = R, |w| <= pi (liegroup.log_so3: from the skew part, near pi from R + R^T) */
+static void log3(const double *R, double *w) {
+    double s[3] = {0.5 * (R[7] - R[5]), 0.5 * (R[2] - R[6]), 0.5 * (R[3] - R[1])};
+    double c = 0.5 * (R[0] + R[4] + R[8] - 1.0);
+    double t = atan2(norm3(s), c);
+    if (c >= -0.9) {
+        double k = 1.0 / sinc_(t);
+        for (int i = 0; i < 3; ++i) w[i] = s[i] * k;
+        return;
+    }
+    double B[9];
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) B[3 * i + j] = 0.5 * (R[3 * i + j] + R[3 * j + i]) - (i == j ? c : 0.0);
+    int k = 0;
+    if (B[4] > B[3 * k + k]) k = 1;
+    if (B[8] > B[3 * k + k]) k = 2;
+    double col[3] = {B[k], B[3 + k], B[6 + k]}, nc = norm3(col);
+    double dot = (col[0] * s[0] + col[1] * s[1] + col[2] * s[2]) / nc;
+    double sign = dot < 0.0 ? -1.0 : 1.0;
+    for (int i = 0; i < 3; ++i) w[i] = sign * t * col[i] / nc;
+}
+
+static void matmul(const double *A, const double *B, double *C) {
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            C[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
+}
+
+static void matTmul(const double *A, const double *B, double *C) {   /* A^T B */
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) C[3 * i + j] = A[i] * B[j] + A[3 + i] * B[3 + j] + A[6 + i] * B[6 + j];
+}
+
+static void mv(const double *A, const double *b, double *y) {
+    for (int i = 0; i < 3; ++i) y[i] = A[3 * i] * b[0] + A[3 * i + 1] * b[1] + A[3 * i + 2] * b[2];
+}
+
+static void mtv(const double *A, const double *b, double *y) {      /* A^T b */
+    for (int i = 0; i < 3; ++i) y[i] = A[i] * b[0] + A[3 + i] * b[1] + A[6 + i] * b[2];
+}
+
+int mgr_internal(long batch, long n, double h, double alpha, const double *K, const double *f0,
+                 const double *x, const double *R, const double *z,
+                 double *xm, double *Rm, double *F, double *Mb) {
+    for (long b = 0; b < batch; ++b) {
+        const double *zb = z + b * n * 6;
+        double *xb = xm + b * n * 3, *Rb = Rm + b * n * 9, *Fb = F + b * n * 3, *Mbb = Mb + b * n * 3;
+        for (long i = 0; i < n; ++i) {
+            double th[3] = {alpha * zb[6 * i + 3], alpha * zb[6 * i + 4], alpha * zb[6 * i + 5]}, E[9];
+            for (int k = 0; k < 3; ++k) xb[3 * i + k] = x[3 * i + k] + alpha * zb[6 * i + k];
+            exp3(th, E);
+            matmul(R + 9 * i, E, Rb + 9 * i);
+        }
+        memset(Fb, 0, sizeof(double) * 3 * n);
+        memset(Mbb, 0, sizeof(double) * 3 * n);
+        for (long e = 0; e + 1 < n; ++e) {
+            const double *Ri = Rb + 9 * e, *Rj = Rb + 9 * (e + 1);
+            double Q[9], Psi[3], half[3], Rh[9], Re[9], d[3], nu[3], eps[6], sig[6];
+            matTmul(Ri, Rj, Q);
+            log3(Q, Psi);
+            for (int k = 0; k < 3; ++k) half[k] = 0.5 * Psi[k];
+            exp3(half, Rh);
+            matmul(Ri, Rh, Re);
+            for (int k = 0; k < 3; ++k) d[k] = xb[3 * (e + 1) + k] - xb[3 * e + k];
+            mtv(Re, d, nu);
+            for (int k = 0; k < 3; ++k) { nu[k] /= h; eps[k] = nu[k] - f0[k]; eps[3 + k] = Psi[k] / h - f0[3 + k]; }
+            for (int r = 0; r < 6; ++r) {
+                double acc = 0.0;
+                for (int s = 0; s < 6; ++s) acc += eps[s] * K[6 * s + r];      /* (f - f0) @ K */
+                sig[r] = acc;
+            }
+            double Fe[3];
+            mv(Re, sig, Fe);
+            for (int k = 0; k < 3; ++k) { Fb[3 * e + k] += Fe[k]; Fb[3 * (e + 1) + k] -= Fe[k]; }
+            double a[3] = {h * (sig[1] * nu[2] - sig[2] * nu[1]), h * (sig[2] * nu[0] - sig[0] * nu[2]),
+                           h * (sig[0] * nu[1] - sig[1] * nu[0])};
+            /* J_r(Psi/2) = J_l(-Psi/2) = I - a1 hat(Psi/2) + a2 hat(Psi/2)^2, at t/2 */
+            double th = norm3(half), Jr[9], ca[3], c[3], Jli[9], Jri[9], bpsi = binv_(norm3(Psi));
+            double mhalf[3] = {-half[0], -half[1], -half[2]};
+            poly3(mhalf, a1_(th), a2_(th), Jr);
+            mtv(Jr, a, ca);
+            for (int k = 0; k < 3; ++k) c[k] = sig[3 + k] + 0.5 * ca[k];
+            poly3(Psi, -0.5, bpsi, Jli);              /* J_l(Psi)^-1 = I - hat/2 + b hat^2 */
+            poly3(Psi, 0.5, bpsi, Jri);               /* J_r(Psi)^-1 = I + hat/2 + b hat^2 */
+            double Rha[3], Jc[3], Jrc[3];
+            mv(Rh, a, Rha);
+            mtv(Jli, c, Jc);
+            mtv(Jri, c, Jrc);
+            for (int k = 0; k < 3; ++k) { Mbb[3 * e + k] -= Rha[k] - Jc[k]; Mbb[3 * (e + 1) + k] -= Jrc[k]; }
+        }
+    }
+    return 0;
+}
