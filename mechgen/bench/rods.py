@@ -56,9 +56,10 @@ Parts:
 Timing: one BLAS thread for both (common.blas_threads); PyElastica's numba functions compiled by an untimed
 warm-up run first (its seconds reported); a PyElastica time is its stepping loop, a mechgen time the whole
 public call (``mechgen.rod_statics`` / ``mechgen.rod_dynamics``: set-up and solve) on a compiled system,
-the best of REPEATS runs after a warm-up (one run in quick mode). Writes ``rods_work_precision.{csv,png}``,
-``rods_ratios.json`` (ratio = PyElastica seconds / mechgen seconds at the condition stated) and
-``rods.json``, ``rods.md``; ``quick``: tiny ladders (about 13 s once numba's cache is warm; numba's
+the best of 3 runs after a warm-up (one run in quick mode); a PyElastica time is one run. Writes
+``rods_work_precision.{csv,png}`` (the static work-precision), ``rods_ratios.json`` (every ratio, = PyElastica
+seconds / mechgen seconds at the condition stated), ``rods_dynamic_work_precision.{csv,png}`` (the dynamic,
+gravity and stiff points), ``rods.json`` and ``rods.md``; ``quick``: tiny ladders (about 13 s once numba's cache is warm; numba's
 first compilation of PyElastica adds about 10 s once).
 """
 from __future__ import annotations
@@ -70,7 +71,8 @@ from pathlib import Path
 
 import numpy as np
 
-from mechgen.bench.common import best_time, blas_threads, environment, suite_report, write_json, write_text
+from mechgen.bench.common import (best_time, blas_threads, environment, loglog_plot, suite_report, write_csv,
+                                  write_json, write_text)
 
 #: the PyElastica release the suite was written and measured against (pyproject's bench extra)
 PYELASTICA_PIN = "1.0.0"
@@ -612,6 +614,16 @@ def run_rods_benchmarks(out: Path, quick: bool = False) -> dict:
             results["dynamic"] = results["gravity"] = results["stiff"] = \
                 "skipped: mechgen.rod_dynamics is not available"
     env["loadavg_after"] = list(__import__("os").getloadavg())
+    write_reports(out, results)
+    return results
+
+
+def write_reports(out: Path, results: dict) -> None:
+    """The suite's reports from its results (also from a saved rods.json): the standard three for the static
+    work-precision (``rods_work_precision.{csv,png}``, ``rods_ratios.json`` with every ratio),
+    ``rods_dynamic_work_precision.{csv,png}`` (the dynamic, gravity and stiff points; stiff errors against
+    mechgen's own same-N run), ``rods.json`` and ``rods.md``."""
+    out = Path(out)
     points = [{"series": f"static: {r['side']}", "setting": f"n={r['n']}", "seconds": r["seconds"],
                "error": r["error"]} for r in results["static"]["rows"]]
     ratios = []
@@ -628,6 +640,7 @@ def run_rods_benchmarks(out: Path, quick: bool = False) -> dict:
                                         f"collocation {ours[0]['n']} elements (error {ours[0]['error']:.2e})"
                                         + ("; mechgen's coarsest point already meets it: a lower bound" if coarsest
                                            else "")})
+    dynamic_points = []
     for key in ("dynamic", "gravity", "stiff"):
         part = results[key]
         if isinstance(part, str):
@@ -635,8 +648,8 @@ def run_rods_benchmarks(out: Path, quick: bool = False) -> dict:
         for r in part["rows"] + (part["pyelastica"] if isinstance(part.get("pyelastica"), list) else
                                  [part["pyelastica"]] if "pyelastica" in part else []):
             if r.get("error") is not None:
-                points.append({"series": f"{key}: {r['side']}", "setting": f"N={r['n']} dt={r['dt']:.3g}",
-                               "seconds": r["seconds"], "error": r["error"]})
+                dynamic_points.append({"series": f"{key}: {r['side']}", "setting": f"N={r['n']} dt={r['dt']:.3g}",
+                                       "seconds": r["seconds"], "error": r["error"]})
         if part.get("same_resolution"):
             m = part["same_resolution"]
             ratios.append({"peer": f"PyElastica ({key}, same N)", "ours_s": m["mechgen_s"], "peer_s": m["pyelastica_s"],
@@ -662,11 +675,22 @@ def run_rods_benchmarks(out: Path, quick: bool = False) -> dict:
                                         + ("; mechgen's coarsest point: a lower bound" if m["mechgen_is_coarsest"]
                                            else "")})
     results["ratios"] = [{**r, "ratio": r["peer_s"] / r["ours_s"]} for r in ratios]
+    steps = results["static"].get("reference_steps")
     suite_report(out, "rods", points,
-                 reference="static: mechgen RKMK4 shooting of the same rod, finest (validated against Bisshopp-"
-                           "Drucker / Mattiasson); dynamic: mechgen's finest run",
-                 error="tip error / L (static); max over the run / max tip deflection (dynamic)",
-                 time="wall time (s)", title="Cosserat cantilever: mechgen against PyElastica", ratios=ratios)
+                 reference=f"mechgen RKMK4 shooting ({steps} steps), same rod",
+                 error="tip error / L", time="wall time (s)",
+                 title="Cantilever, tip load P L^2/EI = 10: statics", ratios=ratios)
+    if dynamic_points:
+        reference = "mechgen's finest run (stiff: its own run at dt/4, same N)"
+        write_csv(out / "rods_dynamic_work_precision.csv",
+                  [{**p, "reference": reference} for p in dynamic_points],
+                  header=["series", "setting", "seconds", "error", "reference"])
+        series: dict = {}
+        for p in dynamic_points:
+            series.setdefault(p["series"], []).append((p["seconds"], p["error"], p["setting"].split()[0]
+                                                       if "PyElastica" in p["series"] else ""))
+        loglog_plot(out / "rods_dynamic_work_precision.png", series, xlabel="wall time (s)",
+                    ylabel="max |tip - tip_ref| over the run / max deflection",
+                    title=f"Cantilever dynamics: mechgen (N x dt) against PyElastica (N)\nreference: {reference}")
     write_json(out / "rods.json", results)
     write_text(out / "rods.md", markdown(results))
-    return results
