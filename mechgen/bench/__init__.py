@@ -70,6 +70,11 @@ REGISTRY: dict[str, Suite] = {s.name: s for s in (
           "the velocity step and of the stick-slip hysteresis energy per integrator", ("friction.json", "friction.md", "friction.csv",
                                                         "friction_work_precision.png"),
           peers=("hand-written solve_ivp Radau (benchmarks/)",)),
+    Suite("rods", "mechgen.bench.rods", "run_rods_benchmarks",
+          "Cosserat cantilever: static tip-load work-precision (collocation, shooting) against the elastica and "
+          "PyElastica's damped static limit; dynamic tip trajectory and a stiff rod against PyElastica",
+          ("rods.json", "rods.md", "rods_dynamic_work_precision.csv", "rods_dynamic_work_precision.png"),
+          peers=("PyElastica",)),
     Suite("threads", "mechgen.bench.threads", "run_threads_benchmarks",
           "every shipped scene as a whole process, default environment against one BLAS thread (unpinned / pinned)",
           ("threads.json", "threads.md"), standard=False),

@@ -1,0 +1,67 @@
+"""``mechgen bench rods`` in quick mode: the reports are written and the static study's numbers hold up.
+
+Independent references: Mattiasson (1981) table 1 at P L^2/EI = 10 for the elliptic-integral solution; the
+observed orders of convergence of the two static discretisations (2: Lie-group midpoint collocation; >= 4:
+RKMK4 shooting). PyElastica's parts are skipped (the test still runs mechgen's) when pyelastica is missing.
+"""
+import importlib.util
+import json
+
+import pytest
+
+from mechgen.bench import REGISTRY
+from mechgen.bench.rods import MATTIASSON_10, base_section, elastica
+
+
+def test_elliptic_reference_reproduces_mattiasson():
+    u, v, _ = elastica(10.0)
+    assert abs(u - MATTIASSON_10[0]) < 6e-6 and abs(-v - MATTIASSON_10[1]) < 6e-6
+
+
+def test_section_mapping_matches_pyelastica():
+    pytest.importorskip("elastica", reason="pyelastica is not installed (the bench extra)")
+    from mechgen.bench.rods import ALPHA_C_PIN, pyelastica_section_check
+
+    got = pyelastica_section_check(base_section())
+    assert got["alpha_c"] == pytest.approx(ALPHA_C_PIN, rel=1e-14)
+    assert max(abs(got[k]) for k in ("EA_rel_diff", "EI_rel_diff", "GJ_rel_diff")) < 1e-14
+    assert got["mass_second_moment_over_rho_dl"] == pytest.approx([got["I"], got["I"], got["J"]], rel=1e-14)
+
+
+def test_quick_run_writes_the_reports(tmp_path):
+    res = REGISTRY["rods"].run(tmp_path, quick=True)
+    for name in REGISTRY["rods"].reports:
+        if name.endswith(".png") and importlib.util.find_spec("matplotlib") is None:
+            continue
+        assert (tmp_path / name).exists(), name
+    st = res["static"]
+    assert st["orders"]["mechgen collocation"] == pytest.approx([2.0, 2.0], abs=0.05)
+    assert min(st["orders"]["mechgen shooting"]) > 3.8
+    assert st["validation"]["reference_self_convergence"] < 2e-6
+    assert max(map(abs, st["validation"]["mechgen_shooting_EA_GA_1e8_minus_elliptic"])) < 2e-6
+    ratios = json.loads((tmp_path / "rods_ratios.json").read_text())
+    if importlib.util.find_spec("elastica") is None:
+        assert res["pyelastica"].startswith("skipped") and ratios["ratios"] == []
+    else:
+        peer = [r for r in st["rows"] if r["side"] == "PyElastica static limit"]
+        assert peer and not any(r["blew_up"] for r in peer) and all(r["max_speed_end"] < 1e-9 for r in peer)
+        assert ratios["ratios"] and all(r["ratio"] > 0 for r in ratios["ratios"])
+    dyn, stiff = res["dynamic"], res["stiff"]
+    assert not isinstance(dyn, str) and not isinstance(stiff, str)
+    assert all(r["orthonormality_error"] < 1e-12 for r in dyn["rows"])
+    # mechgen's coarse runs lie within 3 % of the tip deflection of its fine reference (N = 40 vs 10 here)
+    assert all(r["error"] < 3e-2 for r in dyn["rows"])
+    # the stiff rod at dt hundreds of times PyElastica's limit: within 2 % of its own dt/4 run
+    assert all(r["error"] < 2e-2 and r["dt_over_pyelastica_limit"] > 100 for r in stiff["rows"])
+    grav = res["gravity"]
+    assert all(r["orthonormality_error"] < 1e-12 and r["error"] < 3e-2 for r in grav["rows"])
+    if importlib.util.find_spec("elastica") is not None:
+        # the two codes' trajectories agree to PyElastica's first-order discretisation error (2.2 % at N = 10),
+        # and PyElastica refined to N = 20 moves toward mechgen's reference
+        assert all(r["agreement_with_pyelastica"] < 3e-2 for r in dyn["rows"])
+        peers = dyn["pyelastica"]
+        assert peers[1]["error"] < peers[0]["error"] < 3e-2
+        # under gravity PyElastica converges at first order in N toward mechgen's reference (11 %, 5 %)
+        assert grav["pyelastica_orders"][0] > 0.8 and grav["pyelastica"][-1]["error"] < 0.08
+        stable, over = stiff["pyelastica"][:2]
+        assert not stable["blew_up"] and over["blew_up"] and over["dt_over_limit"] == 2.0
