@@ -41,6 +41,7 @@ from pathlib import Path
 
 import numpy as np
 
+from mechgen.bench.common import best_time as common_best_time
 from mechgen.bench.common import (ROOT, best_time, empty_cache, in_fresh_process, user_path, user_path_markdown,
                                   write_csv, write_json, write_text)
 
@@ -183,9 +184,13 @@ def _row(rows: list, method: str, quantity: str, n: int, batch: int, seconds: fl
 
 
 def kernel_rows(sizes, batch_n: int, batch: int, lambdify_max: int, casadi_max: int = CASADI_MAX,
-                numba: bool = True) -> list[dict]:
+                numba: bool = True, min_time: float = 0.1, repeats: int = 5) -> list[dict]:
     """Time every method for the force and the stiffness; checks agreement first. ``numba``: time the numba
-    loops too (when importable)."""
+    loops too (when importable). ``min_time``, ``repeats``: those of :func:`best_time` (the quick run's
+    are shorter: it checks that the suite runs, its times are not reported as measurements)."""
+    def best_time(fn):
+        return common_best_time(fn, min_time=min_time, repeats=repeats)
+
     from mechgen.codegen.build import load_shared
 
     lib = load_shared(HAND_C.read_text(), stem="hand_fpu")
@@ -422,7 +427,8 @@ def run_fpu_benchmarks(*, out: Path, quick: bool = False) -> dict:
     sizes = QUICK_LADDER if quick else LADDER
     batch = QUICK_BATCH if quick else BATCH
     numba_note = numba_kernels()[2]
-    rows = kernel_rows(sizes, batch[0], batch[1], lambdify_max=256 if quick else 1024)
+    rows = kernel_rows(sizes, batch[0], batch[1], lambdify_max=256 if quick else 1024,
+                       **({"min_time": 0.01, "repeats": 2} if quick else {}))
     batched = batch_bandwidth(rows, *batch)
     leapfrog = leapfrog_bandwidth(*(QUICK_LEAPFROG if quick else LEAPFROG))
     ratios = ratio_table(rows)
