@@ -36,7 +36,7 @@ import numpy as np
 
 from mechgen.analyses import schema
 from mechgen.analyses.registry import AnalysisKind, register
-from mechgen.analyses.rod_statics import AXES, MAX_ELEMENTS, rod_of, vector3
+from mechgen.analyses.rod_statics import AXES, MAX_ELEMENTS, bounded, rod_of, vector3
 from mechgen.analyses.schema import Option
 from mechgen.errors import InputError
 from mechgen.runtime.rods.dynamics import ENDS, Discrete, RodBody, check_inertia, reference_state, simulate
@@ -46,11 +46,7 @@ from mechgen.scene.values import fail
 MAX_STEPS = 10_000_000
 
 
-def _elements(ctx, key: str, value: object) -> int:
-    n = schema.int_at_least(ctx, key, value, 1)
-    if n > MAX_ELEMENTS:
-        raise fail(ctx.file, key, f"value {n} is above {MAX_ELEMENTS}", f"an integer from 1 to {MAX_ELEMENTS}")
-    return n
+_elements = bounded(1, MAX_ELEMENTS)
 
 
 def _non_negative(ctx, key: str, value: object) -> float:
@@ -119,25 +115,7 @@ def body_of(system, options: dict) -> RodBody:
         raise InputError(f"the rod of model {system.metadata.model}: {problem}", key="params",
                          expected="rhoA > 0 and a positive definite rotational inertia (rhoI, rhoJ > 0), "
                                   "from Model.rod(inertia=...)")
-    rod = _constant_load(system, rod, f0)
     return RodBody(rod, M, float(options.get("damping", 0.0)), float(options.get("alpha", 0.5)))
-
-
-def _constant_load(system, rod, f0: np.ndarray):
-    """The rod with its distributed load evaluated once when the kernel says it does not depend on the
-    position (d load/dr = 0 and equal values at random points: uniform gravity); else unchanged. The load is
-    taken at every Newton iterate, so a kernel call saved there is a fifth of the step's cost."""
-    from dataclasses import replace
-
-    if rod.load is None:
-        return rod
-    probe = np.random.default_rng(1).normal(size=(4, 3)) * rod.L
-    out = system.call("rod", f=np.tile(f0, (4, 1)), r=probe)
-    g = np.asarray(out["g"], dtype=float).reshape(4, 6)
-    if np.any(np.asarray(out["g_r"]) != 0.0) or np.any(g != g[0]):
-        return rod
-    value = g[0].copy()
-    return replace(rod, load=lambda r: np.broadcast_to(value, (len(r), 6)))
 
 
 def initial_state(body: RodBody, elements: int, v0, w0):

@@ -36,12 +36,12 @@ of 3 (``user_path`` in ``fpu_kernels.json``, a table in ``fpu_kernels.md``; :fun
 from __future__ import annotations
 
 import time
+from functools import partial
 import tomllib
 from pathlib import Path
 
 import numpy as np
 
-from mechgen.bench.common import best_time as common_best_time
 from mechgen.bench.common import (ROOT, best_time, empty_cache, in_fresh_process, user_path, user_path_markdown,
                                   write_csv, write_json, write_text)
 
@@ -188,8 +188,7 @@ def kernel_rows(sizes, batch_n: int, batch: int, lambdify_max: int, casadi_max: 
     """Time every method for the force and the stiffness; checks agreement first. ``numba``: time the numba
     loops too (when importable). ``min_time``, ``repeats``: those of :func:`best_time` (the quick run's
     are shorter: it checks that the suite runs, its times are not reported as measurements)."""
-    def best_time(fn):
-        return common_best_time(fn, min_time=min_time, repeats=repeats)
+    timer = partial(best_time, min_time=min_time, repeats=repeats)
 
     from mechgen.codegen.build import load_shared
 
@@ -207,25 +206,25 @@ def kernel_rows(sizes, batch_n: int, batch: int, lambdify_max: int, casadi_max: 
         gen(), hand()
         ref = numpy_force(u)
         assert np.allclose(f_gen, ref, rtol=1e-12, atol=1e-15) and np.allclose(f_hand, ref, rtol=1e-12, atol=1e-15)
-        _row(rows, "generated C", "force", n, nb, best_time(gen))
-        _row(rows, "hand C -O3", "force", n, nb, best_time(hand))
-        _row(rows, "numpy", "force", n, nb, best_time(lambda: numpy_force(u)))
+        _row(rows, "generated C", "force", n, nb, timer(gen))
+        _row(rows, "hand C -O3", "force", n, nb, timer(hand))
+        _row(rows, "numpy", "force", n, nb, timer(lambda: numpy_force(u)))
         if nb_force is not None:
             f_nb = np.zeros((nb, n))
             nb_force(u, GAMMA, ALPHA, BETA, f_nb)
             assert np.allclose(f_nb, ref, rtol=1e-12, atol=1e-15)
-            _row(rows, "numba", "force", n, nb, best_time(lambda: nb_force(u, GAMMA, ALPHA, BETA, f_nb)))
+            _row(rows, "numba", "force", n, nb, timer(lambda: nb_force(u, GAMMA, ALPHA, BETA, f_nb)))
         F, Kc = _casadi_force(n) if n <= casadi_max and n * nb <= 1_000_000 else (None, None)
         if F is not None and nb == 1:
             assert np.allclose(np.asarray(F(u1)).ravel(), ref[0], rtol=1e-12, atol=1e-15)
-            _row(rows, "casadi SX", "force", n, nb, best_time(lambda: F(u1)))
+            _row(rows, "casadi SX", "force", n, nb, timer(lambda: F(u1)))
         elif F is not None:
             Fm = F.map(nb)
-            _row(rows, "casadi SX map", "force", n, nb, best_time(lambda: Fm(u.T)))
+            _row(rows, "casadi SX map", "force", n, nb, timer(lambda: Fm(u.T)))
         if n <= lambdify_max and nb == 1:
             lam, _ = _lambdified(n)
             assert np.allclose(lam(u1), ref[0], rtol=1e-12, atol=1e-15)
-            _row(rows, "sympy.lambdify", "force", n, nb, best_time(lambda: lam(u1)))
+            _row(rows, "sympy.lambdify", "force", n, nb, timer(lambda: lam(u1)))
         if nb == 1:
             pat = system.pattern("stiffness")
             outs = {"K": np.zeros(pat.nnz)}
@@ -235,16 +234,16 @@ def kernel_rows(sizes, batch_n: int, batch: int, lambdify_max: int, casadi_max: 
             k_gen(), k_hand()
             ref_k = numpy_stiffness(u1)
             assert np.allclose(outs["K"], ref_k, rtol=1e-12) and np.allclose(k_hand_out, ref_k, rtol=1e-12)
-            _row(rows, "generated C", "stiffness", n, 1, best_time(k_gen))
-            _row(rows, "hand C -O3", "stiffness", n, 1, best_time(k_hand))
-            _row(rows, "numpy", "stiffness", n, 1, best_time(lambda: numpy_stiffness(u1)))
+            _row(rows, "generated C", "stiffness", n, 1, timer(k_gen))
+            _row(rows, "hand C -O3", "stiffness", n, 1, timer(k_hand))
+            _row(rows, "numpy", "stiffness", n, 1, timer(lambda: numpy_stiffness(u1)))
             if nb_stiff is not None:
                 k_nb = np.zeros(3 * n - 2)
                 nb_stiff(u1, GAMMA, ALPHA, BETA, k_nb)
                 assert np.allclose(k_nb, ref_k, rtol=1e-12)
-                _row(rows, "numba", "stiffness", n, 1, best_time(lambda: nb_stiff(u1, GAMMA, ALPHA, BETA, k_nb)))
+                _row(rows, "numba", "stiffness", n, 1, timer(lambda: nb_stiff(u1, GAMMA, ALPHA, BETA, k_nb)))
             if Kc is not None:
-                _row(rows, "casadi SX", "stiffness", n, 1, best_time(lambda: Kc(u1)))
+                _row(rows, "casadi SX", "stiffness", n, 1, timer(lambda: Kc(u1)))
     return rows
 
 

@@ -155,11 +155,6 @@ def reference_state(body: RodBody, elements: int) -> State:
     return State(H[:, :3, 3].copy(), H[:, :3, :3].copy(), np.zeros((n, 3)), np.zeros((n, 3)))
 
 
-def _cross(a, b):
-    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1], a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
-                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
-
-
 def _mv(A, b):
     return np.einsum("...ij,...j->...i", A, b)
 
@@ -196,6 +191,10 @@ class Discrete:
         object.__setattr__(self, "h", h)
         object.__setattr__(self, "weights", wts)
         object.__setattr__(self, "fixed", fixed)
+        # what the C call and the band Jacobian read at every step, made once
+        object.__setattr__(self, "_K_c", np.ascontiguousarray(self.body.rod.K, dtype=float))
+        object.__setattr__(self, "_f0_c", np.ascontiguousarray(self.body.rod.f0, dtype=float))
+        object.__setattr__(self, "_pattern", self._band_pattern())
 
     # ------------------------------------------------------------------ energy and forces
     # Every array below may carry leading batch axes (..., n, 3): the finite-difference Jacobian evaluates
@@ -224,7 +223,7 @@ class Discrete:
         F = np.zeros_like(x)
         F[..., :-1, :] += Fe
         F[..., 1:, :] -= Fe
-        a = h * _cross(n_, f[..., :3])
+        a = h * np.cross(n_, f[..., :3])
         c = m_ + 0.5 * _mtv(jac_left_so3(-0.5 * Psi), a)          # J_r(Psi/2)^T a / 2
         Rh = np.swapaxes(R[..., :-1, :, :], -1, -2) @ Re           # exp(Psi/2)
         Jl_inv = jac_left_so3_inv(Psi)
@@ -254,12 +253,7 @@ class Discrete:
         Rm = np.empty(lead + (3, 3))
         F = np.empty(lead + (3,))
         Mb = np.empty(lead + (3,))
-        K = self.__dict__.get("_Kc")
-        if K is None:
-            K = np.ascontiguousarray(self.body.rod.K, dtype=float)
-            object.__setattr__(self, "_Kc", K)
-            object.__setattr__(self, "_f0c", np.ascontiguousarray(self.body.rod.f0, dtype=float))
-        lib.mgr_internal(batch, lead[-1], self.h, al, K.ctypes.data, self._f0c.ctypes.data, x.ctypes.data,
+        lib.mgr_internal(batch, lead[-1], self.h, al, self._K_c.ctypes.data, self._f0_c.ctypes.data, x.ctypes.data,
                          R.ctypes.data, zc.ctypes.data, xm.ctypes.data, Rm.ctypes.data, F.ctypes.data, Mb.ctypes.data)
         return xm, Rm, F, Mb
 
@@ -295,7 +289,7 @@ class Discrete:
         m = self.body.rhoA * self.weights[:, None]
         Jw = wm @ self.body.J_rho.T
         rt = m * ((vm - st.v) / (al * dt) + c * vm) - F - Fx
-        rr = self.weights[:, None] * (((wm - st.w) / (al * dt) + c * wm) @ self.body.J_rho.T + _cross(wm, Jw)) - Mb - Mx
+        rr = self.weights[:, None] * (((wm - st.w) / (al * dt) + c * wm) @ self.body.J_rho.T + np.cross(wm, Jw)) - Mb - Mx
         r = np.concatenate([rt, rr], axis=-1)
         r[..., self.fixed] = (z * self._fixed_scale(dt))[..., self.fixed]
         return r, Fx, Mx
@@ -310,16 +304,14 @@ class Discrete:
         """Index arrays of the colour-grouped finite differences: perturbation b = 6 colour + k moves unknown k
         of the nodes p = colour mod 3; entry (b, q, a) of its residual change is J[6q + a, 6p + k]."""
         n = self.elements + 1
-        b, q, a, p = [], [], [], []
-        for colour in range(3):
-            for k in range(6):
-                for node in range(colour, n, 3):
-                    for nb in (node - 1, node, node + 1):
-                        if 0 <= nb < n:
-                            for row in range(6):
-                                b.append(6 * colour + k), q.append(nb), a.append(row), p.append(node)
-        b, q, a, p = map(np.asarray, (b, q, a, p))
-        k = b % 6
+        p = np.arange(n)[:, None, None, None]                       # perturbed node
+        k = np.arange(6)[None, :, None, None]                       # its unknown
+        q = p + np.arange(-1, 2)[None, None, :, None]               # the nodes it reaches
+        a = np.arange(6)[None, None, None, :]                       # their equations
+        p, k, q, a = (np.broadcast_to(v, (n, 6, 3, 6)) for v in (p, k, q, a))
+        keep = (q >= 0) & (q < n)
+        p, k, q, a = p[keep], k[keep], q[keep], a[keep]
+        b = 6 * (p % 3) + k
         col = 6 * p + k
         return b, q, a, p, k, col, 2 * BAND + 6 * q + a - col
 
@@ -327,11 +319,7 @@ class Discrete:
         """The residual's Jacobian in LAPACK band storage (3 BAND + 1 rows), by forward differences over three
         colours of nodes (a node's residual depends on its neighbours only), all 18 in one batched call."""
         n = z.shape[0]
-        pattern = self.__dict__.get("_pattern")
-        if pattern is None:
-            pattern = self._band_pattern()
-            object.__setattr__(self, "_pattern", pattern)
-        b, q, a, p, k, col, row = pattern
+        b, q, a, p, k, col, row = self._pattern
         scale = np.concatenate([np.full(3, self.h), np.ones(3)])
         eps = 1e-7 * (scale[None, :] + np.abs(z))                      # (n, 6)
         Z = np.broadcast_to(z, (18, n, 6)).copy()
@@ -502,7 +490,7 @@ def simulate(disc: Discrete, state: State, *, dt: float, t_end: float, save_ever
             record(min(k * dt, t_end), k // save_every)
     out.final = st
     out.newton_iterations, out.jacobians = solver.iterations, solver.jacobians
-    if shape_every and (not out.shapes or out.shapes[-1] is not st.x):
+    if shape_every and (steps // save_every) % shape_every:   # the final shape always (once)
         out.shapes.append(st.x.copy())
     return out
 
