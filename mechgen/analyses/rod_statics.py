@@ -127,16 +127,27 @@ def rod_of(system, options: dict) -> Rod:
         r = np.asarray(r, dtype=float).reshape(-1, 3)
         return np.asarray(system.call("rod", f=np.tile(f0, (len(r), 1)), r=r)["g"], dtype=float).reshape(-1, 6)
 
+    def load_jacobian(r):
+        """d g / d r (n, 6, 3): the kernel's g_r (the generated Jacobian of the declared load)."""
+        r = np.asarray(r, dtype=float).reshape(-1, 3)
+        out = system.call("rod", f=np.tile(f0, (len(r), 1)), r=r)["g_r"]
+        return np.asarray(out, dtype=float).reshape(-1, 6, 3)
+
     g = np.asarray(test["g"], dtype=float).reshape(3, 6)
-    if loaded and not np.any(np.asarray(test["g_r"]) != 0.0) and np.all(g == g[0]):
+    uniform = bool(loaded and not np.any(np.asarray(test["g_r"]) != 0.0) and np.all(g == g[0]))
+    if uniform:
         # independent of the position (uniform gravity): evaluated once, not at every Newton iterate
         value = g[0].copy()
 
         def load(r):  # noqa: F811
             return np.broadcast_to(value, (len(np.asarray(r).reshape(-1, 3)), 6))
 
+        def load_jacobian(r):  # noqa: F811
+            return np.zeros((len(np.asarray(r).reshape(-1, 3)), 6, 3))
+
     return Rod(L, K, f0, load if loaded else None, np.array(options["tip_force"], dtype=float),
-               np.array(options["tip_torque"], dtype=float), options["base"], options["tip"])
+               np.array(options["tip_torque"], dtype=float), options["base"], options["tip"],
+               load_jacobian if loaded else None, uniform)
 
 
 def _check_spd(system, K: np.ndarray) -> None:

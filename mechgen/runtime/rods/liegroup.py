@@ -48,6 +48,14 @@ _SERIES = {
 }
 
 
+def angle_series(name: str) -> tuple[float, ...]:
+    """The Taylor coefficients c_m of an angle function (sinc, a1 … a4) in powers t^(2m), and ``"jl_inv"``:
+    b(t) of :func:`jac_left_so3_inv` (Bernoulli numbers); 12 terms, for t < 1 (round-off there)."""
+    if name == "jl_inv":
+        return tuple(_INV_SERIES)
+    return tuple(_SERIES[name])
+
+
 def _closed(name: str, t: np.ndarray) -> np.ndarray:
     if name == "sinc":
         return np.sin(t) / t

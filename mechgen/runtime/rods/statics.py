@@ -23,12 +23,17 @@ Two discretisations, both on the group (rotations never leave SO(3): each update
 exponential):
 
 * :func:`shoot`: Munthe-Kaas RKMK4 (order 4) in s for (H, sigma) from the 12 unknowns at the base
-  (H(0) = exp(xi0), sigma(0)), Newton on the 12 base + tip conditions with a finite-difference Jacobian
-  of the 13 trajectories integrated as one batch.
+  (H(0) = exp(xi0), sigma(0)), Newton on the 12 base + tip conditions; the Jacobian is the product of the
+  steps' AD transfer matrices (:func:`shooting_jacobian`), or finite differences of the 13 trajectories
+  integrated as one batch (``jacobian="fd"``).
 * :func:`collocate`: Lie-group midpoint collocation on N elements (order 2): per element
   H_{i+1} = H_i exp(h f_m), (sigma_{i+1} - sigma_i)/h = ad_{f_m}^T sigma_m - gbar(H_i exp(h f_m / 2)),
-  f_m = f0 + K^-1 sigma_m, sigma_m = (sigma_i + sigma_{i+1})/2; sparse Newton (scipy.sparse) with a
-  Jacobian by finite differences over two colours of nodes.
+  f_m = f0 + K^-1 sigma_m, sigma_m = (sigma_i + sigma_{i+1})/2; sparse Newton (scipy.sparse) with the
+  element and end Jacobians by CasADi AD mapped over the elements (:func:`collocation_jacobian`), or
+  finite differences over two colours of nodes (``jacobian="fd"``).
+
+The AD pieces (mechgen.runtime.rods.local) are built once per process, whatever N; the distributed load's
+Jacobian is the generated kernel's g_r (Rod.load_jacobian).
 
 :func:`solve_statics` walks the load factor lam from 0 to 1 (natural-parameter continuation: the tip
 wrench and the distributed load scaled by lam, the step halved on a failed Newton solve and grown after an
@@ -55,7 +60,9 @@ UNCONSTRAINED = {("free", "free"), ("pinned", "free"), ("free", "pinned")}
 class Rod:
     """A rod's numbers: length L (m), stiffness K (6 x 6, SPD), reference twist f0 (6), the distributed
     spatial load ``load(r) -> (n, 6)`` (force, torque per unit length at centre-line points r (n, 3); None:
-    unloaded), the tip force and torque (spatial, dead: N, N m) and the ends."""
+    unloaded), the tip force and torque (spatial, dead: N, N m), the ends, and the load's Jacobian
+    ``load_jacobian(r) -> (n, 6, 3)`` (d load/d r, 1/m; a generated kernel's g_r; None with a load: central
+    differences of ``load``, see :func:`load_and_gradient`)."""
 
     L: float
     K: np.ndarray
@@ -65,6 +72,9 @@ class Rod:
     tip_torque: np.ndarray = field(default_factory=lambda: np.zeros(3))
     base: str = "clamped"
     tip: str = "free"
+    load_jacobian: Callable | None = None
+    #: the load does not depend on the position (uniform gravity): the shooting's AD marches in CasADi
+    load_uniform: bool = False
 
     @property
     def compliance(self) -> np.ndarray:
@@ -122,6 +132,23 @@ def distributed(rod: Rod, H: np.ndarray, lam: float) -> np.ndarray:
                                  np.einsum("...ij,...j->...i", Rt, g[..., 3:])], axis=-1)
 
 
+def load_and_gradient(rod: Rod, r: np.ndarray):
+    """The spatial load g(r) (n, 6) and its Jacobian dg/dr (n, 6, 3) at points r (n, 3): rod.load_jacobian
+    when given, else central differences of the pointwise load (step 1e-6 L: error ~1e-12 of its scale)."""
+    r = np.asarray(r, dtype=float).reshape(-1, 3)
+    n = len(r)
+    if rod.load is None:
+        return np.zeros((n, 6)), np.zeros((n, 6, 3))
+    g = np.asarray(rod.load(r), dtype=float).reshape(n, 6)
+    if rod.load_jacobian is not None:
+        return g, np.asarray(rod.load_jacobian(r), dtype=float).reshape(n, 6, 3)
+    d = 1e-6 * rod.L
+    steps = d * np.eye(3)
+    plus = np.asarray(rod.load((r[None] + steps[:, None]).reshape(-1, 3)), dtype=float).reshape(3, n, 6)
+    minus = np.asarray(rod.load((r[None] - steps[:, None]).reshape(-1, 3)), dtype=float).reshape(3, n, 6)
+    return g, np.transpose((plus - minus) / (2 * d), (1, 2, 0))
+
+
 def _rhs(rod: Rod, H: np.ndarray, sigma: np.ndarray, lam: float):
     f = twist_of(rod, sigma)
     ds = np.einsum("...ij,...j->...i", coad6(f), sigma) - distributed(rod, H, lam)
@@ -133,21 +160,28 @@ def _dexpinv(theta: np.ndarray, xi: np.ndarray) -> np.ndarray:
     return np.linalg.solve(jac_right_se3(theta), xi[..., None])[..., 0]
 
 
-def rkmk4_step(rod: Rod, H: np.ndarray, sigma: np.ndarray, h: float, lam: float):
+def rkmk4_step(rod: Rod, H: np.ndarray, sigma: np.ndarray, h: float, lam: float, *, stages: bool = False):
     """One Munthe-Kaas RK4 step in s (batched over leading axes): H_{n+1} = H_n exp(theta), theta from the
-    classical RK4 on theta' = J_r(theta)^-1 f(H_n exp(theta), sigma), sigma by RK4 on R^6."""
+    classical RK4 on theta' = J_r(theta)^-1 f(H_n exp(theta), sigma), sigma by RK4 on R^6. With ``stages``
+    also the 4 stage poses' positions (..., 4, 3), where the distributed load was evaluated."""
     x1, s1 = _rhs(rod, H, sigma, lam)
     t2 = 0.5 * h * x1
-    x2, s2 = _rhs(rod, H @ exp_se3(t2), sigma + 0.5 * h * s1, lam)
+    H2 = H @ exp_se3(t2)
+    x2, s2 = _rhs(rod, H2, sigma + 0.5 * h * s1, lam)
     x2 = _dexpinv(t2, x2)
     t3 = 0.5 * h * x2
-    x3, s3 = _rhs(rod, H @ exp_se3(t3), sigma + 0.5 * h * s2, lam)
+    H3 = H @ exp_se3(t3)
+    x3, s3 = _rhs(rod, H3, sigma + 0.5 * h * s2, lam)
     x3 = _dexpinv(t3, x3)
     t4 = h * x3
-    x4, s4 = _rhs(rod, H @ exp_se3(t4), sigma + h * s3, lam)
+    H4 = H @ exp_se3(t4)
+    x4, s4 = _rhs(rod, H4, sigma + h * s3, lam)
     x4 = _dexpinv(t4, x4)
     theta = h / 6.0 * (x1 + 2 * x2 + 2 * x3 + x4)
-    return H @ exp_se3(theta), sigma + h / 6.0 * (s1 + 2 * s2 + 2 * s3 + s4)
+    out = H @ exp_se3(theta), sigma + h / 6.0 * (s1 + 2 * s2 + 2 * s3 + s4)
+    if stages:
+        return out + (np.stack([P[..., :3, 3] for P in (H, H2, H3, H4)], axis=-2),)
+    return out
 
 
 def integrate(rod: Rod, H0: np.ndarray, sigma0: np.ndarray, steps: int, lam: float, keep: bool = False):
@@ -195,7 +229,7 @@ def tip_residual(rod: Rod, HL: np.ndarray, sigmaL: np.ndarray, lam: float) -> np
 
 # --------------------------------------------------------------------------- shooting
 
-def _shoot_residual(rod: Rod, z: np.ndarray, steps: int, lam: float) -> np.ndarray:
+def shooting_residual(rod: Rod, z: np.ndarray, steps: int, lam: float) -> np.ndarray:
     """Residual of the 12 scaled base unknowns z = (xi0 / (L, 1), sigma0 / (F, M)) (batched over rows)."""
     sc = _expand(rod.scales)
     H0 = exp_se3(z[..., :6] * sc[:6])
@@ -232,12 +266,72 @@ def _newton(residual_and_jacobian, z, *, tol: float, max_iter: int, solve=np.lin
     return None
 
 
-def shoot(rod: Rod, steps: int, lam: float, z0: np.ndarray, *, tol: float = 1e-10, max_iter: int = 30):
-    """Newton on the scaled base unknowns at load factor lam: (z, iterations), or None without convergence."""
+def shooting_jacobian(rod: Rod, z: np.ndarray, steps: int, lam: float):
+    """The shooting residual at the scaled base unknowns z and its 12 x 12 Jacobian by AD of the pieces:
+
+        J = [E_0 T_0; E_L Phi_(N-1) ... Phi_0 T_0],
+
+    T_0 = diag(J_r(xi_0) S_pose, S_wrench) takes z to the base's local increments (exp(xi + d) =
+    exp(xi) exp(J_r(xi) d)), Phi_k the AD transfer of RKMK4 step k in local coordinates
+    (local.rkmk4_transfer, mapped over the steps at the nodes integrated by numpy; for an unloaded rod or a
+    uniform load local.rkmk4_march integrates and differentiates in one CasADi fold), E_0, E_L the AD
+    Jacobians of the base and tip conditions (local.end_condition) divided by the scales of their
+    increments."""
+    from mechgen.runtime.rods import local
+
+    sc = _expand(rod.scales)
+    xi0 = z[:6] * sc[:6]
+    H0, sigma0 = exp_se3(xi0), z[6:] * sc[6:]
+    h = rod.L / steps
+    par = np.concatenate([[h, lam], rod.compliance.ravel(), rod.f0])
+    if rod.load is None or rod.load_uniform:
+        # one CasADi fold integrates and differentiates every step (the load's value is the same everywhere)
+        stage = np.zeros((4, 27))
+        if rod.load is not None:
+            stage[:, :6] = load_and_gradient(rod, np.zeros((1, 3)))[0][0]
+        marched, transfers = local.rkmk4_march(steps)(_pack_node(H0, sigma0), stage.ravel(), par)
+        marched = np.asarray(marched).T
+        phi = np.asarray(transfers).T.reshape(steps, 12, 12)
+        H = np.zeros((steps + 1, 4, 4))
+        H[0], H[1:, :3, :3], H[1:, :3, 3], H[1:, 3, 3] = H0, marched[:, :9].reshape(-1, 3, 3), marched[:, 9:12], 1.0
+        sigma = np.vstack([sigma0, marched[:, 12:]])
+    else:
+        H, sigma = integrate(rod, H0, sigma0, steps, lam, keep=True)
+        nodes = _pack_node(H[:-1], sigma[:-1])
+        points = rkmk4_step(rod, H[:-1], sigma[:-1], h, lam, stages=True)[2].reshape(steps * 4, 3)
+        g0, G = load_and_gradient(rod, points)
+        loads = np.concatenate([g0, G.reshape(-1, 18), points], axis=1).reshape(steps, 108)
+        data = np.concatenate([nodes, loads], axis=1)
+        phi = np.asarray(local.mapped(local.rkmk4_transfer(), steps)(data.T, par)).T.reshape(steps, 12, 12)
+    P = np.eye(12)
+    for k in range(steps):
+        P = phi[k] @ P
+    T0 = np.zeros((12, 12))
+    T0[:6, :6] = jac_right_se3(xi0) * sc[:6]
+    T0[6:, 6:] = np.diag(sc[6:])
+    end_par = np.concatenate([[rod.L, lam], sc])
+    wrench = np.concatenate([rod.tip_force, rod.tip_torque])
+    rows = []
+    for where, end, node, held, transfer in (("base", rod.base, 0, np.eye(4), T0),
+                                             ("tip", rod.tip, -1, reference_tip(rod), P @ T0)):
+        end_data = np.concatenate([_pack_node(H[node], sigma[node]), held[:3, :3].ravel(), held[:3, 3], wrench])
+        E = np.asarray(local.end_condition(where, end)(end_data, end_par)).reshape(6, 12)
+        rows.append((E / sc) @ transfer)
+    r = np.concatenate([base_residual(rod, H[0], sigma[0]), tip_residual(rod, H[-1], sigma[-1], lam)])
+    return r, np.vstack(rows)
+
+
+def shoot(rod: Rod, steps: int, lam: float, z0: np.ndarray, *, tol: float = 1e-10, max_iter: int = 30,
+          jacobian: str = "ad"):
+    """Newton on the scaled base unknowns at load factor lam: (z, iterations), or None without convergence.
+    ``jacobian``: ``ad`` (:func:`shooting_jacobian`) or ``fd`` (forward differences of the 12 unknowns, the
+    13 trajectories integrated as one batch)."""
     def rj(z):
+        if jacobian == "ad":
+            return shooting_jacobian(rod, z, steps, lam)
         d = 1e-7 * np.maximum(1.0, np.abs(z))
         batch = np.vstack([z, z + np.diag(d)])
-        r = _shoot_residual(rod, batch, steps, lam)
+        r = shooting_residual(rod, batch, steps, lam)
         return r[0], ((r[1:] - r[0]) / d[:, None]).T
 
     with np.errstate(all="ignore"):
@@ -253,16 +347,22 @@ def shooting_state(rod: Rod, z: np.ndarray, steps: int, lam: float, iterations: 
 
 # --------------------------------------------------------------------------- collocation
 
-def _collocation_residual(rod: Rod, H: np.ndarray, sigma: np.ndarray, lam: float) -> np.ndarray:
+def midpoints(rod: Rod, H: np.ndarray, sigma: np.ndarray):
+    """Per element of the collocation: sigma_m = (sigma_i + sigma_i+1)/2, f_m = f0 + K^-1 sigma_m and the
+    midpoint pose H_i exp(h f_m / 2) (batched over leading axes)."""
+    h = rod.L / (H.shape[-3] - 1)
+    sm = 0.5 * (sigma[..., 1:, :] + sigma[..., :-1, :])
+    fm = twist_of(rod, sm)
+    return sm, fm, H[..., :-1, :, :] @ exp_se3(0.5 * h * fm)
+
+
+def collocation_residual(rod: Rod, H: np.ndarray, sigma: np.ndarray, lam: float) -> np.ndarray:
     """Rows (base 6, elements 12 N, tip 6), scaled; H (..., N+1, 4, 4), sigma (..., N+1, 6) unscaled."""
     n = H.shape[-3] - 1
     h = rod.L / n
     sc = _expand(rod.scales)
-    sm = 0.5 * (sigma[..., 1:, :] + sigma[..., :-1, :])
-    fm = twist_of(rod, sm)
-    Hi = H[..., :-1, :, :]
-    pose = log_se3(exp_se3(-h * fm) @ inverse(Hi) @ H[..., 1:, :, :]) / sc[:6]
-    Hm = Hi @ exp_se3(0.5 * h * fm)
+    sm, fm, Hm = midpoints(rod, H, sigma)
+    pose = log_se3(exp_se3(-h * fm) @ inverse(H[..., :-1, :, :]) @ H[..., 1:, :, :]) / sc[:6]
     stress = ((sigma[..., 1:, :] - sigma[..., :-1, :]) / h - np.einsum("...ij,...j->...i", coad6(fm), sm)
               + distributed(rod, Hm, lam)) * (rod.L / sc[6:])
     elements = np.concatenate([pose, stress], axis=-1).reshape(H.shape[:-3] + (12 * n,))
@@ -270,22 +370,67 @@ def _collocation_residual(rod: Rod, H: np.ndarray, sigma: np.ndarray, lam: float
                            tip_residual(rod, H[..., -1, :, :], sigma[..., -1, :], lam)], axis=-1)
 
 
-def _perturbed(rod: Rod, H, sigma, dz: np.ndarray):
+def perturbed(rod: Rod, H, sigma, dz: np.ndarray):
     """(H_i exp(dxi_i), sigma_i + dsigma_i) for scaled increments dz (..., N+1, 12)."""
     sc = _expand(rod.scales)
     return H @ exp_se3(dz[..., :6] * sc[:6]), sigma + dz[..., 6:] * sc[6:]
 
 
-def _collocation_jacobian(rod: Rod, H, sigma, lam: float, r0: np.ndarray, eps: float = 1e-7) -> sps.csr_matrix:
-    """Finite differences over two colours of nodes (an element touches one even and one odd node)."""
+def _pack_node(H: np.ndarray, sigma: np.ndarray) -> np.ndarray:
+    """(R row-major 9, p 3, sigma 6) per node: the layout of mechgen.runtime.rods.local."""
+    return np.concatenate([H[..., :3, :3].reshape(H.shape[:-2] + (9,)), H[..., :3, 3], sigma], axis=-1)
+
+
+def collocation_jacobian(rod: Rod, H, sigma, lam: float, r0: np.ndarray | None = None, *,
+                         method: str = "ad", eps: float = 1e-7) -> sps.csr_matrix:
+    """d collocation_residual / d z at the state (H, sigma), z the scaled right increments of every node.
+
+    ``ad``: CasADi's algorithmic derivative of the element and end pieces (mechgen.runtime.rods.local),
+    mapped over the elements: exact to round-off. ``fd``: forward differences (step eps) over two colours
+    of nodes (an element touches one even and one odd node), from the residual r0 at the state: O(eps)."""
+    if method == "fd":
+        return _collocation_jacobian_fd(rod, H, sigma, lam, r0, eps)
+    if method != "ad":
+        raise ValueError(f"unknown Jacobian method {method!r}: ad or fd")
+    from mechgen.runtime.rods import local
+
     n = H.shape[0] - 1
+    sc = _expand(rod.scales)
+    _, _, Hm = midpoints(rod, H, sigma)
+    g0, G = load_and_gradient(rod, Hm[:, :3, 3])
+    nodes = _pack_node(H, sigma)
+    data = np.concatenate([nodes[:-1], nodes[1:], g0, G.reshape(n, 18), Hm[:, :3, 3]], axis=1)
+    par = np.concatenate([[rod.L / n, rod.L, lam], rod.compliance.ravel(), rod.f0, sc])
+    blocks = np.asarray(local.mapped(local.collocation_element(), n)(data.T, par)).T.reshape(n, 12, 24)
+    end_par = np.concatenate([[rod.L, lam], sc])
+    wrench = np.concatenate([rod.tip_force, rod.tip_torque])
+    ends = []
+    for where, end, node, held in (("base", rod.base, 0, np.eye(4)), ("tip", rod.tip, n, reference_tip(rod))):
+        end_data = np.concatenate([nodes[node], held[:3, :3].ravel(), held[:3, 3], wrench])
+        ends.append(np.asarray(local.end_condition(where, end)(end_data, end_par)).reshape(6, 12))
+    e = np.arange(n)
+    rows = [np.broadcast_to(np.arange(6)[:, None], (6, 12)).ravel(),
+            (6 + 12 * e[:, None, None] + np.arange(12)[None, :, None] + 0 * np.arange(24)).ravel(),
+            np.broadcast_to(6 + 12 * n + np.arange(6)[:, None], (6, 12)).ravel()]
+    cols = [np.broadcast_to(np.arange(12), (6, 12)).ravel(),
+            (12 * e[:, None, None] + 0 * np.arange(12)[None, :, None] + np.arange(24)).ravel(),
+            np.broadcast_to(12 * n + np.arange(12), (6, 12)).ravel()]
+    vals = [ends[0].ravel(), blocks.ravel(), ends[1].ravel()]
+    size = 12 * (n + 1)
+    return sps.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(size, size))
+
+
+def _collocation_jacobian_fd(rod: Rod, H, sigma, lam: float, r0, eps: float) -> sps.csr_matrix:
+    n = H.shape[0] - 1
+    if r0 is None:
+        r0 = collocation_residual(rod, H, sigma, lam)
     nodes = np.arange(n + 1)
     batch = np.zeros((24, n + 1, 12))
     for colour in (0, 1):
         for j in range(12):
             batch[12 * colour + j, nodes % 2 == colour, j] = eps
-    Hp, sp_ = _perturbed(rod, H[None], sigma[None], batch)
-    dr = (_collocation_residual(rod, Hp, sp_, lam) - r0) / eps          # (24, rows)
+    Hp, sp_ = perturbed(rod, H[None], sigma[None], batch)
+    dr = (collocation_residual(rod, Hp, sp_, lam) - r0) / eps          # (24, rows)
     rows, cols, vals = [], [], []
     for colour in (0, 1):
         for j in range(12):
@@ -308,23 +453,25 @@ def _collocation_jacobian(rod: Rod, H, sigma, lam: float, r0: np.ndarray, eps: f
     return sps.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(size, size))
 
 
-def collocate(rod: Rod, guess: Solution, lam: float, *, tol: float = 1e-10, max_iter: int = 30):
-    """Sparse Newton for the midpoint collocation from ``guess`` (its nodes fix N): a Solution or None."""
+def collocate(rod: Rod, guess: Solution, lam: float, *, tol: float = 1e-10, max_iter: int = 30,
+              jacobian: str = "ad"):
+    """Sparse Newton for the midpoint collocation from ``guess`` (its nodes fix N): a Solution or None.
+    ``jacobian``: ad or fd (:func:`collocation_jacobian`)."""
     n = guess.H.shape[0] - 1
     base = (guess.H, guess.sigma)
 
     def state(z):
-        return _perturbed(rod, base[0], base[1], z.reshape(n + 1, 12))
+        return perturbed(rod, base[0], base[1], z.reshape(n + 1, 12))
 
     def rj(z):
         H, sigma = state(z)
-        r = _collocation_residual(rod, H, sigma, lam)
-        return r, _collocation_jacobian(rod, H, sigma, lam, r)
+        r = collocation_residual(rod, H, sigma, lam)
+        return r, collocation_jacobian(rod, H, sigma, lam, r, method=jacobian)
 
     def update(z, dz):
         # increments compose on the right of the current poses: re-base them so that exp stays small
         H, sigma = state(z)
-        Hn, sn = _perturbed(rod, H, sigma, dz.reshape(n + 1, 12))
+        Hn, sn = perturbed(rod, H, sigma, dz.reshape(n + 1, 12))
         base_h = base[0]
         zz = np.zeros_like(z).reshape(n + 1, 12)
         sc = _expand(rod.scales)
@@ -370,18 +517,23 @@ class Path:
 
 
 def solve_statics(rod: Rod, *, method: str = "shooting", elements: int = 40, steps: int = 10,
-                  min_step: float = 1e-4, tol: float = 1e-10, progress: Callable | None = None) -> Path:
+                  min_step: float = 1e-4, tol: float = 1e-10, progress: Callable | None = None,
+                  jacobian: str = "ad") -> Path:
     """Continuation in the load factor lam from 0 to 1 in ``steps`` initial steps (halved on a failure or a
     jump off the branch (:func:`_smooth`), grown by 1.5 after a solve in <= 4 Newton iterations, at most
     2/steps). ``elements``: RKMK4 steps of
-    the shooting, or collocation elements. ConvergenceError names the last load factor reached."""
+    the shooting, or collocation elements. ``jacobian``: ``ad`` (CasADi AD of the local pieces) or ``fd``
+    (finite differences; kept as the reference and for comparison). ConvergenceError names the last load
+    factor reached."""
+    if jacobian not in ("ad", "fd"):
+        raise ValueError(f"unknown Jacobian method {jacobian!r}: ad or fd")
     check_ends(rod.base, rod.tip)
     if method not in ("shooting", "collocation"):
         raise ValueError(f"unknown method {method!r}")
     lam, dlam, dmax = 0.0, 1.0 / steps, 2.0 / steps
     if method == "shooting":
         z = np.zeros(12)
-        out = shoot(rod, elements, 0.0, z, tol=tol)
+        out = shoot(rod, elements, 0.0, z, tol=tol, jacobian=jacobian)
         if out is None:
             raise ConvergenceError("rod statics: no unloaded state (shooting)")
         z, prev = out[0], None
@@ -395,14 +547,14 @@ def solve_statics(rod: Rod, *, method: str = "shooting", elements: int = 40, ste
         if method == "shooting":
             guess = z if prev is None else z + (z - prev[0]) * (target - lam) / (lam - prev[1])
             prev_back = prev
-            out = shoot(rod, elements, target, guess, tol=tol)
+            out = shoot(rod, elements, target, guess, tol=tol, jacobian=jacobian)
             ok = out is not None
             if ok:
                 prev, z = (z, lam), out[0]
                 states.append(shooting_state(rod, z, elements, target, out[1]))
                 iters = out[1]
         else:
-            sol = collocate(rod, states[-1], target, tol=tol)
+            sol = collocate(rod, states[-1], target, tol=tol, jacobian=jacobian)
             ok = sol is not None
             if ok:
                 states.append(sol)
@@ -458,4 +610,6 @@ def turning_angle(H: np.ndarray, axis) -> float:
 
 
 __all__ = ["Rod", "Solution", "Path", "check_ends", "solve_statics", "shoot", "collocate", "integrate",
+           "collocation_residual", "collocation_jacobian", "shooting_residual", "shooting_jacobian", "perturbed",
+           "midpoints", "load_and_gradient",
            "rkmk4_step", "turning_angle", "straight", "vee3"]

@@ -1,0 +1,208 @@
+"""The rods' local pieces in CasADi SX and their AD Jacobians, built once and mapped over the repetition.
+
+Each builder returns a casadi.Function of one piece (a collocation element, an end condition, one RKMK4
+step, a dynamics element or node) whose inputs are the numeric state of that piece and its unknowns'
+increments (right perturbations H exp(dxi) of the poses, sigma + dsigma of the wrenches, in the residual's
+scaled units), and whose output is the Jacobian of the piece's residual at zero increment. Callers map it
+over elements or nodes (:func:`mapped`) and assemble the sparse or banded matrix. The residuals
+themselves stay with the numpy solvers (statics.py, dynamics.py): these functions repeat their equations
+(cited there) in SX, and tests hold the two to each other (the AD Jacobian against finite differences of
+the numpy residual).
+
+Distributed loads are Python callables (or generated kernels) of the position; a piece takes their value
+g0 and Jacobian G = dg/dr (6 x 3) at the piece's current point r0 and uses g0 + G (r - r0), exact to first
+order, so the Jacobian at zero increment is exact.
+"""
+from __future__ import annotations
+
+from functools import lru_cache
+
+import casadi as ca
+
+from mechgen.runtime.rods import ad
+
+#: sizes of the packed inputs of the collocation element: nodes i, i+1 (R 9, p 3, sigma 6 each), the load's
+#: value, Jacobian and point at the element's midpoint
+COLLOCATION_ELEMENT_DATA = 18 + 18 + 6 + 18 + 3
+#: h, L, lam, compliance (36), f0 (6), the 12 residual scales
+COLLOCATION_PARAMS = 3 + 36 + 6 + 12
+
+
+def _node(data, at: int):
+    """(R, p, sigma) packed at offset ``at`` (R row-major)."""
+    return ad.matrix(data[at:at + 9], 3, 3), data[at + 9:at + 12], data[at + 12:at + 18]
+
+
+def _perturbed(node, dz, sc):
+    """The node (R, p) exp(hat6(dz[:6] sc[:6])) and sigma + dz[6:] sc[6:] (scaled increments dz)."""
+    R, p, sigma = node
+    step = ad.exp_se3(dz[:6] * sc[:6])
+    Rn, pn = ad.compose((R, p), step)
+    return Rn, pn, sigma + dz[6:] * sc[6:]
+
+
+def _load(lam, R, r, g0, G, r0):
+    """gbar = lam (R^T q, R^T l) with (q, l) = g0 + G (r - r0)."""
+    g = g0 + ad.matrix(G, 6, 3) @ (r - r0)
+    return lam * ca.vertcat(R.T @ g[:3], R.T @ g[3:])
+
+
+@lru_cache(maxsize=None)
+def collocation_element() -> ca.Function:
+    """Jacobian (12 x 24, row-major) of one midpoint-collocation element's 12 scaled rows (statics.py):
+
+        pose   = log(exp(-h f_m) H_i^-1 H_{i+1}) / (L, 1),
+        stress = ((sigma_{i+1} - sigma_i)/h - ad*_{f_m} sigma_m + gbar(H_i exp(h f_m/2))) L / (F, M),
+
+    f_m = f0 + C sigma_m, sigma_m the mean, with respect to the scaled increments of nodes i and i+1."""
+    data = ca.SX.sym("data", COLLOCATION_ELEMENT_DATA)
+    par = ca.SX.sym("par", COLLOCATION_PARAMS)
+    dz = ca.SX.sym("dz", 24)
+    h, L, lam = par[0], par[1], par[2]
+    C = ad.matrix(par[3:39], 6, 6)
+    f0, sc = par[39:45], par[45:57]
+    Ri, pi, si = _perturbed(_node(data, 0), dz[:12], sc)
+    Rj, pj, sj = _perturbed(_node(data, 18), dz[12:], sc)
+    sm = 0.5 * (si + sj)
+    fm = f0 + C @ sm
+    back = ad.exp_se3(-h * fm)
+    X = ad.compose(ad.compose(back, ad.inverse((Ri, pi))), (Rj, pj))
+    pose = ad.log_se3(*X) / sc[:6]
+    Rm, pm = ad.compose((Ri, pi), ad.exp_se3(0.5 * h * fm))
+    gbar = _load(lam, Rm, pm, data[36:42], data[42:60], data[60:63])
+    stress = ((sj - si) / h - ad.coad6(fm, sm) + gbar) * L / sc[6:]
+    residual = ca.vertcat(pose, stress)
+    J = ca.substitute(ca.jacobian(residual, dz), dz, ca.DM.zeros(24))
+    return ca.Function("rod_collocation_element_jacobian", [data, par], [ad.flat(J)])
+
+
+#: packed end data: the node (R 9, p 3, sigma 6), the held pose (R 9, p 3), the tip force and torque (6)
+END_DATA = 18 + 12 + 6
+#: L, lam, the 12 scales
+END_PARAMS = 2 + 12
+
+
+@lru_cache(maxsize=None)
+def end_condition(where: str, end: str) -> ca.Function:
+    """Jacobian (6 x 12, row-major) of the 6 scaled base or tip conditions (statics.base_residual and
+    tip_residual) of an end ``clamped``, ``pinned`` or ``free`` with respect to that node's increments."""
+    data = ca.SX.sym("data", END_DATA)
+    par = ca.SX.sym("par", END_PARAMS)
+    dz = ca.SX.sym("dz", 12)
+    L, lam, sc = par[0], par[1], par[2:14]
+    R, p, sigma = _perturbed(_node(data, 0), dz, sc)
+    held = (ad.matrix(data[18:27], 3, 3), data[27:30])
+    force, torque = data[30:33], data[33:36]
+    if end == "clamped":
+        rows = ad.log_se3(*ad.compose(ad.inverse(held), (R, p))) / sc[:6]
+    elif where == "base" and end == "pinned":
+        rows = ca.vertcat(p / L, ad.log_so3(R)[0], sigma[4:] / sc[10:])
+    elif where == "base":
+        rows = sigma / sc[6:]
+    else:
+        moment = (sigma[3:] - lam * R.T @ torque) / sc[9:]
+        if end == "pinned":
+            rows = ca.vertcat((p - held[1]) / L, moment)
+        else:
+            rows = ca.vertcat((sigma[:3] - lam * R.T @ force) / sc[6:9], moment)
+    J = ca.substitute(ca.jacobian(rows, dz), dz, ca.DM.zeros(12))
+    return ca.Function(f"rod_{where}_{end}_jacobian", [data, par], [ad.flat(J)])
+
+
+#: packed data of one RKMK4 step: the node (R 9, p 3, sigma 6); the load's value (6), Jacobian (18) and
+#: point (3) at each of the 4 stage poses
+STEP_DATA = 18 + 4 * (6 + 18 + 3)
+#: h, lam, compliance (36), f0 (6)
+STEP_PARAMS = 2 + 36 + 6
+
+
+def _rkmk4(node, h, lam, C, f0, load):
+    """statics.rkmk4_step in SX from a node (R, p, sigma): the new (R, p, sigma). ``load(k, R, r)`` is
+    stage k's gbar."""
+    R, p, sigma = node
+
+    def rhs(k, pose, sig):
+        f = f0 + C @ sig
+        return f, ad.coad6(f, sig) - load(k, pose[0], pose[1])
+
+    x1, s1 = rhs(0, (R, p), sigma)
+    t2 = 0.5 * h * x1
+    P2 = ad.compose((R, p), ad.exp_se3(t2))
+    x2, s2 = rhs(1, P2, sigma + 0.5 * h * s1)
+    x2 = ad.dexp_inv_right(t2, x2)
+    t3 = 0.5 * h * x2
+    P3 = ad.compose((R, p), ad.exp_se3(t3))
+    x3, s3 = rhs(2, P3, sigma + 0.5 * h * s2)
+    x3 = ad.dexp_inv_right(t3, x3)
+    t4 = h * x3
+    P4 = ad.compose((R, p), ad.exp_se3(t4))
+    x4, s4 = rhs(3, P4, sigma + h * s3)
+    x4 = ad.dexp_inv_right(t4, x4)
+    theta = h / 6 * (x1 + 2 * x2 + 2 * x3 + x4)
+    Rn, pn = ad.compose((R, p), ad.exp_se3(theta))
+    return Rn, pn, sigma + h / 6 * (s1 + 2 * s2 + 2 * s3 + s4)
+
+
+def _step_inputs():
+    data = ca.SX.sym("data", STEP_DATA)
+    par = ca.SX.sym("par", STEP_PARAMS)
+    return data, par, par[0], par[1], ad.matrix(par[2:38], 6, 6), par[38:44]
+
+
+@lru_cache(maxsize=None)
+def rkmk4_transfer() -> ca.Function:
+    """The 12 x 12 (row-major) derivative of one RKMK4 step in local coordinates: the step maps
+    (H exp(dxi), sigma + dsigma) to (H' exp(dxi'), sigma' + dsigma'); this is d(dxi', dsigma')/d(dxi,
+    dsigma) at zero (unscaled: lengths and radians, forces and moments)."""
+    data, par, h, lam, C, f0 = _step_inputs()
+    dz = ca.SX.sym("dz", 12)
+    R, p, sigma = _node(data, 0)
+    Rp, pp = ad.compose((R, p), ad.exp_se3(dz[:6]))
+
+    def load(k, Rs, rs):
+        at = 18 + 27 * k
+        return _load(lam, Rs, rs, data[at:at + 6], data[at + 6:at + 24], data[at + 24:at + 27])
+
+    Rn, pn, sn = _rkmk4((Rp, pp, sigma + dz[6:]), h, lam, C, f0, load)
+    zero = ca.DM.zeros(12)
+    base = ca.substitute(ca.vertcat(ad.flat(Rn), pn), dz, zero)
+    Rb, pb = ad.matrix(base[:9], 3, 3), base[9:12]
+    local = ca.vertcat(ad.log_se3(*ad.compose(ad.inverse((Rb, pb)), (Rn, pn))), sn)
+    J = ca.substitute(ca.jacobian(local, dz), dz, zero)
+    return ca.Function("rod_rkmk4_transfer", [data, par], [ad.flat(J)])
+
+
+@lru_cache(maxsize=None)
+def rkmk4_march(steps: int) -> ca.Function:
+    """``steps`` RKMK4 steps under a position-independent load (its value g0 in the data of every stage,
+    G = 0) as one CasADi fold: (node 18, stage data 108, params) -> the nodes after each step (18 x steps)
+    and each step's transfer (144 x steps, as :func:`rkmk4_transfer`)."""
+    data, par, h, lam, C, f0 = _step_inputs()
+    node, stage = data[:18], data[18:]
+    zero = ca.DM.zeros(12)
+    dz = ca.SX.sym("dz", 12)
+    R, p, sigma = _node(data, 0)
+
+    def load(k, Rs, rs):
+        at = 27 * k
+        return _load(lam, Rs, rs, stage[at:at + 6], stage[at + 6:at + 24], stage[at + 24:at + 27])
+
+    Rp, pp = ad.compose((R, p), ad.exp_se3(dz[:6]))
+    Rn, pn, sn = _rkmk4((Rp, pp, sigma + dz[6:]), h, lam, C, f0, load)
+    nxt = ca.substitute(ca.vertcat(ad.flat(Rn), pn, sn), dz, zero)
+    Rb, pb = ad.matrix(nxt[:9], 3, 3), nxt[9:12]
+    local = ca.vertcat(ad.log_se3(*ad.compose(ad.inverse((Rb, pb)), (Rn, pn))), sn)
+    J = ca.substitute(ca.jacobian(local, dz), dz, zero)
+    one = ca.Function("rod_rkmk4_step", [node, stage, par], [nxt, ad.flat(J)])
+    return one.mapaccum("rod_rkmk4_march", steps)
+
+
+@lru_cache(maxsize=64)
+def mapped(function: ca.Function, count: int) -> ca.Function:
+    """``function`` mapped over ``count`` columns of its first input (the others broadcast)."""
+    return function.map(count)
+
+
+__all__ = ["collocation_element", "end_condition", "rkmk4_transfer", "rkmk4_march", "mapped", "STEP_DATA",
+           "STEP_PARAMS", "COLLOCATION_ELEMENT_DATA", "COLLOCATION_PARAMS",
+           "END_DATA", "END_PARAMS"]
