@@ -42,7 +42,8 @@ integrated as angles or quaternions), so they stay orthonormal to round-off over
 Kinetic energy of the rotation is conserved exactly by the gyroscopic term (omega_mid . omega_mid x J
 omega_mid = 0); for the elastic energy the step is second-order (energy error O(dt^2), bounded, no drift).
 The coupled increments are found by Newton's method on a banded system (node-major order, bandwidth 11)
-whose Jacobian is taken by finite differences over three colours of nodes and kept over steps while the
+whose Jacobian is CasADi's AD of the element energy's gradient and of the nodes' rows (mechgen.runtime.rods.
+local; finite differences over three colours of nodes with ``jacobian="fd"``) and kept over steps while the
 iteration contracts fast (simplified Newton); a step that does not converge is split in two, down to 2^-12
 of dt, before a ConvergenceError names the time reached.
 """
@@ -195,6 +196,7 @@ class Discrete:
         object.__setattr__(self, "_K_c", np.ascontiguousarray(self.body.rod.K, dtype=float))
         object.__setattr__(self, "_f0_c", np.ascontiguousarray(self.body.rod.f0, dtype=float))
         object.__setattr__(self, "_pattern", self._band_pattern())
+        object.__setattr__(self, "_blocks", self._block_pattern())
 
     # ------------------------------------------------------------------ energy and forces
     # Every array below may carry leading batch axes (..., n, 3): the finite-difference Jacobian evaluates
@@ -315,10 +317,65 @@ class Discrete:
         col = 6 * p + k
         return b, q, a, p, k, col, 2 * BAND + 6 * q + a - col
 
-    def jacobian_band(self, st: State, z: np.ndarray, dt: float, r0: np.ndarray) -> np.ndarray:
-        """The residual's Jacobian in LAPACK band storage (3 BAND + 1 rows), by forward differences over three
-        colours of nodes (a node's residual depends on its neighbours only), all 18 in one batched call."""
+    def _block_pattern(self):
+        """Flat band-storage indices (row 2 BAND + i - j, column j) of the element blocks (N, 12, 12: nodes e,
+        e + 1) and the node blocks (n, 6, 6), and the fixed rows' masks of both."""
+        n, size = self.elements + 1, 6 * (self.elements + 1)
+
+        def flat(first, width):
+            rows = first[:, None, None] + np.arange(width)[None, :, None]
+            cols = first[:, None, None] + np.arange(width)[None, None, :]
+            return ((2 * BAND + rows - cols) * size + cols).ravel()
+
+        fixed = self.fixed.ravel()
+        element_rows = 6 * np.arange(n - 1)[:, None] + np.arange(12)[None, :]
+        return (flat(6 * np.arange(n - 1), 12), flat(6 * np.arange(n), 6), fixed[element_rows],
+                self.fixed)
+
+    def jacobian_band(self, st: State, z: np.ndarray, dt: float, r0: np.ndarray | None = None, *,
+                      method: str = "ad") -> np.ndarray:
+        """The residual's Jacobian in LAPACK band storage (3 BAND + 1 rows).
+
+        ``ad``: CasADi AD of the element's energy gradient (local.dynamics_element, mapped over the
+        elements) and of the node's inertial and external rows (local.dynamics_node), the load's Jacobian
+        from Rod.load_jacobian: exact to round-off. ``fd``: forward differences over three colours of nodes
+        (a node's residual depends on its neighbours only), all 18 in one batched call, from r0."""
+        if method == "fd":
+            return self._jacobian_band_fd(st, z, dt, r0)
+        if method != "ad":
+            raise ValueError(f"unknown Jacobian method {method!r}: ad or fd")
+        from mechgen.runtime.rods import local
+        from mechgen.runtime.rods.statics import load_and_gradient
+
+        body, rod = self.body, self.body.rod
+        n, al = z.shape[0], body.alpha
+        R = st.R.reshape(n, 9)
+        nodes = np.concatenate([st.x, R, z], axis=1)
+        par = np.concatenate([[self.h, al], self._K_c.ravel(), self._f0_c])
+        Je = -np.asarray(local.mapped(local.native("dynamics_element"), n - 1)(
+            np.concatenate([nodes[:-1], nodes[1:]], axis=1).T, par)).T.reshape(n - 1, 12, 12)
+        xa = st.x + al * z[:, :3]
+        g0, G = load_and_gradient(rod, xa)
+        tip = np.zeros((n, 6))
+        tip[-1] = np.concatenate([rod.tip_force, rod.tip_torque])
+        data = np.concatenate([R, st.v, st.w, z, self.weights[:, None], g0, G.reshape(n, 18), xa, tip, st.x], axis=1)
+        npar = np.concatenate([[dt, al, body.rhoA, body.damping], body.J_rho.ravel()])
+        Jn = np.asarray(local.mapped(local.native("dynamics_node"), n)(data.T, npar)).T.reshape(n, 6, 6)
+        element_at, node_at, element_fixed, node_fixed = self._blocks
+        Je[element_fixed] = 0.0                      # rows of fixed unknowns: z itself, scaled
+        Jn[node_fixed] = 0.0
+        diag = np.broadcast_to(self._fixed_scale(dt), (n, 6))
+        i, a = np.nonzero(node_fixed)
+        Jn[i, a, a] = diag[i, a]
+        size = 6 * n
+        ab = np.bincount(element_at, Je.ravel(), minlength=(3 * BAND + 1) * size)
+        ab += np.bincount(node_at, Jn.ravel(), minlength=(3 * BAND + 1) * size)
+        return ab.reshape(3 * BAND + 1, size)
+
+    def _jacobian_band_fd(self, st: State, z: np.ndarray, dt: float, r0: np.ndarray | None) -> np.ndarray:
         n = z.shape[0]
+        if r0 is None:
+            r0 = self.residual(st, z, dt)[0]
         b, q, a, p, k, col, row = self._pattern
         scale = np.concatenate([np.full(3, self.h), np.ones(3)])
         eps = 1e-7 * (scale[None, :] + np.abs(z))                      # (n, 6)
@@ -353,8 +410,8 @@ class Trajectory:
 class _Solver:
     """Newton on the midpoint equations with a factorised band Jacobian kept across steps."""
 
-    def __init__(self, disc: Discrete, tol: float, max_iter: int):
-        self.disc, self.tol, self.max_iter = disc, tol, max_iter
+    def __init__(self, disc: Discrete, tol: float, max_iter: int, jacobian: str = "ad"):
+        self.disc, self.tol, self.max_iter, self.jacobian = disc, tol, max_iter, jacobian
         self.lu = None
         self.dt = None
         self.iterations = 0
@@ -363,7 +420,7 @@ class _Solver:
         self.scale = np.tile(np.concatenate([np.full(3, disc.body.rod.L), np.ones(3)]), size // 6)
 
     def _factor(self, st: State, z: np.ndarray, dt: float, r0: np.ndarray) -> None:
-        ab = self.disc.jacobian_band(st, z, dt, r0)
+        ab = self.disc.jacobian_band(st, z, dt, r0, method=self.jacobian)
         lu, piv, info = lapack.dgbtrf(ab, BAND, BAND)
         if info != 0:
             raise ConvergenceError(f"the rod's step Jacobian is singular (LAPACK dgbtrf info {info})")
@@ -449,13 +506,17 @@ def advance(disc: Discrete, st: State, z: np.ndarray, dt: float, Fx, Mx) -> tupl
 
 
 def simulate(disc: Discrete, state: State, *, dt: float, t_end: float, save_every: int = 1,
-             shape_every: int = 0, tol: float = 1e-10, max_iter: int = 40, axis=(0.0, 0.0, 1.0)) -> Trajectory:
+             shape_every: int = 0, tol: float = 1e-10, max_iter: int = 40, axis=(0.0, 0.0, 1.0),
+             jacobian: str = "ad") -> Trajectory:
     """March the midpoint step from ``state`` at t = 0 to ``t_end`` with steps ``dt`` (s), saving every
-    ``save_every`` steps (and the shape every ``shape_every`` saves, 0: never; the final one always)."""
+    ``save_every`` steps (and the shape every ``shape_every`` saves, 0: never; the final one always).
+    ``jacobian``: the step Jacobian by AD (``ad``) or finite differences (``fd``), :meth:`Discrete.jacobian_band`."""
+    if jacobian not in ("ad", "fd"):
+        raise ValueError(f"unknown Jacobian method {jacobian!r}: ad or fd")
     from mechgen.runtime.rods.statics import turning_angle
 
     steps = max(int(np.ceil(t_end / dt - 1e-9)), 0)
-    solver = _Solver(disc, tol, max_iter)
+    solver = _Solver(disc, tol, max_iter, jacobian)
     out = Trajectory()
     st = state.copy()
     work = 0.0

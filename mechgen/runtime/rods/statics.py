@@ -401,7 +401,7 @@ def collocation_jacobian(rod: Rod, H, sigma, lam: float, r0: np.ndarray | None =
     nodes = _pack_node(H, sigma)
     data = np.concatenate([nodes[:-1], nodes[1:], g0, G.reshape(n, 18), Hm[:, :3, 3]], axis=1)
     par = np.concatenate([[rod.L / n, rod.L, lam], rod.compliance.ravel(), rod.f0, sc])
-    blocks = np.asarray(local.mapped(local.collocation_element(), n)(data.T, par)).T.reshape(n, 12, 24)
+    blocks = np.asarray(local.mapped(local.native("collocation_element"), n)(data.T, par)).T.reshape(n, 12, 24)
     end_par = np.concatenate([[rod.L, lam], sc])
     wrench = np.concatenate([rod.tip_force, rod.tip_torque])
     ends = []
