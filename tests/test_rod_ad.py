@@ -233,3 +233,22 @@ def test_without_a_compiler_the_pieces_run_in_casadis_virtual_machine(monkeypatc
     finally:
         local.native.cache_clear()
     assert np.abs(vm - compiled).max() <= 1e-14 * np.abs(compiled).max()
+
+
+def test_the_jacobian_key_from_scenes_and_python(tmp_path, capsys):
+    """``jacobian = "fd"`` through the Python API gives the AD run's numbers (to the Newton tolerance); a
+    bad value exits 2 naming the key and the scene file."""
+    import mechgen
+    from mechgen.cli import main
+
+    system = mechgen.compile("cosserat_rod", {"rhoA": 1.0, "rhoI": 1e-3, "rhoJ": 2e-3, "g_y": -9.81})
+    runs = [mechgen.rod_dynamics(system, elements=8, dt=0.01, t_end=0.1, jacobian=m).outputs for m in ("ad", "fd")]
+    assert np.abs(np.array(runs[0]["tip_trajectory"]) - np.array(runs[1]["tip_trajectory"])).max() < 1e-9
+    statics = [mechgen.rod_statics(system, elements=8, jacobian=m).outputs for m in ("ad", "fd")]
+    assert np.abs(np.array(statics[0]["shape"]) - np.array(statics[1]["shape"])).max() < 1e-10
+    scenes = __import__("pathlib").Path(__file__).resolve().parents[1] / "scenes"
+    scene = tmp_path / "bad.toml"
+    scene.write_text((scenes / "rod_dynamics.toml").read_text() + '\njacobian = "exact"\n')
+    assert main(["run", str(scene)]) == 2
+    err = capsys.readouterr().err
+    assert "jacobian" in err and "bad.toml" in err and "Traceback" not in err

@@ -15,7 +15,9 @@ v' = ... - c v, omega' = ... - c omega; default 0), ``initial_velocity``, ``init
 (steps between saved points, default 1), ``shape_every`` (saved points between saved shapes, 0: only the
 final shape), ``tol`` (Newton increment, in units of L and rad, default 1e-10), ``bending_axis``, ``alpha``
 (the step weight: 0.5 the energy-conserving midpoint rule of order 2, the default; up to 1, backward
-Euler: numerical dissipation of the stiff shear/axial modes a sudden load excites, order 1).
+Euler: numerical dissipation of the stiff shear/axial modes a sudden load excites, order 1), ``jacobian``
+(ad, the default: the step's band Jacobian by CasADi AD of the element energy and the node rows; fd:
+finite differences).
 
 Outputs: ``t`` (s), ``tip_trajectory`` (n x 3, m), ``tip_rotations`` (rad about the bending axis per saved
 point, unwrapped along the rod), ``tip_position``, ``tip_rotation``, ``tip_orientation`` (final), ``energy``
@@ -81,6 +83,7 @@ SCHEMA = {
     "tol": Option(schema.positive, 1e-10),
     "alpha": Option(_alpha, 0.5),
     "bending_axis": Option(schema.one_of("axis", tuple(AXES)), "z"),
+    "jacobian": Option(schema.one_of("Jacobian method", ("ad", "fd")), "ad"),
 }
 
 
@@ -135,7 +138,7 @@ def run_rod_dynamics(system, options: dict, context: dict) -> dict:
     st = initial_state(body, n, options["initial_velocity"], options["initial_angular_velocity"])
     axis = AXES[options["bending_axis"]]
     tr = simulate(disc, st, dt=options["dt"], t_end=options["t_end"], save_every=options["save_every"],
-                  shape_every=options["shape_every"], tol=options["tol"], axis=axis)
+                  shape_every=options["shape_every"], tol=options["tol"], axis=axis, jacobian=options["jacobian"])
     fin = tr.final
     rows = lambda a: [[float(x) + 0.0 for x in row] for row in np.asarray(a)]  # noqa: E731
     energy, work = np.asarray(tr.energy), np.asarray(tr.work)

@@ -14,7 +14,8 @@ default clamped/free), ``tip_force``, ``tip_torque`` ([x, y, z], N and N m; numb
 parameters), ``steps`` (initial continuation steps, default 10), ``tol`` (scaled Newton residual, 1e-10),
 ``min_step`` (the smallest load step before giving up, 1e-4),
 ``bending_axis`` (x, y or z: the axis ``tip_rotation`` turns about, default z), ``frame_rate`` ([x, y, z],
-rad/s: the rate of the frame the state is steady in, for ``velocity``; default 0).
+rad/s: the rate of the frame the state is steady in, for ``velocity``; default 0), ``jacobian`` (ad, the
+default: Newton's Jacobian by CasADi AD of the element, step and end pieces; fd: finite differences).
 
 Outputs: ``tip_position`` ([x, y, z], m), ``tip_rotation`` (rad about the bending axis, unwrapped: an end
 torque tau gives tau L/EI even beyond 2 pi), ``tip_orientation`` (3 x 3), ``s`` (nodes), ``shape``
@@ -83,6 +84,7 @@ SCHEMA = {
     "min_step": Option(schema.positive, 1e-4),
     "bending_axis": Option(schema.one_of("axis", tuple(AXES)), "z"),
     "frame_rate": Option(vector3, [0.0, 0.0, 0.0]),
+    "jacobian": Option(schema.one_of("Jacobian method", ("ad", "fd")), "ad"),
 }
 
 
@@ -175,7 +177,7 @@ def run_rod_statics(system, options: dict, context: dict) -> dict:
     """Solve along the load path; the final state's tip pose and fields, and the branch."""
     rod = rod_of(system, options)
     path = solve_statics(rod, method=options["method"], elements=options["elements"], steps=options["steps"],
-                         tol=options["tol"], min_step=options["min_step"])
+                         tol=options["tol"], min_step=options["min_step"], jacobian=options["jacobian"])
     final, axis = path.final, AXES[options["bending_axis"]]
     rows = lambda a: [[float(x) + 0.0 for x in row] for row in a]  # noqa: E731
     return {"tip_position": [float(x) + 0.0 for x in final.H[-1, :3, 3]],
