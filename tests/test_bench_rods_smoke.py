@@ -55,6 +55,11 @@ def test_quick_run_writes_the_reports(tmp_path):
     assert all(r["error"] < 2e-2 and r["dt_over_pyelastica_limit"] > 100 for r in stiff["rows"])
     grav = res["gravity"]
     assert all(r["orthonormality_error"] < 1e-12 and r["error"] < 3e-2 for r in grav["rows"])
+    # the AD and finite-difference Jacobians of every piece agree to FD's O(sqrt(eps)) error on the same state
+    # (the AD ones are exact: tests/test_rod_ad.py holds them to central differences)
+    jac = res["jacobians"]["rows"]
+    assert {r["piece"] for r in jac} == {"collocation", "shooting", "dynamics step"}
+    assert all(r["fd_minus_ad"] < 1e-5 and r["ad_s"] > 0 and r["fd_s"] > 0 for r in jac)
     if importlib.util.find_spec("elastica") is not None:
         # the two codes' trajectories agree to PyElastica's first-order discretisation error (2.2 % at N = 10),
         # and PyElastica refined to N = 20 moves toward mechgen's reference
@@ -65,3 +70,4 @@ def test_quick_run_writes_the_reports(tmp_path):
         assert grav["pyelastica_orders"][0] > 0.8 and grav["pyelastica"][-1]["error"] < 0.08
         stable, over = stiff["pyelastica"][:2]
         assert not stable["blew_up"] and over["blew_up"] and over["dt_over_limit"] == 2.0
+

@@ -53,6 +53,10 @@ Parts:
   sqrt(alpha_c G A/(rho I))); it is run at 0.5 and at STIFF_OVER times that limit (the second blows up:
   non-finite or |tip| > 1.5 L), while mechgen's implicit step runs at dt far above it.
 
+Newton's Jacobians (mechgen only): the AD ones (the default) against finite differences on the same
+states, collocation, shooting and the dynamics step over an N ladder: seconds per Jacobian and their
+difference (the FD error), in ``rods.json`` ("jacobians") and ``rods.md``.
+
 Timing: one BLAS thread for both (common.blas_threads); PyElastica's numba functions compiled by an untimed
 warm-up run first (its seconds reported); a PyElastica time is its stepping loop, a mechgen time the whole
 public call (``mechgen.rod_statics`` / ``mechgen.rod_dynamics``: set-up and solve) on a compiled system,
@@ -536,6 +540,64 @@ def stiff_study(quick: bool, repeats: int, have_elastica: bool) -> dict:
     return out
 
 
+def jacobian_study(quick: bool, repeats: int) -> dict:
+    """Newton's Jacobians by AD (the default) against finite differences, on the same states: the time of
+    one Jacobian (best of ``repeats``) and their largest difference relative to the AD one (the FD error).
+    Collocation and shooting at the static tip load's converged state (PL^2/EI = 10), the dynamics step
+    of the gravity case's rod at its reference state with a nonzero increment."""
+    from mechgen.analyses.rod_statics import rod_of
+    from mechgen.runtime.rods import dynamics as dyn
+    from mechgen.runtime.rods import statics as rs
+
+    sec = base_section()
+    system = _system(sec.params())
+    EI = sec.params()["EI"]
+    options = {"tip_force": [0.0, -STATIC_LOAD * EI / sec.L**2, 0.0], "tip_torque": [0.0, 0.0, 0.0],
+               "base": "clamped", "tip": "free"}
+    rod = rod_of(system, options)
+    rows = []
+
+    def timed(kind: str, n: int, ad_fn, fd_fn, dense):
+        ad_fn(), fd_fn()                                      # builds, compiles, caches
+        t_ad, a = _timed_best(ad_fn, repeats)
+        t_fd, f = _timed_best(fd_fn, repeats)
+        a, f = dense(a), dense(f)
+        rows.append({"piece": kind, "n": n, "ad_s": t_ad, "fd_s": t_fd, "ratio": t_fd / t_ad,
+                     "fd_minus_ad": float(np.max(np.abs(f - a)) / np.max(np.abs(a)))})
+
+    for n in ((10, 40) if quick else (40, 160, 640)):
+        state = rs.solve_statics(rod, method="collocation", elements=n).final
+        r0 = rs.collocation_residual(rod, state.H, state.sigma, 1.0)
+        timed("collocation", n, lambda: rs.collocation_jacobian(rod, state.H, state.sigma, 1.0),
+              lambda: rs.collocation_jacobian(rod, state.H, state.sigma, 1.0, r0, method="fd"),
+              lambda J: J.toarray())
+    for n in ((10,) if quick else (40, 160)):
+        z = rs.shoot(rod, n, 1.0, np.zeros(12))
+        z = np.zeros(12) if z is None else z[0]
+        timed("shooting", n, lambda: rs.shooting_jacobian(rod, z, n, 1.0)[1],
+              lambda: _fd_shooting(rod, z, n), lambda J: J)
+    if _dynamics_available():
+        body_sys = _system(scene_section().params())
+        drod = rod_of(body_sys, {**options, "tip_force": [0.0, 0.0, 0.0]})
+        M = np.asarray(body_sys.call("rod", f=np.array([drod.f0]), r=np.zeros((1, 3)))["M"], dtype=float).reshape(6, 6)
+        for n in ((10,) if quick else (20, 80, 320)):
+            disc = dyn.Discrete(dyn.RodBody(drod, M), n)
+            st0 = dyn.reference_state(disc.body, n)
+            z = 1e-3 * np.random.default_rng(0).normal(size=(n + 1, 6))
+            r0 = disc.residual(st0, z, 0.005)[0]
+            timed("dynamics step", n, lambda: disc.jacobian_band(st0, z, 0.005),
+                  lambda: disc.jacobian_band(st0, z, 0.005, r0, method="fd"), lambda J: J)
+    return {"rows": rows}
+
+
+def _fd_shooting(rod, z, steps):
+    from mechgen.runtime.rods import statics as rs
+
+    d = 1e-7 * np.maximum(1.0, np.abs(z))
+    r = rs.shooting_residual(rod, np.vstack([z, z + np.diag(d)]), steps, 1.0)
+    return ((r[1:] - r[0]) / d[:, None]).T
+
+
 # -- the suite ------------------------------------------------------------------------------------------------------
 def markdown(results: dict) -> str:
     """The suite's report as Markdown tables."""
@@ -586,6 +648,12 @@ def markdown(results: dict) -> str:
                           f"PyElastica N = {m['pyelastica_n']}, dt {m['pyelastica_dt']:.3g} s "
                           f"({m['pyelastica_s']:.3g} s): ratio {m['ratio']:.2f} (target {TARGET:g})"
                           + (" - mechgen's coarsest point: a lower bound" if m["mechgen_is_coarsest"] else "") + "."]
+    jac = results.get("jacobians")
+    if isinstance(jac, dict):
+        lines += ["", "## Newton's Jacobians: AD against finite differences (same states)", "",
+                  "| piece | N | AD (s) | FD (s) | FD / AD | max abs(FD - AD) / max abs(AD) |", "|---|---|---|---|---|---|"]
+        lines += [f"| {r['piece']} | {r['n']} | {r['ad_s']:.3g} | {r['fd_s']:.3g} | {r['ratio']:.2f} | "
+                  f"{r['fd_minus_ad']:.1e} |" for r in jac["rows"]]
     return "\n".join(lines) + "\n"
 
 
@@ -613,6 +681,7 @@ def run_rods_benchmarks(out: Path, quick: bool = False) -> dict:
         else:
             results["dynamic"] = results["gravity"] = results["stiff"] = \
                 "skipped: mechgen.rod_dynamics is not available"
+        results["jacobians"] = jacobian_study(quick, repeats)
     env["loadavg_after"] = list(__import__("os").getloadavg())
     write_reports(out, results)
     return results
