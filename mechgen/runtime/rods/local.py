@@ -9,9 +9,17 @@ themselves stay with the numpy solvers (statics.py, dynamics.py): these function
 (cited there) in SX, and tests hold the two to each other (the AD Jacobian against finite differences of
 the numpy residual).
 
+The dynamics pieces differentiate at the current increments z (not at zero): the step's unknowns are
+the increments themselves.
+
 Distributed loads are Python callables (or generated kernels) of the position; a piece takes their value
 g0 and Jacobian G = dg/dr (6 x 3) at the piece's current point r0 and uses g0 + G (r - r0), exact to first
 order, so the Jacobian at zero increment is exact.
+
+The hot pieces (collocation and dynamics elements, dynamics nodes) run compiled (:func:`native`: CasADi's
+C, built in mechgen's content-hashed compile cache); the RKMK4 transfer runs in CasADi's virtual machine
+(its 1.5 MB of generated C would cost more to build than it saves), marched in one fold
+(:func:`rkmk4_march`) when the load is uniform. Symbolic work is one piece's, whatever N is.
 """
 from __future__ import annotations
 
