@@ -59,7 +59,7 @@ import numpy as np
 from scipy.linalg import lapack
 
 from mechgen.errors import ConvergenceError
-from mechgen.runtime.rods.liegroup import exp_so3, hat3, jac_left_so3, jac_left_so3_inv, log_so3
+from mechgen.runtime.rods.liegroup import cross3, exp_so3, hat3, jac_left_so3, jac_left_so3_inv, log_so3
 from mechgen.runtime.rods.statics import Rod
 
 ENDS = ("clamped", "pinned", "free")
@@ -197,6 +197,15 @@ class Discrete:
         object.__setattr__(self, "_f0_c", np.ascontiguousarray(self.body.rod.f0, dtype=float))
         object.__setattr__(self, "_pattern", self._band_pattern())
         object.__setattr__(self, "_blocks", self._block_pattern())
+        rod = self.body.rod
+        # a uniform load (gravity) lumped once: w_i g; and whether it has a torque part
+        uniform = None
+        if rod.load is not None and rod.load_uniform:
+            uniform = np.asarray(rod.load(np.zeros((1, 3))), dtype=float).reshape(6) * wts[:, None]
+        object.__setattr__(self, "_uniform_load", uniform)
+        body = self.body
+        unit = np.concatenate([np.full(3, body.rhoA * h), np.full(3, float(np.max(np.diag(body.J_rho))) * h)])
+        object.__setattr__(self, "_fixed_unit", unit / body.alpha)
 
     # ------------------------------------------------------------------ energy and forces
     # Every array below may carry leading batch axes (..., n, 3): the finite-difference Jacobian evaluates
@@ -225,7 +234,7 @@ class Discrete:
         F = np.zeros_like(x)
         F[..., :-1, :] += Fe
         F[..., 1:, :] -= Fe
-        a = h * np.cross(n_, f[..., :3])
+        a = h * cross3(n_, f[..., :3])
         c = m_ + 0.5 * _mtv(jac_left_so3(-0.5 * Psi), a)          # J_r(Psi/2)^T a / 2
         Rh = np.swapaxes(R[..., :-1, :, :], -1, -2) @ Re           # exp(Psi/2)
         Jl_inv = jac_left_so3_inv(Psi)
@@ -264,13 +273,19 @@ class Discrete:
         rod = self.body.rod
         F = np.zeros_like(x)
         Mb = np.zeros_like(x)
-        if rod.load is not None:
+        if self._uniform_load is not None:
+            g = self._uniform_load
+            F += g[:, :3]
+            if np.any(g[:, 3:]):
+                Mb += _mtv(R, g[:, 3:])
+        elif rod.load is not None:
             g = np.asarray(rod.load(x.reshape(-1, 3)), dtype=float).reshape(x.shape[:-1] + (6,))
             g = g * self.weights[:, None]
             F += g[..., :3]
             Mb += _mtv(R, g[..., 3:])
         F[..., -1, :] += rod.tip_force
-        Mb[..., -1, :] += _mtv(R[..., -1, :, :], rod.tip_torque)
+        if np.any(rod.tip_torque):
+            Mb[..., -1, :] += _mtv(R[..., -1, :, :], rod.tip_torque)
         return F, Mb
 
     def kinetic_energy(self, v: np.ndarray, w: np.ndarray) -> float:
@@ -291,16 +306,14 @@ class Discrete:
         m = self.body.rhoA * self.weights[:, None]
         Jw = wm @ self.body.J_rho.T
         rt = m * ((vm - st.v) / (al * dt) + c * vm) - F - Fx
-        rr = self.weights[:, None] * (((wm - st.w) / (al * dt) + c * wm) @ self.body.J_rho.T + np.cross(wm, Jw)) - Mb - Mx
+        rr = self.weights[:, None] * (((wm - st.w) / (al * dt) + c * wm) @ self.body.J_rho.T + cross3(wm, Jw)) - Mb - Mx
         r = np.concatenate([rt, rr], axis=-1)
         r[..., self.fixed] = (z * self._fixed_scale(dt))[..., self.fixed]
         return r, Fx, Mx
 
     def _fixed_scale(self, dt: float) -> np.ndarray:
         """Rows of fixed degrees of freedom: z itself, scaled like the inertia rows (m / (alpha dt^2))."""
-        m = self.body.rhoA * self.h / (self.body.alpha * dt**2)
-        j = float(np.max(np.diag(self.body.J_rho))) * self.h / (self.body.alpha * dt**2)
-        return np.concatenate([np.full(3, m), np.full(3, j)])
+        return self._fixed_unit / dt**2
 
     def _band_pattern(self):
         """Index arrays of the colour-grouped finite differences: perturbation b = 6 colour + k moves unknown k
