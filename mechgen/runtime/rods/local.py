@@ -154,33 +154,34 @@ def _rkmk4(node, h, lam, C, f0, load):
     return Rn, pn, sigma + h / 6 * (s1 + 2 * s2 + 2 * s3 + s4)
 
 
-def _step_inputs():
-    data = ca.SX.sym("data", STEP_DATA)
-    par = ca.SX.sym("par", STEP_PARAMS)
-    return data, par, par[0], par[1], ad.matrix(par[2:38], 6, 6), par[38:44]
+def _transfer(node, stage, par):
+    """One RKMK4 step from the packed node (18) with the stages' load data (4 x 27): the new node packed
+    (18) and the step's 12 x 12 transfer in local coordinates (flat, row-major)."""
+    h, lam, C, f0 = par[0], par[1], ad.matrix(par[2:38], 6, 6), par[38:44]
+    dz = ca.SX.sym("dz", 12)
+    zero = ca.DM.zeros(12)
+    R, p, sigma = _node(node, 0)
+    Rp, pp = ad.compose((R, p), ad.exp_se3(dz[:6]))
+
+    def load(k, Rs, rs):
+        at = 27 * k
+        return _load(lam, Rs, rs, stage[at:at + 6], stage[at + 6:at + 24], stage[at + 24:at + 27])
+
+    Rn, pn, sn = _rkmk4((Rp, pp, sigma + dz[6:]), h, lam, C, f0, load)
+    nxt = ca.substitute(ca.vertcat(ad.flat(Rn), pn, sn), dz, zero)
+    Rb, pb = ad.matrix(nxt[:9], 3, 3), nxt[9:12]
+    local = ca.vertcat(ad.log_se3(*ad.compose(ad.inverse((Rb, pb)), (Rn, pn))), sn)
+    return nxt, ad.flat(ca.substitute(ca.jacobian(local, dz), dz, zero))
 
 
 @lru_cache(maxsize=None)
 def rkmk4_transfer() -> ca.Function:
     """The 12 x 12 (row-major) derivative of one RKMK4 step in local coordinates: the step maps
     (H exp(dxi), sigma + dsigma) to (H' exp(dxi'), sigma' + dsigma'); this is d(dxi', dsigma')/d(dxi,
-    dsigma) at zero (unscaled: lengths and radians, forces and moments)."""
-    data, par, h, lam, C, f0 = _step_inputs()
-    dz = ca.SX.sym("dz", 12)
-    R, p, sigma = _node(data, 0)
-    Rp, pp = ad.compose((R, p), ad.exp_se3(dz[:6]))
-
-    def load(k, Rs, rs):
-        at = 18 + 27 * k
-        return _load(lam, Rs, rs, data[at:at + 6], data[at + 6:at + 24], data[at + 24:at + 27])
-
-    Rn, pn, sn = _rkmk4((Rp, pp, sigma + dz[6:]), h, lam, C, f0, load)
-    zero = ca.DM.zeros(12)
-    base = ca.substitute(ca.vertcat(ad.flat(Rn), pn), dz, zero)
-    Rb, pb = ad.matrix(base[:9], 3, 3), base[9:12]
-    local = ca.vertcat(ad.log_se3(*ad.compose(ad.inverse((Rb, pb)), (Rn, pn))), sn)
-    J = ca.substitute(ca.jacobian(local, dz), dz, zero)
-    return ca.Function("rod_rkmk4_transfer", [data, par], [ad.flat(J)])
+    dsigma) at zero (unscaled: lengths and radians, forces and moments). Data: the node, then the stages'."""
+    data = ca.SX.sym("data", STEP_DATA)
+    par = ca.SX.sym("par", STEP_PARAMS)
+    return ca.Function("rod_rkmk4_transfer", [data, par], [_transfer(data[:18], data[18:], par)[1]])
 
 
 @lru_cache(maxsize=None)
@@ -188,23 +189,9 @@ def rkmk4_march(steps: int) -> ca.Function:
     """``steps`` RKMK4 steps under a position-independent load (its value g0 in the data of every stage,
     G = 0) as one CasADi fold: (node 18, stage data 108, params) -> the nodes after each step (18 x steps)
     and each step's transfer (144 x steps, as :func:`rkmk4_transfer`)."""
-    data, par, h, lam, C, f0 = _step_inputs()
-    node, stage = data[:18], data[18:]
-    zero = ca.DM.zeros(12)
-    dz = ca.SX.sym("dz", 12)
-    R, p, sigma = _node(data, 0)
-
-    def load(k, Rs, rs):
-        at = 27 * k
-        return _load(lam, Rs, rs, stage[at:at + 6], stage[at + 6:at + 24], stage[at + 24:at + 27])
-
-    Rp, pp = ad.compose((R, p), ad.exp_se3(dz[:6]))
-    Rn, pn, sn = _rkmk4((Rp, pp, sigma + dz[6:]), h, lam, C, f0, load)
-    nxt = ca.substitute(ca.vertcat(ad.flat(Rn), pn, sn), dz, zero)
-    Rb, pb = ad.matrix(nxt[:9], 3, 3), nxt[9:12]
-    local = ca.vertcat(ad.log_se3(*ad.compose(ad.inverse((Rb, pb)), (Rn, pn))), sn)
-    J = ca.substitute(ca.jacobian(local, dz), dz, zero)
-    one = ca.Function("rod_rkmk4_step", [node, stage, par], [nxt, ad.flat(J)])
+    node, stage = ca.SX.sym("node", 18), ca.SX.sym("stage", STEP_DATA - 18)
+    par = ca.SX.sym("par", STEP_PARAMS)
+    one = ca.Function("rod_rkmk4_step", [node, stage, par], list(_transfer(node, stage, par)))
     return one.mapaccum("rod_rkmk4_march", steps)
 
 
