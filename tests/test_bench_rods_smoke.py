@@ -53,6 +53,17 @@ def test_quick_run_writes_the_reports(tmp_path):
     assert all(r["error"] < 3e-2 for r in dyn["rows"])
     # the stiff rod at dt hundreds of times PyElastica's limit: within 2 % of its own dt/4 run
     assert all(r["error"] < 2e-2 and r["dt_over_pyelastica_limit"] > 100 for r in stiff["rows"])
+    # the stiff case's common reference (mechgen N = 40, dt = t_end/320 here) has converged: its distances to
+    # half the elements and to twice the dt (1.3e-3, 1.0e-3) are at least 5 x below every error compared
+    common = stiff["common_reference"]
+    compared = [r["error"] for r in stiff["grid"] + stiff.get("pyelastica_ladder", []) if r["error"] is not None]
+    assert max(common["self_convergence_half_elements"], common["self_convergence_double_dt"]) < 0.2 * min(compared)
+    # mechgen's grid, at dt 280 .. 570 x PyElastica's limit at its N, stays within 2 % of the max deflection of
+    # the common reference (1.1 .. 1.4 %: the midpoint rule keeps the higher bending modes' amplitudes but not
+    # their phase at dt near their periods, a plateau of about 1 % in the full run too, plus N = 10's spatial
+    # error), with orthonormal frames
+    assert all(r["dt_over_pyelastica_limit"] > 100 and r["error"] < 2e-2 and r["orthonormality_error"] < 1e-12
+               for r in stiff["grid"])
     grav = res["gravity"]
     assert all(r["orthonormality_error"] < 1e-12 and r["error"] < 3e-2 for r in grav["rows"])
     # the AD and finite-difference Jacobians of every piece agree to FD's O(sqrt(eps)) error on the same state
@@ -70,4 +81,16 @@ def test_quick_run_writes_the_reports(tmp_path):
         assert grav["pyelastica_orders"][0] > 0.8 and grav["pyelastica"][-1]["error"] < 0.08
         stable, over = stiff["pyelastica"][:2]
         assert not stable["blew_up"] and over["blew_up"] and over["dt_over_limit"] == 2.0
+        # the stiff rod: PyElastica at 0.5 x its limit converges at first order in N toward mechgen's common
+        # reference (3.3 %, 1.6 % at N = 10, 20), and mechgen at N = 10 and dt >= 280 x that limit is closer to
+        # it than PyElastica at N = 10
+        ladder = stiff["pyelastica_ladder"]
+        assert not any(r["blew_up"] for r in ladder) and ladder[1]["error"] < ladder[0]["error"] < 5e-2
+        assert stiff["pyelastica_orders"][0] > 0.8
+        assert all(r["error"] < ladder[0]["error"] for r in stiff["grid"] if r["n"] == ladder[0]["n"])
+        m = stiff["matched"]
+        assert m["target_error"] == ladder[-1]["error"] and m["mechgen_error"] <= m["target_error"]
+        assert m["pyelastica_error"] <= m["target_error"] and m["ratio"] > 0
+        assert any(r["peer"] == "PyElastica (stiff, matched accuracy)" for r in ratios["ratios"])
+        assert "Matched accuracy" in (tmp_path / "rods.md").read_text().split("## Stiff rod")[1]
 
