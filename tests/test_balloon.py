@@ -180,20 +180,13 @@ def test_generated_bvp_jacobians_match_central_differences(law):
     assert errors["f_y"] < 1e-7 and errors["f_p"] < 1e-6
 
 
-def test_branches_scene_locates_the_minimum_eyelet_tension(tmp_path):
+def test_branches_scene_locates_the_minimum_eyelet_tension(balloon_branches_run):
     """scenes/balloon_branches.toml: the single-loop branch by continuation in lambda0 with stability at every
     point; p_e,min against the hand-written reference's minimum (balloon_notes.md: 14.70509 at -0.08853), the
     single loops all stable (the paper's finding), p_e along the branch = the reference's shooting at a few
     lambda0."""
-    import json
-
-    from mechgen.cli import main
-
-    target = tmp_path / "out.json"
-    root = Path(__file__).resolve().parents[1]
-    assert main(["run", str(root / "scenes" / "balloon_branches.toml"), "--json", str(target)]) == 0
-    results = {a["name"]: a["outputs"] for a in json.loads(target.read_text())["analyses"]}
-    branch = results["single_loop"]
+    # the scene run by `mechgen run ... --json` (tests/conftest.py, shared with tests/test_balloon_loops.py)
+    branch = balloon_branches_run["single_loop"]
     assert branch["p_e_min"] == pytest.approx(14.70509, abs=2e-5)
     assert branch["lambda0_at_p_e_min"] == pytest.approx(-0.08853, abs=2e-4)
     points = branch["branch"]

@@ -46,8 +46,10 @@ def _run(scene: Path, out: Path) -> dict:
 
 
 @pytest.fixture(scope="module")
-def branches(tmp_path_factory):
-    return _run(ROOT / "scenes" / "balloon_branches.toml", tmp_path_factory.mktemp("loops") / "branches.json")
+def branches(balloon_branches_run):
+    """scenes/balloon_branches.toml run by ``mechgen run --json`` (tests/conftest.py: once per session, shared with
+    tests/test_balloon.py)."""
+    return balloon_branches_run
 
 
 @pytest.fixture(scope="module")

@@ -9,6 +9,7 @@ runtime's affine summary (and stores rather than accumulates) must equal the
 same kernel run through the slot table alone.
 """
 import dataclasses
+import functools
 
 import numpy as np
 import pytest
@@ -56,7 +57,10 @@ def _whole_chain(n: int, ends: str, onsite: bool):
     return u, sp.Matrix([V]).jacobian(sp.Matrix(u)), sp.hessian(V, u)
 
 
+@functools.lru_cache(maxsize=None)
 def _system(ends, onsite, backend, cse, n):
+    """The compiled chain, built once per arguments in this module (several tests read the same C systems; the
+    tests only call them, and test_affine_interior_equals_slot_table puts back the pattern it swaps)."""
     model = _chain(ends, onsite)
     spec = specialize(model, {"N": n, **VALUES})
     return compile_model(model, spec, backend=backend, cse=cse)[0]
@@ -105,8 +109,10 @@ def test_affine_interior_equals_slot_table(ends, onsite):
             run = pattern.slots["slots1_affine" if "slots1_affine" in pattern.slots else "slots0_affine"]
             fast = [system.call(kernel, q=x) for x in q]
             system.patterns[kernel] = _without_affine(pattern)
-            slow = [system.call(kernel, q=x) for x in q]
-            system.patterns[kernel] = pattern
+            try:
+                slow = [system.call(kernel, q=x) for x in q]
+            finally:
+                system.patterns[kernel] = pattern
             for f, s in zip(fast, slow):
                 for port in f:
                     np.testing.assert_allclose(f[port].toarray(), s[port].toarray(), rtol=1e-14, atol=1e-15,

@@ -25,7 +25,7 @@ fraction >= 0.5.
 
 Also: the Python-level overhead of a prepared call of a small kernel, derivation +
 generation + compile time (first run with an empty cache, and cached, each in a
-new Python process), and the time a scene takes to start solving. Every ratio is
+new Python process; quick: N = 8 only), and the time a scene takes to start solving. Every ratio is
 measured in one run on one machine; the numbers of the methods are checked
 against each other before timing.
 
@@ -293,8 +293,9 @@ def ratio_table(rows: list) -> list[dict]:
     return out
 
 
-def call_overhead() -> dict:
-    """Prepared-call overhead of a small kernel: one call vs its share of a 10^6-state batch."""
+def call_overhead(states: int = 1_000_000, min_time: float = 0.3) -> dict:
+    """Prepared-call overhead of a small kernel: one call (timed for at least ``min_time`` s) vs its share of a
+    batch of ``states`` states (10^6; the quick run: 10^5 and 0.01 s)."""
     from mechgen import models
     from mechgen.pipeline import compile_model
     from mechgen.symbolic.specialize import specialize
@@ -303,8 +304,8 @@ def call_overhead() -> dict:
     system, _ = compile_model(model, specialize(model, {"Omega": 100.0}), kernels={"force"}, backend="c")
     one = {"q": np.full(4, 0.01), "v": np.zeros(4), "z": np.zeros(0), "t": np.zeros(1), "p": system.params}
     out = {"f": np.zeros(4)}
-    single = best_time(system.kernels["force"].bind(one, out), min_time=0.3)
-    nb = 1_000_000
+    single = best_time(system.kernels["force"].bind(one, out), min_time=min_time)
+    nb = states
     many = {"q": np.full((nb, 4), 0.01), "v": np.zeros((nb, 4)), "z": np.zeros(0), "t": np.zeros((nb, 1)),
             "p": system.params}
     per_state = best_time(system.kernels["force"].bind(many, {"f": np.zeros((nb, 4))}), repeats=3) / nb
@@ -431,8 +432,8 @@ def run_fpu_benchmarks(*, out: Path, quick: bool = False) -> dict:
     batched = batch_bandwidth(rows, *batch)
     leapfrog = leapfrog_bandwidth(*(QUICK_LEAPFROG if quick else LEAPFROG))
     ratios = ratio_table(rows)
-    overhead = call_overhead()
-    builds = build_times((8, 100_000) if not quick else (8, 1000))
+    overhead = call_overhead(**({"states": 100_000, "min_time": 0.01} if quick else {}))
+    builds = build_times((8, 100_000) if not quick else (8,))
     start = scene_start(ROOT / "scenes" / "spring_pendulum.toml")
     users = user_path([ROOT / "scenes" / USER_SCENE], repeats=1 if quick else 3, warm=not quick)
     out = Path(out)

@@ -450,19 +450,26 @@ def work_precision(repeats: int, quick: bool, ross_row: dict | None) -> dict:
     """First-8-frequency error against a Richardson reference vs time per Campbell speed."""
     check = (0.0, MAX_SPEED)
 
-    def freqs(system):
-        return np.array([mechgen_modes(system, w)["frequencies"] for w in check], dtype=float)
+    found: dict = {}
+
+    def freqs(n: int, disc: str = "timoshenko2"):
+        """The check frequencies of one mesh, solved once (the quick reference's coarse mesh, N = 192, and its
+        quintic cross-check, N = 24, are also rungs of the ladder)."""
+        if (n, disc) not in found:
+            system = rotor_system(n, disc)[0]
+            found[n, disc] = np.array([mechgen_modes(system, w)["frequencies"] for w in check], dtype=float)
+        return found[n, disc]
 
     coarse, fine = (192, 384) if quick else (384, 768)
-    f_c, f_f = (freqs(rotor_system(n)[0]) for n in (coarse, fine))
+    f_c, f_f = freqs(coarse), freqs(fine)
     ref = f_f + (f_f - f_c) / 3.0                      # second order: error ~ h^2
     cross_n = 24 if quick else 48
-    cross = freqs(rotor_system(cross_n, "quintic")[0])
+    cross = freqs(cross_n, "quintic")
     speeds = speeds_of(10 if quick else 50)
     rows = []
     for disc, n in WP_LADDER:
         system, info = rotor_system(n, disc)
-        err = _rel(freqs(system), ref)
+        err = _rel(freqs(n, disc), ref)
         mechgen_campbell(system, speeds)           # first call (tables) untimed
         times = [_timed(lambda: mechgen_campbell(system, speeds))[0] for _ in range(repeats)]
         rows.append({"method": f"mechgen {disc}", "N": n, "unknowns": system.n, "max_rel_error": err,

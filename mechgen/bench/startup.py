@@ -8,8 +8,9 @@ imports (the sum of the top-level cumulative times that ``-X importtime`` prints
 and whether sympy, jinja2, scipy.optimize or mechgen.symbolic were imported (they must not be: a
 cached run derives nothing). Every run is made as a user makes it, in the default environment (no
 ``OPENBLAS_NUM_THREADS``, ``OMP_NUM_THREADS``, ``MKL_NUM_THREADS``), interleaved with the same run pinned
-to one BLAS thread (``pinned_wall_s`` and ``ratio_unpinned_over_pinned``; issue #12). Writes
-``out/startup.{json,md}``.
+to one BLAS thread (``pinned_wall_s`` and ``ratio_unpinned_over_pinned``; issue #12). ``quick``: one
+repeat (a smoke test of the suite: still one unpinned and one pinned run per scene, each checked for heavy
+imports). Writes ``out/startup.{json,md}``.
 """
 from __future__ import annotations
 
@@ -65,7 +66,7 @@ def time_scene(scene: Path, repeats: int = 7) -> dict:
 def run_startup_benchmarks(out: Path, *, quick: bool = False) -> dict:
     """Time every scene of :data:`SCENES`; writes ``out/startup.{json,md}``."""
     folder = ROOT / "scenes"
-    rows = [time_scene(folder / name, repeats=3 if quick else 7) for name in SCENES]
+    rows = [time_scene(folder / name, repeats=1 if quick else 7) for name in SCENES]
     write_json(out / "startup.json", rows)
     lines = ["| scene | whole process (median, s) | imports (s) | import share | heavy imports | pinned (median, s) | "
              f"unpinned / pinned (target <= {UNPINNED_TARGET:g}) |",
