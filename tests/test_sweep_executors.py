@@ -83,8 +83,10 @@ def test_executors_give_the_same_numbers_and_the_closed_form():
         whirl = sorted([(IP * w + root) / (2 * ID), (-IP * w + root) / (2 * ID)])
         assert min(abs(np.array(freqs) - whirl[0])) < 1e-9 * whirl[1]
         assert min(abs(np.array(freqs) - whirl[1])) < 1e-9 * whirl[1]
-    # the 40 quick points (ms each) go as one chunk per worker, not 39 tasks
-    assert runs["dask"]["tasks"] == 2
+    # the 40 quick points (ms each) go in chunks, not 39 tasks: one per worker when a warm point takes under
+    # 0.5 s / 19 = 26 ms; the count depends on that measured time (a loaded machine gave 3), chunk_size's rule
+    # itself is tested exactly below; 8 tasks would mean a warm point of 0.1 s, 30x its usual time
+    assert 2 <= runs["dask"]["tasks"] <= 8
 
 
 def test_chunk_size_carries_half_a_second_and_feeds_every_worker():
