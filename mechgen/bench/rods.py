@@ -651,7 +651,7 @@ def jacobian_study(quick: bool, repeats: int) -> dict:
         z = rs.shoot(rod, n, 1.0, np.zeros(12))
         z = np.zeros(12) if z is None else z[0]
         timed("shooting", n, lambda: rs.shooting_jacobian(rod, z, n, 1.0)[1],
-              lambda: _fd_shooting(rod, z, n), lambda J: J)
+              lambda: rs.shooting_jacobian_fd(rod, z, n, 1.0)[1], lambda J: J)
     if _dynamics_available():
         body_sys = _system(scene_section().params())
         drod = rod_of(body_sys, {**options, "tip_force": [0.0, 0.0, 0.0]})
@@ -664,14 +664,6 @@ def jacobian_study(quick: bool, repeats: int) -> dict:
             timed("dynamics step", n, lambda: disc.jacobian_band(st0, z, 0.005),
                   lambda: disc.jacobian_band(st0, z, 0.005, r0, method="fd"), lambda J: J)
     return {"rows": rows}
-
-
-def _fd_shooting(rod, z, steps):
-    from mechgen.runtime.rods import statics as rs
-
-    d = 1e-7 * np.maximum(1.0, np.abs(z))
-    r = rs.shooting_residual(rod, np.vstack([z, z + np.diag(d)]), steps, 1.0)
-    return ((r[1:] - r[0]) / d[:, None]).T
 
 
 # -- the suite ------------------------------------------------------------------------------------------------------

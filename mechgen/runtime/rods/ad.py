@@ -48,12 +48,16 @@ def vee3(W):
     return 0.5 * ca.vertcat(W[2, 1] - W[1, 2], W[0, 2] - W[2, 0], W[1, 0] - W[0, 1])
 
 
+_CLOSED = {"sinc": lambda t, t2: ca.sin(t) / t, "a1": lambda t, t2: (1 - ca.cos(t)) / t2,
+           "a2": lambda t, t2: (t - ca.sin(t)) / (t2 * t),
+           "a3": lambda t, t2: (t2 + 2 * ca.cos(t) - 2) / (2 * t2 * t2),
+           "a4": lambda t, t2: (2 * t - 3 * ca.sin(t) + t * ca.cos(t)) / (2 * t2 * t2 * t)}
+
+
 def angle(name: str, t2):
     """sinc, a1 … a4 (liegroup's angle functions) of t = sqrt(t2): the series below t = 1, else the closed form."""
     t = ca.sqrt(t2)
-    closed = {"sinc": ca.sin(t) / t, "a1": (1 - ca.cos(t)) / t2, "a2": (t - ca.sin(t)) / (t2 * t),
-              "a3": (t2 + 2 * ca.cos(t) - 2) / (2 * t2 * t2),
-              "a4": (2 * t - 3 * ca.sin(t) + t * ca.cos(t)) / (2 * t2 * t2 * t)}[name]
+    closed = _CLOSED[name](t, t2)
     return ca.if_else(t2 < SERIES_BELOW, horner(angle_series(name), t2), closed)
 
 

@@ -198,11 +198,13 @@ class Discrete:
         object.__setattr__(self, "_pattern", self._band_pattern())
         object.__setattr__(self, "_blocks", self._block_pattern())
         rod = self.body.rod
-        # a uniform load (gravity) lumped once: w_i g; and whether it has a torque part
-        uniform = None
+        # a uniform load (gravity) lumped once: w_i g, and its torque part (None when zero)
+        uniform = torque = None
         if rod.load is not None and rod.load_uniform:
             uniform = np.asarray(rod.load(np.zeros((1, 3))), dtype=float).reshape(6) * wts[:, None]
+            torque = uniform[:, 3:] if np.any(uniform[:, 3:]) else None
         object.__setattr__(self, "_uniform_load", uniform)
+        object.__setattr__(self, "_uniform_torque", torque)
         body = self.body
         unit = np.concatenate([np.full(3, body.rhoA * h), np.full(3, float(np.max(np.diag(body.J_rho))) * h)])
         object.__setattr__(self, "_fixed_unit", unit / body.alpha)
@@ -274,10 +276,9 @@ class Discrete:
         F = np.zeros_like(x)
         Mb = np.zeros_like(x)
         if self._uniform_load is not None:
-            g = self._uniform_load
-            F += g[:, :3]
-            if np.any(g[:, 3:]):
-                Mb += _mtv(R, g[:, 3:])
+            F += self._uniform_load[:, :3]
+            if self._uniform_torque is not None:
+                Mb += _mtv(R, self._uniform_torque)
         elif rod.load is not None:
             g = np.asarray(rod.load(x.reshape(-1, 3)), dtype=float).reshape(x.shape[:-1] + (6,))
             g = g * self.weights[:, None]
@@ -332,7 +333,7 @@ class Discrete:
 
     def _block_pattern(self):
         """Flat band-storage indices (row 2 BAND + i - j, column j) of the element blocks (N, 12, 12: nodes e,
-        e + 1) and the node blocks (n, 6, 6), and the fixed rows' masks of both."""
+        e + 1) and the node blocks (n, 6, 6), and the element blocks' fixed rows (N, 12)."""
         n, size = self.elements + 1, 6 * (self.elements + 1)
 
         def flat(first, width):
@@ -340,10 +341,8 @@ class Discrete:
             cols = first[:, None, None] + np.arange(width)[None, None, :]
             return ((2 * BAND + rows - cols) * size + cols).ravel()
 
-        fixed = self.fixed.ravel()
         element_rows = 6 * np.arange(n - 1)[:, None] + np.arange(12)[None, :]
-        return (flat(6 * np.arange(n - 1), 12), flat(6 * np.arange(n), 6), fixed[element_rows],
-                self.fixed)
+        return flat(6 * np.arange(n - 1), 12), flat(6 * np.arange(n), 6), self.fixed.ravel()[element_rows]
 
     def jacobian_band(self, st: State, z: np.ndarray, dt: float, r0: np.ndarray | None = None, *,
                       method: str = "ad") -> np.ndarray:
@@ -374,11 +373,11 @@ class Discrete:
         data = np.concatenate([R, st.v, st.w, z, self.weights[:, None], g0, G.reshape(n, 18), xa, tip, st.x], axis=1)
         npar = np.concatenate([[dt, al, body.rhoA, body.damping], body.J_rho.ravel()])
         Jn = np.asarray(local.mapped(local.native("dynamics_node"), n)(data.T, npar)).T.reshape(n, 6, 6)
-        element_at, node_at, element_fixed, node_fixed = self._blocks
+        element_at, node_at, element_fixed = self._blocks
         Je[element_fixed] = 0.0                      # rows of fixed unknowns: z itself, scaled
-        Jn[node_fixed] = 0.0
+        Jn[self.fixed] = 0.0
         diag = np.broadcast_to(self._fixed_scale(dt), (n, 6))
-        i, a = np.nonzero(node_fixed)
+        i, a = np.nonzero(self.fixed)
         Jn[i, a, a] = diag[i, a]
         size = 6 * n
         ab = np.bincount(element_at, Je.ravel(), minlength=(3 * BAND + 1) * size)

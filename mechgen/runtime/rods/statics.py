@@ -321,6 +321,14 @@ def shooting_jacobian(rod: Rod, z: np.ndarray, steps: int, lam: float):
     return r, np.vstack(rows)
 
 
+def shooting_jacobian_fd(rod: Rod, z: np.ndarray, steps: int, lam: float):
+    """The shooting residual and its Jacobian by forward differences (step 1e-7 max(1, |z_k|)): the 13
+    trajectories integrated as one batch."""
+    d = 1e-7 * np.maximum(1.0, np.abs(z))
+    r = shooting_residual(rod, np.vstack([z, z + np.diag(d)]), steps, lam)
+    return r[0], ((r[1:] - r[0]) / d[:, None]).T
+
+
 def shoot(rod: Rod, steps: int, lam: float, z0: np.ndarray, *, tol: float = 1e-10, max_iter: int = 30,
           jacobian: str = "ad"):
     """Newton on the scaled base unknowns at load factor lam: (z, iterations), or None without convergence.
@@ -329,10 +337,7 @@ def shoot(rod: Rod, steps: int, lam: float, z0: np.ndarray, *, tol: float = 1e-1
     def rj(z):
         if jacobian == "ad":
             return shooting_jacobian(rod, z, steps, lam)
-        d = 1e-7 * np.maximum(1.0, np.abs(z))
-        batch = np.vstack([z, z + np.diag(d)])
-        r = shooting_residual(rod, batch, steps, lam)
-        return r[0], ((r[1:] - r[0]) / d[:, None]).T
+        return shooting_jacobian_fd(rod, z, steps, lam)
 
     with np.errstate(all="ignore"):
         return _newton(rj, np.asarray(z0, dtype=float), tol=tol, max_iter=max_iter)
@@ -610,6 +615,7 @@ def turning_angle(H: np.ndarray, axis) -> float:
 
 
 __all__ = ["Rod", "Solution", "Path", "check_ends", "solve_statics", "shoot", "collocate", "integrate",
-           "collocation_residual", "collocation_jacobian", "shooting_residual", "shooting_jacobian", "perturbed",
+           "collocation_residual", "collocation_jacobian", "shooting_residual", "shooting_jacobian",
+           "shooting_jacobian_fd", "perturbed",
            "midpoints", "load_and_gradient",
            "rkmk4_step", "turning_angle", "straight", "vee3"]
