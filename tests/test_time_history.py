@@ -283,3 +283,28 @@ def test_failed_analysis_error_types_are_kept(double):
     """A failure from Python keeps its type (a budget is a MechgenError; a singular start a ConvergenceError)."""
     with pytest.raises(ConvergenceError):
         mechgen.simulate(mechgen.compile("spring_pendulum"), t_end=1.0)  # r = 0: no inertia along theta
+
+
+@pytest.mark.parametrize("scene, words", [
+    ('model = "spring_pendulm"\n', ["'model'", "did you mean 'spring_pendulum'"]),
+    ('model = "spring_pendulum"\n[params]\nkk = 3\n', ["'params.kk'", "did you mean 'k'"]),
+    ('model = "spring_pendulum"\n[[analysis]]\nname = "a"\nkind = "simulat"\n', ["did you mean 'simulate'"]),
+    ('model = "spring_pendulum"\n[[analysis]]\nname = "a"\nkind = "simulate"\nt_end = 1\nsamles = 3\n',
+     ["'analysis[1].samles'", "did you mean 'samples'"]),
+])
+def test_typos_get_the_closest_name(tmp_path, capsys, scene, words):
+    """A mistyped model, parameter, kind or key: exit 2, naming the key and suggesting the closest name."""
+    path = tmp_path / "typo.toml"
+    path.write_text(scene)
+    assert main(["run", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert all(w in err for w in words) and "Traceback" not in err
+
+
+def test_python_typos_get_the_closest_name(double):
+    with pytest.raises(mechgen.InputError, match="did you mean 'samples'"):
+        mechgen.simulate(double, t_end=1.0, samles=3)
+    with pytest.raises(mechgen.InputError, match="did you mean 'm1'"):
+        double.with_params(m11=1.0)
+    with pytest.raises(mechgen.InputError, match="did you mean 'l0'"):
+        mechgen.compile("spring_pendulum", {"l00": 1.0})

@@ -10,7 +10,7 @@ import importlib
 from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping
 
-from mechgen.errors import InputError
+from mechgen.errors import InputError, did_you_mean
 
 #: the modules that register a kind, in the order kinds are listed (scene messages, ``kinds()``)
 MODULES = (
@@ -111,7 +111,7 @@ def get(name: str) -> AnalysisKind:
     """The kind called ``name``; an InputError listing the kinds when there is none."""
     _load()
     if name not in _KINDS:
-        raise InputError(f"unknown analysis kind {name!r}", key="kind", expected="one of: " + ", ".join(kinds()))
+        raise InputError(f"unknown analysis kind {name!r}{did_you_mean(name, kinds())}", key="kind", expected="one of: " + ", ".join(kinds()))
     return _KINDS[name]
 
 

@@ -25,7 +25,7 @@ import scipy.linalg as sla
 import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
-from mechgen.errors import InputError, KernelError
+from mechgen.errors import InputError, KernelError, did_you_mean
 from mechgen.runtime.core.kernels import Kernel
 from mechgen.runtime.core.meta import SystemMeta
 from mechgen.runtime.core.pattern import Pattern, build_pattern, extent
@@ -93,7 +93,7 @@ def number(name: str, value) -> float:
 def unknown_parameters(model, unknown: list, known) -> InputError:
     """The error for names that are no parameter of the compiled system."""
     return InputError(f"unknown parameter{'s' if len(unknown) > 1 else ''} {', '.join(map(repr, unknown))} "
-                      f"for model {model}", key=unknown[0],
+                      f"for model {model}{did_you_mean(unknown[0], known)}", key=unknown[0],
                       expected="one of: " + (", ".join(sorted(known)) or "none"))
 
 
