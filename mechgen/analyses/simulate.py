@@ -34,20 +34,18 @@ from pathlib import Path
 
 import numpy as np
 
-from mechgen.analyses import schema, summary, time_figures, time_series
+from mechgen.analyses import schema, simulate_flow, summary, time_figures, time_series
 from mechgen.analyses.context import NAME
 from mechgen.analyses.operating_point import vector
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import ABSENT, ALL_OUTPUTS, REQUIRED, Option
-from mechgen.errors import ConvergenceError, InputError, SceneError
+from mechgen.errors import ConvergenceError, SceneError
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget, BudgetExceeded
-from mechgen.runtime.core.diagnose import explain_state
-from mechgen.runtime.core.integrate import MIN_RTOL, integrate_first_order, leapfrog
-from mechgen.runtime.core.memory import dense_bytes, require
+from mechgen.runtime.core.integrate import MIN_RTOL, leapfrog
 from mechgen.runtime.linear.modes import modes as solve_modes
 from mechgen.scene.values import fail, listing, show, type_name
 
-METHODS = ("BDF", "Radau", "LSODA", "RK45", "DOP853", "leapfrog", "cvodes")
+METHODS = ("auto", "BDF", "Radau", "LSODA", "RK45", "DOP853", "leapfrog", "cvodes")
 #: the default figure: coordinates against time, or each coordinate against its velocity
 PLOTS = ("time", "phase")
 #: what a hybrid run does when its events accumulate (Zeno): end with an error, or stop there
@@ -85,11 +83,10 @@ def _mode(ctx, key: str, value: object) -> str:
 
 
 def _loop(ctx, key: str, value: object) -> str:
-    """The event loop of a hybrid model (mechgen.runtime.core.events.LOOPS)."""
+    """The loop that steps the integrator (mechgen.runtime.core.events.LOOPS): the compiled one where it can run
+    (``auto``), scipy's steppers in Python, or the compiled one (``c``, an input error where it cannot run)."""
     from mechgen.runtime.core.events import LOOPS
 
-    if not getattr(ctx.model, "modes", ()):
-        raise fail(ctx.file, key, f"model {ctx.model.name} has no modes", "no 'loop' key (a smooth model)")
     return schema.one_of("loop", LOOPS)(ctx, key, value)
 
 
@@ -106,7 +103,7 @@ def _method(ctx, key: str, value: object) -> str:
     return value
 
 
-SCHEMA = {"t_end": Option(schema.positive, REQUIRED, STEP), "method": Option(_method, "BDF"),
+SCHEMA = {"t_end": Option(schema.positive, REQUIRED, STEP), "method": Option(_method, "auto"),
           "dt": Option(schema.positive, ABSENT), "rtol": Option(schema.positive, 1e-8),
           "atol": Option(schema.positive, 1e-10), "q0": Option(schema.coordinate_table, {}),
           "v0": Option(schema.coordinate_table, {}), "initial_mode": Option(schema.count),
@@ -226,19 +223,6 @@ def leapfrog_masses(system, M) -> np.ndarray:
     return 1.0 / diag
 
 
-def _cvodes(system, x0, t_end, t_eval, options, budget, progress, desc):
-    """The run with SUNDIALS' CVODES on the system's CasADi kernels (mechgen.runtime.core.sundials)."""
-    from mechgen.runtime.core.sundials import cvodes_problem, integrate_cvodes
-
-    why = cvodes_problem(system)
-    if why:
-        raise InputError(why, key="method", expected="a method of this system's backend: BDF, Radau, LSODA, RK45, "
-                         "DOP853 or leapfrog, or backend 'casadi' for 'cvodes'")
-    return integrate_cvodes(system, x0, t_end, t_eval=t_eval, rtol=options.get("rtol", 1e-8),
-                            atol=options.get("atol", 1e-10), budget=budget, progress=progress, desc=desc,
-                            explain=lambda t, x: explain_state(system, t, x))
-
-
 def run_simulate(system, options: dict, context: dict) -> dict:
     """Time response: the time history (``t``, ``trajectory``), the model's outputs at t_end and the energy
     figures (mechgen.analyses.time_series)."""
@@ -247,13 +231,19 @@ def run_simulate(system, options: dict, context: dict) -> dict:
 
         return run_hybrid(system, options, context)
     q0, v0 = initial_state(system, options)
-    method = options.get("method", "BDF")
-    budget = budget_of(options, method)
-    run = _leapfrog_run if method == "leapfrog" else _adaptive_run
-    t, X = run(system, options, q0, v0, budget, context.get(NAME, "simulate"))
+    method, desc = options.get("method", "auto"), context.get(NAME, "simulate")
+    if method == "leapfrog":
+        t, X = _leapfrog_run(system, options, q0, v0, budget_of(options, method), desc)
+        how = {"method": method, "loop": "python"}
+    else:
+        start = declared_start(system)
+        x0 = np.concatenate([q0, v0, np.zeros(system.m) if start is None else start[2 * system.n:]])
+        if method == "auto":
+            method = simulate_flow.chosen_method(system, x0, float(options["t_end"]))
+        t, X, how = simulate_flow.adaptive_run(system, options, x0, method, budget_of(options, method), desc)
     n = system.n
     outputs_at = lambda k, tk, x: system.outputs(x[:n], x[n:2 * n], x[2 * n:] if system.m else None, tk)  # noqa: E731
-    out = report(system, options, t, X, outputs_at)
+    out = {**report(system, options, t, X, outputs_at), **how}
     if system.is_lattice and system.metadata.ends == "fixed":
         out["mode_energies"] = mode_energies(system, X[-1, :n], X[-1, n:2 * n])
     return out
@@ -288,27 +278,6 @@ def _leapfrog_run(system, options: dict, q0, v0, budget: Budget, desc: str) -> t
     traj = leapfrog(lambda q: system.force(q) * minv, q0, v0, dt, steps, record_every=every, budget=budget,
                     progress=bool(options.get("progress", True)), desc=desc)
     return traj.t, np.hstack([traj.q, traj.v])
-
-
-def _adaptive_run(system, options: dict, q0, v0, budget: Budget, desc: str) -> tuple[np.ndarray, np.ndarray]:
-    """An adaptive (or CVODES) run from (q0, v0, z0) sampled at ``samples`` equally spaced times."""
-    method, t_end = options.get("method", "BDF"), float(options["t_end"])
-    start = declared_start(system)
-    x0 = np.concatenate([q0, v0, np.zeros(system.m) if start is None else start[2 * system.n:]])
-    refuse_explicit_stiff(system, x0, t_end, method, budget)
-    n_out = int(options.get("samples", 201))
-    require(dense_bytes(n_out, 3 * (2 * system.n + system.m) + 6), f"{n_out} output samples", key="samples")
-    t_eval = np.linspace(0.0, t_end, max(n_out, 2))
-    progress = bool(options.get("progress", True))
-    if method == "cvodes":
-        traj = _cvodes(system, x0, t_end, t_eval, options, budget, progress, desc)
-    else:
-        traj = integrate_first_order(system.rhs, x0, t_end, jac=system.jacobian, method=method,
-                                     rtol=options.get("rtol", 1e-8), atol=options.get("atol", 1e-10),
-                                     t_eval=t_eval, budget=budget, progress=progress, desc=desc,
-                                     explain=lambda t, x: explain_state(system, t, x))
-    xs = traj.x if traj.x.shape[0] == len(traj.t) else traj.x.T
-    return np.asarray(traj.t, float), np.asarray(xs, float)
 
 
 def plot(plt, a: dict, path: Path) -> list[Path]:

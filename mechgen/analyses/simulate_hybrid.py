@@ -63,7 +63,7 @@ def run_hybrid(system, options: dict, context: dict) -> dict:
     x0 = np.concatenate([q0, v0, np.zeros(system.m) if start is None else start[2 * system.n:]])
     n_out = int(options.get("samples", 201))
     require(dense_bytes(n_out, 3 * x0.size + 6), f"{n_out} output samples", key="samples")
-    traj, zeno = hybrid_run(system, options, x0, context.get(NAME, "simulate"))
+    traj, zeno, method = hybrid_run(system, options, x0, context.get(NAME, "simulate"))
     t, X, modes = with_final(traj)
     outputs = mode_outputs(system)
     out = report(system, options, t, X, lambda k, tk, x: outputs(int(modes[k]), x, tk))
@@ -74,15 +74,21 @@ def run_hybrid(system, options: dict, context: dict) -> dict:
         out["mode_series"] = [system.modes[int(k)] for k in modes]
     if zeno:
         out["zeno"] = True
+    out["method"], out["loop"] = method, traj.extra.get("loop", "python")
     return out
 
 
 def hybrid_run(system, options: dict, x0: np.ndarray, desc: str):
-    """(the HybridTrajectory, whether it ended at a Zeno approach): ``on_zeno = "stop"`` keeps the run up to the
-    event that made it Zeno (mechgen.runtime.core.events.ZenoApproach); the default lets the error end it."""
+    """(the HybridTrajectory, whether it ended at a Zeno approach, the method that ran): ``on_zeno = "stop"`` keeps
+    the run up to the event that made it Zeno (mechgen.runtime.core.events.ZenoApproach); the default lets the
+    error end it. ``method = "auto"`` is decided on the initial mode (mechgen.analyses.simulate_flow)."""
     from mechgen.analyses.simulate import budget_of
 
-    method, t_end = options.get("method", "BDF"), float(options["t_end"])
+    method, t_end = options.get("method", "auto"), float(options["t_end"])
+    if method == "auto":  # decided on the initial mode's linearisation (mechgen.analyses.simulate_flow)
+        from mechgen.analyses.simulate_flow import chosen_method
+
+        method = chosen_method(system.mode(start_mode(system, options)), x0, t_end)
     try:
         traj = integrate_hybrid(system, x0, t_end, mode=start_mode(system, options), method=method,
                                 rtol=options.get("rtol", 1e-8), atol=options.get("atol", 1e-10),
@@ -93,8 +99,8 @@ def hybrid_run(system, options: dict, x0: np.ndarray, desc: str):
     except ZenoApproach as exc:
         if options.get("on_zeno", "error") != "stop" or exc.trajectory is None:
             raise
-        return exc.trajectory, True
-    return traj, False
+        return exc.trajectory, True, method
+    return traj, False, method
 
 
 def with_final(traj) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
