@@ -34,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mechgen.analyses import schema, simulate_flow, summary, time_figures, time_series
+from mechgen.analyses import energy_balance, schema, simulate_flow, summary, time_figures, time_series
 from mechgen.analyses.context import NAME
 from mechgen.analyses.operating_point import vector
 from mechgen.analyses.registry import AnalysisKind, register
@@ -140,7 +140,8 @@ def needs(options: dict, *, internal: bool) -> set[str]:
     if options.get("method") == "leapfrog":
         return {"force", "outputs", "linear"}
     start = {"linear"} if options.get("initial_mode") else set()
-    return {"residual", "tangent", "outputs"} | start | ({"rates", "rates_tangent"} if internal else set())
+    balance = {"energy_rates"} if options.get("method") != "cvodes" else set()
+    return {"residual", "tangent", "outputs"} | start | balance | ({"rates", "rates_tangent"} if internal else set())
 
 
 def declared_start(system) -> np.ndarray | None:
@@ -242,17 +243,21 @@ def run_simulate(system, options: dict, context: dict) -> dict:
             method = simulate_flow.chosen_method(system, x0, float(options["t_end"]))
         t, X, how = simulate_flow.adaptive_run(system, options, x0, method, budget_of(options, method), desc)
     n = system.n
-    outputs_at = lambda k, tk, x: system.outputs(x[:n], x[n:2 * n], x[2 * n:] if system.m else None, tk)  # noqa: E731
-    out = {**report(system, options, t, X, outputs_at), **how}
+    extra = how.pop("_extra", 0)
+    state = X[:, :X.shape[1] - extra]
+    series = time_series.sampled_outputs(system, t, state)
+    out = {**report(system, options, t, state, series), **how}
+    if extra:
+        balanced(out, energy_balance.figures(system, t, X, series))
     if system.is_lattice and system.metadata.ends == "fixed":
         out["mode_energies"] = mode_energies(system, X[-1, :n], X[-1, n:2 * n])
     return out
 
 
-def report(system, options: dict, t: np.ndarray, X: np.ndarray, outputs_at) -> dict:
-    """The outputs of a run sampled at ``t`` (states X, one row a sample): the model's outputs at the last
-    sample (those asked for), ``energy_drift``, ``t_end`` and, when kept, the time history."""
-    series = time_series.sampled_outputs(outputs_at, t, X)
+def report(system, options: dict, t: np.ndarray, X: np.ndarray, series: dict) -> dict:
+    """The outputs of a run sampled at ``t`` (states X, one row a sample; ``series``: the model's outputs at each
+    sample): the outputs at the last sample (those asked for), ``energy_drift``, ``t_end`` and, when kept, the
+    time history."""
     wanted = options.get("outputs")
     out = {k: float(v[-1]) for k, v in series.items() if not wanted or k in wanted}
     out["energy_drift"] = time_series.energy_drift(series)
@@ -265,6 +270,18 @@ def report(system, options: dict, t: np.ndarray, X: np.ndarray, outputs_at) -> d
     elif note:
         out["series_note"] = note
     return out
+
+
+def balanced(out: dict, balance: dict | None) -> None:
+    """A run that is not conservative reports its energy balance (mechgen.analyses.energy_balance) instead of
+    ``energy_drift``; with the trajectory, ``work`` and ``dissipated`` at each sample too."""
+    if balance is None:
+        return
+    del out["energy_drift"]
+    work, dissipated = balance.pop("_work_series"), balance.pop("_dissipated_series")
+    out.update(balance)
+    if "trajectory" in out:
+        out["trajectory"]["work"], out["trajectory"]["dissipated"] = work.tolist(), dissipated.tolist()
 
 
 def _leapfrog_run(system, options: dict, q0, v0, budget: Budget, desc: str) -> tuple[np.ndarray, np.ndarray]:

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from mechgen.analyses import energy_balance
 from mechgen.errors import InputError
 from mechgen.runtime.core.budget import Budget
 from mechgen.runtime.core.diagnose import explain_state
@@ -55,13 +56,16 @@ def chosen_method(system, x0: np.ndarray, t_end: float) -> str:
 
 def adaptive_run(system, options: dict, x0: np.ndarray, method: str, budget: Budget,
                  desc: str) -> tuple[np.ndarray, np.ndarray, dict]:
-    """(t, x rows, {method, loop}) of a run of ``method`` (not ``auto``: :func:`chosen_method` resolves it) from x0,
-    sampled at ``samples`` equally spaced times."""
+    """(t, x rows, {method, loop, _extra}) of a run of ``method`` (not ``auto``: :func:`chosen_method` resolves it)
+    from x0, sampled at ``samples`` equally spaced times; ``_extra`` integrals of the energy balance
+    (mechgen.analyses.energy_balance) follow the state in each row where the run integrates them."""
     from mechgen.analyses.simulate import refuse_explicit_stiff
     from mechgen.runtime.core.smooth_c import integrate_smooth_c, smooth_loop_problem
 
     t_end = float(options["t_end"])
     refuse_explicit_stiff(system, x0, t_end, method, budget)
+    extra = energy_balance.EXTRA if energy_balance.accounted(system, method) else 0
+    x0 = np.concatenate([x0, np.zeros(extra)])
     n_out = int(options.get("samples", 201))
     require(dense_bytes(n_out, 3 * x0.size + 6), f"{n_out} output samples", key="samples")
     t_eval = np.linspace(0.0, t_end, max(n_out, 2))
@@ -70,10 +74,10 @@ def adaptive_run(system, options: dict, x0: np.ndarray, method: str, budget: Bud
                   explain=lambda t, x: explain_state(system, t, x))
     loop = options.get("loop", "auto")
     if method == "DOP853" and loop != "python":
-        why = smooth_loop_problem(system, rtol, atol)
+        why = smooth_loop_problem(system, rtol, atol, extra)
         if why is None:
-            t, X, _ = integrate_smooth_c(system, x0, t_end, rtol=rtol, atol=atol, **common)
-            return t, X, {"method": method, "loop": "c"}
+            t, X, _ = integrate_smooth_c(system, x0, t_end, rtol=rtol, atol=atol, extra=extra, **common)
+            return t, X, {"method": method, "loop": "c", "_extra": extra}
         if loop == "c":
             raise InputError(f"loop 'c' cannot run here: {why}", key="loop",
                              expected="method DOP853 (or auto) on the C backend with a C compiler, or loop "
@@ -81,10 +85,11 @@ def adaptive_run(system, options: dict, x0: np.ndarray, method: str, budget: Bud
     if method == "cvodes":
         traj = cvodes_run(system, x0, t_end, options, common)
     else:
-        traj = integrate_first_order(system.rhs, x0, t_end, jac=system.jacobian, method=method, rtol=rtol,
+        flow = energy_balance.AugmentedFlow(system) if extra else system
+        traj = integrate_first_order(flow.rhs, x0, t_end, jac=flow.jacobian, method=method, rtol=rtol,
                                      atol=atol, **common)
     xs = traj.x if traj.x.shape[0] == len(traj.t) else traj.x.T
-    return np.asarray(traj.t, float), np.asarray(xs, float), {"method": method, "loop": "python"}
+    return np.asarray(traj.t, float), np.asarray(xs, float), {"method": method, "loop": "python", "_extra": extra}
 
 
 def cvodes_run(system, x0, t_end: float, options: dict, common: dict):

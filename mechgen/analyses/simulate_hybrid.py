@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from mechgen.analyses import time_series
 from mechgen.analyses.context import NAME
 from mechgen.errors import SceneError
 from mechgen.runtime.core.diagnose import explain_state
@@ -65,8 +66,9 @@ def run_hybrid(system, options: dict, context: dict) -> dict:
     require(dense_bytes(n_out, 3 * x0.size + 6), f"{n_out} output samples", key="samples")
     traj, zeno, method = hybrid_run(system, options, x0, context.get(NAME, "simulate"))
     t, X, modes = with_final(traj)
-    outputs = mode_outputs(system)
-    out = report(system, options, t, X, lambda k, tk, x: outputs(int(modes[k]), x, tk))
+    views: dict = {}
+    mode_system = lambda k: views.setdefault(k, system.mode(k))  # noqa: E731
+    out = report(system, options, t, X, time_series.sampled_outputs_by_mode(mode_system, t, X, modes))
     out["t_final"] = float(traj.t_final)
     out["events"] = event_log(system, traj.events)
     out["final_mode"] = system.modes[traj.final_mode]
@@ -111,15 +113,3 @@ def with_final(traj) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         return t, X, modes
     return (np.append(t, traj.t_final), np.vstack([X.reshape(len(t), -1), traj.x_final[None, :]]),
             np.append(modes, traj.final_mode))
-
-
-def mode_outputs(system):
-    """outputs(mode index, x, t): the model's outputs at a state of a mode (the mode's view built once)."""
-    n, views = system.n, {}
-
-    def outputs(k: int, x: np.ndarray, t: float) -> dict:
-        if k not in views:
-            views[k] = system.mode(k)
-        return views[k].outputs(x[:n], x[n:2 * n], x[2 * n:] if system.m else None, t)
-
-    return outputs

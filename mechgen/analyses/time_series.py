@@ -13,7 +13,7 @@
 """
 from __future__ import annotations
 
-from typing import Callable, Sequence
+from typing import Sequence
 
 import numpy as np
 
@@ -41,12 +41,25 @@ def keep_series(options: dict, states: int, outputs: int, samples: int) -> tuple
                    f"values, more than {SERIES_VALUES:.0e}; series = true keeps it")
 
 
-def sampled_outputs(outputs_at: Callable[[int, float, np.ndarray], dict], t: np.ndarray,
-                    X: np.ndarray) -> dict[str, np.ndarray]:
-    """Each model output at every sample: ``outputs_at(k, t_k, x_k)`` (k: the sample's index) as columns."""
-    rows = [outputs_at(k, float(tk), x) for k, (tk, x) in enumerate(zip(t, X))]
-    names = list(rows[0]) if rows else []
-    return {name: np.array([r[name] for r in rows], float) for name in names}
+def sampled_outputs(system, t: np.ndarray, X: np.ndarray) -> dict[str, np.ndarray]:
+    """Each model output at every sample (row k of X: the state at t[k]) as arrays: one batched kernel call where
+    the system has one (System.outputs_series), else one call a sample."""
+    if hasattr(system, "outputs_series"):
+        return system.outputs_series(t, X)
+    n, m = system.n, system.m
+    rows = [system.outputs(x[:n], x[n:2 * n], x[2 * n:] if m else None, float(tk)) for tk, x in zip(t, X)]
+    return {name: np.array([r[name] for r in rows], float) for name in (rows[0] if rows else {})}
+
+
+def sampled_outputs_by_mode(mode_system, t: np.ndarray, X: np.ndarray, modes: np.ndarray) -> dict[str, np.ndarray]:
+    """:func:`sampled_outputs` of a hybrid run: each sample's outputs in its own mode (``mode_system(k)``: the
+    system of mode k), the samples of one mode in one call."""
+    out: dict[str, np.ndarray] = {}
+    for k in np.unique(modes):
+        rows = np.flatnonzero(modes == k)
+        for name, values in sampled_outputs(mode_system(int(k)), t[rows], X[rows]).items():
+            out.setdefault(name, np.full(len(t), np.nan))[rows] = values
+    return out
 
 
 def energy_drift(series: dict[str, np.ndarray]) -> float:

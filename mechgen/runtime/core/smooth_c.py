@@ -28,9 +28,13 @@ class SmoothView:
     is_lattice = False
     is_field = False
 
-    def __init__(self, system) -> None:
+    def __init__(self, system, extra: int = 0) -> None:
         self.system = system
         self.kernels = {f"{k}__0": system.kernels[k] for k in LOOP_KERNELS if k in system.kernels}
+        self.m = system.m
+        if extra:  # internal variables followed by integrated quantities: the energy_rates kernel's g
+            self.kernels["rates__0"] = system.kernels["energy_rates"]
+            self.m = system.m + extra
         self.patterns: dict = {}  # the loop's memo (its tables), this view's own
 
     def __getattr__(self, name: str):  # n, m, params, metadata, backend: the system's
@@ -43,15 +47,16 @@ class SmoothView:
         return self.system
 
 
-def view_of(system) -> SmoothView:
-    """The system's loop view, made once per system (a memo of its frozen kernels)."""
-    key = ("c_loop", "smooth_view")
+def view_of(system, extra: int = 0) -> SmoothView:
+    """The system's loop view, made once per system (a memo of its frozen kernels); ``extra`` > 0: the state
+    carries that many integrals after the internal variables, their rates from the ``energy_rates`` kernel."""
+    key = ("c_loop", "smooth_view", extra)
     if key not in system.patterns:
-        system.patterns[key] = SmoothView(system)
+        system.patterns[key] = SmoothView(system, extra)
     return system.patterns[key]
 
 
-def smooth_loop_problem(system, rtol=1e-8, atol=1e-10) -> str | None:
+def smooth_loop_problem(system, rtol=1e-8, atol=1e-10, extra: int = 0) -> str | None:
     """Why the compiled loop cannot integrate ``system`` (None when it can): a smooth lumped system on the C
     backend, scalar tolerances, a C compiler for the loop's own library."""
     from mechgen.runtime.core.events_c import c_loop_problem
@@ -66,16 +71,17 @@ def smooth_loop_problem(system, rtol=1e-8, atol=1e-10) -> str | None:
                if k not in system.kernels]
     if missing:
         return f"the system has no {', '.join(missing)} kernel"
-    return c_loop_problem(view_of(system), "DOP853", rtol, atol)
+    return c_loop_problem(view_of(system, extra), "DOP853", rtol, atol)
 
 
 def integrate_smooth_c(system, x0, t_end: float, *, rtol: float = 1e-8, atol: float = 1e-10, t_eval=None,
                        budget=None, progress: bool = False, desc: str = "simulate",
-                       explain=None) -> tuple[np.ndarray, np.ndarray, dict]:
+                       explain=None, extra: int = 0) -> tuple[np.ndarray, np.ndarray, dict]:
     """(t, x rows at ``t_eval``, counts {steps, nfev}) of a smooth lumped system integrated by the compiled
-    DOP853 loop (module doc); failures raise the exceptions (and messages) of the event loop."""
+    DOP853 loop (module doc; ``extra``: :func:`view_of`); failures raise the exceptions (and messages) of the
+    event loop."""
     from mechgen.runtime.core.events_c import integrate_hybrid_c
 
-    traj = integrate_hybrid_c(view_of(system), x0, t_end, mode=0, rtol=rtol, atol=atol, t_eval=t_eval,
+    traj = integrate_hybrid_c(view_of(system, extra), x0, t_end, mode=0, rtol=rtol, atol=atol, t_eval=t_eval,
                               budget=budget, progress=progress, desc=desc, explain=explain)
     return traj.t, traj.x, {"steps": traj.steps, "nfev": traj.nfev}
