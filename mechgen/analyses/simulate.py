@@ -244,7 +244,8 @@ def run_simulate(system, options: dict, context: dict) -> dict:
         start = declared_start(system)
         x0 = np.concatenate([q0, v0, np.zeros(system.m) if start is None else start[2 * system.n:]])
         if method == "auto":
-            method = simulate_flow.chosen_method(system, x0, float(options["t_end"]))
+            limit = budget_of(options, "DOP853").limit
+            method = simulate_flow.chosen_method(system, x0, float(options["t_end"]), limit)
         t, X, how = simulate_flow.adaptive_run(system, options, x0, method, budget_of(options, method), desc)
     n = system.n
     extra = how.pop("_extra", 0)
