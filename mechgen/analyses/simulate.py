@@ -44,6 +44,7 @@ from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget, BudgetExceeded
 from mechgen.runtime.core.diagnose import explain_state
 from mechgen.runtime.core.integrate import MIN_RTOL, integrate_first_order, leapfrog
 from mechgen.runtime.core.memory import dense_bytes, require
+from mechgen.runtime.core.splitting import require_separable
 from mechgen.runtime.linear.modes import modes as solve_modes
 from mechgen.scene.values import fail, listing, show, type_name
 
@@ -53,6 +54,9 @@ STEP = "a number > 0 (or an expression)"
 DEFAULT_STEPS = {"leapfrog": 10_000_000, "adaptive": 100_000}
 #: stability intervals of the explicit methods, doubled (RK45: ~3.3, DOP853: ~6): steps >= t_end |lambda| / c
 EXPLICIT_REACH = {"RK45": 7.0, "DOP853": 12.0}
+#: what a model unfit for the leapfrog uses instead (mechgen.runtime.core.splitting.require_separable)
+INSTEAD = ("method = 'variational' (a variational integrator of the model's own Lagrangian, any kinetic energy), "
+           "or an implicit method ('Radau', 'BDF')")
 #: the explicit methods' up-front stiffness estimate is made for first-order states up to this size
 ESTIMATE_SIZE = 400
 
@@ -240,6 +244,7 @@ def run_simulate(system, options: dict, context: dict) -> dict:
     desc = context.get(NAME, "simulate")
     energy = lambda q, v: system.outputs(q, v)["energy"]  # noqa: E731
     if method == "leapfrog":
+        require_separable(system, "method", "method 'leapfrog'", INSTEAD)
         dt = float(options["dt"])
         steps = int(round(t_end / dt))
         budget.refuse(steps, f"nothing (refused before starting: t_end / dt = {steps:,} steps)")

@@ -31,7 +31,7 @@ from mechgen.analyses import schema, summary
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import REQUIRED, Option
 from mechgen.errors import SceneError
-from mechgen.runtime.core.splitting import METHODS
+from mechgen.runtime.core.splitting import METHODS, require_separable
 from mechgen.scene.values import fail
 
 STEP = "a number > 0 (or an expression)"
@@ -104,6 +104,8 @@ def run_symplectic(system, options: dict, context: dict) -> dict:
     if not system.is_lattice:
         raise SceneError(f"model {system.metadata.model} is not a chain", key="kind",
                          expected="a chain model (Model.chain) for the symplectic kind")
+    require_separable(system, "integrator", f"integrator '{options.get('integrator', 'leapfrog')}'",
+                      "kind = 'simulate' with method = 'variational' (any kinetic energy), or an implicit method")
     split = method(options.get("integrator", "leapfrog"))
     dt, t_end = float(options["dt"]), float(options["t_end"])
     steps = int(round(t_end / dt))
