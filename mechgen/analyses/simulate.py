@@ -1,8 +1,11 @@
 """``simulate``: the time response from an initial state.
 
 Scene keys: ``t_end`` (required), ``method`` (BDF, Radau, LSODA, RK45, DOP853, ``leapfrog`` with a
-step ``dt``, or ``cvodes``: SUNDIALS' variable-order BDF with the exact Jacobian, compiled through CasADi,
-for a lumped model built with ``backend = "casadi"``: mechgen.runtime.core.sundials), ``rtol``, ``atol``, ``q0`` / ``v0`` (tables of coordinates), ``initial_mode`` with
+step ``dt`` (a model whose equations are q'' = M^-1 (-dV/dq) with a constant diagonal M only, else refused at
+``method``: mechgen.runtime.core.splitting.require_separable), ``cvodes``: SUNDIALS' variable-order BDF with the
+exact Jacobian, compiled through CasADi, for a lumped model built with ``backend = "casadi"``:
+mechgen.runtime.core.sundials, or ``variational`` with ``dt`` and ``stages``: the variational integrator of
+the model's own Lagrangian, mechgen.analyses.simulate_variational), ``rtol``, ``atol``, ``q0`` / ``v0`` (tables of coordinates), ``initial_mode`` with
 ``amplitude`` (start from a linear mode), ``outputs`` (which model outputs to report), ``series``
 (also report ``t`` and ``energy_series``), ``samples``. Outputs: the model's outputs at ``t_end``,
 ``energy_drift``, ``t_end``; a fixed-end chain also ``mode_energies``. A model with modes is run by
@@ -39,6 +42,7 @@ from mechgen.analyses.context import NAME
 from mechgen.analyses.operating_point import vector
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import ABSENT, ALL_OUTPUTS, REQUIRED, Option
+from mechgen.analyses.simulate_variational import check_variational, simulate_variational
 from mechgen.errors import ConvergenceError, InputError, SceneError
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget, BudgetExceeded
 from mechgen.runtime.core.diagnose import explain_state
@@ -48,7 +52,9 @@ from mechgen.runtime.core.splitting import require_separable
 from mechgen.runtime.linear.modes import modes as solve_modes
 from mechgen.scene.values import fail, listing, show, type_name
 
-METHODS = ("BDF", "Radau", "LSODA", "RK45", "DOP853", "leapfrog", "cvodes")
+METHODS = ("BDF", "Radau", "LSODA", "RK45", "DOP853", "leapfrog", "cvodes", "variational")
+#: the fixed-step methods (a dt, a step budget refused up front)
+FIXED_STEP = ("leapfrog", "variational")
 STEP = "a number > 0 (or an expression)"
 #: default max_steps: the leapfrog's fixed steps, the adaptive methods' accepted steps
 DEFAULT_STEPS = {"leapfrog": 10_000_000, "adaptive": 100_000}
@@ -108,12 +114,14 @@ SCHEMA = {"t_end": Option(schema.positive, REQUIRED, STEP), "method": Option(_me
           "max_steps": Option(schema.count, ABSENT), "max_seconds": Option(schema.positive, ABSENT),
           "progress": Option(schema.boolean, ABSENT), "mode": Option(_mode, ABSENT),
           "max_events": Option(schema.count, ABSENT), "zeno_events": Option(schema.count, ABSENT),
-          "zeno_span": Option(schema.positive, ABSENT), "loop": Option(_loop, ABSENT)}
+          "zeno_span": Option(schema.positive, ABSENT), "loop": Option(_loop, ABSENT),
+          "stages": Option(schema.count, ABSENT)}
 
 
 def check(ctx, base: str, options: dict) -> None:
-    """leapfrog needs dt; dt <= t_end; initial_mode within the coordinates; rtol at least MIN_RTOL."""
-    if options["method"] != "leapfrog" and options["rtol"] < MIN_RTOL:
+    """leapfrog and variational need dt (variational: a smooth lumped model, ``stages``); dt <= t_end; initial_mode within the coordinates; rtol at least MIN_RTOL."""
+    check_variational(ctx, base, options)
+    if options["method"] not in FIXED_STEP and options["rtol"] < MIN_RTOL:
         raise fail(ctx.file, f"{base}.rtol", f"rtol {options['rtol']!r} is below what the integrators can honour "
                    "in double precision", f"a relative tolerance >= {MIN_RTOL:.3g} (100 machine epsilons)")
     if options["method"] == "cvodes" and getattr(ctx.model, "modes", ()):
@@ -134,6 +142,8 @@ def needs(options: dict, *, internal: bool) -> set[str]:
     if options.get("method") == "leapfrog":
         return {"force", "outputs", "linear"}
     start = {"linear"} if options.get("initial_mode") else set()
+    if options.get("method") == "variational":
+        return {"lagrangian", "outputs"} | start
     return {"residual", "tangent", "outputs"} | start | ({"rates", "rates_tangent"} if internal else set())
 
 
@@ -180,8 +190,8 @@ def mode_energies(system, q: np.ndarray, v: np.ndarray, count: int = 8) -> list[
 
 def budget_of(options: dict, method: str) -> Budget:
     """The run's work budget: ``max_steps`` (default DEFAULT_STEPS of the method) and ``max_seconds``."""
-    steps = options.get("max_steps", DEFAULT_STEPS["leapfrog" if method == "leapfrog" else "adaptive"])
-    what = "leapfrog steps" if method == "leapfrog" else f"{method} steps"
+    steps = options.get("max_steps", DEFAULT_STEPS["leapfrog" if method in FIXED_STEP else "adaptive"])
+    what = f"{method} steps"
     return Budget(what, limit=int(steps), key="max_steps", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
 
 
@@ -255,6 +265,9 @@ def run_simulate(system, options: dict, context: dict) -> dict:
                         desc=desc)
         q_end, v_end, ts, energies = traj.q[-1], traj.v[-1], traj.t, np.asarray(traj.energy)
         z_end = None
+    elif method == "variational":
+        traj = simulate_variational(system, q0, v0, options, budget, progress, desc)
+        q_end, v_end, ts, energies, z_end = traj.q[-1], traj.v[-1], traj.t, traj.energy, None
     else:
         start = declared_start(system)
         x0 = np.concatenate([q0, v0, np.zeros(system.m) if start is None else start[2 * system.n:]])

@@ -8,6 +8,9 @@ Kernel names and what they compute (n coordinates, m internal variables):
 * ``force``     -dV/dq                                 -> f[n]  (meta ``separable``: fit for the splittings,
                 mechgen.symbolic.separable; ``separable_why``: why not)
 * ``rates``     dz/dt = g(q, v, z, t)                  -> g[m]
+* ``lagrangian`` p = dT/dv, F = dL/dq + Q - dR/dv at (q, v, t) and their Jacobians (LumpedEquations.lagrangian)
+                                                       -> p[n], F[n], p_q, p_v, F_q, F_v [n*n]
+                (a smooth model without internal variables: the variational integrator's dp/dt = F)
 * ``rates_tangent``                                    -> g_q[m*n], g_v[m*n], g_z[m*m]
 * ``outputs``   declared outputs and energies          -> one port of length 1 each
 * ``section``   the declared section stiffness K(p)    -> K[36] (6 x 6, symmetric; Model.section_stiffness)
@@ -29,7 +32,8 @@ from mechgen.errors import ModelError
 from mechgen.symbolic.derive import LumpedEquations
 from mechgen.symbolic.separable import separable_obstacle
 
-LUMPED_KERNELS = ("residual", "tangent", "linear", "force", "rates", "rates_tangent", "outputs", "section", "rod")
+LUMPED_KERNELS = ("residual", "tangent", "linear", "force", "rates", "rates_tangent", "outputs", "section", "rod",
+                  "lagrangian")
 
 
 def _inputs(eqs: LumpedEquations, with_accel: bool = True) -> tuple[list[Port], list]:
@@ -95,6 +99,9 @@ def lower_lumped(eqs: LumpedEquations, name: str, *, cse: bool = True) -> Kernel
                                  eqs.coordinates)
         return _matrix_kernel(eqs, name, "potential force -dV/dq", {"f": eqs.force()}, accel=False, cse=cse,
                               extra=separable_meta(why))
+    if name == "lagrangian":
+        return _matrix_kernel(eqs, name, "momentum p = dT/dv, force F = dL/dq + Q - dR/dv and their Jacobians",
+                              eqs.lagrangian(), accel=False, cse=cse)
     if name == "rates":
         return _matrix_kernel(eqs, name, "internal rates dz/dt", {"g": eqs.rates}, accel=False, cse=cse)
     if name == "rates_tangent":
