@@ -9,7 +9,7 @@ Kernel names and what they compute (n coordinates, m internal variables):
                 mechgen.symbolic.separable; ``separable_why``: why not)
 * ``rates``     dz/dt = g(q, v, z, t)                  -> g[m]
 * ``lagrangian`` p = dT/dv, F = dL/dq + Q - dR/dv at (q, v, t) and their Jacobians (LumpedEquations.lagrangian)
-                                                       -> p[n], F[n], p_q, p_v, F_q, F_v [n*n]
+                                                       -> mom[n] (p), F[n], mom_q, mom_v, F_q, F_v [n*n]
                 (a smooth model without internal variables: the variational integrator's dp/dt = F)
 * ``rates_tangent``                                    -> g_q[m*n], g_v[m*n], g_z[m*m]
 * ``outputs``   declared outputs and energies          -> one port of length 1 each

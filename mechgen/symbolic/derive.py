@@ -82,13 +82,14 @@ class LumpedEquations:
             p = dT/dv (the momentum dL/dv, L = T - V),
             F = dL/dq + Q - dR/dv = -r(q, v, 0, z, t) + (dp/dq) v + dp/dt,
 
-        so that Lagrange's equations read dp/dt = F; ``p_q, p_v, F_q, F_v`` are d(p, F)/d(q, v).
+        so that Lagrange's equations read dp/dt = F. Keys ``mom`` (p: the parameters' port is named p), ``F`` and
+        their Jacobians ``mom_q, mom_v, F_q, F_v`` = d(p, F)/d(q, v).
         """
         v = sp.Matrix(self.v)
         p = sp.Matrix([sp.diff(self.kinetic, s) for s in self.v])
         p_q = self.jacobian(p, "q")
         F = -self.residual.subs({ai: 0 for ai in self.a}) + p_q * v + p.diff(TIME)
-        return {"p": p, "F": F, "p_q": p_q, "p_v": self.jacobian(p, "v"), "F_q": self.jacobian(F, "q"),
+        return {"mom": p, "F": F, "mom_q": p_q, "mom_v": self.jacobian(p, "v"), "F_q": self.jacobian(F, "q"),
                 "F_v": self.jacobian(F, "v")}
 
     def force(self) -> sp.Matrix:

@@ -4,7 +4,8 @@ The model's ``lagrangian`` kernel (mechgen.codegen.lower_lumped) gives, at (q, v
 
     p = dL/dv = dT/dv,    F = dL/dq + Q - dR/dv    (Lagrange's equations: dp/dt = F),
 
-and their Jacobians p_q, p_v, F_q, F_v, all derived from the declared T, V, R and forces Q.
+and their Jacobians p_q, p_v, F_q, F_v, all derived from the declared T, V, R and forces Q (the kernel's ports
+``mom``, ``F``, ``mom_q``, ``mom_v``, ``F_q``, ``F_v``: ``p`` is the parameters' input).
 
 **Midpoint** (``stages = 1``, order 2). The discrete Lagrangian of one step h from q_k to q_{k+1} is
 
@@ -105,8 +106,8 @@ class Lagrangian:
         """(p, F, p_q, p_v, F_q, F_v) at (q, v, t)."""
         out = self.system.bound("lagrangian").evaluate(q=q, v=v, t=t)
         n = self.n
-        return (out["p"].reshape(n).copy(), out["F"].reshape(n).copy(), out["p_q"].reshape(n, n).copy(),
-                out["p_v"].reshape(n, n).copy(), out["F_q"].reshape(n, n).copy(), out["F_v"].reshape(n, n).copy())
+        return (out["mom"].reshape(n).copy(), out["F"].reshape(n).copy(), out["mom_q"].reshape(n, n).copy(),
+                out["mom_v"].reshape(n, n).copy(), out["F_q"].reshape(n, n).copy(), out["F_v"].reshape(n, n).copy())
 
     def momentum(self, q: np.ndarray, v: np.ndarray, t: float) -> np.ndarray:
         """p = dL/dv at (q, v, t)."""

@@ -26,7 +26,7 @@ log = logging.getLogger("mechgen")
 SOURCE = Path(__file__).resolve().parent.parent.parent / "codegen" / "templates" / "c99" / "variational_loop.c"
 STEM = "mgvariational"
 INPUTS = ["q", "v", "z", "t", "p"]
-OUTPUTS = ["p", "F", "p_q", "p_v", "F_q", "F_v"]
+OUTPUTS = ["mom", "F", "mom_q", "mom_v", "F_q", "F_v"]
 c_long, c_double, c_void_p = ctypes.c_long, ctypes.c_double, ctypes.c_void_p
 LONG = np.dtype(f"i{ctypes.sizeof(c_long)}")
 
@@ -55,7 +55,7 @@ def c_unavailable(system) -> str | None:
     if kernel.address is None:
         return f"kernel lagrangian has no C function address (backend {kernel.backend})"
     if [p["name"] for p in kernel.spec["inputs"]] != INPUTS or [p["name"] for p in kernel.spec["outputs"]] != OUTPUTS:
-        return "kernel lagrangian has other ports than (q, v, z, t, p) -> (p, F, p_q, p_v, F_q, F_v)"
+        return "kernel lagrangian has other ports than (q, v, z, t, p) -> (mom, F, mom_q, mom_v, F_q, F_v)"
     if system.m:
         return "the system has internal variables"
     return _library()[1]

@@ -11,7 +11,8 @@
  * evaluated last is accepted, and q_{k+1} = q_k + h sum_i b_i V_i, p_{k+1} = p_k + h sum_i b_i F_i.
  * p, F and their Jacobians come from the model's own compiled ``lagrangian`` kernel, called through its address
  * with the mechgen ABI int mg_NAME(const double *const *in, double *const *out, const long *sizes, long nbatch);
- * inputs (q, v, z, t, p) (z empty), outputs (p, F, p_q, p_v, F_q, F_v), matrices row-major n x n.
+ * inputs (q, v, z, t, p) (z empty, p the parameters), outputs (mom = p, F, mom_q = p_q, mom_v = p_v, F_q, F_v),
+ * matrices row-major n x n.
  *
  * Entry point: mgv_run(...) advances ``steps`` steps from global step k0 (t = (k0 + j) h) and copies q, p and
  * the velocity guess sum_i b_i V_i into the records after every global step that is a multiple of save_every
