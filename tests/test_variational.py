@@ -448,3 +448,14 @@ def test_every_backend_gives_the_same_run(folder):
                                q0={"r": 1.3, "theta": 1.0}).outputs
         ends.append(np.array([out["radius"], out["angle"], out["energy"]]))
     assert np.max(np.abs(ends[1] - ends[0])) < 1e-12 and np.max(np.abs(ends[2] - ends[0])) < 1e-12
+
+
+def test_a_coordinate_without_inertia_is_named(folder, tmp_path):
+    """m = 0 makes dp/dv singular: the run ends with a ConvergenceError saying so (at the start's inverse Legendre
+    transform, whichever loop is asked for), not a LinAlgError traceback."""
+    from mechgen.errors import ConvergenceError
+
+    system = mechgen.compile(str(folder / "oscillator.py"), {"m": 0.0}, backend="c", kernels=["lagrangian", "outputs"])
+    for loop in ("c", "python"):
+        with pytest.raises(ConvergenceError, match="singular"):
+            run_variational(system, [1.0], [0.0], 1.0, 0.1, loop=loop)

@@ -127,7 +127,7 @@ def legendre_velocity(lag: Lagrangian, q: np.ndarray, p: np.ndarray, t: float, g
     previous = math.inf
     for _ in range(MAX_NEWTON):
         mom, _, _, p_v, _, _ = lag(q, v, t)
-        step = np.linalg.solve(p_v, mom - p)
+        step = solve(p_v, mom - p, t)
         v -= step
         if converged(step, previous, max(float(np.max(np.abs(v))), 1e-300)):
             return v
@@ -164,7 +164,7 @@ def step(lag: Lagrangian, tab: Tableau, h: float, q: np.ndarray, p: np.ndarray, 
     previous = math.inf
     for it in range(1, MAX_NEWTON + 1):
         R, J, F = stage_system(lag, tab, h, q, p, t, V)
-        delta = np.linalg.solve(J, R).reshape(V.shape)
+        delta = solve(J, R, t).reshape(V.shape)
         if not np.all(np.isfinite(delta)):
             raise nonfinite(t)
         if converged(delta, previous, max(float(np.max(np.abs(V))), 1e-300)) or not np.any(delta):
@@ -172,6 +172,21 @@ def step(lag: Lagrangian, tab: Tableau, h: float, q: np.ndarray, p: np.ndarray, 
         V -= delta
         previous = float(np.max(np.abs(delta)))
     raise newton_failure(t, h)
+
+
+def solve(J: np.ndarray, r: np.ndarray, t: float) -> np.ndarray:
+    """J^-1 r; a singular J (a coordinate without inertia: dp/dv singular) is a ConvergenceError naming t."""
+    try:
+        return np.linalg.solve(J, r)
+    except np.linalg.LinAlgError:
+        raise singular(t) from None
+
+
+def singular(t: float) -> ConvergenceError:
+    """The error of a singular Newton matrix."""
+    return ConvergenceError(f"variational: the Newton matrix of the step from t = {t:.6g} is singular (the mass "
+                            "matrix dp/dv is singular: a coordinate without inertia? The variational integrator "
+                            "needs a regular Lagrangian)")
 
 
 def newton_failure(t: float, h: float) -> ConvergenceError:

@@ -19,7 +19,8 @@ from typing import Callable
 import numpy as np
 
 from mechgen.errors import BuildError, CompilerUnavailable, KernelError
-from mechgen.runtime.core.variational import MAX_NEWTON, NEWTON_RTOL, STALL, Tableau, newton_failure, nonfinite
+from mechgen.runtime.core.variational import (MAX_NEWTON, NEWTON_RTOL, STALL, Tableau, newton_failure, nonfinite,
+                                              singular)
 
 log = logging.getLogger("mechgen")
 
@@ -90,8 +91,10 @@ def compiled_stepper(system, tab: Tableau, h: float, *, required: bool = False) 
                          NEWTON_RTOL, STALL, MAX_NEWTON, _ptr(q), _ptr(p), _ptr(V), _ptr(work), _ptr(piv), _ptr(rq),
                          _ptr(rp), _ptr(rv), _ptr(rt), _ptr(nrec), _ptr(done), _ptr(newton))
         t = (k0 + int(done[0])) * h
-        if rc in (-1, -3):
+        if rc == -1:
             raise nonfinite(t)
+        if rc == -3:
+            raise singular(t)
         if rc == -2:
             raise newton_failure(t, h)
         if rc:
