@@ -459,3 +459,10 @@ def test_a_coordinate_without_inertia_is_named(folder, tmp_path):
     for loop in ("c", "python"):
         with pytest.raises(ConvergenceError, match="singular"):
             run_variational(system, [1.0], [0.0], 1.0, 0.1, loop=loop)
+
+
+def test_leapfrog_refuses_internal_variables_at_load(folder, tmp_path, capsys):
+    """The leapfrog steps no internal variable: a model with one is refused when the scene loads (exit 2)."""
+    text = SCENE.format(model=folder / "sls.py").replace('"variational"', '"leapfrog"') + "dt = 0.01\n"
+    code, _, err = run_here(tmp_path / "bad.toml", text, capsys)
+    assert code == 2 and ".method'" in err and "internal variables" in err

@@ -42,7 +42,7 @@ from mechgen.analyses.context import NAME
 from mechgen.analyses.operating_point import vector
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import ABSENT, ALL_OUTPUTS, REQUIRED, Option
-from mechgen.analyses.simulate_variational import check_variational, simulate_variational
+from mechgen.analyses.simulate_variational import check_fixed_step, simulate_variational
 from mechgen.errors import ConvergenceError, InputError, SceneError
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget, BudgetExceeded
 from mechgen.runtime.core.diagnose import explain_state
@@ -120,7 +120,7 @@ SCHEMA = {"t_end": Option(schema.positive, REQUIRED, STEP), "method": Option(_me
 
 def check(ctx, base: str, options: dict) -> None:
     """leapfrog and variational need dt (variational: a smooth lumped model, ``stages``); dt <= t_end; initial_mode within the coordinates; rtol at least MIN_RTOL."""
-    check_variational(ctx, base, options)
+    check_fixed_step(ctx, base, options)
     if options["method"] not in FIXED_STEP and options["rtol"] < MIN_RTOL:
         raise fail(ctx.file, f"{base}.rtol", f"rtol {options['rtol']!r} is below what the integrators can honour "
                    "in double precision", f"a relative tolerance >= {MIN_RTOL:.3g} (100 machine epsilons)")

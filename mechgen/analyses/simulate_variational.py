@@ -5,7 +5,7 @@ midpoint discrete Lagrangian L_d(q_k, q_{k+1}) = h L((q_k + q_{k+1})/2, (q_{k+1}
 order 2), or of its Gauss-Legendre generalisation (``stages = 2`` or ``3``: orders 4 and 6), with the forces
 and Rayleigh dissipation by the discrete Lagrange-d'Alembert principle, each step solved by Newton with the
 Jacobians of the generated ``lagrangian`` kernel. Any kinetic energy T(q, v, t) is served; a smooth lumped
-model without internal variables only (check_variational: a model with modes, internal variables, a chain or a
+model without internal variables only (check_fixed_step: a model with modes, internal variables, a chain or a
 continuum is refused at ``method``, exit 2).
 
 Keys: ``dt`` (required: the step is h = t_end / ceil(t_end / dt) <= dt, so that t_end is reached exactly),
@@ -22,10 +22,15 @@ from mechgen.runtime.core.variational import STAGES, VariationalRun, run_variati
 from mechgen.scene.values import fail
 
 
-def check_variational(ctx, base: str, options: dict) -> None:
+def check_fixed_step(ctx, base: str, options: dict) -> None:
     """``method = "variational"`` needs a smooth lumped model without internal variables and a ``dt``;
-    ``stages`` belongs to it alone and is one of STAGES."""
+    ``stages`` belongs to it alone and is one of STAGES. ``leapfrog`` is refused here for a model with internal
+    variables (it steps none); whether its mass is constant and diagonal is known from the kernels only, at the
+    run's start (mechgen.runtime.core.splitting.require_separable)."""
     method = options["method"]
+    if method == "leapfrog" and ctx.model.internals and not ctx.model.chain:
+        raise fail(ctx.file, f"{base}.method", f"method 'leapfrog' steps q'' = M^-1 (-dV/dq) alone, and model "
+                   f"{ctx.model.name} has internal variables", "an implicit method ('Radau', 'BDF')")
     if "stages" in options:
         if method != "variational":
             raise fail(ctx.file, f"{base}.stages", f"'stages' is a key of method 'variational', not of {method!r}",

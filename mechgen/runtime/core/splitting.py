@@ -136,7 +136,9 @@ def splitting_refusal(system) -> str | None:
     no other term; a kernel that does not record it (built by an older mechgen) is not trusted either.
     """
     kernel = system.kernels.get("force")
-    meta = kernel.spec.get("meta", {}) if kernel is not None else {}
+    if kernel is None:
+        return "it has no potential force kernel (no coordinates?)"
+    meta = kernel.spec.get("meta", {})
     if "separable" not in meta:
         return "its force kernel does not record whether its kinetic energy is a constant diagonal quadratic form"
     if meta["separable"]:
