@@ -20,8 +20,6 @@
    * refusals (a hybrid model, internal variables, a chain, a missing or too large dt, unknown stages): exit 2.
 """
 import math
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -220,13 +218,6 @@ def triple(folder):
     return mechgen.compile(str(folder / "triple.py"), backend="c", kernels=["lagrangian", "outputs"])
 
 
-def run_scene(path, text: str) -> subprocess.CompletedProcess:
-    """``mechgen run`` of a scene in a process of its own: the exit code and the printed text."""
-    path.write_text(text)
-    return subprocess.run([sys.executable, "-m", "mechgen", "run", str(path)], capture_output=True, text=True,
-                          timeout=300)
-
-
 def run_here(path, text: str, capsys) -> tuple[int, str, str]:
     """``mechgen run`` of a scene in this process (the CLI's main): exit code, stdout, stderr."""
     path.write_text(text)
@@ -237,15 +228,15 @@ def run_here(path, text: str, capsys) -> tuple[int, str, str]:
 
 # --------------------------------------------------------------------------- 1. the splittings' refusal
 
-def test_leapfrog_refuses_the_triple_pendulum_at_method(folder, tmp_path):
+def test_leapfrog_refuses_the_triple_pendulum_at_method(folder, tmp_path, capsys):
     """M(q) of the triple pendulum depends on the angles: the leapfrog's division by diag(M(0)) would be wrong,
     so the scene ends with exit 2 at 'method', naming why and the methods to use instead."""
     scene = (f'model = "{folder / "triple.py"}"\n[[analysis]]\nname = "swing"\nkind = "simulate"\nt_end = 1.0\n'
              'method = "leapfrog"\ndt = 0.01\nq0 = { th1 = 1.0 }\n')
-    done = run_scene(tmp_path / "leap.toml", scene)
-    assert done.returncode == 2, done.stderr
-    assert "'method'" in done.stderr and "depends on th1, th2, th3" in done.stderr
-    assert "variational" in done.stderr and "Traceback" not in done.stderr
+    code, _, err = run_here(tmp_path / "leap.toml", scene, capsys)
+    assert code == 2, err
+    assert "'method'" in err and "depends on th1, th2, th3" in err
+    assert "variational" in err and "Traceback" not in err
     system = mechgen.compile(str(folder / "triple.py"), backend="numpy", kernels=["force", "outputs", "linear"])
     with pytest.raises(InputError) as info:
         mechgen.simulate(system, t_end=1.0, method="leapfrog", dt=0.01)
@@ -402,11 +393,11 @@ def test_chaotic_swing_energy_error_stays_at_the_truncation_level(triple):
 SCENE = 'model = "{model}"\n[[analysis]]\nname = "run"\nkind = "simulate"\nt_end = 2.0\nmethod = "variational"\n'
 
 
-def test_a_scene_runs_variational(folder, tmp_path):
-    done = run_scene(tmp_path / "ok.toml", SCENE.format(model=folder / "swing.py")
-                     + 'dt = 0.01\nstages = 2\nq0 = { r = 1.3, theta = 1.0 }\n')
-    assert done.returncode == 0, done.stderr
-    assert "energy_drift" in done.stdout and "radius" in done.stdout
+def test_a_scene_runs_variational(folder, tmp_path, capsys):
+    code, out, err = run_here(tmp_path / "ok.toml", SCENE.format(model=folder / "swing.py")
+                              + 'dt = 0.01\nstages = 2\nq0 = { r = 1.3, theta = 1.0 }\n', capsys)
+    assert code == 0, err
+    assert "energy_drift" in out and "radius" in out
 
 
 @pytest.mark.parametrize("model, extra, key, words", [

@@ -5,7 +5,8 @@ step ``dt`` (a model whose equations are q'' = M^-1 (-dV/dq) with a constant dia
 ``method``: mechgen.runtime.core.splitting.require_separable), ``cvodes``: SUNDIALS' variable-order BDF with the
 exact Jacobian, compiled through CasADi, for a lumped model built with ``backend = "casadi"``:
 mechgen.runtime.core.sundials, or ``variational`` with ``dt`` and ``stages``: the variational integrator of
-the model's own Lagrangian, mechgen.analyses.simulate_variational), ``rtol``, ``atol``, ``q0`` / ``v0`` (tables of coordinates), ``initial_mode`` with
+the model's own Lagrangian, mechgen.analyses.simulate_variational), ``rtol``, ``atol``, ``q0`` / ``v0`` (tables
+of coordinates), ``initial_mode`` with
 ``amplitude`` (start from a linear mode), ``outputs`` (which model outputs to report), ``series``
 (also report ``t`` and ``energy_series``), ``samples``. Outputs: the model's outputs at ``t_end``,
 ``energy_drift``, ``t_end``; a fixed-end chain also ``mode_energies``. A model with modes is run by
@@ -119,7 +120,8 @@ SCHEMA = {"t_end": Option(schema.positive, REQUIRED, STEP), "method": Option(_me
 
 
 def check(ctx, base: str, options: dict) -> None:
-    """leapfrog and variational need dt (variational: a smooth lumped model, ``stages``); dt <= t_end; initial_mode within the coordinates; rtol at least MIN_RTOL."""
+    """leapfrog and variational need dt (mechgen.analyses.simulate_variational.check_fixed_step); dt <= t_end;
+    initial_mode within the coordinates; rtol at least MIN_RTOL."""
     check_fixed_step(ctx, base, options)
     if options["method"] not in FIXED_STEP and options["rtol"] < MIN_RTOL:
         raise fail(ctx.file, f"{base}.rtol", f"rtol {options['rtol']!r} is below what the integrators can honour "

@@ -49,7 +49,8 @@ def check_fixed_step(ctx, base: str, options: dict) -> None:
         raise fail(ctx.file, f"{base}.method", f"method 'variational' needs a smooth lumped model, and model "
                    f"{model.name} is not one: {why}", "another method for this model")
     if "dt" not in options:
-        raise fail(ctx.file, f"{base}.dt", "method 'variational' needs a time step dt", "a number > 0 (or an expression)")
+        raise fail(ctx.file, f"{base}.dt", "method 'variational' needs a time step dt",
+                   "a number > 0 (or an expression)")
 
 
 def simulate_variational(system, q0: np.ndarray, v0: np.ndarray, options: dict, budget, progress: bool,

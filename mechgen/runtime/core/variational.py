@@ -287,7 +287,8 @@ class Recorder:
     def __init__(self, lag: Lagrangian, energy: Callable | None, steps: int, save_every: int, n: int) -> None:
         count = steps // save_every + 2
         self.lag, self.energy = lag, energy
-        self.t, self.q, self.v, self.p = np.empty(count), np.empty((count, n)), np.empty((count, n)), np.empty((count, n))
+        self.t = np.empty(count)
+        self.q, self.v, self.p = np.empty((count, n)), np.empty((count, n)), np.empty((count, n))
         self.e: list[float] = []
         self.k = 0
 

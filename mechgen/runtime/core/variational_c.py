@@ -98,7 +98,8 @@ def compiled_stepper(system, tab: Tableau, h: float, *, required: bool = False) 
         if rc == -2:
             raise newton_failure(t, h)
         if rc:
-            raise KernelError(f"variational loop: kernel lagrangian returned error code {rc} in the step from t = {t:.6g}")
+            raise KernelError(f"variational loop: kernel lagrangian returned error code {rc} in the step from "
+                              f"t = {t:.6g}")
         samples = [(float(rt[i]), rq[i], rp[i], rv[i]) for i in range(int(nrec[0]))]
         return q, p, V, int(newton[0]), samples
     return advance
