@@ -322,30 +322,45 @@ def test_central_force_keeps_angular_momentum_by_discrete_noether(folder, stages
 
 @pytest.mark.parametrize("stages, steps", [(1, [0.1, 0.05, 0.025]), (2, [0.2, 0.1, 0.05])])
 def test_damped_energy_decay_meets_the_closed_form_at_the_methods_order(folder, stages, steps):
-    """E(t = 10) of m x'' + c x' + k x = 0 (zeta = 0.1) against the closed form: the error falls as dt^(2 s)."""
-    system = mechgen.compile(str(folder / "oscillator.py"), backend="c", kernels=["lagrangian", "outputs"])
+    """E(t = 10) of m x'' + c x' + k x = 0 (zeta = 0.1) against the closed form, and the dissipated energy
+    E(0) - E(10): both errors fall as dt^(2 s)."""
+    system = mechgen.compile(str(folder / "oscillator.py"), backend="c",
+                             kernels=["lagrangian", "outputs", "energy_rates"])
     m, k, c, x0, t = 1.0, 4.0, 0.4, 1.0, 10.0
     w, zeta = math.sqrt(k / m), c / (2 * math.sqrt(k * m))
     wd = w * math.sqrt(1 - zeta**2)
     x = math.exp(-zeta * w * t) * (x0 * math.cos(wd * t) + zeta * w * x0 / wd * math.sin(wd * t))
     v = -math.exp(-zeta * w * t) * x0 * w**2 / wd * math.sin(wd * t)
     exact = m * v**2 / 2 + k * x**2 / 2
-    errors = [abs(mechgen.simulate(system, t_end=t, method="variational", dt=dt, stages=stages,
-                                   q0={"x": x0}).outputs["energy"] - exact) for dt in steps]
+    runs = [mechgen.simulate(system, t_end=t, method="variational", dt=dt, stages=stages, q0={"x": x0}).outputs
+            for dt in steps]
+    errors = [abs(out["energy"] - exact) for out in runs]
     slope = np.polyfit(np.log(steps), np.log(errors), 1)[0]
+    # the dissipated energy, integrated by the step's own quadrature, is E(0) - E(10) of the closed form
+    lost = [abs(out["dissipated"] - (k * x0**2 / 2 - exact)) for out in runs]
+    lost_slope = np.polyfit(np.log(steps), np.log(lost), 1)[0]
     print(f"damped oscillator, {stages} stage(s): E(10) = {exact:.6g}, errors {['%.2e' % e for e in errors]}, "
-          f"order {slope:.3f}")
+          f"order {slope:.3f}; dissipated errors {['%.2e' % e for e in lost]}, order {lost_slope:.3f}; "
+          f"balance error {['%.1e' % out['energy_balance_error'] for out in runs]}")
     assert abs(slope - 2 * stages) < 0.3  # asymptotic C dt^p (the same allowance as the order study)
+    assert abs(lost_slope - 2 * stages) < 0.3
+    assert "energy_drift" not in runs[0]  # a dissipative run reports its balance instead
 
 
-def test_compiled_and_python_loops_agree(triple):
+def test_compiled_and_python_loops_agree(triple, folder):
     """The C loop (variational_loop.c) and the Python stepper keep one set of rules: the same samples to
-    rounding (1e-12 after 500 Gauss steps of a large swing; LU here, LAPACK there)."""
+    rounding (1e-12 after 500 Gauss steps of a large swing; LU here, LAPACK there), and for the driven, damped
+    swing the same integrals of the energy balance (work, dissipated)."""
     runs = {loop: run_variational(triple, [1.5, 1.0, 0.5], [0.0, 0.0, 0.0], 5.0, 0.01, stages=2, save_every=50,
                                   loop=loop) for loop in ("c", "python")}
     assert runs["c"].loop == "c" and runs["python"].loop == "python"
     assert np.max(np.abs(runs["c"].q - runs["python"].q)) < 1e-12
     assert np.max(np.abs(runs["c"].v - runs["python"].v)) < 1e-12
+    swing = mechgen.compile(str(folder / "swing.py"), backend="c", kernels=["lagrangian", "outputs", "energy_rates"])
+    runs = {loop: run_variational(swing, [1.3, 1.0], [0.0, 0.5], 3.0, 0.01, stages=3, save_every=30, balance=True,
+                                  loop=loop) for loop in ("c", "python")}
+    assert np.max(np.abs(runs["c"].q - runs["python"].q)) < 1e-12
+    assert np.max(np.abs(runs["c"].w - runs["python"].w)) < 1e-12 and np.all(runs["c"].w[-1, :2] != 0.0)
 
 
 def triple_energy_run(system, q0, periods: float, dt: float, stages: int, samples: int = 20000):
@@ -397,7 +412,7 @@ def test_a_scene_runs_variational(folder, tmp_path, capsys):
     code, out, err = run_here(tmp_path / "ok.toml", SCENE.format(model=folder / "swing.py")
                               + 'dt = 0.01\nstages = 2\nq0 = { r = 1.3, theta = 1.0 }\n', capsys)
     assert code == 0, err
-    assert "energy_drift" in out and "radius" in out
+    assert "energy_balance_error" in out and "radius" in out  # a driven, damped run: its balance
 
 
 @pytest.mark.parametrize("model, extra, key, words", [

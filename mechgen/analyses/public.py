@@ -16,7 +16,7 @@ from typing import Any, Mapping
 from mechgen.analyses.registry import get, kinds
 from mechgen.analyses.result import Result, run_analysis
 from mechgen.analyses.schema import OptionContext, validate
-from mechgen.errors import InputError
+from mechgen.errors import InputError, did_you_mean
 
 __all__ = ["analysis", "campbell", "continuation", "fit", "impact", "modes", "restitution", "simulate", "stability",
            "steady", "sweep", "cross_section", "symplectic", "rod_statics",
@@ -61,7 +61,7 @@ def _check_keys(function: str, kind: str, options: Mapping[str, Any]) -> None:
     schema = get(kind).schema
     for key in options:
         if key not in schema:
-            raise InputError(f"{function}() got an unknown option {key!r}", key=key,
+            raise InputError(f"{function}() got an unknown option {key!r}{did_you_mean(key, schema)}", key=key,
                              expected=f"one of the {function}() options: " + ", ".join(schema))
 
 

@@ -9,8 +9,13 @@ model without internal variables only (check_fixed_step: a model with modes, int
 continuum is refused at ``method``, exit 2).
 
 Keys: ``dt`` (required: the step is h = t_end / ceil(t_end / dt) <= dt, so that t_end is reached exactly),
-``stages`` (1, 2 or 3; default 1), ``samples`` (about that many samples: every save_every = round(steps /
-(samples - 1)) steps, and the last), ``max_steps`` (default 10^7, refused before the first step).
+``stages`` (1, 2 or 3; default 1), ``save_every`` (a sample every that many steps, and the last; default
+round(steps / (samples - 1)): about ``samples`` of them), ``loop`` (``auto``: the compiled loop of
+mechgen.runtime.core.variational_c on the C backend, else Python; ``python``; ``c``), ``max_steps`` (default
+10^7, refused before the first step). Outputs as for every simulate (the time history of q and v, the
+outputs at t_end, ``energy_drift``; for a run with forces or dissipation the energy balance instead, its work
+and dissipated energy integrated by the step's own Gauss quadrature of the ``energy_rates`` powers), with
+``method = "variational"`` and the ``loop`` that ran.
 """
 from __future__ import annotations
 
@@ -53,9 +58,12 @@ def check_fixed_step(ctx, base: str, options: dict) -> None:
                    "a number > 0 (or an expression)")
 
 
-def simulate_variational(system, q0: np.ndarray, v0: np.ndarray, options: dict, budget, progress: bool,
-                         desc: str) -> VariationalRun:
-    """The run: samples of t, q, v, p and the energy E(q, v, t) (outputs kernel) every save_every steps."""
+def simulate_variational(system, q0: np.ndarray, v0: np.ndarray, options: dict, budget,
+                         desc: str) -> tuple[np.ndarray, np.ndarray, dict]:
+    """(t, x rows, {method, loop, _extra}) of the run, as mechgen.analyses.simulate_flow.adaptive_run gives them:
+    samples of (q, v) every ``save_every`` steps (default: about ``samples`` evenly spaced ones) and at t_end, in
+    the loop ``loop`` asks for (auto: the compiled one on the C backend); with the ``energy_rates`` kernel the
+    ``_extra`` = 3 integrals of the energy balance (mechgen.analyses.energy_balance) follow in each row."""
     if "lagrangian" not in system.kernels:
         raise InputError(f"the system of model {system.metadata.model} was compiled without the 'lagrangian' kernel "
                          "that method 'variational' steps", key="method",
@@ -64,9 +72,12 @@ def simulate_variational(system, q0: np.ndarray, v0: np.ndarray, options: dict, 
     t_end, dt = float(options["t_end"]), float(options["dt"])
     steps, _ = steps_for(t_end, dt)
     samples = max(int(options.get("samples", 201)), 2)
-    save_every = max(1, int(round(steps / (samples - 1))))
+    save_every = int(options.get("save_every", max(1, int(round(steps / (samples - 1))))))
     count = steps // save_every + 2
-    require(dense_bytes(count, 3 * system.n + 2), f"{count} samples of the variational run", key="samples")
-    energy = lambda q, v, t: system.outputs(q, v, t=t)["energy"]  # noqa: E731
-    return run_variational(system, q0, v0, t_end, dt, stages=int(options.get("stages", 1)), save_every=save_every,
-                           energy=energy, budget=budget, progress=progress, desc=desc)
+    require(dense_bytes(count, 3 * system.n + 5), f"{count} samples of the variational run", key="samples")
+    balance = "energy_rates" in system.kernels
+    run = run_variational(system, q0, v0, t_end, dt, stages=int(options.get("stages", 1)), save_every=save_every,
+                          balance=balance, budget=budget, progress=bool(options.get("progress", True)), desc=desc,
+                          loop=options.get("loop", "auto"))
+    X = np.hstack([run.q, run.v] + ([run.w] if balance else []))
+    return run.t, X, {"method": "variational", "loop": run.loop, "_extra": 3 if balance else 0}

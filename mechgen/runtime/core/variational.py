@@ -114,6 +114,23 @@ class Lagrangian:
         return self(q, v, t)[0]
 
 
+class Powers:
+    """The system's ``energy_rates`` kernel at the stages: the powers g = (Q.v, v.dR/dv, -dL/dt) of the energy
+    balance (mechgen.analyses.energy_balance), whose integrals W advance by the step's own quadrature,
+    W_{k+1} = W_k + h sum_i b_i g(Q_i, V_i, t_k + c_i h) (the Gauss method applied to W' = g: order 2 s)."""
+
+    def __init__(self, system) -> None:
+        self.system = system
+
+    def increment(self, tab: Tableau, h: float, q: np.ndarray, t: float, V: np.ndarray) -> np.ndarray:
+        """h sum_i b_i g(Q_i, V_i, t + c_i h), Q_i = q + h sum_j a_ij V_j (3 numbers)."""
+        Q = q + h * tab.a @ V
+        bound = self.system.bound("energy_rates")
+        g = np.array([bound.evaluate(q=Q[i], v=V[i], t=t + tab.c[i] * h)["g"][:3].copy()  # the next call reuses it
+                      for i in range(tab.stages)])
+        return h * tab.b @ g
+
+
 def converged(step: np.ndarray, previous: float, scale: float) -> bool:
     """Newton's stop: |step| <= NEWTON_RTOL scale, or a stall at round-off (|step| <= STALL scale and no longer
     halving)."""
@@ -201,18 +218,22 @@ def nonfinite(t: float) -> ConvergenceError:
     return ConvergenceError(f"variational: the state became NaN/Inf in the step from t = {t:.6g} (a smaller dt?)")
 
 
-def python_stepper(lag: Lagrangian, tab: Tableau, h: float) -> Callable:
-    """``advance(q, p, V, k0, count, total, save_every)``: ``count`` steps from global step k0 in Python, returning
-    (q, p, V, Newton iterations, samples): (t, q, p, velocity guess b.V) after every step that is a multiple of
-    save_every or the ``total``-th (the rules of the compiled loop, mechgen.runtime.core.variational_c)."""
-    def advance(q, p, V, k0: int, count: int, total: int, save_every: int):
+def python_stepper(lag: Lagrangian, tab: Tableau, h: float, powers: Powers | None = None) -> Callable:
+    """``advance(q, p, V, W, k0, count, total, save_every)``: ``count`` steps from global step k0 in Python,
+    returning (q, p, V, W, Newton iterations, samples): (t, q, p, velocity guess b.V, W) after every step that is
+    a multiple of save_every or the ``total``-th; W (3) the energy balance's integrals (Powers; unchanged without
+    ``powers``). The rules of the compiled loop, mechgen.runtime.core.variational_c."""
+    def advance(q, p, V, W, k0: int, count: int, total: int, save_every: int):
         samples, iterations = [], 0
         for k in range(k0, k0 + count):
+            q_old = q
             q, p, V, used = step(lag, tab, h, q, p, k * h, V)
+            if powers is not None:
+                W = W + powers.increment(tab, h, q_old, k * h, V)
             iterations += used
             if (k + 1) % save_every == 0 or k + 1 == total:
-                samples.append(((k + 1) * h, q, p, tab.b @ V))
-        return q, p, V, iterations, samples
+                samples.append(((k + 1) * h, q, p, tab.b @ V, W))
+        return q, p, V, W, iterations, samples
     return advance
 
 
@@ -220,8 +241,9 @@ def python_stepper(lag: Lagrangian, tab: Tableau, h: float) -> Callable:
 class VariationalRun:
     """Samples of a variational run every ``save_every`` steps (and at the last): times ``t``, coordinates ``q``,
     velocities ``v`` (the inverse Legendre transform of p), discrete momenta ``p`` (samples x n) and ``energy``
-    (when an energy function was given, else empty); ``h`` the step, ``steps``, ``newton`` iterations in all,
-    ``loop`` the loop that ran (``c`` or ``python``)."""
+    (when an energy function was given, else empty), ``w`` the energy balance's integrals (samples x 3: the forces'
+    work, the dissipated energy, the explicit work; None when not integrated); ``h`` the step, ``steps``,
+    ``newton`` iterations in all, ``loop`` the loop that ran (``c`` or ``python``)."""
 
     t: np.ndarray
     q: np.ndarray
@@ -232,6 +254,7 @@ class VariationalRun:
     steps: int
     newton: int
     loop: str
+    w: np.ndarray | None = None
 
 
 def steps_for(t_end: float, dt: float) -> tuple[int, float]:
@@ -241,15 +264,16 @@ def steps_for(t_end: float, dt: float) -> tuple[int, float]:
 
 
 def run_variational(system, q0, v0, t_end: float, dt: float, *, stages: int = 1, save_every: int = 1,
-                    energy: Callable | None = None, budget: Budget | None = None, progress: bool = False,
-                    desc: str = "variational", loop: str = "auto") -> VariationalRun:
+                    energy: Callable | None = None, balance: bool = False, budget: Budget | None = None,
+                    progress: bool = False, desc: str = "variational", loop: str = "auto") -> VariationalRun:
     """Integrate from (q0, v0) at t = 0 to t_end with the Gauss-Legendre variational integrator of ``stages``
     (module doc), equal steps h = t_end / ceil(t_end / dt); samples every ``save_every`` steps and at the end.
 
     ``loop``: ``auto`` (the compiled loop, mechgen.runtime.core.variational_c, when the kernels are C, else
-    Python), ``python`` or ``c``. ``energy(q, v, t)`` is evaluated at the samples. ``budget`` refuses the step
-    count up front and checks the wall time every CHUNK steps; a Newton failure or a NaN/Inf state ends the
-    run (ConvergenceError naming the time).
+    Python), ``python`` or ``c``. ``energy(q, v, t)`` is evaluated at the samples; ``balance`` integrates the
+    energy balance's powers too (Powers; the system's ``energy_rates`` kernel). ``budget`` refuses the step count
+    up front and checks the wall time every CHUNK steps; a Newton failure or a NaN/Inf state ends the run
+    (ConvergenceError naming the time).
     """
     from mechgen.runtime.core.variational_c import compiled_stepper
 
@@ -257,28 +281,29 @@ def run_variational(system, q0, v0, t_end: float, dt: float, *, stages: int = 1,
     if budget is not None:
         budget.refuse(steps, f"nothing (refused before starting: t_end / dt = {steps:,} steps)")
     lag, tab = Lagrangian(system), gauss_legendre(stages)
-    q, v = np.array(q0, float), np.array(v0, float)
+    powers = Powers(system) if balance else None
+    q, v, W = np.array(q0, float), np.array(v0, float), np.zeros(3)
     p = lag.momentum(q, v, 0.0)
     V = np.tile(v, (tab.stages, 1))
     rec = Recorder(lag, energy, steps, save_every, q.size)
-    rec.add(0.0, q, p, v)
-    advance = compiled_stepper(system, tab, h, required=loop == "c") if loop != "python" else None
+    rec.add(0.0, q, p, v, W)
+    advance = compiled_stepper(system, tab, h, balance=balance, required=loop == "c") if loop != "python" else None
     used = "python" if advance is None else "c"
-    advance = advance or python_stepper(lag, tab, h)
+    advance = advance or python_stepper(lag, tab, h, powers)
     newton, done = 0, 0
     with Progress(steps, desc=desc, unit="step", enabled=progress) as bar:
         while done < steps:
             count = min(CHUNK, steps - done)
-            q, p, V, iterations, samples = advance(q, p, V, done, count, steps, save_every)
-            for t, qk, pk, guess in samples:
-                rec.add(t, qk, pk, guess)
+            q, p, V, W, iterations, samples = advance(q, p, V, W, done, count, steps, save_every)
+            for sample in samples:
+                rec.add(*sample)
             newton, done = newton + iterations, done + count
             if not (np.all(np.isfinite(q)) and np.all(np.isfinite(p))):
                 raise nonfinite(done * h)
             if budget is not None:
                 budget.check_time(lambda: f"t = {done * h:.6g} of t_end = {t_end:.6g} after {done:,} steps")
             bar.to(done)
-    return rec.run(h, steps, newton, used)
+    return rec.run(h, steps, newton, used, balance)
 
 
 class Recorder:
@@ -287,21 +312,21 @@ class Recorder:
     def __init__(self, lag: Lagrangian, energy: Callable | None, steps: int, save_every: int, n: int) -> None:
         count = steps // save_every + 2
         self.lag, self.energy = lag, energy
-        self.t = np.empty(count)
+        self.t, self.w = np.empty(count), np.empty((count, 3))
         self.q, self.v, self.p = np.empty((count, n)), np.empty((count, n)), np.empty((count, n))
         self.e: list[float] = []
         self.k = 0
 
-    def add(self, t: float, q: np.ndarray, p: np.ndarray, guess: np.ndarray) -> None:
-        """Record the state (q, p) at time t (v from p, Newton from ``guess``)."""
+    def add(self, t: float, q: np.ndarray, p: np.ndarray, guess: np.ndarray, w: np.ndarray) -> None:
+        """Record the state (q, p) and the balance's integrals w at time t (v from p, Newton from ``guess``)."""
         v = legendre_velocity(self.lag, q, p, t, guess)
-        self.t[self.k], self.q[self.k], self.v[self.k], self.p[self.k] = t, q, v, p
+        self.t[self.k], self.q[self.k], self.v[self.k], self.p[self.k], self.w[self.k] = t, q, v, p, w
         if self.energy is not None:
             self.e.append(float(self.energy(q, v, t)))
         self.k += 1
 
-    def run(self, h: float, steps: int, newton: int, loop: str) -> VariationalRun:
-        """The finished record."""
+    def run(self, h: float, steps: int, newton: int, loop: str, balance: bool) -> VariationalRun:
+        """The finished record (``w`` only when the balance was integrated)."""
         k = self.k
         return VariationalRun(self.t[:k], self.q[:k], self.v[:k], self.p[:k], np.asarray(self.e), h, steps, newton,
-                              loop)
+                              loop, self.w[:k] if balance else None)

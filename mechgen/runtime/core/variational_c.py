@@ -28,6 +28,7 @@ SOURCE = Path(__file__).resolve().parent.parent.parent / "codegen" / "templates"
 STEM = "mgvariational"
 INPUTS = ["q", "v", "z", "t", "p"]
 OUTPUTS = ["mom", "F", "mom_q", "mom_v", "F_q", "F_v"]
+RATES = ["g", "excess"]
 c_long, c_double, c_void_p = ctypes.c_long, ctypes.c_double, ctypes.c_void_p
 LONG = np.dtype(f"i{ctypes.sizeof(c_long)}")
 
@@ -42,14 +43,20 @@ def _library():
     except (CompilerUnavailable, BuildError, OSError) as exc:
         log.info("C variational loop unavailable (%s)", exc)
         return None, f"the C variational loop cannot be built ({exc})"
-    lib.mgv_run.argtypes = ([c_void_p, c_void_p, c_long, c_long, c_void_p, c_void_p, c_void_p, c_double]
-                            + [c_long] * 4 + [c_double, c_double, c_long] + [c_void_p] * 12)
+    lib.mgv_run.argtypes = ([c_void_p, c_void_p, c_void_p, c_long, c_long, c_void_p, c_void_p, c_void_p, c_double]
+                            + [c_long] * 4 + [c_double, c_double, c_long] + [c_void_p] * 14)
     lib.mgv_run.restype = ctypes.c_int
     return lib, None
 
 
-def c_unavailable(system) -> str | None:
-    """Why ``system`` cannot run in the C loop (None when it can)."""
+def c_unavailable(system, balance: bool = False) -> str | None:
+    """Why ``system`` cannot run in the C loop (None when it can); ``balance``: with its energy_rates kernel too."""
+    if balance:
+        rates = system.kernels.get("energy_rates")
+        if rates is None or rates.address is None:
+            return "kernel energy_rates is missing or has no C function address"
+        if [p["name"] for p in rates.spec["inputs"]] != INPUTS or [p["name"] for p in rates.spec["outputs"]] != RATES:
+            return "kernel energy_rates has other ports than (q, v, z, t, p) -> (g, excess)"
     kernel = system.kernels.get("lagrangian")
     if kernel is None:
         return "the system has no lagrangian kernel"
@@ -66,10 +73,12 @@ def _ptr(arr: np.ndarray) -> int:
     return arr.ctypes.data
 
 
-def compiled_stepper(system, tab: Tableau, h: float, *, required: bool = False) -> Callable | None:
-    """``advance(q, p, V, k0, count, total, save_every)`` running ``mgv_run`` (the Python stepper's contract), or
-    None when the C loop cannot run (CompilerUnavailable instead with ``required``)."""
-    why = c_unavailable(system)
+def compiled_stepper(system, tab: Tableau, h: float, *, balance: bool = False,
+                     required: bool = False) -> Callable | None:
+    """``advance(q, p, V, W, k0, count, total, save_every)`` running ``mgv_run`` (the Python stepper's contract;
+    ``balance``: W integrated with the energy_rates kernel), or None when the C loop cannot run
+    (CompilerUnavailable instead with ``required``)."""
+    why = c_unavailable(system, balance)
     if why:
         if required:
             raise CompilerUnavailable(why)
@@ -81,15 +90,18 @@ def compiled_stepper(system, tab: Tableau, h: float, *, required: bool = False) 
     A, b, c = (np.ascontiguousarray(x, float) for x in (tab.a, tab.b, tab.c))
     params = np.ascontiguousarray(system.params, float)
     address = system.kernels["lagrangian"].address
+    rates = system.kernels["energy_rates"].address if balance else None
 
-    def advance(q, p, V, k0: int, count: int, total: int, save_every: int):
-        q, p, V = (np.array(x, float, order="C") for x in (q, p, V))
+    def advance(q, p, V, W, k0: int, count: int, total: int, save_every: int):
+        q, p, V, W = (np.array(x, float, order="C") for x in (q, p, V, W))
         cap = count // save_every + 2
         rq, rp, rv, rt = np.zeros((cap, n)), np.zeros((cap, n)), np.zeros((cap, n)), np.zeros(cap)
+        rw = np.zeros((cap, 3))
         nrec, done, newton = (np.zeros(1, dtype=LONG) for _ in range(3))
-        rc = lib.mgv_run(address, _ptr(params), n, s, _ptr(A), _ptr(b), _ptr(c), h, k0, count, total, save_every,
-                         NEWTON_RTOL, STALL, MAX_NEWTON, _ptr(q), _ptr(p), _ptr(V), _ptr(work), _ptr(piv), _ptr(rq),
-                         _ptr(rp), _ptr(rv), _ptr(rt), _ptr(nrec), _ptr(done), _ptr(newton))
+        rc = lib.mgv_run(address, rates, _ptr(params), n, s, _ptr(A), _ptr(b), _ptr(c), h, k0, count, total,
+                         save_every, NEWTON_RTOL, STALL, MAX_NEWTON, _ptr(q), _ptr(p), _ptr(V), _ptr(W), _ptr(work),
+                         _ptr(piv), _ptr(rq), _ptr(rp), _ptr(rv), _ptr(rw), _ptr(rt), _ptr(nrec), _ptr(done),
+                         _ptr(newton))
         t = (k0 + int(done[0])) * h
         if rc == -1:
             raise nonfinite(t)
@@ -100,8 +112,8 @@ def compiled_stepper(system, tab: Tableau, h: float, *, required: bool = False) 
         if rc:
             raise KernelError(f"variational loop: kernel lagrangian returned error code {rc} in the step from "
                               f"t = {t:.6g}")
-        samples = [(float(rt[i]), rq[i], rp[i], rv[i]) for i in range(int(nrec[0]))]
-        return q, p, V, int(newton[0]), samples
+        samples = [(float(rt[i]), rq[i], rp[i], rv[i], rw[i]) for i in range(int(nrec[0]))]
+        return q, p, V, W, int(newton[0]), samples
     return advance
 
 

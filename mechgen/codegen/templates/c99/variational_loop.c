@@ -14,7 +14,11 @@
  * inputs (q, v, z, t, p) (z empty, p the parameters), outputs (mom = p, F, mom_q = p_q, mom_v = p_v, F_q, F_v),
  * matrices row-major n x n.
  *
- * Entry point: mgv_run(...) advances ``steps`` steps from global step k0 (t = (k0 + j) h) and copies q, p and
+ * With the model's ``energy_rates`` kernel (``rates``, not NULL: inputs (q, v, z, t, p), outputs g = (Q.v,
+ * v.dR/dv, -dL/dt) and the excess), the three integrals W of the energy balance (mechgen.analyses.energy_balance)
+ * advance by the same quadrature, W += h sum_i b_i g(Q_i, V_i, t_k + c_i h): the Gauss method applied to W' = g.
+ *
+ * Entry point: mgv_run(...) advances ``steps`` steps from global step k0 (t = (k0 + j) h) and copies q, p, W and
  * the velocity guess sum_i b_i V_i into the records after every global step that is a multiple of save_every
  * or equals ``total``. Returns 0, a kernel's nonzero code (> 0), -1 when the state became NaN/Inf, -2 when
  * Newton did not converge in max_newton iterations, -3 for a singular Jacobian; *done holds the steps taken.
@@ -131,6 +135,32 @@ static int mgv_system(mgv_fn lag, const double *par, long n, long s, const doubl
     return 0;
 }
 
+/* W += h sum_i b_i g(Q_i, V_i, t + c_i h) over the stages (g: the three powers of the energy balance) */
+static int mgv_powers(mgv_fn rates, const double *par, long n, long s, const double *b, const double *c, double h,
+                      double t, const double *Q, const double *V, double *W)
+{
+    const double *in[5];
+    double *out[2];
+    double g[3], excess, tt, z = 0.0;
+    long i, j;
+    int rc;
+    for (i = 0; i < s; ++i) {
+        tt = t + c[i] * h;
+        g[0] = g[1] = g[2] = excess = 0.0;
+        in[0] = &Q[i * n];
+        in[1] = &V[i * n];
+        in[2] = &z;
+        in[3] = &tt;
+        in[4] = par;
+        out[0] = g;
+        out[1] = &excess;
+        rc = rates(in, (double *const *)out, mgv_no_sizes, 1);
+        if (rc) return rc;
+        for (j = 0; j < 3; ++j) W[j] += h * b[i] * g[j];
+    }
+    return 0;
+}
+
 static double mgv_maxabs(const double *x, long m)
 {
     double big = 0.0;
@@ -142,10 +172,10 @@ static double mgv_maxabs(const double *x, long m)
     return big;
 }
 
-int mgv_run(mgv_fn lag, const double *par, long n, long s, const double *A, const double *b, const double *c,
-            double h, long k0, long steps, long total, long save_every, double rtol, double stall, long max_newton,
-            double *q, double *p, double *V, double *work, long *piv, double *rec_q, double *rec_p, double *rec_v,
-            double *rec_t, long *nrec, long *done, long *newton)
+int mgv_run(mgv_fn lag, mgv_fn rates, const double *par, long n, long s, const double *A, const double *b,
+            const double *c, double h, long k0, long steps, long total, long save_every, double rtol, double stall,
+            long max_newton, double *q, double *p, double *V, double *W, double *work, long *piv, double *rec_q,
+            double *rec_p, double *rec_v, double *rec_w, double *rec_t, long *nrec, long *done, long *newton)
 {
     long m = s * n, nn = n * n, j, i, a, it;
     double *Q = work, *P = Q + m, *F = P + m, *R = F + m, *pq = R + m, *pv = pq + s * nn, *Fq = pv + s * nn;
@@ -175,6 +205,10 @@ int mgv_run(mgv_fn lag, const double *par, long n, long s, const double *A, cons
         }
         if (!accepted) return -2;
         *newton += it;
+        if (rates) {
+            rc = mgv_powers(rates, par, n, s, b, c, h, t, Q, V, W);
+            if (rc) return rc;
+        }
         for (a = 0; a < n; ++a) {
             double dq = 0.0, dp = 0.0;
             for (i = 0; i < s; ++i) {
@@ -194,6 +228,7 @@ int mgv_run(mgv_fn lag, const double *par, long n, long s, const double *A, cons
                 rec_p[*nrec * n + a] = p[a];
                 rec_v[*nrec * n + a] = v;
             }
+            for (a = 0; a < 3; ++a) rec_w[*nrec * 3 + a] = W[a];
             rec_t[*nrec] = (double)(k + 1) * h;
             ++*nrec;
         }
