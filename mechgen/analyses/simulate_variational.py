@@ -33,7 +33,7 @@ def check_fixed_step(ctx, base: str, options: dict) -> None:
     variables (it steps none); whether its mass is constant and diagonal is known from the kernels only, at the
     run's start (mechgen.runtime.core.splitting.require_separable)."""
     method = options["method"]
-    if method == "leapfrog" and ctx.model.internals and not ctx.model.chain:
+    if method == "leapfrog" and getattr(ctx.model, "internals", False) and not getattr(ctx.model, "chain", None):
         raise fail(ctx.file, f"{base}.method", f"method 'leapfrog' steps q'' = M^-1 (-dV/dq) alone, and model "
                    f"{ctx.model.name} has internal variables", "an implicit method ('Radau', 'BDF')")
     if "stages" in options:
