@@ -1,5 +1,9 @@
 """``symplectic``: a chain (separable H = sum v^2/(2m) + V(q)) run by a splitting method, the time loop in C.
 
+A chain whose site kinetic energy is not m u'^2 / 2 with a constant m (or whose potential depends on a velocity)
+is refused at ``integrator`` (exit 2; mechgen.runtime.core.splitting.require_separable): the splittings would
+be silently wrong for it; simulate's ``method = "variational"`` serves any Lagrangian.
+
 Scene keys: ``integrator`` (leapfrog | yoshida4 | yoshida6 | aba864: mechgen.runtime.core.splitting,
 orders 2, 4, 6, 4), ``dt`` and ``t_end`` (required, model time units), ``stride`` (steps between outputs;
 default 0: about 40 outputs per period T_1 = 2 pi / omega_1 of the lowest linear mode), ``initial_mode``
