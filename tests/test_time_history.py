@@ -308,3 +308,15 @@ def test_python_typos_get_the_closest_name(double):
         double.with_params(m11=1.0)
     with pytest.raises(mechgen.InputError, match="did you mean 'l0'"):
         mechgen.compile("spring_pendulum", {"l00": 1.0})
+
+
+def test_docstrings_list_the_schema_options():
+    """Each analysis function's docstring names every option of its kind's schema (one source for both)."""
+    from mechgen.analyses import public
+    from mechgen.analyses.registry import get, kinds
+
+    for kind in kinds():
+        function = getattr(public, kind, None)
+        if function is None:
+            continue
+        assert all(f"``{name}``" in function.__doc__ for name in get(kind).schema), kind

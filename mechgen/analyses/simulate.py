@@ -1,17 +1,20 @@
 """``simulate``: the time response from an initial state.
 
-Scene keys: ``t_end`` (required), ``method`` (BDF, Radau, LSODA, RK45, DOP853, ``leapfrog`` with a
-step ``dt`` (a model whose equations are q'' = M^-1 (-dV/dq) with a constant diagonal M only, else refused at
-``method``: mechgen.runtime.core.splitting.require_separable), ``cvodes``: SUNDIALS' variable-order BDF with the
-exact Jacobian, compiled through CasADi, for a lumped model built with ``backend = "casadi"``:
-mechgen.runtime.core.sundials, or ``variational`` with ``dt`` and ``stages``: the variational integrator of
-the model's own Lagrangian, mechgen.analyses.simulate_variational), ``rtol``, ``atol``, ``q0`` / ``v0`` (tables
-of coordinates), ``initial_mode`` with
-``amplitude`` (start from a linear mode), ``outputs`` (which model outputs to report), ``series``
-(also report ``t`` and ``energy_series``), ``samples``. Outputs: the model's outputs at ``t_end``,
-``energy_drift``, ``t_end``; a fixed-end chain also ``mode_energies``. A model with modes is run by
-mechgen.analyses.simulate_hybrid, with the keys ``mode``, ``max_events``, ``zeno_events``, ``zeno_span``
-and ``loop`` (the event loop: ``auto``, ``python`` or ``c``).
+Scene keys: ``t_end`` (required), ``method`` (``auto``, the default, and the compiled loop:
+mechgen.analyses.simulate_flow; BDF, Radau, LSODA, RK45, DOP853, ``leapfrog`` with a step ``dt`` and
+``save_every`` (a model whose equations are q'' = M^-1 (-dV/dq) with a constant diagonal M only, else refused
+at ``method``: mechgen.runtime.core.splitting.require_separable), ``cvodes``: SUNDIALS' variable-order BDF with
+the exact Jacobian, compiled through CasADi, for a lumped model built with ``backend = "casadi"``:
+mechgen.runtime.core.sundials, or ``variational`` with ``dt``, ``stages`` and ``save_every``: the variational
+integrator of the model's own Lagrangian, mechgen.analyses.simulate_variational), ``loop`` (``auto``,
+``python`` or ``c``), ``rtol``, ``atol``, ``q0`` / ``v0`` (tables of coordinates), ``initial_mode`` with
+``amplitude`` (start from a linear mode), ``outputs`` (which model outputs to report), ``series`` (the time
+history; left out: kept while small, mechgen.analyses.time_series), ``samples``, ``plot`` (``time`` or
+``phase``). Outputs: ``t`` and ``trajectory`` (with ``energy_series``), the model's outputs at ``t_end``,
+``energy_drift`` (a conservative run) or ``energy_balance_error``, ``work`` and ``dissipated``
+(mechgen.analyses.energy_balance), ``t_end``, ``method`` and ``loop`` (what ran); a fixed-end chain also
+``mode_energies``. A model with modes is run by mechgen.analyses.simulate_hybrid, with the keys ``mode``,
+``max_events``, ``zeno_events``, ``zeno_span`` and ``on_zeno``.
 
 Work budget (mechgen.runtime.core.budget): ``max_steps`` (integrator steps; default 10^7 for the
 leapfrog, whose t_end / dt steps are refused before the first one when they exceed it, and 10^5
