@@ -68,7 +68,7 @@ DEFAULT_STEPS = {"leapfrog": 10_000_000, "adaptive": 100_000}
 EXPLICIT_REACH = {"RK45": 7.0, "DOP853": 12.0}
 #: what a model unfit for the leapfrog uses instead (mechgen.runtime.core.splitting.require_separable)
 INSTEAD = ("method = 'variational' (a variational integrator of the model's own Lagrangian, any kinetic energy), "
-           "or an implicit method ('Radau', 'BDF')")
+           "or an adaptive one ('auto', the default, or 'Radau')")
 #: the explicit methods' up-front stiffness estimate is made for first-order states up to this size
 ESTIMATE_SIZE = 400
 
