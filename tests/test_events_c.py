@@ -319,7 +319,7 @@ def test_without_a_compiler_the_loop_falls_back_to_python(monkeypatch, tmp_path)
 
 
 
-def test_simulate_takes_the_loop_key_for_a_model_with_modes_only():
+def test_simulate_takes_the_loop_key():
     """The Kelvin-Voigt contact lasts half a damped period: release at pi / (omega_n sqrt(1 - zeta^2))."""
     from mechgen.errors import MechgenError
     from mechgen.models.spring_pendulum import model as pendulum
@@ -334,9 +334,10 @@ def test_simulate_takes_the_loop_key_for_a_model_with_modes_only():
         assert abs(out["events"][1]["t"] - math.pi / math.sqrt(1 - zeta**2)) < 1e-9
     with pytest.raises(MechgenError, match="loop"):
         mechgen.simulate(system, t_end=1.0, v0={"x": 1.0}, loop="fortran")
-    smooth = mechgen.compile(pendulum, {}, kernels=["residual", "tangent", "outputs"])
-    with pytest.raises(MechgenError, match="no modes"):
-        mechgen.simulate(smooth, t_end=1.0, loop="c")
+    # a smooth model takes the key too (its compiled loop: mechgen.runtime.core.smooth_c), refused where it cannot run
+    smooth = mechgen.compile(pendulum, {}, kernels=["residual", "tangent", "outputs"], backend="numpy")
+    with pytest.raises(MechgenError, match="loop 'c' cannot run here"):
+        mechgen.simulate(smooth, t_end=1.0, q0={"r": 1.0}, loop="c", method="DOP853")
 
 
 def test_resuming_at_clean_points_changes_nothing(ball, monkeypatch):

@@ -58,7 +58,7 @@ def test_limestone_fit_is_the_linear_closed_form_and_brackets_the_paper(pendulum
     np.testing.assert_allclose(fit["covariance"], C, rtol=1e-9)
     np.testing.assert_allclose(fit["residuals"], r, rtol=1e-8, atol=1e-9)
     np.testing.assert_allclose(np.array(fit["fitted"]) + fit["residuals"], R, rtol=1e-14)
-    assert fit["observed"] == R.tolist() and fit["dof"] == 1 and fit["converged"] is True
+    assert fit.outputs["observed"] == R.tolist() and fit["dof"] == 1 and fit["converged"] is True
     assert fit["rms"] == pytest.approx(np.sqrt(np.mean(r**2)), rel=1e-9)
     # the numbers worked by hand for the brief: K = 611.607 +- 9.278 MPa, k = 84.862 +- 3.809 MPa
     assert fit["K"] == pytest.approx(611.607, abs=5e-4) and fit["K_stderr"] == pytest.approx(9.278, abs=5e-4)
@@ -80,8 +80,8 @@ def test_sigma_weights_and_groups_are_the_weighted_closed_form_per_group(pendulu
     y = np.where(group == 3.0, 2.0 + 0.5 * x, -1.0 + 1.5 * x) + rng.normal(0.0, 1.0, 10) * sigma
     fit = mechgen.fit(pendulum, parameters=["a", "b"], start={"a": 0.0, "b": 0.0}, observed="y", sigma="s",
                       group="g", expression="a + b * x", data={"x": x, "y": y, "s": sigma, "g": group})
-    assert fit["groups"] == [3.0, 1.0] and fit["group_rows"] == [[1, 2, 3, 4, 5], [6, 7, 8, 9, 10]]
-    assert fit["dof"] == [3, 3]
+    assert fit.outputs["groups"] == [3.0, 1.0] and fit.outputs["group_rows"] == [[1, 2, 3, 4, 5], [6, 7, 8, 9, 10]]
+    assert fit.outputs["dof"] == [3, 3]
     for i, g in enumerate((3.0, 1.0)):
         rows = group == g
         ref, C, _ = _normal_equations(np.column_stack([np.ones(5), x[rows]]), y[rows], 1.0 / sigma[rows] ** 2)
@@ -164,7 +164,7 @@ def test_spring_constant_from_modes_of_several_masses(pendulum):
                       output="frequencies[2]")
     assert fit["k"] == pytest.approx(40.0, rel=1e-10)
     assert fit["k_stderr"] < 1e-10 and fit["converged"] and fit["evaluations"] < 100
-    assert fit["x_column"] == "m" and fit["x_values"] == m.tolist()
+    assert fit["x_column"] == "m" and fit.outputs["x_values"] == m.tolist()
     assert mechgen.modes(pendulum, at={"r": 1.5})["frequencies"][1] == pytest.approx(np.sqrt(40.0), rel=1e-12)
     with pytest.raises(SceneError, match="frequencies"):   # a list output needs its index
         mechgen.fit(pendulum, parameters=["k"], data={"m": m, "omega": omega}, observed="omega", inputs=["m"],
