@@ -24,6 +24,7 @@ from mechgen.runtime.core.budget import Budget
 from mechgen.runtime.core.diagnose import explain_state
 from mechgen.runtime.core.integrate import integrate_first_order
 from mechgen.runtime.core.memory import dense_bytes, require
+from mechgen.runtime.core.run_options import RunOptions
 
 #: an explicit method needing more steps than this for stability alone makes ``auto`` choose Radau
 STIFF_STEPS = 10_000
@@ -76,31 +77,30 @@ def adaptive_run(system, options: dict, x0: np.ndarray, method: str, budget: Bud
     n_out = int(options.get("samples", 201))
     require(dense_bytes(n_out, 3 * x0.size + 6), f"{n_out} output samples", key="samples")
     t_eval = np.linspace(0.0, t_end, max(n_out, 2))
-    rtol, atol = options.get("rtol", 1e-8), options.get("atol", 1e-10)
     size = 2 * system.n + system.m  # the diagnosis reads the model's state, not the integrals after it
-    common = dict(t_eval=t_eval, budget=budget, progress=bool(options.get("progress", True)), desc=desc,
-                  explain=lambda t, x: explain_state(system, t, np.asarray(x)[:size]))
-    loop = options.get("loop", "auto")
-    if method == "DOP853" and loop != "python":
-        why = smooth_loop_problem(system, rtol, atol, extra)
+    run = RunOptions(method=method, rtol=options.get("rtol", 1e-8), atol=options.get("atol", 1e-10), t_eval=t_eval,
+                     budget=budget, progress=bool(options.get("progress", True)), desc=desc,
+                     explain=lambda t, x: explain_state(system, t, np.asarray(x)[:size]),
+                     loop=options.get("loop", "auto"))
+    if method == "DOP853" and run.loop != "python":
+        why = smooth_loop_problem(system, run.rtol, run.atol, extra)
         if why is None:
-            t, X, _ = integrate_smooth_c(system, x0, t_end, rtol=rtol, atol=atol, extra=extra, **common)
+            t, X, _ = integrate_smooth_c(system, x0, t_end, run, extra=extra)
             return t, X, {"method": method, "loop": "c", "_extra": extra}
-        if loop == "c":
+        if run.loop == "c":
             raise InputError(f"loop 'c' cannot run here: {why}", key="loop",
                              expected="method DOP853 (or auto) on the C backend with a C compiler, or loop "
                                       "'auto' / 'python'")
     if method == "cvodes":
-        traj = cvodes_run(system, x0, t_end, options, common)
+        traj = cvodes_run(system, x0, t_end, run)
     else:
         flow = energy_balance.AugmentedFlow(system) if extra else system
-        traj = integrate_first_order(flow.rhs, x0, t_end, jac=flow.jacobian, method=method, rtol=rtol,
-                                     atol=atol, **common)
+        traj = integrate_first_order(flow.rhs, x0, t_end, jac=flow.jacobian, options=run)
     xs = traj.x if traj.x.shape[0] == len(traj.t) else traj.x.T
     return np.asarray(traj.t, float), np.asarray(xs, float), {"method": method, "loop": "python", "_extra": extra}
 
 
-def cvodes_run(system, x0, t_end: float, options: dict, common: dict):
+def cvodes_run(system, x0, t_end: float, run: RunOptions):
     """The run with SUNDIALS' CVODES on the system's CasADi kernels (mechgen.runtime.core.sundials)."""
     from mechgen.runtime.core.sundials import cvodes_problem, integrate_cvodes
 
@@ -108,5 +108,5 @@ def cvodes_run(system, x0, t_end: float, options: dict, common: dict):
     if why:
         raise InputError(why, key="method", expected="a method of this system's backend: auto, BDF, Radau, LSODA, "
                          "RK45, DOP853 or leapfrog, or backend 'casadi' for 'cvodes'")
-    return integrate_cvodes(system, x0, t_end, rtol=options.get("rtol", 1e-8), atol=options.get("atol", 1e-10),
-                            **common)
+    return integrate_cvodes(system, x0, t_end, t_eval=run.t_eval, rtol=run.rtol, atol=run.atol, budget=run.budget,
+                            progress=run.progress, desc=run.desc, explain=run.explain)

@@ -24,6 +24,7 @@ from mechgen.analyses.context import NAME
 from mechgen.errors import SceneError
 from mechgen.runtime.core.diagnose import explain_state
 from mechgen.runtime.core.events import EventRules, ZenoApproach, integrate_hybrid
+from mechgen.runtime.core.run_options import RunOptions
 from mechgen.runtime.core.memory import dense_bytes, require
 
 
@@ -96,13 +97,13 @@ def hybrid_run(system, options: dict, x0: np.ndarray, desc: str):
         from mechgen.analyses.simulate_flow import chosen_method
 
         method = chosen_method(system.mode(start_mode(system, options)), x0, t_end)
+    run = RunOptions(method=method, rtol=options.get("rtol", 1e-8), atol=options.get("atol", 1e-10),
+                     t_eval=np.linspace(0.0, t_end, int(options.get("samples", 201))),
+                     budget=budget_of(options, method), rules=rules_of(options),
+                     progress=bool(options.get("progress", True)), desc=desc,
+                     explain=lambda t, x: explain_state(system, t, x), loop=options.get("loop", "auto"))
     try:
-        traj = integrate_hybrid(system, x0, t_end, mode=start_mode(system, options), method=method,
-                                rtol=options.get("rtol", 1e-8), atol=options.get("atol", 1e-10),
-                                t_eval=np.linspace(0.0, t_end, int(options.get("samples", 201))),
-                                budget=budget_of(options, method), rules=rules_of(options),
-                                progress=bool(options.get("progress", True)), desc=desc,
-                                explain=lambda t, x: explain_state(system, t, x), loop=options.get("loop", "auto"))
+        traj = integrate_hybrid(system, x0, t_end, mode=start_mode(system, options), options=run)
     except ZenoApproach as exc:
         if options.get("on_zeno", "error") != "stop" or exc.trajectory is None:
             raise

@@ -64,9 +64,10 @@ from typing import Callable
 import numpy as np
 
 from mechgen.errors import ConvergenceError, InputError, KernelError
-from mechgen.runtime.core.budget import Budget, BudgetExceeded, Progress
+from mechgen.runtime.core.budget import BudgetExceeded, Progress
 from mechgen.runtime.core.diagnose import explain_state
 from mechgen.runtime.core.integrate import IMPLICIT, METHODS
+from mechgen.runtime.core.run_options import EventRules, RunOptions
 
 #: the event loops: this module's ("python"), the compiled one ("c"), or the compiled one where it applies
 LOOPS = ("auto", "python", "c")
@@ -77,16 +78,6 @@ DIP_DEPTH = 4
 EPS = float(np.finfo(float).eps)
 #: what a Zeno error says a run that should end there can do
 ZENO_HINT = "simulate's on_zeno = \"stop\" ends the run there, keeping the events so far"
-
-
-@dataclass(frozen=True)
-class EventRules:
-    """Bounds of the event loop: at most ``max_events`` events, and no more than ``zeno_events`` of them within
-    ``zeno_span`` (None: 1e-9 t_end)."""
-
-    max_events: int = 10_000
-    zeno_events: int = 100
-    zeno_span: float | None = None
 
 
 class ZenoApproach(BudgetExceeded):
@@ -286,32 +277,30 @@ def _crossed(sign: np.ndarray, g: np.ndarray, directions: np.ndarray) -> np.ndar
     return flip & ((directions == 0) | (directions == new))
 
 
-def integrate_hybrid(system, x0, t_end: float, *, mode: int | None = None, method: str = "Radau",
-                     rtol: float = 1e-8, atol: float = 1e-10, t_eval=None, budget: Budget | None = None,
-                     rules: EventRules = EventRules(), progress: bool = False, desc: str = "simulate",
-                     explain: Callable | None = None,
-                     stop_after: Callable[[Event], bool] | None = None, loop: str = "auto") -> HybridTrajectory:
+def integrate_hybrid(system, x0, t_end: float, *, mode: int | None = None, options: RunOptions | None = None,
+                     **changes) -> HybridTrajectory:
     """Integrate a :class:`~mechgen.runtime.core.hybrid_system.HybridSystem` from x0 at t = 0 in ``mode``
     (default its initial mode) to t_end or a terminal event, by the rules of the module doc.
 
-    Samples are taken at ``t_eval`` (sorted, in [0, t_end]), else at every step end and on both
+    ``options`` (mechgen.runtime.core.run_options.RunOptions; its fields may also be given as keywords, which
+    change it): samples are taken at ``t_eval`` (sorted, in [0, t_end]), else at every step end and on both
     sides of every event. ``budget`` counts accepted steps; ``rules`` bound the events;
     ``stop_after(event)`` true ends the run after that event (an impact measured up to its release).
     ``loop``: "python" (this loop), "c" (the compiled loop of mechgen.runtime.core.events_c: DOP853 on
     the C backend) or "auto" (the compiled one where it can run, else this one).
     """
+    options = RunOptions.of(options, **changes)
+    method, rtol, atol, rules = options.method, options.rtol, options.atol, options.rules
     # -- loop dispatch: the compiled DOP853 loop (mechgen.runtime.core.events_c) where it applies ---------
-    if loop not in LOOPS:
-        raise ValueError(f"unknown loop {loop!r}; expected one of {LOOPS}")
-    if loop != "python" and method in METHODS:
+    if options.loop not in LOOPS:
+        raise ValueError(f"unknown loop {options.loop!r}; expected one of {LOOPS}")
+    if options.loop != "python" and method in METHODS:
         from mechgen.runtime.core.events_c import c_loop_problem, integrate_hybrid_c
 
         why = c_loop_problem(system, method, rtol, atol)
         if why is None:
-            return integrate_hybrid_c(system, x0, t_end, mode=mode, rtol=rtol, atol=atol, t_eval=t_eval,
-                                      budget=budget, rules=rules, progress=progress, desc=desc, explain=explain,
-                                      stop_after=stop_after)
-        if loop == "c":
+            return integrate_hybrid_c(system, x0, t_end, mode=mode, options=options)
+        if options.loop == "c":
             raise InputError(f"loop 'c' cannot run here: {why}", key="loop",
                              expected="method DOP853 on the C backend with a C compiler, or loop 'auto'/'python'")
     # -- end of the loop dispatch ------------------------------------------------------------------------
@@ -319,7 +308,7 @@ def integrate_hybrid(system, x0, t_end: float, *, mode: int | None = None, metho
         raise ValueError(f"unknown method {method!r}; expected one of {METHODS}")
     t_end = float(t_end)
     mode = system.initial_mode if mode is None else int(mode)
-    t_eval = None if t_eval is None else np.asarray(t_eval, float)
+    t_eval = options.samples()
     zeno_span = rules.zeno_span if rules.zeno_span is not None else 1e-9 * t_end
     names = system.modes
     ts, xs, ms = [], [], []
@@ -374,7 +363,7 @@ def integrate_hybrid(system, x0, t_end: float, *, mode: int | None = None, metho
 
     record(t, x, mode)
     try:
-        with Progress(t_end, desc=desc, unit="t", enabled=progress) as bar:
+        with Progress(t_end, desc=options.desc, unit="t", enabled=options.progress) as bar:
             while True:
                 if mode not in segments:
                     segments[mode] = _Segment(system, mode, t_end, counts)
@@ -385,7 +374,7 @@ def integrate_hybrid(system, x0, t_end: float, *, mode: int | None = None, metho
                     k = at_once[0]  # the guards are in priority order: terminal first, then declared order
                     target, x = fire(seg, k, t, x)
                     record(t, x, mode if target is None else target)
-                    if target is None or (stop_after is not None and stop_after(events[-1])):
+                    if target is None or (options.stop_after is not None and options.stop_after(events[-1])):
                         terminated = True
                         mode = mode if target is None else target
                         break
@@ -393,8 +382,8 @@ def integrate_hybrid(system, x0, t_end: float, *, mode: int | None = None, metho
                     continue
                 if t >= t_end:
                     break
-                hit = _integrate_segment(seg, x, t, (g0, d0), method, rtol, atol, sign, budget, stats,
-                                         sample_until, record, bar, explain, where)
+                hit = _integrate_segment(seg, (t, x), (g0, d0), sign, options, stats,
+                                         _Hooks(sample_until, record, bar, where))
                 if hit is None:
                     t, x = t_end, stats["y_end"]
                     break
@@ -403,7 +392,7 @@ def integrate_hybrid(system, x0, t_end: float, *, mode: int | None = None, metho
                 target, x = fire(seg, k, t, x_before)
                 record(t, x_before, mode)
                 record(t, x, mode if target is None else target)
-                if target is None or (stop_after is not None and stop_after(events[-1])):
+                if target is None or (options.stop_after is not None and options.stop_after(events[-1])):
                     terminated = True
                     mode = mode if target is None else target
                     break
@@ -443,12 +432,26 @@ def _end_rate(solver, seg, t: float, y: np.ndarray) -> np.ndarray:
     return seg.rhs(t, y)
 
 
-def _integrate_segment(seg, x, t, start, method, rtol, atol, sign, budget, stats, sample_until, record, bar,
-                       explain, where):
-    """Integrate one mode from (t, x) until a guard fires (-> (guard, t*, x*)) or t_end (-> None).
+@dataclass(frozen=True)
+class _Hooks:
+    """What one mode's integration reports to the loop around it: samples up to a time, step records, the
+    progress bar, and where a time is (for messages)."""
+
+    sample_until: Callable
+    record: Callable
+    bar: Progress
+    where: Callable
+
+
+def _integrate_segment(seg, state: tuple, start, sign, options: RunOptions, stats: dict, hooks: _Hooks):
+    """Integrate one mode from ``state`` = (t, x) until a guard fires (-> (guard, t*, x*)) or t_end (-> None).
     ``start``: the guards' (g, g_t) at (t, x); ``sign``: their tracked signs there."""
     from numpy.linalg import LinAlgError
 
+    t, x = state
+    method, rtol, atol, budget = options.method, options.rtol, options.atol, options.budget
+    sample_until, record, bar, where = hooks.sample_until, hooks.record, hooks.bar, hooks.where
+    explain = options.explain
     kwargs = {"jac": seg.jac} if method in IMPLICIT else {}
     t_end = seg.t_end
     y_old, t_old = np.array(x), t
@@ -569,3 +572,8 @@ def _locate(seg, dense, k, t_d, t_lo, t_hi, t_old, y_old, method, rtol, atol, kw
         dt = -g[k] / g_t[k]
         return t_d + dt, x_d + dt * f
     return t_d, x_d
+
+
+__all__ = ["DIP_DEPTH", "EPS", "Event", "EventRules", "HybridTrajectory", "LOOPS", "MAX_DEPTH", "RunOptions",
+           "ZENO_HINT", "ZenoApproach", "diagnosis", "integrate_hybrid", "split_point", "start_signs",
+           "time_tolerance"]

@@ -32,7 +32,8 @@ import numpy as np
 
 from mechgen.errors import BuildError, CompilerUnavailable, ConvergenceError, KernelError
 from mechgen.runtime.core.budget import BudgetExceeded, Progress
-from mechgen.runtime.core.events import ZENO_HINT, Event, EventRules, HybridTrajectory, ZenoApproach, diagnosis
+from mechgen.runtime.core.events import ZENO_HINT, Event, HybridTrajectory, ZenoApproach, diagnosis
+from mechgen.runtime.core.run_options import RunOptions
 from mechgen.runtime.core.pattern import extent
 
 log = logging.getLogger("mechgen")
@@ -294,14 +295,14 @@ class _Buffers:
         setattr(self.problem, cap, 2 * keep)
 
 
-def integrate_hybrid_c(system, x0, t_end: float, *, mode: int | None = None, rtol: float = 1e-8,
-                       atol: float = 1e-10, t_eval=None, budget=None, rules: EventRules = EventRules(),
-                       progress: bool = False, desc: str = "simulate", explain=None,
-                       stop_after=None) -> HybridTrajectory:
+def integrate_hybrid_c(system, x0, t_end: float, *, mode: int | None = None, options: RunOptions | None = None,
+                       **changes) -> HybridTrajectory:
     """:func:`mechgen.runtime.core.events.integrate_hybrid` with ``method="DOP853"``, run by the C loop (module
-    doc); the same arguments (but ``method``) and the same HybridTrajectory (``extra["loop"] = "c"``; ``nfev``
-    counts every evaluation of dx/dt, ``guard_evaluations`` every one of the guards). CompilerUnavailable
-    when the loop cannot run ``system`` (:func:`c_loop_problem` says why)."""
+    doc); the same options (RunOptions; ``method`` and ``loop`` are not read) and the same HybridTrajectory
+    (``extra["loop"] = "c"``; ``nfev`` counts every evaluation of dx/dt, ``guard_evaluations`` every one of the
+    guards). CompilerUnavailable when the loop cannot run ``system`` (:func:`c_loop_problem` says why)."""
+    options = RunOptions.of(options, **changes)
+    rtol, atol, budget, rules, stop_after = options.rtol, options.atol, options.budget, options.rules, options.stop_after
     why = c_loop_problem(system, "DOP853")
     if why is not None:
         raise CompilerUnavailable(why)
@@ -317,7 +318,7 @@ def integrate_hybrid_c(system, x0, t_end: float, *, mode: int | None = None, rto
     if not 0 <= start < len(system.modes):
         raise ValueError(f"mode {start} is not a mode index of {len(system.modes)} modes")
     names = system.modes
-    t_eval = None if t_eval is None else np.ascontiguousarray(t_eval, dtype=float).reshape(-1)
+    t_eval = None if options.t_eval is None else np.ascontiguousarray(options.t_eval, dtype=float).reshape(-1)
     zeno_span = rules.zeno_span if rules.zeno_span is not None else 1e-9 * t_end
     params = np.ascontiguousarray(system.params, dtype=float)
     ng = max(1, tables.max_guards)
@@ -351,7 +352,7 @@ def integrate_hybrid_c(system, x0, t_end: float, *, mode: int | None = None, rto
                                 arrays["e_before"][e].copy(), arrays["e_after"][e].copy()))
 
     terminated = False
-    with Progress(t_end, desc=desc, unit="t", enabled=progress) as bar:
+    with Progress(t_end, desc=options.desc, unit="t", enabled=options.progress) as bar:
         while True:
             if budget is not None and budget.limit is not None:
                 problem.budget_left = max(0, budget.limit - budget.used)
@@ -360,7 +361,7 @@ def integrate_hybrid_c(system, x0, t_end: float, *, mode: int | None = None, rto
                 budget.spend(state.counted, lambda: where(state.t, state.mode))
             if rc < 0:
                 new_events()
-                error = _error(rc, system, state, err_x, where, rules, zeno_span, explain)
+                error = _error(rc, system, state, err_x, where, options, zeno_span)
                 if isinstance(error, ZenoApproach):  # the run so far, up to the event that made it Zeno
                     raise error.with_trajectory(_zeno_trajectory(arrays, state, events))
                 raise error
@@ -397,8 +398,10 @@ def _zeno_trajectory(arrays: dict, state: CState, events: list) -> HybridTraject
                             {"loop": "c", "rate_evaluations": int(state.nrate)})
 
 
-def _error(rc: int, system, state: CState, err_x: np.ndarray, where, rules, zeno_span, explain) -> Exception:
+def _error(rc: int, system, state: CState, err_x: np.ndarray, where, options: RunOptions,
+           zeno_span: float) -> Exception:
     """The exception the Python loop raises for the C loop's error code ``rc``."""
+    rules, explain = options.rules, options.explain
     t, seg = float(state.err_t), int(state.err_mode)
     model = system.metadata.model
     if rc == E_KERNEL:
@@ -431,7 +434,7 @@ def _error(rc: int, system, state: CState, err_x: np.ndarray, where, rules, zeno
                             f"(guard {system.guards(seg)[state.err_guard].name} of mode {system.modes[seg]}); "
                             f"{ZENO_HINT}", key="zeno_events", reached=where(t, seg))
     if rc == E_BUDGET:
-        return BudgetExceeded(f"DOP853 steps: stopped by the step budget", key="max_steps", reached=where(t, seg))
+        return BudgetExceeded("DOP853 steps: stopped by the step budget", key="max_steps", reached=where(t, seg))
     if rc == E_MEMORY:
         return MemoryError("the C event loop could not allocate its workspace")
     return RuntimeError(f"the C event loop refused its input (code {rc})")

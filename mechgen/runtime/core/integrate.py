@@ -17,13 +17,13 @@ called only on that path.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 
 from mechgen.errors import ConvergenceError, KernelError
 from mechgen.runtime.core.budget import Budget, BudgetExceeded, Progress
 from mechgen.runtime.core.memory import dense_bytes, require
+from mechgen.runtime.core.run_options import RunOptions
 
 METHODS = ("BDF", "Radau", "LSODA", "RK45", "DOP853")
 IMPLICIT = ("BDF", "Radau", "LSODA")
@@ -61,15 +61,18 @@ def _where(t: float, t_end: float, steps: int) -> str:
     return f"t = {t:.6g} of t_end = {t_end:.6g} after {steps:,} steps"
 
 
-def integrate_first_order(rhs, x0, t_end: float, *, jac=None, method: str = "BDF", rtol: float = 1e-8,
-                          atol: float = 1e-10, t_eval=None, budget: Budget | None = None,
-                          progress: bool = False, desc: str = "simulate",
-                          explain: Callable[[float, np.ndarray], str] | None = None) -> Trajectory:
+def integrate_first_order(rhs, x0, t_end: float, *, jac=None, options: RunOptions | None = None,
+                          **changes) -> Trajectory:
     """Integrate dx/dt = rhs(t, x) from 0 to t_end; rows of ``x`` are states at ``t`` (``t_eval``, or every step).
 
-    Each accepted step is one unit of ``budget`` (BudgetExceeded names t reached); ``progress`` draws
-    a bar in t (see :class:`~mechgen.runtime.core.budget.Progress`).
+    ``options``: mechgen.runtime.core.run_options.RunOptions (default method BDF here; its fields may be given
+    as keywords, which change it; ``rules``, ``stop_after`` and ``loop`` are not read). Each accepted step is
+    one unit of ``budget`` (BudgetExceeded names t reached); ``progress`` draws a bar in t (see
+    :class:`~mechgen.runtime.core.budget.Progress`).
     """
+    options = RunOptions.of(options or RunOptions(method="BDF"), **changes)
+    method, rtol, atol, t_eval, budget = options.method, options.rtol, options.atol, options.t_eval, options.budget
+    progress, desc, explain = options.progress, options.desc, options.explain
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}; expected one of {METHODS}")
     t_end = float(t_end)

@@ -76,14 +76,12 @@ def smooth_loop_problem(system, rtol=1e-8, atol=1e-10, extra: int = 0) -> str | 
     return c_loop_problem(view_of(system, extra), "DOP853", rtol, atol)
 
 
-def integrate_smooth_c(system, x0, t_end: float, *, rtol: float = 1e-8, atol: float = 1e-10, t_eval=None,
-                       budget=None, progress: bool = False, desc: str = "simulate",
-                       explain=None, extra: int = 0) -> tuple[np.ndarray, np.ndarray, dict]:
-    """(t, x rows at ``t_eval``, counts {steps, nfev}) of a smooth lumped system integrated by the compiled
-    DOP853 loop (module doc; ``extra``: :func:`view_of`); failures raise the exceptions (and messages) of the
-    event loop."""
+def integrate_smooth_c(system, x0, t_end: float, options, *, extra: int = 0) -> tuple[np.ndarray, np.ndarray, dict]:
+    """(t, x rows at the options' ``t_eval``, counts {steps, nfev}) of a smooth lumped system integrated by the
+    compiled DOP853 loop (module doc; ``options``: mechgen.runtime.core.run_options.RunOptions, ``method`` and
+    ``loop`` not read; ``extra``: :func:`view_of`); failures raise the exceptions (and messages) of the event
+    loop."""
     from mechgen.runtime.core.events_c import integrate_hybrid_c
 
-    traj = integrate_hybrid_c(view_of(system, extra), x0, t_end, mode=0, rtol=rtol, atol=atol, t_eval=t_eval,
-                              budget=budget, progress=progress, desc=desc, explain=explain)
+    traj = integrate_hybrid_c(view_of(system, extra), x0, t_end, mode=0, options=options)
     return traj.t, traj.x, {"steps": traj.steps, "nfev": traj.nfev}
