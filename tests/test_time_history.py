@@ -320,3 +320,13 @@ def test_docstrings_list_the_schema_options():
         if function is None:
             continue
         assert all(f"``{name}``" in function.__doc__ for name in get(kind).schema), kind
+
+
+def test_a_model_of_internal_variables_only_is_drawn_in_panels(tmp_path):
+    """The rate-and-state slider has no coordinates (first-order laws only): its variables get a panel each, and
+    no energy figure (its energies are zero)."""
+    pytest.importorskip("matplotlib")
+    slider = mechgen.compile("rate_state_slider")
+    r = mechgen.simulate(slider, t_end=1.0, method="Radau")
+    assert "trajectory" in r and not any(name.endswith("_dot") for name in r["trajectory"])
+    assert [p.name for p in r.plot(tmp_path)] == ["simulate.png"]

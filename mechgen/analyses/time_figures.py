@@ -13,6 +13,8 @@ MAX_CURVES = 8
 #: the most phase portraits in one figure
 MAX_PANELS = 6
 TIME_LABEL = "t (s, or the model's time unit)"
+#: the energy series a trajectory carries besides the states (drawn in the energy figure, not as states)
+ENERGIES = ("kinetic_energy", "potential_energy", "energy", "work", "dissipated")
 
 
 def coordinates_of(trajectory: dict) -> list[str]:
@@ -27,10 +29,26 @@ def time_history(plt, a: dict, path: Path) -> list[Path]:
     names = coordinates_of(out["trajectory"])
     if out.get("plot") == "phase":
         return [phase_portrait(plt, a, names, path)]
-    written = [against_time(plt, a, names, path)]
-    if out.get("energy_series"):
+    written = [against_time(plt, a, names, path) if names else stacked(plt, a, path)]
+    if any(out.get("energy_series") or ()):  # a model with no energy (first-order laws only) has nothing to draw
         written.append(energy(plt, a, path.with_name(path.stem + "_energy.png")))
     return written
+
+
+def stacked(plt, a: dict, path: Path) -> Path:
+    """A model without coordinates (internal variables only): each variable in its own panel against t (up to
+    MAX_PANELS; their scales differ), the energies left out."""
+    out = a["outputs"]
+    names = [n for n in out["trajectory"] if n not in ENERGIES][:MAX_PANELS]
+    fig, axes = plt.subplots(len(names) or 1, 1, figsize=(7, 1.8 * max(len(names), 1) + 0.6), sharex=True,
+                             squeeze=False)
+    for ax, name in zip(axes[:, 0], names):
+        ax.plot(out["t"], out["trajectory"][name])
+        _events(ax, out)
+        ax.set_ylabel(name)
+    axes[-1, 0].set_xlabel(TIME_LABEL)
+    fig.suptitle(f"{a['name']}: time history")
+    return _save(plt, fig, path)
 
 
 def against_time(plt, a: dict, names: list[str], path: Path) -> Path:
