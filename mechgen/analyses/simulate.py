@@ -160,7 +160,8 @@ def needs(options: dict, *, internal: bool) -> set[str]:
     if options.get("method") == "variational":
         return {"lagrangian", "outputs", "energy_rates"} | start
     balance = {"energy_rates"} if options.get("method") != "cvodes" else set()
-    return {"residual", "tangent", "outputs"} | start | balance | ({"rates", "rates_tangent"} if internal else set())
+    return ({"residual", "tangent", "flow", "outputs"} | start | balance
+            | ({"rates", "rates_tangent"} if internal else set()))
 
 
 def declared_start(system) -> np.ndarray | None:

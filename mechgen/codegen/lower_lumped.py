@@ -4,6 +4,7 @@ Kernel names and what they compute (n coordinates, m internal variables):
 
 * ``residual``  r(q, v, a, z, t)                       -> r[n]
 * ``tangent``   dr/dq, dr/dv, dr/da, dr/dz            -> r_q[n*n], r_v[n*n], r_a[n*n], r_z[n*m]
+* ``flow``      what a time step needs of the residual, in one block: r(q, v, 0, z, t), M = dr/da -> r[n], M[n*n]
 * ``linear``    M, D, G, K at (q, v, z, t) with a = 0  -> M, D, G, K [n*n]
 * ``force``     -dV/dq                                 -> f[n]  (meta ``separable``: fit for the splittings,
                 mechgen.symbolic.separable; ``separable_why``: why not)
@@ -93,6 +94,10 @@ def lower_lumped(eqs: LumpedEquations, name: str, *, cse: bool = True) -> Kernel
     if name == "tangent":
         mats = {f"r_{w}": eqs.jacobian(r, w) for w in ("q", "v", "a", "z")}
         return _matrix_kernel(eqs, name, "Jacobians of the residual", mats, accel=True, cse=cse)
+    if name == "flow":
+        at_rest = {ai: 0 for ai in eqs.a}
+        mats = {"r": r.subs(at_rest), "M": eqs.jacobian(r, "a").subs(at_rest)}
+        return _matrix_kernel(eqs, name, "r at a = 0 and M = dr/da (dx/dt = (v, -M^-1 r))", mats, accel=False, cse=cse)
     if name == "linear":
         return _matrix_kernel(eqs, name, "M, D, G, K of the linearisation (a = 0)", eqs.linear_matrices(),
                               accel=False, cse=cse, symmetric=("M", "D"))

@@ -48,7 +48,7 @@ PORTS = 8
 INPUTS = {"q": 0, "v": 1, "a": 2, "z": 3, "t": 4, "p": 5}
 #: the outputs each kernel kind gives the loop
 PICKS = {"residual": ("r", "r"), "tangent": ("r_a", "r_a"), "rates": ("g", "g"), "guards": ("g", "g_t"),
-         "reset": ("x", "x")}
+         "reset": ("x", "x"), "flow_r": ("r", "r"), "flow_M": ("M", "M")}
 KINDS = ("residual", "tangent", "rates", "guards", "reset")
 
 DONE, TERMINATED, PAUSED, FULL_SAMPLES, FULL_EVENTS, SLICED = 0, 1, 2, 3, 4, 5
@@ -152,6 +152,9 @@ class _Tables:
                 name = f"{kind}__{i}"
                 if name in system.kernels:
                     setattr(mode, kind, self.kernel(system.kernels[name], kind))
+            if f"flow__{i}" in system.kernels:  # r and M from one call (the loop calls it once for both)
+                mode.residual = self.kernel(system.kernels[f"flow__{i}"], "flow_r")
+                mode.tangent = self.kernel(system.kernels[f"flow__{i}"], "flow_M")
             guards = system.guards(i)
             self.names.append(tuple(g.name for g in guards))
             mode.nguards = len(guards)
@@ -188,8 +191,9 @@ def _supported(system) -> str | None:
     """Why the kernels of ``system`` cannot be called from the C loop (None when they can)."""
     for name, kernel in system.kernels.items():
         base = name.rpartition("__")[0]
-        if base not in KINDS:
+        if base not in KINDS and base != "flow":
             continue
+        picks = PICKS["flow_r"] + PICKS["flow_M"] if base == "flow" else PICKS[base]
         if kernel.address is None:
             return f"kernel {name} has no C function address"
         spec = kernel.spec
@@ -198,8 +202,8 @@ def _supported(system) -> str | None:
         if any(p["name"] not in INPUTS or p.get("integer") for p in spec["inputs"]):
             return f"kernel {name} has inputs other than q, v, a, z, t, p"
         names = [p["name"] for p in spec["outputs"]]
-        if any(p not in names for p in PICKS[base]):
-            return f"kernel {name} lacks the outputs {', '.join(PICKS[base])}"
+        if any(p not in names for p in picks):
+            return f"kernel {name} lacks the outputs {', '.join(dict.fromkeys(picks))}"
     for i in range(len(system.modes)):
         for kind in (("residual", "tangent") if system.n else ()) + (("rates",) if system.m else ()):
             if f"{kind}__{i}" not in system.kernels:

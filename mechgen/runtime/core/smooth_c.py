@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 #: the kernels the loop calls, per mode
-LOOP_KERNELS = ("residual", "tangent", "rates")
+LOOP_KERNELS = ("residual", "tangent", "flow", "rates")
 
 
 class SmoothView:

@@ -338,8 +338,12 @@ class System:
             M = tan["r_a"]
             return self._solve(M, -self.residual(q, v, None, z, t)), M
         state = {"q": q, "v": v, "z": z, "t": t}
-        r = self.bound("residual").evaluate(**state)["r"]
-        M = self.bound("tangent").evaluate(**state)["r_a"].reshape(self.n, self.n)
+        if "flow" in self.kernels:  # r and M in one call
+            out = self.bound("flow").evaluate(**state)
+            r, M = out["r"], out["M"].reshape(self.n, self.n)
+        else:
+            r = self.bound("residual").evaluate(**state)["r"]
+            M = self.bound("tangent").evaluate(**state)["r_a"].reshape(self.n, self.n)
         return np.linalg.solve(M, -r), M
 
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray:

@@ -309,7 +309,8 @@ static int rhs(mgh_ctx *c, long mode, double t, const double *x, double *f)
         return rc;
     for (i = 0; i < n; ++i)
         c->b[i] = -c->kout[md->residual.pick[0]][i];
-    if ((rc = kcall(c, &md->tangent, MGH_K_TANGENT, mode, x, NULL, t)) != 0)
+    /* one kernel may give both r and M (the fused `flow` kernel): its outputs are still in kout */
+    if (md->tangent.fn != md->residual.fn && (rc = kcall(c, &md->tangent, MGH_K_TANGENT, mode, x, NULL, t)) != 0)
         return rc;
     memcpy(c->M, c->kout[md->tangent.pick[0]], (size_t)(n * n) * sizeof(double));
     if (solve(n, c->M, c->b)) {
