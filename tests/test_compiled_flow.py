@@ -142,3 +142,17 @@ def test_loop_c_refused_where_it_cannot_run(folder):
         mechgen.simulate(system, t_end=1.0, method="DOP853", loop="c")
     r = mechgen.simulate(system, t_end=1.0, q0={"x": 0.5})
     assert r["loop"] == "python"
+
+
+def test_a_parameter_change_reaches_the_compiled_loop(duffing):
+    """No hidden state: with_params copies share the loop's kernel tables but each run reads its own system's
+    parameters (a sweep over F gave the first point's answer at every point when the view was memoised)."""
+    grid = [0.0, 0.3, 1.0]
+    swept = mechgen.sweep(duffing, "simulate", grid={"F": grid}, t_end=10.0, q0={"x": 0.5}, samples=11)
+    for F, x_end in zip(grid, swept["energy"]):
+        c = mechgen.simulate(duffing.with_params(F=F), t_end=10.0, q0={"x": 0.5}, samples=11)
+        py = mechgen.simulate(duffing.with_params(F=F), t_end=10.0, q0={"x": 0.5}, samples=11, loop="python")
+        assert c["loop"] == "c" and py["loop"] == "python"
+        assert c["trajectory"]["x"][-1] == pytest.approx(py["trajectory"]["x"][-1], abs=1e-9)
+        assert x_end == pytest.approx(c["energy"], rel=1e-12)
+    assert len(set(np.round(swept["energy"], 6))) == 3

@@ -30,14 +30,16 @@ class SmoothView:
     is_lattice = False
     is_field = False
 
-    def __init__(self, system, extra: int = 0) -> None:
+    def __init__(self, system, extra: int = 0, patterns: dict | None = None) -> None:
         self.system = system
         self.kernels = {f"{k}__0": system.kernels[k] for k in LOOP_KERNELS if k in system.kernels}
         self.m = system.m
         if extra:  # internal variables followed by integrated quantities: the energy_rates kernel's g
             self.kernels["rates__0"] = system.kernels["energy_rates"]
             self.m = system.m + extra
-        self.patterns: dict = {}  # the loop's memo (its tables), this view's own
+        #: the loop's memo (its kernel tables): a function of the kernels only, shared by the systems that share
+        #: them (with_params copies); the parameters are read from ``system`` at every run
+        self.patterns: dict = {} if patterns is None else patterns
 
     def __getattr__(self, name: str):  # n, m, params, metadata, backend: the system's
         return getattr(self.system, name)
@@ -50,12 +52,11 @@ class SmoothView:
 
 
 def view_of(system, extra: int = 0) -> SmoothView:
-    """The system's loop view, made once per system (a memo of its frozen kernels); ``extra`` > 0: the state
-    carries that many integrals after the internal variables, their rates from the ``energy_rates`` kernel."""
-    key = ("c_loop", "smooth_view", extra)
-    if key not in system.patterns:
-        system.patterns[key] = SmoothView(system, extra)
-    return system.patterns[key]
+    """The system's loop view (``extra`` > 0: the state carries that many integrals after the internal variables,
+    their rates from the ``energy_rates`` kernel). A new view of this very system each time (it reads the
+    system's parameters), over a memo of kernel tables kept in the system's own memo (shared by its
+    with_params copies, whose kernels are the same)."""
+    return SmoothView(system, extra, system.patterns.setdefault(("c_loop", "smooth_view", extra), {}))
 
 
 def smooth_loop_problem(system, rtol=1e-8, atol=1e-10, extra: int = 0) -> str | None:
