@@ -1,0 +1,189 @@
+"""The reference pages of the analysis kinds, generated from the analyses registry (reStructuredText text).
+
+Each page comes from the objects the scene loader validates against: the kind's ``schema`` (option names,
+defaults, the ``expected`` text, the check function's docstring as the meaning), the kind's module docstring
+(what it computes) and the outputs documented in :mod:`mechgen.analyses.outputs_doc`. Nothing here imports
+Sphinx; ``docs/_ext/mechgen_reference.py`` writes these strings into the documentation at build time, so
+the reference and the loader cannot disagree on names or defaults.
+"""
+from __future__ import annotations
+
+import importlib
+import inspect
+from typing import Any
+
+from mechgen.analyses.outputs_doc import outputs_of
+from mechgen.analyses.registry import MODULES, get, kinds
+from mechgen.analyses.schema import ABSENT, ALL_OUTPUTS, REQUIRED, Option
+
+#: where a kind's page lives relative to the documentation's root (``kinds/<kind>``)
+FOLDER = "kinds"
+
+
+def escape_bars(line: str) -> str:
+    """``|`` outside inline literals escaped (a docstring's \|x\| is a norm, not a substitution)."""
+    parts = line.split("``")
+    return "``".join(part if i % 2 else part.replace("|", "\\|") for i, part in enumerate(parts))
+
+
+def docstring_rst(text: str | None) -> str:
+    """A module docstring as reStructuredText: bars escaped, and each indented block after a blank line (the
+    formulas docstrings set apart) shown as a literal block, as Python's help() shows it; an
+    indented line right after text (a bullet's continuation) stays as it is."""
+    lines = inspect.cleandoc(text or "").splitlines()
+    out: list[str] = []
+    inside = False
+    for line in lines:
+        indented = line.startswith(" ") and line.strip()
+        follows_text = bool(out) and bool(out[-1].strip())
+        if indented and not inside and follows_text:
+            out.append(escape_bars(line))  # a bullet's or a definition's continuation
+            continue
+        if indented and not inside:
+            while out and not out[-1].strip():
+                out.pop()
+            if out and out[-1].rstrip().endswith(":") and not out[-1].rstrip().endswith("::"):
+                out[-1] = out[-1].rstrip() + ":"
+            else:
+                out.append("::")
+            out.append("")
+            inside = True
+        elif line.strip() and not indented:
+            if inside:
+                out.append("")
+            inside = False
+        out.append(line if inside else escape_bars(line))
+    return "\n".join(out)
+
+
+def default_text(option: Option) -> str:
+    """An option's default as a reader sees it: ``required``, ``optional`` (no default), every output, or the
+    value as TOML-like literal text."""
+    if option.default is REQUIRED:
+        return "**required**"
+    if option.default is ABSENT:
+        return "optional (no default)"
+    if option.default is ALL_OUTPUTS:
+        return "every model output"
+    return f"``{option.default!r}``"
+
+
+def first_paragraph(text: str | None) -> str:
+    """The first paragraph of a docstring, its lines joined (empty for none)."""
+    paragraph = inspect.cleandoc(text or "").split("\n\n")[0]
+    return " ".join(line.strip() for line in paragraph.splitlines())
+
+
+def check_meaning(check: Any) -> str:
+    """What a check accepts: its docstring's first paragraph, or for the checks made by a factory (a choice,
+    a bounded count) the values closed over; empty when neither says."""
+    text = first_paragraph(getattr(check, "__doc__", None))
+    if text:
+        return text
+    try:
+        closed = inspect.getclosurevars(check).nonlocals
+    except (TypeError, ValueError):
+        return ""
+    if "names" in closed:
+        return "One of: " + ", ".join(f"``{name}``" for name in closed["names"]) + "."
+    if "limit" in closed:
+        return f"An integer from 1 to the safety limit ``{closed['limit']}`` (raised in a scene's ``[limits]``)."
+    if "low" in closed and "high" in closed:
+        return f"An integer from {closed['low']} to {closed['high']}."
+    return ""
+
+
+def option_meaning(option: Option) -> str:
+    """An option's meaning: what its check accepts, the ``expected`` text where it says more."""
+    meaning = check_meaning(option.check)
+    if option.expected and option.expected != "a value" and option.expected.lower() not in meaning.lower():
+        meaning = (meaning + " " if meaning else "") + f"Expected: {option.expected}."
+    return meaning or "See the module's description above."
+
+
+def cell(text: str) -> str:
+    """Text for one cell of a list-table (one line; an empty cell as a dash)."""
+    return " ".join(text.split()) or "-"
+
+
+def table(header: tuple[str, ...], rows: list[tuple[str, ...]], widths: str) -> list[str]:
+    """A reStructuredText list-table."""
+    lines = [".. list-table::", "   :header-rows: 1", f"   :widths: {widths}", ""]
+    for row in [header, *rows]:
+        lines.append(f"   * - {cell(row[0])}")
+        lines.extend(f"     - {cell(value)}" for value in row[1:])
+    return lines + [""]
+
+
+def module_of(kind: str) -> str:
+    """The module that registers ``kind`` (a built-in kind's own module)."""
+    for module in MODULES:
+        if module.rsplit(".", 1)[1] == kind:
+            return module
+    return get(kind).run.__module__
+
+
+def title(text: str, underline: str) -> list[str]:
+    return [text, underline * len(text), ""]
+
+
+def options_section(kind: str) -> list[str]:
+    """The scene keys of ``kind``: name, default, meaning, from its schema."""
+    schema = get(kind).schema
+    if not schema:
+        return title("Scene keys", "-") + ["This kind takes no options.", ""]
+    rows = [(f"``{name}``", default_text(option), option_meaning(option)) for name, option in schema.items()]
+    return title("Scene keys", "-") + table(("key", "default", "meaning"), rows, "18 18 64")
+
+
+def outputs_section(kind: str) -> list[str]:
+    """The outputs of ``kind`` (mechgen.analyses.outputs_doc), or a pointer to its module docstring."""
+    documented = outputs_of(kind)
+    head = title("Outputs", "-")
+    if not documented:
+        return head + [f"Not tabulated yet: see the outputs named in the description above "
+                       f"(``{module_of(kind)}``).", ""]
+    rows = [(f"``{o.name}``", o.shape, o.unit, o.meaning) for o in documented]
+    return head + table(("name", "shape", "unit", "meaning"), rows, "18 16 16 50")
+
+
+def usage_section(kind: str) -> list[str]:
+    """How to call the kind: a scene table and the Python function."""
+    required = [name for name, option in get(kind).schema.items() if option.default is REQUIRED]
+    scene = ["[[analysis]]", f'name = "{kind}"', f'kind = "{kind}"'] + [f"# {name} = ...  (required)"
+                                                                        for name in required]
+    from mechgen.analyses import public
+
+    python = (f"mechgen.{kind}(system, ...)" if kind in public.__all__
+              else f'mechgen.analysis("{kind}", system, ...)')
+    lines = title("Usage", "-") + ["In a scene (required keys shown):", "", ".. code-block:: toml", ""]
+    lines += [f"   {line}" for line in scene] + ["", f"From Python: ``{python}``, returning a "
+                                                    ":class:`mechgen.Result`.", ""]
+    return lines
+
+
+def kind_page(kind: str) -> str:
+    """The reference page of one analysis kind (reStructuredText)."""
+    module = module_of(kind)
+    doc = docstring_rst(importlib.import_module(module).__doc__)
+    lines = [f".. _kind-{kind}:", ""] + title(f"``{kind}``", "=")
+    lines += [doc, "", f"*Module:* ``{module}``.", ""]
+    lines += options_section(kind) + outputs_section(kind) + usage_section(kind)
+    return "\n".join(lines)
+
+
+def index_page() -> str:
+    """The page listing every kind, with a toctree of their pages."""
+    lines = title("Analysis kinds", "=")
+    lines += ["One page per analysis kind, generated from the analyses registry (``mechgen.analyses.registry``) "
+              "and the schemas the scene loader validates against.", ""]
+    rows = [(f":ref:`{kind} <kind-{kind}>`", first_paragraph(importlib.import_module(module_of(kind)).__doc__))
+            for kind in kinds()]
+    lines += table(("kind", "what it computes"), rows, "20 80")
+    lines += [".. toctree::", "   :hidden:", ""] + [f"   {kind}" for kind in kinds()] + [""]
+    return "\n".join(lines)
+
+
+def pages() -> dict[str, str]:
+    """Every generated page: file name (``index.rst``, ``<kind>.rst``) -> text."""
+    return {"index.rst": index_page(), **{f"{kind}.rst": kind_page(kind) for kind in kinds()}}
