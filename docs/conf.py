@@ -36,7 +36,6 @@ html_theme_options = {"nosidebar": False}
 # fetches nothing (no intersphinx mapping, no remote images)
 autodoc_member_order = "bysource"
 autodoc_typehints = "description"
-autodoc_default_options = {"members": False}
 napoleon_google_docstring = True
 napoleon_numpy_docstring = False
 myst_heading_anchors = 3

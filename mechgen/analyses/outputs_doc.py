@@ -64,8 +64,9 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("iterations", "scalar (int)", "-", "Newton iterations (or the BVP solver's)."),
         _o("residual_norm", "scalar", "the residual's", "The norm of the residual at the answer."),
         _o("coordinates", "{coordinate: value}", MODEL_UNIT, "A lumped model's equilibrium."),
-        _o("<output>", "scalar", "the output's", "Each model output at the equilibrium (Newton), or at the "
-           "ends and its extremes along s (a boundary value problem)."),
+        _o("<output>", "scalar", "the output's", "Each model output (with the built-in ``kinetic_energy``, "
+           "``potential_energy`` and ``energy``) at the equilibrium (Newton), or at the ends and its extremes "
+           "along s (a boundary value problem)."),
         _o("s", "(points,)", "m", "A continuum's stations along s."),
         _o("deflection", "(points,)", MODEL_UNIT, "A continuum's steady deflection at ``s``."),
         _o("reactions", "table", MODEL_UNIT, "A continuum solved by Newton: the constraint reactions."),
@@ -76,8 +77,13 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
            "The time history: each coordinate, ``<coordinate>_dot``, internal variable and model output at "
            "``t`` (numpy arrays through ``result['trajectory']['x']``), with ``energy_series``; left out for a "
            "very large state unless ``series = true``."),
-        _o("<output>", "scalar", "the output's", "Each model output (and coordinate) at ``t_end``."),
-        _o("energy_drift", "scalar", "-", "A conservative run: max \\|E - E(0)\\| / max(\\|T\\| + \\|V\\|) over the samples."),
+        _o("<output>", "scalar", "the output's", "Each model output and the built-in ``kinetic_energy``, "
+           "``potential_energy`` and ``energy`` at ``t_end``."),
+        _o("energy_series", "(samples,)", "J (the model's energy unit)", "The energy E = T + V at ``t`` (with "
+           "``trajectory``)."),
+        _o("series_note", "string", "-", "Why the time history was left out (a very large state)."),
+        _o("energy_drift", "scalar", "-",
+           "A conservative run: max \\|E - E(0)\\| / max(\\|T\\| + \\|V\\|) over the samples."),
         _o("energy_balance_error", "scalar", "-", "A run with forcing or dissipation: max_t \\|h(t) - h(0) - W(t) + "
            "D(t)\\| / S, S = max_t (\\|T\\| + \\|V\\|, \\|W\\|, D) (mechgen.analyses.energy_balance)."),
         _o("work", "scalar", "J (the model's energy unit)", "The work done on the system by forces and by "

@@ -21,7 +21,7 @@ FOLDER = "kinds"
 
 
 def escape_bars(line: str) -> str:
-    """``|`` outside inline literals escaped (a docstring's \|x\| is a norm, not a substitution)."""
+    """``|`` outside inline literals escaped (a docstring's |x| is a norm, not a substitution)."""
     parts = line.split("``")
     return "``".join(part if i % 2 else part.replace("|", "\\|") for i, part in enumerate(parts))
 
@@ -154,10 +154,10 @@ def usage_section(kind: str) -> list[str]:
                                                                         for name in required]
     from mechgen.analyses import public
 
-    python = (f"mechgen.{kind}(system, ...)" if kind in public.__all__
-              else f'mechgen.analysis("{kind}", system, ...)')
+    python = (f":func:`mechgen.{kind}(system, ...) <mechgen.analyses.public.{kind}>`" if kind in public.__all__
+              else f':func:`mechgen.analysis("{kind}", system, ...) <mechgen.analyses.public.analysis>`')
     lines = title("Usage", "-") + ["In a scene (required keys shown):", "", ".. code-block:: toml", ""]
-    lines += [f"   {line}" for line in scene] + ["", f"From Python: ``{python}``, returning a "
+    lines += [f"   {line}" for line in scene] + ["", f"From Python: {python}, returning a "
                                                     ":class:`mechgen.Result`.", ""]
     return lines
 

@@ -1,0 +1,189 @@
+"""The documentation site (issue 26, first increment): it builds with warnings as errors, offline, every
+analysis kind has its generated reference page, no internal link or anchor is broken, and every gallery
+script runs (sphinx-gallery executes them during the build and aborts on an error; each script asserts its
+own error against its reference).
+
+The outputs documented in mechgen.analyses.outputs_doc are checked against what the kinds return for a few
+runs: every output a run returns is documented (or is a coordinate / model output, documented as such).
+"""
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+import sys
+from html.parser import HTMLParser
+from pathlib import Path
+from urllib.parse import unquote, urlsplit
+
+import pytest
+
+from mechgen.analyses import reference
+from mechgen.analyses.outputs_doc import OUTPUTS, outputs_of
+from mechgen.analyses.registry import get, kinds
+from mechgen.symbolic.names import BUILTIN_OUTPUTS
+
+ROOT = Path(__file__).resolve().parents[1]
+DOCS = ROOT / "docs"
+
+pytest.importorskip("sphinx")
+pytest.importorskip("sphinx_gallery")
+
+
+class Links(HTMLParser):
+    """The href/src targets and the ids of one HTML page."""
+
+    def __init__(self):
+        super().__init__()
+        self.targets: list[str] = []
+        self.ids: set[str] = set()
+
+    def handle_starttag(self, tag, attrs):
+        for key, value in attrs:
+            if key in ("href", "src") and value is not None:
+                self.targets.append(value)
+            if key in ("id", "name") and value:
+                self.ids.add(value)
+
+
+def parse(page: Path) -> Links:
+    links = Links()
+    links.feed(page.read_text(encoding="utf-8"))
+    return links
+
+
+@pytest.fixture(scope="module")
+def site(tmp_path_factory):
+    """The site built from a copy of docs/ (the build writes the generated pages and the gallery into its
+    source folder), warnings as errors, with the network unused: no intersphinx, no remote image."""
+    work = tmp_path_factory.mktemp("docs")
+    source = work / "docs"
+    shutil.copytree(DOCS, source, ignore=shutil.ignore_patterns("_build", "auto_examples", "kinds",
+                                                               "sg_execution_times.rst"))
+    out = work / "html"
+    run = subprocess.run([sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-b", "html", str(source),
+                          str(out)], capture_output=True, text=True, timeout=600, cwd=work)
+    assert run.returncode == 0, run.stdout + run.stderr
+    return out
+
+
+def test_every_kind_has_its_generated_page(site):
+    index = (site / "kinds" / "index.html").read_text(encoding="utf-8")
+    for kind in kinds():
+        page = site / "kinds" / f"{kind}.html"
+        assert page.exists(), kind
+        text = page.read_text(encoding="utf-8")
+        for option in get(kind).schema:  # every scene key the loader accepts is on the page
+            assert f">{option}<" in text, (kind, option)
+        assert f"{kind}.html" in index
+
+
+def test_no_broken_internal_links(site):
+    """Every relative href/src of every page names a file of the build, and every #fragment an id there."""
+    pages = sorted(site.rglob("*.html"))
+    assert len(pages) > 20
+    ids = {page: parse(page).ids for page in pages}
+    broken = []
+    for page in pages:
+        for target in parse(page).targets:
+            parts = urlsplit(target)
+            if parts.scheme or target.startswith("//"):  # external (docstrings' tcp://host:port included)
+                continue
+            path = (page.parent / unquote(parts.path)).resolve() if parts.path else page
+            if not path.exists():
+                broken.append((page.relative_to(site), target))
+            elif parts.fragment and path.suffix == ".html" and unquote(parts.fragment) not in ids.get(path, set()):
+                broken.append((page.relative_to(site), target))
+    assert not broken, broken
+
+
+def test_no_remote_images(site):
+    """Offline: no page shows an image fetched from the network."""
+    for page in site.rglob("*.html"):
+        for target in re.findall(r'<img[^>]+src="([^"]+)"', page.read_text(encoding="utf-8")):
+            assert not urlsplit(target).scheme, (page, target)
+
+
+def test_every_gallery_script_ran_and_drew(site):
+    """Each docs/examples/plot_*.py has its page with its printed output and at least one figure."""
+    scripts = sorted((DOCS / "examples").glob("plot_*.py"))
+    assert len(scripts) >= 3
+    for script in scripts:
+        page = site / "auto_examples" / f"{script.stem}.html"
+        text = page.read_text(encoding="utf-8")
+        assert "sphx-glr-script-out" in text, script.name  # the captured stdout
+        assert re.search(rf'src="[^"]*sphx_glr_{script.stem}_\d+\.png"', text), script.name
+        assert "Traceback" not in text, script.name
+
+
+def test_generated_pages_name_every_option_and_output():
+    """Without Sphinx: each page holds each schema key with its default, and each documented output."""
+    pages = reference.pages()
+    assert set(pages) == {"index.rst"} | {f"{k}.rst" for k in kinds()}
+    for kind in kinds():
+        text = pages[f"{kind}.rst"]
+        for name, option in get(kind).schema.items():
+            assert f"``{name}``" in text and reference.default_text(option) in text, (kind, name)
+        for output in outputs_of(kind):
+            assert f"``{output.name}``" in text, (kind, output.name)
+    assert {"modes", "stability", "steady", "simulate", "sweep", "campbell"} <= set(OUTPUTS)
+
+
+def test_docstring_rst_keeps_formulas_literal():
+    """A norm's bars are escaped outside literals, an indented formula after a blank line becomes a literal
+    block, and a bullet's continuation line stays in its bullet."""
+    text = "Title.\n\nThe error |x| and ``a|b``:\n\n    e = |v_r| / v_c\n\n* item\n  continued\n"
+    rst = reference.docstring_rst(text)
+    assert "The error \\|x\\| and ``a|b``::" in rst
+    assert "    e = |v_r| / v_c" in rst
+    assert "* item\n  continued" in rst
+
+
+MODEL = '''\
+"""Forced, damped oscillator with a floor: m x'' + c x' + k x = F cos(w t)."""
+import sympy as sp
+from mechgen import Model, Param
+
+model = Model("docs_outputs_oscillator", doc=__doc__)
+model.params(Param("m", 1.0), Param("c", 0.1), Param("k", 4.0), Param("F", 0.5), Param("w", 1.5))
+model.coordinates("x")
+
+
+@model.kinetic
+def kinetic(v, p):
+    return p.m * v.x**2 / 2
+
+
+@model.potential
+def potential(q, p):
+    return p.k * q.x**2 / 2
+
+
+@model.dissipation
+def dissipation(v, p):
+    return p.c * v.x**2 / 2
+
+
+@model.forces
+def forces(p, t):
+    return {"x": p.F * sp.cos(p.w * t)}
+
+
+model.output("spring_force", lambda q, p: p.k * q.x, unit="N")
+'''
+
+
+def test_documented_outputs_cover_what_the_kinds_return(tmp_path):
+    """Every output modes, stability, steady and simulate return for a forced, damped oscillator is documented
+    (a coordinate or a model output counts as the documented ``<output>``)."""
+    import mechgen
+
+    (tmp_path / "oscillator.py").write_text(MODEL)
+    system = mechgen.compile(str(tmp_path / "oscillator.py"))
+    model_names = {"x", "spring_force", *BUILTIN_OUTPUTS}
+    results = {"modes": mechgen.modes(system), "stability": mechgen.stability(system),
+               "steady": mechgen.steady(system), "simulate": mechgen.simulate(system, t_end=1.0, samples=11)}
+    for kind, result in results.items():
+        documented = {o.name for o in outputs_of(kind)}
+        for key in result.keys():
+            assert key in documented or (key in model_names and "<output>" in documented), (kind, key)
