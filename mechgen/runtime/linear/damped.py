@@ -26,6 +26,10 @@ sigma defaults to a small negative real number below the lowest frequency scale,
 Whirl: with x = Re(X e^{i wd t}), y = Re(Y e^{i wd t}) the orbit's signed area rate is
 x y' - y x' averaged = wd Im(X conj(Y)), so the orbit is counter-clockwise about z = x cross y
 (forward, the sense of a positive spin) when Im(X conj(Y)) > 0 and clockwise (backward) when < 0.
+The orbit is an ellipse (:func:`orbit_axes`: semi-axes, the major axis's angle, the signed ratio
+kappa = minor / major); a straight line (|kappa| <= 1e-6) has no direction and is labelled 'linear', a
+mode that leaves the stations at rest 'none' (:func:`whirl`). A double eigenvalue's plane is re-chosen
+as its backward and forward circles by :func:`circular_pair`.
 """
 from __future__ import annotations
 
