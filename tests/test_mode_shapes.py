@@ -292,3 +292,30 @@ def test_shapes_and_orbits_plots(model_files, tmp_path):
     rotor = mechgen.modes(mechgen.compile(str(model_files["laval_tilt"]), {"Omega": 2.5}, backend="numpy"))
     written = rotor.plot(tmp_path / "rotor")
     assert {p.name.rsplit("_", 1)[-1] for p in written} >= {"shapes.png", "orbits.png"}
+
+
+def test_laval_rotor_judges_tilt_modes_at_its_tilt_station():
+    """The built-in Laval rotor declares two whirl stations (centre x, y and tilts theta_x, theta_y): its tilt
+    modes, which leave x, y at rest, whirl backward at w_b and forward at w_f = (-+Ip Omega + sqrt(Ip^2 Omega^2
+    + 4 Id k_r)) / (2 Id) (model docstring), circles (whirl_ratio -+1); the translation pair at sqrt(k_t/m)
+    stays (backward, forward). Frequencies to 1e-12 relative."""
+    m, Ip, Id, k_t, k_r, speed = 10.0, 0.2, 0.1, 4.0e5, 2.0e4, 600.0
+    res = mechgen.modes(mechgen.compile("laval_rotor", {"Omega": speed}, backend="numpy"))
+    root = np.sqrt(Ip**2 * speed**2 + 4 * Id * k_r)
+    wb, wf, wt = (-Ip * speed + root) / (2 * Id), (Ip * speed + root) / (2 * Id), np.sqrt(k_t / m)
+    np.testing.assert_allclose(res["frequencies"], [wb, wt, wt, wf], rtol=1e-12)
+    assert res["whirl"] == ["backward", "backward", "forward", "forward"]
+    np.testing.assert_allclose(res["whirl_ratio"], [-1.0, -1.0, 1.0, 1.0], rtol=1e-12)
+
+
+def test_whirl_pair_adds_stations_and_refuses_a_repeated_name():
+    from mechgen import Model
+    from mechgen.errors import ModelError
+
+    model = Model("pairs", doc="two stations")
+    model.coordinates("x", "y", "u", "v")
+    model.whirl_pair("x", "y")
+    model.whirl_pair("u", "v")
+    assert model.whirl == ("x", "y", "u", "v")
+    with pytest.raises(ModelError, match="repeats a name"):
+        model.whirl_pair("x", "v")
