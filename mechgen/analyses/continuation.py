@@ -302,12 +302,28 @@ def _one_branch(system, start: dict, options: dict, label: str | None, budget: B
     return out
 
 
+def require_bvp_start(name: str, steady: dict) -> None:
+    """Refuse (SceneError, exit 2 at ``about``) a start that is not a boundary-value steady state: continuation
+    follows the BVP in s (method shooting, multiple_shooting or collocation), not a Newton steady state of the
+    discretised (Galerkin) or lumped residual, which has no BVP to continue."""
+    if "_bvp" in steady:
+        return
+    raise SceneError(f"continuation follows a continuum's boundary-value steady state, and {name!r} is a Newton "
+                     "steady state (of the discretised or lumped residual)", key="about",
+                     expected="a steady analysis with method = \"shooting\", \"multiple_shooting\" or "
+                              "\"collocation\" (a continuum's BVP in s); for a Newton steady state, a sweep of it "
+                              "over the parameter (kind = \"sweep\", analysis = { kind = \"steady\" }) or, for "
+                              "where it loses stability, kind = \"stability_boundary\"")
+
+
 def run_continuation(system, options: dict, context: dict) -> dict:
     """The branch of steady states through the ``about`` one (or one branch per start) as ``parameter`` goes to
     ``stop``; see the module doc for the keys and outputs."""
     about = options["about"]
     starts = about if isinstance(about, list) else [about]
     name, aliases = options["parameter"], options.get("aliases", {})
+    for start in starts:
+        require_bvp_start(start, context[start])
     budget = Budget("continuation", unit="points", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
     branches = [_one_branch(system, context[s], options, s if isinstance(about, list) else None, budget)
                 for s in starts]
