@@ -20,7 +20,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import replace
 
-from mechgen.errors import InputError
+from mechgen.errors import InputError, did_you_mean
 
 
 def compile(model, params: Mapping | None = None, *, free=None, backend: str = "c", kernels=None,  # noqa: A001
@@ -93,7 +93,8 @@ def _values(model, params) -> dict:
     known = {p.name: p for p in model.param_list}
     unknown = [k for k in params if k not in known]
     if unknown:
-        raise InputError(f"model {model.name} has no parameter {', '.join(map(repr, unknown))}", key=unknown[0],
+        raise InputError(f"model {model.name} has no parameter {', '.join(map(repr, unknown))}"
+                         f"{did_you_mean(unknown[0], known)}", key=unknown[0],
                          expected="one of: " + ", ".join(known))
     out = {}
     for name, value in params.items():

@@ -109,16 +109,33 @@ def _cmd_run(args) -> int:
         check_output("--json", args.json_path, folder=False)
     if args.plot_dir is not None:
         check_output("--plot", args.plot_dir, folder=True)
-    results = run_scene(args.scene, overrides=args.overrides, backend=args.backend)
-    print(summary(results))
+    try:
+        results = run_scene(args.scene, overrides=args.overrides, backend=args.backend)
+    except MechgenError as exc:  # the analyses before the failed one are printed and written, then the error
+        partial = getattr(exc, "partial_results", None)
+        if partial is not None:
+            _report(args, partial, summary)
+        raise
+    _report(args, results, summary)
+    if not args.plot_dir:
+        print("(mechgen run SCENE --plot DIR draws the figures)")
+    return 0
+
+
+def _report(args, results: dict, summary) -> None:
+    """Write --json and draw --plot of a (possibly partial) results dict, then print the summary and the
+    files written (printing last: a reader that goes away early, ``| head``, cannot cost the files)."""
     if args.json_path:
         _write_json(args.json_path, results)
+    written = []
     if args.plot_dir:
         from mechgen.scene.plots import plot_results
 
-        for path in plot_results(results, Path(args.plot_dir)):
-            print(f"wrote {path}")
-    return 0
+        written = plot_results(results, Path(args.plot_dir))
+    print(summary(results))
+    for path in written:
+        print(f"wrote {path}")
+    sys.stdout.flush()
 
 
 def _cmd_models(_args) -> int:
@@ -176,6 +193,16 @@ def _cmd_export(args) -> int:
     return 0
 
 
+def _quiet_stdout() -> None:
+    """Point stdout at /dev/null so that Python's flush at exit does not raise into a closed pipe again."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError):
+        pass
+
+
 COMMANDS = {"run": _cmd_run, "models": _cmd_models, "show": _cmd_show, "regen": _cmd_regen, "bench": _cmd_bench,
             "export": _cmd_export}
 
@@ -189,6 +216,9 @@ def main(argv: list[str] | None = None) -> int:
         return int(exc.code or 0)
     try:
         return COMMANDS[args.command](args)
+    except BrokenPipeError:  # the reader went away (mechgen run ... | head): stop quietly, as Python's docs advise
+        _quiet_stdout()
+        return 1
     except InputError as exc:
         print(f"mechgen: {exc.paragraph()}", file=sys.stderr)
         return 2

@@ -8,6 +8,16 @@ numerical (:class:`ConvergenceError`, :class:`KernelError`) or environmental
 from __future__ import annotations
 
 
+def did_you_mean(name: object, names) -> str:
+    """`` (did you mean 'x'?)`` for the known name closest to a mistyped ``name`` (difflib's ratio >= 0.6), or ''."""
+    import difflib
+
+    if not isinstance(name, str):
+        return ""
+    close = difflib.get_close_matches(name, [str(n) for n in names], n=1)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
 class MechgenError(Exception):
     """Base class of every error mechgen raises on purpose."""
 

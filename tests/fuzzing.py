@@ -571,8 +571,18 @@ def run_case(case: Case, workdir: Path, isolate: bool = ISOLATE) -> Outcome:
     outcome = run_argv(["run", str(scene)] + own + list(case.args), workdir, case.limit_s, isolate)
     if outcome.code != 0:
         outcome.leftovers = sorted(str(p.relative_to(workdir)) for p in workdir.rglob("*")
-                                   if p == target or p.name.startswith(".tmp-"))
+                                   if p.name.startswith(".tmp-") or (p == target and not partial_json(p)))
     return outcome
+
+
+def partial_json(path: Path) -> bool:
+    """A failed run may leave its --json only whole and saying so: the analyses before the failure, then the
+    failed one as an entry with its ``error`` (issue 25: results survive a failure)."""
+    try:
+        analyses = json.loads(path.read_text())["analyses"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return False
+    return bool(analyses) and "error" in analyses[-1] and all("error" not in a for a in analyses[:-1])
 
 
 # --- judging ----------------------------------------------------------------------------------------------------

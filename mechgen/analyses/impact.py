@@ -37,7 +37,7 @@ STEP = "a number > 0 (or an expression)"
 def _method(ctx, key: str, value: object) -> str:
     from mechgen.analyses.simulate import METHODS
 
-    return schema.one_of("method", [m for m in METHODS if m != "leapfrog"])(ctx, key, value)
+    return schema.one_of("method", [m for m in METHODS if m not in ("leapfrog", "auto")])(ctx, key, value)
 
 
 def _coordinate(ctx, key: str, value: object) -> str:

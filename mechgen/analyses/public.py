@@ -16,11 +16,11 @@ from typing import Any, Mapping
 from mechgen.analyses.registry import get, kinds
 from mechgen.analyses.result import Result, run_analysis
 from mechgen.analyses.schema import OptionContext, validate
-from mechgen.errors import InputError
+from mechgen.errors import InputError, did_you_mean
 
 __all__ = ["analysis", "campbell", "continuation", "fit", "impact", "modes", "restitution", "simulate", "stability",
-           "steady", "sweep", "cross_section", "symplectic", "rod_statics",
-           "rod_dynamics"]
+           "steady", "sweep", "cross_section", "symplectic", "rod_statics", "rod_dynamics", "periodic", "spectrum",
+           "stability_boundary", "option_lines"]
 
 
 def _model_info(system):
@@ -61,7 +61,7 @@ def _check_keys(function: str, kind: str, options: Mapping[str, Any]) -> None:
     schema = get(kind).schema
     for key in options:
         if key not in schema:
-            raise InputError(f"{function}() got an unknown option {key!r}", key=key,
+            raise InputError(f"{function}() got an unknown option {key!r}{did_you_mean(key, schema)}", key=key,
                              expected=f"one of the {function}() options: " + ", ".join(schema))
 
 
@@ -136,12 +136,14 @@ def steady(system, *, name: str | None = None, **options) -> Result:
 def simulate(system, *, name: str | None = None, **options) -> Result:
     """The time response from ``q0``, ``v0`` (or ``initial_mode``) to ``t_end`` (required).
 
-    Options: ``t_end``, ``method``, ``dt``, ``rtol``, ``atol``, ``q0``, ``v0``, ``initial_mode``,
-    ``amplitude``, ``outputs``, ``series``, ``samples``, and the work budget ``max_steps``,
-    ``max_seconds``, ``progress`` (a spent budget raises BudgetExceeded). Outputs: the model's outputs at ``t_end``,
-    ``energy_drift``, ``t_end`` (and ``t``, ``energy_series`` with ``series=True``). A hybrid model
-    (mechgen.symbolic.hybrid) also takes ``mode``, ``max_events``, ``zeno_events``, ``zeno_span`` and reports
-    ``events`` (``{t, from, to, guard}``), ``final_mode`` and ``t_final`` (mechgen.analyses.simulate_hybrid).
+    Outputs: ``t`` and ``trajectory`` (each coordinate, ``<coordinate>_dot``, internal variable and output at
+    the sample times, as numpy arrays; left out for a very large state unless ``series=True``), the model's
+    outputs at ``t_end``, ``energy_drift`` (conservative runs) or ``energy_balance_error``, ``work`` and
+    ``dissipated``, ``method`` and ``loop`` (what ran: ``method="auto"`` picks DOP853 in the compiled loop, or
+    Radau when the start is stiff). A hybrid model (mechgen.symbolic.hybrid) also reports ``events``
+    (``{t, from, to, guard}``), ``final_mode``, ``t_final`` and ``mode_series`` (mechgen.analyses.simulate_hybrid);
+    ``on_zeno="stop"`` ends it at a Zeno accumulation point with ``zeno=True``. A spent budget raises
+    BudgetExceeded.
     """
     return _run("simulate", system, options, name)
 
@@ -314,3 +316,34 @@ def symplectic(system, *, name: str | None = None, **options) -> Result:
     ``recurrence_fraction``, ``t`` and ``mode_energies_series``.
     """
     return _run("symplectic", system, options, name)
+
+
+def option_lines(kind: str) -> list[str]:
+    """One line per option of ``kind``, from the schema the scene loader validates against: its name and its
+    default (``required`` / ``optional`` where it has none, ``all outputs`` for the outputs list)."""
+    from mechgen.analyses.schema import ABSENT, ALL_OUTPUTS, REQUIRED
+
+    def default(option) -> str:
+        if option.default is REQUIRED:
+            return "required"
+        if option.default is ABSENT:
+            return "optional"
+        if option.default is ALL_OUTPUTS:
+            return "default: every model output"
+        return f"default {option.default!r}"
+
+    return [f"``{name}`` ({default(option)})" for name, option in get(kind).schema.items()]
+
+
+def _with_schema_options() -> None:
+    """Append to each analysis function's docstring the options its kind's schema accepts (so that the
+    docstrings and the loader cannot disagree on names and defaults)."""
+    functions = {name: globals()[name] for name in __all__ if name not in ("analysis", "option_lines")}
+    for kind, function in functions.items():
+        if kind in kinds():
+            function.__doc__ = (function.__doc__ or "").rstrip() + (
+                "\n\n    Options accepted (from the scene schema of kind ``%s``): " % kind
+                + ", ".join(option_lines(kind)) + ".\n")
+
+
+_with_schema_options()

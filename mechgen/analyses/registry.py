@@ -7,10 +7,10 @@ and never name one. Adding a kind: write ``mechgen/analyses/<kind>.py`` ending i
 from __future__ import annotations
 
 import importlib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping
 
-from mechgen.errors import InputError
+from mechgen.errors import InputError, did_you_mean
 
 #: the modules that register a kind, in the order kinds are listed (scene messages, ``kinds()``)
 MODULES = (
@@ -56,6 +56,9 @@ class AnalysisKind:
         summary: ``outputs -> [line]``: the text summary's lines for these outputs.
         plot: ``(plt, entry, path) -> [written paths]`` for a scene-JSON entry, or None (nothing to plot).
         sweepable: whether a sweep may repeat this kind over a grid.
+        point_defaults: options a sweep's point takes where the sweep's table leaves them out, when they
+            differ from a lone analysis's defaults (a simulate's ``series``: a grid of time histories would be
+            the samples times the points).
     """
 
     name: str
@@ -67,6 +70,7 @@ class AnalysisKind:
     frees: Callable[[Mapping[str, Any]], list[str]] = no_free
     plot: Callable | None = None
     sweepable: bool = False
+    point_defaults: Mapping[str, Any] = field(default_factory=dict)
 
 
 _KINDS: dict[str, AnalysisKind] = {}
@@ -107,7 +111,7 @@ def get(name: str) -> AnalysisKind:
     """The kind called ``name``; an InputError listing the kinds when there is none."""
     _load()
     if name not in _KINDS:
-        raise InputError(f"unknown analysis kind {name!r}", key="kind", expected="one of: " + ", ".join(kinds()))
+        raise InputError(f"unknown analysis kind {name!r}{did_you_mean(name, kinds())}", key="kind", expected="one of: " + ", ".join(kinds()))
     return _KINDS[name]
 
 

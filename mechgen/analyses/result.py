@@ -1,14 +1,21 @@
 """The result of one analysis: what ``mechgen.modes(...)`` and friends return, and what a scene's run collects.
 
 ``Result.outputs`` holds the named outputs under the names the scene JSON uses (DESIGN.md,
-"results contract"); ``to_json()`` is exactly the scene JSON's entry for the analysis
-({"name", "kind", "outputs", "seconds"}); ``plot(directory)`` draws the kind's figures.
+"results contract"), JSON-ready; ``result[name]`` gives the same output as numpy arrays (a list of
+numbers, or a rectangular nest of them, becomes an array; an object its values converted; strings
+and lists of objects stay as they are). ``to_json()`` is exactly the scene JSON's entry for the
+analysis ({"name", "kind", "outputs", "seconds"}); ``plot(directory)`` draws the kind's figures. A
+Result prints the summary lines ``mechgen run`` prints, and renders as a table in a notebook.
 """
 from __future__ import annotations
 
+import difflib
+import html
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+
+import numpy as np
 
 from mechgen.analyses.context import public
 from mechgen.analyses.registry import get
@@ -34,7 +41,24 @@ class Result:
     working: dict = field(default_factory=dict, repr=False, compare=False)
 
     def __getitem__(self, key: str):
-        return self.outputs[key]
+        """The output ``key`` with numbers as numpy arrays (:func:`as_arrays`); a missing key lists those there
+        are (and the closest one)."""
+        if key not in self.outputs:
+            raise KeyError(missing_key(key, self.outputs, f"{self.kind} result {self.name!r}"))
+        return as_arrays(self.outputs[key])
+
+    def __repr__(self) -> str:
+        return "\n".join([f"Result {self.kind} {self.name!r} ({self.seconds:.3f} s)", *get(self.kind).summary(
+            self.outputs)])
+
+    def _repr_html_(self) -> str:
+        """A two-column table (output, value as the summary shows it) for a notebook."""
+        from mechgen.analyses.summary import fmt
+
+        rows = "".join(f"<tr><td><code>{html.escape(str(k))}</code></td><td>{html.escape(fmt(v))}</td></tr>"
+                       for k, v in self.outputs.items())
+        return (f"<p><b>{html.escape(self.kind)}</b> {html.escape(repr(self.name))} ({self.seconds:.3f} s)</p>"
+                f"<table><tr><th>output</th><th>value</th></tr>{rows}</table>")
 
     def __contains__(self, key: object) -> bool:
         return key in self.outputs
@@ -42,6 +66,10 @@ class Result:
     def keys(self):
         """The output names."""
         return self.outputs.keys()
+
+    def get(self, key: str, default=None):
+        """The output ``key`` as ``result[key]`` gives it, or ``default`` when there is none."""
+        return self[key] if key in self.outputs else default
 
     @property
     def state(self) -> dict:
@@ -65,6 +93,43 @@ class Result:
         folder = Path(directory)
         folder.mkdir(parents=True, exist_ok=True)
         return draw(plt, self.to_json(), folder / f"{stem or self.name}.png")
+
+
+def as_arrays(value):
+    """A JSON-ready output as numpy: a list of numbers (or a rectangular nest of lists of numbers) becomes a
+    float array (an integer array when every entry is an int), an object its values converted, a list of
+    objects or strings stays a list (its objects converted); numbers and strings are returned as they are."""
+    if isinstance(value, dict):
+        return {k: as_arrays(v) for k, v in value.items()}
+    if not isinstance(value, (list, tuple)):
+        return value
+    if _numeric(value):
+        try:
+            return np.asarray(value, dtype=int if _all_ints(value) else float)
+        except (TypeError, ValueError):  # ragged: not one array
+            pass
+    return [as_arrays(v) for v in value]
+
+
+def _numeric(value) -> bool:
+    """True for a (nested) list whose leaves are all numbers (bool excluded) or None (a JSON null: nan)."""
+    if isinstance(value, (list, tuple)):
+        return len(value) > 0 and all(_numeric(v) for v in value)
+    return value is None or (isinstance(value, (int, float, np.number)) and not isinstance(value, bool))
+
+
+def _all_ints(value) -> bool:
+    if isinstance(value, (list, tuple)):
+        return all(_all_ints(v) for v in value)
+    return isinstance(value, (int, np.integer))
+
+
+def missing_key(key: object, present, where: str) -> str:
+    """The message for a key that is not there: what was asked, the closest name, every name there is."""
+    names = [str(k) for k in present]
+    close = difflib.get_close_matches(str(key), names, n=1) if isinstance(key, str) else []
+    hint = f" (did you mean {close[0]!r}?)" if close else ""
+    return f"{key!r} is not an output of the {where}{hint}; its outputs: {', '.join(names) or '(none)'}"
 
 
 def run_analysis(name: str, kind: str, system, options: dict, context: dict) -> Result:

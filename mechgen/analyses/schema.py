@@ -15,6 +15,7 @@ from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
+from mechgen.errors import did_you_mean
 from mechgen.scene.expr import is_identifier
 from mechgen.scene.values import (IDENTIFIER_RULE, NUMBER, ModelInfoLike, choice_value, evaluate, expression,
                                   fail, finish, finite, is_choice, is_number, join, listing, param_info, show,
@@ -86,7 +87,7 @@ def analysis_kind(ctx: OptionContext, base: str, table: dict, kinds: Sequence[st
         raise fail(ctx.file, key, "missing key 'kind'", expected)
     kind = table["kind"]
     if not isinstance(kind, str) or kind not in kinds:
-        raise fail(ctx.file, key, f"unknown analysis kind {show(kind)}", expected)
+        raise fail(ctx.file, key, f"unknown analysis kind {show(kind)}{did_you_mean(kind, kinds)}", expected)
     return kind
 
 
@@ -95,7 +96,8 @@ def validate(ctx: OptionContext, base: str, kind, table: Mapping[str, Any]) -> d
     schema = kind.schema
     for name in table:
         if name not in schema:
-            raise fail(ctx.file, join(base, name), f"unknown key {show(name)} for a {kind.name} analysis",
+            raise fail(ctx.file, join(base, name), f"unknown key {show(name)} for a {kind.name} analysis"
+                       f"{did_you_mean(name, schema)}",
                        "one of: " + ", ".join(schema))
     options: dict[str, Any] = {}
     for name, option in schema.items():

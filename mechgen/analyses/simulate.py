@@ -1,13 +1,17 @@
 """``simulate``: the time response from an initial state.
 
-Scene keys: ``t_end`` (required), ``method`` (BDF, Radau, LSODA, RK45, DOP853, ``leapfrog`` with a
-step ``dt``, or ``cvodes``: SUNDIALS' variable-order BDF with the exact Jacobian, compiled through CasADi,
-for a lumped model built with ``backend = "casadi"``: mechgen.runtime.core.sundials), ``rtol``, ``atol``, ``q0`` / ``v0`` (tables of coordinates), ``initial_mode`` with
-``amplitude`` (start from a linear mode), ``outputs`` (which model outputs to report), ``series``
-(also report ``t`` and ``energy_series``), ``samples``. Outputs: the model's outputs at ``t_end``,
-``energy_drift``, ``t_end``; a fixed-end chain also ``mode_energies``. A model with modes is run by
-mechgen.analyses.simulate_hybrid, with the keys ``mode``, ``max_events``, ``zeno_events``, ``zeno_span``
-and ``loop`` (the event loop: ``auto``, ``python`` or ``c``).
+Scene keys: ``t_end`` (required), ``method`` (``auto``, the default, and the compiled loop:
+mechgen.analyses.simulate_flow; BDF, Radau, LSODA, RK45, DOP853, ``leapfrog`` with a step ``dt`` and
+``save_every``, or ``cvodes``: SUNDIALS' variable-order BDF with the exact Jacobian, compiled through CasADi,
+for a lumped model built with ``backend = "casadi"``: mechgen.runtime.core.sundials), ``loop`` (``auto``,
+``python`` or ``c``), ``rtol``, ``atol``, ``q0`` / ``v0`` (tables of coordinates), ``initial_mode`` with
+``amplitude`` (start from a linear mode), ``outputs`` (which model outputs to report), ``series`` (the time
+history; left out: kept while small, mechgen.analyses.time_series), ``samples``, ``plot`` (``time`` or
+``phase``). Outputs: ``t`` and ``trajectory`` (with ``energy_series``), the model's outputs at ``t_end``,
+``energy_drift`` (a conservative run) or ``energy_balance_error``, ``work`` and ``dissipated``
+(mechgen.analyses.energy_balance), ``t_end``, ``method`` and ``loop`` (what ran); a fixed-end chain also
+``mode_energies``. A model with modes is run by mechgen.analyses.simulate_hybrid, with the keys ``mode``,
+``max_events``, ``zeno_events``, ``zeno_span`` and ``on_zeno``.
 
 Work budget (mechgen.runtime.core.budget): ``max_steps`` (integrator steps; default 10^7 for the
 leapfrog, whose t_end / dt steps are refused before the first one when they exceed it, and 10^5
@@ -34,20 +38,22 @@ from pathlib import Path
 
 import numpy as np
 
-from mechgen.analyses import schema, summary
+from mechgen.analyses import energy_balance, schema, simulate_flow, summary, time_figures, time_series
 from mechgen.analyses.context import NAME
 from mechgen.analyses.operating_point import vector
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import ABSENT, ALL_OUTPUTS, REQUIRED, Option
-from mechgen.errors import ConvergenceError, InputError, SceneError
+from mechgen.errors import ConvergenceError, SceneError
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget, BudgetExceeded
-from mechgen.runtime.core.diagnose import explain_state
-from mechgen.runtime.core.integrate import MIN_RTOL, integrate_first_order, leapfrog
-from mechgen.runtime.core.memory import dense_bytes, require
+from mechgen.runtime.core.integrate import MIN_RTOL, leapfrog
 from mechgen.runtime.linear.modes import modes as solve_modes
 from mechgen.scene.values import fail, listing, show, type_name
 
-METHODS = ("BDF", "Radau", "LSODA", "RK45", "DOP853", "leapfrog", "cvodes")
+METHODS = ("auto", "BDF", "Radau", "LSODA", "RK45", "DOP853", "leapfrog", "cvodes")
+#: the default figure: coordinates against time, or each coordinate against its velocity
+PLOTS = ("time", "phase")
+#: what a hybrid run does when its events accumulate (Zeno): end with an error, or stop there
+ON_ZENO = ("error", "stop")
 STEP = "a number > 0 (or an expression)"
 #: default max_steps: the leapfrog's fixed steps, the adaptive methods' accepted steps
 DEFAULT_STEPS = {"leapfrog": 10_000_000, "adaptive": 100_000}
@@ -81,12 +87,18 @@ def _mode(ctx, key: str, value: object) -> str:
 
 
 def _loop(ctx, key: str, value: object) -> str:
-    """The event loop of a hybrid model (mechgen.runtime.core.events.LOOPS)."""
+    """The loop that steps the integrator (mechgen.runtime.core.events.LOOPS): the compiled one where it can run
+    (``auto``), scipy's steppers in Python, or the compiled one (``c``, an input error where it cannot run)."""
     from mechgen.runtime.core.events import LOOPS
 
-    if not getattr(ctx.model, "modes", ()):
-        raise fail(ctx.file, key, f"model {ctx.model.name} has no modes", "no 'loop' key (a smooth model)")
     return schema.one_of("loop", LOOPS)(ctx, key, value)
+
+
+def _on_zeno(ctx, key: str, value: object) -> str:
+    """What a hybrid run does at a Zeno approach: ``error`` (the default) or ``stop`` there."""
+    if not getattr(ctx.model, "modes", ()):
+        raise fail(ctx.file, key, f"model {ctx.model.name} has no modes", "no 'on_zeno' key (a smooth model)")
+    return schema.one_of("on_zeno", ON_ZENO)(ctx, key, value)
 
 
 def _method(ctx, key: str, value: object) -> str:
@@ -95,12 +107,14 @@ def _method(ctx, key: str, value: object) -> str:
     return value
 
 
-SCHEMA = {"t_end": Option(schema.positive, REQUIRED, STEP), "method": Option(_method, "BDF"),
+SCHEMA = {"t_end": Option(schema.positive, REQUIRED, STEP), "method": Option(_method, "auto"),
           "dt": Option(schema.positive, ABSENT), "rtol": Option(schema.positive, 1e-8),
           "atol": Option(schema.positive, 1e-10), "q0": Option(schema.coordinate_table, {}),
           "v0": Option(schema.coordinate_table, {}), "initial_mode": Option(schema.count),
           "amplitude": Option(schema.number, 1.0), "outputs": Option(_outputs, ALL_OUTPUTS),
-          "series": Option(schema.boolean, False), "samples": Option(schema.count_within("samples"), 201),
+          "series": Option(schema.boolean, ABSENT), "samples": Option(schema.count_within("samples"), 201),
+          "save_every": Option(schema.count, ABSENT), "plot": Option(schema.one_of("plot", PLOTS), ABSENT),
+          "on_zeno": Option(_on_zeno, ABSENT),
           "max_steps": Option(schema.count, ABSENT), "max_seconds": Option(schema.positive, ABSENT),
           "progress": Option(schema.boolean, ABSENT), "mode": Option(_mode, ABSENT),
           "max_events": Option(schema.count, ABSENT), "zeno_events": Option(schema.count, ABSENT),
@@ -130,7 +144,8 @@ def needs(options: dict, *, internal: bool) -> set[str]:
     if options.get("method") == "leapfrog":
         return {"force", "outputs", "linear"}
     start = {"linear"} if options.get("initial_mode") else set()
-    return {"residual", "tangent", "outputs"} | start | ({"rates", "rates_tangent"} if internal else set())
+    balance = {"energy_rates"} if options.get("method") != "cvodes" else set()
+    return {"residual", "tangent", "outputs"} | start | balance | ({"rates", "rates_tangent"} if internal else set())
 
 
 def declared_start(system) -> np.ndarray | None:
@@ -213,98 +228,102 @@ def leapfrog_masses(system, M) -> np.ndarray:
     return 1.0 / diag
 
 
-def _cvodes(system, x0, t_end, t_eval, options, budget, progress, desc):
-    """The run with SUNDIALS' CVODES on the system's CasADi kernels (mechgen.runtime.core.sundials)."""
-    from mechgen.runtime.core.sundials import cvodes_problem, integrate_cvodes
-
-    why = cvodes_problem(system)
-    if why:
-        raise InputError(why, key="method", expected="a method of this system's backend: BDF, Radau, LSODA, RK45, "
-                         "DOP853 or leapfrog, or backend 'casadi' for 'cvodes'")
-    return integrate_cvodes(system, x0, t_end, t_eval=t_eval, rtol=options.get("rtol", 1e-8),
-                            atol=options.get("atol", 1e-10), budget=budget, progress=progress, desc=desc,
-                            explain=lambda t, x: explain_state(system, t, x))
-
-
 def run_simulate(system, options: dict, context: dict) -> dict:
-    """Time response; reports the model's outputs at t_end and the energy drift."""
+    """Time response: the time history (``t``, ``trajectory``), the model's outputs at t_end and the energy
+    figures (mechgen.analyses.time_series)."""
     if hasattr(system, "modes"):
         from mechgen.analyses.simulate_hybrid import run_hybrid
 
         return run_hybrid(system, options, context)
     q0, v0 = initial_state(system, options)
-    t_end = float(options["t_end"])
-    method = options.get("method", "BDF")
-    budget = budget_of(options, method)
-    progress = bool(options.get("progress", True))
-    desc = context.get(NAME, "simulate")
-    energy = lambda q, v: system.outputs(q, v)["energy"]  # noqa: E731
+    method, desc = options.get("method", "auto"), context.get(NAME, "simulate")
     if method == "leapfrog":
-        dt = float(options["dt"])
-        steps = int(round(t_end / dt))
-        budget.refuse(steps, f"nothing (refused before starting: t_end / dt = {steps:,} steps)")
-        mats = system.linear(np.zeros(system.n))
-        minv = leapfrog_masses(system, mats["M"])
-        traj = leapfrog(lambda q: system.force(q) * minv, q0, v0, dt, steps,
-                        record_every=max(1, steps // 1000), energy=energy, budget=budget, progress=progress,
-                        desc=desc)
-        q_end, v_end, ts, energies = traj.q[-1], traj.v[-1], traj.t, np.asarray(traj.energy)
-        z_end = None
+        t, X = _leapfrog_run(system, options, q0, v0, budget_of(options, method), desc)
+        how = {"method": method, "loop": "python"}
     else:
         start = declared_start(system)
         x0 = np.concatenate([q0, v0, np.zeros(system.m) if start is None else start[2 * system.n:]])
-        refuse_explicit_stiff(system, x0, t_end, method, budget)
-        n_out = int(options.get("samples", 201))
-        require(dense_bytes(n_out, 3 * (2 * system.n + system.m) + 6), f"{n_out} output samples", key="samples")
-        t_eval = np.linspace(0.0, t_end, max(n_out, 2))
-        if method == "cvodes":
-            traj = _cvodes(system, x0, t_end, t_eval, options, budget, progress, desc)
-        else:
-            traj = integrate_first_order(system.rhs, x0, t_end, jac=system.jacobian, method=method,
-                                         rtol=options.get("rtol", 1e-8), atol=options.get("atol", 1e-10),
-                                         t_eval=t_eval, budget=budget, progress=progress, desc=desc,
-                                         explain=lambda t, x: explain_state(system, t, x))
-        xs = traj.x if traj.x.shape[0] == len(traj.t) else traj.x.T
-        n = system.n
-        q_end, v_end, z_end = xs[-1, :n], xs[-1, n:2 * n], xs[-1, 2 * n:]
-        ts = traj.t
-        energies = np.array([system.outputs(x[:n], x[n:2 * n], x[2 * n:] if system.m else None)["energy"]
-                             for x in xs])
-    out = system.outputs(q_end, v_end, z_end if system.m else None)
-    wanted = options.get("outputs")
-    if wanted:
-        out = {k: v for k, v in out.items() if k in wanted}
-    e0 = energies[0]
-    out["energy_drift"] = float(np.max(np.abs(energies - e0)) / max(abs(e0), 1e-300))
-    out["t_end"] = t_end
+        if method == "auto":
+            method = simulate_flow.chosen_method(system, x0, float(options["t_end"]))
+        t, X, how = simulate_flow.adaptive_run(system, options, x0, method, budget_of(options, method), desc)
+    n = system.n
+    extra = how.pop("_extra", 0)
+    state = X[:, :X.shape[1] - extra]
+    series = time_series.sampled_outputs(system, t, state)
+    out = {**report(system, options, t, state, series), **how}
+    if extra:
+        balanced(out, energy_balance.figures(system, t, X, series))
     if system.is_lattice and system.metadata.ends == "fixed":
-        out["mode_energies"] = mode_energies(system, q_end, v_end)
-    if options.get("series"):
-        out["t"] = [float(t) for t in ts]
-        out["energy_series"] = [float(e) for e in energies]
+        out["mode_energies"] = mode_energies(system, X[-1, :n], X[-1, n:2 * n])
     return out
 
 
+def report(system, options: dict, t: np.ndarray, X: np.ndarray, series: dict) -> dict:
+    """The outputs of a run sampled at ``t`` (states X, one row a sample; ``series``: the model's outputs at each
+    sample): the outputs at the last sample (those asked for), ``energy_drift``, ``t_end`` and, when kept, the
+    time history."""
+    wanted = options.get("outputs")
+    out = {k: float(v[-1]) for k, v in series.items() if not wanted or k in wanted}
+    out["energy_drift"] = time_series.energy_drift(series)
+    out["t_end"] = float(options["t_end"])
+    keep, note = time_series.keep_series(options, X.shape[1], len(wanted or series), len(t))
+    if keep:
+        out.update(time_series.time_history(system, t, X, series, wanted))
+        if options.get("plot") == "phase":
+            out["plot"] = "phase"
+    elif note:
+        out["series_note"] = note
+    return out
+
+
+def balanced(out: dict, balance: dict | None) -> None:
+    """A run that is not conservative reports its energy balance (mechgen.analyses.energy_balance) instead of
+    ``energy_drift``; with the trajectory, ``work`` and ``dissipated`` at each sample too."""
+    if balance is None:
+        return
+    del out["energy_drift"]
+    work, dissipated = balance.pop("_work_series"), balance.pop("_dissipated_series")
+    out.update(balance)
+    if "trajectory" in out:
+        out["trajectory"]["work"], out["trajectory"]["dissipated"] = work.tolist(), dissipated.tolist()
+
+
+def _leapfrog_run(system, options: dict, q0, v0, budget: Budget, desc: str) -> tuple[np.ndarray, np.ndarray]:
+    """Velocity Verlet from (q0, v0) with step dt, every ``save_every``-th state kept (default: about 1000)."""
+    dt, t_end = float(options["dt"]), float(options["t_end"])
+    steps = int(round(t_end / dt))
+    budget.refuse(steps, f"nothing (refused before starting: t_end / dt = {steps:,} steps)")
+    mats = system.linear(np.zeros(system.n))
+    minv = leapfrog_masses(system, mats["M"])
+    every = int(options.get("save_every", max(1, steps // 1000)))
+    traj = leapfrog(lambda q: system.force(q) * minv, q0, v0, dt, steps, record_every=every, budget=budget,
+                    progress=bool(options.get("progress", True)), desc=desc)
+    return traj.t, np.hstack([traj.q, traj.v])
+
+
 def plot(plt, a: dict, path: Path) -> list[Path]:
-    """Energy against time (``series = true``), else a chain's final mode energies; nothing otherwise."""
+    """The coordinates against t (``plot = "phase"``: each coordinate against its velocity), the energy against
+    t beside it (``<stem>_energy.png``); a chain without a trajectory: its final mode energies."""
     out = a["outputs"]
-    if "energy_series" not in out and "mode_energies" not in out:
+    if "trajectory" in out:
+        return time_figures.time_history(plt, a, path)
+    if "mode_energies" not in out:
         return []
     fig, ax = plt.subplots(figsize=(6, 4))
-    if "energy_series" in out:
-        ax.plot(out["t"], out["energy_series"])
-        ax.set_xlabel("t")
-        ax.set_ylabel("energy")
-    else:
-        ax.bar(range(1, len(out["mode_energies"]) + 1), out["mode_energies"])
-        ax.set_xlabel("mode k")
-        ax.set_ylabel("E_k at t_end")
-    ax.set_title(a["name"])
+    ax.bar(range(1, len(out["mode_energies"]) + 1), out["mode_energies"])
+    ax.set_xlabel("mode k")
+    ax.set_ylabel("E_k at t_end (J, or the model's energy unit)")
+    ax.set_title(f"{a['name']}: mode energies at t_end")
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return [path]
 
 
-register(AnalysisKind("simulate", SCHEMA, run_simulate, needs, summary.lines, check=check, plot=plot,
-                      sweepable=True))
+def summary_lines(outputs: dict) -> list[str]:
+    """The default summary, the trajectory in one line."""
+    return summary.output_lines(outputs, skip=("trajectory",)) + time_series.summary_lines(outputs)
+
+
+register(AnalysisKind("simulate", SCHEMA, run_simulate, needs, summary_lines, check=check, plot=plot,
+                      sweepable=True, point_defaults={"series": False}))

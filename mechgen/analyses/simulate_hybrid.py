@@ -10,16 +10,20 @@ compiled one of mechgen.runtime.core.events_c for DOP853 on the C backend, else 
 ``python`` or ``c`` to choose). Outputs: the model's outputs at the end of the run (in the mode it
 ended in), ``events`` (a list of ``{t, from, to, guard}``; ``to`` is null for a terminal event),
 ``final_mode``, ``t_final`` (t_end, or the time of the terminal event), ``energy_drift`` and
-``t_end``; with ``series``: ``t``, ``energy_series`` and ``mode_series``.
+``t_end``; with the time history (mechgen.analyses.time_series: ``t``, ``trajectory``, ``energy_series``)
+``mode_series``, the mode at each sample (the state where the run ended is the last sample). ``on_zeno =
+"stop"`` ends a run at a Zeno approach instead of failing: the events so far, ``t_final`` at the event that
+made it Zeno, and ``zeno = true``.
 """
 from __future__ import annotations
 
 import numpy as np
 
+from mechgen.analyses import time_series
 from mechgen.analyses.context import NAME
 from mechgen.errors import SceneError
 from mechgen.runtime.core.diagnose import explain_state
-from mechgen.runtime.core.events import EventRules, integrate_hybrid
+from mechgen.runtime.core.events import EventRules, ZenoApproach, integrate_hybrid
 from mechgen.runtime.core.memory import dense_bytes, require
 
 
@@ -50,48 +54,62 @@ def event_log(system, events) -> list[dict]:
 
 def run_hybrid(system, options: dict, context: dict) -> dict:
     """Time response of a hybrid system; see the module doc."""
-    from mechgen.analyses.simulate import budget_of, initial_state
+    from mechgen.analyses.simulate import declared_start, initial_state, report
 
     if options.get("method") == "leapfrog":
         raise SceneError("method 'leapfrog' cannot integrate a hybrid model (its modes switch at events)",
                          key="method", expected="BDF, Radau, LSODA, RK45 or DOP853")
     q0, v0 = initial_state(system, options)
-    t_end = float(options["t_end"])
-    method = options.get("method", "BDF")
-    mode = start_mode(system, options)
-    from mechgen.analyses.simulate import declared_start
-
     start = declared_start(system)
     x0 = np.concatenate([q0, v0, np.zeros(system.m) if start is None else start[2 * system.n:]])
     n_out = int(options.get("samples", 201))
     require(dense_bytes(n_out, 3 * x0.size + 6), f"{n_out} output samples", key="samples")
-    traj = integrate_hybrid(system, x0, t_end, mode=mode, method=method, rtol=options.get("rtol", 1e-8),
-                            atol=options.get("atol", 1e-10), t_eval=np.linspace(0.0, t_end, n_out),
-                            budget=budget_of(options, method), rules=rules_of(options),
-                            progress=bool(options.get("progress", True)), desc=context.get(NAME, "simulate"),
-                            explain=lambda t, x: explain_state(system, t, x), loop=options.get("loop", "auto"))
-    n = system.n
-    views = {}
-
-    def outputs(k: int, x: np.ndarray, t: float) -> dict:
-        if k not in views:
-            views[k] = system.mode(k)
-        return views[k].outputs(x[:n], x[n:2 * n], x[2 * n:] if system.m else None, t)
-
-    out = outputs(traj.final_mode, traj.x_final, traj.t_final)
-    wanted = options.get("outputs")
-    if wanted:
-        out = {k: v for k, v in out.items() if k in wanted}
-    energies = np.array([outputs(int(k), x, float(t))["energy"] for t, x, k in zip(traj.t, traj.x, traj.mode)]
-                        + [outputs(traj.final_mode, traj.x_final, traj.t_final)["energy"]])
-    e0 = energies[0]
-    out["energy_drift"] = float(np.max(np.abs(energies - e0)) / max(abs(e0), 1e-300))
-    out["t_end"] = t_end
+    traj, zeno, method = hybrid_run(system, options, x0, context.get(NAME, "simulate"))
+    t, X, modes = with_final(traj)
+    views: dict = {}
+    mode_system = lambda k: views.setdefault(k, system.mode(k))  # noqa: E731
+    out = report(system, options, t, X, time_series.sampled_outputs_by_mode(mode_system, t, X, modes))
     out["t_final"] = float(traj.t_final)
     out["events"] = event_log(system, traj.events)
     out["final_mode"] = system.modes[traj.final_mode]
-    if options.get("series"):
-        out["t"] = [float(t) for t in traj.t]
-        out["energy_series"] = [float(e) for e in energies[:-1]]
-        out["mode_series"] = [system.modes[int(k)] for k in traj.mode]
+    if "trajectory" in out:
+        out["mode_series"] = [system.modes[int(k)] for k in modes]
+    if zeno:
+        out["zeno"] = True
+    out["method"], out["loop"] = method, traj.extra.get("loop", "python")
     return out
+
+
+def hybrid_run(system, options: dict, x0: np.ndarray, desc: str):
+    """(the HybridTrajectory, whether it ended at a Zeno approach, the method that ran): ``on_zeno = "stop"`` keeps
+    the run up to the event that made it Zeno (mechgen.runtime.core.events.ZenoApproach); the default lets the
+    error end it. ``method = "auto"`` is decided on the initial mode (mechgen.analyses.simulate_flow)."""
+    from mechgen.analyses.simulate import budget_of
+
+    method, t_end = options.get("method", "auto"), float(options["t_end"])
+    if method == "auto":  # decided on the initial mode's linearisation (mechgen.analyses.simulate_flow)
+        from mechgen.analyses.simulate_flow import chosen_method
+
+        method = chosen_method(system.mode(start_mode(system, options)), x0, t_end)
+    try:
+        traj = integrate_hybrid(system, x0, t_end, mode=start_mode(system, options), method=method,
+                                rtol=options.get("rtol", 1e-8), atol=options.get("atol", 1e-10),
+                                t_eval=np.linspace(0.0, t_end, int(options.get("samples", 201))),
+                                budget=budget_of(options, method), rules=rules_of(options),
+                                progress=bool(options.get("progress", True)), desc=desc,
+                                explain=lambda t, x: explain_state(system, t, x), loop=options.get("loop", "auto"))
+    except ZenoApproach as exc:
+        if options.get("on_zeno", "error") != "stop" or exc.trajectory is None:
+            raise
+        return exc.trajectory, True, method
+    return traj, False, method
+
+
+def with_final(traj) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The samples (t, x rows, mode per sample) with the state where the run ended appended when it ended after
+    the last sample (a terminal event or a Zeno stop before t_end, or no sample at all)."""
+    t, X, modes = np.asarray(traj.t, float), np.asarray(traj.x, float), np.asarray(traj.mode, int)
+    if t.size and t[-1] >= traj.t_final and modes[-1] == traj.final_mode:
+        return t, X, modes
+    return (np.append(t, traj.t_final), np.vstack([X.reshape(len(t), -1), traj.x_final[None, :]]),
+            np.append(modes, traj.final_mode))

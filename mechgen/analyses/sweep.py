@@ -38,6 +38,7 @@ def _inner(ctx, key: str, value: object) -> AnalysisSpec:
         raise fail(ctx.file, key, f"value is {type_name(value)}", "a table with kind and its options")
     kind = schema.analysis_kind(ctx, key, value, inner_kinds)
     options = schema.validate(ctx, key, get(kind), {k: v for k, v in value.items() if k != "kind"})
+    options.update({k: v for k, v in get(kind).point_defaults.items() if k not in value})
     return AnalysisSpec(ctx.current, kind, options)
 
 

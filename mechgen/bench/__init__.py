@@ -78,6 +78,10 @@ REGISTRY: dict[str, Suite] = {s.name: s for s in (
     Suite("threads", "mechgen.bench.threads", "run_threads_benchmarks",
           "every shipped scene as a whole process, default environment against one BLAS thread (unpinned / pinned)",
           ("threads.json", "threads.md"), standard=False),
+    Suite("simulate", "mechgen.bench.simulate", "run_simulate_benchmarks",
+          "a forced Duffing oscillator's time response: the compiled loop against scipy's stepper on the same "
+          "kernels and a hand-written solve_ivp; a 10^3-point sweep of simulate", ("simulate.json", "simulate.md"),
+          peers=("scipy DOP853 stepped in Python", "hand-written solve_ivp")),
     Suite("sweep", "mechgen.bench.sweep", "run_sweep_benchmarks",
           "a 10^4-point Laval rotor stability sweep on the serial, local-process and Dask executors (2 workers): wall "
           "time, overhead per point, dask / processes", ("sweep.json", "sweep.md"),

@@ -8,6 +8,8 @@ Kernel names and what they compute (n coordinates, m internal variables):
 * ``force``     -dV/dq                                 -> f[n]
 * ``rates``     dz/dt = g(q, v, z, t)                  -> g[m]
 * ``rates_tangent``                                    -> g_q[m*n], g_v[m*n], g_z[m*m]
+* ``energy_rates`` the internal rates and the powers of the energy balance (mechgen.symbolic.derive.energy_powers)
+                -> g[m + 3] = (dz/dt, Q.v, v.dR/dv, -dL/dt), excess[1] = v.dT/dv - 2 T
 * ``outputs``   declared outputs and energies          -> one port of length 1 each
 * ``section``   the declared section stiffness K(p)    -> K[36] (6 x 6, symmetric; Model.section_stiffness)
 * ``rod``       a declared rod's local pieces at (f, r) -> sigma[6], C[36], W[1], f0[6], g[6], g_r[18], L[1], M[36]
@@ -27,7 +29,8 @@ from mechgen.codegen.lower import canonical_block, dense_writes, kernel
 from mechgen.errors import ModelError
 from mechgen.symbolic.derive import LumpedEquations
 
-LUMPED_KERNELS = ("residual", "tangent", "linear", "force", "rates", "rates_tangent", "outputs", "section", "rod")
+LUMPED_KERNELS = ("residual", "tangent", "linear", "force", "rates", "rates_tangent", "energy_rates", "outputs", "section",
+                  "rod")
 
 
 def _inputs(eqs: LumpedEquations, with_accel: bool = True) -> tuple[list[Port], list]:
@@ -89,6 +92,9 @@ def lower_lumped(eqs: LumpedEquations, name: str, *, cse: bool = True) -> Kernel
     if name == "rates_tangent":
         mats = {f"g_{w}": eqs.jacobian(eqs.rates, w) for w in ("q", "v", "z")}
         return _matrix_kernel(eqs, name, "Jacobians of the internal rates", mats, accel=False, cse=cse)
+    if name == "energy_rates":
+        mats = {"g": eqs.rates.col_join(eqs.power), "excess": sp.Matrix([[eqs.excess]])}
+        return _matrix_kernel(eqs, name, "internal rates and the energy balance's powers", mats, accel=False, cse=cse)
     if name == "outputs":
         mats = {k: sp.Matrix([[e]]) for k, e in eqs.outputs.items()}
         return _matrix_kernel(eqs, name, "named outputs", mats, accel=False, cse=cse)

@@ -25,7 +25,7 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from mechgen.errors import InputError, ModelError
+from mechgen.errors import InputError, ModelError, did_you_mean
 
 BUILTIN = ("balloon_string", "euler_bernoulli_beam", "follower_column", "fpu_chain", "laval_rotor", "moving_string",
            "spinning_shaft", "rotating_string", "spring_pendulum", "timoshenko_beam", "viscoelastic_impact",
@@ -242,7 +242,7 @@ def resolve(ref: str, *, base: str | Path | None = None) -> ModelSource:
     registered = entry_points().get(ref)
     if registered is not None:
         return registered
-    raise InputError(f"unknown model {ref!r}", key="model",
+    raise InputError(f"unknown model {ref!r}{did_you_mean(ref, known())}", key="model",
                      expected=f"one of {', '.join(known())}; or a path to a .py file or package.module:attribute")
 
 

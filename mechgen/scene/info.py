@@ -22,7 +22,7 @@ from functools import lru_cache
 from pathlib import Path
 
 from mechgen import models
-from mechgen.errors import InputError
+from mechgen.errors import InputError, did_you_mean
 
 #: version of the JSON layout of a ModelInfo (part of its cache key)
 INFO_SCHEMA = "model-info-4"
@@ -85,7 +85,7 @@ class ModelInfo:
         try:
             return self.params[name]
         except KeyError:
-            raise InputError(f"model {self.name} has no parameter {name!r}", key=name,
+            raise InputError(f"model {self.name} has no parameter {name!r}{did_you_mean(name, self.params)}", key=name,
                              expected=f"one of {', '.join(self.params)}") from None
 
     def to_json(self) -> dict:

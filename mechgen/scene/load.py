@@ -27,7 +27,7 @@ try:
 except ImportError:  # pragma: no cover - Python 3.10
     import tomli as tomllib  # type: ignore[no-redef]
 
-from mechgen.errors import InputError
+from mechgen.errors import InputError, did_you_mean
 from mechgen.analyses.registry import get as get_kind
 from mechgen.analyses.registry import kinds as analysis_kinds
 from mechgen.analyses.schema import AnalysisSpec, OptionContext, analysis_kind, validate
@@ -143,7 +143,7 @@ def _top_level(file: str, data: dict, lookup_model: Callable[..., Any],
     name = _string(file, "model", data["model"])
     info = _model_info(file, name, lookup_model, base)
     if info is None:
-        raise fail(file, "model", f"unknown model {show(name)}",
+        raise fail(file, "model", f"unknown model {show(name)}{did_you_mean(name, model_names())}",
                     "one of: " + listing(sorted(model_names())) + "; or " + MODEL_FORMS)
     backend = _string(file, "backend", data.get("backend", "c"))
     if backend not in BACKENDS:

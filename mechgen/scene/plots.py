@@ -18,6 +18,6 @@ def plot_results(results: dict, folder: Path) -> list[Path]:
     written = []
     for a in results["analyses"]:
         draw = get(a["kind"]).plot
-        if draw is not None:
+        if draw is not None and "error" not in a:  # a failed analysis (its error in the summary) has nothing
             written += draw(plt, a, folder / f"{Path(results['scene']).stem}_{a['name']}.png")
     return written

@@ -12,6 +12,9 @@ def summary(results: dict) -> str:
              f"{' (cached)' if build.get('cached') else ''}",
              "kernels: " + ", ".join(f"{k} ({v['ops']} ops)" for k, v in build.get("kernels", {}).items())]
     for a in results["analyses"]:
+        if "error" in a:
+            lines.append(f"[{a['kind']}] {a['name']} FAILED: {a['error']}")
+            continue
         lines.append(f"[{a['kind']}] {a['name']} ({a['seconds']:.3f} s)")
         lines += get(a["kind"]).summary(a["outputs"])
     return "\n".join(lines)

@@ -18,7 +18,7 @@ from mechgen import models
 from mechgen.analyses.context import NAME, POINTS, PointRunner, public
 from mechgen.analyses.registry import get
 from mechgen.analyses.result import run_analysis
-from mechgen.errors import InputError, SceneError
+from mechgen.errors import InputError, MechgenError, SceneError
 from mechgen.pipeline import compile_request, file_digest
 from mechgen.runtime.fields.mesh import Layout
 from mechgen.scene.info import lookup_model, model_info
@@ -119,10 +119,27 @@ def _run_loaded(scn, backend: str | None) -> dict:
     context: dict = {POINTS: PointRunner(sweep_point, partial(_point_task, scene_inputs, layout))}
     for analysis in scn.analyses:
         context[NAME] = analysis.name
-        result = run_analysis(analysis.name, analysis.kind, system, dict(analysis.options), context)
+        try:
+            result = run_analysis(analysis.name, analysis.kind, system, dict(analysis.options), context)
+        except MechgenError as exc:
+            raise with_partial(exc, results, analysis, scn) from None
         context[analysis.name] = result.state
         results["analyses"].append(result.to_json())
     return results
+
+
+def with_partial(exc: MechgenError, results: dict, analysis, scn) -> MechgenError:
+    """The error of a failed analysis carrying the results so far as ``exc.partial_results``: the analyses
+    before it, then an entry ``{"name", "kind", "outputs": {}, "error"}`` for it (the CLI prints them and
+    writes them to --json before the error; the exit code stays the error's). A bad input found while
+    running is placed in the scene first (:func:`placed`)."""
+    if isinstance(exc, InputError) and exc.file is None:
+        exc = placed(exc, scn)
+    message = exc.paragraph() if isinstance(exc, InputError) else str(exc)
+    results["analyses"].append({"name": analysis.name, "kind": analysis.kind, "outputs": {}, "seconds": 0.0,
+                                "error": f"{type(exc).__name__}: {message}"})
+    exc.partial_results = results
+    return exc
 
 
 def check_backend(name: str | None) -> None:

@@ -12,7 +12,7 @@ import re
 import sys
 from typing import Any, Mapping, Protocol, Sequence
 
-from mechgen.errors import InputError, SceneError
+from mechgen.errors import InputError, SceneError, did_you_mean
 from mechgen.scene.expr import Expression, is_identifier, parse_expression
 
 IDENTIFIER_RULE = ("an identifier: ASCII letters, digits and underscores, not starting with a digit or '__', "
@@ -131,7 +131,8 @@ def is_choice(info: ParamInfoLike) -> bool:
 def param_info(file: str | None, key: str, model: ModelInfoLike, name: object) -> ParamInfoLike:
     """The model's parameter ``name``, or a SceneError listing the parameters."""
     if not isinstance(name, str) or name not in model.params:
-        raise fail(file, key, f"model '{model.name}' has no parameter {show(name)}",
+        raise fail(file, key, f"model '{model.name}' has no parameter {show(name)}"
+                   f"{did_you_mean(name, model.params)}",
                    "one of the model's parameters: " + listing(list(model.params)))
     return model.params[name]
 

@@ -55,6 +55,10 @@ class LumpedEquations:
     section: sp.Matrix | None = None
     #: the declared rod's local pieces (mechgen.symbolic.rod.RodPieces, Model.rod), None when none is declared
     rod: object = None
+    #: the powers of the energy balance (:func:`energy_powers`): Q.v, v.dR/dv, -dL/dt (a 3 x 1 Matrix)
+    power: sp.Matrix | None = None
+    #: v.dT/dv - 2 T: zero for a kinetic energy quadratic in v (:func:`energy_powers`)
+    excess: sp.Expr | None = None
 
     @property
     def t(self) -> sp.Symbol:
@@ -127,6 +131,25 @@ def lagrange_residual(T: sp.Expr, V: sp.Expr, R: sp.Expr, q, v, a) -> list[sp.Ex
     return res
 
 
+def energy_powers(T: sp.Expr, V: sp.Expr, R: sp.Expr, Q: list, q, v) -> tuple[sp.Matrix, sp.Expr]:
+    """The terms of the energy balance along a solution of Lagrange's equations (the residual above minus Q).
+
+    With p = dT/dv, multiplying the residual by v gives, for the energy function h = v.p - T + V,
+
+        dh/dt = Q.v - v.dR/dv - dL/dt,      L = T - V  (dL/dt: the explicit time derivative),
+
+    and h = E + (v.p - 2 T) with E = T + V: the excess v.p - 2 T is zero when T is a quadratic form in v
+    (Euler), so that dE/dt = (power of the forces) - (dissipated power) + (power of an explicit time
+    dependence). Returns ([Q.v, v.dR/dv, -dL/dt], v.p - 2 T).
+    """
+    zero = sp.Integer(0)
+    forces = sum((Qi * vi for Qi, vi in zip(Q, v)), zero)
+    dissipated = sum((vi * sp.diff(R, vi) for vi in v), zero)
+    explicit = sp.diff(V, TIME) - sp.diff(T, TIME)
+    excess = sp.expand(sum((vi * sp.diff(T, vi) for vi in v), zero) - 2 * T)
+    return sp.Matrix([forces, dissipated, explicit]), excess
+
+
 def _energy(model: Model, scope, what: str, env) -> sp.Expr:
     """The model-wide energy ``what`` plus the mode's own (``scope``: a ModeScope or None)."""
     total = sp.Integer(0)
@@ -160,6 +183,7 @@ def derive_lumped(model: Model, spec: Specialization, mode: str | None = None) -
     outputs = {o.name: _scalar(call_declared(own.get(o.name, o.fn), **env), f"output {o.name}", model)
                for o in model.outputs}
     outputs.update(kinetic_energy=T, potential_energy=V, energy=T + V)
+    power, excess = energy_powers(T, V, R, Q, v=v, q=q)
     return LumpedEquations(
         model=model.name, coordinates=names, q=q, v=v, a=a, z=z, params=free,
         param_names=tuple(s.name for s in free), internal_names=tuple(i.name for i in model.internals),
@@ -167,7 +191,7 @@ def derive_lumped(model: Model, spec: Specialization, mode: str | None = None) -
         rates=sp.Matrix(rates) if rates else sp.zeros(0, 1), outputs=outputs,
         initial=initial_column(model, p_ns, names, tuple(i.name for i in model.internals)),
         section=(section := _section(model, p_ns)),
-        rod=derive_rod(model, p_ns, section, free),
+        rod=derive_rod(model, p_ns, section, free), power=power, excess=excess,
     )
 
 

@@ -75,6 +75,8 @@ MAX_DEPTH = 12
 #: levels of splitting at a guard's cubic dip beyond MAX_DEPTH (module doc, "Missed events")
 DIP_DEPTH = 4
 EPS = float(np.finfo(float).eps)
+#: what a Zeno error says a run that should end there can do
+ZENO_HINT = "simulate's on_zeno = \"stop\" ends the run there, keeping the events so far"
 
 
 @dataclass(frozen=True)
@@ -85,6 +87,21 @@ class EventRules:
     max_events: int = 10_000
     zeno_events: int = 100
     zeno_span: float | None = None
+
+
+class ZenoApproach(BudgetExceeded):
+    """More than ``zeno_events`` events within ``zeno_span``: a Zeno accumulation or chattering (exit 1).
+
+    ``trajectory`` is the run up to and including the event that tipped it (a HybridTrajectory whose
+    ``t_final``, ``x_final`` and ``final_mode`` are those just after that event), so that an analysis that
+    asks to stop there (``on_zeno = "stop"``) keeps the events so far."""
+
+    trajectory = None
+
+    def with_trajectory(self, trajectory) -> "ZenoApproach":
+        """The same error carrying the run so far."""
+        self.trajectory = trajectory
+        return self
 
 
 @dataclass(frozen=True)
@@ -348,53 +365,62 @@ def integrate_hybrid(system, x0, t_end: float, *, mode: int | None = None, metho
             raise BudgetExceeded(f"events: more than max_events = {rules.max_events:,} events", key="max_events",
                                  reached=where(tk, seg.index))
         if len(recent) == recent.maxlen and recent[-1] - recent[0] <= zeno_span:
-            raise BudgetExceeded(f"events: {len(recent)} events within {recent[-1] - recent[0]:.3g} (more than "
-                                 f"zeno_events = {rules.zeno_events} within zeno_span = {zeno_span:.3g}): a Zeno or "
-                                 f"chattering approach (guard {info.name} of mode {names[seg.index]})",
-                                 key="zeno_events", reached=where(tk, seg.index))
+            raise ZenoApproach(f"events: {len(recent)} events within {recent[-1] - recent[0]:.3g} (more than "
+                               f"zeno_events = {rules.zeno_events} within zeno_span = {zeno_span:.3g}): a Zeno or "
+                               f"chattering approach (guard {info.name} of mode {names[seg.index]}); {ZENO_HINT}",
+                               key="zeno_events", reached=where(tk, seg.index))
         return target, x_after
 
     record(t, x, mode)
-    with Progress(t_end, desc=desc, unit="t", enabled=progress) as bar:
-        while True:
-            if mode not in segments:
-                segments[mode] = _Segment(system, mode, t_end, counts)
-            seg = segments[mode]
-            g0, d0 = seg.values(t, x)
-            sign, at_once = start_signs(g0, d0, seg.directions, time_tolerance(t, t_end))
-            if at_once:
-                k = at_once[0]  # the guards are in priority order: terminal first, then declared order
-                target, x = fire(seg, k, t, x)
+    try:
+        with Progress(t_end, desc=desc, unit="t", enabled=progress) as bar:
+            while True:
+                if mode not in segments:
+                    segments[mode] = _Segment(system, mode, t_end, counts)
+                seg = segments[mode]
+                g0, d0 = seg.values(t, x)
+                sign, at_once = start_signs(g0, d0, seg.directions, time_tolerance(t, t_end))
+                if at_once:
+                    k = at_once[0]  # the guards are in priority order: terminal first, then declared order
+                    target, x = fire(seg, k, t, x)
+                    record(t, x, mode if target is None else target)
+                    if target is None or (stop_after is not None and stop_after(events[-1])):
+                        terminated = True
+                        mode = mode if target is None else target
+                        break
+                    mode = target
+                    continue
+                if t >= t_end:
+                    break
+                hit = _integrate_segment(seg, x, t, (g0, d0), method, rtol, atol, sign, budget, stats,
+                                         sample_until, record, bar, explain, where)
+                if hit is None:
+                    t, x = t_end, stats["y_end"]
+                    break
+                k, t, x_before = hit
+                sample_until(t, stats["dense"], mode, inclusive=True)
+                target, x = fire(seg, k, t, x_before)
+                record(t, x_before, mode)
                 record(t, x, mode if target is None else target)
                 if target is None or (stop_after is not None and stop_after(events[-1])):
                     terminated = True
                     mode = mode if target is None else target
                     break
                 mode = target
-                continue
-            if t >= t_end:
-                break
-            hit = _integrate_segment(seg, x, t, (g0, d0), method, rtol, atol, sign, budget, stats,
-                                     sample_until, record, bar, explain, where)
-            if hit is None:
-                t, x = t_end, stats["y_end"]
-                break
-            k, t, x_before = hit
-            sample_until(t, stats["dense"], mode, inclusive=True)
-            target, x = fire(seg, k, t, x_before)
-            record(t, x_before, mode)
-            record(t, x, mode if target is None else target)
-            if target is None or (stop_after is not None and stop_after(events[-1])):
-                terminated = True
-                mode = mode if target is None else target
-                break
-            mode = target
+    except ZenoApproach as exc:  # the run so far, up to the event that made it Zeno (on_zeno = "stop")
+        last = events[-1]
+        stats["zeno"] = exc
+        mode = last.source if last.target is None else last.target
+        t, x, terminated = last.t, last.x_after, True
     t_out = np.hstack(ts) if ts else np.empty(0)
     x_out = np.vstack(xs) if xs else np.empty((0, np.size(x0)))
     m_out = np.hstack(ms).astype(int) if ms else np.empty(0, int)
-    return HybridTrajectory(t_out, x_out, m_out, tuple(events), mode, float(t), np.array(x), terminated,
-                            stats["steps"], stats["nfev"], stats["njev"], counts["guards"],
-                            {"rate_evaluations": counts["rates"]})
+    trajectory = HybridTrajectory(t_out, x_out, m_out, tuple(events), mode, float(t), np.array(x), terminated,
+                                  stats["steps"], stats["nfev"], stats["njev"], counts["guards"],
+                                  {"rate_evaluations": counts["rates"]})
+    if "zeno" in stats:
+        raise stats["zeno"].with_trajectory(trajectory)
+    return trajectory
 
 
 def start_signs(g0: np.ndarray, d0: np.ndarray, directions: np.ndarray, tol: float):

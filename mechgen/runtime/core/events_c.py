@@ -32,7 +32,7 @@ import numpy as np
 
 from mechgen.errors import BuildError, CompilerUnavailable, ConvergenceError, KernelError
 from mechgen.runtime.core.budget import BudgetExceeded, Progress
-from mechgen.runtime.core.events import Event, EventRules, HybridTrajectory, diagnosis
+from mechgen.runtime.core.events import ZENO_HINT, Event, EventRules, HybridTrajectory, ZenoApproach, diagnosis
 from mechgen.runtime.core.pattern import extent
 
 log = logging.getLogger("mechgen")
@@ -359,7 +359,10 @@ def integrate_hybrid_c(system, x0, t_end: float, *, mode: int | None = None, rto
                 budget.spend(state.counted, lambda: where(state.t, state.mode))
             if rc < 0:
                 new_events()
-                raise _error(rc, system, state, err_x, where, rules, zeno_span, explain)
+                error = _error(rc, system, state, err_x, where, rules, zeno_span, explain)
+                if isinstance(error, ZenoApproach):  # the run so far, up to the event that made it Zeno
+                    raise error.with_trajectory(_zeno_trajectory(arrays, state, events))
+                raise error
             bar.to(state.t)
             if rc == FULL_SAMPLES:
                 buffers.grow("s")
@@ -380,6 +383,16 @@ def integrate_hybrid_c(system, x0, t_end: float, *, mode: int | None = None, rto
     return HybridTrajectory(arrays["s_t"][:count].copy(), arrays["s_x"][:count].copy(),
                             arrays["s_mode"][:count].astype(int), tuple(events), int(state.mode), float(state.t),
                             x.copy(), terminated, int(state.steps), int(state.nfev), 0, int(state.nguard),
+                            {"loop": "c", "rate_evaluations": int(state.nrate)})
+
+
+def _zeno_trajectory(arrays: dict, state: CState, events: list) -> HybridTrajectory:
+    """The C loop's run up to the event that tipped its Zeno bound (ZenoApproach's ``trajectory``)."""
+    count, last = state.n_samples, events[-1]
+    return HybridTrajectory(arrays["s_t"][:count].copy(), arrays["s_x"][:count].copy(),
+                            arrays["s_mode"][:count].astype(int), tuple(events),
+                            last.source if last.target is None else last.target, float(last.t),
+                            last.x_after.copy(), True, int(state.steps), int(state.nfev), 0, int(state.nguard),
                             {"loop": "c", "rate_evaluations": int(state.nrate)})
 
 
@@ -412,10 +425,10 @@ def _error(rc: int, system, state: CState, err_x: np.ndarray, where, rules, zeno
                               reached=where(t, seg))
     if rc == E_ZENO:
         count = max(2, rules.zeno_events + 1)
-        return BudgetExceeded(f"events: {count} events within {state.err_span:.3g} (more than zeno_events = "
-                              f"{rules.zeno_events} within zeno_span = {zeno_span:.3g}): a Zeno or chattering approach (guard "
-                              f"{system.guards(seg)[state.err_guard].name} of mode {system.modes[seg]})",
-                              key="zeno_events", reached=where(t, seg))
+        return ZenoApproach(f"events: {count} events within {state.err_span:.3g} (more than zeno_events = "
+                            f"{rules.zeno_events} within zeno_span = {zeno_span:.3g}): a Zeno or chattering approach "
+                            f"(guard {system.guards(seg)[state.err_guard].name} of mode {system.modes[seg]}); "
+                            f"{ZENO_HINT}", key="zeno_events", reached=where(t, seg))
     if rc == E_BUDGET:
         return BudgetExceeded(f"DOP853 steps: stopped by the step budget", key="max_steps", reached=where(t, seg))
     if rc == E_MEMORY:

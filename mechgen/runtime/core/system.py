@@ -25,7 +25,7 @@ import scipy.linalg as sla
 import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
-from mechgen.errors import InputError, KernelError
+from mechgen.errors import InputError, KernelError, did_you_mean
 from mechgen.runtime.core.kernels import Kernel
 from mechgen.runtime.core.meta import SystemMeta
 from mechgen.runtime.core.pattern import Pattern, build_pattern, extent
@@ -93,7 +93,7 @@ def number(name: str, value) -> float:
 def unknown_parameters(model, unknown: list, known) -> InputError:
     """The error for names that are no parameter of the compiled system."""
     return InputError(f"unknown parameter{'s' if len(unknown) > 1 else ''} {', '.join(map(repr, unknown))} "
-                      f"for model {model}", key=unknown[0],
+                      f"for model {model}{did_you_mean(unknown[0], known)}", key=unknown[0],
                       expected="one of: " + (", ".join(sorted(known)) or "none"))
 
 
@@ -300,6 +300,21 @@ class System:
             raise KernelError(f"kernel outputs of {self.metadata.model} produced NaN/Inf in {', '.join(bad)} "
                               f"at q = {np.asarray(q).ravel()[:6].tolist()}")
         return values
+
+    def outputs_series(self, t: np.ndarray, X: np.ndarray) -> dict[str, np.ndarray]:
+        """Named outputs and energies at many states in one batched call of the outputs kernel: row k of X is
+        (q, v, z) at time t[k]; each output an array over the rows (a chain's sites summed: one call a row)."""
+        t, X = np.asarray(t, float), np.asarray(X, float)
+        if self.is_lattice:
+            rows = [self.outputs(x[:self.n], x[self.n:2 * self.n], x[2 * self.n:] if self.m else None, tk)
+                    for tk, x in zip(t, X)]
+            return {k: np.array([r[k] for r in rows], float) for k in (rows[0] if rows else {})}
+        n = self.n
+        inputs = {"q": X[:, :n], "v": X[:, n:2 * n], "z": X[:, 2 * n:], "t": t[:, None], "p": self.params}
+        spec = self.kernels["outputs"].spec
+        wanted = {port["name"] for port in spec["inputs"]}
+        raw = self.kernels["outputs"].evaluate({k: v for k, v in inputs.items() if k in wanted})
+        return {k: np.asarray(v, float).reshape(len(t), -1)[:, 0] for k, v in raw.items()}
 
     def force(self, q, t=0.0) -> np.ndarray:
         """Potential force -dV/dq."""

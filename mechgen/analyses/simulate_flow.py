@@ -1,0 +1,104 @@
+"""How ``simulate`` integrates a smooth model with an adaptive method: the method ``auto``, and the loop.
+
+* ``method = "auto"`` (the default) looks at the linearisation of dx/dt at the start, J = d(dx/dt)/dx: when
+  its fastest *decaying* rate, max(-Re lambda), would hold an explicit method to more than :data:`STIFF_STEPS`
+  steps for stability alone over t_end (t_end max(-Re lambda) / 12, DOP853's stability interval doubled), the
+  problem is stiff and ``Radau`` (implicit, order 5, Newton on the generated Jacobian) runs it; otherwise
+  ``DOP853`` (explicit, order 8). Fast *oscillations* (Re lambda ~ 0) do not make it stiff: any method must
+  resolve them to be accurate, and the explicit one does so cheapest. Above :data:`ESTIMATE_SIZE` first-order
+  states (no dense eigen-solve) ``auto`` is ``BDF``, the sparse-friendly implicit method.
+* ``DOP853`` on the C backend runs in the compiled loop (mechgen.runtime.core.smooth_c: no Python between the
+  steps; the same steps as scipy's DOP853) unless ``loop = "python"``; every other method (``BDF``,
+  ``Radau``, ``LSODA``, ``RK45``, and ``DOP853`` on the numpy or CasADi backends) is scipy's, stepped in
+  Python (mechgen.runtime.core.integrate), and ``cvodes`` SUNDIALS' (mechgen.runtime.core.sundials).
+
+The outputs ``method`` and ``loop`` say what ran.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from mechgen.analyses import energy_balance
+from mechgen.errors import InputError
+from mechgen.runtime.core.budget import Budget
+from mechgen.runtime.core.diagnose import explain_state
+from mechgen.runtime.core.integrate import integrate_first_order
+from mechgen.runtime.core.memory import dense_bytes, require
+
+#: an explicit method needing more steps than this for stability alone makes ``auto`` choose Radau
+STIFF_STEPS = 10_000
+#: DOP853's stability interval on the negative real axis, doubled (steps >= t_end |lambda| / c)
+DOP853_REACH = 12.0
+#: ``auto`` estimates the start's rates for first-order states up to this size (a dense eigen-solve)
+ESTIMATE_SIZE = 400
+
+
+def start_rates(system, x0: np.ndarray) -> np.ndarray | None:
+    """The eigenvalues of J = d(dx/dt)/dx at (t = 0, x0), or None (too large, or no finite J)."""
+    if x0.size > ESTIMATE_SIZE:
+        return None
+    try:
+        J = system.jacobian(0.0, x0)
+        J = J.toarray() if hasattr(J, "toarray") else np.asarray(J, float)
+        return np.linalg.eigvals(J) if np.all(np.isfinite(J)) else None
+    except Exception:  # no estimate: auto falls back to the sparse-friendly implicit method
+        return None
+
+
+def chosen_method(system, x0: np.ndarray, t_end: float) -> str:
+    """What ``auto`` runs (module doc): Radau when stiff at the start, DOP853 when not, BDF without an estimate."""
+    rates = start_rates(system, x0)
+    if rates is None:
+        return "BDF"
+    decay = float(np.max(-rates.real, initial=0.0))
+    return "Radau" if t_end * decay / DOP853_REACH > STIFF_STEPS else "DOP853"
+
+
+def adaptive_run(system, options: dict, x0: np.ndarray, method: str, budget: Budget,
+                 desc: str) -> tuple[np.ndarray, np.ndarray, dict]:
+    """(t, x rows, {method, loop, _extra}) of a run of ``method`` (not ``auto``: :func:`chosen_method` resolves it)
+    from x0, sampled at ``samples`` equally spaced times; ``_extra`` integrals of the energy balance
+    (mechgen.analyses.energy_balance) follow the state in each row where the run integrates them."""
+    from mechgen.analyses.simulate import refuse_explicit_stiff
+    from mechgen.runtime.core.smooth_c import integrate_smooth_c, smooth_loop_problem
+
+    t_end = float(options["t_end"])
+    refuse_explicit_stiff(system, x0, t_end, method, budget)
+    extra = energy_balance.EXTRA if energy_balance.accounted(system, method) else 0
+    x0 = np.concatenate([x0, np.zeros(extra)])
+    n_out = int(options.get("samples", 201))
+    require(dense_bytes(n_out, 3 * x0.size + 6), f"{n_out} output samples", key="samples")
+    t_eval = np.linspace(0.0, t_end, max(n_out, 2))
+    rtol, atol = options.get("rtol", 1e-8), options.get("atol", 1e-10)
+    common = dict(t_eval=t_eval, budget=budget, progress=bool(options.get("progress", True)), desc=desc,
+                  explain=lambda t, x: explain_state(system, t, x))
+    loop = options.get("loop", "auto")
+    if method == "DOP853" and loop != "python":
+        why = smooth_loop_problem(system, rtol, atol, extra)
+        if why is None:
+            t, X, _ = integrate_smooth_c(system, x0, t_end, rtol=rtol, atol=atol, extra=extra, **common)
+            return t, X, {"method": method, "loop": "c", "_extra": extra}
+        if loop == "c":
+            raise InputError(f"loop 'c' cannot run here: {why}", key="loop",
+                             expected="method DOP853 (or auto) on the C backend with a C compiler, or loop "
+                                      "'auto' / 'python'")
+    if method == "cvodes":
+        traj = cvodes_run(system, x0, t_end, options, common)
+    else:
+        flow = energy_balance.AugmentedFlow(system) if extra else system
+        traj = integrate_first_order(flow.rhs, x0, t_end, jac=flow.jacobian, method=method, rtol=rtol,
+                                     atol=atol, **common)
+    xs = traj.x if traj.x.shape[0] == len(traj.t) else traj.x.T
+    return np.asarray(traj.t, float), np.asarray(xs, float), {"method": method, "loop": "python", "_extra": extra}
+
+
+def cvodes_run(system, x0, t_end: float, options: dict, common: dict):
+    """The run with SUNDIALS' CVODES on the system's CasADi kernels (mechgen.runtime.core.sundials)."""
+    from mechgen.runtime.core.sundials import cvodes_problem, integrate_cvodes
+
+    why = cvodes_problem(system)
+    if why:
+        raise InputError(why, key="method", expected="a method of this system's backend: auto, BDF, Radau, LSODA, "
+                         "RK45, DOP853 or leapfrog, or backend 'casadi' for 'cvodes'")
+    return integrate_cvodes(system, x0, t_end, rtol=options.get("rtol", 1e-8), atol=options.get("atol", 1e-10),
+                            **common)
