@@ -13,6 +13,9 @@ def test_quick_simulate_benchmark_writes_reports(tmp_path):
     # each side at rtol 1e-10 over 50 periods: within 1e-8 of the reference (its own error ~1e-10 here)
     assert all(e < 1e-8 for e in data["errors"].values())
     assert data["sweep_ok"] and data["sweep_points"] == 100
+    # the hand-written C DOP853 loop takes scipy's steps, as the compiled loop does: the end states agree to
+    # rounding accumulated over ~1800 steps (1e-9 of |x| ~ 1)
+    assert data["hand_c"]["end_x_difference"] < 1e-9 and data["hand_c"]["hand_steps"] > 1000
     ratios = json.loads((tmp_path / "simulate_ratios.json").read_text())["ratios"]
     assert {r["peer"] for r in ratios} == {"mechgen scipy stepper", "hand-written scipy"}
     assert "compiled / scipy stepper" in (tmp_path / "simulate.md").read_text()

@@ -70,8 +70,9 @@ def adaptive_run(system, options: dict, x0: np.ndarray, method: str, budget: Bud
     require(dense_bytes(n_out, 3 * x0.size + 6), f"{n_out} output samples", key="samples")
     t_eval = np.linspace(0.0, t_end, max(n_out, 2))
     rtol, atol = options.get("rtol", 1e-8), options.get("atol", 1e-10)
+    size = 2 * system.n + system.m  # the diagnosis reads the model's state, not the integrals after it
     common = dict(t_eval=t_eval, budget=budget, progress=bool(options.get("progress", True)), desc=desc,
-                  explain=lambda t, x: explain_state(system, t, x))
+                  explain=lambda t, x: explain_state(system, t, np.asarray(x)[:size]))
     loop = options.get("loop", "auto")
     if method == "DOP853" and loop != "python":
         why = smooth_loop_problem(system, rtol, atol, extra)

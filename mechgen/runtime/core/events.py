@@ -144,7 +144,8 @@ def diagnosis(system, mode: int, t: float, x: np.ndarray) -> str:
     """Why the flow of ``mode`` fails at (t, x): the non-finite kernel output, a singular mass matrix or the
     largest rate, found on the mode's own kernels (diagnose.explain_state); "" when nothing is found."""
     try:
-        return explain_state(system.mode(mode), t, np.asarray(x, float))
+        flow = system.mode(mode)  # its own state (q, v, z): integrals a loop carries after it are left out
+        return explain_state(flow, t, np.asarray(x, float)[:2 * flow.n + flow.m])
     except Exception:  # the diagnosis never hides the error it explains
         return ""
 
