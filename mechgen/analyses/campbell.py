@@ -186,7 +186,7 @@ def plot(plt, a: dict, path: Path) -> list[Path]:
         ax.plot(c["speed"], c["frequency"], "kx", ms=6)
     ax.set_xlabel(f"{out.get('parameter', 'speed')} (rad/s)")
     ax.set_ylabel("damped natural frequency (rad/s)")
-    ax.set_title(f"{a['name']}: Campbell diagram (solid forward, dashed backward, dash-dot linear; "
+    ax.set_title(f"{a['name']}: Campbell diagram\n(solid forward, dashed backward, dash-dot linear; "
                  f"x critical speeds)", fontsize=9)
     ax.legend(fontsize=7, ncol=2, loc="upper left")
     fig.tight_layout()
