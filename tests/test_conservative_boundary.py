@@ -104,35 +104,3 @@ def test_a_bracket_on_one_side_says_so_and_a_straddling_one_is_never_refused(col
     assert "stable at P = 1" in str(err.value) and "stable at P = 5" in str(err.value)
     # the stable end's growth rate is exactly 0: before issue 25 this straddling bracket was refused
     assert mechgen.stability_boundary(system, parameter="P", bracket=[8.0, 9.0])["P_critical"] > 8.0
-
-
-CONTINUE_NEWTON = '''model = "euler_bernoulli_beam"
-backend = "numpy"
-[params]
-q = 1.0
-N = 8
-[[analysis]]
-name = "eq"
-kind = "steady"
-[[analysis]]
-name = "cont"
-kind = "continuation"
-about = "eq"
-parameter = "q"
-stop = 2.0
-'''
-
-
-def test_continuation_about_a_newton_steady_state_is_refused_by_name(tmp_path, capsys):
-    """A Newton (Galerkin) steady state of a continuum has no BVP to continue: exit 2 at 'about', naming the
-    BVP methods and what to use instead (it was a KeyError traceback)."""
-    from mechgen.cli import main
-
-    scene = tmp_path / "cont.toml"
-    scene.write_text(CONTINUE_NEWTON)
-    assert main(["run", str(scene)]) == 2
-    err = capsys.readouterr().err
-    assert "key 'about'" in err and "Newton steady state" in err and "collocation" in err and "sweep" in err
-    assert "Traceback" not in err and "KeyError" not in err
-    with pytest.raises(InputError, match="boundary-value steady state"):
-        mechgen.run(str(scene))

@@ -47,7 +47,7 @@ def chain3_matrices(m1=1.0, m2=2.0, m3=0.5, k1=100.0, k2=50.0, k3=80.0, k4=30.0)
     return M, K
 
 
-DOUBLE_PENDULUM = '''"""Planar double pendulum: point masses on rigid rods, angles a, b from the vertical (exact energies)."""
+DOUBLE_PENDULUM = '''"""Planar double pendulum: point masses on rigid rods, angles a, b from the vertical."""
 import sympy as sp
 from mechgen import Model, Param
 
@@ -92,7 +92,7 @@ model.kinetic(lambda v, p: p.m / 2 * (v.x**2 + v.y**2))
 model.potential(lambda q, p: (p.kx * q.x**2 + p.ky * q.y**2) / 2)
 '''
 
-LAVAL_TILT = '''"""A disk's tilts on a shaft of tilt stiffnesses kx, ky, spinning at Omega: G = Ip Omega [[0, 1], [-1, 0]]."""
+LAVAL_TILT = '''"""A disk's tilts on a shaft of tilt stiffnesses kx, ky at spin Omega: G = Ip Omega [[0, 1], [-1, 0]]."""
 from mechgen import Model, Param
 
 model = Model("laval_tilt", doc=__doc__)

@@ -8,8 +8,8 @@ are those of the ``stability`` kind: with internal variables, of A = d(dx/dt)/dx
 of M q'' + (D + G) q' + K q = 0. The bracket's ends must have different verdicts, one stable (or neutral),
 one unstable (divergence or flutter); else exit 1 naming both verdicts. When g(p_lo) and g(p_hi) have opposite
 signs beyond the eigen-solve's accuracy and beyond AMBIGUOUS (1e-5) times the spectrum's scale (a damped
-system: g is then certain of its sign and smooth at a simple crossing), Brent's method brackets the root of g to ``rtol``
-(default 1e-12) relative to it. Otherwise - a conservative system, whose growth rate is exactly 0 on the stable
+system: g is then certain of its sign and smooth at a simple crossing), Brent's method brackets the root of g
+to ``rtol`` (default 1e-12) relative to it. Otherwise - a conservative system, whose growth rate is exactly 0 on the stable
 side (undamped: s = +-i w; gyroscopic with M, K > 0 and C skew: s = i mu), losing stability when an eigenvalue
 passes through zero (divergence) or two frequencies merge and leave the imaginary axis (flutter) - the
 boundary is located by bisection on that event (the verdict changes) to ``rtol``: about 40 steps from a

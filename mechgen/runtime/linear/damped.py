@@ -343,7 +343,8 @@ def orbit_axes(shapes, x_index, y_index) -> dict[str, np.ndarray]:
     Returns arrays (one entry per mode): ``major`` a and ``minor`` b, the semi-axes (a >= b >= 0, in the
     units of the shape's x and y entries: a^2, b^2 are the eigenvalues of Re(v v^H), v = (X, Y), so
     a^2 + b^2 = |X|^2 + |Y|^2 and a b = |Im(X conj Y)|); ``angle``, the major axis's angle from x towards y
-    (rad, in (-pi/2 + 1e-9, pi/2 + 1e-9]: an axis within 1e-9 of vertical is pi/2; tan 2 angle = 2 Re(X conj Y) / (|X|^2 - |Y|^2), 0 for a circle); ``kappa``, the
+    (rad, in (-pi/2 + 1e-9, pi/2 + 1e-9]: an axis within 1e-9 of vertical is pi/2;
+    tan 2 angle = 2 Re(X conj Y) / (|X|^2 - |Y|^2), 0 for a circle); ``kappa``, the
     signed ratio b / a (:func:`orbit_kappa`: its sign is that of the orbit's angular momentum x y' - y x',
     whose time average is w Im(X conj Y)); ``station``, the index (into the stations) of the largest orbit.
     """
