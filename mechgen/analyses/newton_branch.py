@@ -24,6 +24,7 @@ from mechgen.analyses.stability_boundary import own_value, spectrum
 from mechgen.analyses.steady import equilibrium_functions, newton_aliases
 from mechgen.errors import SceneError
 from mechgen.runtime.core.budget import Budget
+from mechgen.runtime.core.memory import require_dense
 from mechgen.runtime.steady import branch_scan
 from mechgen.runtime.steady.continuation import ContinuationOptions, ParametricEquations, continuation
 
@@ -73,6 +74,8 @@ def point(system, name: str, y: np.ndarray, p: float, options: dict) -> dict:
     out.update(moved.outputs(y[:n], None, y[n:] if system.m else None))
     out.update(newton_aliases(out, options.get("aliases", {})))
     if options.get("stability", True):
+        require_dense(2 * n, 40, "the stability verdict at every branch point", key="stability",
+                      expected="stability = false for a system this large (or a smaller N)")
         res = spectrum(moved, y)
         out["verdict"], out["frequencies"] = res.verdict, [float(f) for f in res.frequencies]
         if options.get("eigenvalues"):
