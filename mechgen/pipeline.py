@@ -160,7 +160,8 @@ def all_kernels(model: Model) -> tuple[str, ...]:
     if model.is_field:
         return FIELD_KERNELS
     lumped = tuple(k for k in LUMPED_KERNELS if (k != "section" or model.section_fn is not None)
-                   and (k != "rod" or model.rod_spec is not None))
+                   and (k != "rod" or model.rod_spec is not None)
+                   and (k != "lagrangian" or not (model.is_hybrid or model.internals)))
     if not model.coordinate_names and not model.internals:  # no state: a section's stiffness, a rod, the outputs
         return tuple(k for k in lumped if k in ("outputs", "section", "rod"))
     if model.internals:  # a model of internal variables only (no coordinate) has no potential force
@@ -216,7 +217,7 @@ def _initial_kernel(eqs, kernels, cse: bool) -> list[KernelIR]:
     from mechgen.codegen.lower_lumped import lower_matrices
 
     column = getattr(eqs, "initial", None)
-    if column is None or not {"residual", "force"} & set(kernels):
+    if column is None or not {"residual", "force", "lagrangian"} & set(kernels):
         return []
     return [lower_matrices(eqs, "initial", "the declared initial state (q, v, z)", {"x": column}, cse=cse)]
 

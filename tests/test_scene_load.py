@@ -175,7 +175,7 @@ name = "sim"
 kind = "simulate"
 t_end = 5
 """)
-    assert scene.analyses[0].options == {"t_end": 5.0, "method": "BDF", "rtol": 1e-8, "atol": 1e-10, "q0": {},
+    assert scene.analyses[0].options == {"t_end": 5.0, "method": "auto", "rtol": 1e-8, "atol": 1e-10, "q0": {},
                                          "v0": {}, "amplitude": 1.0, "outputs": ["energy"], "samples": 201}
     # series left out: the time history is kept while it is small (mechgen.analyses.time_series.keep_series)
 

@@ -136,6 +136,10 @@ def steady(system, *, name: str | None = None, **options) -> Result:
 def simulate(system, *, name: str | None = None, **options) -> Result:
     """The time response from ``q0``, ``v0`` (or ``initial_mode``) to ``t_end`` (required).
 
+    ``method="variational"`` with ``dt`` (and ``stages`` 1, 2 or 3: orders 2, 4, 6) steps a variational
+    integrator of the model's own Lagrangian (mechgen.analyses.simulate_variational); ``method="leapfrog"``
+    serves only q'' = M^-1 (-dV/dq) with a constant diagonal M (else InputError at ``method``).
+
     Outputs: ``t`` and ``trajectory`` (each coordinate, ``<coordinate>_dot``, internal variable and output at
     the sample times, as numpy arrays; left out for a very large state unless ``series=True``), the model's
     outputs at ``t_end``, ``energy_drift`` (conservative runs) or ``energy_balance_error``, ``work`` and

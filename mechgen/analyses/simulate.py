@@ -2,8 +2,11 @@
 
 Scene keys: ``t_end`` (required), ``method`` (``auto``, the default, and the compiled loop:
 mechgen.analyses.simulate_flow; BDF, Radau, LSODA, RK45, DOP853, ``leapfrog`` with a step ``dt`` and
-``save_every``, or ``cvodes``: SUNDIALS' variable-order BDF with the exact Jacobian, compiled through CasADi,
-for a lumped model built with ``backend = "casadi"``: mechgen.runtime.core.sundials), ``loop`` (``auto``,
+``save_every`` (a model whose equations are q'' = M^-1 (-dV/dq) with a constant diagonal M only, else refused
+at ``method``: mechgen.runtime.core.splitting.require_separable), ``cvodes``: SUNDIALS' variable-order BDF with
+the exact Jacobian, compiled through CasADi, for a lumped model built with ``backend = "casadi"``:
+mechgen.runtime.core.sundials, or ``variational`` with ``dt``, ``stages`` and ``save_every``: the variational
+integrator of the model's own Lagrangian, mechgen.analyses.simulate_variational), ``loop`` (``auto``,
 ``python`` or ``c``), ``rtol``, ``atol``, ``q0`` / ``v0`` (tables of coordinates), ``initial_mode`` with
 ``amplitude`` (start from a linear mode), ``outputs`` (which model outputs to report), ``series`` (the time
 history; left out: kept while small, mechgen.analyses.time_series), ``samples``, ``plot`` (``time`` or
@@ -43,13 +46,17 @@ from mechgen.analyses.context import NAME
 from mechgen.analyses.operating_point import vector
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import ABSENT, ALL_OUTPUTS, REQUIRED, Option
+from mechgen.analyses.simulate_variational import check_fixed_step, simulate_variational
 from mechgen.errors import ConvergenceError, SceneError
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget, BudgetExceeded
 from mechgen.runtime.core.integrate import MIN_RTOL, leapfrog
+from mechgen.runtime.core.splitting import require_separable
 from mechgen.runtime.linear.modes import modes as solve_modes
 from mechgen.scene.values import fail, listing, show, type_name
 
-METHODS = ("auto", "BDF", "Radau", "LSODA", "RK45", "DOP853", "leapfrog", "cvodes")
+METHODS = ("auto", "BDF", "Radau", "LSODA", "RK45", "DOP853", "leapfrog", "cvodes", "variational")
+#: the fixed-step methods (a dt, a step budget refused up front)
+FIXED_STEP = ("leapfrog", "variational")
 #: the default figure: coordinates against time, or each coordinate against its velocity
 PLOTS = ("time", "phase")
 #: what a hybrid run does when its events accumulate (Zeno): end with an error, or stop there
@@ -59,6 +66,9 @@ STEP = "a number > 0 (or an expression)"
 DEFAULT_STEPS = {"leapfrog": 10_000_000, "adaptive": 100_000}
 #: stability intervals of the explicit methods, doubled (RK45: ~3.3, DOP853: ~6): steps >= t_end |lambda| / c
 EXPLICIT_REACH = {"RK45": 7.0, "DOP853": 12.0}
+#: what a model unfit for the leapfrog uses instead (mechgen.runtime.core.splitting.require_separable)
+INSTEAD = ("method = 'variational' (a variational integrator of the model's own Lagrangian, any kinetic energy), "
+           "or an adaptive one ('auto', the default, or 'Radau')")
 #: the explicit methods' up-front stiffness estimate is made for first-order states up to this size
 ESTIMATE_SIZE = 400
 
@@ -118,12 +128,15 @@ SCHEMA = {"t_end": Option(schema.positive, REQUIRED, STEP), "method": Option(_me
           "max_steps": Option(schema.count, ABSENT), "max_seconds": Option(schema.positive, ABSENT),
           "progress": Option(schema.boolean, ABSENT), "mode": Option(_mode, ABSENT),
           "max_events": Option(schema.count, ABSENT), "zeno_events": Option(schema.count, ABSENT),
-          "zeno_span": Option(schema.positive, ABSENT), "loop": Option(_loop, ABSENT)}
+          "zeno_span": Option(schema.positive, ABSENT), "loop": Option(_loop, ABSENT),
+          "stages": Option(schema.count, ABSENT)}
 
 
 def check(ctx, base: str, options: dict) -> None:
-    """leapfrog needs dt; dt <= t_end; initial_mode within the coordinates; rtol at least MIN_RTOL."""
-    if options["method"] != "leapfrog" and options["rtol"] < MIN_RTOL:
+    """leapfrog and variational need dt (mechgen.analyses.simulate_variational.check_fixed_step); dt <= t_end;
+    initial_mode within the coordinates; rtol at least MIN_RTOL."""
+    check_fixed_step(ctx, base, options)
+    if options["method"] not in FIXED_STEP and options["rtol"] < MIN_RTOL:
         raise fail(ctx.file, f"{base}.rtol", f"rtol {options['rtol']!r} is below what the integrators can honour "
                    "in double precision", f"a relative tolerance >= {MIN_RTOL:.3g} (100 machine epsilons)")
     if options["method"] == "cvodes" and getattr(ctx.model, "modes", ()):
@@ -144,6 +157,8 @@ def needs(options: dict, *, internal: bool) -> set[str]:
     if options.get("method") == "leapfrog":
         return {"force", "outputs", "linear"}
     start = {"linear"} if options.get("initial_mode") else set()
+    if options.get("method") == "variational":
+        return {"lagrangian", "outputs", "energy_rates"} | start
     balance = {"energy_rates"} if options.get("method") != "cvodes" else set()
     return {"residual", "tangent", "outputs"} | start | balance | ({"rates", "rates_tangent"} if internal else set())
 
@@ -191,8 +206,8 @@ def mode_energies(system, q: np.ndarray, v: np.ndarray, count: int = 8) -> list[
 
 def budget_of(options: dict, method: str) -> Budget:
     """The run's work budget: ``max_steps`` (default DEFAULT_STEPS of the method) and ``max_seconds``."""
-    steps = options.get("max_steps", DEFAULT_STEPS["leapfrog" if method == "leapfrog" else "adaptive"])
-    what = "leapfrog steps" if method == "leapfrog" else f"{method} steps"
+    steps = options.get("max_steps", DEFAULT_STEPS["leapfrog" if method in FIXED_STEP else "adaptive"])
+    what = f"{method} steps"
     return Budget(what, limit=int(steps), key="max_steps", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
 
 
@@ -238,13 +253,17 @@ def run_simulate(system, options: dict, context: dict) -> dict:
     q0, v0 = initial_state(system, options)
     method, desc = options.get("method", "auto"), context.get(NAME, "simulate")
     if method == "leapfrog":
+        require_separable(system, "method", "method 'leapfrog'", INSTEAD)
         t, X = _leapfrog_run(system, options, q0, v0, budget_of(options, method), desc)
         how = {"method": method, "loop": "python"}
+    elif method == "variational":
+        t, X, how = simulate_variational(system, q0, v0, options, budget_of(options, method), desc)
     else:
         start = declared_start(system)
         x0 = np.concatenate([q0, v0, np.zeros(system.m) if start is None else start[2 * system.n:]])
         if method == "auto":
-            method = simulate_flow.chosen_method(system, x0, float(options["t_end"]))
+            limit = budget_of(options, "DOP853").limit
+            method = simulate_flow.chosen_method(system, x0, float(options["t_end"]), limit)
         t, X, how = simulate_flow.adaptive_run(system, options, x0, method, budget_of(options, method), desc)
     n = system.n
     extra = how.pop("_extra", 0)

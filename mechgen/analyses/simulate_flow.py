@@ -45,13 +45,20 @@ def start_rates(system, x0: np.ndarray) -> np.ndarray | None:
         return None
 
 
-def chosen_method(system, x0: np.ndarray, t_end: float) -> str:
-    """What ``auto`` runs (module doc): Radau when stiff at the start, DOP853 when not, BDF without an estimate."""
+def chosen_method(system, x0: np.ndarray, t_end: float, max_steps: int | None = None) -> str:
+    """What ``auto`` runs (module doc): Radau when stiff at the start, or when an explicit method's stability
+    alone (t_end max|lambda| / 12) would take more than ``max_steps`` steps (it would be refused); DOP853
+    otherwise; BDF without an estimate."""
     rates = start_rates(system, x0)
     if rates is None:
         return "BDF"
     decay = float(np.max(-rates.real, initial=0.0))
-    return "Radau" if t_end * decay / DOP853_REACH > STIFF_STEPS else "DOP853"
+    fastest = float(np.max(np.abs(rates), initial=0.0))
+    if t_end * decay / DOP853_REACH > STIFF_STEPS:
+        return "Radau"
+    if max_steps is not None and t_end * fastest / DOP853_REACH > max_steps:
+        return "Radau"
+    return "DOP853"
 
 
 def adaptive_run(system, options: dict, x0: np.ndarray, method: str, budget: Budget,

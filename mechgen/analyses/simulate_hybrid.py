@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mechgen.analyses import time_series
+from mechgen.analyses import energy_balance, time_series
 from mechgen.analyses.context import NAME
 from mechgen.errors import SceneError
 from mechgen.runtime.core.diagnose import explain_state
@@ -68,7 +68,12 @@ def run_hybrid(system, options: dict, context: dict) -> dict:
     t, X, modes = with_final(traj)
     views: dict = {}
     mode_system = lambda k: views.setdefault(k, system.mode(k))  # noqa: E731
-    out = report(system, options, t, X, time_series.sampled_outputs_by_mode(mode_system, t, X, modes))
+    series = time_series.sampled_outputs_by_mode(mode_system, t, X, modes)
+    out = report(system, options, t, X, series)
+    figures = energy_balance.hybrid_figures(mode_system, t, X, modes, traj.events, series)
+    if figures is not None:  # resets that change the energy, or modes that are not conservative
+        del out["energy_drift"]
+        out.update(figures)
     out["t_final"] = float(traj.t_final)
     out["events"] = event_log(system, traj.events)
     out["final_mode"] = system.modes[traj.final_mode]

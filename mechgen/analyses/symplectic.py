@@ -1,5 +1,9 @@
 """``symplectic``: a chain (separable H = sum v^2/(2m) + V(q)) run by a splitting method, the time loop in C.
 
+A chain whose site kinetic energy is not m u'^2 / 2 with a constant m (or whose potential depends on a velocity)
+is refused at ``integrator`` (exit 2; mechgen.runtime.core.splitting.require_separable): the splittings would
+be silently wrong for it; simulate's ``method = "variational"`` serves any Lagrangian.
+
 Scene keys: ``integrator`` (leapfrog | yoshida4 | yoshida6 | aba864: mechgen.runtime.core.splitting,
 orders 2, 4, 6, 4), ``dt`` and ``t_end`` (required, model time units), ``stride`` (steps between outputs;
 default 0: about 40 outputs per period T_1 = 2 pi / omega_1 of the lowest linear mode), ``initial_mode``
@@ -31,7 +35,7 @@ from mechgen.analyses import schema, summary
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import REQUIRED, Option
 from mechgen.errors import SceneError
-from mechgen.runtime.core.splitting import METHODS
+from mechgen.runtime.core.splitting import METHODS, require_separable
 from mechgen.scene.values import fail
 
 STEP = "a number > 0 (or an expression)"
@@ -104,6 +108,8 @@ def run_symplectic(system, options: dict, context: dict) -> dict:
     if not system.is_lattice:
         raise SceneError(f"model {system.metadata.model} is not a chain", key="kind",
                          expected="a chain model (Model.chain) for the symplectic kind")
+    require_separable(system, "integrator", f"integrator '{options.get('integrator', 'leapfrog')}'",
+                      "kind = 'simulate' with method = 'variational' (any kinetic energy), or an implicit method")
     split = method(options.get("integrator", "leapfrog"))
     dt, t_end = float(options["dt"]), float(options["t_end"])
     steps = int(round(t_end / dt))

@@ -7,7 +7,7 @@ Sparse matrices are written into the data array of one CSR pattern (runtime
 size ``nnz``) through slot tables the runtime fills once.
 
 Kernel names as for lumped models (:mod:`mechgen.codegen.lower_lumped`):
-``residual``, ``tangent``, ``linear``, ``force``, ``outputs``; plus ``stiffness``,
+``residual``, ``tangent``, ``linear``, ``force`` (with the meta ``separable``), ``outputs``; plus ``stiffness``,
 K = d2V/du2 alone (at a = 0), the Jacobian Newton and the benchmarks need.
 """
 from __future__ import annotations
@@ -16,7 +16,9 @@ import sympy as sp
 
 from mechgen.codegen.ir import Block, Extent, KernelIR, Loop, Port, Write, fixed, sized
 from mechgen.codegen.lower import canonical_block, kernel
+from mechgen.codegen.lower_lumped import separable_meta
 from mechgen.symbolic.lattice import LatticeEquations
+from mechgen.symbolic.separable import lattice_obstacle
 
 LATTICE_KERNELS = ("residual", "tangent", "linear", "stiffness", "force", "outputs")
 SITES = sized("sites")
@@ -84,6 +86,9 @@ def lower_lattice(eqs: LatticeEquations, name: str, *, cse: bool = True) -> Kern
         port = "r" if name == "residual" else "f"
         site, bond = _vector_writes(port, sign * site_expr, [sign * g for g in eqs.bond_gradient()], offsets)
         outputs = [Port(port, SITES)]
+        if name == "force":
+            meta.update(separable_meta(lattice_obstacle(eqs.site_kinetic, eqs.site_potential, eqs.bond_potential,
+                                                        eqs.site_q, eqs.site_v, eqs.coordinate)))
     elif name in ("tangent", "linear", "stiffness"):
         tan = eqs.site_tangent()
         if name == "tangent":

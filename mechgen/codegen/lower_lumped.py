@@ -5,8 +5,12 @@ Kernel names and what they compute (n coordinates, m internal variables):
 * ``residual``  r(q, v, a, z, t)                       -> r[n]
 * ``tangent``   dr/dq, dr/dv, dr/da, dr/dz            -> r_q[n*n], r_v[n*n], r_a[n*n], r_z[n*m]
 * ``linear``    M, D, G, K at (q, v, z, t) with a = 0  -> M, D, G, K [n*n]
-* ``force``     -dV/dq                                 -> f[n]
+* ``force``     -dV/dq                                 -> f[n]  (meta ``separable``: fit for the splittings,
+                mechgen.symbolic.separable; ``separable_why``: why not)
 * ``rates``     dz/dt = g(q, v, z, t)                  -> g[m]
+* ``lagrangian`` p = dT/dv, F = dL/dq + Q - dR/dv at (q, v, t) and their Jacobians (LumpedEquations.lagrangian)
+                                                       -> mom[n] (p), F[n], mom_q, mom_v, F_q, F_v [n*n]
+                (a smooth model without internal variables: the variational integrator's dp/dt = F)
 * ``rates_tangent``                                    -> g_q[m*n], g_v[m*n], g_z[m*m]
 * ``energy_rates`` the internal rates and the powers of the energy balance (mechgen.symbolic.derive.energy_powers)
                 -> g[m + 3] = (dz/dt, Q.v, v.dR/dv, -dL/dt), excess[1] = v.dT/dv - 2 T
@@ -28,9 +32,10 @@ from mechgen.codegen.ir import KernelIR, Port, fixed
 from mechgen.codegen.lower import canonical_block, dense_writes, kernel
 from mechgen.errors import ModelError
 from mechgen.symbolic.derive import LumpedEquations
+from mechgen.symbolic.separable import separable_obstacle
 
 LUMPED_KERNELS = ("residual", "tangent", "linear", "force", "rates", "rates_tangent", "energy_rates", "outputs", "section",
-                  "rod")
+                  "rod", "lagrangian")
 
 
 def _inputs(eqs: LumpedEquations, with_accel: bool = True) -> tuple[list[Port], list]:
@@ -53,13 +58,19 @@ def _inputs(eqs: LumpedEquations, with_accel: bool = True) -> tuple[list[Port], 
 
 
 def _matrix_kernel(eqs: LumpedEquations, name: str, doc: str, mats: dict[str, sp.Matrix], *, accel: bool,
-                   cse: bool, symmetric: tuple[str, ...] = ()) -> KernelIR:
+                   cse: bool, symmetric: tuple[str, ...] = (), extra: dict | None = None) -> KernelIR:
     inputs, gathers = _inputs(eqs, accel)
     outputs = [Port(k, fixed(m.rows * m.cols), shape=(m.rows, m.cols), symmetric=k in symmetric)
                for k, m in mats.items()]
     writes = [w for k, m in mats.items() for w in dense_writes(k, m)]
     block = canonical_block(gathers, writes, cse=cse, model=eqs.model)
-    return kernel(name, doc, inputs, outputs, [block], meta=_meta(eqs))
+    return kernel(name, doc, inputs, outputs, [block], meta={**_meta(eqs), **(extra or {})})
+
+
+def separable_meta(why: str | None) -> dict:
+    """The force kernel's record of mechgen.symbolic.separable: ``separable`` (H = v^T M v / 2 + V(q) with a
+    constant diagonal M and nothing else: fit for the splittings) and ``separable_why`` (the reason when not)."""
+    return {"separable": why is None, "separable_why": why or ""}
 
 
 def _meta(eqs: LumpedEquations) -> dict:
@@ -86,7 +97,13 @@ def lower_lumped(eqs: LumpedEquations, name: str, *, cse: bool = True) -> Kernel
         return _matrix_kernel(eqs, name, "M, D, G, K of the linearisation (a = 0)", eqs.linear_matrices(),
                               accel=False, cse=cse, symmetric=("M", "D"))
     if name == "force":
-        return _matrix_kernel(eqs, name, "potential force -dV/dq", {"f": eqs.force()}, accel=False, cse=cse)
+        why = separable_obstacle(eqs.kinetic, eqs.potential, eqs.residual, eqs.q, eqs.v, eqs.a, (eqs.t, *eqs.z),
+                                 eqs.coordinates)
+        return _matrix_kernel(eqs, name, "potential force -dV/dq", {"f": eqs.force()}, accel=False, cse=cse,
+                              extra=separable_meta(why))
+    if name == "lagrangian":
+        return _matrix_kernel(eqs, name, "momentum p = dT/dv, force F = dL/dq + Q - dR/dv and their Jacobians",
+                              eqs.lagrangian(), accel=False, cse=cse)
     if name == "rates":
         return _matrix_kernel(eqs, name, "internal rates dz/dt", {"g": eqs.rates}, accel=False, cse=cse)
     if name == "rates_tangent":

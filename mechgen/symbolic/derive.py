@@ -80,6 +80,22 @@ class LumpedEquations:
         K = self.jacobian(self.residual, "q").subs(at_rest)
         return {"M": M, "D": (C + C.T) / 2, "G": (C - C.T) / 2, "K": K}
 
+    def lagrangian(self) -> dict[str, sp.Matrix]:
+        """The pieces a variational integrator needs (mechgen.runtime.core.variational), with their Jacobians:
+
+            p = dT/dv (the momentum dL/dv, L = T - V),
+            F = dL/dq + Q - dR/dv = -r(q, v, 0, z, t) + (dp/dq) v + dp/dt,
+
+        so that Lagrange's equations read dp/dt = F. Keys ``mom`` (p: the parameters' port is named p), ``F`` and
+        their Jacobians ``mom_q, mom_v, F_q, F_v`` = d(p, F)/d(q, v).
+        """
+        v = sp.Matrix(self.v)
+        p = sp.Matrix([sp.diff(self.kinetic, s) for s in self.v])
+        p_q = self.jacobian(p, "q")
+        F = -self.residual.subs({ai: 0 for ai in self.a}) + p_q * v + p.diff(TIME)
+        return {"mom": p, "F": F, "mom_q": p_q, "mom_v": self.jacobian(p, "v"), "F_q": self.jacobian(F, "q"),
+                "F_v": self.jacobian(F, "v")}
+
     def force(self) -> sp.Matrix:
         """Potential force -dV/dq (for symplectic integration of separable systems)."""
         return -sp.Matrix([self.potential]).jacobian(sp.Matrix(self.q)).T

@@ -339,7 +339,8 @@ def integrate_hybrid_c(system, x0, t_end: float, *, mode: int | None = None, rto
     events: list[Event] = []
 
     def where(tk: float, seg: int) -> str:
-        return f"t = {tk:.9g} of t_end = {t_end:.6g} in mode {names[seg]}"
+        mode = "" if getattr(system, "smooth", False) else f" in mode {names[seg]}"
+        return f"t = {tk:.9g} of t_end = {t_end:.6g}{mode}"
 
     def new_events() -> None:
         for e in range(len(events), state.n_events):

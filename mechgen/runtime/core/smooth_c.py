@@ -25,6 +25,8 @@ class SmoothView:
 
     modes = ("smooth",)
     initial_mode = 0
+    #: the loop's messages name no mode for it
+    smooth = True
     is_lattice = False
     is_field = False
 

@@ -126,3 +126,32 @@ def evolve(acceleration: Callable[[np.ndarray], np.ndarray], q, v, dt: float, n_
 
 
 __all__ = ["METHODS", "Splitting", "compose_leapfrogs", "evolve", "method"]
+
+
+def splitting_refusal(system) -> str | None:
+    """Why ``system`` is not fit for a splitting (leapfrog included), from its force kernel's meta, or None.
+
+    The force kernel records (mechgen.codegen.lower_lumped.separable_meta, decided symbolically on the
+    specialised equations) whether Lagrange's equations are q'' = M^-1 (-dV/dq) with a constant diagonal M and
+    no other term; a kernel that does not record it (built by an older mechgen) is not trusted either.
+    """
+    kernel = system.kernels.get("force")
+    if kernel is None:
+        return "it has no potential force kernel (no coordinates?)"
+    meta = kernel.spec.get("meta", {})
+    if "separable" not in meta:
+        return "its force kernel does not record whether its kinetic energy is a constant diagonal quadratic form"
+    if meta["separable"]:
+        return None
+    return meta.get("separable_why") or "its equations are not q'' = M^-1 (-dV/dq) with a constant diagonal M"
+
+
+def require_separable(system, key: str, what: str, instead: str) -> None:
+    """InputError at ``key`` (exit 2) when ``system`` is not fit for the splitting ``what`` (splitting_refusal),
+    naming why and ``instead``, what to use; nothing otherwise."""
+    from mechgen.errors import InputError
+
+    why = splitting_refusal(system)
+    if why:
+        raise InputError(f"{what} integrates q'' = M^-1 (-dV/dq) with a constant diagonal mass matrix M and no other "
+                         f"term, and model {system.metadata.model} does not fit: {why}", key=key, expected=instead)
