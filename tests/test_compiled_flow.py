@@ -156,3 +156,13 @@ def test_a_parameter_change_reaches_the_compiled_loop(duffing):
         assert c["trajectory"]["x"][-1] == pytest.approx(py["trajectory"]["x"][-1], abs=1e-9)
         assert x_end == pytest.approx(c["energy"], rel=1e-12)
     assert len(set(np.round(swept["energy"], 6))) == 3
+
+
+def test_a_python_sweep_on_processes_needs_no_pickling(duffing):
+    """sweep(system, workers=2) from Python: the forked workers inherit the tasks (a compiled system does not
+    pickle; this was a TypeError traceback) and give the serial numbers bit for bit."""
+    grid = {"w": [0.8, 1.0, 1.2, 1.4]}
+    serial = mechgen.sweep(duffing, "simulate", grid=grid, t_end=5.0, q0={"x": 0.5}, samples=2)
+    pooled = mechgen.sweep(duffing, "simulate", grid=grid, t_end=5.0, q0={"x": 0.5}, samples=2, workers=2)
+    assert pooled["executor"] == "processes" and pooled["failed"] == 0
+    np.testing.assert_array_equal(pooled["energy"], serial["energy"])

@@ -53,8 +53,10 @@ def test_whirl_sign_of_elementary_orbits():
     area = 0.5 * np.trapezoid(x * np.gradient(y, t) - y * np.gradient(x, t), t)  # > 0: counter-clockwise
     assert area > 0 and np.imag(X * np.conj(Y)) > 0
     shapes = np.array([[1.0, 1.0, 1.0, 1.0], [-1j, 1j, 0.5, -0.3j]])  # ccw, cw, straight line, ccw ellipse
-    assert whirl(shapes, 0, 1) == ["forward", "backward", "forward", "forward"]
+    # a straight line has no whirl direction: 'linear' (issue 25; the rule before it, forward, on request)
+    assert whirl(shapes, 0, 1) == ["forward", "backward", "linear", "forward"]
     assert whirl(shapes, 0, 1, planar="backward")[2] == "backward"
+    assert whirl(shapes, 0, 1, planar="forward")[2] == "forward"
     assert np.allclose(orbit_kappa(shapes, 0, 1), [1.0, -1.0, 0.0, 0.3])
     # the station with the largest orbit decides; a straight line there defers to the weighted sum
     two = np.array([[0.1, 1.0], [0.1j, 0.0], [1.0, 0.2], [-0.5j, 0.05j]])  # rows: x0, y0, x1, y1
@@ -148,7 +150,7 @@ def test_anisotropic_jeffcott_planar_modes_at_rest():
     assert np.allclose(res.wd, [np.sqrt(kxx / m), np.sqrt(kyy / m)], rtol=1e-12)
     assert np.allclose(orbit_kappa(res.shapes, 0, 1), 0.0, atol=1e-12)
     assert np.allclose(np.abs(res.shapes), np.eye(2), atol=1e-12)
-    assert whirl(res.shapes, 0, 1) == ["forward", "forward"]  # documented rule for a straight line
+    assert whirl(res.shapes, 0, 1) == ["linear", "linear"]  # a straight line has no whirl direction (issue 25)
     assert list(whirl_sign(res.shapes, 0, 1)) == [0, 0]
 
 
@@ -219,15 +221,17 @@ def test_campbell_sparse_path_with_spare_modes():
     assert all(row == ["backward", "forward", "backward", "forward"] for row in res.whirl)
 
 
-def test_campbell_anisotropic_start_inherits_whirl():
-    # planar orbits at Omega = 0 take the label of the curve at the next speed
+def test_campbell_anisotropic_start_is_linear_then_whirls():
+    # at Omega = 0 the anisotropic rotor's modes are x-only and y-only (straight lines: 'linear', issue 25);
+    # the gyroscopic coupling makes them ellipses, backward (lower) and forward (upper), at every speed > 0
     def mats(speed):
         M, G, _ = laval(1.0, 0.8, 1.0, speed)
         return {"M": M, "C": G, "K": np.diag([4.0, 6.0])}
 
     res = campbell(mats, np.linspace(0.0, 4.0, 9), 2, x_index=0, y_index=1)
     assert np.allclose(res.frequencies[0], [2.0, np.sqrt(6.0)])
-    assert all(row == ["backward", "forward"] for row in res.whirl)
+    assert res.whirl[0] == ["linear", "linear"]
+    assert all(row == ["backward", "forward"] for row in res.whirl[1:])
 
 
 def laval_mats(Id, Ip, k, D=0.0):

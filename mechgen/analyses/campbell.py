@@ -12,7 +12,8 @@ address). On a parallel executor every speed is solved exactly (full size; the s
 matrices are assembled here, the solves are distributed, in Dask chunks of at least ~0.5 s of work) and the
 modes are tracked here afterwards, so the result is the serial exact one; ``method = "reduced"`` (whose basis
 grows from speed to speed) is refused there, and ``auto`` means exact. Outputs: ``speeds``, ``frequencies`` and
-``whirl`` and ``log_dec`` (one row per speed), ``critical_speeds``, ``parameter``, ``method``, ``exact_solves``
+``whirl`` (forward, backward, linear for a straight-line orbit at that speed, none for a mode that leaves the
+whirl stations at rest: mechgen.analyses.whirl) and ``log_dec`` (one row per speed), ``critical_speeds``, ``parameter``, ``method``, ``exact_solves``
 and ``executor``.
 """
 from __future__ import annotations
@@ -160,17 +161,22 @@ def summary_lines(outputs: dict) -> list[str]:
     return summary.output_lines(outputs, skip=("eigenvalues", "log_dec"))
 
 
+#: line styles of the whirl labels in the Campbell plot
+STYLES = {"forward": "-", "backward": "--", "linear": "-.", "none": ":"}
+
+
 def plot(plt, a: dict, path: Path) -> list[Path]:
-    """Tracked whirl frequencies against spin speed (forward solid, backward dashed), multiples of the
-    speed as excitation lines and the critical speeds where they cross."""
+    """Tracked whirl frequencies against spin speed (forward solid, backward dashed, linear dash-dotted,
+    none dotted: the label at the middle speed), multiples of the speed as excitation lines and the critical
+    speeds where they cross."""
     out = a["outputs"]
     speeds, freqs = out["speeds"], list(zip(*out["frequencies"]))
     whirls = list(zip(*out["whirl"]))
     fig, ax = plt.subplots(figsize=(6.5, 4.5))
     for k, (curve, labels) in enumerate(zip(freqs, whirls)):
-        forward = labels[len(labels) // 2] == "forward"
-        ax.plot(speeds, curve, "-" if forward else "--", color=f"C{k % 10}", lw=1.2,
-                label=f"mode {k + 1} ({'F' if forward else 'B'})")
+        label = labels[len(labels) // 2]
+        ax.plot(speeds, curve, STYLES.get(label, ":"), color=f"C{k % 10}", lw=1.2,
+                label=f"mode {k + 1} ({label[0].upper()})")
     top = max(max(c) for c in freqs)
     for r in sorted({c["multiple"] for c in out.get("critical_speeds", [])} or {1.0}):
         reach = min(speeds[-1], top / r)
@@ -180,7 +186,8 @@ def plot(plt, a: dict, path: Path) -> list[Path]:
         ax.plot(c["speed"], c["frequency"], "kx", ms=6)
     ax.set_xlabel(f"{out.get('parameter', 'speed')} (rad/s)")
     ax.set_ylabel("damped natural frequency (rad/s)")
-    ax.set_title(f"{a['name']}: Campbell diagram (solid forward, dashed backward; x critical speeds)", fontsize=9)
+    ax.set_title(f"{a['name']}: Campbell diagram\n(solid forward, dashed backward, dash-dot linear; "
+                 f"x critical speeds)", fontsize=9)
     ax.legend(fontsize=7, ncol=2, loc="upper left")
     fig.tight_layout()
     fig.savefig(path, dpi=120)

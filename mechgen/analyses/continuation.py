@@ -1,4 +1,5 @@
-"""``continuation``: branches of a continuum's steady states (boundary value problems in s).
+"""``continuation``: branches of a continuum's steady states (boundary value problems in s), and of Newton
+steady states (lumped models, a continuum's discretised residual: mechgen.analyses.newton_branch).
 
 ``continuation`` follows such a steady state in one parameter by pseudo-arclength
 (mechgen.runtime.steady.continuation), through turning points, with the stability verdict
@@ -56,6 +57,7 @@ import numpy as np
 from mechgen.analyses import figures, schema, summary
 from mechgen.analyses.bvp_states import (bvp_summary, shape_declarations, shape_values, stability_about,
                                          stability_of_each)
+from mechgen.analyses.newton_branch import newton_branch
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import REQUIRED, Option
 from mechgen.errors import SceneError
@@ -302,6 +304,36 @@ def _one_branch(system, start: dict, options: dict, label: str | None, budget: B
     return out
 
 
+def newton_starts(starts: list[str], context: dict) -> bool:
+    """True when every start is a Newton steady state (no BVP), False when every one is a BVP steady state;
+    a mix is refused (SceneError at ``about``): the two kinds of branch are followed differently."""
+    newton = ["_bvp" not in context[s] for s in starts]
+    if any(newton) and not all(newton):
+        raise SceneError("the starts mix Newton steady states (" + ", ".join(s for s, n in zip(starts, newton) if n)
+                         + ") with boundary-value ones", key="about",
+                         expected="starts of one kind: all Newton steady states, or all with method = "
+                                  "\"collocation\", \"shooting\" or \"multiple_shooting\"")
+    return all(newton)
+
+
+def _newton_continuation(system, starts: list[str], options: dict, context: dict, budget: Budget) -> dict:
+    """The branches through Newton steady states (mechgen.analyses.newton_branch), in the outputs' layout."""
+    name, several = options["parameter"], len(starts) > 1
+    branches = []
+    for s in starts:
+        b = newton_branch(system, context[s], options, budget)
+        if several:
+            for item in b["points"] + b["folds"] + b["stability_changes"]:
+                item["start"] = s
+        branches.append(b)
+    out = {"parameter": name, "shape_outputs": [], "branch": [p for b in branches for p in b["points"]],
+           "status": branches[0]["status"] if not several else {s: b["status"] for s, b in zip(starts, branches)},
+           "points": sum(len(b["points"]) for b in branches), "folds": [f for b in branches for f in b["folds"]]}
+    if options.get("stability", True):
+        out["stability_changes"] = [c for b in branches for c in b["stability_changes"]]
+    return out
+
+
 def run_continuation(system, options: dict, context: dict) -> dict:
     """The branch of steady states through the ``about`` one (or one branch per start) as ``parameter`` goes to
     ``stop``; see the module doc for the keys and outputs."""
@@ -309,6 +341,8 @@ def run_continuation(system, options: dict, context: dict) -> dict:
     starts = about if isinstance(about, list) else [about]
     name, aliases = options["parameter"], options.get("aliases", {})
     budget = Budget("continuation", unit="points", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
+    if newton_starts(starts, context):
+        return _newton_continuation(system, starts, options, context, budget)
     branches = [_one_branch(system, context[s], options, s if isinstance(about, list) else None, budget)
                 for s in starts]
     out = {"parameter": name, "shape_outputs": [d.name for d in shape_declarations(system)],
@@ -346,13 +380,15 @@ _POINT_KEYS = ("start", "verdict", "frequencies", "eigenvalues")
 
 def _branch_axes(out: dict) -> tuple[str, str, list[str]]:
     """(parameter, the output drawn against it, the shape outputs written on the diagram) of a continuation:
-    the output of ``at``, else the minimized one, else the first number reported per point."""
+    the output of ``at``, else the minimized one, else the first number reported per point that varies along
+    the branch (else the first number)."""
     points = out["branch"]
     name = out.get("parameter") or next(iter(points[0]))
     at = [k[3:] for k in out if k.startswith("at_") and not k.endswith("_shapes")]
     minimized = [k[:-4] for k in out if k.endswith("_min") and f"{name}_at_{k[:-4]}_min" in out]
     numeric = [k for k, v in points[0].items() if k not in _POINT_KEYS and k != name and isinstance(v, float)]
-    return name, (at or minimized or numeric)[0], list(out.get("shape_outputs", []))
+    varying = [k for k in numeric if len({p.get(k) for p in points}) > 1]
+    return name, (at or minimized or varying or numeric)[0], list(out.get("shape_outputs", []))
 
 
 def _families(points: list) -> list[list[dict]]:

@@ -5,6 +5,7 @@ A kind's ``plot(plt, entry, path)`` gets pyplot, its scene-JSON entry ({"name", 
 """
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from mechgen.errors import InputError
@@ -48,7 +49,7 @@ def eigen(plt, a: dict, path: Path) -> None:
 def shapes(plt, a: dict, path: Path) -> bool:
     """Mode shapes (modes of a continuum) or the deflection (steady state of a continuum) against s."""
     out = a["outputs"]
-    key = "shapes" if "shapes" in out else "deflection" if "deflection" in out else None
+    key = "shapes" if "shapes" in out and "s" in out else "deflection" if "deflection" in out else None
     if key is None:
         return False
     fields = list(out[key])
@@ -71,13 +72,106 @@ def shapes(plt, a: dict, path: Path) -> bool:
 
 
 def linear(plt, a: dict, path: Path) -> list[Path]:
-    """A modes or stability analysis: its spectrum, and a continuum's mode shapes beside it."""
+    """A modes or stability analysis: its spectrum, and beside it a continuum's mode shapes, a lumped
+    model's mode shapes as bars (``_shapes.png``) and a rotor's orbits (``_orbits.png``)."""
     eigen(plt, a, path)
     written = []
     shaped = path.with_name(path.stem + "_shapes.png")
-    if shapes(plt, a, shaped):
+    if shapes(plt, a, shaped) or bars(plt, a, shaped):
         written.append(shaped)
+    orbits = path.with_name(path.stem + "_orbits.png")
+    if ellipses(plt, a, orbits):
+        written.append(orbits)
     return written + [path]
+
+
+#: the most modes a shapes or orbits figure draws (the lowest ones)
+MOST_PANELS = 12
+
+
+def _grid(plt, count: int, width: float, height: float):
+    """A figure of ``count`` panels, at most four a row; unused panels switched off."""
+    cols = min(count, 4)
+    rows = (count + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(width * cols, height * rows), squeeze=False)
+    for ax in axes.ravel()[count:]:
+        ax.axis("off")
+    return fig, axes.ravel()[:count]
+
+
+def _finish(fig, title: str, path: Path) -> None:
+    fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+
+
+def bars(plt, a: dict, path: Path) -> bool:
+    """A lumped model's mode shapes: one panel per mode (the lowest MOST_PANELS), a bar per coordinate
+    (real shapes: phi_i; complex shapes: Re X_i and Im X_i side by side), titled with the frequency."""
+    out = a["outputs"]
+    modes = out.get("shapes")
+    if not isinstance(modes, list) or not modes or not isinstance(modes[0], dict):
+        return False
+    modes = modes[:MOST_PANELS]
+    names = list(modes[0])
+    fig, axes = _grid(plt, len(modes), 0.45 * len(names) + 1.8, 2.6)
+    x = list(range(len(names)))
+    for k, (ax, shape) in enumerate(zip(axes, modes)):
+        values = [shape[n] for n in names]
+        if isinstance(values[0], dict):
+            re = [v["amplitude"] * math.cos(v["phase"]) for v in values]
+            im = [v["amplitude"] * math.sin(v["phase"]) for v in values]
+            ax.bar([i - 0.2 for i in x], re, width=0.4, label="Re")
+            ax.bar([i + 0.2 for i in x], im, width=0.4, label="Im")
+            if k == 0:
+                ax.legend(fontsize=6)
+        else:
+            ax.bar(x, values)
+        ax.axhline(0.0, color="0.5", lw=0.5)
+        ax.set_xticks(x, names, rotation=45 if len(names) > 4 else 0, fontsize=7)
+        ax.set_ylabel("Re X, Im X" if isinstance(values[0], dict) else "phi (mass-normalised)", fontsize=7)
+        ax.set_title(f"mode {k + 1}: {out['frequencies'][k]:.4g} rad/s", fontsize=8)
+    kind = "complex (Re, Im)" if isinstance(modes[0][names[0]], dict) else "mass-normalised"
+    _finish(fig, f"{a['name']}: {kind} mode shapes", path)
+    plt.close(fig)
+    return True
+
+
+def ellipses(plt, a: dict, path: Path) -> bool:
+    """A rotor's orbits: one panel per mode (the lowest MOST_PANELS), the ellipse at its station (semi-axes
+    ``orbits``, turning as ``whirl_ratio``'s sign says, an arrow at its start), equal axes; a mode without
+    an orbit there (whirl ``none``) is said in words, not drawn at round-off scale."""
+    out = a["outputs"]
+    orbits = out.get("orbits")
+    if not isinstance(orbits, list) or not orbits:
+        return False
+    fig, axes = _grid(plt, min(len(orbits), MOST_PANELS), 2.6, 2.6)
+    for k, ax in enumerate(axes):
+        o, label = orbits[k], out["whirl"][k]
+        ax.set_title(f"mode {k + 1}: {out['frequencies'][k]:.4g} rad/s, {label}", fontsize=8)
+        if label == "none" or o["major"] <= 0.0:
+            ax.text(0.5, 0.5, "no orbit at the\nwhirl stations", ha="center", va="center", fontsize=8)
+            ax.set_xticks([])
+            ax.set_yticks([])
+            continue
+        sense = 1.0 if out["whirl_ratio"][k] >= 0 else -1.0
+        ts = [2 * math.pi * i / 120 for i in range(121)]
+        c, s = math.cos(o["angle"]), math.sin(o["angle"])
+        xs = [o["major"] * math.cos(t) * c - sense * o["minor"] * math.sin(t) * s for t in ts]
+        ys = [o["major"] * math.cos(t) * s + sense * o["minor"] * math.sin(t) * c for t in ts]
+        ax.plot(xs, ys, "-")
+        ax.annotate("", xy=(xs[6], ys[6]), xytext=(xs[0], ys[0]), arrowprops={"arrowstyle": "->"})
+        reach = 1.15 * o["major"]
+        ax.set_xlim(-reach, reach)
+        ax.set_ylim(-reach, reach)
+        ax.set_aspect("equal")
+        ax.axhline(0.0, color="0.7", lw=0.5)
+        ax.axvline(0.0, color="0.7", lw=0.5)
+        ax.set_xlabel("x", fontsize=7)
+        ax.set_ylabel("y", fontsize=7)
+    _finish(fig, f"{a['name']}: orbits at the whirl station (arrow: direction of whirl)", path)
+    plt.close(fig)
+    return True
 
 
 def curves(plt, title: str, items: list[tuple[str, dict]], path: Path) -> bool:

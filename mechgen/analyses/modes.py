@@ -6,10 +6,18 @@ unit; elastic modes only); ``rigid_modes`` (how many rigid-body modes, K phi = 0
 accuracy, mechgen.runtime.linear.modes.rigid_count; they are not frequencies, and ``count`` counts
 the elastic modes after them) with, for a lumped model, ``rigid_shapes`` (one {coordinate: value}
 per rigid mode, largest entry 1); ``operating_point`` when the point given (``at``, or zero) was
-not an equilibrium and Newton found one (mechgen.analyses.operating_point.equilibrium_point); a
-continuum with ``count`` also ``s`` and ``shapes``. A system with damping, gyroscopic terms
-or a non-symmetric stiffness, and any rotor, gets its damped modes (mechgen.analyses.whirl) with
-``eigenvalues``, ``log_dec`` and (rotors) ``whirl``.
+not an equilibrium and Newton found one (mechgen.analyses.operating_point.equilibrium_point).
+
+A lumped model (not a continuum, not a chain) also gets ``shapes``: one {coordinate: value} per elastic
+mode, in the order of ``frequencies``, mass-normalised (phi^T M phi = 1) and signed so that the first
+largest |entry| is positive; ``modal_mass`` (phi^T M phi as computed from the model's M: 1 to round-off)
+and ``modal_stiffness`` (phi^T K phi = omega^2, (rad/s)^2) per mode (:func:`modal_outputs`). A continuum
+with ``count`` gets ``s`` and ``shapes`` (per field, one curve per mode, largest |value| 1); a chain
+reports frequencies only (its shapes would be N x N).
+
+A system with damping, gyroscopic terms or a non-symmetric stiffness, and any rotor, gets its damped
+modes (mechgen.analyses.whirl) with ``eigenvalues``, ``log_dec``, for a lumped model complex ``shapes``
+(amplitude and phase per coordinate) and for a rotor ``whirl``, ``whirl_ratio`` and ``orbits``.
 """
 from __future__ import annotations
 
@@ -51,11 +59,31 @@ def run_modes(system, options: dict, context: dict) -> dict:
     elastic = res.shapes[:, res.rigid:]
     out = {"frequencies": [float(f) for f in res.frequencies[res.rigid:]], "rigid_modes": int(res.rigid),
            "_shapes": elastic}
-    if res.rigid and not system.is_field and not system.is_lattice:
-        out["rigid_shapes"] = [_largest_one(system, res.shapes[:, j]) for j in range(res.rigid)]
+    if not system.is_field and not system.is_lattice:
+        out.update(modal_outputs(system.coordinates, mats["M"], mats["K"], elastic))
+        if res.rigid:
+            out["rigid_shapes"] = [_largest_one(system, res.shapes[:, j]) for j in range(res.rigid)]
     if system.is_field and options.get("count"):
         out.update(field_shapes(system, elastic, "shapes"))
     return _with_point(out, found)
+
+
+def modal_outputs(names, M, K, phi: np.ndarray) -> dict:
+    """Mass-normalised real mode shapes: ``shapes`` [{coordinate: phi_i}], ``modal_mass`` phi^T M phi (1 up to
+    round-off) and ``modal_stiffness`` phi^T K phi (= omega^2, (rad/s)^2), computed from M and K as given.
+
+    The solver's columns satisfy phi^T M phi = 1; each is signed so that its first largest |entry| (the
+    first within 1e-9 of the largest) is positive.
+    """
+    phi = np.asarray(phi, dtype=float)
+    if phi.size:
+        mag = np.abs(phi)
+        top = np.argmax(mag >= (1.0 - 1e-9) * mag.max(axis=0)[None, :], axis=0)
+        phi = phi * np.where(phi[top, np.arange(phi.shape[1])] < 0, -1.0, 1.0)[None, :]
+    Mphi, Kphi = np.asarray(M @ phi), np.asarray(K @ phi)
+    return {"shapes": [{n: float(x) + 0.0 for n, x in zip(names, col)} for col in phi.T],
+            "modal_mass": [float(v) for v in np.einsum("ik,ik->k", phi, Mphi)],
+            "modal_stiffness": [float(v) for v in np.einsum("ik,ik->k", phi, Kphi)]}
 
 
 def _largest_one(system, phi: np.ndarray) -> dict[str, float]:

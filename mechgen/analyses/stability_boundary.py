@@ -5,15 +5,24 @@ rate g(p) = max Re s(p), the largest real part of the eigenvalues s of the linea
 equilibrium at p (recomputed by Newton at every p, with the generated Jacobians: r(q, 0, 0, z) = 0 and the
 internal rates g(q, 0, z) = 0, from the ``about`` steady analysis's state, else ``guess``). The eigenvalues
 are those of the ``stability`` kind: with internal variables, of A = d(dx/dt)/dx at (q, 0, z); otherwise
-of M q'' + (D + G) q' + K q = 0. g(p_lo) and g(p_hi) must have opposite signs (else exit 1 naming both);
-Brent's method then brackets p_c to ``rtol`` (default 1e-12) relative to it.
+of M q'' + (D + G) q' + K q = 0. The bracket's ends must have different verdicts, one stable (or neutral),
+one unstable (divergence or flutter); else exit 1 naming both verdicts. When g(p_lo) and g(p_hi) have opposite
+signs beyond the eigen-solve's accuracy and beyond AMBIGUOUS (1e-5) times the spectrum's scale (a damped
+system: g is then certain of its sign and smooth at a simple crossing), Brent's method brackets the root of g
+to ``rtol`` (default 1e-12) relative to it. Otherwise - a conservative system, whose growth rate is exactly 0 on the stable
+side (undamped: s = +-i w; gyroscopic with M, K > 0 and C skew: s = i mu), losing stability when an eigenvalue
+passes through zero (divergence) or two frequencies merge and leave the imaginary axis (flutter) - the
+boundary is located by bisection on that event (the verdict changes) to ``rtol``: about 40 steps from a
+bracket of the size of p_c. ``method`` says which (``growth_rate`` or ``bisection``).
 
 Outputs: ``<parameter>_critical`` (p_c), ``frequency_critical`` (|Im s| of the eigenvalue that crosses at
 p_c, rad/s; 0 for a real crossing), ``crossing`` (``complex``: an oscillation sets in, a Hopf bifurcation;
 ``real``: a divergence), ``eigenvalues_critical`` ([re, im]), and at the system's own value of the
 parameter ``growth_rate``, ``eigenvalues`` and ``verdict``: the stability verdict (stable / neutral /
 divergence / flutter), reported under the scene's word for it when ``labels`` maps it to one
-(``labels = { flutter = "stick_slip", divergence = "stick_slip" }``). Also ``iterations`` (of Brent).
+(``labels = { flutter = "stick_slip", divergence = "stick_slip" }``). Also ``iterations`` (of Brent or of
+the bisection) and ``method``. On the bisection path the crossing eigenvalue is taken just beyond p_c on the
+unstable side (within 2 rtol p_c), where it has left the imaginary axis.
 """
 from __future__ import annotations
 
@@ -25,6 +34,7 @@ from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import ABSENT, REQUIRED, Option
 from mechgen.analyses.steady import equilibrium_functions
 from mechgen.errors import ConvergenceError, InputError
+from mechgen.runtime.linear.stability import AMBIGUOUS
 from mechgen.runtime.linear.stability import stability as solve_stability
 from mechgen.runtime.linear.stability import stability_first_order
 from mechgen.runtime.steady.newton import newton
@@ -106,10 +116,43 @@ def own_value(system, name: str) -> float:
     return values[name]
 
 
-def run_stability_boundary(system, options: dict, context: dict) -> dict:
-    """p_c with g(p_c) = 0 between the bracket's ends, and the verdict at the system's own parameter value."""
+def unstable(result) -> bool:
+    """Whether a stability result says the equilibrium loses stability (divergence or flutter)."""
+    return result.verdict in ("divergence", "flutter")
+
+
+def by_growth_rate(at, low: float, high: float, options: dict, name: str) -> tuple[float, int]:
+    """p_c with g(p_c) = 0 by Brent's method, g = max Re s (opposite signs at the bracket's ends)."""
     from scipy.optimize import brentq  # here, not at import: every scene loads the registry (startup budget)
 
+    critical, info = brentq(lambda v: at(v).growth_rate, low, high, xtol=1e-300, rtol=options.get("rtol", 1e-12),
+                            maxiter=options.get("max_iter", 100), full_output=True, disp=False)
+    if not info.converged:
+        raise ConvergenceError(f"stability_boundary: Brent's method did not converge in {info.iterations} "
+                               f"iterations ({name} = {critical:.12g}); raise max_iter")
+    return float(critical), int(info.iterations)
+
+
+def by_bisection(at, low: float, high: float, low_unstable: bool, options: dict, name: str) -> tuple[float, int]:
+    """p_c where the verdict changes (stable/neutral on one side, divergence/flutter on the other), by bisection
+    on that event until the bracket is within ``rtol`` of its ends: for a conservative system, whose growth rate
+    is exactly 0 on the stable side (an eigenvalue through zero: divergence; two frequencies merging: flutter)."""
+    rtol, most = options.get("rtol", 1e-12), options.get("max_iter", 100)
+    for iteration in range(1, most + 1):
+        mid = 0.5 * (low + high)
+        if unstable(at(mid)) == low_unstable:
+            low = mid
+        else:
+            high = mid
+        if high - low <= rtol * max(abs(low), abs(high)):
+            return 0.5 * (low + high), iteration
+    raise ConvergenceError(f"stability_boundary: bisection on the stability verdict did not reach rtol = {rtol:g} in "
+                           f"{most} iterations ({name} in [{low:.12g}, {high:.12g}]); raise max_iter")
+
+
+def run_stability_boundary(system, options: dict, context: dict) -> dict:
+    """p_c where the equilibrium loses stability between the bracket's ends, and the verdict at the system's own
+    parameter value (module doc: Brent on the growth rate, or bisection on the verdict)."""
     name, (low, high) = options["parameter"], options["bracket"]
     here = float(own_value(system, name))
     if options.get("about"):
@@ -127,26 +170,41 @@ def run_stability_boundary(system, options: dict, context: dict) -> dict:
             raise ConvergenceError(f"stability_boundary: no equilibrium at {name} = {value:.12g} ({exc})") from exc
         return spectrum(moved, point["y"])
 
-    g_low, g_high = at(low).growth_rate, at(high).growth_rate
-    if not np.sign(g_low) * np.sign(g_high) < 0:
-        raise ConvergenceError(f"stability_boundary: the growth rate max Re s has the same sign at both ends of "
-                               f"the bracket ({name} = {low:.6g}: {g_low:.6g}/s, {name} = {high:.6g}: {g_high:.6g}/s); "
-                               "give a bracket across the stability boundary")
-    critical, info = brentq(lambda v: at(v).growth_rate, low, high, xtol=1e-300, rtol=options.get("rtol", 1e-12),
-                            maxiter=options.get("max_iter", 100), full_output=True, disp=False)
-    if not info.converged:
-        raise ConvergenceError(f"stability_boundary: Brent's method did not converge in {info.iterations} "
-                               f"iterations ({name} = {critical:.12g}); raise max_iter")
+    ends = at(low), at(high)
+    g_low, g_high = ends[0].growth_rate, ends[1].growth_rate
+    if unstable(ends[0]) == unstable(ends[1]):
+        same = ", the same sign at both ends" if np.sign(g_low) == np.sign(g_high) != 0 else ""
+        raise ConvergenceError(f"stability_boundary: the bracket does not straddle a stability boundary: the verdict "
+                               f"is {ends[0].verdict} at {name} = {low:.6g} and {ends[1].verdict} at {name} = "
+                               f"{high:.6g} (growth rate max Re s {g_low:.6g}/s and {g_high:.6g}/s{same}); give a "
+                               "bracket with a stable and an unstable end")
+    if g_low * g_high < 0 and all(abs(r.growth_rate) > max(r.threshold, AMBIGUOUS * r.scale) for r in ends):
+        critical, iterations = by_growth_rate(at, low, high, options, name)
+        method = "growth_rate"
+    else:
+        critical, iterations = by_bisection(at, low, high, unstable(ends[0]), options, name)
+        method = "bisection"
+    return _outputs(at, critical, here, options, method, iterations, name)
+
+
+def _outputs(at, critical: float, here: float, options: dict, method: str, iterations: int, name: str) -> dict:
+    """The outputs at p_c (the crossing eigenvalue: the one whose real part is the growth rate there, or just
+    beyond p_c on the unstable side when p_c was found by bisection) and at the system's own value."""
     res = at(critical)
     s = np.asarray(res.eigenvalues)
-    crossing = s[np.argmax(s.real)]  # the eigenvalue whose real part is the growth rate
+    past = res
+    if method == "bisection" and not unstable(res):  # the event's eigenvalue just beyond p_c (within rtol)
+        step = 2.0 * options.get("rtol", 1e-12) * max(abs(critical), 1e-300)
+        past = next((r for r in (at(critical + step), at(critical - step)) if unstable(r)), res)
+    t = np.asarray(past.eigenvalues)
+    crossing = t[np.argmax(t.real)]  # the eigenvalue whose real part is the growth rate
     own = at(here)
     labels = options.get("labels", {})
     return {f"{name}_critical": float(critical), "frequency_critical": float(abs(crossing.imag)),
-            "crossing": "complex" if abs(crossing.imag) > res.threshold else "real",
+            "crossing": "complex" if abs(crossing.imag) > past.threshold else "real",
             "eigenvalues_critical": _pairs(s), "verdict": labels.get(own.verdict, own.verdict),
-            "growth_rate": float(own.growth_rate), "eigenvalues": _pairs(own.eigenvalues),
-            "iterations": int(info.iterations)}
+            "growth_rate": float(own.growth_rate) + 0.0, "eigenvalues": _pairs(own.eigenvalues),
+            "iterations": int(iterations), "method": method}
 
 
 register(AnalysisKind("stability_boundary", SCHEMA, run_stability_boundary, needs, summary.lines, frees=frees))

@@ -13,6 +13,9 @@ omega = (theta_x' cos(theta_y), theta_y', Omega + theta_x' sin(theta_y)) and
 Linearised about rest: translations vibrate at sqrt(k_t/m); the tilts whirl at
 omega_f,b = (+-Ip Omega + sqrt(Ip^2 Omega^2 + 4 Id k_r)) / (2 Id), forward and
 backward, so omega_f - omega_b = Ip Omega / Id (the gyroscopic moment Ip Omega).
+Whirl is judged at two stations, the centre's (x, y) and the tilts (theta_x, theta_y): the disk normal is
+n = (theta_y, -theta_x, 1), a rotation of (theta_x, theta_y) by -90 degrees, so a counter-clockwise tilt
+orbit is a counter-clockwise (forward) whirl of the normal.
 Frequencies in rad/s. SI units.
 """
 import sympy as sp
@@ -34,6 +37,7 @@ model.params(
 )
 model.coordinates("x", "y", "theta_x", "theta_y")
 model.whirl_pair("x", "y")
+model.whirl_pair("theta_x", "theta_y")  # the tilt modes whirl here (x, y stay at rest in them)
 
 
 @model.kinetic

@@ -279,7 +279,8 @@ class Model:
         self.point_terms: dict[str, dict[str, Callable]] = {}
         self.parts: dict[str, tuple[str, ...]] = {}
         self.shear_pairs: list[tuple[str, str, int]] = []
-        self.whirl: tuple[str, str] | None = None
+        #: the whirl stations (Model.whirl_pair): x1, y1[, x2, y2, ...]; None when the model declares none
+        self.whirl: tuple[str, ...] | None = None
         #: hybrid models (mechgen.symbolic.hybrid): the modes in declaration order, the initial one, the guards
         self.mode_scopes: dict = {}
         self.initial_mode: str | None = None
@@ -519,14 +520,23 @@ class Model:
 
         A mode whirls *forward* when its orbit turns from x towards y, the sense of a
         positive spin about z = x cross y, and *backward* otherwise; modes analyses
-        of gyroscopic systems then report ``whirl`` per mode.
+        of gyroscopic systems then report ``whirl`` per mode. A lumped model may call this
+        again to add stations (a disk's translations and its tilts): each mode is judged at
+        the station where its orbit is largest. A continuum declares one pair (its stations
+        are the mesh's nodes).
         """
         names = set(self.coordinates_all) | set(self.field_names)
         for name in (x, y):
             if name not in names:
                 raise ModelError(f"whirl pair names {name!r}, which is not a coordinate or field of {self.name}",
                                  file=self.file, key="whirl_pair", expected=f"names among {', '.join(sorted(names))}")
-        self.whirl = (x, y)
+        if x == y or (self.whirl and {x, y} & set(self.whirl)):
+            raise ModelError(f"whirl pair ({x!r}, {y!r}) repeats a name", file=self.file, key="whirl_pair",
+                             expected="two names not yet in a whirl pair")
+        if self.whirl and self.field_names:
+            raise ModelError(f"a second whirl pair ({x!r}, {y!r}) for a continuum", file=self.file, key="whirl_pair",
+                             expected="one whirl pair for a model with fields (its stations are the mesh's nodes)")
+        self.whirl = (self.whirl or ()) + (x, y)
 
     def part_params(self) -> tuple[str, ...]:
         """Model parameter names of every part kind's parameters (always symbolic)."""

@@ -25,7 +25,8 @@ class SystemMeta:
         params: the free parameters, in the order of ``system.params``.
         coordinates: the coordinate names (a lattice: the one coordinate of every site).
         internal: the internal variables' names.
-        whirl: the (x, y) coordinate pair of a rotor's whirl (Model.whirl), None when the model has none.
+        whirl: the (x, y) coordinate pair of a rotor's whirl (Model.whirl), None when the model has none; a
+            lumped model with several stations: x1, y1, x2, y2, ...
         sites_param: a lattice's parameter for its number of sites, None otherwise.
         ends: a lattice's ends ("fixed", "free", ...), None otherwise.
     """
@@ -36,7 +37,7 @@ class SystemMeta:
     params: tuple[str, ...] = ()
     coordinates: tuple[str, ...] = ()
     internal: tuple[str, ...] = ()
-    whirl: tuple[str, str] | None = None
+    whirl: tuple[str, ...] | None = None
     sites_param: str | None = None
     ends: str | None = None
 

@@ -129,12 +129,31 @@ def sweep_points(func, points, *, executor: SweepExecutor | None = None, progres
     return run
 
 
+#: the tasks of the sweep now running on forked workers (they inherit it: a task need not pickle)
+_INHERITED: dict = {}
+
+
+def inherited_point(i: int, inner: str, record: bool) -> tuple:
+    """Point i of the sweep the worker inherited at its fork (:func:`guarded` on it)."""
+    func, points = _INHERITED["tasks"]
+    return guarded(func, points[i], inner, None, record)
+
+
 def _run_processes(func, points, workers: int, store, done, label, inner: str, record: bool) -> None:
+    """The points on ``workers`` local processes. Where the platform forks (Linux, macOS), the workers inherit
+    the tasks and receive only their indices, so a task holding a compiled system (a sweep called from Python)
+    need not pickle; elsewhere each task is pickled to its worker."""
+    import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor
 
-    pool = ProcessPoolExecutor(max_workers=workers, initializer=single_thread_worker)
+    forks = "fork" in mp.get_all_start_methods()
+    context = mp.get_context("fork") if forks else None
+    if forks:
+        _INHERITED["tasks"] = (func, points)
+    pool = ProcessPoolExecutor(max_workers=workers, initializer=single_thread_worker, mp_context=context)
     try:
-        futures = [pool.submit(guarded, func, point, inner, None, record) for point in points]
+        futures = [pool.submit(inherited_point, i, inner, record) if forks
+                   else pool.submit(guarded, func, points[i], inner, None, record) for i in range(len(points))]
         for i, fut in enumerate(futures):
             try:
                 outcome = fut.result()
@@ -146,6 +165,7 @@ def _run_processes(func, points, workers: int, store, done, label, inner: str, r
             done(1)
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
+        _INHERITED.pop("tasks", None)
 
 
 def guarded(func, point, inner: str, label, record: bool = True) -> tuple:

@@ -19,8 +19,9 @@ speed's modes for a cluster at the first speed (so the Omega = 0 pair becomes th
 backward and forward modes), of the tracked curves for a cluster later on.
 
 Curves are numbered by wd at the first speed; ties (a degenerate cluster) put backward before forward.
-Whirl labels follow :func:`.damped.whirl_sign`; a planar (straight-line) orbit takes the label of the
-nearest speed on the same curve where the orbit is not planar ('forward' if it is planar everywhere).
+Whirl labels are :func:`.damped.whirl`'s at each speed: forward, backward, ``linear`` where the orbit is a
+straight line at that speed (an anisotropic rotor's x-only and y-only modes: at rest, or at every speed
+without gyroscopic coupling) and ``none`` where the mode leaves the stations at rest.
 
 Reduced basis. When ``matrices_at`` is a :class:`SpeedPolynomial` (matrices that are polynomials of the
 speed, as :func:`fit_speed_polynomial` detects them: a rotor's G grows linearly with the spin), the
@@ -46,7 +47,8 @@ import scipy.linalg as sla
 from mechgen.errors import InputError
 from mechgen.runtime.core.options import Options
 from mechgen.runtime.linear.damped import (DampedModes, damped_modes, frequency_scale, has_symmetry, matrix_norm,
-                                           normalise_columns, split_modes, station_indices, whirl_sign)
+                                           normalise_columns, split_modes, station_indices, whirl,
+                                           whirl_sign)
 
 #: the automatic choice uses the reduced basis from this many speeds on ...
 REDUCED_MIN_SPEEDS = 5
@@ -142,21 +144,6 @@ def _modes_at(mats, speed: float, n: int, m: int, count: int, sparse, sigma) -> 
                          f"{count} (the others are overdamped or rigid)", key="count",
                          expected=f"at most {len(dm.eigenvalues)}")
     return dm
-
-
-def _fill_planar(signs: np.ndarray) -> np.ndarray:
-    """Each 0 (planar) of a curve takes the sign of the nearest nonzero speed (the later one on a tie)."""
-    out = signs.copy()
-    for j in range(signs.shape[1]):
-        nz = np.flatnonzero(signs[:, j])
-        if not nz.size:
-            out[:, j] = 1
-            continue
-        for i in np.flatnonzero(signs[:, j] == 0):
-            d = np.abs(nz - i)
-            best = nz[d == d.min()].max()
-            out[i, j] = signs[best, j]
-    return out
 
 
 # ------------------------------------------------------------------------------------ speed polynomial
@@ -442,8 +429,7 @@ class CampbellOptions(Options):
         freq_weight: weight of the frequency distance against the shape distance (MAC) in the tracking.
         cluster_tol: relative frequency gap under which modes count as one degenerate cluster (aligned
             within it instead of matched one by one).
-        planar_tol: an orbit whose minor/major axis ratio is below this is planar (its whirl is taken
-            from its neighbours).
+        planar_tol: an orbit whose minor/major axis ratio is below this is a straight line (whirl 'linear').
         method: 'exact', 'reduced' or 'auto' (see :func:`campbell`).
         residual_tol: the largest backward error eta of a reduced speed's tracked modes.
         mac_min: the smallest MAC of a curve to the previous speed that a reduced speed may have.
@@ -546,9 +532,7 @@ def campbell(matrices_at, speeds, count: int, options: CampbellOptions | None = 
                                   **track)
         n_exact = S
 
-    signs = np.array([whirl_sign(shp[i], x_index, y_index, planar_tol=planar_tol) for i in range(S)])
-    signs = _fill_planar(signs.reshape(S, count))
-    labels = [["forward" if v > 0 else "backward" for v in row] for row in signs]
+    labels = [whirl(shp[i], x_index, y_index, planar_tol=planar_tol) for i in range(S)]
     wd = eig.imag
     wn = np.abs(eig)
     return CampbellResult(

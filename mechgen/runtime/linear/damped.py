@@ -26,6 +26,10 @@ sigma defaults to a small negative real number below the lowest frequency scale,
 Whirl: with x = Re(X e^{i wd t}), y = Re(Y e^{i wd t}) the orbit's signed area rate is
 x y' - y x' averaged = wd Im(X conj(Y)), so the orbit is counter-clockwise about z = x cross y
 (forward, the sense of a positive spin) when Im(X conj(Y)) > 0 and clockwise (backward) when < 0.
+The orbit is an ellipse (:func:`orbit_axes`: semi-axes, the major axis's angle, the signed ratio
+kappa = minor / major); a straight line (|kappa| <= 1e-6) has no direction and is labelled 'linear', a
+mode that leaves the stations at rest 'none' (:func:`whirl`). A double eigenvalue's plane is re-chosen
+as its backward and forward circles by :func:`circular_pair`.
 """
 from __future__ import annotations
 
@@ -333,6 +337,50 @@ def orbit_kappa(shapes, x_index, y_index) -> np.ndarray:
     return np.where(a2 > 0, P / np.where(a2 > 0, a2, 1.0), 0.0)
 
 
+def orbit_axes(shapes, x_index, y_index) -> dict[str, np.ndarray]:
+    """The ellipse x = Re(X e^{i w t}), y = Re(Y e^{i w t}) of each mode at its largest station.
+
+    Returns arrays (one entry per mode): ``major`` a and ``minor`` b, the semi-axes (a >= b >= 0, in the
+    units of the shape's x and y entries: a^2, b^2 are the eigenvalues of Re(v v^H), v = (X, Y), so
+    a^2 + b^2 = |X|^2 + |Y|^2 and a b = |Im(X conj Y)|); ``angle``, the major axis's angle from x towards y
+    (rad, in (-pi/2 + 1e-9, pi/2 + 1e-9]: an axis within 1e-9 of vertical is pi/2;
+    tan 2 angle = 2 Re(X conj Y) / (|X|^2 - |Y|^2), 0 for a circle); ``kappa``, the
+    signed ratio b / a (:func:`orbit_kappa`: its sign is that of the orbit's angular momentum x y' - y x',
+    whose time average is w Im(X conj Y)); ``station``, the index (into the stations) of the largest orbit.
+    """
+    Q = np.asarray(shapes, dtype=complex)
+    Q = Q[:, None] if Q.ndim == 1 else Q
+    xi, yi = station_indices(x_index, y_index, Q.shape[0])
+    S = np.abs(Q[xi]) ** 2 + np.abs(Q[yi]) ** 2
+    top = S.max(axis=0) if S.size else np.zeros(0)
+    dom = np.argmax(S >= (1.0 - 1e-9) * top[None, :], axis=0)
+    X, Y = Q[xi[dom], np.arange(Q.shape[1])], Q[yi[dom], np.arange(Q.shape[1])]
+    P, C = np.imag(X * np.conj(Y)), np.real(X * np.conj(Y))
+    S = np.abs(X) ** 2 + np.abs(Y) ** 2
+    root = np.sqrt(np.maximum(S * S - 4.0 * P * P, 0.0))
+    a2, b2 = 0.5 * (S + root), np.maximum(0.5 * (S - root), 0.0)
+    angle = 0.5 * np.arctan2(2.0 * C, np.abs(X) ** 2 - np.abs(Y) ** 2)
+    angle = np.where(angle <= -np.pi / 2 + 1e-9, angle + np.pi, angle) + 0.0
+    kappa = np.where(a2 > 0, P / np.where(a2 > 0, a2, 1.0), 0.0)
+    return {"major": np.sqrt(a2), "minor": np.sqrt(b2), "angle": angle, "kappa": kappa, "station": dom}
+
+
+#: a mode whose orbit at every station is below this times its largest entry does not move the stations
+STILL_TOL = 1e-6
+
+
+def still_modes(shapes, x_index, y_index, tol: float = STILL_TOL) -> np.ndarray:
+    """True for each mode (column) whose orbits at all stations are below ``tol`` times its largest entry:
+    sqrt(max_station |X|^2 + |Y|^2) <= tol max_i |Q_i| (a mode that leaves the whirl stations at rest, e.g.
+    a tilt mode of a rotor whose whirl pair is the translations). Its whirl is ``none``."""
+    Q = np.asarray(shapes, dtype=complex)
+    Q = Q[:, None] if Q.ndim == 1 else Q
+    xi, yi = station_indices(x_index, y_index, Q.shape[0])
+    S = np.abs(Q[xi]) ** 2 + np.abs(Q[yi]) ** 2
+    size = np.sqrt(S.max(axis=0)) if S.size else np.zeros(Q.shape[1])
+    return size <= tol * np.abs(Q).max(axis=0, initial=0.0)
+
+
 def whirl_sign(shapes, x_index, y_index, *, planar_tol: float = 1e-6) -> np.ndarray:
     """+1 forward, -1 backward, 0 planar (a straight-line orbit at every station, within ``planar_tol``).
 
@@ -347,17 +395,46 @@ def whirl_sign(shapes, x_index, y_index, *, planar_tol: float = 1e-6) -> np.ndar
     return np.where(sign != 0, sign, fallback).astype(int)
 
 
-def whirl(shapes, x_index, y_index, *, planar: str = "forward", planar_tol: float = 1e-6) -> list[str]:
-    """'forward' or 'backward' for each mode (column of ``shapes``, eigenvalue with Im s > 0).
+#: the labels :func:`whirl` gives
+WHIRL_LABELS = ("forward", "backward", "linear", "none")
+
+
+def whirl(shapes, x_index, y_index, *, planar: str = "linear", planar_tol: float = 1e-6) -> list[str]:
+    """'forward', 'backward', 'linear' or 'none' for each mode (column of ``shapes``, eigenvalue with Im s > 0).
 
     ``x_index``, ``y_index``: the dofs of the lateral displacements (or tilts about x and y) of one
     station, or sequences of them, one entry per station. Forward = counter-clockwise about
-    z = x cross y (Im(X conj Y) > 0), judged at the station with the largest orbit (see
-    :func:`whirl_sign`). A mode whose orbits are all straight lines gets the label ``planar``
-    ('forward' unless told otherwise): a planar orbit is the sum of equal forward and backward
-    circles, and neither label is more right.
+    z = x cross y (Im(X conj Y) > 0: the orbit's angular momentum x y' - y x' is positive), judged at the
+    station with the largest orbit (see :func:`whirl_sign`). A mode whose orbits are all straight lines
+    (|kappa| <= ``planar_tol``, kappa the signed minor/major ratio) is 'linear' (``planar``: the label
+    such a mode gets; 'forward' or 'backward' give the rule of mechgen before issue 25): a straight line
+    is the sum of equal forward and backward circles and has no whirl direction. A mode that does not
+    move the stations (:func:`still_modes`) is 'none'.
     """
-    if planar not in ("forward", "backward"):
-        raise InputError(f"planar is {planar!r}", key="planar", expected="'forward' or 'backward'")
+    if planar not in ("linear", "forward", "backward"):
+        raise InputError(f"planar is {planar!r}", key="planar", expected="'linear', 'forward' or 'backward'")
     signs = whirl_sign(shapes, x_index, y_index, planar_tol=planar_tol)
-    return ["forward" if v > 0 else "backward" if v < 0 else planar for v in signs]
+    still = still_modes(shapes, x_index, y_index)
+    return ["none" if z else "forward" if v > 0 else "backward" if v < 0 else planar for v, z in zip(signs, still)]
+
+
+def circular_pair(pair: np.ndarray, x_index, y_index) -> np.ndarray:
+    """The basis of a double eigenvalue's plane (two columns) re-chosen as (backward, forward) circles.
+
+    An isotropic rotor's double frequency has an arbitrary eigenbasis; its plane holds one mode with a
+    backward circle Y = i X and one with a forward circle Y = -i X at the station where the plane's orbits
+    are largest. With r_f = Y + i X and r_b = Y - i X (rows over the two columns), the forward mode is
+    the combination c with r_f c = 0, c = (r_f[1], -r_f[0]), and likewise the backward one. The pair is
+    returned unchanged when either row vanishes (the plane holds no such circles at that station).
+    """
+    Q = np.asarray(pair, dtype=complex)
+    xi, yi = station_indices(x_index, y_index, Q.shape[0])
+    S = (np.abs(Q[xi]) ** 2 + np.abs(Q[yi]) ** 2).sum(axis=1)
+    k = int(np.argmax(S >= (1.0 - 1e-9) * S.max()))
+    X, Y = Q[xi[k]], Q[yi[k]]
+    rows = (Y - 1j * X, Y + 1j * X)  # backward, forward conditions
+    scale = np.sqrt(S[k]) if S[k] > 0 else 0.0
+    if scale == 0.0 or min(np.abs(r).max() for r in rows) <= 1e-9 * scale:
+        return Q
+    out = np.column_stack([Q @ np.array([r[1], -r[0]]) for r in rows])
+    return normalise_columns(out)
