@@ -187,3 +187,14 @@ def test_documented_outputs_cover_what_the_kinds_return(tmp_path):
         documented = {o.name for o in outputs_of(kind)}
         for key in result.keys():
             assert key in documented or (key in model_names and "<output>" in documented), (kind, key)
+
+
+def test_example_scene_is_a_shipped_table_of_its_kind():
+    """A page's example is an [[analysis]] table of that kind copied from a shipped scene (not an inner one)."""
+    text = reference.kind_page("sweep", ROOT / "scenes")
+    example = text.split("Example\n-------\n", 1)[1]
+    name = re.search(r"``scenes/(\S+)``", example).group(1)
+    body = [line[3:] for line in example.splitlines() if line.startswith("   ")]
+    assert "\n".join(body) in (ROOT / "scenes" / name).read_text()
+    assert 'kind = "sweep"' in body
+    assert "Example" not in reference.kind_page("sweep", None)

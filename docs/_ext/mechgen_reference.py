@@ -1,6 +1,6 @@
 """Sphinx extension: write the analysis kinds' reference pages (mechgen.analyses.reference) before reading.
 
-The pages go to ``<srcdir>/kinds/`` (not committed: .gitignore); a page is rewritten only when its text
+Each kind's page takes its example from the shipped scenes beside the package (a checkout). The pages go to ``<srcdir>/kinds/`` (not committed: .gitignore); a page is rewritten only when its text
 changed, so an incremental build re-reads only what changed.
 """
 from __future__ import annotations
@@ -10,11 +10,13 @@ from pathlib import Path
 
 def write_pages(app) -> None:
     """Write every generated page into the source folder (builder-inited)."""
+    import mechgen
     from mechgen.analyses.reference import FOLDER, pages
 
     folder = Path(app.srcdir) / FOLDER
     folder.mkdir(exist_ok=True)
-    texts = pages()
+    scenes = Path(mechgen.__file__).resolve().parents[1] / "scenes"  # the checkout's shipped scenes, if any
+    texts = pages(scenes if scenes.is_dir() else None)
     for stale in folder.glob("*.rst"):
         if stale.name not in texts:
             stale.unlink()

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import importlib
 import inspect
+from pathlib import Path
 from typing import Any
 
 from mechgen.analyses.outputs_doc import outputs_of
@@ -147,6 +148,67 @@ def outputs_section(kind: str) -> list[str]:
     return head + table(("name", "shape", "unit", "meaning"), rows, "18 16 16 50")
 
 
+def kernels_section(kind: str) -> list[str]:
+    """The kernels the kind asks the compile step for, with its default options (the kind's ``needs``)."""
+    entry = get(kind)
+    defaults = {name: option.default for name, option in entry.schema.items()
+                if option.default not in (REQUIRED, ABSENT, ALL_OUTPUTS)}
+    head = title("Kernels", "-")
+    try:
+        needed = sorted(entry.needs(defaults, internal=False))
+    except (KeyError, TypeError, ValueError):  # a kind whose kernels are those of an inner analysis
+        return head + ["Those of the analysis it runs (see the description above).", ""]
+    names = ", ".join(f"``{name}``" for name in needed) or "none"
+    return head + [f"Generated kernels it needs with its default options: {names} (other options may add "
+                   "some: the kind's ``needs``).", ""]
+
+
+def analysis_tables(text: str) -> list[str]:
+    """The ``[[analysis]]`` tables of a scene's text, each from its header to the next header, trailing
+    comments and blank lines left to the next table."""
+    tables, current = [], None
+    for line in text.splitlines():
+        if line.startswith("["):
+            if current is not None:
+                tables.append(current)
+            current = [line] if line.strip() == "[[analysis]]" else None
+        elif current is not None:
+            current.append(line)
+    if current is not None:
+        tables.append(current)
+    trimmed = []
+    for lines in tables:
+        while lines and (not lines[-1].strip() or lines[-1].lstrip().startswith("#")):
+            lines.pop()
+        trimmed.append("\n".join(lines))
+    return trimmed
+
+
+def example_scene(kind: str, scenes: Path | None) -> tuple[str, str] | None:
+    """The shortest ``[[analysis]]`` table of ``kind`` among the shipped scenes: (file name, table text)."""
+    if scenes is None or not scenes.is_dir():
+        return None
+    found = []
+    for path in sorted(scenes.glob("*.toml")):
+        for table_text in analysis_tables(path.read_text(encoding="utf-8")):
+            if f'\nkind = "{kind}"' in table_text:  # the table's own kind, not an inner table's
+                found.append((len(table_text), path.name, table_text))
+    if not found:
+        return None
+    _, name, table_text = min(found)
+    return name, table_text
+
+
+def example_section(kind: str, scenes: Path | None) -> list[str]:
+    """A shipped scene's table of this kind, when one has it."""
+    found = example_scene(kind, scenes)
+    if found is None:
+        return []
+    name, table_text = found
+    lines = title("Example", "-") + [f"From the shipped scene ``scenes/{name}``:", "", ".. code-block:: toml", ""]
+    return lines + [f"   {line}" if line.strip() else "" for line in table_text.splitlines()] + [""]
+
+
 def usage_section(kind: str) -> list[str]:
     """How to call the kind: a scene table and the Python function."""
     required = [name for name, option in get(kind).schema.items() if option.default is REQUIRED]
@@ -162,13 +224,15 @@ def usage_section(kind: str) -> list[str]:
     return lines
 
 
-def kind_page(kind: str) -> str:
-    """The reference page of one analysis kind (reStructuredText)."""
+def kind_page(kind: str, scenes: Path | None = None) -> str:
+    """The reference page of one analysis kind (reStructuredText); ``scenes``: a folder of scenes to take an
+    example table from."""
     module = module_of(kind)
     doc = docstring_rst(importlib.import_module(module).__doc__)
     lines = [f".. _kind-{kind}:", ""] + title(f"``{kind}``", "=")
     lines += [doc, "", f"*Module:* ``{module}``.", ""]
-    lines += options_section(kind) + outputs_section(kind) + usage_section(kind)
+    lines += options_section(kind) + outputs_section(kind) + kernels_section(kind) + usage_section(kind)
+    lines += example_section(kind, scenes)
     return "\n".join(lines)
 
 
@@ -184,6 +248,7 @@ def index_page() -> str:
     return "\n".join(lines)
 
 
-def pages() -> dict[str, str]:
-    """Every generated page: file name (``index.rst``, ``<kind>.rst``) -> text."""
-    return {"index.rst": index_page(), **{f"{kind}.rst": kind_page(kind) for kind in kinds()}}
+def pages(scenes: Path | None = None) -> dict[str, str]:
+    """Every generated page: file name (``index.rst``, ``<kind>.rst``) -> text; ``scenes``: the shipped scenes'
+    folder for the examples (left out: no example sections)."""
+    return {"index.rst": index_page(), **{f"{kind}.rst": kind_page(kind, scenes) for kind in kinds()}}
