@@ -198,3 +198,20 @@ def test_example_scene_is_a_shipped_table_of_its_kind():
     assert "\n".join(body) in (ROOT / "scenes" / name).read_text()
     assert 'kind = "sweep"' in body
     assert "Example" not in reference.kind_page("sweep", None)
+
+
+def test_documented_outputs_cover_a_rotors_modes_sweep_and_campbell():
+    """The built-in Laval rotor: modes (damped, with whirl), a sweep of modes and a Campbell diagram return only
+    documented outputs (a sweep's inner outputs are the modes' ones)."""
+    import mechgen
+
+    rotor = mechgen.compile("laval_rotor")
+    modes = {o.name for o in outputs_of("modes")}
+    for key in mechgen.modes(rotor).keys():
+        assert key in modes, ("modes", key)
+    sweep = {o.name for o in outputs_of("sweep")} | modes
+    for key in mechgen.sweep(rotor, "modes", {"Omega": [0.0, 100.0]}).keys():
+        assert key in sweep, ("sweep", key)
+    campbell = {o.name for o in outputs_of("campbell")}
+    for key in mechgen.campbell(rotor, over={"Omega": [0.0, 100.0, 200.0]}, count=2).keys():
+        assert key in campbell, ("campbell", key)

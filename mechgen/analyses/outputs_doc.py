@@ -40,10 +40,20 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("operating_point", "{coordinate: value}", MODEL_UNIT,
            "The equilibrium Newton found, when the point given (``at``, or zero) was not one."),
         _o("s", "(points,)", "m (the field's length unit)", "A continuum's stations along s (with ``count``)."),
-        _o("shapes", "(count, points)", "-", "A continuum's mode shapes at ``s`` (with ``count``)."),
+        _o("shapes", "(count, points) or list of {coordinate: {amplitude, phase}}", "-, phase in rad",
+           "A continuum's mode shapes at ``s`` (with ``count``); a lumped model's damped modes: the complex "
+           "shape X of each mode (q(t) = Re(X e^{st})) as amplitude \\|X_i\\| and phase arg X_i, the first "
+           "largest amplitude 1 with phase 0 (mechgen.analyses.whirl)."),
         _o("eigenvalues", "(modes, 2)", "1/s", "Damped modes only: the eigenvalues s as [re, im] pairs."),
         _o("log_dec", "(modes,)", "-", "Damped modes only: the logarithmic decrement of each mode."),
-        _o("whirl", "(modes,)", "-", "Rotors only: each mode's whirl direction (forward / backward)."),
+        _o("whirl", "(modes,)", "-", "Rotors only: each mode's whirl, ``forward`` (counter-clockwise about "
+           "z = x cross y), ``backward``, ``linear`` (a straight-line orbit) or ``none`` (the whirl stations at "
+           "rest)."),
+        _o("whirl_ratio", "(modes,)", "-", "Rotors only: the signed ratio b / a of the orbit's semi-axes (+1 a "
+           "forward circle, -1 a backward one, 0 a line)."),
+        _o("orbits", "list of {major, minor, angle}", "-, angle in rad", "Rotors only: per mode, the ellipse "
+           "of the normalised shape at the whirl station with the largest orbit (semi-axes and the major "
+           "axis's angle from x towards y)."),
     ),
     "stability": (
         _o("eigenvalues", "(n, 2)", "1/s", "The eigenvalues s of M q'' + (D + G) q' + K q = 0 as [re, im] "
