@@ -215,3 +215,13 @@ def test_documented_outputs_cover_a_rotors_modes_sweep_and_campbell():
     campbell = {o.name for o in outputs_of("campbell")}
     for key in mechgen.campbell(rotor, over={"Omega": [0.0, 100.0, 200.0]}, count=2).keys():
         assert key in campbell, ("campbell", key)
+
+
+def test_option_meanings_come_from_the_schema_and_the_module():
+    """An option's row holds the kind docstring's parenthesis about it and its check's docstring."""
+    text = reference.kind_page("simulate")
+    row = text.split("* - ``series``", 1)[1].split("* - ", 1)[0]
+    assert "the time history; left out: kept while small" in row and "true or false" in row
+    assert reference.described("x ``a`` (b (c) d) e", "a") == "b (c) d"
+    assert reference.described("x ``a`` b", "a") == ""
+    assert reference.toml_literal({"a": [1.0, True], "b": "auto"}) == '{ a = [1.0, true], b = "auto" }'

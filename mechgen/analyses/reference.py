@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import importlib
 import inspect
+import json
 from pathlib import Path
 from typing import Any
 
@@ -66,7 +67,36 @@ def default_text(option: Option) -> str:
         return "optional (no default)"
     if option.default is ALL_OUTPUTS:
         return "every model output"
-    return f"``{option.default!r}``"
+    return f"``{toml_literal(option.default)}``"
+
+
+def toml_literal(value: Any) -> str:
+    """A default as a scene writes it: ``"auto"``, ``true``, ``1e-08``, ``[1.0]``, ``{ a = 1 }``."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return json.dumps(value)
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(toml_literal(v) for v in value) + "]"
+    if isinstance(value, dict):
+        return "{ " + ", ".join(f"{k} = {toml_literal(v)}" for k, v in value.items()) + " }" if value else "{}"
+    return repr(value)
+
+
+def described(doc: str, name: str) -> str:
+    """What a kind's module docstring says of option ``name``: the parenthesis right after its first
+    ``name`` (``series`` (the time history; ...)), brackets balanced; empty when it says nothing so."""
+    text = " ".join(doc.split())
+    start = text.find(f"``{name}`` (")
+    if start < 0:
+        return ""
+    i = start + len(name) + 5
+    depth = 0
+    for j in range(i, len(text)):
+        depth += {"(": 1, ")": -1}.get(text[j], 0)
+        if depth == 0:
+            return text[i + 1:j]
+    return ""
 
 
 def first_paragraph(text: str | None) -> str:
@@ -94,12 +124,15 @@ def check_meaning(check: Any) -> str:
     return ""
 
 
-def option_meaning(option: Option) -> str:
-    """An option's meaning: what its check accepts, the ``expected`` text where it says more."""
-    meaning = check_meaning(option.check)
-    if option.expected and option.expected != "a value" and option.expected.lower() not in meaning.lower():
-        meaning = (meaning + " " if meaning else "") + f"Expected: {option.expected}."
-    return meaning or "See the module's description above."
+def option_meaning(option: Option, said: str = "") -> str:
+    """An option's meaning: what the kind's docstring says of it (``said``), then what its check accepts and the
+    ``expected`` text where it says more."""
+    accepts = check_meaning(option.check)
+    if option.expected and option.expected != "a value" and option.expected.lower() not in accepts.lower():
+        accepts = (accepts + " " if accepts else "") + f"Expected: {option.expected}."
+    parts = [f"*Described:* {escape_bars(said)}." if said else "",
+             f"*Accepts:* {accepts}" if accepts else ""]
+    return " ".join(p for p in parts if p) or "See the description above."
 
 
 def cell(text: str) -> str:
@@ -133,7 +166,9 @@ def options_section(kind: str) -> list[str]:
     schema = get(kind).schema
     if not schema:
         return title("Scene keys", "-") + ["This kind takes no options.", ""]
-    rows = [(f"``{name}``", default_text(option), option_meaning(option)) for name, option in schema.items()]
+    doc = importlib.import_module(module_of(kind)).__doc__ or ""
+    rows = [(f"``{name}``", default_text(option), option_meaning(option, described(doc, name)))
+            for name, option in schema.items()]
     return title("Scene keys", "-") + table(("key", "default", "meaning"), rows, "18 18 64")
 
 
