@@ -1,7 +1,8 @@
 """Sphinx extension: write the analysis kinds' reference pages (mechgen.analyses.reference) before reading.
 
-Each kind's page takes its example from the shipped scenes beside the package (a checkout). The pages go to ``<srcdir>/kinds/`` (not committed: .gitignore); a page is rewritten only when its text
-changed, so an incremental build re-reads only what changed.
+Each kind's page takes its example from the shipped scenes beside the package (a checkout). The pages go to
+``<srcdir>/kinds/`` (not committed: .gitignore); a page is rewritten only when its text changed, so an
+incremental build re-reads only what changed.
 """
 from __future__ import annotations
 

@@ -83,10 +83,11 @@ left.set_ylabel("natural frequency [rad/s]")
 left.legend()
 left.set_title("Frequencies")
 for j in range(3):
-    right.plot(modes_axis, shapes[:, j] / np.max(np.abs(shapes[:, j])), "o-",
+    shape = shapes[:, j] / shapes[np.argmax(np.abs(shapes[:, j])), j]  # the largest entry +1
+    right.plot(modes_axis, shape, "o-",
                label=f"mode {j + 1}, {reference[j]:.2f} rad/s")
 right.set_xticks(modes_axis, ["x1", "x2", "x3"])
-right.set_ylabel("amplitude (largest = 1)")
+right.set_ylabel("amplitude (largest entry = 1)")
 right.legend()
 right.set_title("Mode shapes (scipy reference)")
 fig.tight_layout()
