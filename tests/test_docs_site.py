@@ -52,11 +52,9 @@ def parse(page: Path) -> Links:
     return links
 
 
-@pytest.fixture(scope="module")
-def site(tmp_path_factory):
+def build_site(work: Path) -> Path:
     """The site built from a copy of docs/ (the build writes the generated pages and the gallery into its
     source folder), warnings as errors, with the network unused: no intersphinx, no remote image."""
-    work = tmp_path_factory.mktemp("docs")
     source = work / "docs"
     shutil.copytree(DOCS, source, ignore=shutil.ignore_patterns("_build", "auto_examples", "kinds",
                                                                "sg_execution_times.rst"))
@@ -67,7 +65,17 @@ def site(tmp_path_factory):
     return out
 
 
-def test_every_kind_has_its_generated_page(site):
+def test_site(tmp_path):
+    """One build, then each check of the built site (one test rather than a shared fixture: pytest-xdist would
+    build the site once per worker that holds a test needing it)."""
+    site = build_site(tmp_path)
+    check_every_kind_has_its_generated_page(site)
+    check_no_broken_internal_links(site)
+    check_no_remote_images(site)
+    check_every_gallery_script_ran_and_drew(site)
+
+
+def check_every_kind_has_its_generated_page(site):
     index = (site / "kinds" / "index.html").read_text(encoding="utf-8")
     for kind in kinds():
         page = site / "kinds" / f"{kind}.html"
@@ -78,7 +86,7 @@ def test_every_kind_has_its_generated_page(site):
         assert f"{kind}.html" in index
 
 
-def test_no_broken_internal_links(site):
+def check_no_broken_internal_links(site):
     """Every relative href/src of every page names a file of the build, and every #fragment an id there."""
     pages = sorted(site.rglob("*.html"))
     assert len(pages) > 20
@@ -97,14 +105,14 @@ def test_no_broken_internal_links(site):
     assert not broken, broken
 
 
-def test_no_remote_images(site):
+def check_no_remote_images(site):
     """Offline: no page shows an image fetched from the network."""
     for page in site.rglob("*.html"):
         for target in re.findall(r'<img[^>]+src="([^"]+)"', page.read_text(encoding="utf-8")):
             assert not urlsplit(target).scheme, (page, target)
 
 
-def test_every_gallery_script_ran_and_drew(site):
+def check_every_gallery_script_ran_and_drew(site):
     """Each docs/examples/plot_*.py has its page with its printed output and at least one figure."""
     scripts = sorted((DOCS / "examples").glob("plot_*.py"))
     assert len(scripts) >= 3
