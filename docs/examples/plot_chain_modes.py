@@ -20,7 +20,8 @@ The natural frequencies :math:`\\omega` (rad/s) solve :math:`K \\phi = \\omega^2
 
 Reference: M and K written by hand and solved by :func:`scipy.linalg.eigh` (any vibration text, e.g.
 Rao, *Mechanical Vibrations*, ch. 6). mechgen derives M and K from the energies and solves the same
-problem in :func:`mechgen.modes`.
+problem in :func:`mechgen.modes`, which also returns the mass-normalised shapes (``shapes``, one
+``{coordinate: value}`` per mode), ``modal_mass`` and ``modal_stiffness``.
 """
 import tempfile
 from pathlib import Path
@@ -73,6 +74,16 @@ print(f"max relative error of the frequencies: {relative:.2e}")
 # the same 3 x 3 eigenproblem solved twice: agreement to 1e-10 (the solvers' round-off on well-separated modes)
 assert relative < 1e-10
 
+# %%
+# Mode shapes: mechgen's are mass-normalised (phi^T M phi = 1, the largest entry positive), as scipy's eigh
+# returns them up to sign.
+names = ["x1", "x2", "x3"]
+ours = np.array([[shape[n] for n in names] for shape in result["shapes"]]).T
+signs = np.sign(np.sum(ours * shapes, axis=0))
+shape_error = np.max(np.abs(ours - shapes * signs))
+print(f"max error of the mass-normalised shapes: {shape_error:.2e}; modal masses {result['modal_mass']}")
+assert shape_error < 1e-10  # the same well-separated eigenproblem: round-off
+
 fig, (left, right) = plt.subplots(1, 2, figsize=(9, 4))
 modes_axis = np.arange(1, 4)
 left.plot(modes_axis, frequencies, "o", ms=9, label="mechgen.modes")
@@ -83,12 +94,11 @@ left.set_ylabel("natural frequency [rad/s]")
 left.legend()
 left.set_title("Frequencies")
 for j in range(3):
-    shape = shapes[:, j] / shapes[np.argmax(np.abs(shapes[:, j])), j]  # the largest entry +1
-    right.plot(modes_axis, shape, "o-",
-               label=f"mode {j + 1}, {reference[j]:.2f} rad/s")
-right.set_xticks(modes_axis, ["x1", "x2", "x3"])
-right.set_ylabel("amplitude (largest entry = 1)")
+    line, = right.plot(modes_axis, ours[:, j], "o-", label=f"mode {j + 1}, {frequencies[j]:.2f} rad/s")
+    right.plot(modes_axis, shapes[:, j] * signs[j], "x", ms=9, color=line.get_color())
+right.set_xticks(modes_axis, names)
+right.set_ylabel("mass-normalised amplitude [kg^-1/2]")
 right.legend()
-right.set_title("Mode shapes (scipy reference)")
+right.set_title("Mode shapes: mechgen (o) and scipy (x)")
 fig.tight_layout()
 plt.show()
