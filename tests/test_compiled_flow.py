@@ -9,6 +9,7 @@ system whose rates are known in closed form (eigenvalues of a two-rate linear sy
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -18,36 +19,7 @@ import mechgen
 from mechgen.analyses import simulate_flow
 from mechgen.runtime.core.smooth_c import smooth_loop_problem
 
-DUFFING = '''\
-"""Forced, damped Duffing oscillator: m x'' + c x' + k x + k3 x^3 = F cos(w t)."""
-import sympy as sp
-from mechgen import Model, Param
-
-model = Model("user_duffing", doc=__doc__)
-model.params(Param("m", 1.0, "kg", positive=True), Param("c", 0.05, "N s/m", minimum=0.0),
-             Param("k", 1.0, "N/m"), Param("k3", 0.5, "N/m^3"), Param("F", 0.3, "N"), Param("w", 1.2, "rad/s"))
-model.coordinates("x")
-
-
-@model.kinetic
-def kinetic(v, p):
-    return p.m * v.x**2 / 2
-
-
-@model.potential
-def potential(q, p):
-    return p.k * q.x**2 / 2 + p.k3 * q.x**4 / 4
-
-
-@model.dissipation
-def dissipation(v, p):
-    return p.c * v.x**2 / 2
-
-
-@model.forces
-def forces(p, t):
-    return {"x": p.F * sp.cos(p.w * t)}
-'''
+MODELS = Path(__file__).resolve().parent / "models"  # forced_duffing.py: the forced, damped Duffing oscillator
 
 TWO_RATES = '''\
 """Two decoupled damped coordinates: x'' + c1 x' + k1 x = 0, y'' + c2 y' + k2 y = 0."""
@@ -77,14 +49,13 @@ def dissipation(v, p):
 @pytest.fixture(scope="module")
 def folder(tmp_path_factory):
     path = tmp_path_factory.mktemp("compiled_flow_models")
-    (path / "duffing.py").write_text(DUFFING)
     (path / "two_rates.py").write_text(TWO_RATES)
     return path
 
 
 @pytest.fixture(scope="module")
 def duffing(folder):
-    system = mechgen.compile(str(folder / "duffing.py"))
+    system = mechgen.compile(str(MODELS / "forced_duffing.py"))
     if smooth_loop_problem(system) is not None:
         pytest.skip(f"no compiled loop here: {smooth_loop_problem(system)}")
     return system
@@ -137,7 +108,7 @@ def test_stiffness_rule_counts_decay_not_oscillation(folder):
 
 def test_loop_c_refused_where_it_cannot_run(folder):
     """loop = "c" on the numpy backend: exit-2 error at the key, naming why."""
-    system = mechgen.compile(str(folder / "duffing.py"), backend="numpy")
+    system = mechgen.compile(str(MODELS / "forced_duffing.py"), backend="numpy")
     with pytest.raises(mechgen.InputError, match="loop"):
         mechgen.simulate(system, t_end=1.0, method="DOP853", loop="c")
     r = mechgen.simulate(system, t_end=1.0, q0={"x": 0.5})

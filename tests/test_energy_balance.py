@@ -14,6 +14,7 @@ integrated with the state, against references independent of mechgen:
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -21,36 +22,7 @@ import scipy.integrate as si
 
 import mechgen
 
-DUFFING = '''\
-"""Forced, damped Duffing oscillator."""
-import sympy as sp
-from mechgen import Model, Param
-
-model = Model("user_duffing_balance", doc=__doc__)
-model.params(Param("m", 1.0), Param("c", 0.05), Param("k", 1.0), Param("k3", 0.5), Param("F", 0.3),
-             Param("w", 1.2))
-model.coordinates("x")
-
-
-@model.kinetic
-def kinetic(v, p):
-    return p.m * v.x**2 / 2
-
-
-@model.potential
-def potential(q, p):
-    return p.k * q.x**2 / 2 + p.k3 * q.x**4 / 4
-
-
-@model.dissipation
-def dissipation(v, p):
-    return p.c * v.x**2 / 2
-
-
-@model.forces
-def forces(p, t):
-    return {"x": p.F * sp.cos(p.w * t)}
-'''
+MODELS = Path(__file__).resolve().parent / "models"  # forced_duffing.py, bouncing_ball.py
 
 ROTATING = '''\
 """A particle on an anisotropic spring that rotates with the frame (rate Omega)."""
@@ -95,7 +67,7 @@ def potential(q, p, t):
 @pytest.fixture(scope="module")
 def folder(tmp_path_factory):
     path = tmp_path_factory.mktemp("balance_models")
-    for name, text in {"duffing": DUFFING, "rotating": ROTATING, "pumped": PUMPED}.items():
+    for name, text in {"rotating": ROTATING, "pumped": PUMPED}.items():
         (path / f"{name}.py").write_text(text)
     return path
 
@@ -105,7 +77,7 @@ def test_forced_damped_duffing_work_and_dissipation(folder, loop):
     """work and dissipated against scipy's quadratures of the hand-derived powers (1e-8 relative: both runs'
     errors at rtol 1e-11 / 1e-12 over 60 s); the balance closes to 1e-9 of the energy scale; no energy_drift
     (a forced run from rest: E0 = 0, where the old figure divided by zero)."""
-    system = mechgen.compile(str(folder / "duffing.py"))
+    system = mechgen.compile(str(MODELS / "forced_duffing.py"))
     r = mechgen.simulate(system, t_end=60.0, rtol=1e-11, atol=1e-13, loop=loop)
     assert "energy_drift" not in r
     m, c, k, k3, F, w = 1.0, 0.05, 1.0, 0.5, 0.3, 1.2
@@ -126,7 +98,7 @@ def test_forced_damped_duffing_work_and_dissipation(folder, loop):
 def test_free_damped_oscillator_dissipates_its_energy(folder):
     """F = 0: the dissipated energy is E(0) - E(t) with E from the closed form x(t) = e^{-zeta wn t}(cos wd t +
     zeta wn / wd sin wd t), x(0) = 1 (k3 = 0, m = k = 1, c = 0.05)."""
-    system = mechgen.compile(str(folder / "duffing.py"), {"F": 0.0, "k3": 0.0})
+    system = mechgen.compile(str(MODELS / "forced_duffing.py"), {"F": 0.0, "k3": 0.0})
     r = mechgen.simulate(system, t_end=30.0, q0={"x": 1.0}, rtol=1e-11, atol=1e-13, samples=31)
     zeta, wn = 0.025, 1.0
     wd = wn * math.sqrt(1 - zeta**2)
@@ -166,35 +138,9 @@ def test_explicit_time_dependence_is_work(folder):
 
 def test_a_conservative_run_keeps_energy_drift(folder):
     """c = F = 0: the powers are generated zeros, so the run reports energy_drift, not a balance."""
-    system = mechgen.compile(str(folder / "duffing.py"), {"F": 0.0, "c": 0.0})
+    system = mechgen.compile(str(MODELS / "forced_duffing.py"), {"F": 0.0, "c": 0.0})
     r = mechgen.simulate(system, t_end=10.0, q0={"x": 1.0}, rtol=1e-10, atol=1e-12)
     assert "energy_balance_error" not in r and r["energy_drift"] < 1e-8
-
-
-BALL = '''\
-"""A bouncing ball: flight under gravity; y falling through 0 resets y' -> -cor y'."""
-from mechgen import Model, Param
-
-model = Model("user_ball_balance", doc=__doc__)
-model.params(Param("m", 1.0), Param("g", 9.81), Param("cor", 0.8, "", minimum=0.0))
-model.coordinates("y")
-flight = model.mode("flight")
-
-
-@model.kinetic
-def kinetic(v, p):
-    return p.m / 2 * v.y**2
-
-
-@model.potential
-def potential(q, p):
-    return p.m * p.g * q.y
-
-
-@flight.guard(to="flight", direction="falling", reset=lambda v, p: {"y_dot": -p.cor * v.y})
-def floor(q):
-    return q.y
-'''
 
 
 @pytest.mark.parametrize("loop", ["c", "python"])
@@ -202,8 +148,7 @@ def test_bouncing_ball_resets_dissipate_the_closed_form(tmp_path, loop):
     """Dropped from h = 1 with e = 0.8: after k impacts the resets have taken m g h (1 - e^(2k)); the flights
     conserve E, so the balance E(t) - E(0) + D(t) closes to the integrator's accuracy; no energy_drift (the
     energy's drop is the resets', not an error)."""
-    (tmp_path / "ball.py").write_text(BALL)
-    ball = mechgen.compile(str(tmp_path / "ball.py"))
+    ball = mechgen.compile(str(MODELS / "bouncing_ball.py"))
     r = mechgen.simulate(ball, t_end=3.0, q0={"y": 1.0}, method="DOP853", rtol=1e-11, atol=1e-13, loop=loop)
     k = len(r["events"])
     assert k >= 5 and "energy_drift" not in r

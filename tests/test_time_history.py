@@ -74,39 +74,13 @@ def potential(q, p):
     return p.k * q.x**2 / 2
 '''
 
-BALL = '''\
-"""A bouncing ball: flight under gravity; y falling through 0 resets y' -> -cor y'."""
-from mechgen import Model, Param
-
-model = Model("user_ball", doc=__doc__)
-model.params(Param("m", 1.0, "kg", positive=True), Param("g", 9.81, "m/s^2", positive=True),
-             Param("cor", 0.8, "", minimum=0.0))
-model.coordinates("y")
-flight = model.mode("flight")
-
-
-@model.kinetic
-def kinetic(v, p):
-    return p.m / 2 * v.y**2
-
-
-@model.potential
-def potential(q, p):
-    return p.m * p.g * q.y
-
-
-@flight.guard(to="flight", direction="falling", reset=lambda v, p: {"y_dot": -p.cor * v.y})
-def floor(q):
-    return q.y
-'''
-
 M1, M2, L1, L2, G = 1.0, 0.5, 1.0, 0.7, 9.81
 
 
 @pytest.fixture(scope="module")
 def folder(tmp_path_factory):
     path = tmp_path_factory.mktemp("time_history_models")
-    for name, text in {"double": DOUBLE, "oscillator": OSCILLATOR, "ball": BALL}.items():
+    for name, text in {"double": DOUBLE, "oscillator": OSCILLATOR}.items():
         (path / f"{name}.py").write_text(text)
     return path
 
@@ -195,7 +169,7 @@ def test_zeno_stop_ends_the_ball_at_its_accumulation_time(folder):
     """on_zeno = "stop": the run ends at the accumulation point T = t1 (1 + e)/(1 - e) with the events so far
     (the events' times converge geometrically to T: the last one within e^k t1-size of it); the default is
     still an error."""
-    ball = mechgen.compile(str(folder / "ball.py"))
+    ball = mechgen.compile(str(ROOT / "tests" / "models" / "bouncing_ball.py"))
     t1 = math.sqrt(2 * 1.0 / 9.81)
     T = t1 * 1.8 / 0.2
     options = dict(t_end=2 * T, q0={"y": 1.0}, method="DOP853", rtol=1e-10, atol=1e-12, zeno_events=20,
