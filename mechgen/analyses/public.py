@@ -324,19 +324,10 @@ def symplectic(system, *, name: str | None = None, **options) -> Result:
 
 def option_lines(kind: str) -> list[str]:
     """One line per option of ``kind``, from the schema the scene loader validates against: its name and its
-    default (``required`` / ``optional`` where it has none, ``all outputs`` for the outputs list)."""
-    from mechgen.analyses.schema import ABSENT, ALL_OUTPUTS, REQUIRED
+    default as the reference pages write it (mechgen.analyses.reference.default_text)."""
+    from mechgen.analyses.reference import default_text
 
-    def default(option) -> str:
-        if option.default is REQUIRED:
-            return "required"
-        if option.default is ABSENT:
-            return "optional"
-        if option.default is ALL_OUTPUTS:
-            return "default: every model output"
-        return f"default {option.default!r}"
-
-    return [f"``{name}`` ({default(option)})" for name, option in get(kind).schema.items()]
+    return [f"``{name}``: {default_text(option).replace('**', '')}" for name, option in get(kind).schema.items()]
 
 
 def _with_schema_options() -> None:
@@ -347,7 +338,7 @@ def _with_schema_options() -> None:
         if kind in kinds():
             function.__doc__ = (function.__doc__ or "").rstrip() + (
                 "\n\n    Options accepted (from the scene schema of kind ``%s``): " % kind
-                + ", ".join(option_lines(kind)) + ".\n")
+                + "; ".join(option_lines(kind)) + ".\n")
 
 
 _with_schema_options()
