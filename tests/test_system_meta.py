@@ -28,7 +28,7 @@ def test_metadata_reads_the_meta_dict(name):
 
 def test_metadata_of_known_models():
     rotor = mechgen.compile("laval_rotor").metadata
-    assert rotor.whirl == ("x", "y") and rotor.kind == "lumped" and rotor.sites_param is None
+    assert rotor.whirl == ("x", "y", "theta_x", "theta_y") and rotor.kind == "lumped" and rotor.sites_param is None
     chain = mechgen.compile("fpu_chain").metadata
     assert chain.is_lattice and chain.sites_param and chain.ends
     pendulum = mechgen.compile("spring_pendulum").metadata
