@@ -53,3 +53,17 @@ def test_bad_options_name_the_key():
         mechgen.analysis("response", rotor, input="x", omega=[-1.0])
     with pytest.raises(InputError, match="omega"):
         mechgen.analysis("response", rotor, input="x")
+
+
+def test_python_function_response_is_the_closed_form_receptance():
+    """mechgen.response (the Python face of the kind): the spring pendulum driven along r at its hanging
+    equilibrium r0 = l0 + m g / k: M_rr = m, K_rr = k, so |H_rr| = 1 / (k - m omega^2) below resonance, and no
+    coupling into theta at theta = 0 (K and M diagonal there)."""
+    import mechgen
+
+    m, k, l0, g = 1.0, 40.0, 1.0, 9.81
+    system = mechgen.compile("spring_pendulum")
+    r = mechgen.response(system, input="r", omega=[1.0, 2.0, 3.0], at={"r": l0 + m * g / k})
+    omega = np.array([1.0, 2.0, 3.0])
+    np.testing.assert_allclose(r["amplitude"]["r"], 1.0 / (k - m * omega**2), rtol=1e-12)
+    np.testing.assert_allclose(r["amplitude"]["theta"], 0.0, atol=1e-15)

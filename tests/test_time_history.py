@@ -265,6 +265,10 @@ def test_failed_analysis_error_types_are_kept(double):
     ('model = "spring_pendulum"\n[[analysis]]\nname = "a"\nkind = "simulat"\n', ["did you mean 'simulate'"]),
     ('model = "spring_pendulum"\n[[analysis]]\nname = "a"\nkind = "simulate"\nt_end = 1\nsamles = 3\n',
      ["'analysis[1].samles'", "did you mean 'samples'"]),
+    ('model = "spring_pendulum"\n[[analysis]]\nname = "a"\nkind = "simulate"\nt_end = 1\nmethod = "dop853"\n',
+     ["'analysis[1].method'", "did you mean 'DOP853'"]),
+    ('model = "spring_pendulum"\n[[analysis]]\nname = "a"\nkind = "simulate"\nt_end = 1\nloop = "pyhton"\n',
+     ["'analysis[1].loop'", "did you mean 'python'"]),
 ])
 def test_typos_get_the_closest_name(tmp_path, capsys, scene, words):
     """A mistyped model, parameter, kind or key: exit 2, naming the key and suggesting the closest name."""

@@ -20,7 +20,7 @@ from mechgen.errors import InputError, did_you_mean
 
 __all__ = ["analysis", "campbell", "continuation", "fit", "impact", "modes", "restitution", "simulate", "stability",
            "steady", "sweep", "cross_section", "symplectic", "rod_statics", "rod_dynamics", "periodic", "spectrum",
-           "stability_boundary", "option_lines"]
+           "stability_boundary", "response", "option_lines"]
 
 
 def _model_info(system):
@@ -179,6 +179,17 @@ def periodic(system, *, name: str | None = None, **options) -> Result:
     ``equivalent_stiffness``, ``equivalent_damping`` and the hysteresis loop of the detected period.
     """
     return _run("periodic", system, options, name)
+
+
+def response(system, *, name: str | None = None, **options) -> Result:
+    """The steady harmonic response to a unit force at one coordinate: the receptance
+    H(omega) = (K - omega^2 M + i omega (D + G))^-1 about an operating point (mechgen.analyses.response).
+
+    Options: ``input`` (the driven coordinate) and ``omega`` (rad/s: a list or {start, stop, num}) required,
+    ``outputs``, ``about``, ``at``, ``max_seconds``. Outputs: ``omega``, ``amplitude`` and ``phase`` per output
+    coordinate (|H_kj|, arg H_kj in rad).
+    """
+    return _run("response", system, options, name)
 
 
 def spectrum(system, *, name: str | None = None, **options) -> Result:

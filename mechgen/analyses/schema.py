@@ -183,10 +183,20 @@ def one_of(what: str, names: Sequence[str]) -> Callable:
     """A check of a string option whose value is one of ``names`` (``what`` names it in the message)."""
     def check(ctx: OptionContext, key: str, value: object) -> str:
         if not isinstance(value, str) or value not in names:
-            raise fail(ctx.file, key, f"unknown {what} {show(value)}", "one of: " + ", ".join(names))
+            raise fail(ctx.file, key, f"unknown {what} {show(value)}{closest_value(value, names)}",
+                       "one of: " + ", ".join(names))
         return value
 
     return check
+
+
+def closest_value(value: object, names: Sequence[str]) -> str:
+    """`` (did you mean 'DOP853'?)`` for a mistyped choice: a case-insensitive match first, else difflib's."""
+    if isinstance(value, str):
+        same = [n for n in names if n.lower() == value.lower()]
+        if same:
+            return f" (did you mean {same[0]!r}?)"
+    return did_you_mean(value, names)
 
 
 def name(ctx: OptionContext, key: str, value: object) -> str:

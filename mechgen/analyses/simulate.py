@@ -113,7 +113,8 @@ def _on_zeno(ctx, key: str, value: object) -> str:
 
 def _method(ctx, key: str, value: object) -> str:
     if not isinstance(value, str) or value not in METHODS:
-        raise fail(ctx.file, key, f"unknown method {show(value)}", "one of: " + ", ".join(METHODS))
+        raise fail(ctx.file, key, f"unknown method {show(value)}{schema.closest_value(value, METHODS)}",
+                   "one of: " + ", ".join(METHODS))
     return value
 
 
