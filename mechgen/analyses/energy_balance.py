@@ -104,6 +104,19 @@ def mode_powers(mode_system, t: np.ndarray, X: np.ndarray, modes: np.ndarray) ->
     return out
 
 
+def unaccounted(system, t: np.ndarray, X: np.ndarray) -> dict | None:
+    """For a run that did not integrate its balance (CVODES): ``energy_note`` when the model has forces,
+    dissipation or an explicit time dependence at the samples (its energy_drift would mean nothing), else None."""
+    if "energy_rates" not in system.kernels or system.is_lattice or system.is_field:
+        return None
+    powers = mode_powers(lambda k: system, t, X, np.zeros(len(t), int))
+    if powers is None or not np.any(powers):
+        return None
+    return {"energy_note": "the model has forces, dissipation or an explicit time dependence whose work this "
+                           "method does not integrate: no energy figure (the other methods report "
+                           "energy_balance_error)"}
+
+
 def reset_losses(mode_system, events) -> list[tuple[float, float]]:
     """(t, E before - E after) of each event that resets the state into a mode (terminal events excluded)."""
     return [(float(e.t), _energy(mode_system(e.source), e.t, e.x_before) - _energy(mode_system(e.target), e.t,

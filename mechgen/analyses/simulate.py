@@ -160,8 +160,7 @@ def needs(options: dict, *, internal: bool) -> set[str]:
     start = {"linear"} if options.get("initial_mode") else set()
     if options.get("method") == "variational":
         return {"lagrangian", "outputs", "energy_rates"} | start
-    balance = {"energy_rates"} if options.get("method") != "cvodes" else set()
-    return ({"residual", "tangent", "flow", "outputs"} | start | balance
+    return ({"residual", "tangent", "flow", "energy_rates", "outputs"} | start
             | ({"rates", "rates_tangent"} if internal else set()))
 
 
@@ -274,6 +273,9 @@ def run_simulate(system, options: dict, context: dict) -> dict:
     out = {**report(system, options, t, state, series), **how}
     if extra:
         balanced(out, energy_balance.figures(system, t, X, series))
+    elif method == "cvodes" and (note := energy_balance.unaccounted(system, t, state)) is not None:
+        del out["energy_drift"]
+        out.update(note)
     if system.is_lattice and system.metadata.ends == "fixed":
         out["mode_energies"] = mode_energies(system, X[-1, :n], X[-1, n:2 * n])
     return out
