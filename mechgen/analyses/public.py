@@ -187,7 +187,7 @@ def response(system, *, name: str | None = None, **options) -> Result:
 
     Options: ``input`` (the driven coordinate) and ``omega`` (rad/s: a list or {start, stop, num}) required,
     ``outputs``, ``about``, ``at``, ``max_seconds``. Outputs: ``omega``, ``amplitude`` and ``phase`` per output
-    coordinate (|H_kj|, arg H_kj in rad).
+    coordinate (``abs(H_kj)``, ``arg(H_kj)`` in rad).
     """
     return _run("response", system, options, name)
 
