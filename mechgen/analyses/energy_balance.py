@@ -60,13 +60,7 @@ class AugmentedFlow:
 
 def excess(system, t: np.ndarray, X: np.ndarray) -> np.ndarray:
     """v.dT/dv - 2 T at each sample (zero for a kinetic energy quadratic in v), in one batched call."""
-    n = system.n
-    kernel = system.kernels["energy_rates"]
-    wanted = {port["name"] for port in kernel.spec["inputs"]}
-    inputs = {"q": X[:, :n], "v": X[:, n:2 * n], "z": X[:, 2 * n:2 * n + system.m], "t": t[:, None],
-              "p": system.params}
-    return np.asarray(kernel.evaluate({k: v for k, v in inputs.items() if k in wanted})["excess"],
-                      float).reshape(len(t))
+    return np.asarray(system.evaluate_series("energy_rates", t, X)["excess"], float).reshape(len(t))
 
 
 def figures(system, t: np.ndarray, X: np.ndarray, series: dict) -> dict | None:
@@ -93,13 +87,8 @@ def mode_powers(mode_system, t: np.ndarray, X: np.ndarray, modes: np.ndarray) ->
         if "energy_rates" not in flow.kernels:
             return None
         rows = np.flatnonzero(modes == k)
-        n, m = flow.n, flow.m
-        kernel = flow.kernels["energy_rates"]
-        wanted = {port["name"] for port in kernel.spec["inputs"]}
-        inputs = {"q": X[rows, :n], "v": X[rows, n:2 * n], "z": X[rows, 2 * n:2 * n + m], "t": t[rows, None],
-                  "p": flow.params}
-        raw = kernel.evaluate({key: v for key, v in inputs.items() if key in wanted})
-        out[rows, :EXTRA] = np.asarray(raw["g"], float).reshape(len(rows), -1)[:, m:]
+        raw = flow.evaluate_series("energy_rates", t[rows], X[rows])
+        out[rows, :EXTRA] = np.asarray(raw["g"], float).reshape(len(rows), -1)[:, flow.m:]
         out[rows, EXTRA] = np.asarray(raw["excess"], float).reshape(len(rows))
     return out
 

@@ -212,18 +212,18 @@ def budget_of(options: dict, method: str) -> Budget:
     return Budget(what, limit=int(steps), key="max_steps", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
 
 
-def refuse_explicit_stiff(system, x0: np.ndarray, t_end: float, method: str, budget: Budget) -> None:
+def refuse_explicit_stiff(system, x0: np.ndarray, t_end: float, method: str, budget: Budget,
+                          rates: np.ndarray | None = None) -> None:
     """An explicit method needs at least t_end |lambda|max / c steps for stability alone (|lambda|max: the
-    largest eigenvalue magnitude of d(dx/dt)/dx at the start; c: EXPLICIT_REACH); refuse when that is
-    more than the budget (the problem is stiff: the implicit methods have no such stability limit)."""
+    largest eigenvalue magnitude of d(dx/dt)/dx at the start, ``rates`` when the caller has them, else
+    simulate_flow.start_rates; c: EXPLICIT_REACH); refuse when that is more than the budget (the problem is
+    stiff: the implicit methods have no such stability limit)."""
     if method not in EXPLICIT_REACH or x0.size > ESTIMATE_SIZE or budget.limit is None:
         return
-    try:
-        J = system.jacobian(0.0, x0)
-        J = J.toarray() if hasattr(J, "toarray") else np.asarray(J, float)
-        fastest = float(np.max(np.abs(np.linalg.eigvals(J)))) if np.all(np.isfinite(J)) else 0.0
-    except Exception:  # no estimate: the step budget still holds during the run
+    rates = simulate_flow.start_rates(system, x0) if rates is None else rates
+    if rates is None:  # no estimate: the step budget still holds during the run
         return
+    fastest = float(np.max(np.abs(rates), initial=0.0))
     needed = t_end * fastest / EXPLICIT_REACH[method]
     if needed > budget.limit:
         raise BudgetExceeded(f"{method} steps: an explicit method needs at least {needed:.3g} steps to stay stable "
@@ -262,10 +262,12 @@ def run_simulate(system, options: dict, context: dict) -> dict:
     else:
         start = declared_start(system)
         x0 = np.concatenate([q0, v0, np.zeros(system.m) if start is None else start[2 * system.n:]])
+        rates = simulate_flow.start_rates(system, x0) if method in ("auto", *EXPLICIT_REACH) else None
         if method == "auto":
             limit = budget_of(options, "DOP853").limit
-            method = simulate_flow.chosen_method(system, x0, float(options["t_end"]), limit)
-        t, X, how = simulate_flow.adaptive_run(system, options, x0, method, budget_of(options, method), desc)
+            method = simulate_flow.chosen_method(system, x0, float(options["t_end"]), limit, rates=rates)
+        t, X, how = simulate_flow.adaptive_run(system, options, x0, method, budget_of(options, method), desc,
+                                               rates=rates)
     n = system.n
     extra = how.pop("_extra", 0)
     state = X[:, :X.shape[1] - extra]

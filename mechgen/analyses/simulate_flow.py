@@ -46,11 +46,12 @@ def start_rates(system, x0: np.ndarray) -> np.ndarray | None:
         return None
 
 
-def chosen_method(system, x0: np.ndarray, t_end: float, max_steps: int | None = None) -> str:
+def chosen_method(system, x0: np.ndarray, t_end: float, max_steps: int | None = None, *,
+                  rates: np.ndarray | None = None) -> str:
     """What ``auto`` runs (module doc): Radau when stiff at the start, or when an explicit method's stability
     alone (t_end max|lambda| / 12) would take more than ``max_steps`` steps (it would be refused); DOP853
-    otherwise; BDF without an estimate."""
-    rates = start_rates(system, x0)
+    otherwise; BDF without an estimate. ``rates``: the start's eigenvalues when the caller has them."""
+    rates = start_rates(system, x0) if rates is None else rates
     if rates is None:
         return "BDF"
     decay = float(np.max(-rates.real, initial=0.0))
@@ -62,16 +63,17 @@ def chosen_method(system, x0: np.ndarray, t_end: float, max_steps: int | None = 
     return "DOP853"
 
 
-def adaptive_run(system, options: dict, x0: np.ndarray, method: str, budget: Budget,
-                 desc: str) -> tuple[np.ndarray, np.ndarray, dict]:
+def adaptive_run(system, options: dict, x0: np.ndarray, method: str, budget: Budget, desc: str, *,
+                 rates: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, dict]:
     """(t, x rows, {method, loop, _extra}) of a run of ``method`` (not ``auto``: :func:`chosen_method` resolves it)
-    from x0, sampled at ``samples`` equally spaced times; ``_extra`` integrals of the energy balance
+    from x0 (``rates``: the start's eigenvalues, when already solved for), sampled at ``samples`` equally spaced
+    times; ``_extra`` integrals of the energy balance
     (mechgen.analyses.energy_balance) follow the state in each row where the run integrates them."""
     from mechgen.analyses.simulate import refuse_explicit_stiff
     from mechgen.runtime.core.smooth_c import integrate_smooth_c, smooth_loop_problem
 
     t_end = float(options["t_end"])
-    refuse_explicit_stiff(system, x0, t_end, method, budget)
+    refuse_explicit_stiff(system, x0, t_end, method, budget, rates)
     extra = energy_balance.EXTRA if energy_balance.accounted(system, method) else 0
     x0 = np.concatenate([x0, np.zeros(extra)])
     n_out = int(options.get("samples", 201))

@@ -67,8 +67,7 @@ def run_hybrid(system, options: dict, context: dict) -> dict:
     require(dense_bytes(n_out, 3 * x0.size + 6), f"{n_out} output samples", key="samples")
     traj, zeno, method = hybrid_run(system, options, x0, context.get(NAME, "simulate"))
     t, X, modes = with_final(traj)
-    views: dict = {}
-    mode_system = lambda k: views.setdefault(k, system.mode(k))  # noqa: E731
+    mode_system = mode_views(system)
     series = time_series.sampled_outputs_by_mode(mode_system, t, X, modes)
     out = report(system, options, t, X, series)
     figures = energy_balance.hybrid_figures(mode_system, t, X, modes, traj.events, series)
@@ -119,3 +118,15 @@ def with_final(traj) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         return t, X, modes
     return (np.append(t, traj.t_final), np.vstack([X.reshape(len(t), -1), traj.x_final[None, :]]),
             np.append(modes, traj.final_mode))
+
+
+def mode_views(system):
+    """``mode_system(k)``: the system of mode k (System.mode), each made once."""
+    views: dict = {}
+
+    def mode_system(k: int):
+        if k not in views:
+            views[k] = system.mode(k)
+        return views[k]
+
+    return mode_system

@@ -309,12 +309,18 @@ class System:
             rows = [self.outputs(x[:self.n], x[self.n:2 * self.n], x[2 * self.n:] if self.m else None, tk)
                     for tk, x in zip(t, X)]
             return {k: np.array([r[k] for r in rows], float) for k in (rows[0] if rows else {})}
-        n = self.n
-        inputs = {"q": X[:, :n], "v": X[:, n:2 * n], "z": X[:, 2 * n:], "t": t[:, None], "p": self.params}
-        spec = self.kernels["outputs"].spec
-        wanted = {port["name"] for port in spec["inputs"]}
-        raw = self.kernels["outputs"].evaluate({k: v for k, v in inputs.items() if k in wanted})
+        raw = self.evaluate_series("outputs", t, X)
         return {k: np.asarray(v, float).reshape(len(t), -1)[:, 0] for k, v in raw.items()}
+
+    def evaluate_series(self, kernel: str, t: np.ndarray, X: np.ndarray) -> dict[str, np.ndarray]:
+        """The outputs of a lumped kernel of (q, v, z, t) at many states in one batched call: row k of X starts
+        with (q, v, z) at time t[k] (columns after them, integrals a run carries, are not read)."""
+        n, m = self.n, self.m
+        X = np.asarray(X, float)
+        inputs = {"q": X[:, :n], "v": X[:, n:2 * n], "z": X[:, 2 * n:2 * n + m],
+                  "t": np.asarray(t, float)[:, None], "p": self.params}
+        wanted = {port["name"] for port in self.kernels[kernel].spec["inputs"]}
+        return self.kernels[kernel].evaluate({k: v for k, v in inputs.items() if k in wanted})
 
     def force(self, q, t=0.0) -> np.ndarray:
         """Potential force -dV/dq."""
