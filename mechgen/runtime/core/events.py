@@ -476,8 +476,7 @@ def _integrate_segment(seg, state: tuple, start, sign, options: RunOptions, stat
             found = _scan(seg, dense, sign, (t_old, g_old, d_old), (t_new, g_new, d_new), t_start)
             if found is not None:
                 k, t_root, t_lo, t_hi = found
-                t_star, x_star = _locate(seg, dense, k, t_root, t_lo, t_hi, t_old, y_old, method, rtol, atol,
-                                         kwargs)
+                t_star, x_star = _locate(seg, dense, k, (t_root, t_lo, t_hi), (t_old, y_old), options)
                 stats["nfev"] += solver.nfev
                 stats["njev"] += getattr(solver, "njev", 0)
                 return k, t_star, x_star
@@ -554,13 +553,17 @@ def _root(seg, dense, k: int, ta: float, tb: float) -> float:
     return brentq(g, ta, tb, xtol=4 * EPS * max(abs(ta), abs(tb), 1e-300), rtol=4 * EPS, maxiter=200)
 
 
-def _locate(seg, dense, k, t_d, t_lo, t_hi, t_old, y_old, method, rtol, atol, kwargs):
-    """(t*, x*) of guard k's zero t_d (on the dense output, in [t_lo, t_hi]): the state integrated afresh from
-    the step's start (t_old, y_old) to it, and one Newton correction on g."""
+def _locate(seg, dense, k: int, bracket: tuple, start: tuple, options: RunOptions):
+    """(t*, x*) of guard k's zero on the dense output (``bracket`` = (t_d, t_lo, t_hi): the zero and the interval
+    holding it): the state integrated afresh from the step's start ``start`` = (t_old, y_old) to t_d by the run's
+    method and tolerances, and one Newton correction on g."""
+    t_d, t_lo, t_hi = bracket
+    t_old, y_old = start
     if t_d > t_old:
+        jac = {"jac": seg.jac} if options.method in IMPLICIT else {}
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-            fresh = _solver_class(method)(seg.rhs, t_old, y_old, t_d, rtol=rtol, atol=atol,
-                                          first_step=t_d - t_old, **kwargs)
+            fresh = _solver_class(options.method)(seg.rhs, t_old, y_old, t_d, rtol=options.rtol, atol=options.atol,
+                                                  first_step=t_d - t_old, **jac)
             while fresh.status == "running":
                 fresh.step()
         x_d = np.array(fresh.y) if fresh.status == "finished" else dense(t_d)
