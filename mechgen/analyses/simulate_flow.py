@@ -7,8 +7,9 @@
   ``DOP853`` (explicit, order 8). Fast *oscillations* (Re lambda ~ 0) do not make it stiff: any method must
   resolve them to be accurate, and the explicit one does so cheapest. Above :data:`ESTIMATE_SIZE` first-order
   states (no dense eigen-solve) ``auto`` is ``BDF``, the sparse-friendly implicit method.
-* ``DOP853`` on the C backend runs in the compiled loop (mechgen.runtime.core.smooth_c: no Python between the
-  steps; the same steps as scipy's DOP853) unless ``loop = "python"``; every other method (``BDF``,
+* ``DOP853`` on the C backend runs in the compiled loop (mechgen.runtime.core.smooth_c for a lumped model,
+  mechgen.runtime.fields.flow_c for a continuum with a constant mass: no Python between the steps; the same steps
+  as scipy's DOP853) unless ``loop = "python"``; every other method (``BDF``,
   ``Radau``, ``LSODA``, ``RK45``, and ``DOP853`` on the numpy or CasADi backends) is scipy's, stepped in
   Python (mechgen.runtime.core.integrate), and ``cvodes`` SUNDIALS' (mechgen.runtime.core.sundials).
 
@@ -70,7 +71,6 @@ def adaptive_run(system, options: dict, x0: np.ndarray, method: str, budget: Bud
     times; ``_extra`` integrals of the energy balance
     (mechgen.analyses.energy_balance) follow the state in each row where the run integrates them."""
     from mechgen.analyses.simulate import refuse_explicit_stiff
-    from mechgen.runtime.core.smooth_c import integrate_smooth_c, smooth_loop_problem
 
     t_end = float(options["t_end"])
     refuse_explicit_stiff(system, x0, t_end, method, budget, rates)
@@ -85,9 +85,9 @@ def adaptive_run(system, options: dict, x0: np.ndarray, method: str, budget: Bud
                      explain=lambda t, x: explain_state(system, t, np.asarray(x)[:size]),
                      loop=options.get("loop", "auto"))
     if method == "DOP853" and run.loop != "python":
-        why = smooth_loop_problem(system, run.rtol, run.atol, extra)
+        why = compiled_loop_problem(system, run, extra)
         if why is None:
-            t, X, _ = integrate_smooth_c(system, x0, t_end, run, extra=extra)
+            t, X = compiled_run(system, x0, t_end, run, extra)
             return t, X, {"method": method, "loop": "c", "_extra": extra}
         if run.loop == "c":
             raise InputError(f"loop 'c' cannot run here: {why}", key="loop",
@@ -100,6 +100,31 @@ def adaptive_run(system, options: dict, x0: np.ndarray, method: str, budget: Bud
         traj = integrate_first_order(flow.rhs, x0, t_end, jac=flow.jacobian, options=run)
     xs = traj.x if traj.x.shape[0] == len(traj.t) else traj.x.T
     return np.asarray(traj.t, float), np.asarray(xs, float), {"method": method, "loop": "python", "_extra": extra}
+
+
+def compiled_loop_problem(system, run: RunOptions, extra: int) -> str | None:
+    """Why the compiled DOP853 loop cannot run ``system`` (None when it can): mechgen.runtime.core.smooth_c for a
+    lumped model, mechgen.runtime.fields.flow_c for a continuum."""
+    if system.is_field:
+        from mechgen.runtime.fields.flow_c import field_loop_problem
+
+        return field_loop_problem(system, run.rtol, run.atol)
+    from mechgen.runtime.core.smooth_c import smooth_loop_problem
+
+    return smooth_loop_problem(system, run.rtol, run.atol, extra)
+
+
+def compiled_run(system, x0: np.ndarray, t_end: float, run: RunOptions, extra: int) -> tuple[np.ndarray, np.ndarray]:
+    """(t, x rows at the samples) of the compiled DOP853 loop (where :func:`compiled_loop_problem` says it can)."""
+    if system.is_field:
+        from mechgen.runtime.fields.flow_c import integrate_field_c
+
+        t, X, _ = integrate_field_c(system, x0, t_end, run)
+        return t, X
+    from mechgen.runtime.core.smooth_c import integrate_smooth_c
+
+    t, X, _ = integrate_smooth_c(system, x0, t_end, run, extra=extra)
+    return t, X
 
 
 def cvodes_run(system, x0, t_end: float, run: RunOptions):

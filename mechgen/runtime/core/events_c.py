@@ -86,7 +86,8 @@ class CProblem(ctypes.Structure):
                 ("n_eval", c_long), ("t_eval", c_void_p), ("sample_cap", c_long), ("event_cap", c_long),
                 ("s_t", c_void_p), ("s_x", c_void_p), ("s_mode", c_void_p),
                 ("e_t", c_void_p), ("e_before", c_void_p), ("e_after", c_void_p),
-                ("e_source", c_void_p), ("e_target", c_void_p), ("e_guard", c_void_p)]
+                ("e_source", c_void_p), ("e_target", c_void_p), ("e_guard", c_void_p),
+                ("flow", c_void_p), ("flow_data", c_void_p)]
 
 
 class CState(ctypes.Structure):
@@ -205,7 +206,8 @@ def _supported(system) -> str | None:
         if any(p not in names for p in picks):
             return f"kernel {name} lacks the outputs {', '.join(dict.fromkeys(picks))}"
     for i in range(len(system.modes)):
-        for kind in (("residual", "tangent") if system.n else ()) + (("rates",) if system.m else ()):
+        lumped = system.n and getattr(system, "flow", None) is None  # a flow provider gives dq/dt, dv/dt
+        for kind in (("residual", "tangent") if lumped else ()) + (("rates",) if system.m else ()):
             if f"{kind}__{i}" not in system.kernels:
                 return f"mode {system.modes[i]} has no {kind} kernel"
         if system.guards(i) and f"guards__{i}" not in system.kernels:
@@ -333,6 +335,9 @@ def integrate_hybrid_c(system, x0, t_end: float, *, mode: int | None = None, opt
                        t_end=t_end, max_events=int(rules.max_events), zeno_events=int(rules.zeno_events),
                        zeno_span=float(zeno_span), stop_mode=-1, pause=int(stop_after is not None),
                        budget_left=-1, slice=SLICE)
+    flow = getattr(system, "flow", None)  # (fn, data) addresses of a provider of dq/dt, dv/dt (a continuum)
+    if flow is not None:
+        problem.flow, problem.flow_data = flow
     if t_eval is not None:  # (params and t_eval stay referenced here while the loop reads them)
         problem.n_eval, problem.t_eval = (len(t_eval), t_eval.ctypes.data) if len(t_eval) else (-1, None)
     state = CState(phase=-1, mode=start, t=0.0)

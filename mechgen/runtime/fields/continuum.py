@@ -370,6 +370,10 @@ class FieldSystem:
             params[names.index(full)] = float(value)
         return params
 
+    def segment_params(self) -> list[np.ndarray] | None:
+        """One parameter vector per segment, in mesh order (None: every element uses ``params``)."""
+        return self._segment_params()
+
     def _segment_params(self) -> list[np.ndarray] | None:
         """One parameter vector per segment (None: every element uses ``params``)."""
         if self.layout is None or not any(seg.values for seg in self.layout.segments):
@@ -462,8 +466,9 @@ class FieldSystem:
         return self._memo.get(("point", *self._key(float(x))),
                               lambda: sps.csr_matrix(np.array([disc.row(f, k, x) for f, k in disc.jets])))
 
-    def _ends(self, kernel: str, states, t: float):
-        """(B_x, local outputs) of every end term and placed part: states are full dof vectors (q, q', q'') or None."""
+    def placed_points(self) -> list[tuple[str, float, np.ndarray | None]]:
+        """(name, position s, parameter vector or None for ``params``) of every end term and placed part: its
+        pointwise kernels are ``<kernel>_at_<name>``, evaluated at s with those parameters."""
         placed = [(at, 0.0 if at == "start" else self.disc.length, None) for at in self.info.get("points", [])]
         kinds = self.info.get("parts", {})
         for part in (self.layout.parts if self.layout is not None else ()):
@@ -471,7 +476,25 @@ class FieldSystem:
                 raise InputError(f"part kind {part.kind!r} is not declared by model {self.meta.get('model')}",
                                  key="parts.kind", expected=f"one of: {', '.join(kinds) or 'none'}")
             placed.append((part.kind, part.at, self._with(part.values, f"{part.kind}_", f"part {part.kind}")))
-        for name, x, params in placed:
+        return placed
+
+    def point_table(self, x: float):
+        """B_x (jets x full dofs, CSR): the jets at s = x from the full dof vector (memoised per position)."""
+        return self._point_table(x)
+
+    def memo(self, key: tuple, make: Callable):
+        """A value memoised in this system's memo (shared by its with_param_vector copies): ``key`` must name
+        everything the value depends on (:meth:`loop_key` for what depends on the discretisation, the
+        reduction and the parameters)."""
+        return self._memo.get(key, make)
+
+    def loop_key(self) -> tuple:
+        """What the discretised operators depend on: the discretisation, the reduction and the parameter vector."""
+        return (*self._reduction_key(), self._pkey)
+
+    def _ends(self, kernel: str, states, t: float):
+        """(B_x, local outputs) of every end term and placed part: states are full dof vectors (q, q', q'') or None."""
+        for name, x, params in self.placed_points():
             B = self._point_table(x)
             at_point = [None if y is None else (B @ y)[None] for y in states]
             yield B, self._evaluate(f"{kernel}_at_{name}", *at_point, t, np.array([x]), params=params)

@@ -98,6 +98,10 @@ typedef struct {
     long *s_mode;
     double *e_t, *e_before, *e_after;   /* events: time, states (event_cap x nx) */
     long *e_source, *e_target, *e_guard;
+    /* a provider of (dq/dt, dv/dt) = f[0 .. 2n) at (t, x) in place of the residual and tangent kernels (a
+       continuum: mechgen/codegen/templates/c99/field_flow.c), returning 0 or a kernel's nonzero code; NULL: none */
+    int (*flow)(void *data, double t, const double *x, double *f);
+    void *flow_data;
 } mgh_problem;
 
 typedef struct {
@@ -297,6 +301,21 @@ static void fail_at(mgh_ctx *c, double t, const double *x)
         memcpy(c->S->err_x, x, (size_t)c->nx * sizeof(double));
 }
 
+/* f[0 .. 2n) from the problem's flow provider; its nonzero code is a kernel error of the residual */
+static int flow_rhs(mgh_ctx *c, long mode, double t, const double *x, double *f)
+{
+    int rc = c->P->flow(c->P->flow_data, t, x, f);
+    if (rc != 0) {
+        c->S->err_kind = MGH_K_RESIDUAL;
+        c->S->err_guard = mode;
+        c->S->err_mode = mode;
+        c->S->err_rc = rc;
+        c->S->err_t = t;
+        return MGH_E_KERNEL;
+    }
+    return 0;
+}
+
 /* f = dx/dt of mode `mode` at (t, x): (v, -M^-1 r(q, v, 0, z, t), rates); only the rates when n = 0 */
 static int rhs(mgh_ctx *c, long mode, double t, const double *x, double *f)
 {
@@ -305,6 +324,11 @@ static int rhs(mgh_ctx *c, long mode, double t, const double *x, double *f)
     int rc;
     if (n == 0)
         goto rates;
+    if (c->P->flow != NULL) {
+        if ((rc = flow_rhs(c, mode, t, x, f)) != 0)
+            return rc;
+        goto rates;
+    }
     if ((rc = kcall(c, &md->residual, MGH_K_RESIDUAL, mode, x, NULL, t)) != 0)
         return rc;
     for (i = 0; i < n; ++i)
@@ -1163,6 +1187,7 @@ static int setup(mgh_ctx *c, const mgh_problem *P, mgh_state *S)
 {
     long n = P->n, m = P->m, nx = 2 * P->n + P->m, ng = P->max_guards > 0 ? P->max_guards : 1;
     long i, j, total, len[MGH_PORTS];
+    long lumped = P->flow == NULL ? n : 0;   /* unknowns whose dx/dt the residual and tangent kernels give */
     double *p;
     memset(c, 0, sizeof(*c));
     c->P = P;
@@ -1172,13 +1197,13 @@ static int setup(mgh_ctx *c, const mgh_problem *P, mgh_state *S)
         return MGH_E_INPUT;
     for (i = 0; i < P->nmodes; ++i) {
         const mgh_mode *md = &P->modes[i];
-        if (check_kernel(&md->residual, n > 0) || check_kernel(&md->tangent, n > 0) || check_kernel(&md->rates, m > 0)
+        if (check_kernel(&md->residual, lumped > 0) || check_kernel(&md->tangent, lumped > 0) || check_kernel(&md->rates, m > 0)
             || check_kernel(&md->guards, md->nguards > 0) || md->nguards > P->max_guards || md->nguards < 0)
             return MGH_E_INPUT;
         for (j = 0; j < md->nguards; ++j)
             if (md->target[j] >= P->nmodes || md->reset[j] >= P->nresets || (!md->terminal[j] && md->target[j] < 0))
                 return MGH_E_INPUT;
-        if (n > 0 && (md->tangent.out_len[md->tangent.pick[0]] != n * n
+        if (lumped > 0 && (md->tangent.out_len[md->tangent.pick[0]] != n * n
                       || md->residual.out_len[md->residual.pick[0]] != n))
             return MGH_E_INPUT;
     }
@@ -1190,7 +1215,7 @@ static int setup(mgh_ctx *c, const mgh_problem *P, mgh_state *S)
     c->nx = nx;
     c->ng = ng;
     c->ring = P->zeno_events + 1 > 2 ? P->zeno_events + 1 : 2;  /* more than zeno_events within zeno_span */
-    total = nx + n * n + n + 16 * nx + 7 * nx + 15 * nx + 12 * ng + MGH_STACK * 4 * ng;
+    total = nx + lumped * lumped + n + 16 * nx + 7 * nx + 15 * nx + 12 * ng + MGH_STACK * 4 * ng;
     for (j = 0; j < MGH_PORTS; ++j) {
         len[j] = 1;
         for (i = 0; i < P->nmodes; ++i) {
@@ -1218,7 +1243,7 @@ static int setup(mgh_ctx *c, const mgh_problem *P, mgh_state *S)
     p = c->mem;
 #define MGH_TAKE(name, count) do { c->name = p; p += (count); } while (0)
     MGH_TAKE(zeros, nx);
-    MGH_TAKE(M, n * n);
+    MGH_TAKE(M, lumped * lumped);
     MGH_TAKE(b, n);
     MGH_TAKE(K, 16 * nx);
     MGH_TAKE(F, 7 * nx);

@@ -1,0 +1,357 @@
+"""The compiled DOP853 loop for a continuum: FieldSystem.rhs as sparse operators and one pointwise kernel call.
+
+FieldSystem.rhs assembles, at every call, r(q, v, 0) = Z^T (sum_e B_e^T W_e rho(B_e Z q, B_e Z v, 0) + end and
+part terms + C^T diag(alpha) C Z q) and solves M a = -r. Everything in it but the pointwise residual rho is
+linear in the reduced state, so it is precomputed here once per parameter set (:func:`field_operators`,
+memoised in the system) as
+
+    J_b = (jet tables of block b) Z   (CSR: rows point-major then jet, columns the reduced unknowns),
+    w_b  the quadrature weight of each row (1 at an end term or placed part),
+    P    = Z^T C^T diag(alpha) C Z    (CSR; the penalty stiffness, absent without penalty rows),
+    L    the Cholesky factor of the constant reduced mass M (reverse Cuthill-McKee ordered, banded),
+
+with one block per segment (its own parameters) and one per end term and placed part. In C
+(``codegen/templates/c99/field_flow.c``, built once as ``libmgfield``) the rhs is then, for x = (q, v),
+
+    dq/dt = v,   dv/dt = -M^-1 (sum_b J_b^T (w_b .* rho_b(J_b q, J_b v, 0, t, s_b, p_b)) + P q),
+
+rho_b the model's C kernel called by address once per block over its points. That function is the event loop's
+flow provider (``mgh_problem.flow`` in ``hybrid_loop.c``): the one DOP853 of mechgen.runtime.core.events_c steps
+it exactly as scipy's DOP853 steps FieldSystem.rhs (the same steps; the states agree to rounding, the sums taken
+in another order). A mass matrix that depends on the state, Lagrange multipliers (a DAE), kernels without C
+addresses and a mass that is not positive definite are refused (:func:`field_loop_problem` says why; simulate
+then runs scipy's DOP853 in Python).
+"""
+from __future__ import annotations
+
+import ctypes
+import logging
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sps
+from scipy.sparse.csgraph import reverse_cuthill_mckee
+
+from mechgen.errors import BuildError, CompilerUnavailable
+from mechgen.runtime.core.events_c import LONG, integrate_hybrid_c
+from mechgen.runtime.core.memory import dense_bytes, require
+from mechgen.runtime.core.pattern import extent
+
+log = logging.getLogger("mechgen")
+
+SOURCE = Path(__file__).resolve().parent.parent.parent / "codegen" / "templates" / "c99" / "field_flow.c"
+STEM = "mgfield"
+PORTS = 8
+INPUTS = {"q": 0, "v": 1, "a": 2, "z": 3, "t": 4, "s": 5, "p": 6}
+c_long, c_double, c_void_p = ctypes.c_long, ctypes.c_double, ctypes.c_void_p
+
+
+class CBlock(ctypes.Structure):
+    """mgf_block: a pointwise kernel over a batch of points, its jet operator J_b and row weights."""
+
+    _fields_ = [("fn", c_void_p), ("nin", c_long), ("nout", c_long), ("pick", c_long), ("ports", c_long * PORTS),
+                ("out_len", c_long * PORTS), ("npts", c_long), ("na", c_long), ("s", c_void_p), ("p", c_void_p),
+                ("indptr", c_void_p), ("indices", c_void_p), ("data", c_void_p), ("w", c_void_p)]
+
+
+class CFlow(ctypes.Structure):
+    """mgf_flow: the blocks, the penalty stiffness, the mass factor and the workspace."""
+
+    _fields_ = [("n", c_long), ("nblocks", c_long), ("blocks", c_void_p), ("p_indptr", c_void_p),
+                ("p_indices", c_void_p), ("p_data", c_void_p), ("band", c_long), ("chol", c_void_p),
+                ("perm", c_void_p), ("jq", c_void_p), ("jv", c_void_p), ("ja", c_void_p), ("tt", c_void_p),
+                ("out", c_void_p * PORTS), ("r", c_void_p), ("y", c_void_p), ("err_block", c_long),
+                ("err_rc", c_long)]
+
+
+@lru_cache(maxsize=1)
+def _library():
+    """(the loaded flow library, None) or (None, why it is unavailable); built once per process."""
+    from mechgen.codegen.build import load_shared
+
+    try:
+        lib = load_shared(SOURCE.read_text(encoding="utf-8"), stem=STEM, symbols=("mgf_rhs", "mgf_layout"))
+    except (CompilerUnavailable, BuildError, OSError) as exc:
+        log.info("C field flow unavailable (%s)", exc)
+        return None, f"the C field flow cannot be built ({exc})"
+    lib.mgf_layout.argtypes, lib.mgf_layout.restype = [c_long], c_long
+    for i, struct in enumerate((CBlock, CFlow)):
+        if lib.mgf_layout(i) != ctypes.sizeof(struct):
+            return None, f"the C field flow's {struct.__name__} layout differs from its Python mirror"
+    return lib, None
+
+
+@dataclass(frozen=True)
+class Block:
+    """A pointwise kernel over ``s.size`` points: jets J q (CSR), row weights ``w``, positions, parameters."""
+
+    kernel: object
+    J: sps.csr_matrix
+    w: np.ndarray
+    s: np.ndarray
+    params: np.ndarray
+
+
+@dataclass(frozen=True)
+class Operators:
+    """What FieldSystem.rhs is made of (module doc): the blocks, the penalty P (or None), the mass factor."""
+
+    n: int
+    blocks: tuple
+    penalty: sps.csr_matrix | None
+    chol: np.ndarray       # (band + 1, n): lower band storage of L, M[perm][:, perm] = L L^T
+    perm: np.ndarray
+
+
+def _csr(A) -> sps.csr_matrix:
+    """A as CSR with sorted indices, explicit zeros dropped."""
+    out = sps.csr_matrix(A)
+    out.eliminate_zeros()
+    out.sort_indices()
+    return out
+
+
+def jet_operator(system) -> sps.csr_matrix:
+    """J_full Z: the jets j[e, q, a] at every Gauss point (row (e nq + q) na + a) from the reduced unknowns,
+    j = sum_l B[e, q, a, l] x[dofs[e, l]], x = Z q."""
+    disc = system.disc
+    ne, nq, na, nl = disc.tables.shape
+    rows = np.broadcast_to(np.arange(ne * nq * na).reshape(ne, nq, na, 1), (ne, nq, na, nl))
+    cols = np.broadcast_to(disc.dofs[:, None, None, :], (ne, nq, na, nl))
+    full = sps.csr_matrix((np.ascontiguousarray(disc.tables).ravel(), (rows.ravel(), cols.ravel())),
+                          shape=(ne * nq * na, disc.ndof))
+    return _csr(_reduce_columns(system, full))
+
+
+def _reduce_columns(system, B) -> sps.csr_matrix:
+    """B Z: a table on the full dofs composed with the reduction x = Z q (a column selection where it is one)."""
+    red = system.reduction
+    if red.Z is None:
+        return sps.csr_matrix(B)
+    if red.keep is not None:
+        return sps.csr_matrix(B)[:, red.keep]
+    return sps.csr_matrix(B @ red.Z)
+
+
+def gauss_blocks(system) -> list[Block]:
+    """One block per segment (each its parameter vector; one block without segment values)."""
+    disc = system.disc
+    ne, nq, na, _ = disc.tables.shape
+    J = jet_operator(system)
+    w = np.repeat(np.asarray(disc.weights, float).ravel(), na)
+    s = np.asarray(disc.points, float).ravel()
+    segment = disc.mesh.segment if disc.mesh is not None else np.zeros(ne, int)
+    per_segment = system.segment_params()
+    kernel = system.kernels["residual"]
+    if per_segment is None:
+        return [Block(kernel, J, w, s, np.asarray(system.params, float))]
+    blocks = []
+    for k, params in enumerate(per_segment):
+        elements = np.flatnonzero(segment == k)
+        points = slice(elements[0] * nq, (elements[-1] + 1) * nq)
+        rows = slice(points.start * na, points.stop * na)
+        blocks.append(Block(kernel, _csr(J[rows]), w[rows], s[points], np.asarray(params, float)))
+    return blocks
+
+
+def point_blocks(system) -> list[Block]:
+    """One block per end term and placed part: its kernel ``residual_at_<name>`` at one point, weight 1."""
+    blocks = []
+    for name, x, params in system.placed_points():
+        J = _csr(_reduce_columns(system, system.point_table(x)))
+        params = np.asarray(system.params if params is None else params, float)
+        blocks.append(Block(system.kernels[f"residual_at_{name}"], J, np.ones(J.shape[0]), np.array([float(x)]),
+                            params))
+    return blocks
+
+
+def penalty_operator(system) -> sps.csr_matrix | None:
+    """P = Z^T C^T diag(alpha) C Z, the penalty's stiffness on the reduced unknowns (None without penalty rows)."""
+    choice = system.penalty_choice
+    if choice is None:
+        return None
+    red = system.reduction
+    zero = sps.csr_matrix((red.ndof, red.ndof))
+    return _csr(red.matrix(zero, choice.alphas))
+
+
+def mass_factor(M) -> tuple[np.ndarray, np.ndarray]:
+    """(L in lower band storage, perm): M[perm][:, perm] = L L^T, perm the reverse Cuthill-McKee ordering of M's
+    pattern (a narrow band for element meshes). LinAlgError when M is not symmetric positive definite."""
+    A = sps.csr_matrix(M)
+    n = A.shape[0]
+    if abs(A - A.T).max() > 1e-13 * max(abs(A).max(), 1e-300):
+        raise np.linalg.LinAlgError("the mass matrix is not symmetric")
+    perm = np.asarray(reverse_cuthill_mckee(A, symmetric_mode=True), int) if n > 1 else np.arange(n)
+    P = A[perm][:, perm].tocoo()
+    band = int(np.max(np.abs(P.row - P.col), initial=0))
+    require(dense_bytes(band + 1, n), f"the banded factor of the {n} x {n} mass matrix (bandwidth {band})",
+            key="params.N")
+    ab = np.zeros((band + 1, n))
+    lower = P.row >= P.col
+    ab[(P.row - P.col)[lower], P.col[lower]] = P.data[lower]
+    return np.ascontiguousarray(sla.cholesky_banded(ab, lower=True)), perm
+
+
+def field_operators(system) -> Operators:
+    """The operators of FieldSystem.rhs (module doc), memoised in the system per parameter set."""
+    def make() -> Operators:
+        M = system.tangent(np.zeros(system.n))["r_a"]
+        chol, perm = mass_factor(M)
+        blocks = tuple(gauss_blocks(system) + point_blocks(system))
+        return Operators(system.n, blocks, penalty_operator(system), chol, perm)
+
+    return system.memo(("c_loop", "operators", *system.loop_key()), make)
+
+
+def kernel_problem(kernel, na: int) -> str | None:
+    """Why ``kernel`` cannot be called by field_flow.c as a pointwise residual (None when it can)."""
+    spec = kernel.spec
+    if kernel.address is None:
+        return f"kernel {kernel.name} has no C function address"
+    if len(spec["inputs"]) > PORTS or len(spec["outputs"]) > PORTS or spec.get("sizes"):
+        return f"kernel {kernel.name} has more than {PORTS} ports or size inputs"
+    for port in spec["inputs"]:
+        if port["name"] not in INPUTS or port.get("integer") or (port["batched"] == (port["name"] == "p")):
+            return f"kernel {kernel.name} has inputs other than batched q, v, a, z, t, s and a parameter vector p"
+    names = [p["name"] for p in spec["outputs"]]
+    if "r" not in names or extent(spec["outputs"][names.index("r")]["extent"], {}) != na:
+        return f"kernel {kernel.name} has no output r of {na} entries a point"
+    return None
+
+
+class FieldFlow:
+    """The C structures of :class:`Operators` and a workspace: ``address`` is the mgf_flow the loop's flow
+    provider reads; the arrays it points to are kept here for as long as this object lives."""
+
+    def __init__(self, ops: Operators) -> None:
+        self.keep: list = []
+        self.blocks = (CBlock * max(1, len(ops.blocks)))()
+        rows = max(1, max(b.J.shape[0] for b in ops.blocks))
+        points = max(1, max(b.s.size for b in ops.blocks))
+        out_len = [1] * PORTS
+        for i, block in enumerate(ops.blocks):
+            self.blocks[i] = self._block(block, out_len)
+        self.flow = CFlow(n=ops.n, nblocks=len(ops.blocks), blocks=ctypes.addressof(self.blocks),
+                          band=ops.chol.shape[0] - 1, chol=self._address(ops.chol),
+                          perm=self._address(ops.perm.astype(LONG)))
+        if ops.penalty is not None:
+            P = ops.penalty
+            self.flow.p_indptr, self.flow.p_indices = (self._address(P.indptr.astype(LONG)),
+                                                      self._address(P.indices.astype(LONG)))
+            self.flow.p_data = self._address(P.data)
+        for name, size in (("jq", rows), ("jv", rows), ("ja", rows), ("tt", points), ("r", ops.n), ("y", ops.n)):
+            setattr(self.flow, name, self._address(np.zeros(max(1, size))))
+        for j in range(PORTS):
+            self.flow.out[j] = self._address(np.zeros(points * out_len[j]))
+        self.address = ctypes.addressof(self.flow)
+
+    def _address(self, array: np.ndarray) -> int:
+        array = np.ascontiguousarray(array)
+        self.keep.append(array)
+        return array.ctypes.data
+
+    def _block(self, block: Block, out_len: list) -> CBlock:
+        spec = block.kernel.spec
+        out = CBlock(fn=block.kernel.address, nin=len(spec["inputs"]), nout=len(spec["outputs"]),
+                     npts=block.s.size, na=block.J.shape[0] // max(1, block.s.size))
+        names = [p["name"] for p in spec["outputs"]]
+        out.pick = names.index("r")
+        for i, port in enumerate(spec["inputs"]):
+            out.ports[i] = INPUTS[port["name"]]
+        for j, port in enumerate(spec["outputs"]):
+            out.out_len[j] = extent(port["extent"], {})
+            out_len[j] = max(out_len[j], out.out_len[j])
+        out.s, out.p = self._address(block.s.astype(float)), self._address(block.params)
+        out.indptr, out.indices = self._address(block.J.indptr.astype(LONG)), self._address(block.J.indices.astype(LONG))
+        out.data, out.w = self._address(block.J.data), self._address(block.w)
+        return out
+
+
+class FieldView:
+    """A continuum as the compiled event loop sees a system: one mode, no guards, no kernels of its own; its
+    dx/dt comes from the flow provider ``flow`` = (mgf_rhs, the mgf_flow of a :class:`FieldFlow`)."""
+
+    modes = ("smooth",)
+    initial_mode = 0
+    smooth = True
+    is_lattice = False
+    is_field = False
+    m = 0
+    backend = "c"
+
+    def __init__(self, system, flow: FieldFlow, fn: int) -> None:
+        self.system = system
+        self.kernels: dict = {}
+        self.patterns: dict = {}
+        self.field_flow = flow  # (its arrays stay referenced while the loop runs)
+        self.flow = (fn, flow.address)
+        self.n = system.n
+        self.params = np.zeros(0)
+
+    @property
+    def metadata(self):
+        return self.system.metadata
+
+    def guards(self, mode: int) -> tuple:
+        return ()
+
+    def mode(self, mode: int):
+        return self.system
+
+
+def field_loop_problem(system, rtol=1e-8, atol=1e-10) -> str | None:
+    """Why the compiled loop cannot integrate the continuum ``system`` (None when it can): the C backend, a
+    constant mass matrix that is symmetric positive definite, no Lagrange multipliers, C kernels of the
+    pointwise residual (and of each end term and part), scalar tolerances and a C compiler for both loops."""
+    from mechgen.runtime.core.events_c import c_loop_problem
+
+    if getattr(system, "backend", None) != "c":
+        return f"the system's kernels are {getattr(system, 'backend', 'unknown')} ones, not compiled C"
+    if system.has_multipliers:
+        return "the unknowns include Lagrange multipliers (a DAE)"
+    if not system.info.get("constant_mass"):
+        return "the mass matrix depends on the state"
+    na = len(system.info["jets"])
+    names = ["residual"] + [f"residual_at_{name}" for name, _, _ in system.placed_points()]
+    for name in names:
+        if name not in system.kernels:
+            return f"the system has no {name} kernel"
+        why = kernel_problem(system.kernels[name], na)
+        if why is not None:
+            return why
+    why = _library()[1]
+    if why is not None:
+        return why
+    try:
+        field_operators(system)
+    except np.linalg.LinAlgError as exc:
+        return f"the mass matrix cannot be factorised by Cholesky ({exc})"
+    return c_loop_problem(FieldView(system, _EMPTY, 0), "DOP853", rtol, atol)
+
+
+class _Empty:
+    """A stand-in flow for the loop's checks, which read no arrays."""
+
+    address = 0
+
+
+_EMPTY = _Empty()
+
+
+def integrate_field_c(system, x0, t_end: float, options) -> tuple[np.ndarray, np.ndarray, dict]:
+    """(t, x rows at the options' ``t_eval``, counts {steps, nfev}) of a continuum integrated by the compiled
+    DOP853 loop (module doc; ``options``: mechgen.runtime.core.run_options.RunOptions, ``method`` and ``loop``
+    not read); failures raise the event loop's exceptions. CompilerUnavailable where
+    :func:`field_loop_problem` gives a reason."""
+    why = field_loop_problem(system, options.rtol, options.atol)
+    if why is not None:
+        raise CompilerUnavailable(why)
+    lib, _ = _library()
+    fn = ctypes.cast(lib.mgf_rhs, c_void_p).value
+    view = FieldView(system, FieldFlow(field_operators(system)), fn)
+    traj = integrate_hybrid_c(view, x0, t_end, mode=0, options=options)
+    return traj.t, traj.x, {"steps": traj.steps, "nfev": traj.nfev}
