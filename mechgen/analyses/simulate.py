@@ -135,7 +135,8 @@ SCHEMA = {"t_end": Option(schema.positive, REQUIRED, STEP), "method": Option(_me
 
 def check(ctx, base: str, options: dict) -> None:
     """leapfrog and variational need dt (mechgen.analyses.simulate_variational.check_fixed_step); dt <= t_end;
-    initial_mode within the coordinates; rtol at least MIN_RTOL."""
+    initial_mode within the coordinates (a continuum's unknowns, set by N, are counted when it runs:
+    initial_state); rtol at least MIN_RTOL."""
     check_fixed_step(ctx, base, options)
     if options["method"] not in FIXED_STEP and options["rtol"] < MIN_RTOL:
         raise fail(ctx.file, f"{base}.rtol", f"rtol {options['rtol']!r} is below what the integrators can honour "
@@ -148,7 +149,7 @@ def check(ctx, base: str, options: dict) -> None:
     if "dt" in options and options["dt"] > options["t_end"]:
         raise fail(ctx.file, f"{base}.dt", f"dt {options['dt']!r} exceeds t_end {options['t_end']!r}",
                    "a time step no larger than t_end")
-    if options.get("initial_mode", 0) > len(ctx.coordinates):
+    if ctx.coordinates and options.get("initial_mode", 0) > len(ctx.coordinates):  # (a continuum's: at run time)
         raise fail(ctx.file, f"{base}.initial_mode", f"initial_mode {options['initial_mode']} exceeds the "
                    f"{len(ctx.coordinates)} coordinates", f"an integer from 1 to {len(ctx.coordinates)}")
 

@@ -355,3 +355,24 @@ def integrate_field_c(system, x0, t_end: float, options) -> tuple[np.ndarray, np
     view = FieldView(system, FieldFlow(field_operators(system)), fn)
     traj = integrate_hybrid_c(view, x0, t_end, mode=0, options=options)
     return traj.t, traj.x, {"steps": traj.steps, "nfev": traj.nfev}
+
+
+def compiled_rhs(system):
+    """dx/dt = ``f(t, x)`` of ``system`` computed by field_flow.c (what the loop steps; FieldSystem.rhs to
+    rounding), one ctypes call each: for checks and tests. CompilerUnavailable where the loop cannot run."""
+    why = field_loop_problem(system)
+    if why is not None:
+        raise CompilerUnavailable(why)
+    lib, _ = _library()
+    lib.mgf_rhs.argtypes, lib.mgf_rhs.restype = [c_void_p, c_double, c_void_p, c_void_p], ctypes.c_int
+    flow = FieldFlow(field_operators(system))
+
+    def f(t: float, x) -> np.ndarray:
+        x = np.ascontiguousarray(x, dtype=float)
+        out = np.zeros(2 * system.n)
+        rc = lib.mgf_rhs(flow.address, float(t), x.ctypes.data, out.ctypes.data)
+        if rc:
+            raise RuntimeError(f"kernel of block {flow.flow.err_block} returned error code {rc}")
+        return out
+
+    return f

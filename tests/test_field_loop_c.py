@@ -1,0 +1,174 @@
+"""Continua in the compiled DOP853 loop (issue 25, item 3; mechgen.runtime.fields.flow_c, field_flow.c).
+
+References: FieldSystem.rhs itself (numpy assembly of the pointwise residual, end and part terms, reduction,
+penalty, mass solve), to rounding; scipy's DOP853 stepping FieldSystem.rhs in Python (the compiled loop takes
+its steps: the same number of steps, states equal to rounding); the closed-form free vibration of a string
+fixed at one end and free at the other, w = sin(pi s / 2L) cos(omega_1 t), omega_1 = (pi / 2L) sqrt(T / rho).
+The continuum is declared here (a user model), with segments, placed parts, end terms, damping and a
+time-dependent load, so that every block of the operators is exercised.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import mechgen
+from mechgen.errors import InputError
+from mechgen.runtime.core.integrate import integrate_first_order
+from mechgen.runtime.core.run_options import RunOptions
+from mechgen.runtime.fields.flow_c import compiled_rhs, field_loop_problem, integrate_field_c
+
+STRING = '''\
+"""A taut string on a viscous foundation, fixed at s = 0, with a spring and a mass at s = L, beads placed along
+it (parts) and a distributed harmonic load:
+
+    rho w_tt + c w_t - T w_ss = f0 sin(Omega t) s / L   on (0, L),   w(0) = 0,
+    T w_s(L) + k_e w(L) + m_e w_tt(L) = 0,   a bead of mass m at s_b.
+"""
+import sympy as sp
+
+from mechgen import Model, Param, fix
+
+model = Model("user_loaded_string", doc=__doc__)
+model.params(Param("T", 1.0, "N", positive=True), Param("rho", 1.0, "kg/m", positive=True),
+             Param("L", 1.0, "m", positive=True), Param("c", 0.0, "N s/m^2"), Param("f0", 0.0, "N/m"),
+             Param("Omega", 1.0, "rad/s"), Param("k_e", 0.0, "N/m"), Param("m_e", 0.0, "kg"))
+model.field("w", length="L", discretisation="hermite", N=8)
+model.part("bead", Param("m", 0.0, "kg", "mass"))
+
+
+@model.kinetic_density
+def kinetic(u, p):
+    return p.rho / 2 * u.w_t**2
+
+
+@model.potential_density
+def potential(u, p, s, t):
+    return p.T / 2 * u.w_s**2 - p.f0 * sp.sin(p.Omega * t) * s / p.L * u.w
+
+
+@model.dissipation_density
+def dissipation(u, p):
+    return p.c / 2 * u.w_t**2
+
+
+@model.point_kinetic("end")
+def end_mass(u, p):
+    return p.m_e / 2 * u.w_t**2
+
+
+@model.point_potential("end")
+def end_spring(u, p):
+    return p.k_e / 2 * u.w**2
+
+
+@model.point_kinetic("bead")
+def bead(u, p, part):
+    return part.m / 2 * u.w_t**2
+
+
+@model.boundary
+def boundary():
+    return [fix("w", "start")]
+'''
+
+LOADED = {"N": 6, "c": 0.3, "f0": 2.0, "Omega": 3.0, "k_e": 2.0, "m_e": 0.5}
+SEGMENTS = [{"length": 0.4, "elements": 2, "rho": 2.0}, {"length": 0.6, "elements": 4}]
+PARTS = [{"kind": "bead", "at": 0.2, "m": 0.2}, {"kind": "bead", "at": 0.7, "m": 0.1}]
+
+
+@pytest.fixture(scope="module")
+def model_file(tmp_path_factory):
+    path = tmp_path_factory.mktemp("field_loop_models") / "loaded_string.py"
+    path.write_text(STRING)
+    return str(path)
+
+
+@pytest.fixture(scope="module")
+def plain(model_file):
+    system = mechgen.compile(model_file)
+    if field_loop_problem(system) is not None:
+        pytest.skip(f"no compiled loop here: {field_loop_problem(system)}")
+    return system
+
+
+@pytest.fixture(scope="module")
+def loaded(model_file, plain):
+    return mechgen.compile(model_file, LOADED, segments=SEGMENTS, parts=PARTS)
+
+
+@pytest.mark.parametrize("choices", [{}, {"constraints": "penalty"}, {"discretisation": "legendre"}],
+                         ids=["eliminate", "penalty", "global-basis"])
+def test_compiled_rhs_is_field_system_rhs(loaded, plain, choices):
+    """dx/dt from the precomputed operators and one kernel call a block equals FieldSystem.rhs at random states
+    and times, to rounding (1e-13 of its largest entry: sums of a few dozen terms, taken in another order).
+    Cases: segments with their own rho, two beads, an end mass and spring (eliminated w(0) = 0; the penalty
+    instead), and a global Legendre basis (a dense null-space reduction)."""
+    system = (plain.with_params(**LOADED) if "discretisation" in choices else loaded).with_params(**choices)
+    f = compiled_rhs(system)
+    rng = np.random.default_rng(7)
+    for _ in range(4):
+        x, t = rng.standard_normal(2 * system.n), float(rng.uniform(0.0, 3.0))
+        expected = system.rhs(t, x)
+        assert np.abs(f(t, x) - expected).max() <= 1e-13 * np.abs(expected).max()
+
+
+def test_compiled_loop_is_scipys_dop853_step_for_step(loaded):
+    """The forced, damped string with beads from rest over 2 s at rtol 1e-10: the compiled loop takes as many steps
+    as scipy's DOP853 on FieldSystem.rhs, and the samples agree to 1e-11 of the largest state (rounding: measured
+    2e-13; the residual's sums are taken in another order)."""
+    run = RunOptions(method="DOP853", rtol=1e-10, atol=1e-12, t_eval=np.linspace(0.0, 2.0, 21))
+    x0 = np.zeros(2 * loaded.n)
+    t, X, counts = integrate_field_c(loaded, x0, 2.0, run)
+    ref = integrate_first_order(loaded.rhs, x0, 2.0, options=run)
+    xs = ref.x if ref.x.shape[0] == len(ref.t) else ref.x.T
+    assert counts["steps"] == ref.steps
+    np.testing.assert_array_equal(t, ref.t)
+    assert np.abs(X - xs).max() <= 1e-11 * np.abs(xs).max()
+
+
+def test_simulate_runs_a_continuum_in_the_compiled_loop(loaded):
+    """simulate (method auto -> DOP853 on the C backend): loop = "c", the same outputs as loop = "python" (names and
+    values, to 1e-11 of each series' scale: rounding, as above)."""
+    options = dict(t_end=1.0, rtol=1e-10, atol=1e-12, samples=11)
+    c = mechgen.simulate(loaded, **options)
+    py = mechgen.simulate(loaded, loop="python", **options)
+    assert (c["method"], c["loop"], py["method"], py["loop"]) == ("DOP853", "c", "DOP853", "python")
+    assert sorted(c.outputs) == sorted(py.outputs) and list(c["trajectory"]) == list(py["trajectory"])
+    for name, series in py["trajectory"].items():
+        scale = max(np.abs(series).max(), 1e-300)
+        assert np.abs(np.asarray(c["trajectory"][name]) - series).max() <= 1e-11 * scale, name
+
+
+def test_free_vibration_of_a_string_at_its_closed_form_frequency(plain):
+    """Started in its first mode, the fixed-free string oscillates as q(t) = q(0) cos(omega_1 t) with
+    omega_1 = (pi / 2L) sqrt(T / rho) = pi / 2: over one period within 2e-8 of q(0) (the Hermite mesh of 8 elements
+    has omega_1 high by 8e-10, a phase error of 2 pi 8e-10 = 5e-9 after a period; integration at rtol 1e-11)."""
+    omega = math.pi / 2
+    r = mechgen.simulate(plain, t_end=2 * math.pi / omega, initial_mode=1, amplitude=0.1, rtol=1e-11, atol=1e-13,
+                         samples=41)
+    assert r["loop"] == "c"
+    t = np.asarray(r["t"])
+    Q = np.column_stack([r["trajectory"][name] for name in plain.coordinates])
+    error = np.abs(Q - np.outer(np.cos(omega * t), Q[0])).max() / np.abs(Q[0]).max()
+    assert error < 2e-8
+
+
+def test_where_the_compiled_loop_cannot_run(model_file, plain):
+    """The numpy backend and a state-dependent mass are named; loop = "c" is then an input error, and loop "auto"
+    falls back to scipy's DOP853 in Python."""
+    numpy_system = mechgen.compile(model_file, backend="numpy")
+    assert "numpy ones" in field_loop_problem(numpy_system)
+    with pytest.raises(InputError, match="loop 'c' cannot run here"):
+        mechgen.simulate(numpy_system, t_end=0.1, method="DOP853", loop="c", initial_mode=1)
+    assert mechgen.simulate(numpy_system, t_end=0.1, method="DOP853", initial_mode=1)["loop"] == "python"
+    assert "multipliers" in field_loop_problem(plain.with_params(constraints="multiplier"))
+    heavy = model_file.replace(".py", "_heavy.py")
+    with open(heavy, "w", encoding="utf-8") as out:
+        out.write(STRING.replace('"user_loaded_string"', '"user_heavy_string"')
+                  .replace("p.rho / 2 * u.w_t**2", "p.rho * (1 + u.w**2) / 2 * u.w_t**2"))
+    varying = mechgen.compile(heavy)
+    assert field_loop_problem(varying) == "the mass matrix depends on the state"
+    assert mechgen.simulate(varying, t_end=0.1, method="DOP853", initial_mode=1)["loop"] == "python"
