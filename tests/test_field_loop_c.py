@@ -115,6 +115,19 @@ def test_compiled_rhs_is_field_system_rhs(loaded, plain, choices):
         assert np.abs(f(t, x) - expected).max() <= 1e-13 * np.abs(expected).max()
 
 
+def test_outputs_series_is_outputs_at_each_sample(loaded):
+    """FieldSystem.outputs_series (each block's points of all samples in one kernel call) equals FieldSystem.outputs
+    sample by sample, to rounding (1e-13 of the largest energy: sums over 30 points in another order)."""
+    rng = np.random.default_rng(3)
+    X, t = rng.standard_normal((5, 2 * loaded.n)), rng.uniform(0.0, 3.0, 5)
+    series = loaded.outputs_series(t, X)
+    for k in range(len(t)):
+        one = loaded.outputs(X[k, :loaded.n], X[k, loaded.n:], None, float(t[k]))
+        assert sorted(one) == sorted(series)
+        scale = max(abs(v) for v in one.values())
+        assert all(abs(series[name][k] - one[name]) <= 1e-13 * scale for name in one)
+
+
 def test_compiled_loop_is_scipys_dop853_step_for_step(loaded):
     """The forced, damped string with beads from rest over 2 s at rtol 1e-10: the compiled loop takes as many steps
     as scipy's DOP853 on FieldSystem.rhs, and the samples agree to 1e-11 of the largest state (rounding: measured

@@ -705,6 +705,13 @@ class FieldSystem:
             raise KernelError(f"outputs of {self.meta.get('model')} are NaN/Inf: {', '.join(bad)}")
         return values
 
+    def outputs_series(self, t, X) -> dict[str, np.ndarray]:
+        """:meth:`outputs` at every sample (row k of X: the state (q, v) at t[k]), the samples of each block of
+        points in one kernel call (mechgen.runtime.fields.operators.outputs_series)."""
+        from mechgen.runtime.fields.operators import outputs_series
+
+        return outputs_series(self, np.asarray(t, float), np.atleast_2d(np.asarray(X, float)))
+
     # -- first-order form (time integration) ------------------------------------
     def split(self, x: np.ndarray):
         """(q, v, z) of a first-order state."""

@@ -1,16 +1,8 @@
 """The compiled DOP853 loop for a continuum: FieldSystem.rhs as sparse operators and one pointwise kernel call.
 
-FieldSystem.rhs assembles, at every call, r(q, v, 0) = Z^T (sum_e B_e^T W_e rho(B_e Z q, B_e Z v, 0) + end and
-part terms + C^T diag(alpha) C Z q) and solves M a = -r. Everything in it but the pointwise residual rho is
-linear in the reduced state, so it is precomputed here once per parameter set (:func:`field_operators`,
-memoised in the system) as
-
-    J_b = (jet tables of block b) Z   (CSR: rows point-major then jet, columns the reduced unknowns),
-    w_b  the quadrature weight of each row (1 at an end term or placed part),
-    P    = Z^T C^T diag(alpha) C Z    (CSR; the penalty stiffness, absent without penalty rows),
-    L    the Cholesky factor of the constant reduced mass M (reverse Cuthill-McKee ordered, banded),
-
-with one block per segment (its own parameters) and one per end term and placed part. In C
+FieldSystem.rhs is precomputed once per parameter set as sparse operators around the pointwise residual
+(mechgen.runtime.fields.operators: the jets J_b of each block of points, their weights w_b, the penalty P, the
+banded Cholesky factor of the constant mass). In C
 (``codegen/templates/c99/field_flow.c``, built once as ``libmgfield``) the rhs is then, for x = (q, v),
 
     dq/dt = v,   dv/dt = -M^-1 (sum_b J_b^T (w_b .* rho_b(J_b q, J_b v, 0, t, s_b, p_b)) + P q),
@@ -26,19 +18,15 @@ from __future__ import annotations
 
 import ctypes
 import logging
-from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
-import scipy.linalg as sla
-import scipy.sparse as sps
-from scipy.sparse.csgraph import reverse_cuthill_mckee
 
 from mechgen.errors import BuildError, CompilerUnavailable
 from mechgen.runtime.core.events_c import LONG, integrate_hybrid_c
-from mechgen.runtime.core.memory import dense_bytes, require
 from mechgen.runtime.core.pattern import extent
+from mechgen.runtime.fields.operators import Block, Operators, field_operators
 
 log = logging.getLogger("mechgen")
 
@@ -82,129 +70,6 @@ def _library():
         if lib.mgf_layout(i) != ctypes.sizeof(struct):
             return None, f"the C field flow's {struct.__name__} layout differs from its Python mirror"
     return lib, None
-
-
-@dataclass(frozen=True)
-class Block:
-    """A pointwise kernel over ``s.size`` points: jets J q (CSR), row weights ``w``, positions, parameters."""
-
-    kernel: object
-    J: sps.csr_matrix
-    w: np.ndarray
-    s: np.ndarray
-    params: np.ndarray
-
-
-@dataclass(frozen=True)
-class Operators:
-    """What FieldSystem.rhs is made of (module doc): the blocks, the penalty P (or None), the mass factor."""
-
-    n: int
-    blocks: tuple
-    penalty: sps.csr_matrix | None
-    chol: np.ndarray       # (band + 1, n): lower band storage of L, M[perm][:, perm] = L L^T
-    perm: np.ndarray
-
-
-def _csr(A) -> sps.csr_matrix:
-    """A as CSR with sorted indices, explicit zeros dropped."""
-    out = sps.csr_matrix(A)
-    out.eliminate_zeros()
-    out.sort_indices()
-    return out
-
-
-def jet_operator(system) -> sps.csr_matrix:
-    """J_full Z: the jets j[e, q, a] at every Gauss point (row (e nq + q) na + a) from the reduced unknowns,
-    j = sum_l B[e, q, a, l] x[dofs[e, l]], x = Z q."""
-    disc = system.disc
-    ne, nq, na, nl = disc.tables.shape
-    rows = np.broadcast_to(np.arange(ne * nq * na).reshape(ne, nq, na, 1), (ne, nq, na, nl))
-    cols = np.broadcast_to(disc.dofs[:, None, None, :], (ne, nq, na, nl))
-    full = sps.csr_matrix((np.ascontiguousarray(disc.tables).ravel(), (rows.ravel(), cols.ravel())),
-                          shape=(ne * nq * na, disc.ndof))
-    return _csr(_reduce_columns(system, full))
-
-
-def _reduce_columns(system, B) -> sps.csr_matrix:
-    """B Z: a table on the full dofs composed with the reduction x = Z q (a column selection where it is one)."""
-    red = system.reduction
-    if red.Z is None:
-        return sps.csr_matrix(B)
-    if red.keep is not None:
-        return sps.csr_matrix(B)[:, red.keep]
-    return sps.csr_matrix(B @ red.Z)
-
-
-def gauss_blocks(system) -> list[Block]:
-    """One block per segment (each its parameter vector; one block without segment values)."""
-    disc = system.disc
-    ne, nq, na, _ = disc.tables.shape
-    J = jet_operator(system)
-    w = np.repeat(np.asarray(disc.weights, float).ravel(), na)
-    s = np.asarray(disc.points, float).ravel()
-    segment = disc.mesh.segment if disc.mesh is not None else np.zeros(ne, int)
-    per_segment = system.segment_params()
-    kernel = system.kernels["residual"]
-    if per_segment is None:
-        return [Block(kernel, J, w, s, np.asarray(system.params, float))]
-    blocks = []
-    for k, params in enumerate(per_segment):
-        elements = np.flatnonzero(segment == k)
-        points = slice(elements[0] * nq, (elements[-1] + 1) * nq)
-        rows = slice(points.start * na, points.stop * na)
-        blocks.append(Block(kernel, _csr(J[rows]), w[rows], s[points], np.asarray(params, float)))
-    return blocks
-
-
-def point_blocks(system) -> list[Block]:
-    """One block per end term and placed part: its kernel ``residual_at_<name>`` at one point, weight 1."""
-    blocks = []
-    for name, x, params in system.placed_points():
-        J = _csr(_reduce_columns(system, system.point_table(x)))
-        params = np.asarray(system.params if params is None else params, float)
-        blocks.append(Block(system.kernels[f"residual_at_{name}"], J, np.ones(J.shape[0]), np.array([float(x)]),
-                            params))
-    return blocks
-
-
-def penalty_operator(system) -> sps.csr_matrix | None:
-    """P = Z^T C^T diag(alpha) C Z, the penalty's stiffness on the reduced unknowns (None without penalty rows)."""
-    choice = system.penalty_choice
-    if choice is None:
-        return None
-    red = system.reduction
-    zero = sps.csr_matrix((red.ndof, red.ndof))
-    return _csr(red.matrix(zero, choice.alphas))
-
-
-def mass_factor(M) -> tuple[np.ndarray, np.ndarray]:
-    """(L in lower band storage, perm): M[perm][:, perm] = L L^T, perm the reverse Cuthill-McKee ordering of M's
-    pattern (a narrow band for element meshes). LinAlgError when M is not symmetric positive definite."""
-    A = sps.csr_matrix(M)
-    n = A.shape[0]
-    if abs(A - A.T).max() > 1e-13 * max(abs(A).max(), 1e-300):
-        raise np.linalg.LinAlgError("the mass matrix is not symmetric")
-    perm = np.asarray(reverse_cuthill_mckee(A, symmetric_mode=True), int) if n > 1 else np.arange(n)
-    P = A[perm][:, perm].tocoo()
-    band = int(np.max(np.abs(P.row - P.col), initial=0))
-    require(dense_bytes(band + 1, n), f"the banded factor of the {n} x {n} mass matrix (bandwidth {band})",
-            key="params.N")
-    ab = np.zeros((band + 1, n))
-    lower = P.row >= P.col
-    ab[(P.row - P.col)[lower], P.col[lower]] = P.data[lower]
-    return np.ascontiguousarray(sla.cholesky_banded(ab, lower=True)), perm
-
-
-def field_operators(system) -> Operators:
-    """The operators of FieldSystem.rhs (module doc), memoised in the system per parameter set."""
-    def make() -> Operators:
-        M = system.tangent(np.zeros(system.n))["r_a"]
-        chol, perm = mass_factor(M)
-        blocks = tuple(gauss_blocks(system) + point_blocks(system))
-        return Operators(system.n, blocks, penalty_operator(system), chol, perm)
-
-    return system.memo(("c_loop", "operators", *system.loop_key()), make)
 
 
 def kernel_problem(kernel, na: int) -> str | None:
