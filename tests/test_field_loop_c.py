@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 import mechgen
+from mechgen.analyses import simulate_flow
 from mechgen.errors import InputError
 from mechgen.runtime.core.integrate import integrate_first_order
 from mechgen.runtime.core.run_options import RunOptions
@@ -185,3 +186,19 @@ def test_where_the_compiled_loop_cannot_run(model_file, plain):
     varying = mechgen.compile(heavy)
     assert field_loop_problem(varying) == "the mass matrix depends on the state"
     assert mechgen.simulate(varying, t_end=0.1, method="DOP853", initial_mode=1)["loop"] == "python"
+
+
+def test_auto_weighs_a_large_continuums_largest_rates(plain):
+    """Above 400 first-order states, auto's estimate is ARPACK's 6 largest eigenvalues of the sparse linearisation:
+    against the dense eigenvalues of FieldSystem.jacobian, the fastest rate and (c / 2 rho = 0.15 for every mode of
+    the string on its viscous foundation) the fastest decay agree to 1e-6; auto then runs DOP853 in the C loop."""
+    system = plain.with_params(N=120, c=0.3)
+    x0 = np.concatenate([0.01 * np.sin(np.arange(system.n)), np.zeros(system.n)])
+    assert x0.size > simulate_flow.ESTIMATE_SIZE
+    largest = simulate_flow.start_rates(system, x0)
+    dense = np.linalg.eigvals(system.jacobian(0.0, x0))
+    assert np.abs(largest).max() == pytest.approx(np.abs(dense).max(), rel=1e-6)
+    assert np.max(-largest.real) == pytest.approx(np.max(-dense.real), rel=1e-6)
+    assert np.max(-dense.real) == pytest.approx(0.15, rel=1e-9)
+    r = mechgen.simulate(system, t_end=0.01, initial_mode=1, amplitude=0.1, samples=3)
+    assert (r["method"], r["loop"]) == ("DOP853", "c")

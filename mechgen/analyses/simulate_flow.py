@@ -6,7 +6,9 @@
   problem is stiff and ``Radau`` (implicit, order 5, Newton on the generated Jacobian) runs it; otherwise
   ``DOP853`` (explicit, order 8). Fast *oscillations* (Re lambda ~ 0) do not make it stiff: any method must
   resolve them to be accurate, and the explicit one does so cheapest. Above :data:`ESTIMATE_SIZE` first-order
-  states (no dense eigen-solve) ``auto`` is ``BDF``, the sparse-friendly implicit method.
+  states (no dense eigen-solve) the rule weighs a continuum's :data:`LARGEST` eigenvalues of largest magnitude
+  (ARPACK on the sparse linearisation: :func:`largest_rates`); any other system's ``auto`` is ``BDF``, the
+  sparse-friendly implicit method.
 * ``DOP853`` on the C backend runs in the compiled loop (mechgen.runtime.core.smooth_c for a lumped model,
   mechgen.runtime.fields.flow_c for a continuum with a constant mass: no Python between the steps; the same steps
   as scipy's DOP853) unless ``loop = "python"``; every other method (``BDF``,
@@ -33,16 +35,46 @@ STIFF_STEPS = 10_000
 DOP853_REACH = 12.0
 #: ``auto`` estimates the start's rates for first-order states up to this size (a dense eigen-solve)
 ESTIMATE_SIZE = 400
+#: above it, a continuum's estimate is this many eigenvalues of largest magnitude (ARPACK)
+LARGEST = 6
 
 
 def start_rates(system, x0: np.ndarray) -> np.ndarray | None:
-    """The eigenvalues of J = d(dx/dt)/dx at (t = 0, x0), or None (too large, or no finite J)."""
+    """The eigenvalues of J = d(dx/dt)/dx at (t = 0, x0), or None (too large, or no finite J); above
+    ESTIMATE_SIZE states a continuum's largest ones (:func:`largest_rates`)."""
     if x0.size > ESTIMATE_SIZE:
-        return None
+        return largest_rates(system, x0) if system.is_field else None
     try:
         J = system.jacobian(0.0, x0)
         J = J.toarray() if hasattr(J, "toarray") else np.asarray(J, float)
         return np.linalg.eigvals(J) if np.all(np.isfinite(J)) else None
+    except Exception:  # no estimate: auto falls back to the sparse-friendly implicit method
+        return None
+
+
+def largest_rates(system, x0: np.ndarray, count: int = LARGEST) -> np.ndarray | None:
+    """The ``count`` eigenvalues of largest magnitude of a continuum's J = [[0, I], [-M^-1 r_q, -M^-1 r_v]] at
+    (t = 0, x0), by ARPACK on J as an operator (the sparse tangent, a sparse LU of M), or None. Converged to
+    1e-10: the real parts, small beside |lambda| (weak damping), are what the rule weighs.
+
+    They hold the fastest rate |lambda|max; the fastest decay max(-Re lambda) is taken among them (for a
+    continuum the highest modes decay fastest under stiffness-proportional damping, and all alike under
+    mass-proportional damping); any faster decay belongs to an eigenvalue no larger than these, which an
+    explicit method must resolve for stability anyway."""
+    import scipy.sparse as sps
+    import scipy.sparse.linalg as spla
+
+    n = system.n
+    try:
+        tan = system.tangent(x0[:n], x0[n:2 * n], t=0.0)
+        mass = spla.splu(sps.csc_matrix(tan["r_a"]))
+        r_q, r_v = tan["r_q"], tan["r_v"]
+
+        def times(x):
+            return np.concatenate([x[n:], -mass.solve(np.asarray(r_q @ x[:n] + r_v @ x[n:], float))])
+
+        J = spla.LinearOperator((2 * n, 2 * n), matvec=times, dtype=float)
+        return spla.eigs(J, k=count, which="LM", return_eigenvectors=False, tol=1e-10, maxiter=50 * n)
     except Exception:  # no estimate: auto falls back to the sparse-friendly implicit method
         return None
 
