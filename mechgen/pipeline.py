@@ -28,7 +28,7 @@ if TYPE_CHECKING:  # the symbolic side is imported only where text is derived (a
 
 log = logging.getLogger("mechgen")
 BACKENDS = ("c", "numpy", "casadi")
-FIELD_KERNELS = ("residual", "tangent", "linear", "outputs")
+FIELD_KERNELS = ("residual", "tangent", "linear", "outputs", "energy_rates")
 _FIELD_CHOICES = ("discretisation", "N", "quadrature", "constraints", "joints")
 #: kernels of a continuum's steady boundary value problem (mechgen.symbolic.steady)
 STEADY_KERNELS = ("bvp_residual", "bvp_tangent", "bvp_outputs")

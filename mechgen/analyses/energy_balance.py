@@ -1,4 +1,5 @@
-"""The energy balance of a ``simulate`` run of a lumped model: a dissipative or forced run checked, not labelled.
+"""The energy balance of a ``simulate`` run of a lumped model or a continuum: a dissipative or forced run checked,
+not labelled.
 
 Along a solution of Lagrange's equations with non-conservative forces Q and Rayleigh dissipation R
 (mechgen.symbolic.derive.energy_powers), the energy function h = v.dT/dv - T + V obeys
@@ -13,7 +14,9 @@ T or V) and the dissipated energy D(t) = int_0^t v.dR/dv dt,
 which is E(t) - E(0) - W(t) + D(t) when T is a quadratic form in v (the excess v.dT/dv - 2 T is zero). W and D
 are integrated with the state, as three more components of dx/dt (the generated ``energy_rates`` kernel: the
 internal rates followed by Q.v, v.dR/dv and -dL/dt), by the same integrator under the same error control, so
-the figure measures the run's accuracy. A run is *conservative* when the three powers and the excess are zero
+the figure measures the run's accuracy. A continuum's kernel gives the power densities at a point, and the
+quadrature over the domain (with the end and part terms) is the discretised system's Q.v, v.dR/dv and -dL/dt
+(mechgen.symbolic.field), so its balance is checked the same way. A run is *conservative* when the three powers and the excess are zero
 at every sample (exactly: a term the model does not declare is a generated zero): it reports ``energy_drift``
 (mechgen.analyses.time_series); any other reports ``energy_balance_error``, ``work`` and ``dissipated`` (their
 values at the end; in the trajectory too, when kept) instead.
@@ -27,10 +30,11 @@ EXTRA = 3
 
 
 def accounted(system, method: str) -> bool:
-    """Whether the run integrates the balance: a smooth lumped system with the energy_rates kernel, and an
+    """Whether the run integrates the balance: a smooth lumped system or a continuum with the energy_rates kernel
+    (a continuum's: power densities at a point, integrated over the domain with the end and part terms), and an
     integrator that takes the augmented state (not CVODES, whose problem is built from the plain kernels)."""
     return ("energy_rates" in system.kernels and method != "cvodes" and not hasattr(system, "modes")
-            and not system.is_lattice and not system.is_field)
+            and not system.is_lattice)
 
 
 class AugmentedFlow:
@@ -41,6 +45,8 @@ class AugmentedFlow:
         self.size = 2 * system.n + system.m
 
     def powers(self, t: float, x: np.ndarray) -> np.ndarray:
+        if self.system.is_field:  # the power densities integrated over the domain (and the end and part terms)
+            return field_rates(self.system, np.array([t]), np.asarray(x, float)[None])["g"][0]
         n, m = self.system.n, self.system.m
         g = self.system.bound("energy_rates").evaluate(q=x[:n], v=x[n:2 * n], z=x[2 * n:2 * n + m], t=t)["g"]
         return np.asarray(g[m:], float).copy()
@@ -58,8 +64,18 @@ class AugmentedFlow:
         return J
 
 
+def field_rates(system, t: np.ndarray, X: np.ndarray) -> dict:
+    """A continuum's energy_rates integrated over its domain at each sample: g (rows: samples; Q.v, v.dR/dv,
+    -dL/dt) and the excess (mechgen.runtime.fields.operators.integrated_series)."""
+    from mechgen.runtime.fields.operators import integrated_series
+
+    return integrated_series(system, "energy_rates", t, X)
+
+
 def excess(system, t: np.ndarray, X: np.ndarray) -> np.ndarray:
     """v.dT/dv - 2 T at each sample (zero for a kinetic energy quadratic in v), in one batched call."""
+    if system.is_field:
+        return field_rates(system, t, X)["excess"][:, 0]
     return np.asarray(system.evaluate_series("energy_rates", t, X)["excess"], float).reshape(len(t))
 
 

@@ -140,7 +140,7 @@ def compiled_loop_problem(system, run: RunOptions, extra: int) -> str | None:
     if system.is_field:
         from mechgen.runtime.fields.flow_c import field_loop_problem
 
-        return field_loop_problem(system, run.rtol, run.atol)
+        return field_loop_problem(system, run.rtol, run.atol, extra)
     from mechgen.runtime.core.smooth_c import smooth_loop_problem
 
     return smooth_loop_problem(system, run.rtol, run.atol, extra)
@@ -151,7 +151,7 @@ def compiled_run(system, x0: np.ndarray, t_end: float, run: RunOptions, extra: i
     if system.is_field:
         from mechgen.runtime.fields.flow_c import integrate_field_c
 
-        t, X, _ = integrate_field_c(system, x0, t_end, run)
+        t, X, _ = integrate_field_c(system, x0, t_end, run, extra=extra)
         return t, X
     from mechgen.runtime.core.smooth_c import integrate_smooth_c
 

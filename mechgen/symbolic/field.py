@@ -19,7 +19,8 @@ Jacobians d rho/dj_tt, d rho/dj_t, d rho/dj are the pointwise mass, damping +
 gyroscopic and stiffness (incl. centrifugal and geometric) coefficients. The
 local equations are a :class:`~mechgen.symbolic.derive.LumpedEquations` whose
 "coordinates" are the jets and which takes the position s as an extra input;
-every kernel kind of a lumped model (residual, tangent, linear, outputs) follows.
+every kernel kind of a lumped model (residual, tangent, linear, outputs, energy_rates: the power densities
+of the energy balance, whose quadrature is the discretised system's) follows.
 """
 from __future__ import annotations
 
@@ -28,7 +29,7 @@ from dataclasses import dataclass, field
 import sympy as sp
 
 from mechgen.errors import ModelError
-from mechgen.symbolic.derive import TIME, LumpedEquations, lagrange_residual
+from mechgen.symbolic.derive import TIME, LumpedEquations, energy_powers, lagrange_residual
 from mechgen.symbolic.model import Model, as_expr, call_declared
 from mechgen.symbolic.names import jet_of
 from mechgen.symbolic.params import Namespace
@@ -196,15 +197,28 @@ def _residual(model: Model, pieces: tuple, jets, u: Jets, test: Jets) -> list[sp
     return rho
 
 
-def _equations(model: Model, pieces: tuple, rho: list, jets, u: Jets, free) -> LumpedEquations:
+def _powers(pieces: tuple, jets, u: Jets, test: Jets) -> tuple:
+    """The energy balance's power densities (mechgen.symbolic.derive.energy_powers) of one piece: the jets are the
+    coordinates, and a weak form's generalized force on jet a is Q_a = -dW/dtest_a (W is linear in the tests), so
+    that the quadrature of Q.j_t is the discretised system's Q.v."""
+    T, V, R, W = pieces
+    q = tuple(u.symbol(f, k, 0) for f, k in jets)
+    v = tuple(u.symbol(f, k, 1) for f, k in jets)
+    Q = [-sp.diff(W, test.symbol(f, k, 0)) for f, k in jets]
+    return energy_powers(T, V, R, Q, q=q, v=v)
+
+
+def _equations(model: Model, pieces: tuple, rho: list, jets, u: Jets, free, test: Jets) -> LumpedEquations:
     T, V = pieces[0], pieces[1]
     q = tuple(u.symbol(f, k, 0) for f, k in jets)
+    power, excess = _powers(pieces, jets, u, test)
     return LumpedEquations(
         model=model.name, coordinates=tuple(s.name for s in q), q=q,
         v=tuple(u.symbol(f, k, 1) for f, k in jets), a=tuple(u.symbol(f, k, 2) for f, k in jets), z=(),
         params=free, param_names=tuple(s.name for s in free), internal_names=(), kinetic=T, potential=V,
         residual=sp.Matrix(rho) if rho else sp.zeros(0, 1), rates=sp.zeros(0, 1),
         outputs={"kinetic_energy": T, "potential_energy": V, "energy": T + V}, position=(POSITION,),
+        power=power, excess=excess,
     )
 
 
@@ -236,8 +250,8 @@ def derive_field(model: Model, spec: Specialization) -> FieldEquations:
     if any(key[2] > 2 for key in u.used):
         raise ModelError(f"densities of {model.name} use more than two time derivatives", file=model.file)
     jets = tuple((f, k) for f in model.field_names for k in range(orders[f] + 1))
-    local = _equations(model, domain, _residual(model, domain, jets, u, test), jets, u, free)
-    points = {at: _equations(model, pieces, _residual(model, pieces, jets, u, test), jets, u, free)
+    local = _equations(model, domain, _residual(model, domain, jets, u, test), jets, u, free, test)
+    points = {at: _equations(model, pieces, _residual(model, pieces, jets, u, test), jets, u, free, test)
               for at, pieces in ends.items()}
     parts = {kind: [f"{kind}_{n}" for n in names] for kind, names in model.parts.items()}
     return FieldEquations(local, jets, tuple(model.field_names), cont.length, constraints, points, parts,

@@ -205,9 +205,9 @@ def _supported(system) -> str | None:
         names = [p["name"] for p in spec["outputs"]]
         if any(p not in names for p in picks):
             return f"kernel {name} lacks the outputs {', '.join(dict.fromkeys(picks))}"
+    provided = getattr(system, "flow", None) is not None  # a flow provider gives all of dx/dt
     for i in range(len(system.modes)):
-        lumped = system.n and getattr(system, "flow", None) is None  # a flow provider gives dq/dt, dv/dt
-        for kind in (("residual", "tangent") if lumped else ()) + (("rates",) if system.m else ()):
+        for kind in () if provided else (("residual", "tangent") if system.n else ()) + (("rates",) if system.m else ()):
             if f"{kind}__{i}" not in system.kernels:
                 return f"mode {system.modes[i]} has no {kind} kernel"
         if system.guards(i) and f"guards__{i}" not in system.kernels:

@@ -26,7 +26,7 @@ import numpy as np
 from mechgen.errors import BuildError, CompilerUnavailable
 from mechgen.runtime.core.events_c import LONG, integrate_hybrid_c
 from mechgen.runtime.core.pattern import extent
-from mechgen.runtime.fields.operators import Block, Operators, field_operators
+from mechgen.runtime.fields.operators import Block, Operators, field_operators, gauss_blocks, point_blocks
 
 log = logging.getLogger("mechgen")
 
@@ -48,7 +48,8 @@ class CBlock(ctypes.Structure):
 class CFlow(ctypes.Structure):
     """mgf_flow: the blocks, the penalty stiffness, the mass factor and the workspace."""
 
-    _fields_ = [("n", c_long), ("nblocks", c_long), ("blocks", c_void_p), ("p_indptr", c_void_p),
+    _fields_ = [("n", c_long), ("nblocks", c_long), ("m", c_long), ("nrates", c_long), ("blocks", c_void_p),
+                ("rates", c_void_p), ("p_indptr", c_void_p),
                 ("p_indices", c_void_p), ("p_data", c_void_p), ("band", c_long), ("chol", c_void_p),
                 ("perm", c_void_p), ("jq", c_void_p), ("jv", c_void_p), ("ja", c_void_p), ("tt", c_void_p),
                 ("out", c_void_p * PORTS), ("r", c_void_p), ("y", c_void_p), ("err_block", c_long),
@@ -72,8 +73,9 @@ def _library():
     return lib, None
 
 
-def kernel_problem(kernel, na: int) -> str | None:
-    """Why ``kernel`` cannot be called by field_flow.c as a pointwise residual (None when it can)."""
+def kernel_problem(kernel, na: int, output: str = "r") -> str | None:
+    """Why ``kernel`` cannot be called by field_flow.c for its ``output`` of ``na`` entries a point (None when it
+    can)."""
     spec = kernel.spec
     if kernel.address is None:
         return f"kernel {kernel.name} has no C function address"
@@ -83,8 +85,8 @@ def kernel_problem(kernel, na: int) -> str | None:
         if port["name"] not in INPUTS or port.get("integer") or (port["batched"] == (port["name"] == "p")):
             return f"kernel {kernel.name} has inputs other than batched q, v, a, z, t, s and a parameter vector p"
     names = [p["name"] for p in spec["outputs"]]
-    if "r" not in names or extent(spec["outputs"][names.index("r")]["extent"], {}) != na:
-        return f"kernel {kernel.name} has no output r of {na} entries a point"
+    if output not in names or extent(spec["outputs"][names.index(output)]["extent"], {}) != na:
+        return f"kernel {kernel.name} has no output {output} of {na} entries a point"
     return None
 
 
@@ -92,15 +94,20 @@ class FieldFlow:
     """The C structures of :class:`Operators` and a workspace: ``address`` is the mgf_flow the loop's flow
     provider reads; the arrays it points to are kept here for as long as this object lives."""
 
-    def __init__(self, ops: Operators) -> None:
+    def __init__(self, ops: Operators, rates: tuple = (), m: int = 0) -> None:
         self.keep: list = []
         self.blocks = (CBlock * max(1, len(ops.blocks)))()
-        rows = max(1, max(b.J.shape[0] for b in ops.blocks))
-        points = max(1, max(b.s.size for b in ops.blocks))
+        self.rates = (CBlock * max(1, len(rates)))()
+        every = ops.blocks + tuple(rates)
+        rows = max(1, max(b.J.shape[0] for b in every))
+        points = max(1, max(b.s.size for b in every))
         out_len = [1] * PORTS
         for i, block in enumerate(ops.blocks):
-            self.blocks[i] = self._block(block, out_len)
-        self.flow = CFlow(n=ops.n, nblocks=len(ops.blocks), blocks=ctypes.addressof(self.blocks),
+            self.blocks[i] = self._block(block, out_len, "r")
+        for i, block in enumerate(rates):
+            self.rates[i] = self._block(block, out_len, "g")
+        self.flow = CFlow(n=ops.n, nblocks=len(ops.blocks), blocks=ctypes.addressof(self.blocks), m=m,
+                          nrates=len(rates), rates=ctypes.addressof(self.rates),
                           band=ops.chol.shape[0] - 1, chol=self._address(ops.chol),
                           perm=self._address(ops.perm.astype(LONG)))
         if ops.penalty is not None:
@@ -119,12 +126,12 @@ class FieldFlow:
         self.keep.append(array)
         return array.ctypes.data
 
-    def _block(self, block: Block, out_len: list) -> CBlock:
+    def _block(self, block: Block, out_len: list, output: str) -> CBlock:
         spec = block.kernel.spec
         out = CBlock(fn=block.kernel.address, nin=len(spec["inputs"]), nout=len(spec["outputs"]),
                      npts=block.s.size, na=block.J.shape[0] // max(1, block.s.size))
         names = [p["name"] for p in spec["outputs"]]
-        out.pick = names.index("r")
+        out.pick = names.index(output)
         for i, port in enumerate(spec["inputs"]):
             out.ports[i] = INPUTS[port["name"]]
         for j, port in enumerate(spec["outputs"]):
@@ -145,11 +152,11 @@ class FieldView:
     smooth = True
     is_lattice = False
     is_field = False
-    m = 0
     backend = "c"
 
-    def __init__(self, system, flow: FieldFlow, fn: int) -> None:
+    def __init__(self, system, flow: FieldFlow, fn: int, extra: int = 0) -> None:
         self.system = system
+        self.m = extra  # the integrals after (q, v): the energy balance's
         self.kernels: dict = {}
         self.patterns: dict = {}
         self.field_flow = flow  # (its arrays stay referenced while the loop runs)
@@ -168,10 +175,11 @@ class FieldView:
         return self.system
 
 
-def field_loop_problem(system, rtol=1e-8, atol=1e-10) -> str | None:
+def field_loop_problem(system, rtol=1e-8, atol=1e-10, extra: int = 0) -> str | None:
     """Why the compiled loop cannot integrate the continuum ``system`` (None when it can): the C backend, a
     constant mass matrix that is symmetric positive definite, no Lagrange multipliers, C kernels of the
-    pointwise residual (and of each end term and part), scalar tolerances and a C compiler for both loops."""
+    pointwise residual (and of each end term and part; with ``extra`` integrals their energy_rates too, whose g
+    has ``extra`` entries), scalar tolerances and a C compiler for both loops."""
     from mechgen.runtime.core.events_c import c_loop_problem
 
     if getattr(system, "backend", None) != "c":
@@ -181,13 +189,14 @@ def field_loop_problem(system, rtol=1e-8, atol=1e-10) -> str | None:
     if not system.info.get("constant_mass"):
         return "the mass matrix depends on the state"
     na = len(system.info["jets"])
-    names = ["residual"] + [f"residual_at_{name}" for name, _, _ in system.placed_points()]
-    for name in names:
-        if name not in system.kernels:
-            return f"the system has no {name} kernel"
-        why = kernel_problem(system.kernels[name], na)
-        if why is not None:
-            return why
+    wanted = [("residual", "r", na)] + ([("energy_rates", "g", extra)] if extra else [])
+    for kernel, output, size in wanted:
+        for name in [kernel] + [f"{kernel}_at_{at}" for at, _, _ in system.placed_points()]:
+            if name not in system.kernels:
+                return f"the system has no {name} kernel"
+            why = kernel_problem(system.kernels[name], size, output)
+            if why is not None:
+                return why
     why = _library()[1]
     if why is not None:
         return why
@@ -195,7 +204,7 @@ def field_loop_problem(system, rtol=1e-8, atol=1e-10) -> str | None:
         field_operators(system)
     except np.linalg.LinAlgError as exc:
         return f"the mass matrix cannot be factorised by Cholesky ({exc})"
-    return c_loop_problem(FieldView(system, _EMPTY, 0), "DOP853", rtol, atol)
+    return c_loop_problem(FieldView(system, _EMPTY, 0, extra), "DOP853", rtol, atol)
 
 
 class _Empty:
@@ -207,34 +216,45 @@ class _Empty:
 _EMPTY = _Empty()
 
 
-def integrate_field_c(system, x0, t_end: float, options) -> tuple[np.ndarray, np.ndarray, dict]:
+def integrate_field_c(system, x0, t_end: float, options, *, extra: int = 0) -> tuple[np.ndarray, np.ndarray, dict]:
     """(t, x rows at the options' ``t_eval``, counts {steps, nfev}) of a continuum integrated by the compiled
     DOP853 loop (module doc; ``options``: mechgen.runtime.core.run_options.RunOptions, ``method`` and ``loop``
-    not read); failures raise the event loop's exceptions. CompilerUnavailable where
-    :func:`field_loop_problem` gives a reason."""
-    why = field_loop_problem(system, options.rtol, options.atol)
+    not read; ``extra`` > 0: the state (q, v) is followed by that many integrals of the energy_rates kernels' g,
+    the energy balance's work and dissipated energy); failures raise the event loop's exceptions.
+    CompilerUnavailable where :func:`field_loop_problem` gives a reason."""
+    why = field_loop_problem(system, options.rtol, options.atol, extra)
     if why is not None:
         raise CompilerUnavailable(why)
-    lib, _ = _library()
-    fn = ctypes.cast(lib.mgf_rhs, c_void_p).value
-    view = FieldView(system, FieldFlow(field_operators(system)), fn)
+    view = FieldView(system, flow_of(system, extra), _rhs_address(), extra)
     traj = integrate_hybrid_c(view, x0, t_end, mode=0, options=options)
     return traj.t, traj.x, {"steps": traj.steps, "nfev": traj.nfev}
 
 
-def compiled_rhs(system):
+def _rhs_address() -> int:
+    lib, _ = _library()
+    return ctypes.cast(lib.mgf_rhs, c_void_p).value
+
+
+def flow_of(system, extra: int = 0) -> FieldFlow:
+    """The C structures of the system's operators (and, with ``extra``, of its energy_rates blocks)."""
+    rates = tuple(gauss_blocks(system, "energy_rates") + point_blocks(system, "energy_rates")) if extra else ()
+    return FieldFlow(field_operators(system), rates, extra)
+
+
+def compiled_rhs(system, extra: int = 0):
     """dx/dt = ``f(t, x)`` of ``system`` computed by field_flow.c (what the loop steps; FieldSystem.rhs to
-    rounding), one ctypes call each: for checks and tests. CompilerUnavailable where the loop cannot run."""
-    why = field_loop_problem(system)
+    rounding, followed by ``extra`` integrals' rates), one ctypes call each: for checks and tests.
+    CompilerUnavailable where the loop cannot run."""
+    why = field_loop_problem(system, extra=extra)
     if why is not None:
         raise CompilerUnavailable(why)
     lib, _ = _library()
     lib.mgf_rhs.argtypes, lib.mgf_rhs.restype = [c_void_p, c_double, c_void_p, c_void_p], ctypes.c_int
-    flow = FieldFlow(field_operators(system))
+    flow = flow_of(system, extra)
 
     def f(t: float, x) -> np.ndarray:
         x = np.ascontiguousarray(x, dtype=float)
-        out = np.zeros(2 * system.n)
+        out = np.zeros(2 * system.n + extra)
         rc = lib.mgf_rhs(flow.address, float(t), x.ctypes.data, out.ctypes.data)
         if rc:
             raise RuntimeError(f"kernel of block {flow.flow.err_block} returned error code {rc}")

@@ -14,9 +14,9 @@ with one block per segment (its own parameters) and one per end term and placed 
 
     dq/dt = v,   dv/dt = -M^-1 (sum_b J_b^T (w_b .* rho_b(J_b q, J_b v, 0, t, s_b, p_b)) + P q).
 
-mechgen.runtime.fields.flow_c evaluates that in C for the compiled DOP853 loop. :func:`outputs_series` uses the
-same blocks for the model's outputs (energies) at many samples in one kernel call a block:
-E_k = sum_b sum_points w rho_out(J_b q_k, J_b v_k, 0, t_k, s, p_b).
+mechgen.runtime.fields.flow_c evaluates that in C for the compiled DOP853 loop. :func:`integrated_series` uses
+the same blocks for any pointwise kernel's integral at many samples in one kernel call a block (the outputs, the
+energy balance's powers): I_k = sum_b sum_points w out(J_b q_k, J_b v_k, 0, t_k, s, p_b).
 """
 from __future__ import annotations
 
@@ -155,14 +155,14 @@ def field_operators(system) -> Operators:
     return system.memo(("c_loop", "operators", *system.loop_key()), make)
 
 
-def outputs_series(system, t: np.ndarray, X: np.ndarray) -> dict[str, np.ndarray]:
-    """Each output of the ``outputs`` kernels at every sample (row k of X: (q, v) at t[k]): the integral over the
-    Gauss points plus the end and part terms, E_k = sum_b sum_i w_i rho_out(J_b q_k, J_b v_k, 0, t_k, s_i, p_b),
-    each block's points of all samples in one kernel call (FieldSystem.outputs per row, to rounding)."""
+def integrated_series(system, kernel: str, t: np.ndarray, X: np.ndarray) -> dict[str, np.ndarray]:
+    """Each output of the pointwise ``kernel`` (and of its ``<kernel>_at_<name>`` end and part terms) integrated
+    over the domain at every sample (row k of X: (q, v) at t[k]): rows (samples, entries),
+    I_k = sum_b sum_i w_i out(J_b q_k, J_b v_k, 0, t_k, s_i, p_b), each block's points of all samples in one call."""
     n, ns = system.n, len(t)
     Q, V = np.asarray(X[:, :n], float).T, np.asarray(X[:, n:2 * n], float).T
     values: dict[str, np.ndarray] = {}
-    for block in gauss_blocks(system, "outputs") + point_blocks(system, "outputs"):
+    for block in gauss_blocks(system, kernel) + point_blocks(system, kernel):
         npts = block.s.size
         na = block.J.shape[0] // npts
         jets = [np.ascontiguousarray((block.J @ Y).reshape(npts, na, ns).transpose(2, 0, 1).reshape(-1, na))
@@ -173,9 +173,16 @@ def outputs_series(system, t: np.ndarray, X: np.ndarray) -> dict[str, np.ndarray
         out = block.kernel.evaluate(inputs, check=False)
         weights = block.w[::na]
         for name, arr in out.items():
-            values[name] = values.get(name, 0.0) + arr[:, 0].reshape(ns, npts) @ weights
+            summed = np.einsum("kij,i->kj", arr.reshape(ns, npts, -1), weights)
+            values[name] = values[name] + summed if name in values else summed
     bad = [k for k, v in values.items() if not np.all(np.isfinite(v))]
     if bad:
-        raise KernelError(f"outputs of {system.meta.get('model')} are NaN/Inf: {', '.join(bad)}")
+        raise KernelError(f"{kernel} of {system.meta.get('model')} is NaN/Inf: {', '.join(bad)}")
     return values
 
+
+def outputs_series(system, t: np.ndarray, X: np.ndarray) -> dict[str, np.ndarray]:
+    """Each output of the ``outputs`` kernels at every sample (row k of X: (q, v) at t[k]): the integral over the
+    Gauss points plus the end and part terms (:func:`integrated_series`; FieldSystem.outputs per row, to
+    rounding)."""
+    return {name: values[:, 0] for name, values in integrated_series(system, "outputs", t, X).items()}

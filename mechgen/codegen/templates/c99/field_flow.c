@@ -17,7 +17,11 @@
  * band storage, chol[i * n + j] = L[j + i, j] for i = 0..band, of M permuted: M[perm][:, perm] = L L^T.
  * Everything that is linear in q is thus a sparse product; only rho is evaluated pointwise.
  *
- * Entry point: mgf_rhs(flow, t, x, f): writes f[0 .. 2n) and returns 0, or the nonzero code a kernel returned
+ * With m > 0 the state carries m integrals after (q, v) (the energy balance's work and dissipated energy), whose
+ * rates are quadratures of a pointwise kernel's output g (m entries a point) over the rate blocks (the same points,
+ * jets and weights as the residual's, another kernel): dz_j/dt = sum_b sum_i w_b,i g_b,j(J_b q, J_b v, t, s_i, p_b).
+ *
+ * Entry point: mgf_rhs(flow, t, x, f): writes f[0 .. 2n + m) and returns 0, or the nonzero code a kernel returned
  * (flow->err_block names its block). Not reentrant: each run has its own workspace.
  */
 #include <string.h>
@@ -43,8 +47,9 @@ typedef struct {
 } mgf_block;
 
 typedef struct {
-    long n, nblocks;
+    long n, nblocks, m, nrates;
     const mgf_block *blocks;
+    const mgf_block *rates;        /* nrates blocks whose kernel's output `pick` is g (m entries a point) */
     const long *p_indptr, *p_indices;   /* P: CSR n x n (p_indptr NULL: none) */
     const double *p_data;
     long band;
@@ -141,7 +146,28 @@ static void mass_solve(const mgf_flow *F, const double *r, double *y)
     }
 }
 
-/* f = (v, -M^-1 r(q, v, t)) at (t, x = (q, v)): module doc */
+/* f[2n + j] = sum over the rate blocks and their points of w g_j (module doc); 0 or a kernel's code */
+static int integrals(mgf_flow *F, double t, const double *x, double *f)
+{
+    long b, i, j, m = F->m;
+    int rc;
+    memset(f, 0, (size_t)m * sizeof(double));
+    for (b = 0; b < F->nrates; ++b) {
+        const mgf_block *blk = &F->rates[b];
+        const double *g = F->out[blk->pick];
+        if ((rc = pointwise(F, blk, t, x)) != 0) {
+            F->err_block = F->nblocks + b;
+            F->err_rc = rc;
+            return rc;
+        }
+        for (i = 0; i < blk->npts; ++i)
+            for (j = 0; j < m; ++j)
+                f[j] += blk->w[i * blk->na] * g[i * m + j];
+    }
+    return 0;
+}
+
+/* f = (v, -M^-1 r(q, v, t), the integrals' rates) at (t, x = (q, v, z)): module doc */
 int mgf_rhs(void *data, double t, const double *x, double *f);
 int mgf_rhs(void *data, double t, const double *x, double *f)
 {
@@ -166,5 +192,5 @@ int mgf_rhs(void *data, double t, const double *x, double *f)
     memcpy(f, x + n, (size_t)n * sizeof(double));
     for (i = 0; i < n; ++i)
         f[n + F->perm[i]] = -F->y[i];
-    return 0;
+    return F->m > 0 ? integrals(F, t, x, f + 2 * n) : 0;
 }

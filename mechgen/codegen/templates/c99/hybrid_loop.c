@@ -98,7 +98,7 @@ typedef struct {
     long *s_mode;
     double *e_t, *e_before, *e_after;   /* events: time, states (event_cap x nx) */
     long *e_source, *e_target, *e_guard;
-    /* a provider of (dq/dt, dv/dt) = f[0 .. 2n) at (t, x) in place of the residual and tangent kernels (a
+    /* a provider of dx/dt = f[0 .. 2n + m) at (t, x) in place of the residual, tangent and rates kernels (a
        continuum: mechgen/codegen/templates/c99/field_flow.c), returning 0 or a kernel's nonzero code; NULL: none */
     int (*flow)(void *data, double t, const double *x, double *f);
     void *flow_data;
@@ -301,7 +301,7 @@ static void fail_at(mgh_ctx *c, double t, const double *x)
         memcpy(c->S->err_x, x, (size_t)c->nx * sizeof(double));
 }
 
-/* f[0 .. 2n) from the problem's flow provider; its nonzero code is a kernel error of the residual */
+/* f[0 .. 2n + m) from the problem's flow provider; its nonzero code is a kernel error of the residual */
 static int flow_rhs(mgh_ctx *c, long mode, double t, const double *x, double *f)
 {
     int rc = c->P->flow(c->P->flow_data, t, x, f);
@@ -344,7 +344,7 @@ static int rhs(mgh_ctx *c, long mode, double t, const double *x, double *f)
     memcpy(f, x + n, (size_t)n * sizeof(double));
     memcpy(f + n, c->b, (size_t)n * sizeof(double));
 rates:
-    if (c->m) {
+    if (c->m && c->P->flow == NULL) {   /* a flow provider gives dz/dt as well */
         if ((rc = kcall(c, &md->rates, MGH_K_RATES, mode, x, NULL, t)) != 0)
             return rc;
         memcpy(f + 2 * n, c->kout[md->rates.pick[0]], (size_t)c->m * sizeof(double));
@@ -1197,7 +1197,7 @@ static int setup(mgh_ctx *c, const mgh_problem *P, mgh_state *S)
         return MGH_E_INPUT;
     for (i = 0; i < P->nmodes; ++i) {
         const mgh_mode *md = &P->modes[i];
-        if (check_kernel(&md->residual, lumped > 0) || check_kernel(&md->tangent, lumped > 0) || check_kernel(&md->rates, m > 0)
+        if (check_kernel(&md->residual, lumped > 0) || check_kernel(&md->tangent, lumped > 0) || check_kernel(&md->rates, m > 0 && P->flow == NULL)
             || check_kernel(&md->guards, md->nguards > 0) || md->nguards > P->max_guards || md->nguards < 0)
             return MGH_E_INPUT;
         for (j = 0; j < md->nguards; ++j)
