@@ -187,7 +187,8 @@ def test_damped_string_loses_its_energy_as_the_closed_form_says(plain):
     """The fixed-free string on a viscous foundation (c = 0.2, rho = T = L = 1) started in mode 1 at rest: each mode
     obeys q'' + (c / rho) q' + omega^2 q = 0 (the damping is proportional to the mass), so with gamma = c / 2 rho,
     omega_d = sqrt(omega^2 - gamma^2) and omega = pi / 2,
-    E(t) / E(0) = exp(-2 gamma t) ((omega / omega_d)^2 sin^2 omega_d t + (cos omega_d t + gamma / omega_d sin omega_d t)^2)
+    E(t) / E(0) = exp(-2 gamma t) ((omega / omega_d)^2 sin^2 omega_d t
+                                   + (cos omega_d t + gamma / omega_d sin omega_d t)^2)
     and the dissipated energy is E(0) - E(t). The run (compiled loop) reports energy_balance_error, work = 0 and
     dissipated, integrated with the state; both series meet the closed form to 3e-9 of E(0) (measured 3e-10: the
     Hermite mesh's omega_1 is high by 8e-10; integration at rtol 1e-11)."""

@@ -16,8 +16,9 @@ are integrated with the state, as three more components of dx/dt (the generated 
 internal rates followed by Q.v, v.dR/dv and -dL/dt), by the same integrator under the same error control, so
 the figure measures the run's accuracy. A continuum's kernel gives the power densities at a point, and the
 quadrature over the domain (with the end and part terms) is the discretised system's Q.v, v.dR/dv and -dL/dt
-(mechgen.symbolic.field), so its balance is checked the same way. A run is *conservative* when the three powers and the excess are zero
-at every sample (exactly: a term the model does not declare is a generated zero): it reports ``energy_drift``
+(mechgen.symbolic.field), so its balance is checked the same way. A run is *conservative* when the three
+powers and the excess are zero at every sample (exactly: a term the model does not declare is a generated
+zero): it reports ``energy_drift``
 (mechgen.analyses.time_series); any other reports ``energy_balance_error``, ``work`` and ``dissipated`` (their
 values at the end; in the trajectory too, when kept) instead.
 """

@@ -207,7 +207,8 @@ def _supported(system) -> str | None:
             return f"kernel {name} lacks the outputs {', '.join(dict.fromkeys(picks))}"
     provided = getattr(system, "flow", None) is not None  # a flow provider gives all of dx/dt
     for i in range(len(system.modes)):
-        for kind in () if provided else (("residual", "tangent") if system.n else ()) + (("rates",) if system.m else ()):
+        lumped = () if provided else (("residual", "tangent") if system.n else ()) + (("rates",) if system.m else ())
+        for kind in lumped:
             if f"{kind}__{i}" not in system.kernels:
                 return f"mode {system.modes[i]} has no {kind} kernel"
         if system.guards(i) and f"guards__{i}" not in system.kernels:

@@ -138,7 +138,8 @@ class FieldFlow:
             out.out_len[j] = extent(port["extent"], {})
             out_len[j] = max(out_len[j], out.out_len[j])
         out.s, out.p = self._address(block.s.astype(float)), self._address(block.params)
-        out.indptr, out.indices = self._address(block.J.indptr.astype(LONG)), self._address(block.J.indices.astype(LONG))
+        out.indptr = self._address(block.J.indptr.astype(LONG))
+        out.indices = self._address(block.J.indices.astype(LONG))
         out.data, out.w = self._address(block.J.data), self._address(block.w)
         return out
 

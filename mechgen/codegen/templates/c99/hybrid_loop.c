@@ -1197,7 +1197,8 @@ static int setup(mgh_ctx *c, const mgh_problem *P, mgh_state *S)
         return MGH_E_INPUT;
     for (i = 0; i < P->nmodes; ++i) {
         const mgh_mode *md = &P->modes[i];
-        if (check_kernel(&md->residual, lumped > 0) || check_kernel(&md->tangent, lumped > 0) || check_kernel(&md->rates, m > 0 && P->flow == NULL)
+        if (check_kernel(&md->residual, lumped > 0) || check_kernel(&md->tangent, lumped > 0)
+            || check_kernel(&md->rates, m > 0 && P->flow == NULL)
             || check_kernel(&md->guards, md->nguards > 0) || md->nguards > P->max_guards || md->nguards < 0)
             return MGH_E_INPUT;
         for (j = 0; j < md->nguards; ++j)
