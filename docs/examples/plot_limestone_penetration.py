@@ -1,6 +1,6 @@
 """
 Ogive-nose projectiles into limestone: depth, fitted resistance, scale law (Frew, Forrestal & Hanchak)
-=====================================================================================================
+======================================================================================================
 
 A rigid projectile of mass ``m`` (kg), shank radius ``a`` (m) and caliber-radius-head :math:`\\psi` strikes a
 limestone target (density :math:`\\rho`, kg/m³; resistance ``R``, Pa) at :math:`V_s` (m/s). It decelerates

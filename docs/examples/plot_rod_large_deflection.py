@@ -1,6 +1,6 @@
 """
 A soft rod's large deflection: the cantilever elastica and the rolled-up rod (Cosserat rod on SE(3))
-===================================================================================================
+====================================================================================================
 
 A geometrically exact (Cosserat) rod of length ``L`` (m): its configuration is a curve of frames
 :math:`H(s) \\in SE(3)` with strains :math:`f = H^{-1} H'` (stretch and shear :math:`\\nu`, curvature and
