@@ -74,6 +74,17 @@ def test_readme_python_api_runs_verbatim(tmp_path):
 
 
 @pytest.mark.slow
+@pytest.mark.parametrize("name", ["lumped", "rotor", "hybrid", "rod"])
+def test_tutorial_per_kind_of_model_runs_verbatim(name, tmp_path):
+    """docs/tutorials/<name>.md: its file blocks written, its run blocks run in order; each run block asserts
+    its numbers against closed forms (pendulums, Jeffcott whirl, restitution, the circular arc, beam theory) or
+    stored ROSS frequencies."""
+    found = blocks((ROOT / "docs" / "tutorials" / f"{name}.md").read_text())
+    assert any("file" in a for _, a, _ in found)
+    assert run_blocks(found, tmp_path) >= 2
+
+
+@pytest.mark.slow
 def test_tutorial_runs_verbatim(tmp_path):
     found = blocks((ROOT / "docs" / "tutorial.md").read_text())
     assert any("file" in a for _, a, _ in found)
