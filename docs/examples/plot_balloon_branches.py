@@ -19,8 +19,9 @@ the fixed eyelet. Linearising about a balloon and projecting on ``N = 10`` sines
 :math:`M \\ddot q + G \\dot q + K q = 0`, whose eigenvalues say stable, divergence (a real pair) or flutter (a
 complex quartet).
 
-Reference: S. Sarangi, R. Bhattacharyya, A. K. Samantaray, "On the Ballooning Motion of Hyperelastic Strings"
-(the seed paper; h = 10, beta = 100). The symbols of its equations were lost in the text extraction, so the
+Reference: S. Sarangi, R. Bhattacharyya, A. K. Samantaray, "On the Ballooning Motion of Hyperelastic Strings",
+Indian Institute of Technology Kharagpur (the seed paper, a preprint whose text carries no year; h = 10,
+beta = 100). The symbols of its equations were lost in the text extraction, so the
 equations were rebuilt from the physics (``benchmarks/balloon_notes.md``), and the numbers compared here are
 those of the hand-written scipy baseline ``benchmarks/balloon_handwritten.py`` (tension-vector shooting and its
 own Galerkin matrices), which ``tests/test_balloon*.py`` use: the single-loop minimum :math:`p_{e,min}` =
