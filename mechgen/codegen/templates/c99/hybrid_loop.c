@@ -196,7 +196,8 @@ typedef struct {
     long n, m, nx, ng, ring;
     long *flags;               /* 2 * max_guards: crossed, crossing just after (a tie) */
     double *mem;
-    double *zeros, *kout[MGH_PORTS], *M, *b, *K, *F;
+    double *zeros, *M, *b, *K, *F;
+    double **kout;             /* (4 nmodes + nresets) x MGH_PORTS: each kernel's own outputs (kout_of) */
     double *y_old, *f_old, *y_new, *f_new, *ytmp, *xm, *fm, *xd, *fd, *xa, *xs, *fy, *ff, *fy2, *ff2;
     double *g_new, *d_new, *gm, *dm, *gt, *gtt, *ca, *cda, *cb, *cdb, *roots, *t_his;
     double *st_g;              /* MGH_STACK entries of 4 * max_guards: ga, da, gb, db */
@@ -213,10 +214,19 @@ static double time_tolerance(double t, double t_end)
     return fmax(1e-12 * fabs(t_end), 64 * MGH_EPS * fabs(t));
 }
 
+/* the outputs of the kernel `kind` (MGH_K_*) of mode `where`, or of reset `where`: its own buffers, zeroed once at
+ * setup. A lumped kernel sets its structurally nonzero entries at every call and never accumulates (only lattice
+ * kernels do, and the loop does not run lattices), so its structural zeros stay zero without a memset per call. */
+static double *const *kout_of(const mgh_ctx *c, long kind, long where)
+{
+    long slot = kind == MGH_K_RESET ? 4 * c->P->nmodes + where : 4 * where + kind;
+    return c->kout + slot * MGH_PORTS;
+}
+
 static int kcall(mgh_ctx *c, const mgh_kernel *k, long kind, long where, const double *x, const double *a, double t)
 {
     const double *in[MGH_PORTS];
-    double *out[MGH_PORTS];
+    double *const *out = kout_of(c, kind, where);
     double tt = t;
     long sizes = 0, i;
     int rc;
@@ -229,10 +239,6 @@ static int kcall(mgh_ctx *c, const mgh_kernel *k, long kind, long where, const d
         case MGH_IN_T: in[i] = &tt; break;
         default: in[i] = c->P->p != NULL ? c->P->p : c->zeros; break;
         }
-    }
-    for (i = 0; i < k->nout; ++i) {
-        out[i] = c->kout[i];
-        memset(out[i], 0, (size_t)k->out_len[i] * sizeof(double));
     }
     rc = k->fn(in, out, &sizes, 1);
     if (rc != 0) {
@@ -302,28 +308,41 @@ static int rhs(mgh_ctx *c, long mode, double t, const double *x, double *f)
 {
     const mgh_mode *md = &c->P->modes[mode];
     long n = c->n, i;
+    double *const *r_out = kout_of(c, MGH_K_RESIDUAL, mode), *const *M_out = r_out;
     int rc;
     if (n == 0)
         goto rates;
     if ((rc = kcall(c, &md->residual, MGH_K_RESIDUAL, mode, x, NULL, t)) != 0)
         return rc;
     for (i = 0; i < n; ++i)
-        c->b[i] = -c->kout[md->residual.pick[0]][i];
-    /* one kernel may give both r and M (the fused `flow` kernel): its outputs are still in kout */
-    if (md->tangent.fn != md->residual.fn && (rc = kcall(c, &md->tangent, MGH_K_TANGENT, mode, x, NULL, t)) != 0)
-        return rc;
-    memcpy(c->M, c->kout[md->tangent.pick[0]], (size_t)(n * n) * sizeof(double));
+        c->b[i] = -r_out[md->residual.pick[0]][i];
+    /* one kernel may give both r and M (the fused `flow` kernel): then M is among the residual call's outputs */
+    if (md->tangent.fn != md->residual.fn) {
+        if ((rc = kcall(c, &md->tangent, MGH_K_TANGENT, mode, x, NULL, t)) != 0)
+            return rc;
+        M_out = kout_of(c, MGH_K_TANGENT, mode);
+    }
+    if (n == 1) {  /* a scalar M: no elimination */
+        if (M_out[md->tangent.pick[0]][0] == 0.0) {
+            fail_at(c, t, x);
+            return MGH_E_SINGULAR;
+        }
+        c->b[0] /= M_out[md->tangent.pick[0]][0];
+        goto solved;
+    }
+    memcpy(c->M, M_out[md->tangent.pick[0]], (size_t)(n * n) * sizeof(double));
     if (solve(n, c->M, c->b)) {
         fail_at(c, t, x);
         return MGH_E_SINGULAR;
     }
+solved:
     memcpy(f, x + n, (size_t)n * sizeof(double));
     memcpy(f + n, c->b, (size_t)n * sizeof(double));
 rates:
     if (c->m) {
         if ((rc = kcall(c, &md->rates, MGH_K_RATES, mode, x, NULL, t)) != 0)
             return rc;
-        memcpy(f + 2 * n, c->kout[md->rates.pick[0]], (size_t)c->m * sizeof(double));
+        memcpy(f + 2 * n, kout_of(c, MGH_K_RATES, mode)[md->rates.pick[0]], (size_t)c->m * sizeof(double));
     }
     c->S->nfev++;
     for (i = 0; i < c->nx; ++i) {
@@ -340,6 +359,7 @@ rates:
 static int guards(mgh_ctx *c, long mode, double t, const double *x, const double *f, double *g, double *gt)
 {
     const mgh_mode *md = &c->P->modes[mode];
+    double *const *out = kout_of(c, MGH_K_GUARDS, mode);
     long k, ng = md->nguards;
     int rc;
     if (ng == 0)
@@ -348,8 +368,8 @@ static int guards(mgh_ctx *c, long mode, double t, const double *x, const double
         return rc;
     c->S->nguard++;
     for (k = 0; k < ng; ++k) {
-        g[k] = c->kout[md->guards.pick[0]][k];
-        gt[k] = f != NULL ? c->kout[md->guards.pick[1]][k] : 0.0;
+        g[k] = out[md->guards.pick[0]][k];
+        gt[k] = f != NULL ? out[md->guards.pick[1]][k] : 0.0;
         if (!isfinite(g[k]) || !isfinite(gt[k])) {
             fail_at(c, t, x);
             c->S->err_guard = k;
@@ -578,7 +598,7 @@ static int fire(mgh_ctx *c, long k, double t, const double *x, long *target)
     if (r >= 0) {
         if ((rc = kcall(c, &P->resets[r], MGH_K_RESET, r, x, NULL, t)) != 0)
             return rc;
-        memcpy(c->xa, c->kout[P->resets[r].pick[0]], (size_t)nx * sizeof(double));
+        memcpy(c->xa, kout_of(c, MGH_K_RESET, r)[P->resets[r].pick[0]], (size_t)nx * sizeof(double));
     } else {
         memcpy(c->xa, x, (size_t)nx * sizeof(double));
     }
@@ -1090,7 +1110,12 @@ static int step(mgh_ctx *c)
             return MGH_E_STATE;
         }
     }
-    if ((rc = dense_prepare(c, mode, t_old, h)) != 0 || (rc = guards(c, mode, t_new, c->y_new, c->f_new, c->g_new, c->d_new)) != 0)
+    /* the dense output (3 more evaluations) only where it is read: guards to scan, or a sample inside the step
+     * (scipy's solve_ivp builds it on the same condition) */
+    if (ng > 0 || (P->n_eval > 0 && S->i_eval < P->n_eval && P->t_eval[S->i_eval] <= t_new))
+        if ((rc = dense_prepare(c, mode, t_old, h)) != 0)
+            goto failed;
+    if ((rc = guards(c, mode, t_new, c->y_new, c->f_new, c->g_new, c->d_new)) != 0)
         goto failed;
     found = ng > 0 ? scan(c, mode, S->sign, t_old, t_new, &k, &t_lo, &t_hi, &t_root) : 0;
     if (found < 0) {
@@ -1159,10 +1184,35 @@ static int check_kernel(const mgh_kernel *k, int needed)
     return 0;
 }
 
+/* kernel slot i of kout_of: 4 per mode (residual, tangent, rates, guards), then the resets */
+static const mgh_kernel *loop_kernel(const mgh_problem *P, long i)
+{
+    const mgh_mode *md;
+    if (i >= 4 * P->nmodes)
+        return &P->resets[i - 4 * P->nmodes];
+    md = &P->modes[i / 4];
+    switch (i % 4) {
+    case MGH_K_RESIDUAL: return &md->residual;
+    case MGH_K_TANGENT: return &md->tangent;
+    case MGH_K_RATES: return &md->rates;
+    default: return &md->guards;
+    }
+}
+
+static void release(mgh_ctx *c)
+{
+    free(c->mem);
+    free(c->flags);
+    free(c->kout);
+    c->mem = NULL;
+    c->flags = NULL;
+    c->kout = NULL;
+}
+
 static int setup(mgh_ctx *c, const mgh_problem *P, mgh_state *S)
 {
     long n = P->n, m = P->m, nx = 2 * P->n + P->m, ng = P->max_guards > 0 ? P->max_guards : 1;
-    long i, j, total, len[MGH_PORTS];
+    long i, j, total, nk = 4 * P->nmodes + P->nresets;
     double *p;
     memset(c, 0, sizeof(*c));
     c->P = P;
@@ -1191,28 +1241,14 @@ static int setup(mgh_ctx *c, const mgh_problem *P, mgh_state *S)
     c->ng = ng;
     c->ring = P->zeno_events + 1 > 2 ? P->zeno_events + 1 : 2;  /* more than zeno_events within zeno_span */
     total = nx + n * n + n + 16 * nx + 7 * nx + 15 * nx + 12 * ng + MGH_STACK * 4 * ng;
-    for (j = 0; j < MGH_PORTS; ++j) {
-        len[j] = 1;
-        for (i = 0; i < P->nmodes; ++i) {
-            const mgh_mode *md = &P->modes[i];
-            long l = kernel_outputs(&md->residual, j);
-            if (kernel_outputs(&md->tangent, j) > l) l = kernel_outputs(&md->tangent, j);
-            if (kernel_outputs(&md->rates, j) > l) l = kernel_outputs(&md->rates, j);
-            if (kernel_outputs(&md->guards, j) > l) l = kernel_outputs(&md->guards, j);
-            if (l > len[j]) len[j] = l;
-        }
-        for (i = 0; i < P->nresets; ++i)
-            if (kernel_outputs(&P->resets[i], j) > len[j])
-                len[j] = kernel_outputs(&P->resets[i], j);
-        total += len[j];
-    }
+    for (i = 0; i < nk; ++i)
+        for (j = 0; j < MGH_PORTS; ++j)
+            total += kernel_outputs(loop_kernel(P, i), j);
     c->mem = (double *)calloc((size_t)total, sizeof(double));
     c->flags = (long *)calloc((size_t)(2 * ng), sizeof(long));
-    if (c->mem == NULL || c->flags == NULL) {
-        free(c->mem);
-        free(c->flags);
-        c->mem = NULL;
-        c->flags = NULL;
+    c->kout = (double **)calloc((size_t)(nk * MGH_PORTS), sizeof(double *));
+    if (c->mem == NULL || c->flags == NULL || c->kout == NULL) {
+        release(c);
         return MGH_E_MEMORY;
     }
     p = c->mem;
@@ -1229,8 +1265,9 @@ static int setup(mgh_ctx *c, const mgh_problem *P, mgh_state *S)
     MGH_TAKE(gtt, ng); MGH_TAKE(ca, ng); MGH_TAKE(cda, ng); MGH_TAKE(cb, ng); MGH_TAKE(cdb, ng);
     MGH_TAKE(roots, ng); MGH_TAKE(t_his, ng);
     MGH_TAKE(st_g, MGH_STACK * 4 * ng);
-    for (j = 0; j < MGH_PORTS; ++j)
-        MGH_TAKE(kout[j], len[j]);
+    for (i = 0; i < nk; ++i)
+        for (j = 0; j < MGH_PORTS; ++j)
+            MGH_TAKE(kout[i * MGH_PORTS + j], kernel_outputs(loop_kernel(P, i), j));
 #undef MGH_TAKE
     return 0;
 }
@@ -1261,7 +1298,6 @@ int mgh_run(const mgh_problem *P, mgh_state *S)
         if (rc != MGH_CONTINUE)
             break;
     }
-    free(c.mem);
-    free(c.flags);
+    release(&c);
     return rc;
 }
