@@ -187,6 +187,18 @@ const double mgh_D[4][16] = {
     {-25.69393346270375, 0.0, 0.0, 0.0, 0.0, -154.18974869023643, -231.5293791760455, 357.6391179106141, 93.40532418362432, -37.45832313645163, 104.0996495089623, 29.8402934266605, -43.53345659001114, 96.32455395918828, -39.17726167561544, -149.72683625798564}};
 
 /* ---- the run's workspace ---- */
+/* The state's sizes: the fields of the context, or constants when the library is built for one size
+ * (-DMGH_FIXED_N=n -DMGH_FIXED_M=m: the compiler then unrolls the loops over the state; mgh_run refuses any
+ * other size with MGH_E_INPUT) */
+#ifdef MGH_FIXED_N
+#define MGH_N(c) ((long)(MGH_FIXED_N))
+#define MGH_M(c) ((long)(MGH_FIXED_M))
+#else
+#define MGH_N(c) ((c)->n)
+#define MGH_M(c) ((c)->m)
+#endif
+#define MGH_NX(c) (2 * MGH_N(c) + MGH_M(c))
+
 #define MGH_CONTINUE 100
 #define MGH_EPS DBL_EPSILON
 
@@ -233,9 +245,9 @@ static int kcall(mgh_ctx *c, const mgh_kernel *k, long kind, long where, const d
     for (i = 0; i < k->nin; ++i) {
         switch (k->ports[i]) {
         case MGH_IN_Q: in[i] = x; break;
-        case MGH_IN_V: in[i] = x + c->n; break;
+        case MGH_IN_V: in[i] = x + MGH_N(c); break;
         case MGH_IN_A: in[i] = a != NULL ? a : c->zeros; break;
-        case MGH_IN_Z: in[i] = c->m ? x + 2 * c->n : c->zeros; break;
+        case MGH_IN_Z: in[i] = MGH_M(c) ? x + 2 * MGH_N(c) : c->zeros; break;
         case MGH_IN_T: in[i] = &tt; break;
         default: in[i] = c->P->p != NULL ? c->P->p : c->zeros; break;
         }
@@ -300,14 +312,15 @@ static void fail_at(mgh_ctx *c, double t, const double *x)
 {
     c->S->err_t = t;
     if (x != c->S->err_x)
-        memcpy(c->S->err_x, x, (size_t)c->nx * sizeof(double));
+        memcpy(c->S->err_x, x, (size_t)MGH_NX(c) * sizeof(double));
 }
 
-/* f = dx/dt of mode `mode` at (t, x): (v, -M^-1 r(q, v, 0, z, t), rates); only the rates when n = 0 */
-static int rhs(mgh_ctx *c, long mode, double t, const double *x, double *f)
+/* f = dx/dt of mode `mode` at (t, x): (v, -M^-1 r(q, v, 0, z, t), rates); only the rates when n = 0.
+ * Not checked for NaN/Inf: rhs() checks; the step's stages are checked at once through their error norm. */
+static int rhs_unchecked(mgh_ctx *c, long mode, double t, const double *x, double *f)
 {
     const mgh_mode *md = &c->P->modes[mode];
-    long n = c->n, i;
+    long n = MGH_N(c), i;
     double *const *r_out = kout_of(c, MGH_K_RESIDUAL, mode), *const *M_out = r_out;
     int rc;
     if (n == 0)
@@ -339,13 +352,23 @@ solved:
     memcpy(f, x + n, (size_t)n * sizeof(double));
     memcpy(f + n, c->b, (size_t)n * sizeof(double));
 rates:
-    if (c->m) {
+    if (MGH_M(c)) {
         if ((rc = kcall(c, &md->rates, MGH_K_RATES, mode, x, NULL, t)) != 0)
             return rc;
-        memcpy(f + 2 * n, kout_of(c, MGH_K_RATES, mode)[md->rates.pick[0]], (size_t)c->m * sizeof(double));
+        memcpy(f + 2 * n, kout_of(c, MGH_K_RATES, mode)[md->rates.pick[0]], (size_t)MGH_M(c) * sizeof(double));
     }
     c->S->nfev++;
-    for (i = 0; i < c->nx; ++i) {
+    return 0;
+}
+
+/* rhs_unchecked, MGH_E_RHS (at t, x) when dx/dt is NaN/Inf */
+static int rhs(mgh_ctx *c, long mode, double t, const double *x, double *f)
+{
+    long i;
+    int rc = rhs_unchecked(c, mode, t, x, f);
+    if (rc != 0)
+        return rc;
+    for (i = 0; i < MGH_NX(c); ++i) {
         if (!isfinite(f[i])) {
             fail_at(c, t, x);
             c->S->err_mode = mode;
@@ -364,7 +387,7 @@ static int guards(mgh_ctx *c, long mode, double t, const double *x, const double
     int rc;
     if (ng == 0)
         return 0;
-    if ((rc = kcall(c, &md->guards, MGH_K_GUARDS, mode, x, f != NULL ? f + c->n : NULL, t)) != 0)
+    if ((rc = kcall(c, &md->guards, MGH_K_GUARDS, mode, x, f != NULL ? f + MGH_N(c) : NULL, t)) != 0)
         return rc;
     c->S->nguard++;
     for (k = 0; k < ng; ++k) {
@@ -383,7 +406,7 @@ static int guards(mgh_ctx *c, long mode, double t, const double *x, const double
 static int rk_stages(mgh_ctx *c, long mode, double t, const double *y, const double *f, double h,
                      double *y_new, double *f_new)
 {
-    long nx = c->nx, s, j, i;
+    long nx = MGH_NX(c), s, j, i;
     double *K = c->K, dy;
     int rc;
     memcpy(K, f, (size_t)nx * sizeof(double));
@@ -394,7 +417,7 @@ static int rk_stages(mgh_ctx *c, long mode, double t, const double *y, const dou
                 dy += K[j * nx + i] * mgh_A[s][j];
             c->ytmp[i] = y[i] + dy * h;
         }
-        if ((rc = rhs(c, mode, t + mgh_C[s] * h, c->ytmp, K + s * nx)) != 0)
+        if ((rc = rhs_unchecked(c, mode, t + mgh_C[s] * h, c->ytmp, K + s * nx)) != 0)
             return rc;
     }
     for (i = 0; i < nx; ++i) {
@@ -403,15 +426,45 @@ static int rk_stages(mgh_ctx *c, long mode, double t, const double *y, const dou
             dy += K[j * nx + i] * mgh_B[j];
         y_new[i] = y[i] + h * dy;
     }
-    if ((rc = rhs(c, mode, t + h, y_new, f_new)) != 0)
+    if ((rc = rhs_unchecked(c, mode, t + h, y_new, f_new)) != 0)
         return rc;
     memcpy(K + 12 * nx, f_new, (size_t)nx * sizeof(double));
     return 0;
 }
 
+/* After a step whose error norm is NaN/Inf: MGH_E_RHS at the first stage whose dx/dt is NaN/Inf (its state
+ * rebuilt exactly as rk_stages made it), 0 when every stage is finite. A NaN/Inf entry of any stage makes the
+ * norm NaN/Inf (it enters the E5 sum multiplied by a coefficient, and 0 * Inf is NaN), so a finite norm
+ * vouches for all 13 stages: the same failures rhs() reports, checked once per step. */
+static int stage_failure(mgh_ctx *c, long mode, double t, const double *y, double h, const double *y_new)
+{
+    long nx = MGH_NX(c), s, j, i;
+    double dy;
+    for (s = 1; s < 13; ++s) {  /* K[0] = f was checked where it was made */
+        for (i = 0; i < nx && isfinite(c->K[s * nx + i]); ++i)
+            ;
+        if (i == nx)
+            continue;
+        if (s == 12) {
+            fail_at(c, t + h, y_new);
+        } else {
+            for (i = 0; i < nx; ++i) {
+                dy = 0.0;
+                for (j = 0; j < s; ++j)
+                    dy += c->K[j * nx + i] * mgh_A[s][j];
+                c->ytmp[i] = y[i] + dy * h;
+            }
+            fail_at(c, t + mgh_C[s] * h, c->ytmp);
+        }
+        c->S->err_mode = mode;
+        return MGH_E_RHS;
+    }
+    return 0;
+}
+
 static double error_norm(mgh_ctx *c, double h, const double *y, const double *y_new)
 {
-    long nx = c->nx, i, j;
+    long nx = MGH_NX(c), i, j;
     const mgh_problem *P = c->P;
     double e5 = 0.0, e3 = 0.0, s5, s3, scale;
     for (i = 0; i < nx; ++i) {
@@ -452,6 +505,8 @@ static int dop_step(mgh_ctx *c, long mode, double t, const double *y, const doub
         if ((rc = rk_stages(c, mode, t, y, f, h, y_new, f_new)) != 0)
             return rc;
         err = error_norm(c, h, y, y_new);
+        if (!isfinite(err) && (rc = stage_failure(c, mode, t, y, h, y_new)) != 0)
+            return rc;
         if (err < 1) {
             factor = err == 0 ? 10.0 : fmin(10.0, 0.9 * pow(err, -0.125));
             if (rejected)
@@ -471,7 +526,7 @@ static int dop_step(mgh_ctx *c, long mode, double t, const double *y, const doub
 /* the dense output of the last step (t_old, y_old, f_old) -> (t_old + h, y_new, f_new): F (7 x nx) */
 static int dense_prepare(mgh_ctx *c, long mode, double t_old, double h)
 {
-    long nx = c->nx, s, j, i, r;
+    long nx = MGH_NX(c), s, j, i, r;
     double *K = c->K, dy;
     int rc;
     for (s = 13; s < 16; ++s) {
@@ -504,7 +559,7 @@ static int dense_prepare(mgh_ctx *c, long mode, double t_old, double h)
 /* the dense output at tt (scipy Dop853DenseOutput._call_impl) */
 static void dense_eval(mgh_ctx *c, double tt, double *out)
 {
-    long nx = c->nx, i, k;
+    long nx = MGH_NX(c), i, k;
     double x = (tt - c->dense_t0) / c->dense_h;
     for (i = 0; i < nx; ++i) {
         double y = 0.0;
@@ -529,7 +584,7 @@ static double rms(const double *a, const double *scale, long nx)
 static int initial_step(mgh_ctx *c, long mode, double t0, const double *y0, const double *f0, double *h_out)
 {
     const mgh_problem *P = c->P;
-    long nx = c->nx, i;
+    long nx = MGH_NX(c), i;
     double interval = fabs(P->t_end - t0), d0, d1, d2, h0, h1;
     double *scale = c->xd, *y1 = c->ytmp, *f1 = c->fd;
     int rc;
@@ -566,7 +621,7 @@ static void record(mgh_ctx *c, double t, const double *x, long mode)
     if (P->n_eval != 0 || S->n_samples >= P->sample_cap)
         return;
     P->s_t[S->n_samples] = t;
-    memcpy(P->s_x + S->n_samples * c->nx, x, (size_t)c->nx * sizeof(double));
+    memcpy(P->s_x + S->n_samples * MGH_NX(c), x, (size_t)MGH_NX(c) * sizeof(double));
     P->s_mode[S->n_samples] = mode;
     S->n_samples++;
 }
@@ -580,7 +635,7 @@ static void sample_until(mgh_ctx *c, double t_hi, long mode)
         return;
     while (S->i_eval < P->n_eval && P->t_eval[S->i_eval] <= t_hi) {
         P->s_t[S->i_eval] = P->t_eval[S->i_eval];
-        dense_eval(c, P->t_eval[S->i_eval], P->s_x + S->i_eval * c->nx);
+        dense_eval(c, P->t_eval[S->i_eval], P->s_x + S->i_eval * MGH_NX(c));
         P->s_mode[S->i_eval] = mode;
         S->i_eval++;
     }
@@ -593,7 +648,7 @@ static int fire(mgh_ctx *c, long k, double t, const double *x, long *target)
     const mgh_problem *P = c->P;
     mgh_state *S = c->S;
     const mgh_mode *md = &P->modes[S->mode];
-    long nx = c->nx, r = md->reset[k], e, i;
+    long nx = MGH_NX(c), r = md->reset[k], e, i;
     int rc;
     if (r >= 0) {
         if ((rc = kcall(c, &P->resets[r], MGH_K_RESET, r, x, NULL, t)) != 0)
@@ -643,7 +698,7 @@ static int after_event(mgh_ctx *c, long target)
 {
     mgh_state *S = c->S;
     long source = S->mode;
-    memcpy(S->x, c->xa, (size_t)c->nx * sizeof(double));
+    memcpy(S->x, c->xa, (size_t)MGH_NX(c) * sizeof(double));
     S->phase = 0;
     if (target < 0)
         return MGH_TERMINATED;
@@ -997,7 +1052,7 @@ static int locate(mgh_ctx *c, long mode, long k, double t_lo, double t_hi, doubl
                   double *t_star)
 {
     const mgh_problem *P = c->P;
-    long nx = c->nx, i;
+    long nx = MGH_NX(c), i;
     double t = t_old, h_abs = t_d - t_old, t_new, h, dt;
     int rc;
     if (t_d > t_old) {
@@ -1086,7 +1141,7 @@ static int step(mgh_ctx *c)
     const mgh_problem *P = c->P;
     mgh_state *S = c->S;
     const mgh_mode *md = &P->modes[S->mode];
-    long nx = c->nx, ng = md->nguards, mode = S->mode, k = 0, i, target;
+    long nx = MGH_NX(c), ng = md->nguards, mode = S->mode, k = 0, i, target;
     double t_old = S->t, t_new, h, t_lo = 0.0, t_hi = 0.0, t_root = 0.0, t_star;
     int rc, found;
     if (P->n_eval == 0 && S->n_samples + 3 > P->sample_cap)
@@ -1217,6 +1272,10 @@ static int setup(mgh_ctx *c, const mgh_problem *P, mgh_state *S)
     memset(c, 0, sizeof(*c));
     c->P = P;
     c->S = S;
+#ifdef MGH_FIXED_N
+    if (n != MGH_FIXED_N || m != MGH_FIXED_M)
+        return MGH_E_INPUT;
+#endif
     if (n < 0 || m < 0 || n + m < 1 || P->nmodes < 1 || P->modes == NULL || S->mode < 0 || S->mode >= P->nmodes
         || P->max_guards < 0 || (P->nresets > 0 && P->resets == NULL) || P->zeno_events < 0)
         return MGH_E_INPUT;
