@@ -24,11 +24,10 @@ __all__ = ["analysis", "campbell", "continuation", "fit", "impact", "modes", "re
 
 
 def _model_info(system):
-    """The ModelInfo of the system's model: looked up once per compiled system (kept in its memo; a compiled
-    system is immutable, so the facts of the model it was compiled from do not change under it)."""
-    memo = getattr(system, "patterns", None)
-    if memo is not None and ("model_info",) in memo:
-        return memo[("model_info",)]
+    """The ModelInfo of the system's model: the facts compiled into it (mechgen.compile), else looked up by the
+    model's reference."""
+    if getattr(system, "facts", None) is not None:
+        return system.facts
     from mechgen.scene.info import lookup_model
 
     name = system.metadata.reference  # the canonical reference, for users' models
@@ -36,8 +35,6 @@ def _model_info(system):
     if info is None:
         raise InputError(f"the system's model {name!r} is not one mechgen can look up", key="system",
                          expected="a system compiled by mechgen.compile")
-    if memo is not None:
-        memo[("model_info",)] = info
     return info
 
 

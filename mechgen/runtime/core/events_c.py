@@ -86,7 +86,7 @@ class CProblem(ctypes.Structure):
                 ("n_eval", c_long), ("t_eval", c_void_p), ("sample_cap", c_long), ("event_cap", c_long),
                 ("s_t", c_void_p), ("s_x", c_void_p), ("s_mode", c_void_p),
                 ("e_t", c_void_p), ("e_before", c_void_p), ("e_after", c_void_p),
-                ("e_source", c_void_p), ("e_target", c_void_p), ("e_guard", c_void_p)]
+                ("e_source", c_void_p), ("e_target", c_void_p), ("e_guard", c_void_p), ("carried", c_long)]
 
 
 class CState(ctypes.Structure):
@@ -346,7 +346,7 @@ def integrate_hybrid_c(system, x0, t_end: float, *, mode: int | None = None, opt
                        p=params.ctypes.data if params.size else None, rtol=float(rtol), atol=float(atol),
                        t_end=t_end, max_events=int(rules.max_events), zeno_events=int(rules.zeno_events),
                        zeno_span=float(zeno_span), stop_mode=-1, pause=int(stop_after is not None),
-                       budget_left=-1, slice=SLICE)
+                       budget_left=-1, slice=SLICE, carried=int(getattr(system, "carried", 0)))
     if t_eval is not None:  # (params and t_eval stay referenced here while the loop reads them)
         problem.n_eval, problem.t_eval = (len(t_eval), t_eval.ctypes.data) if len(t_eval) else (-1, None)
     state = CState(phase=-1, mode=start, t=0.0)

@@ -131,6 +131,9 @@ class System:
     backend: str = "numpy"
     rebuild: Callable | None = field(default=None, repr=False)
     folded: tuple[str, ...] = ()
+    #: the facts of the model it was compiled from (mechgen.scene.info.ModelInfo), set by the compile layer for
+    #: a model given as an object (one a reference cannot find again); None: looked up by the model's reference
+    facts: object = field(default=None, repr=False, compare=False)
     patterns: dict = field(init=False, repr=False)
     metadata: SystemMeta = field(init=False, repr=False)
 

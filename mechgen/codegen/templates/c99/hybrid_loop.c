@@ -98,6 +98,8 @@ typedef struct {
     long *s_mode;
     double *e_t, *e_before, *e_after;   /* events: time, states (event_cap x nx) */
     long *e_source, *e_target, *e_guard;
+    long carried;              /* the state's last `carried` entries (<= m) pass through resets unchanged: integrals
+                                  carried across events; the reset kernels give the nx - carried before them */
 } mgh_problem;
 
 typedef struct {
@@ -653,7 +655,8 @@ static int fire(mgh_ctx *c, long k, double t, const double *x, long *target)
     if (r >= 0) {
         if ((rc = kcall(c, &P->resets[r], MGH_K_RESET, r, x, NULL, t)) != 0)
             return rc;
-        memcpy(c->xa, kout_of(c, MGH_K_RESET, r)[P->resets[r].pick[0]], (size_t)nx * sizeof(double));
+        memcpy(c->xa, kout_of(c, MGH_K_RESET, r)[P->resets[r].pick[0]], (size_t)(nx - P->carried) * sizeof(double));
+        memcpy(c->xa + nx - P->carried, x + nx - P->carried, (size_t)P->carried * sizeof(double));
     } else {
         memcpy(c->xa, x, (size_t)nx * sizeof(double));
     }
@@ -1277,7 +1280,8 @@ static int setup(mgh_ctx *c, const mgh_problem *P, mgh_state *S)
         return MGH_E_INPUT;
 #endif
     if (n < 0 || m < 0 || n + m < 1 || P->nmodes < 1 || P->modes == NULL || S->mode < 0 || S->mode >= P->nmodes
-        || P->max_guards < 0 || (P->nresets > 0 && P->resets == NULL) || P->zeno_events < 0)
+        || P->max_guards < 0 || (P->nresets > 0 && P->resets == NULL) || P->zeno_events < 0
+        || P->carried < 0 || P->carried > m)
         return MGH_E_INPUT;
     for (i = 0; i < P->nmodes; ++i) {
         const mgh_mode *md = &P->modes[i];
@@ -1292,7 +1296,7 @@ static int setup(mgh_ctx *c, const mgh_problem *P, mgh_state *S)
             return MGH_E_INPUT;
     }
     for (i = 0; i < P->nresets; ++i)
-        if (check_kernel(&P->resets[i], 1) || P->resets[i].out_len[P->resets[i].pick[0]] != nx)
+        if (check_kernel(&P->resets[i], 1) || P->resets[i].out_len[P->resets[i].pick[0]] != nx - P->carried)
             return MGH_E_INPUT;
     c->n = n;
     c->m = m;
