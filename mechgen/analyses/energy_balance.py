@@ -29,9 +29,9 @@ EXTRA = INTEGRALS
 
 
 def accounted(system, method: str) -> bool:
-    """Whether the run integrates the balance: a smooth lumped system with the energy_rates kernel, and an
-    integrator that takes the augmented state (not CVODES, whose problem is built from the plain kernels)."""
-    return ("energy_rates" in system.kernels and method != "cvodes" and not hasattr(system, "modes")
+    """Whether the run integrates the balance: a smooth lumped system with the energy_rates kernel (every method:
+    scipy's and the compiled loop on the augmented flow, CVODES on the augmented CasADi expression)."""
+    return ("energy_rates" in system.kernels and not hasattr(system, "modes")
             and not system.is_lattice and not system.is_field)
 
 
@@ -74,19 +74,6 @@ def mode_powers(mode_system, t: np.ndarray, X: np.ndarray, modes: np.ndarray) ->
         out[rows, :EXTRA] = np.asarray(raw["g"], float).reshape(len(rows), -1)[:, flow.m:]
         out[rows, EXTRA] = np.asarray(raw["excess"], float).reshape(len(rows))
     return out
-
-
-def unaccounted(system, t: np.ndarray, X: np.ndarray) -> dict | None:
-    """For a run that did not integrate its balance (CVODES): ``energy_note`` when the model has forces,
-    dissipation or an explicit time dependence at the samples (its energy_drift would mean nothing), else None."""
-    if "energy_rates" not in system.kernels or system.is_lattice or system.is_field:
-        return None
-    powers = mode_powers(lambda k: system, t, X, np.zeros(len(t), int))
-    if powers is None or not np.any(powers):
-        return None
-    return {"energy_note": "the model has forces, dissipation or an explicit time dependence whose work this "
-                           "method does not integrate: no energy figure (the other methods report "
-                           "energy_balance_error)"}
 
 
 def reset_losses(mode_system, events) -> list[tuple[float, float]]:

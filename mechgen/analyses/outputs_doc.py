@@ -111,9 +111,8 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("t_final", "scalar", "s", "A hybrid model: where the run ended (before ``t_end`` at a terminal "
            "event or a Zeno stop)."),
         _o("mode_series", "(samples,)", "-", "A hybrid model: the mode at each sample time."),
-        _o("energy_note", "string", "-", "Why a run gives no energy figure: CVODES on a model with forces or "
-           "dissipation, or a hybrid model compiled without its modes' ``energy_rates`` kernels (their work is "
-           "not integrated)."),
+        _o("energy_note", "string", "-", "Why a run gives no energy figure: a hybrid model with forces or "
+           "dissipation compiled without its modes' ``energy_rates`` kernels (their work is not integrated)."),
         _o("zeno", "bool", "-", "``on_zeno = \"stop\"``: whether the run ended at a Zeno accumulation point."),
     ),
     "sweep": (

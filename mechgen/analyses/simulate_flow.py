@@ -112,4 +112,5 @@ def cvodes_run(system, x0, t_end: float, run: RunOptions):
         raise InputError(why, key="method", expected="a method of this system's backend: auto, BDF, Radau, LSODA, "
                          "RK45, DOP853 or leapfrog, or backend 'casadi' for 'cvodes'")
     return integrate_cvodes(system, x0, t_end, t_eval=run.t_eval, rtol=run.rtol, atol=run.atol, budget=run.budget,
-                            progress=run.progress, desc=run.desc, explain=run.explain)
+                            progress=run.progress, desc=run.desc, explain=run.explain,
+                            integrals=x0.size - (2 * system.n + system.m))
