@@ -23,7 +23,7 @@ import numpy as np
 
 from mechgen.errors import InputError
 from mechgen.runtime.core.memory import dense_bytes, require
-from mechgen.runtime.core.variational import STAGES, VariationalRun, run_variational, steps_for
+from mechgen.runtime.core.variational import STAGES, run_variational, steps_for
 from mechgen.scene.values import fail
 
 
