@@ -75,7 +75,11 @@ def compile(model, params: Mapping | None = None, *, free=None, backend: str = "
                        segments=here.segments if here is not None else None,
                        parts=here.parts if here is not None else None)
 
-    system = replace(system, rebuild=rebuild, folded=folded)
+    from mechgen.scene.info import info_of_model
+
+    # the model's facts travel with the system: the analyses check options against them, and a model object
+    # (declared in a notebook) has no reference they could be looked up by
+    system = replace(system, rebuild=rebuild, folded=folded, facts=info_of_model(model))
     if layout is not None:
         system = system.with_layout(layout)
     return system

@@ -1,6 +1,6 @@
 """Scene fuzzing harness: mutate the shipped scenes, run each through ``mechgen.cli.main`` and judge the outcome.
 
-The contract checked (issue 12 section 5, README "exit codes"): a run of ``mechgen run SCENE`` either
+The contract checked (issue 12 section 5, docs/guide.md "exit codes"): a run of ``mechgen run SCENE`` either
 
 * exits 0 (and wrote its ``--json`` file), or
 * exits 2 with one ``mechgen: ...`` paragraph on stderr that names the scene file and a key

@@ -129,6 +129,20 @@ def test_plot_writes_pngs(tmp_path, capsys):
     assert all((tmp_path / p).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for p in pngs)
 
 
+def test_run_says_once_that_plot_draws_the_figures(tmp_path, capsys):
+    """Without --plot the run's output ends with one line naming ``--plot DIR``; with --plot it is left out
+    (the figures are drawn, and the files written are listed instead)."""
+    pytest.importorskip("matplotlib")
+    scene = str(ROOT / "scenes" / "laval_rotor.toml")
+    code, out, err = _run(["run", scene], capsys)
+    assert code == 0, err
+    hints = [line for line in out.splitlines() if "--plot DIR" in line]
+    assert hints == ["(mechgen run SCENE --plot DIR draws the figures)"] and out.rstrip().endswith(hints[0])
+    code, out, err = _run(["run", scene, "--plot", str(tmp_path)], capsys)
+    assert code == 0, err
+    assert "--plot DIR" not in out and "wrote " in out
+
+
 def test_plot_continuum_shapes_and_sweep(tmp_path, capsys):
     pytest.importorskip("matplotlib")
     code, out, err = _run(["run", str(ROOT / "scenes" / "beam_modes.toml"), "--plot", str(tmp_path)], capsys)

@@ -1,10 +1,10 @@
-"""The README's Python API example and the tutorial run verbatim.
+"""The user guide's Python API example (docs/guide.md, moved from the README) and the tutorial run verbatim.
 
 Code blocks are taken from the Markdown as written: a block whose info string has
 ``file=PATH`` is written to PATH in a fresh folder; a ``python run`` block is run there
 with this interpreter; a ``bash run`` block's ``mechgen ...`` lines are run as
 ``python -m mechgen ...``. Every block must exit 0; the blocks carry their own checks
-against closed forms (the tutorial's bead on a string, the README's pendulum).
+against closed forms (the tutorial's bead on a string, the guide's pendulum).
 """
 from __future__ import annotations
 
@@ -69,8 +69,19 @@ def run_blocks(found, folder: Path) -> int:
 
 
 def test_readme_python_api_runs_verbatim(tmp_path):
-    found = blocks(section((ROOT / "README.md").read_text(), "## Python API"))
+    found = blocks(section((ROOT / "docs" / "guide.md").read_text(), "## Python API"))
     assert run_blocks(found, tmp_path) >= 1
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["lumped", "rotor", "hybrid", "rod"])
+def test_tutorial_per_kind_of_model_runs_verbatim(name, tmp_path):
+    """docs/tutorials/<name>.md: its file blocks written, its run blocks run in order; each run block asserts
+    its numbers against closed forms (pendulums, Jeffcott whirl, restitution, the circular arc, beam theory) or
+    stored ROSS frequencies."""
+    found = blocks((ROOT / "docs" / "tutorials" / f"{name}.md").read_text())
+    assert any("file" in a for _, a, _ in found)
+    assert run_blocks(found, tmp_path) >= 2
 
 
 @pytest.mark.slow

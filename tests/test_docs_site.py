@@ -73,6 +73,7 @@ def test_site(tmp_path):
     check_no_broken_internal_links(site)
     check_no_remote_images(site)
     check_every_gallery_script_ran_and_drew(site)
+    check_readme_links_reach_the_site(site)
 
 
 def check_every_kind_has_its_generated_page(site):
@@ -122,6 +123,25 @@ def check_every_gallery_script_ran_and_drew(site):
         assert "sphx-glr-script-out" in text, script.name  # the captured stdout
         assert re.search(rf'src="[^"]*sphx_glr_{script.stem}_\d+\.png"', text), script.name
         assert "Traceback" not in text, script.name
+
+
+SEED_PAGES = ("plot_balloon_branches", "plot_rotor_campbell_ross", "plot_fpu_recurrence", "plot_rod_large_deflection",
+              "plot_impact_restitution", "plot_limestone_penetration", "plot_stick_slip_hysteresis",
+              "plot_rate_state_friction", "plot_friction_beam_spectrum")
+
+
+def check_readme_links_reach_the_site(site):
+    """The README's front page links every seed system's gallery page: each relative link names a file of the
+    repository or, under docs/_build/html/, a page of the built site (and each seed page is linked)."""
+    links = re.findall(r"\]\(([^)#]+)\)", (ROOT / "README.md").read_text(encoding="utf-8"))
+    built = "docs/_build/html/"
+    for link in links:
+        if link.startswith(built):
+            assert (site / link[len(built):]).exists(), link
+        else:
+            assert (ROOT / link).exists(), link
+    for stem in SEED_PAGES:
+        assert f"docs/examples/{stem}.py" in links and f"{built}auto_examples/{stem}.html" in links, stem
 
 
 def test_generated_pages_name_every_option_and_output():

@@ -483,7 +483,7 @@ def test_hostile_docs_and_choices_reach_no_code(tmp_path, monkeypatch, backend):
 
 
 def _readme_section():
-    text = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    text = (Path(__file__).resolve().parents[1] / "docs" / "guide.md").read_text()  # moved from the README
     section = text.split("## Export", 1)[1].split("\n## ", 1)[0]
     blocks = re.findall(r"```(\w*)\n(.*?)```", section, re.S)
     return [(lang, body) for lang, body in blocks]
@@ -519,5 +519,5 @@ def test_readme_export_examples_run_verbatim(tmp_path, monkeypatch):
             assert g == pytest.approx(0.03 * 300, rel=1e-14) and k == pytest.approx(4e4, rel=1e-14)  # Ip Omega, k_t
         else:
             namespace: dict = {}
-            exec(compile(body, "README.md", "exec"), namespace)
+            exec(compile(body, "guide.md", "exec"), namespace)
             assert isinstance(namespace["F"], ca.Function)

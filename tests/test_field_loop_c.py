@@ -17,7 +17,8 @@ import scipy.linalg as sla
 
 import mechgen
 from mechgen.analyses import simulate_flow
-from mechgen.analyses.energy_balance import EXTRA, AugmentedFlow
+from mechgen.runtime.core.augmented import INTEGRALS as EXTRA
+from mechgen.runtime.core.augmented import AugmentedFlow
 from mechgen.errors import InputError
 from mechgen.runtime.core.integrate import integrate_first_order
 from mechgen.runtime.core.run_options import RunOptions

@@ -226,7 +226,7 @@ def test_segments_with_a_global_basis_are_refused_at_load(tmp_path, capsys):
     ("stepped_rotor", "L=2", ["segments[1].length", "sum of the segment lengths"]),
 ])
 def test_set_of_a_value_a_table_sets_is_refused(scene, flag, places, capsys):
-    """README: [[segments]] and [[parts]] tables set their values themselves, so a --set of the same
+    """docs/guide.md: [[segments]] and [[parts]] tables set their values themselves, so a --set of the same
     value would be ignored; it is refused, naming the tables and the scene file."""
     path = SCENES / f"{scene}.toml"
     name = flag.split("=")[0]

@@ -26,57 +26,34 @@ from __future__ import annotations
 
 import numpy as np
 
-#: the integrated powers appended to the state: the forces' work, the dissipated energy, the explicit work
-EXTRA = 3
+from mechgen.runtime.core.augmented import INTEGRALS, balance_kernels
+
+#: the integrated powers appended to the state (mechgen.runtime.core.augmented): W_forces, D, W_explicit
+EXTRA = INTEGRALS
 
 
 def accounted(system, method: str) -> bool:
-    """Whether the run integrates the balance: a smooth lumped system or a continuum with the energy_rates kernel
-    (a continuum's: power densities at a point, integrated over the domain with the end and part terms), and an
-    integrator that takes the augmented state (not CVODES, whose problem is built from the plain kernels)."""
-    return ("energy_rates" in system.kernels and method != "cvodes" and not hasattr(system, "modes")
-            and not system.is_lattice)
+    """Whether the run integrates the balance: a smooth lumped system with the energy_rates kernel (every method:
+    scipy's and the compiled loop on the augmented flow, CVODES on the augmented CasADi expression), or a
+    continuum with its pointwise energy_rates kernels (power densities integrated over the domain with the end and
+    part terms; scipy's methods and the compiled loop)."""
+    return ("energy_rates" in system.kernels and not hasattr(system, "modes") and not system.is_lattice
+            and (not system.is_field or method != "cvodes"))
 
 
-class AugmentedFlow:
-    """dx/dt and its Jacobian for x = (q, v, z, W_forces, D, W_explicit): the system's own, then the powers."""
-
-    def __init__(self, system) -> None:
-        self.system = system
-        self.size = 2 * system.n + system.m
-
-    def powers(self, t: float, x: np.ndarray) -> np.ndarray:
-        if self.system.is_field:  # the power densities integrated over the domain (and the end and part terms)
-            return field_rates(self.system, np.array([t]), np.asarray(x, float)[None])["g"][0]
-        n, m = self.system.n, self.system.m
-        g = self.system.bound("energy_rates").evaluate(q=x[:n], v=x[n:2 * n], z=x[2 * n:2 * n + m], t=t)["g"]
-        return np.asarray(g[m:], float).copy()
-
-    def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
-        state = x[:self.size]
-        return np.concatenate([self.system.rhs(t, state), self.powers(t, state)])
-
-    def jacobian(self, t: float, x: np.ndarray) -> np.ndarray:
-        """The system's Jacobian bordered by zeros: the integrals do not feed back, and their rows' dependence
-        on the state is left to the corrector (the Newton iteration still converges: those rows are explicit)."""
-        J = np.zeros((self.size + EXTRA, self.size + EXTRA))
-        inner = self.system.jacobian(t, x[:self.size])
-        J[:self.size, :self.size] = inner.toarray() if hasattr(inner, "toarray") else inner
-        return J
-
-
-def field_rates(system, t: np.ndarray, X: np.ndarray) -> dict:
-    """A continuum's energy_rates integrated over its domain at each sample: g (rows: samples; Q.v, v.dR/dv,
-    -dL/dt) and the excess (mechgen.runtime.fields.operators.integrated_series)."""
-    from mechgen.runtime.fields.operators import integrated_series
-
-    return integrated_series(system, "energy_rates", t, X)
+def hybrid_accounted(system) -> bool:
+    """Whether a hybrid run carries the balance's integrals across its events: every mode has its energy_rates
+    kernel (mechgen.runtime.core.augmented.BalancedHybrid)."""
+    return hasattr(system, "modes") and balance_kernels(system)
 
 
 def excess(system, t: np.ndarray, X: np.ndarray) -> np.ndarray:
-    """v.dT/dv - 2 T at each sample (zero for a kinetic energy quadratic in v), in one batched call."""
+    """v.dT/dv - 2 T at each sample (zero for a kinetic energy quadratic in v), in one batched call (a
+    continuum's: integrated over the domain, mechgen.runtime.fields.operators.integrated_series)."""
     if system.is_field:
-        return field_rates(system, t, X)["excess"][:, 0]
+        from mechgen.runtime.fields.operators import integrated_series
+
+        return integrated_series(system, "energy_rates", t, X)["excess"][:, 0]
     return np.asarray(system.evaluate_series("energy_rates", t, X)["excess"], float).reshape(len(t))
 
 
@@ -110,19 +87,6 @@ def mode_powers(mode_system, t: np.ndarray, X: np.ndarray, modes: np.ndarray) ->
     return out
 
 
-def unaccounted(system, t: np.ndarray, X: np.ndarray) -> dict | None:
-    """For a run that did not integrate its balance (CVODES): ``energy_note`` when the model has forces,
-    dissipation or an explicit time dependence at the samples (its energy_drift would mean nothing), else None."""
-    if "energy_rates" not in system.kernels or system.is_lattice or system.is_field:
-        return None
-    powers = mode_powers(lambda k: system, t, X, np.zeros(len(t), int))
-    if powers is None or not np.any(powers):
-        return None
-    return {"energy_note": "the model has forces, dissipation or an explicit time dependence whose work this "
-                           "method does not integrate: no energy figure (the other methods report "
-                           "energy_balance_error)"}
-
-
 def reset_losses(mode_system, events) -> list[tuple[float, float]]:
     """(t, E before - E after) of each event that resets the state into a mode (terminal events excluded)."""
     return [(float(e.t), _energy(mode_system(e.source), e.t, e.x_before) - _energy(mode_system(e.target), e.t,
@@ -140,8 +104,9 @@ def hybrid_figures(mode_system, t: np.ndarray, X: np.ndarray, modes: np.ndarray,
     powers in any mode, no reset that changes the energy). Modes without powers but resets that change the
     energy: ``energy_balance_error`` of E(t) - E(0) + D(t), D the energy the resets took up to t (a sample at an
     event's instant is compared on the side of it that fits), ``dissipated`` = D at the end, ``work`` = 0.
-    Modes with forces, dissipation or an explicit time dependence: their powers are not integrated across the
-    events, so no figure is given (``energy_note`` says so)."""
+    Modes with forces, dissipation or an explicit time dependence: their powers were not integrated across the
+    events (a run without every mode's energy_rates kernel; hybrid_balance where they were), so no figure is
+    given (``energy_note`` says so)."""
     powers = mode_powers(mode_system, t, X, modes)
     losses = reset_losses(mode_system, events)
     E = series["energy"]
@@ -153,12 +118,46 @@ def hybrid_figures(mode_system, t: np.ndarray, X: np.ndarray, modes: np.ndarray,
     if powers is None or np.any(powers):
         return {"energy_note": "the modes have forces, dissipation or an explicit time dependence whose work "
                                "is not integrated across events: no energy figure"}
-    times = np.array([tl for tl, _ in losses])
-    cumulative = np.concatenate([[0.0], np.cumsum(jumps)])
-    before = cumulative[np.searchsorted(times, t, side="left")]
-    through = cumulative[np.searchsorted(times, t, side="right")]
+    before, through, total = _reset_steps(losses, t)
     error = np.minimum(np.abs(E - E[0] + before), np.abs(E - E[0] + through))
-    total = float(cumulative[-1])
     scale = max(scale, abs(total))
     return {"energy_balance_error": float(np.max(error) / scale) if scale > 0 else 0.0, "work": 0.0,
             "dissipated": total}
+
+
+def _reset_steps(losses, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+    """The energy the resets took up to each sample time, counting an event at the sample's instant out
+    (``before``) and in (``through``), and in all (a sample at an event's instant may hold either side)."""
+    times = np.array([tl for tl, _ in losses])
+    cumulative = np.concatenate([[0.0], np.cumsum([loss for _, loss in losses])])
+    return (cumulative[np.searchsorted(times, t, side="left")], cumulative[np.searchsorted(times, t, side="right")],
+            float(cumulative[-1]))
+
+
+def hybrid_balance(mode_system, t: np.ndarray, X: np.ndarray, modes: np.ndarray, events, series: dict) -> dict | None:
+    """The energy balance of a hybrid run whose state carried the integrals (X: samples of the augmented state,
+    the three integrals last; mechgen.runtime.core.augmented.BalancedHybrid), or None when it is conservative:
+
+        error(t) = h(t) - h(0) - W(t) + D(t) + D_resets(t),   h = E + (v.dT/dv - 2 T) in the sample's mode,
+
+    W the forces' and the explicit work, D the energy dissipated in the flow (both integrated through every mode),
+    D_resets the energy the resets took up to t (E before - E after each; a sample at an event's instant is
+    compared on the side of it that fits). ``dissipated`` = D + D_resets at the end, ``work`` = W at the end."""
+    state = X[:, :X.shape[1] - EXTRA]
+    powers = mode_powers(mode_system, t, state, modes)
+    if powers is None:
+        return hybrid_figures(mode_system, t, state, modes, events, series)
+    W, D = X[:, -3] + X[:, -1], X[:, -2]
+    E = series["energy"]
+    before, through, total = _reset_steps(reset_losses(mode_system, events), t)
+    scale = float(np.max(np.abs(series["kinetic_energy"]) + np.abs(series["potential_energy"])))
+    quiet = float(np.max(np.abs(through), initial=0.0)) <= 1e-14 * max(scale, 1e-300) and abs(total) <= 1e-14 * max(
+        scale, 1e-300)
+    if quiet and not np.any(X[:, -EXTRA:]) and not np.any(powers[:, EXTRA]):
+        return None
+    h = E + powers[:, EXTRA]
+    drift = h - h[0] - W + D
+    error = np.minimum(np.abs(drift + before), np.abs(drift + through))
+    scale = max(scale, float(np.max(np.abs(W))), float(np.max(np.abs(D + through))), abs(total))
+    return {"energy_balance_error": float(np.max(error) / scale) if scale > 0 else 0.0, "work": float(W[-1]),
+            "dissipated": float(D[-1] + total), "_work_series": W, "_dissipated_series": D + through}

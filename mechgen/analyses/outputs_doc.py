@@ -99,7 +99,8 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("work", "scalar", "J (the model's energy unit)", "The work done on the system by forces and by "
            "explicit time dependence, integrated with the state."),
         _o("dissipated", "scalar", "J (the model's energy unit)", "The energy dissipated by the dissipation "
-           "function and, for a hybrid model, taken by the resets."),
+           "function and, for a hybrid model, taken by the resets (the flow's part integrated through every "
+           "mode and carried across the events)."),
         _o("t_end", "scalar", "s", "The end time asked for."),
         _o("method", "string", "-", "The integrator that ran (``auto`` resolved)."),
         _o("loop", "string", "-", "The loop that stepped it: ``c`` (compiled) or ``python``."),
@@ -110,8 +111,8 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("t_final", "scalar", "s", "A hybrid model: where the run ended (before ``t_end`` at a terminal "
            "event or a Zeno stop)."),
         _o("mode_series", "(samples,)", "-", "A hybrid model: the mode at each sample time."),
-        _o("energy_note", "string", "-", "Why a run gives no energy figure: a hybrid model whose modes have forces "
-           "or dissipation, or CVODES on such a model (their work is not integrated)."),
+        _o("energy_note", "string", "-", "Why a run gives no energy figure: a hybrid model with forces or "
+           "dissipation compiled without its modes' ``energy_rates`` kernels (their work is not integrated)."),
         _o("zeno", "bool", "-", "``on_zeno = \"stop\"``: whether the run ended at a Zeno accumulation point."),
     ),
     "sweep": (

@@ -24,6 +24,10 @@ __all__ = ["analysis", "campbell", "continuation", "fit", "impact", "modes", "re
 
 
 def _model_info(system):
+    """The ModelInfo of the system's model: the facts compiled into it (mechgen.compile), else looked up by the
+    model's reference."""
+    if getattr(system, "facts", None) is not None:
+        return system.facts
     from mechgen.scene.info import lookup_model
 
     name = system.metadata.reference  # the canonical reference, for users' models

@@ -33,7 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mechgen.analyses import schema, summary
+from mechgen.analyses import schema
 from mechgen.analyses.cross_section import STRAINS, checked_stiffness
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import Option

@@ -276,9 +276,6 @@ def run_simulate(system, options: dict, context: dict) -> dict:
     out = {**report(system, options, t, state, series), **how}
     if extra:
         balanced(out, energy_balance.figures(system, t, X, series))
-    elif method == "cvodes" and (note := energy_balance.unaccounted(system, t, state)) is not None:
-        del out["energy_drift"]
-        out.update(note)
     if system.is_lattice and system.metadata.ends == "fixed":
         out["mode_energies"] = mode_energies(system, X[-1, :n], X[-1, n:2 * n])
     return out

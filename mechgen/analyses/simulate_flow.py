@@ -23,6 +23,7 @@ import numpy as np
 
 from mechgen.analyses import energy_balance
 from mechgen.errors import InputError
+from mechgen.runtime.core.augmented import AugmentedFlow
 from mechgen.runtime.core.budget import Budget
 from mechgen.runtime.core.diagnose import explain_state
 from mechgen.runtime.core.integrate import integrate_first_order
@@ -128,7 +129,7 @@ def adaptive_run(system, options: dict, x0: np.ndarray, method: str, budget: Bud
     if method == "cvodes":
         traj = cvodes_run(system, x0, t_end, run)
     else:
-        flow = energy_balance.AugmentedFlow(system) if extra else system
+        flow = AugmentedFlow(system) if extra else system
         traj = integrate_first_order(flow.rhs, x0, t_end, jac=flow.jacobian, options=run)
     xs = traj.x if traj.x.shape[0] == len(traj.t) else traj.x.T
     return np.asarray(traj.t, float), np.asarray(xs, float), {"method": method, "loop": "python", "_extra": extra}
@@ -168,4 +169,5 @@ def cvodes_run(system, x0, t_end: float, run: RunOptions):
         raise InputError(why, key="method", expected="a method of this system's backend: auto, BDF, Radau, LSODA, "
                          "RK45, DOP853 or leapfrog, or backend 'casadi' for 'cvodes'")
     return integrate_cvodes(system, x0, t_end, t_eval=run.t_eval, rtol=run.rtol, atol=run.atol, budget=run.budget,
-                            progress=run.progress, desc=run.desc, explain=run.explain)
+                            progress=run.progress, desc=run.desc, explain=run.explain,
+                            integrals=x0.size - (2 * system.n + system.m))

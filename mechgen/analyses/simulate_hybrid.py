@@ -9,8 +9,10 @@ mechgen.runtime.core.events; ``loop`` chooses the event loop that applies them (
 compiled one of mechgen.runtime.core.events_c for DOP853 on the C backend, else the Python one;
 ``python`` or ``c`` to choose). Outputs: the model's outputs at the end of the run (in the mode it
 ended in), ``events`` (a list of ``{t, from, to, guard}``; ``to`` is null for a terminal event),
-``final_mode``, ``t_final`` (t_end, or the time of the terminal event), ``energy_drift`` and
-``t_end``; with the time history (mechgen.analyses.time_series: ``t``, ``trajectory``, ``energy_series``)
+``final_mode``, ``t_final`` (t_end, or the time of the terminal event), ``energy_drift`` (a conservative
+run) or the energy balance (``energy_balance_error``, ``work``, ``dissipated``: the powers of every mode
+integrated with the state and carried across the events, mechgen.runtime.core.augmented.BalancedHybrid, and
+the energy each reset takes; mechgen.analyses.energy_balance.hybrid_balance) and ``t_end``; with the time history (mechgen.analyses.time_series: ``t``, ``trajectory``, ``energy_series``)
 ``mode_series``, the mode at each sample (the state where the run ended is the last sample). ``on_zeno =
 "stop"`` ends a run at a Zeno approach instead of failing: the events so far, ``t_final`` at the event that
 made it Zeno, and ``zeno = true``.
@@ -22,6 +24,7 @@ import numpy as np
 from mechgen.analyses import energy_balance, time_series
 from mechgen.analyses.context import NAME
 from mechgen.errors import SceneError
+from mechgen.runtime.core.augmented import BalancedHybrid
 from mechgen.runtime.core.diagnose import explain_state
 from mechgen.runtime.core.events import EventRules, ZenoApproach, integrate_hybrid
 from mechgen.runtime.core.run_options import RunOptions
@@ -55,7 +58,7 @@ def event_log(system, events) -> list[dict]:
 
 def run_hybrid(system, options: dict, context: dict) -> dict:
     """Time response of a hybrid system; see the module doc."""
-    from mechgen.analyses.simulate import declared_start, initial_state, report
+    from mechgen.analyses.simulate import balanced, declared_start, initial_state, report
 
     if options.get("method") == "leapfrog":
         raise SceneError("method 'leapfrog' cannot integrate a hybrid model (its modes switch at events)",
@@ -65,13 +68,22 @@ def run_hybrid(system, options: dict, context: dict) -> dict:
     x0 = np.concatenate([q0, v0, np.zeros(system.m) if start is None else start[2 * system.n:]])
     n_out = int(options.get("samples", 201))
     require(dense_bytes(n_out, 3 * x0.size + 6), f"{n_out} output samples", key="samples")
-    traj, zeno, method = hybrid_run(system, options, x0, context.get(NAME, "simulate"))
-    t, X, modes = with_final(traj)
+    carry = energy_balance.hybrid_accounted(system)
+    runner = BalancedHybrid(system) if carry else system
+    x_run = np.concatenate([x0, np.zeros(energy_balance.EXTRA)]) if carry else x0
+    traj, zeno, method = hybrid_run(runner, options, x_run, context.get(NAME, "simulate"))
+    t, X_run, modes = with_final(traj)
+    X = X_run[:, :x0.size]
     mode_system = mode_views(system)
     series = time_series.sampled_outputs_by_mode(mode_system, t, X, modes)
     out = report(system, options, t, X, series)
-    figures = energy_balance.hybrid_figures(mode_system, t, X, modes, traj.events, series)
-    if figures is not None:  # resets that change the energy, or modes that are not conservative
+    if carry:  # the powers integrated through every mode, the resets' losses from the states at the events
+        figures = energy_balance.hybrid_balance(mode_system, t, X_run, modes, traj.events, series)
+    else:
+        figures = energy_balance.hybrid_figures(mode_system, t, X, modes, traj.events, series)
+    if figures is not None and "_work_series" in figures:
+        balanced(out, figures)
+    elif figures is not None:  # resets that change the energy, or modes that are not conservative
         del out["energy_drift"]
         out.update(figures)
     out["t_final"] = float(traj.t_final)
@@ -91,6 +103,7 @@ def hybrid_run(system, options: dict, x0: np.ndarray, desc: str):
     error end it. ``method = "auto"`` is decided on the initial mode (mechgen.analyses.simulate_flow)."""
     from mechgen.analyses.simulate import budget_of
 
+    plain = getattr(system, "system", system)  # a BalancedHybrid's own system: the state without the integrals
     method, t_end = options.get("method", "auto"), float(options["t_end"])
     if method == "auto":  # decided on the initial mode's linearisation (mechgen.analyses.simulate_flow)
         from mechgen.analyses.simulate_flow import chosen_method
@@ -100,7 +113,8 @@ def hybrid_run(system, options: dict, x0: np.ndarray, desc: str):
                      t_eval=np.linspace(0.0, t_end, int(options.get("samples", 201))),
                      budget=budget_of(options, method), rules=rules_of(options),
                      progress=bool(options.get("progress", True)), desc=desc,
-                     explain=lambda t, x: explain_state(system, t, x), loop=options.get("loop", "auto"))
+                     explain=lambda t, x: explain_state(plain, t, np.asarray(x)[:2 * plain.n + plain.m]),
+                     loop=options.get("loop", "auto"))
     try:
         traj = integrate_hybrid(system, x0, t_end, mode=start_mode(system, options), options=run)
     except ZenoApproach as exc:

@@ -23,7 +23,7 @@ import numpy as np
 
 from mechgen.errors import InputError
 from mechgen.runtime.core.memory import dense_bytes, require
-from mechgen.runtime.core.variational import STAGES, VariationalRun, run_variational, steps_for
+from mechgen.runtime.core.variational import STAGES, VariationalOptions, run_variational, steps_for
 from mechgen.scene.values import fail
 
 
@@ -76,8 +76,9 @@ def simulate_variational(system, q0: np.ndarray, v0: np.ndarray, options: dict, 
     count = steps // save_every + 2
     require(dense_bytes(count, 3 * system.n + 5), f"{count} samples of the variational run", key="samples")
     balance = "energy_rates" in system.kernels
-    run = run_variational(system, q0, v0, t_end, dt, stages=int(options.get("stages", 1)), save_every=save_every,
-                          balance=balance, budget=budget, progress=bool(options.get("progress", True)), desc=desc,
-                          loop=options.get("loop", "auto"))
+    how = VariationalOptions(stages=int(options.get("stages", 1)), save_every=save_every, balance=balance,
+                             budget=budget, progress=bool(options.get("progress", True)), desc=desc,
+                             loop=options.get("loop", "auto"))
+    run = run_variational(system, q0, v0, t_end, dt, options=how)
     X = np.hstack([run.q, run.v] + ([run.w] if balance else []))
     return run.t, X, {"method": "variational", "loop": run.loop, "_extra": 3 if balance else 0}

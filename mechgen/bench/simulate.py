@@ -126,7 +126,7 @@ def hand_c_loop():
 
 def _against_hand_c(mechgen, model_file: Path, t_end: float, repeats: int) -> dict:
     """Like for like with the hand-written C loop: end state only, no energy balance (module doc)."""
-    plain = mechgen.compile(str(model_file), kernels=["residual", "tangent", "outputs"])
+    plain = mechgen.compile(str(model_file), kernels=["residual", "tangent", "flow", "outputs"])
     run_c = hand_c_loop()
     got = {}
 

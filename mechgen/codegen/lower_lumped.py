@@ -35,8 +35,8 @@ from mechgen.errors import ModelError
 from mechgen.symbolic.derive import LumpedEquations
 from mechgen.symbolic.separable import separable_obstacle
 
-LUMPED_KERNELS = ("residual", "tangent", "linear", "force", "rates", "rates_tangent", "energy_rates", "outputs", "section",
-                  "rod", "lagrangian")
+LUMPED_KERNELS = ("residual", "tangent", "flow", "linear", "force", "rates", "rates_tangent", "energy_rates", "outputs",
+                  "section", "rod", "lagrangian")
 
 
 def _inputs(eqs: LumpedEquations, with_accel: bool = True) -> tuple[list[Port], list]:

@@ -137,7 +137,7 @@ def check_layout(file: str, data: dict, model: Any, params: dict, segments: tupl
 
 
 def _check_overrides(file: str, model: Any, segments: tuple, parts: tuple, written: dict) -> None:
-    """Refuse ``--set NAME=value`` where a [[segments]] or [[parts]] table sets NAME (README: tables win
+    """Refuse ``--set NAME=value`` where a [[segments]] or [[parts]] table sets NAME (docs/guide.md: tables win
     over [params] and --set, so the flag would be silently ignored)."""
     length = getattr(model, "length", None)
     for name, (_, key) in written.items():

@@ -86,7 +86,7 @@ class CProblem(ctypes.Structure):
                 ("n_eval", c_long), ("t_eval", c_void_p), ("sample_cap", c_long), ("event_cap", c_long),
                 ("s_t", c_void_p), ("s_x", c_void_p), ("s_mode", c_void_p),
                 ("e_t", c_void_p), ("e_before", c_void_p), ("e_after", c_void_p),
-                ("e_source", c_void_p), ("e_target", c_void_p), ("e_guard", c_void_p),
+                ("e_source", c_void_p), ("e_target", c_void_p), ("e_guard", c_void_p), ("carried", c_long),
                 ("flow", c_void_p), ("flow_data", c_void_p)]
 
 
@@ -105,14 +105,23 @@ class CState(ctypes.Structure):
 LAYOUT = (CKernel, CMode, CProblem, CState)
 
 
-@lru_cache(maxsize=1)
-def _library():
-    """(the loaded loop library, None) or (None, why it is unavailable); built once per process."""
+#: states (2n + m) up to which a run uses a loop library built for its own sizes (the compiler unrolls the loops
+#: over the state: ~15-20 % less time per step on small models); larger states use the generic one
+SPECIALISE_MAX_STATES = 16
+
+
+@lru_cache(maxsize=None)
+def _library(n: int | None = None, m: int | None = None):
+    """(the loaded loop library, None) or (None, why it is unavailable); built once per machine (the compile
+    cache) and loaded once per process. With sizes (n, m): the loop built for exactly those (MGH_FIXED_N/M)."""
     from mechgen.codegen.build import load_shared
 
+    source, stem = SOURCE.read_text(encoding="utf-8"), STEM
+    if n is not None:
+        source = f"#define MGH_FIXED_N {int(n)}\n#define MGH_FIXED_M {int(m)}\n" + source
+        stem = f"{STEM}_{int(n)}_{int(m)}"
     try:
-        lib = load_shared(SOURCE.read_text(encoding="utf-8"), stem=STEM, ldflags=("-lm",),
-                          symbols=("mgh_run", "mgh_layout"))
+        lib = load_shared(source, stem=stem, ldflags=("-lm",), symbols=("mgh_run", "mgh_layout"))
     except (CompilerUnavailable, BuildError, OSError) as exc:
         log.info("C event loop unavailable (%s)", exc)
         return None, f"the C event loop cannot be built ({exc})"
@@ -126,12 +135,17 @@ def _library():
 
 
 def forget_library() -> None:
-    """Forget the loaded (or refused) loop library: the next run builds or finds it again (tests change CC)."""
+    """Forget the loaded (or refused) loop libraries: the next run builds or finds them again (tests change CC)."""
     _library.cache_clear()
 
 
-def loop_library():
-    """The loaded C loop library (CompilerUnavailable or BuildError when it cannot be had)."""
+def loop_library(n: int | None = None, m: int | None = None):
+    """The loaded C loop library (CompilerUnavailable or BuildError when it cannot be had); for a state of sizes
+    (n, m) with 2n + m <= SPECIALISE_MAX_STATES the one built for them (the generic one if that build fails)."""
+    if n is not None and 2 * n + m <= SPECIALISE_MAX_STATES:
+        lib, _ = _library(int(n), int(m))
+        if lib is not None:
+            return lib
     lib, why = _library()
     if lib is None:
         raise CompilerUnavailable(why)
@@ -313,7 +327,7 @@ def integrate_hybrid_c(system, x0, t_end: float, *, mode: int | None = None, opt
     why = c_loop_problem(system, "DOP853")
     if why is not None:
         raise CompilerUnavailable(why)
-    lib = loop_library()
+    lib = loop_library(system.n, system.m)
     tables = _tables(system)
     t_end = float(t_end)
     n, m = system.n, system.m
@@ -335,8 +349,8 @@ def integrate_hybrid_c(system, x0, t_end: float, *, mode: int | None = None, opt
                        p=params.ctypes.data if params.size else None, rtol=float(rtol), atol=float(atol),
                        t_end=t_end, max_events=int(rules.max_events), zeno_events=int(rules.zeno_events),
                        zeno_span=float(zeno_span), stop_mode=-1, pause=int(stop_after is not None),
-                       budget_left=-1, slice=SLICE)
-    flow = getattr(system, "flow", None)  # (fn, data) addresses of a provider of dq/dt, dv/dt (a continuum)
+                       budget_left=-1, slice=SLICE, carried=int(getattr(system, "carried", 0)))
+    flow = getattr(system, "flow", None)  # (fn, data) addresses of a provider of dx/dt (a continuum)
     if flow is not None:
         problem.flow, problem.flow_data = flow
     if t_eval is not None:  # (params and t_eval stay referenced here while the loop reads them)

@@ -56,14 +56,15 @@ def cvodes_problem(system) -> str | None:
     return None
 
 
-def first_order_expression(system):
+def first_order_expression(system, integrals: int = 0):
     """(x, t, p, f): CasADi MX symbols of the state, time and free parameters and the expression f(t, x; p)
-    of the module doc, from the system's CasADi kernels."""
+    of the module doc, from the system's CasADi kernels. ``integrals`` = 3: the state also carries the energy
+    balance's integrals (mechgen.runtime.core.augmented), their rates the ``energy_rates`` kernel's powers."""
     import casadi as ca
 
     n, m = int(system.n), int(system.m)
-    x, t, p = ca.MX.sym("x", 2 * n + m), ca.MX.sym("t"), ca.MX.sym("p", len(system.params))
-    q, v, z = x[:n], x[n:2 * n], x[2 * n:]
+    x, t, p = ca.MX.sym("x", 2 * n + m + integrals), ca.MX.sym("t"), ca.MX.sym("p", len(system.params))
+    q, v, z = x[:n], x[n:2 * n], x[2 * n:2 * n + m]
     a0 = ca.MX.zeros(n)
 
     def call(kernel: str, **ports):
@@ -78,6 +79,8 @@ def first_order_expression(system):
     parts = [v, -ca.solve(M, r0)]
     if m:
         parts.append(call("rates", **{k: state[k] for k in ("q", "v", "z", "t", "p")})["g"])
+    if integrals:  # g = (dz/dt, Q.v, v.dR/dv, -dL/dt): the powers follow the internal rates
+        parts.append(call("energy_rates", **{k: state[k] for k in ("q", "v", "z", "t", "p")})["g"][m:])
     return x, t, p, ca.vertcat(*parts)
 
 
@@ -88,15 +91,16 @@ def _flag(message: str) -> str:
 
 def integrate_cvodes(system, x0, t_end: float, *, t_eval, rtol: float = 1e-8, atol: float = 1e-10,
                      budget: Budget | None = None, progress: bool = False, desc: str = "simulate",
-                     explain=None) -> Trajectory:
+                     explain=None, integrals: int = 0) -> Trajectory:
     """Integrate the system's dx/dt = f(t, x) from 0 to t_end with CVODES; states at the uniform ``t_eval``
-    (from 0 to t_end; module doc for pieces, budget and failures)."""
+    (from 0 to t_end; module doc for pieces, budget and failures); ``integrals`` = 3: x0 and the states carry
+    the energy balance's integrals after (q, v, z) (first_order_expression)."""
     import casadi as ca
 
     t_eval = np.asarray(t_eval, float)
     if t_eval.size < 2 or t_eval[0] != 0.0 or not np.allclose(np.diff(t_eval), t_eval[1] - t_eval[0], rtol=1e-9):
         raise ValueError("integrate_cvodes samples a uniform grid from t = 0")
-    x_sym, t_sym, p_sym, f = first_order_expression(system)
+    x_sym, t_sym, p_sym, f = first_order_expression(system, integrals)
     t0, tau = ca.MX.sym("t0"), ca.MX.sym("tau")
     dae = {"x": x_sym, "t": tau, "p": ca.vertcat(p_sym, t0), "ode": ca.substitute(f, t_sym, t0 + tau)}
     sub = max(1, -(-CHUNKS // (t_eval.size - 1)))  # grid points per sample interval: at least CHUNKS pieces

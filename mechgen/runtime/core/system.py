@@ -30,6 +30,10 @@ from mechgen.runtime.core.kernels import Kernel
 from mechgen.runtime.core.meta import SystemMeta
 from mechgen.runtime.core.pattern import Pattern, build_pattern, extent
 
+#: dense mass matrices up to this size are solved by numpy's LAPACK call (scipy.linalg.solve's checks cost more
+#: than the solve for a handful of coordinates)
+SMALL_DENSE = 32
+
 
 class Memo:
     """A bounded memo of values that are pure functions of their key (and of the frozen structure of the
@@ -127,6 +131,9 @@ class System:
     backend: str = "numpy"
     rebuild: Callable | None = field(default=None, repr=False)
     folded: tuple[str, ...] = ()
+    #: the facts of the model it was compiled from (mechgen.scene.info.ModelInfo), set by the compile layer for
+    #: a model given as an object (one a reference cannot find again); None: looked up by the model's reference
+    facts: object = field(default=None, repr=False, compare=False)
     patterns: dict = field(init=False, repr=False)
     metadata: SystemMeta = field(init=False, repr=False)
 
@@ -335,6 +342,8 @@ class System:
     def _solve(self, M, rhs):
         if sps.issparse(M):
             return spla.spsolve(M.tocsc(), rhs)
+        if M.shape[0] <= SMALL_DENSE:  # LAPACK's gesv without scipy's checks (tens of microseconds a call)
+            return np.linalg.solve(M, rhs)
         return sla.solve(M, rhs, assume_a="sym") if rhs.ndim == 1 else sla.solve(M, rhs)
 
     def acceleration(self, q, v, z=None, t=0.0) -> tuple[np.ndarray, object]:

@@ -45,7 +45,7 @@ Runtime module: numbers only (no sympy); units are the model's (t in its time un
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, fields, replace
 from typing import Callable
 
 import numpy as np
@@ -263,47 +263,77 @@ def steps_for(t_end: float, dt: float) -> tuple[int, float]:
     return steps, t_end / steps
 
 
-def run_variational(system, q0, v0, t_end: float, dt: float, *, stages: int = 1, save_every: int = 1,
-                    energy: Callable | None = None, balance: bool = False, budget: Budget | None = None,
-                    progress: bool = False, desc: str = "variational", loop: str = "auto") -> VariationalRun:
-    """Integrate from (q0, v0) at t = 0 to t_end with the Gauss-Legendre variational integrator of ``stages``
-    (module doc), equal steps h = t_end / ceil(t_end / dt); samples every ``save_every`` steps and at the end.
+@dataclass(frozen=True)
+class VariationalOptions:
+    """How a variational run goes (run_variational).
 
-    ``loop``: ``auto`` (the compiled loop, mechgen.runtime.core.variational_c, when the kernels are C, else
-    Python), ``python`` or ``c``. ``energy(q, v, t)`` is evaluated at the samples; ``balance`` integrates the
-    energy balance's powers too (Powers; the system's ``energy_rates`` kernel). ``budget`` refuses the step count
-    up front and checks the wall time every CHUNK steps; a Newton failure or a NaN/Inf state ends the run
-    (ConvergenceError naming the time).
+    Attributes:
+        stages: Gauss-Legendre stages s (order 2s; 1 is the midpoint rule).
+        save_every: a sample every this many steps (and at the end).
+        energy: ``(q, v, t) -> float`` evaluated at the samples, or None.
+        balance: integrate the energy balance's powers too (Powers; the system's ``energy_rates`` kernel).
+        budget: refuses the step count up front and checks the wall time every CHUNK steps, or None.
+        progress, desc: a progress bar in steps and its label.
+        loop: "auto" (the compiled loop, mechgen.runtime.core.variational_c, when the kernels are C), "python" or
+            "c".
     """
+
+    stages: int = 1
+    save_every: int = 1
+    energy: Callable | None = None
+    balance: bool = False
+    budget: Budget | None = None
+    progress: bool = False
+    desc: str = "variational"
+    loop: str = "auto"
+
+    @classmethod
+    def of(cls, options: "VariationalOptions | None" = None, **changes) -> "VariationalOptions":
+        """``options`` (default: the defaults) with ``changes`` (keyword names of the fields) applied."""
+        known = {f.name for f in fields(cls)}
+        unknown = set(changes) - known
+        if unknown:
+            raise TypeError(f"unknown variational options {sorted(unknown)}; expected some of {sorted(known)}")
+        base = cls() if options is None else options
+        return replace(base, **changes) if changes else base
+
+
+def run_variational(system, q0, v0, t_end: float, dt: float, *, options: VariationalOptions | None = None,
+                    **changes) -> VariationalRun:
+    """Integrate from (q0, v0) at t = 0 to t_end with the Gauss-Legendre variational integrator of
+    ``options.stages`` (module doc), equal steps h = t_end / ceil(t_end / dt); samples every ``save_every`` steps
+    and at the end (VariationalOptions; its fields may also be given as keywords). A Newton failure or a NaN/Inf
+    state ends the run (ConvergenceError naming the time)."""
     from mechgen.runtime.core.variational_c import compiled_stepper
 
+    opt = VariationalOptions.of(options, **changes)
     steps, h = steps_for(t_end, dt)
-    if budget is not None:
-        budget.refuse(steps, f"nothing (refused before starting: t_end / dt = {steps:,} steps)")
-    lag, tab = Lagrangian(system), gauss_legendre(stages)
-    powers = Powers(system) if balance else None
+    if opt.budget is not None:
+        opt.budget.refuse(steps, f"nothing (refused before starting: t_end / dt = {steps:,} steps)")
+    lag, tab = Lagrangian(system), gauss_legendre(opt.stages)
     q, v, W = np.array(q0, float), np.array(v0, float), np.zeros(3)
     p = lag.momentum(q, v, 0.0)
     V = np.tile(v, (tab.stages, 1))
-    rec = Recorder(lag, energy, steps, save_every, q.size)
+    rec = Recorder(lag, opt.energy, steps, opt.save_every, q.size)
     rec.add(0.0, q, p, v, W)
-    advance = compiled_stepper(system, tab, h, balance=balance, required=loop == "c") if loop != "python" else None
+    advance = (compiled_stepper(system, tab, h, balance=opt.balance, required=opt.loop == "c")
+               if opt.loop != "python" else None)
     used = "python" if advance is None else "c"
-    advance = advance or python_stepper(lag, tab, h, powers)
+    advance = advance or python_stepper(lag, tab, h, Powers(system) if opt.balance else None)
     newton, done = 0, 0
-    with Progress(steps, desc=desc, unit="step", enabled=progress) as bar:
+    with Progress(steps, desc=opt.desc, unit="step", enabled=opt.progress) as bar:
         while done < steps:
             count = min(CHUNK, steps - done)
-            q, p, V, W, iterations, samples = advance(q, p, V, W, done, count, steps, save_every)
+            q, p, V, W, iterations, samples = advance(q, p, V, W, done, count, steps, opt.save_every)
             for sample in samples:
                 rec.add(*sample)
             newton, done = newton + iterations, done + count
             if not (np.all(np.isfinite(q)) and np.all(np.isfinite(p))):
                 raise nonfinite(done * h)
-            if budget is not None:
-                budget.check_time(lambda: f"t = {done * h:.6g} of t_end = {t_end:.6g} after {done:,} steps")
+            if opt.budget is not None:
+                opt.budget.check_time(lambda: f"t = {done * h:.6g} of t_end = {t_end:.6g} after {done:,} steps")
             bar.to(done)
-    return rec.run(h, steps, newton, used, balance)
+    return rec.run(h, steps, newton, used, opt.balance)
 
 
 class Recorder:

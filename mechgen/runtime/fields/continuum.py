@@ -99,6 +99,9 @@ class FieldSystem:
     _cache: InitVar[dict | None] = None
     rebuild: Callable | None = field(default=None, repr=False)
     folded: tuple[str, ...] = ()
+    #: the facts of the model it was compiled from (mechgen.scene.info.ModelInfo), set by the compile layer for
+    #: a model given as an object (one a reference cannot find again); None: looked up by the model's reference
+    facts: object = field(default=None, repr=False, compare=False)
     _memo: Memo = field(init=False, repr=False)
     _pkey: bytes = field(init=False, repr=False)
 

@@ -98,6 +98,8 @@ typedef struct {
     long *s_mode;
     double *e_t, *e_before, *e_after;   /* events: time, states (event_cap x nx) */
     long *e_source, *e_target, *e_guard;
+    long carried;              /* the state's last `carried` entries (<= m) pass through resets unchanged: integrals
+                                  carried across events; the reset kernels give the nx - carried before them */
     /* a provider of dx/dt = f[0 .. 2n + m) at (t, x) in place of the residual, tangent and rates kernels (a
        continuum: mechgen/codegen/templates/c99/field_flow.c), returning 0 or a kernel's nonzero code; NULL: none */
     int (*flow)(void *data, double t, const double *x, double *f);
@@ -191,6 +193,18 @@ const double mgh_D[4][16] = {
     {-25.69393346270375, 0.0, 0.0, 0.0, 0.0, -154.18974869023643, -231.5293791760455, 357.6391179106141, 93.40532418362432, -37.45832313645163, 104.0996495089623, 29.8402934266605, -43.53345659001114, 96.32455395918828, -39.17726167561544, -149.72683625798564}};
 
 /* ---- the run's workspace ---- */
+/* The state's sizes: the fields of the context, or constants when the library is built for one size
+ * (-DMGH_FIXED_N=n -DMGH_FIXED_M=m: the compiler then unrolls the loops over the state; mgh_run refuses any
+ * other size with MGH_E_INPUT) */
+#ifdef MGH_FIXED_N
+#define MGH_N(c) ((long)(MGH_FIXED_N))
+#define MGH_M(c) ((long)(MGH_FIXED_M))
+#else
+#define MGH_N(c) ((c)->n)
+#define MGH_M(c) ((c)->m)
+#endif
+#define MGH_NX(c) (2 * MGH_N(c) + MGH_M(c))
+
 #define MGH_CONTINUE 100
 #define MGH_EPS DBL_EPSILON
 
@@ -200,7 +214,8 @@ typedef struct {
     long n, m, nx, ng, ring;
     long *flags;               /* 2 * max_guards: crossed, crossing just after (a tie) */
     double *mem;
-    double *zeros, *kout[MGH_PORTS], *M, *b, *K, *F;
+    double *zeros, *M, *b, *K, *F;
+    double **kout;             /* (4 nmodes + nresets) x MGH_PORTS: each kernel's own outputs (kout_of) */
     double *y_old, *f_old, *y_new, *f_new, *ytmp, *xm, *fm, *xd, *fd, *xa, *xs, *fy, *ff, *fy2, *ff2;
     double *g_new, *d_new, *gm, *dm, *gt, *gtt, *ca, *cda, *cb, *cdb, *roots, *t_his;
     double *st_g;              /* MGH_STACK entries of 4 * max_guards: ga, da, gb, db */
@@ -217,26 +232,31 @@ static double time_tolerance(double t, double t_end)
     return fmax(1e-12 * fabs(t_end), 64 * MGH_EPS * fabs(t));
 }
 
+/* the outputs of the kernel `kind` (MGH_K_*) of mode `where`, or of reset `where`: its own buffers, zeroed once at
+ * setup. A lumped kernel sets its structurally nonzero entries at every call and never accumulates (only lattice
+ * kernels do, and the loop does not run lattices), so its structural zeros stay zero without a memset per call. */
+static double *const *kout_of(const mgh_ctx *c, long kind, long where)
+{
+    long slot = kind == MGH_K_RESET ? 4 * c->P->nmodes + where : 4 * where + kind;
+    return c->kout + slot * MGH_PORTS;
+}
+
 static int kcall(mgh_ctx *c, const mgh_kernel *k, long kind, long where, const double *x, const double *a, double t)
 {
     const double *in[MGH_PORTS];
-    double *out[MGH_PORTS];
+    double *const *out = kout_of(c, kind, where);
     double tt = t;
     long sizes = 0, i;
     int rc;
     for (i = 0; i < k->nin; ++i) {
         switch (k->ports[i]) {
         case MGH_IN_Q: in[i] = x; break;
-        case MGH_IN_V: in[i] = x + c->n; break;
+        case MGH_IN_V: in[i] = x + MGH_N(c); break;
         case MGH_IN_A: in[i] = a != NULL ? a : c->zeros; break;
-        case MGH_IN_Z: in[i] = c->m ? x + 2 * c->n : c->zeros; break;
+        case MGH_IN_Z: in[i] = MGH_M(c) ? x + 2 * MGH_N(c) : c->zeros; break;
         case MGH_IN_T: in[i] = &tt; break;
         default: in[i] = c->P->p != NULL ? c->P->p : c->zeros; break;
         }
-    }
-    for (i = 0; i < k->nout; ++i) {
-        out[i] = c->kout[i];
-        memset(out[i], 0, (size_t)k->out_len[i] * sizeof(double));
     }
     rc = k->fn(in, out, &sizes, 1);
     if (rc != 0) {
@@ -298,7 +318,7 @@ static void fail_at(mgh_ctx *c, double t, const double *x)
 {
     c->S->err_t = t;
     if (x != c->S->err_x)
-        memcpy(c->S->err_x, x, (size_t)c->nx * sizeof(double));
+        memcpy(c->S->err_x, x, (size_t)MGH_NX(c) * sizeof(double));
 }
 
 /* f[0 .. 2n + m) from the problem's flow provider; its nonzero code is a kernel error of the residual */
@@ -316,11 +336,13 @@ static int flow_rhs(mgh_ctx *c, long mode, double t, const double *x, double *f)
     return 0;
 }
 
-/* f = dx/dt of mode `mode` at (t, x): (v, -M^-1 r(q, v, 0, z, t), rates); only the rates when n = 0 */
-static int rhs(mgh_ctx *c, long mode, double t, const double *x, double *f)
+/* f = dx/dt of mode `mode` at (t, x): (v, -M^-1 r(q, v, 0, z, t), rates); only the rates when n = 0.
+ * Not checked for NaN/Inf: rhs() checks; the step's stages are checked at once through their error norm. */
+static int rhs_unchecked(mgh_ctx *c, long mode, double t, const double *x, double *f)
 {
     const mgh_mode *md = &c->P->modes[mode];
-    long n = c->n, i;
+    long n = MGH_N(c), i;
+    double *const *r_out = kout_of(c, MGH_K_RESIDUAL, mode), *const *M_out = r_out;
     int rc;
     if (n == 0)
         goto rates;
@@ -332,25 +354,47 @@ static int rhs(mgh_ctx *c, long mode, double t, const double *x, double *f)
     if ((rc = kcall(c, &md->residual, MGH_K_RESIDUAL, mode, x, NULL, t)) != 0)
         return rc;
     for (i = 0; i < n; ++i)
-        c->b[i] = -c->kout[md->residual.pick[0]][i];
-    /* one kernel may give both r and M (the fused `flow` kernel): its outputs are still in kout */
-    if (md->tangent.fn != md->residual.fn && (rc = kcall(c, &md->tangent, MGH_K_TANGENT, mode, x, NULL, t)) != 0)
-        return rc;
-    memcpy(c->M, c->kout[md->tangent.pick[0]], (size_t)(n * n) * sizeof(double));
+        c->b[i] = -r_out[md->residual.pick[0]][i];
+    /* one kernel may give both r and M (the fused `flow` kernel): then M is among the residual call's outputs */
+    if (md->tangent.fn != md->residual.fn) {
+        if ((rc = kcall(c, &md->tangent, MGH_K_TANGENT, mode, x, NULL, t)) != 0)
+            return rc;
+        M_out = kout_of(c, MGH_K_TANGENT, mode);
+    }
+    if (n == 1) {  /* a scalar M: no elimination */
+        if (M_out[md->tangent.pick[0]][0] == 0.0) {
+            fail_at(c, t, x);
+            return MGH_E_SINGULAR;
+        }
+        c->b[0] /= M_out[md->tangent.pick[0]][0];
+        goto solved;
+    }
+    memcpy(c->M, M_out[md->tangent.pick[0]], (size_t)(n * n) * sizeof(double));
     if (solve(n, c->M, c->b)) {
         fail_at(c, t, x);
         return MGH_E_SINGULAR;
     }
+solved:
     memcpy(f, x + n, (size_t)n * sizeof(double));
     memcpy(f + n, c->b, (size_t)n * sizeof(double));
 rates:
-    if (c->m && c->P->flow == NULL) {   /* a flow provider gives dz/dt as well */
+    if (MGH_M(c) && c->P->flow == NULL) {   /* a flow provider gives dz/dt as well */
         if ((rc = kcall(c, &md->rates, MGH_K_RATES, mode, x, NULL, t)) != 0)
             return rc;
-        memcpy(f + 2 * n, c->kout[md->rates.pick[0]], (size_t)c->m * sizeof(double));
+        memcpy(f + 2 * n, kout_of(c, MGH_K_RATES, mode)[md->rates.pick[0]], (size_t)MGH_M(c) * sizeof(double));
     }
     c->S->nfev++;
-    for (i = 0; i < c->nx; ++i) {
+    return 0;
+}
+
+/* rhs_unchecked, MGH_E_RHS (at t, x) when dx/dt is NaN/Inf */
+static int rhs(mgh_ctx *c, long mode, double t, const double *x, double *f)
+{
+    long i;
+    int rc = rhs_unchecked(c, mode, t, x, f);
+    if (rc != 0)
+        return rc;
+    for (i = 0; i < MGH_NX(c); ++i) {
         if (!isfinite(f[i])) {
             fail_at(c, t, x);
             c->S->err_mode = mode;
@@ -364,16 +408,17 @@ rates:
 static int guards(mgh_ctx *c, long mode, double t, const double *x, const double *f, double *g, double *gt)
 {
     const mgh_mode *md = &c->P->modes[mode];
+    double *const *out = kout_of(c, MGH_K_GUARDS, mode);
     long k, ng = md->nguards;
     int rc;
     if (ng == 0)
         return 0;
-    if ((rc = kcall(c, &md->guards, MGH_K_GUARDS, mode, x, f != NULL ? f + c->n : NULL, t)) != 0)
+    if ((rc = kcall(c, &md->guards, MGH_K_GUARDS, mode, x, f != NULL ? f + MGH_N(c) : NULL, t)) != 0)
         return rc;
     c->S->nguard++;
     for (k = 0; k < ng; ++k) {
-        g[k] = c->kout[md->guards.pick[0]][k];
-        gt[k] = f != NULL ? c->kout[md->guards.pick[1]][k] : 0.0;
+        g[k] = out[md->guards.pick[0]][k];
+        gt[k] = f != NULL ? out[md->guards.pick[1]][k] : 0.0;
         if (!isfinite(g[k]) || !isfinite(gt[k])) {
             fail_at(c, t, x);
             c->S->err_guard = k;
@@ -387,7 +432,7 @@ static int guards(mgh_ctx *c, long mode, double t, const double *x, const double
 static int rk_stages(mgh_ctx *c, long mode, double t, const double *y, const double *f, double h,
                      double *y_new, double *f_new)
 {
-    long nx = c->nx, s, j, i;
+    long nx = MGH_NX(c), s, j, i;
     double *K = c->K, dy;
     int rc;
     memcpy(K, f, (size_t)nx * sizeof(double));
@@ -398,7 +443,7 @@ static int rk_stages(mgh_ctx *c, long mode, double t, const double *y, const dou
                 dy += K[j * nx + i] * mgh_A[s][j];
             c->ytmp[i] = y[i] + dy * h;
         }
-        if ((rc = rhs(c, mode, t + mgh_C[s] * h, c->ytmp, K + s * nx)) != 0)
+        if ((rc = rhs_unchecked(c, mode, t + mgh_C[s] * h, c->ytmp, K + s * nx)) != 0)
             return rc;
     }
     for (i = 0; i < nx; ++i) {
@@ -407,15 +452,45 @@ static int rk_stages(mgh_ctx *c, long mode, double t, const double *y, const dou
             dy += K[j * nx + i] * mgh_B[j];
         y_new[i] = y[i] + h * dy;
     }
-    if ((rc = rhs(c, mode, t + h, y_new, f_new)) != 0)
+    if ((rc = rhs_unchecked(c, mode, t + h, y_new, f_new)) != 0)
         return rc;
     memcpy(K + 12 * nx, f_new, (size_t)nx * sizeof(double));
     return 0;
 }
 
+/* After a step whose error norm is NaN/Inf: MGH_E_RHS at the first stage whose dx/dt is NaN/Inf (its state
+ * rebuilt exactly as rk_stages made it), 0 when every stage is finite. A NaN/Inf entry of any stage makes the
+ * norm NaN/Inf (it enters the E5 sum multiplied by a coefficient, and 0 * Inf is NaN), so a finite norm
+ * vouches for all 13 stages: the same failures rhs() reports, checked once per step. */
+static int stage_failure(mgh_ctx *c, long mode, double t, const double *y, double h, const double *y_new)
+{
+    long nx = MGH_NX(c), s, j, i;
+    double dy;
+    for (s = 1; s < 13; ++s) {  /* K[0] = f was checked where it was made */
+        for (i = 0; i < nx && isfinite(c->K[s * nx + i]); ++i)
+            ;
+        if (i == nx)
+            continue;
+        if (s == 12) {
+            fail_at(c, t + h, y_new);
+        } else {
+            for (i = 0; i < nx; ++i) {
+                dy = 0.0;
+                for (j = 0; j < s; ++j)
+                    dy += c->K[j * nx + i] * mgh_A[s][j];
+                c->ytmp[i] = y[i] + dy * h;
+            }
+            fail_at(c, t + mgh_C[s] * h, c->ytmp);
+        }
+        c->S->err_mode = mode;
+        return MGH_E_RHS;
+    }
+    return 0;
+}
+
 static double error_norm(mgh_ctx *c, double h, const double *y, const double *y_new)
 {
-    long nx = c->nx, i, j;
+    long nx = MGH_NX(c), i, j;
     const mgh_problem *P = c->P;
     double e5 = 0.0, e3 = 0.0, s5, s3, scale;
     for (i = 0; i < nx; ++i) {
@@ -456,6 +531,8 @@ static int dop_step(mgh_ctx *c, long mode, double t, const double *y, const doub
         if ((rc = rk_stages(c, mode, t, y, f, h, y_new, f_new)) != 0)
             return rc;
         err = error_norm(c, h, y, y_new);
+        if (!isfinite(err) && (rc = stage_failure(c, mode, t, y, h, y_new)) != 0)
+            return rc;
         if (err < 1) {
             factor = err == 0 ? 10.0 : fmin(10.0, 0.9 * pow(err, -0.125));
             if (rejected)
@@ -475,7 +552,7 @@ static int dop_step(mgh_ctx *c, long mode, double t, const double *y, const doub
 /* the dense output of the last step (t_old, y_old, f_old) -> (t_old + h, y_new, f_new): F (7 x nx) */
 static int dense_prepare(mgh_ctx *c, long mode, double t_old, double h)
 {
-    long nx = c->nx, s, j, i, r;
+    long nx = MGH_NX(c), s, j, i, r;
     double *K = c->K, dy;
     int rc;
     for (s = 13; s < 16; ++s) {
@@ -508,7 +585,7 @@ static int dense_prepare(mgh_ctx *c, long mode, double t_old, double h)
 /* the dense output at tt (scipy Dop853DenseOutput._call_impl) */
 static void dense_eval(mgh_ctx *c, double tt, double *out)
 {
-    long nx = c->nx, i, k;
+    long nx = MGH_NX(c), i, k;
     double x = (tt - c->dense_t0) / c->dense_h;
     for (i = 0; i < nx; ++i) {
         double y = 0.0;
@@ -533,7 +610,7 @@ static double rms(const double *a, const double *scale, long nx)
 static int initial_step(mgh_ctx *c, long mode, double t0, const double *y0, const double *f0, double *h_out)
 {
     const mgh_problem *P = c->P;
-    long nx = c->nx, i;
+    long nx = MGH_NX(c), i;
     double interval = fabs(P->t_end - t0), d0, d1, d2, h0, h1;
     double *scale = c->xd, *y1 = c->ytmp, *f1 = c->fd;
     int rc;
@@ -570,7 +647,7 @@ static void record(mgh_ctx *c, double t, const double *x, long mode)
     if (P->n_eval != 0 || S->n_samples >= P->sample_cap)
         return;
     P->s_t[S->n_samples] = t;
-    memcpy(P->s_x + S->n_samples * c->nx, x, (size_t)c->nx * sizeof(double));
+    memcpy(P->s_x + S->n_samples * MGH_NX(c), x, (size_t)MGH_NX(c) * sizeof(double));
     P->s_mode[S->n_samples] = mode;
     S->n_samples++;
 }
@@ -584,7 +661,7 @@ static void sample_until(mgh_ctx *c, double t_hi, long mode)
         return;
     while (S->i_eval < P->n_eval && P->t_eval[S->i_eval] <= t_hi) {
         P->s_t[S->i_eval] = P->t_eval[S->i_eval];
-        dense_eval(c, P->t_eval[S->i_eval], P->s_x + S->i_eval * c->nx);
+        dense_eval(c, P->t_eval[S->i_eval], P->s_x + S->i_eval * MGH_NX(c));
         P->s_mode[S->i_eval] = mode;
         S->i_eval++;
     }
@@ -597,12 +674,13 @@ static int fire(mgh_ctx *c, long k, double t, const double *x, long *target)
     const mgh_problem *P = c->P;
     mgh_state *S = c->S;
     const mgh_mode *md = &P->modes[S->mode];
-    long nx = c->nx, r = md->reset[k], e, i;
+    long nx = MGH_NX(c), r = md->reset[k], e, i;
     int rc;
     if (r >= 0) {
         if ((rc = kcall(c, &P->resets[r], MGH_K_RESET, r, x, NULL, t)) != 0)
             return rc;
-        memcpy(c->xa, c->kout[P->resets[r].pick[0]], (size_t)nx * sizeof(double));
+        memcpy(c->xa, kout_of(c, MGH_K_RESET, r)[P->resets[r].pick[0]], (size_t)(nx - P->carried) * sizeof(double));
+        memcpy(c->xa + nx - P->carried, x + nx - P->carried, (size_t)P->carried * sizeof(double));
     } else {
         memcpy(c->xa, x, (size_t)nx * sizeof(double));
     }
@@ -647,7 +725,7 @@ static int after_event(mgh_ctx *c, long target)
 {
     mgh_state *S = c->S;
     long source = S->mode;
-    memcpy(S->x, c->xa, (size_t)c->nx * sizeof(double));
+    memcpy(S->x, c->xa, (size_t)MGH_NX(c) * sizeof(double));
     S->phase = 0;
     if (target < 0)
         return MGH_TERMINATED;
@@ -1001,7 +1079,7 @@ static int locate(mgh_ctx *c, long mode, long k, double t_lo, double t_hi, doubl
                   double *t_star)
 {
     const mgh_problem *P = c->P;
-    long nx = c->nx, i;
+    long nx = MGH_NX(c), i;
     double t = t_old, h_abs = t_d - t_old, t_new, h, dt;
     int rc;
     if (t_d > t_old) {
@@ -1090,7 +1168,7 @@ static int step(mgh_ctx *c)
     const mgh_problem *P = c->P;
     mgh_state *S = c->S;
     const mgh_mode *md = &P->modes[S->mode];
-    long nx = c->nx, ng = md->nguards, mode = S->mode, k = 0, i, target;
+    long nx = MGH_NX(c), ng = md->nguards, mode = S->mode, k = 0, i, target;
     double t_old = S->t, t_new, h, t_lo = 0.0, t_hi = 0.0, t_root = 0.0, t_star;
     int rc, found;
     if (P->n_eval == 0 && S->n_samples + 3 > P->sample_cap)
@@ -1114,7 +1192,12 @@ static int step(mgh_ctx *c)
             return MGH_E_STATE;
         }
     }
-    if ((rc = dense_prepare(c, mode, t_old, h)) != 0 || (rc = guards(c, mode, t_new, c->y_new, c->f_new, c->g_new, c->d_new)) != 0)
+    /* the dense output (3 more evaluations) only where it is read: guards to scan, or a sample inside the step
+     * (scipy's solve_ivp builds it on the same condition) */
+    if (ng > 0 || (P->n_eval > 0 && S->i_eval < P->n_eval && P->t_eval[S->i_eval] <= t_new))
+        if ((rc = dense_prepare(c, mode, t_old, h)) != 0)
+            goto failed;
+    if ((rc = guards(c, mode, t_new, c->y_new, c->f_new, c->g_new, c->d_new)) != 0)
         goto failed;
     found = ng > 0 ? scan(c, mode, S->sign, t_old, t_new, &k, &t_lo, &t_hi, &t_root) : 0;
     if (found < 0) {
@@ -1183,23 +1266,52 @@ static int check_kernel(const mgh_kernel *k, int needed)
     return 0;
 }
 
+/* kernel slot i of kout_of: 4 per mode (residual, tangent, rates, guards), then the resets */
+static const mgh_kernel *loop_kernel(const mgh_problem *P, long i)
+{
+    const mgh_mode *md;
+    if (i >= 4 * P->nmodes)
+        return &P->resets[i - 4 * P->nmodes];
+    md = &P->modes[i / 4];
+    switch (i % 4) {
+    case MGH_K_RESIDUAL: return &md->residual;
+    case MGH_K_TANGENT: return &md->tangent;
+    case MGH_K_RATES: return &md->rates;
+    default: return &md->guards;
+    }
+}
+
+static void release(mgh_ctx *c)
+{
+    free(c->mem);
+    free(c->flags);
+    free(c->kout);
+    c->mem = NULL;
+    c->flags = NULL;
+    c->kout = NULL;
+}
+
 static int setup(mgh_ctx *c, const mgh_problem *P, mgh_state *S)
 {
     long n = P->n, m = P->m, nx = 2 * P->n + P->m, ng = P->max_guards > 0 ? P->max_guards : 1;
-    long i, j, total, len[MGH_PORTS];
+    long i, j, total, nk = 4 * P->nmodes + P->nresets;
     long lumped = P->flow == NULL ? n : 0;   /* unknowns whose dx/dt the residual and tangent kernels give */
     double *p;
     memset(c, 0, sizeof(*c));
     c->P = P;
     c->S = S;
+#ifdef MGH_FIXED_N
+    if (n != MGH_FIXED_N || m != MGH_FIXED_M)
+        return MGH_E_INPUT;
+#endif
     if (n < 0 || m < 0 || n + m < 1 || P->nmodes < 1 || P->modes == NULL || S->mode < 0 || S->mode >= P->nmodes
-        || P->max_guards < 0 || (P->nresets > 0 && P->resets == NULL) || P->zeno_events < 0)
+        || P->max_guards < 0 || (P->nresets > 0 && P->resets == NULL) || P->zeno_events < 0
+        || P->carried < 0 || P->carried > m)
         return MGH_E_INPUT;
     for (i = 0; i < P->nmodes; ++i) {
         const mgh_mode *md = &P->modes[i];
         if (check_kernel(&md->residual, lumped > 0) || check_kernel(&md->tangent, lumped > 0)
-            || check_kernel(&md->rates, m > 0 && P->flow == NULL)
-            || check_kernel(&md->guards, md->nguards > 0) || md->nguards > P->max_guards || md->nguards < 0)
+            || check_kernel(&md->rates, m > 0 && P->flow == NULL) || check_kernel(&md->guards, md->nguards > 0) || md->nguards > P->max_guards || md->nguards < 0)
             return MGH_E_INPUT;
         for (j = 0; j < md->nguards; ++j)
             if (md->target[j] >= P->nmodes || md->reset[j] >= P->nresets || (!md->terminal[j] && md->target[j] < 0))
@@ -1209,7 +1321,7 @@ static int setup(mgh_ctx *c, const mgh_problem *P, mgh_state *S)
             return MGH_E_INPUT;
     }
     for (i = 0; i < P->nresets; ++i)
-        if (check_kernel(&P->resets[i], 1) || P->resets[i].out_len[P->resets[i].pick[0]] != nx)
+        if (check_kernel(&P->resets[i], 1) || P->resets[i].out_len[P->resets[i].pick[0]] != nx - P->carried)
             return MGH_E_INPUT;
     c->n = n;
     c->m = m;
@@ -1217,28 +1329,14 @@ static int setup(mgh_ctx *c, const mgh_problem *P, mgh_state *S)
     c->ng = ng;
     c->ring = P->zeno_events + 1 > 2 ? P->zeno_events + 1 : 2;  /* more than zeno_events within zeno_span */
     total = nx + lumped * lumped + n + 16 * nx + 7 * nx + 15 * nx + 12 * ng + MGH_STACK * 4 * ng;
-    for (j = 0; j < MGH_PORTS; ++j) {
-        len[j] = 1;
-        for (i = 0; i < P->nmodes; ++i) {
-            const mgh_mode *md = &P->modes[i];
-            long l = kernel_outputs(&md->residual, j);
-            if (kernel_outputs(&md->tangent, j) > l) l = kernel_outputs(&md->tangent, j);
-            if (kernel_outputs(&md->rates, j) > l) l = kernel_outputs(&md->rates, j);
-            if (kernel_outputs(&md->guards, j) > l) l = kernel_outputs(&md->guards, j);
-            if (l > len[j]) len[j] = l;
-        }
-        for (i = 0; i < P->nresets; ++i)
-            if (kernel_outputs(&P->resets[i], j) > len[j])
-                len[j] = kernel_outputs(&P->resets[i], j);
-        total += len[j];
-    }
+    for (i = 0; i < nk; ++i)
+        for (j = 0; j < MGH_PORTS; ++j)
+            total += kernel_outputs(loop_kernel(P, i), j);
     c->mem = (double *)calloc((size_t)total, sizeof(double));
     c->flags = (long *)calloc((size_t)(2 * ng), sizeof(long));
-    if (c->mem == NULL || c->flags == NULL) {
-        free(c->mem);
-        free(c->flags);
-        c->mem = NULL;
-        c->flags = NULL;
+    c->kout = (double **)calloc((size_t)(nk * MGH_PORTS), sizeof(double *));
+    if (c->mem == NULL || c->flags == NULL || c->kout == NULL) {
+        release(c);
         return MGH_E_MEMORY;
     }
     p = c->mem;
@@ -1255,8 +1353,9 @@ static int setup(mgh_ctx *c, const mgh_problem *P, mgh_state *S)
     MGH_TAKE(gtt, ng); MGH_TAKE(ca, ng); MGH_TAKE(cda, ng); MGH_TAKE(cb, ng); MGH_TAKE(cdb, ng);
     MGH_TAKE(roots, ng); MGH_TAKE(t_his, ng);
     MGH_TAKE(st_g, MGH_STACK * 4 * ng);
-    for (j = 0; j < MGH_PORTS; ++j)
-        MGH_TAKE(kout[j], len[j]);
+    for (i = 0; i < nk; ++i)
+        for (j = 0; j < MGH_PORTS; ++j)
+            MGH_TAKE(kout[i * MGH_PORTS + j], kernel_outputs(loop_kernel(P, i), j));
 #undef MGH_TAKE
     return 0;
 }
@@ -1287,7 +1386,6 @@ int mgh_run(const mgh_problem *P, mgh_state *S)
         if (rc != MGH_CONTINUE)
             break;
     }
-    free(c.mem);
-    free(c.flags);
+    release(&c);
     return rc;
 }
