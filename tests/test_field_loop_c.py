@@ -239,6 +239,9 @@ def test_auto_weighs_a_large_continuums_largest_rates(plain):
     assert np.max(-dense.real) == pytest.approx(0.15, rel=1e-9)
     r = mechgen.simulate(system, t_end=0.01, initial_mode=1, amplitude=0.1, samples=3)
     assert (r["method"], r["loop"]) == ("DOP853", "c")
+    fastest = float(np.abs(dense).max())  # DOP853 needs >= t_end |lambda|max / 12 steps: refused up front
+    with pytest.raises(mechgen.errors.MechgenError, match="needs at least .* steps to stay stable"):
+        mechgen.simulate(system, t_end=10.0, method="DOP853", initial_mode=1, max_steps=int(10.0 * fastest / 24))
 
 
 def test_a_follower_loads_work_is_its_power_integrated_along_the_run():

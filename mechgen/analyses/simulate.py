@@ -219,8 +219,9 @@ def refuse_explicit_stiff(system, x0: np.ndarray, t_end: float, method: str, bud
     """An explicit method needs at least t_end |lambda|max / c steps for stability alone (|lambda|max: the
     largest eigenvalue magnitude of d(dx/dt)/dx at the start, ``rates`` when the caller has them, else
     simulate_flow.start_rates; c: EXPLICIT_REACH); refuse when that is more than the budget (the problem is
-    stiff: the implicit methods have no such stability limit)."""
-    if method not in EXPLICIT_REACH or x0.size > ESTIMATE_SIZE or budget.limit is None:
+    stiff: the implicit methods have no such stability limit). Beyond ESTIMATE_SIZE states only a continuum has an
+    estimate (its largest rates, simulate_flow.largest_rates)."""
+    if method not in EXPLICIT_REACH or (x0.size > ESTIMATE_SIZE and not system.is_field) or budget.limit is None:
         return
     rates = simulate_flow.start_rates(system, x0) if rates is None else rates
     if rates is None:  # no estimate: the step budget still holds during the run

@@ -26,7 +26,7 @@ import numpy as np
 from mechgen.errors import BuildError, CompilerUnavailable
 from mechgen.runtime.core.events_c import LONG, integrate_hybrid_c
 from mechgen.runtime.core.pattern import extent
-from mechgen.runtime.fields.operators import Block, Operators, field_operators, gauss_blocks, point_blocks
+from mechgen.runtime.fields.operators import Block, Operators, blocks_of, field_operators
 
 log = logging.getLogger("mechgen")
 
@@ -238,7 +238,7 @@ def _rhs_address() -> int:
 
 def flow_of(system, extra: int = 0) -> FieldFlow:
     """The C structures of the system's operators (and, with ``extra``, of its energy_rates blocks)."""
-    rates = tuple(gauss_blocks(system, "energy_rates") + point_blocks(system, "energy_rates")) if extra else ()
+    rates = blocks_of(system, "energy_rates") if extra else ()
     return FieldFlow(field_operators(system), rates, extra)
 
 

@@ -149,10 +149,16 @@ def field_operators(system) -> Operators:
     def make() -> Operators:
         M = system.tangent(np.zeros(system.n))["r_a"]
         chol, perm = mass_factor(M)
-        blocks = tuple(gauss_blocks(system) + point_blocks(system))
+        blocks = blocks_of(system, "residual")
         return Operators(system.n, blocks, penalty_operator(system), chol, perm)
 
     return system.memo(("c_loop", "operators", *system.loop_key()), make)
+
+
+def blocks_of(system, kernel: str) -> tuple:
+    """The Gauss-point blocks and the end and part blocks of ``kernel`` (memoised per parameter set)."""
+    return system.memo(("c_loop", "blocks", kernel, *system.loop_key()),
+                       lambda: tuple(gauss_blocks(system, kernel) + point_blocks(system, kernel)))
 
 
 def integrated_series(system, kernel: str, t: np.ndarray, X: np.ndarray) -> dict[str, np.ndarray]:
@@ -162,7 +168,7 @@ def integrated_series(system, kernel: str, t: np.ndarray, X: np.ndarray) -> dict
     n, ns = system.n, len(t)
     Q, V = np.asarray(X[:, :n], float).T, np.asarray(X[:, n:2 * n], float).T
     values: dict[str, np.ndarray] = {}
-    for block in gauss_blocks(system, kernel) + point_blocks(system, kernel):
+    for block in blocks_of(system, kernel):
         npts = block.s.size
         na = block.J.shape[0] // npts
         jets = [np.ascontiguousarray((block.J @ Y).reshape(npts, na, ns).transpose(2, 0, 1).reshape(-1, na))
