@@ -228,7 +228,8 @@ def test_where_the_compiled_loop_cannot_run(model_file, plain):
 def test_auto_weighs_a_large_continuums_largest_rates(plain):
     """Above 400 first-order states, auto's estimate is ARPACK's 6 largest eigenvalues of the sparse linearisation:
     against the dense eigenvalues of FieldSystem.jacobian, the fastest rate and (c / 2 rho = 0.15 for every mode of
-    the string on its viscous foundation) the fastest decay agree to 1e-6; auto then runs DOP853 in the C loop."""
+    the string on its viscous foundation) the fastest decay agree to 1e-6; auto then runs DOP853 in the C loop, and
+    DOP853 over a t_end whose stability alone needs twice max_steps is refused before the first step."""
     system = plain.with_params(N=120, c=0.3)
     x0 = np.concatenate([0.01 * np.sin(np.arange(system.n)), np.zeros(system.n)])
     assert x0.size > simulate_flow.ESTIMATE_SIZE
