@@ -22,6 +22,7 @@ from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
+import scipy.sparse as sps
 
 from mechgen.errors import BuildError, CompilerUnavailable
 from mechgen.runtime.core.events_c import LONG, integrate_hybrid_c
@@ -42,7 +43,8 @@ class CBlock(ctypes.Structure):
 
     _fields_ = [("fn", c_void_p), ("nin", c_long), ("nout", c_long), ("pick", c_long), ("ports", c_long * PORTS),
                 ("out_len", c_long * PORTS), ("npts", c_long), ("na", c_long), ("s", c_void_p), ("p", c_void_p),
-                ("indptr", c_void_p), ("indices", c_void_p), ("data", c_void_p), ("w", c_void_p)]
+                ("indptr", c_void_p), ("indices", c_void_p), ("data", c_void_p), ("w", c_void_p),
+                ("t_indptr", c_void_p), ("t_indices", c_void_p), ("t_data", c_void_p)]
 
 
 class CFlow(ctypes.Structure):
@@ -50,7 +52,7 @@ class CFlow(ctypes.Structure):
 
     _fields_ = [("n", c_long), ("nblocks", c_long), ("m", c_long), ("nrates", c_long), ("blocks", c_void_p),
                 ("rates", c_void_p), ("p_indptr", c_void_p),
-                ("p_indices", c_void_p), ("p_data", c_void_p), ("band", c_long), ("chol", c_void_p),
+                ("p_indices", c_void_p), ("p_data", c_void_p), ("band", c_long), ("lrow", c_void_p), ("lcol", c_void_p),
                 ("perm", c_void_p), ("jq", c_void_p), ("jv", c_void_p), ("ja", c_void_p), ("tt", c_void_p),
                 ("out", c_void_p * PORTS), ("r", c_void_p), ("y", c_void_p), ("err_block", c_long),
                 ("err_rc", c_long)]
@@ -90,6 +92,24 @@ def kernel_problem(kernel, na: int, output: str = "r") -> str | None:
     return None
 
 
+def band_rows(ab: np.ndarray) -> np.ndarray:
+    """The rows of L within the band, out[j, i] = L[j, j - i] for i >= 1 (0 where j < i) and out[j, 0] =
+    1 / L[j, j], from the lower band storage ab[i, j] = L[j + i, j] of a (band + 1) x n factor."""
+    width, n = ab.shape
+    out = np.zeros((n, width))
+    for i in range(width):
+        out[i:, i] = ab[i, :n - i]
+    out[:, 0] = 1.0 / ab[0]
+    return out
+
+
+def band_columns(ab: np.ndarray) -> np.ndarray:
+    """The columns of L within the band, out[j, i] = L[j + i, j] for i >= 1 and out[j, 0] = 1 / L[j, j]."""
+    out = np.ascontiguousarray(ab.T)
+    out[:, 0] = 1.0 / ab[0]
+    return out
+
+
 class FieldFlow:
     """The C structures of :class:`Operators` and a workspace: ``address`` is the mgf_flow the loop's flow
     provider reads; the arrays it points to are kept here for as long as this object lives."""
@@ -108,7 +128,8 @@ class FieldFlow:
             self.rates[i] = self._block(block, out_len, "g")
         self.flow = CFlow(n=ops.n, nblocks=len(ops.blocks), blocks=ctypes.addressof(self.blocks), m=m,
                           nrates=len(rates), rates=ctypes.addressof(self.rates),
-                          band=ops.chol.shape[0] - 1, chol=self._address(ops.chol),
+                          band=ops.chol.shape[0] - 1, lrow=self._address(band_rows(ops.chol)),
+                          lcol=self._address(band_columns(ops.chol)),
                           perm=self._address(ops.perm.astype(LONG)))
         if ops.penalty is not None:
             P = ops.penalty
@@ -141,6 +162,10 @@ class FieldFlow:
         out.indptr = self._address(block.J.indptr.astype(LONG))
         out.indices = self._address(block.J.indices.astype(LONG))
         out.data, out.w = self._address(block.J.data), self._address(block.w)
+        S = (sps.diags(block.w) @ block.J).T.tocsr()  # the gather r += S rho
+        S.sort_indices()
+        out.t_indptr, out.t_indices = self._address(S.indptr.astype(LONG)), self._address(S.indices.astype(LONG))
+        out.t_data = self._address(S.data)
         return out
 
 

@@ -13,8 +13,11 @@
  * quadrature weight of its point; 1 at an end or part), rho_b the model's pointwise residual kernel called once
  * over the block's points by address (the mechgen kernel ABI), s_b the points' positions and p_b the block's
  * parameter vector (a segment's or a part's). P (CSR, n x n) is the penalty stiffness Z^T C^T diag(alpha) C Z
- * (absent without penalty rows). M, the constant reduced mass matrix, comes as its Cholesky factor L in lower
- * band storage, chol[i * n + j] = L[j + i, j] for i = 0..band, of M permuted: M[perm][:, perm] = L L^T.
+ * (absent without penalty rows). The sum over a block's rows is a gather through S_b = (diag(w_b) J_b)^T, also
+ * CSR (n rows). M, the constant reduced mass matrix, comes as its Cholesky factor L of M permuted,
+ * M[perm][:, perm] = L L^T, banded: lrow[j (band + 1) + i] = L[j, j - i] and lcol[j (band + 1) + i] = L[j + i, j]
+ * for i = 1..band (zero outside L), so that both substitutions read memory in order, and entry i = 0 of both
+ * the reciprocal 1 / L[j, j] (a product in the substitutions' dependency chain, not a division).
  * Everything that is linear in q is thus a sparse product; only rho is evaluated pointwise.
  *
  * With m > 0 the state carries m integrals after (q, v) (the energy balance's work and dissipated energy), whose
@@ -44,6 +47,8 @@ typedef struct {
     const long *indptr, *indices;  /* J_b: CSR, npts * na rows, n columns */
     const double *data;
     const double *w;               /* npts * na: each row's weight */
+    const long *t_indptr, *t_indices;   /* S_b = (diag(w_b) J_b)^T: CSR, n rows, npts * na columns */
+    const double *t_data;
 } mgf_block;
 
 typedef struct {
@@ -53,7 +58,7 @@ typedef struct {
     const long *p_indptr, *p_indices;   /* P: CSR n x n (p_indptr NULL: none) */
     const double *p_data;
     long band;
-    const double *chol;            /* (band + 1) x n, lower band storage of L */
+    const double *lrow, *lcol;     /* n x (band + 1) each: the rows and the columns of L within the band */
     const long *perm;              /* n */
     /* workspace, sized for the largest block: jets (rows each), times and positions (points), outputs */
     double *jq, *jv, *ja, *tt, *out[MGF_PORTS];
@@ -72,30 +77,35 @@ long mgf_layout(long which)
     }
 }
 
-/* out[row] = (J x)[row] for the rows of a block */
-static void jets(const mgf_block *b, const double *x, double *out)
+/* jq = J q and jv = J v for the rows of a block (one pass over J) */
+static void jets(const mgf_block *b, const double *q, const double *v, double *jq, double *jv)
 {
-    long rows = b->npts * b->na, i, k;
-    double s;
+    long rows = b->npts * b->na, i, k, col;
+    double sq, sv, a;
     for (i = 0; i < rows; ++i) {
-        s = 0.0;
-        for (k = b->indptr[i]; k < b->indptr[i + 1]; ++k)
-            s += b->data[k] * x[b->indices[k]];
-        out[i] = s;
+        sq = 0.0;
+        sv = 0.0;
+        for (k = b->indptr[i]; k < b->indptr[i + 1]; ++k) {
+            a = b->data[k];
+            col = b->indices[k];
+            sq += a * q[col];
+            sv += a * v[col];
+        }
+        jq[i] = sq;
+        jv[i] = sv;
     }
 }
 
-/* r += J^T (w .* rho) */
-static void scatter(const mgf_block *b, const double *rho, double *r)
+/* r += J^T (w .* rho) = S rho (a gather: each r[i] summed in a register) */
+static void gather(const mgf_block *b, long n, const double *rho, double *r)
 {
-    long rows = b->npts * b->na, i, k;
-    double c;
-    for (i = 0; i < rows; ++i) {
-        c = b->w[i] * rho[i];
-        if (c == 0.0)
-            continue;
-        for (k = b->indptr[i]; k < b->indptr[i + 1]; ++k)
-            r[b->indices[k]] += b->data[k] * c;
+    long i, k;
+    double s;
+    for (i = 0; i < n; ++i) {
+        s = 0.0;
+        for (k = b->t_indptr[i]; k < b->t_indptr[i + 1]; ++k)
+            s += b->t_data[k] * rho[b->t_indices[k]];
+        r[i] += s;
     }
 }
 
@@ -105,8 +115,7 @@ static int pointwise(mgf_flow *F, const mgf_block *b, double t, const double *x)
     const double *in[MGF_PORTS];
     double *out[MGF_PORTS];
     long sizes = 0, i;
-    jets(b, x, F->jq);
-    jets(b, x + F->n, F->jv);
+    jets(b, x, x + F->n, F->jq, F->jv);
     for (i = 0; i < b->npts; ++i)
         F->tt[i] = t;
     for (i = 0; i < b->nin; ++i) {
@@ -129,20 +138,22 @@ static int pointwise(mgf_flow *F, const mgf_block *b, double t, const double *x)
 /* y = M^-1 r by the banded Cholesky factor (forward and back substitution in the permuted order) */
 static void mass_solve(const mgf_flow *F, const double *r, double *y)
 {
-    long n = F->n, band = F->band, i, j;
-    const double *L = F->chol;
+    long n = F->n, w = F->band + 1, i, j;
+    const double *row, *col;
     double s;
     for (j = 0; j < n; ++j) {
+        row = F->lrow + j * w;
         s = r[F->perm[j]];
-        for (i = 1; i <= band && i <= j; ++i)
-            s -= L[i * n + (j - i)] * y[j - i];
-        y[j] = s / L[j];
+        for (i = 1; i < w && i <= j; ++i)
+            s -= row[i] * y[j - i];
+        y[j] = s * row[0];
     }
     for (j = n - 1; j >= 0; --j) {
+        col = F->lcol + j * w;
         s = y[j];
-        for (i = 1; i <= band && j + i < n; ++i)
-            s -= L[i * n + j] * y[j + i];
-        y[j] = s / L[j];
+        for (i = 1; i < w && j + i < n; ++i)
+            s -= col[i] * y[j + i];
+        y[j] = s * col[0];
     }
 }
 
@@ -182,7 +193,7 @@ int mgf_rhs(void *data, double t, const double *x, double *f)
             F->err_rc = rc;
             return rc;
         }
-        scatter(blk, F->out[blk->pick], F->r);
+        gather(blk, n, F->out[blk->pick], F->r);
     }
     if (F->p_indptr != NULL)
         for (i = 0; i < n; ++i)
