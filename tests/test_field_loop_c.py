@@ -240,7 +240,12 @@ def test_auto_weighs_a_large_continuums_largest_rates(plain):
     assert np.max(-dense.real) == pytest.approx(0.15, rel=1e-9)
     r = mechgen.simulate(system, t_end=0.01, initial_mode=1, amplitude=0.1, samples=3)
     assert (r["method"], r["loop"]) == ("DOP853", "c")
-    fastest = float(np.abs(dense).max())  # DOP853 needs >= t_end |lambda|max / 12 steps: refused up front
+    fastest = float(np.abs(dense).max())
+    # the mesh's fastest modes needing more than STIFF_STEPS explicit steps for stability alone: implicit
+    long = 1.01 * simulate_flow.STIFF_STEPS * simulate_flow.DOP853_MESH_STEP / fastest
+    assert simulate_flow.chosen_method(system, x0, long, rates=largest) == "Radau"
+    assert simulate_flow.chosen_method(system, x0, 0.98 * long, rates=largest) == "DOP853"
+    # DOP853 needs >= t_end |lambda|max / 12 steps: refused up front
     with pytest.raises(mechgen.errors.MechgenError, match="needs at least .* steps to stay stable"):
         mechgen.simulate(system, t_end=10.0, method="DOP853", initial_mode=1, max_steps=int(10.0 * fastest / 24))
 

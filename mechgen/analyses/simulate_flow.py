@@ -34,6 +34,11 @@ from mechgen.runtime.core.run_options import RunOptions
 STIFF_STEPS = 10_000
 #: DOP853's stability interval on the negative real axis, doubled (steps >= t_end |lambda| / c)
 DOP853_REACH = 12.0
+#: h |lambda|max that DOP853 reaches on a continuum's fastest (oscillating) mesh modes, measured: about 2.2 on a
+#: 64-element cantilever (its stability along the imaginary axis, well below DOP853_REACH); a continuum whose
+#: stability alone needs more than STIFF_STEPS such steps is stiff: its fastest modes are artefacts of the mesh
+#: that an implicit method need not resolve (a lumped model's fast oscillation is physics: any method resolves it)
+DOP853_MESH_STEP = 2.0
 #: ``auto`` estimates the start's rates for first-order states up to this size (a dense eigen-solve)
 ESTIMATE_SIZE = 400
 #: above it, a continuum's estimate is this many eigenvalues of largest magnitude (ARPACK)
@@ -82,9 +87,11 @@ def largest_rates(system, x0: np.ndarray, count: int = LARGEST) -> np.ndarray | 
 
 def chosen_method(system, x0: np.ndarray, t_end: float, max_steps: int | None = None, *,
                   rates: np.ndarray | None = None) -> str:
-    """What ``auto`` runs (module doc): Radau when stiff at the start, or when an explicit method's stability
-    alone (t_end max|lambda| / 12) would take more than ``max_steps`` steps (it would be refused); DOP853
-    otherwise; BDF without an estimate. ``rates``: the start's eigenvalues when the caller has them."""
+    """What ``auto`` runs (module doc): Radau when stiff at the start (a continuum also when its fastest mesh modes
+    alone need more than STIFF_STEPS explicit steps, t_end max|lambda| / DOP853_MESH_STEP), or when an explicit
+    method's stability alone (t_end max|lambda| / 12) would take more than ``max_steps`` steps (it would be
+    refused); DOP853 otherwise; BDF without an estimate. ``rates``: the start's eigenvalues when the caller has
+    them."""
     rates = start_rates(system, x0) if rates is None else rates
     if rates is None:
         return "BDF"
@@ -92,6 +99,8 @@ def chosen_method(system, x0: np.ndarray, t_end: float, max_steps: int | None = 
     fastest = float(np.max(np.abs(rates), initial=0.0))
     if t_end * decay / DOP853_REACH > STIFF_STEPS:
         return "Radau"
+    if system.is_field and t_end * fastest / DOP853_MESH_STEP > STIFF_STEPS:
+        return "Radau"  # a mesh's fastest modes are artefacts an implicit method need not resolve
     if max_steps is not None and t_end * fastest / DOP853_REACH > max_steps:
         return "Radau"
     return "DOP853"
