@@ -101,7 +101,7 @@ def scipy_impact(law: str, zeta: float) -> float:
 
 
 def mechgen_impact(system, loop: str) -> float:
-    from mechgen.runtime.core.events import integrate_hybrid
+    from mechgen.runtime.integration.events import integrate_hybrid
 
     x0 = np.array([0.0, 1.0, 0.0])
     tr = integrate_hybrid(system, x0, T_END, method="DOP853", rtol=RTOL, atol=ATOL, loop=loop,

@@ -1,5 +1,5 @@
 """The compiled DOP853 loop for smooth lumped models and ``method = "auto"`` (issue 25, item 3;
-mechgen.analyses.simulate_flow, mechgen.runtime.core.smooth_c).
+mechgen.analyses.simulate_flow, mechgen.runtime.integration.smooth_c).
 
 References: scipy's DOP853 (the compiled loop takes its steps: same coefficients, error norm and step control,
 so the two agree to rounding, and take the same number of steps), the hand-derived equations of a forced,
@@ -17,7 +17,7 @@ import scipy.integrate as si
 
 import mechgen
 from mechgen.analyses import simulate_flow
-from mechgen.runtime.core.smooth_c import smooth_loop_problem
+from mechgen.runtime.integration.smooth_c import smooth_loop_problem
 
 MODELS = Path(__file__).resolve().parent / "models"  # forced_duffing.py: the forced, damped Duffing oscillator
 
@@ -154,7 +154,7 @@ def test_a_python_sweep_on_processes_needs_no_pickling(duffing):
 def test_the_loop_built_for_the_state_size_is_the_generic_loop(duffing, monkeypatch):
     """The loop library built for one state size (its loops unrolled by the compiler) takes the same steps as
     the generic library and gives the same samples, bit for bit: only the loop bounds are constants."""
-    from mechgen.runtime.core import events_c
+    from mechgen.runtime.integration import events_c
 
     options = dict(t_end=60.0, q0={"x": 0.5}, method="DOP853", rtol=1e-9, atol=1e-12, samples=121)
     sized = mechgen.simulate(duffing, **options)

@@ -1,4 +1,4 @@
-"""The compiled event loop (mechgen.runtime.core.events_c) against closed forms and the Python loop.
+"""The compiled event loop (mechgen.runtime.integration.events_c) against closed forms and the Python loop.
 
 References:
 
@@ -27,9 +27,9 @@ import sympy as sp
 
 import mechgen
 from mechgen.errors import InputError
-from mechgen.runtime.core import events_c
+from mechgen.runtime.integration import events_c
 from mechgen.runtime.core.budget import Budget, BudgetExceeded
-from mechgen.runtime.core.events import EventRules, integrate_hybrid
+from mechgen.runtime.integration.events import EventRules, integrate_hybrid
 from mechgen.symbolic.model import Model
 from mechgen.symbolic.params import Param
 
@@ -334,7 +334,7 @@ def test_simulate_takes_the_loop_key():
         assert abs(out["events"][1]["t"] - math.pi / math.sqrt(1 - zeta**2)) < 1e-9
     with pytest.raises(MechgenError, match="loop"):
         mechgen.simulate(system, t_end=1.0, v0={"x": 1.0}, loop="fortran")
-    # a smooth model takes the key too (its compiled loop: mechgen.runtime.core.smooth_c), refused where it cannot run
+    # a smooth model takes the key too (its compiled loop: mechgen.runtime.integration.smooth_c), refused where it cannot run
     smooth = mechgen.compile(pendulum, {}, kernels=["residual", "tangent", "outputs"], backend="numpy")
     with pytest.raises(MechgenError, match="loop 'c' cannot run here"):
         mechgen.simulate(smooth, t_end=1.0, q0={"r": 1.0}, loop="c", method="DOP853")

@@ -17,11 +17,11 @@ import scipy.linalg as sla
 
 import mechgen
 from mechgen.analyses import simulate_flow
-from mechgen.runtime.core.augmented import INTEGRALS as EXTRA
-from mechgen.runtime.core.augmented import AugmentedFlow
+from mechgen.runtime.integration.augmented import INTEGRALS as EXTRA
+from mechgen.runtime.integration.augmented import AugmentedFlow
 from mechgen.errors import InputError
 from mechgen.runtime.core.integrate import integrate_first_order
-from mechgen.runtime.core.run_options import RunOptions
+from mechgen.runtime.integration.run_options import RunOptions
 from mechgen.runtime.fields.flow_c import compiled_rhs, field_loop_problem, integrate_field_c
 
 STRING = '''\

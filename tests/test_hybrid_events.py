@@ -1,4 +1,4 @@
-"""The event rules of the hybrid integrator (mechgen.runtime.core.events, module doc), each against a closed form.
+"""The event rules of the hybrid integrator (mechgen.runtime.integration.events, module doc), each against a closed form.
 
 Small hybrid models are written to model files in a temporary folder (a model file is what a scene names and
 what keys the compile cache) and compiled with ``mechgen.compile``; the engine is driven directly through
@@ -28,7 +28,7 @@ from scipy.optimize import brentq
 import mechgen
 from mechgen.cli import main
 from mechgen.runtime.core.budget import BudgetExceeded
-from mechgen.runtime.core.events import MAX_DEPTH, EventRules, integrate_hybrid, time_tolerance
+from mechgen.runtime.integration.events import MAX_DEPTH, EventRules, integrate_hybrid, time_tolerance
 
 G, COR, H = 9.81, 0.8, 1.0
 

@@ -26,9 +26,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from mechgen.runtime.core.augmented import INTEGRALS, balance_kernels
+from mechgen.runtime.integration.augmented import INTEGRALS, balance_kernels
 
-#: the integrated powers appended to the state (mechgen.runtime.core.augmented): W_forces, D, W_explicit
+#: the integrated powers appended to the state (mechgen.runtime.integration.augmented): W_forces, D, W_explicit
 EXTRA = INTEGRALS
 
 
@@ -43,7 +43,7 @@ def accounted(system, method: str) -> bool:
 
 def hybrid_accounted(system) -> bool:
     """Whether a hybrid run carries the balance's integrals across its events: every mode has its energy_rates
-    kernel (mechgen.runtime.core.augmented.BalancedHybrid)."""
+    kernel (mechgen.runtime.integration.augmented.BalancedHybrid)."""
     return hasattr(system, "modes") and balance_kernels(system)
 
 
@@ -136,7 +136,7 @@ def _reset_steps(losses, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
 
 def hybrid_balance(mode_system, t: np.ndarray, X: np.ndarray, modes: np.ndarray, events, series: dict) -> dict | None:
     """The energy balance of a hybrid run whose state carried the integrals (X: samples of the augmented state,
-    the three integrals last; mechgen.runtime.core.augmented.BalancedHybrid), or None when it is conservative:
+    the three integrals last; mechgen.runtime.integration.augmented.BalancedHybrid), or None when it is conservative:
 
         error(t) = h(t) - h(0) - W(t) + D(t) + D_resets(t),   h = E + (v.dT/dv - 2 T) in the sample's mode,
 

@@ -16,7 +16,7 @@ With ``curve = true`` the outputs also hold ``penetration_series`` and ``force_s
 coordinate and the output ``force_output``, default ``force``) at ``samples`` times over the
 contact: the force-penetration hysteresis. Integration keys as simulate (mechgen.analyses.simulate):
 ``method`` (default DOP853), ``rtol`` (1e-10), ``atol`` (1e-12), ``max_steps``, ``max_seconds``, and
-``loop`` (default ``auto``: the compiled event loop of mechgen.runtime.core.events_c for DOP853 on the C
+``loop`` (default ``auto``: the compiled event loop of mechgen.runtime.integration.events_c for DOP853 on the C
 backend, else the Python one; ``python`` or ``c`` to choose).
 """
 from __future__ import annotations
@@ -28,7 +28,7 @@ from mechgen.analyses.operating_point import vector
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import ABSENT, REQUIRED, Option
 from mechgen.errors import SceneError
-from mechgen.runtime.core.events import LOOPS, integrate_hybrid
+from mechgen.runtime.integration.events import LOOPS, integrate_hybrid
 from mechgen.scene.values import fail, listing, show
 
 STEP = "a number > 0 (or an expression)"

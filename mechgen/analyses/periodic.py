@@ -38,7 +38,7 @@ from mechgen.analyses import figures, schema, summary
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import ABSENT, REQUIRED, Option
 from mechgen.errors import ConvergenceError, SceneError
-from mechgen.runtime.core.events import LOOPS, integrate_hybrid
+from mechgen.runtime.integration.events import LOOPS, integrate_hybrid
 
 SCHEMA = {"period": Option(schema.positive, REQUIRED, "a number > 0"),
           "force_output": Option(schema.name, "force"), "displacement_output": Option(schema.name, "displacement"),

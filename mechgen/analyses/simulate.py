@@ -98,9 +98,9 @@ def _mode(ctx, key: str, value: object) -> str:
 
 
 def _loop(ctx, key: str, value: object) -> str:
-    """The loop that steps the integrator (mechgen.runtime.core.events.LOOPS): the compiled one where it can run
+    """The loop that steps the integrator (mechgen.runtime.integration.events.LOOPS): the compiled one where it can run
     (``auto``), scipy's steppers in Python, or the compiled one (``c``, an input error where it cannot run)."""
-    from mechgen.runtime.core.events import LOOPS
+    from mechgen.runtime.integration.events import LOOPS
 
     return schema.one_of("loop", LOOPS)(ctx, key, value)
 

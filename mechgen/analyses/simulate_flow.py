@@ -9,7 +9,7 @@
   states (no dense eigen-solve) the rule weighs a continuum's :data:`LARGEST` eigenvalues of largest magnitude
   (ARPACK on the sparse linearisation: :func:`largest_rates`); any other system's ``auto`` is ``BDF``, the
   sparse-friendly implicit method.
-* ``DOP853`` on the C backend runs in the compiled loop (mechgen.runtime.core.smooth_c for a lumped model,
+* ``DOP853`` on the C backend runs in the compiled loop (mechgen.runtime.integration.smooth_c for a lumped model,
   mechgen.runtime.fields.flow_c for a continuum with a constant mass: no Python between the steps; the same steps
   as scipy's DOP853) unless ``loop = "python"``; every other method (``BDF``,
   ``Radau``, ``LSODA``, ``RK45``, and ``DOP853`` on the numpy or CasADi backends) is scipy's, stepped in
@@ -23,12 +23,12 @@ import numpy as np
 
 from mechgen.analyses import energy_balance
 from mechgen.errors import InputError
-from mechgen.runtime.core.augmented import AugmentedFlow
+from mechgen.runtime.integration.augmented import AugmentedFlow
 from mechgen.runtime.core.budget import Budget
 from mechgen.runtime.core.diagnose import explain_state
 from mechgen.runtime.core.integrate import integrate_first_order
 from mechgen.runtime.core.memory import dense_bytes, require
-from mechgen.runtime.core.run_options import RunOptions
+from mechgen.runtime.integration.run_options import RunOptions
 
 #: an explicit method needing more steps than this for stability alone makes ``auto`` choose Radau
 STIFF_STEPS = 10_000
@@ -145,13 +145,13 @@ def adaptive_run(system, options: dict, x0: np.ndarray, method: str, budget: Bud
 
 
 def compiled_loop_problem(system, run: RunOptions, extra: int) -> str | None:
-    """Why the compiled DOP853 loop cannot run ``system`` (None when it can): mechgen.runtime.core.smooth_c for a
+    """Why the compiled DOP853 loop cannot run ``system`` (None when it can): mechgen.runtime.integration.smooth_c for a
     lumped model, mechgen.runtime.fields.flow_c for a continuum."""
     if system.is_field:
         from mechgen.runtime.fields.flow_c import field_loop_problem
 
         return field_loop_problem(system, run.rtol, run.atol, extra)
-    from mechgen.runtime.core.smooth_c import smooth_loop_problem
+    from mechgen.runtime.integration.smooth_c import smooth_loop_problem
 
     return smooth_loop_problem(system, run.rtol, run.atol, extra)
 
@@ -163,7 +163,7 @@ def compiled_run(system, x0: np.ndarray, t_end: float, run: RunOptions, extra: i
 
         t, X, _ = integrate_field_c(system, x0, t_end, run, extra=extra)
         return t, X
-    from mechgen.runtime.core.smooth_c import integrate_smooth_c
+    from mechgen.runtime.integration.smooth_c import integrate_smooth_c
 
     t, X, _ = integrate_smooth_c(system, x0, t_end, run, extra=extra)
     return t, X

@@ -5,13 +5,13 @@ the run starts in; default the model's initial mode), ``max_events`` (default 10
 (default 100) and ``zeno_span`` (default 1e-9 t_end): more than ``zeno_events`` events within
 ``zeno_span`` is a Zeno or chattering approach and ends the run (exit 1, naming time and mode).
 The rules for grazing, simultaneous events, events at t = 0 and events inside a step are those of
-mechgen.runtime.core.events; ``loop`` chooses the event loop that applies them (default ``auto``: the
-compiled one of mechgen.runtime.core.events_c for DOP853 on the C backend, else the Python one;
+mechgen.runtime.integration.events; ``loop`` chooses the event loop that applies them (default ``auto``: the
+compiled one of mechgen.runtime.integration.events_c for DOP853 on the C backend, else the Python one;
 ``python`` or ``c`` to choose). Outputs: the model's outputs at the end of the run (in the mode it
 ended in), ``events`` (a list of ``{t, from, to, guard}``; ``to`` is null for a terminal event),
 ``final_mode``, ``t_final`` (t_end, or the time of the terminal event), ``energy_drift`` (a conservative
 run) or the energy balance (``energy_balance_error``, ``work``, ``dissipated``: the powers of every mode
-integrated with the state and carried across the events, mechgen.runtime.core.augmented.BalancedHybrid, and
+integrated with the state and carried across the events, mechgen.runtime.integration.augmented.BalancedHybrid, and
 the energy each reset takes; mechgen.analyses.energy_balance.hybrid_balance) and ``t_end``; with the time history (mechgen.analyses.time_series: ``t``, ``trajectory``, ``energy_series``)
 ``mode_series``, the mode at each sample (the state where the run ended is the last sample). ``on_zeno =
 "stop"`` ends a run at a Zeno approach instead of failing: the events so far, ``t_final`` at the event that
@@ -24,10 +24,10 @@ import numpy as np
 from mechgen.analyses import energy_balance, time_series
 from mechgen.analyses.context import NAME
 from mechgen.errors import SceneError
-from mechgen.runtime.core.augmented import BalancedHybrid
+from mechgen.runtime.integration.augmented import BalancedHybrid
 from mechgen.runtime.core.diagnose import explain_state
-from mechgen.runtime.core.events import EventRules, ZenoApproach, integrate_hybrid
-from mechgen.runtime.core.run_options import RunOptions
+from mechgen.runtime.integration.events import EventRules, ZenoApproach, integrate_hybrid
+from mechgen.runtime.integration.run_options import RunOptions
 from mechgen.runtime.core.memory import dense_bytes, require
 
 
@@ -99,7 +99,7 @@ def run_hybrid(system, options: dict, context: dict) -> dict:
 
 def hybrid_run(system, options: dict, x0: np.ndarray, desc: str):
     """(the HybridTrajectory, whether it ended at a Zeno approach, the method that ran): ``on_zeno = "stop"`` keeps
-    the run up to the event that made it Zeno (mechgen.runtime.core.events.ZenoApproach); the default lets the
+    the run up to the event that made it Zeno (mechgen.runtime.integration.events.ZenoApproach); the default lets the
     error end it. ``method = "auto"`` is decided on the initial mode (mechgen.analyses.simulate_flow)."""
     from mechgen.analyses.simulate import budget_of
 

@@ -23,7 +23,7 @@ import numpy as np
 from mechgen.errors import ConvergenceError, KernelError
 from mechgen.runtime.core.budget import Budget, BudgetExceeded, Progress
 from mechgen.runtime.core.memory import dense_bytes, require
-from mechgen.runtime.core.run_options import RunOptions
+from mechgen.runtime.integration.run_options import RunOptions
 
 METHODS = ("BDF", "Radau", "LSODA", "RK45", "DOP853")
 IMPLICIT = ("BDF", "Radau", "LSODA")
@@ -65,7 +65,7 @@ def integrate_first_order(rhs, x0, t_end: float, *, jac=None, options: RunOption
                           **changes) -> Trajectory:
     """Integrate dx/dt = rhs(t, x) from 0 to t_end; rows of ``x`` are states at ``t`` (``t_eval``, or every step).
 
-    ``options``: mechgen.runtime.core.run_options.RunOptions (default method BDF here; its fields may be given
+    ``options``: mechgen.runtime.integration.run_options.RunOptions (default method BDF here; its fields may be given
     as keywords, which change it; ``rules``, ``stop_after`` and ``loop`` are not read). Each accepted step is
     one unit of ``budget`` (BudgetExceeded names t reached); ``progress`` draws a bar in t (see
     :class:`~mechgen.runtime.core.budget.Progress`).

@@ -59,7 +59,7 @@ def cvodes_problem(system) -> str | None:
 def first_order_expression(system, integrals: int = 0):
     """(x, t, p, f): CasADi MX symbols of the state, time and free parameters and the expression f(t, x; p)
     of the module doc, from the system's CasADi kernels. ``integrals`` = 3: the state also carries the energy
-    balance's integrals (mechgen.runtime.core.augmented), their rates the ``energy_rates`` kernel's powers."""
+    balance's integrals (mechgen.runtime.integration.augmented), their rates the ``energy_rates`` kernel's powers."""
     import casadi as ca
 
     n, m = int(system.n), int(system.m)

@@ -8,7 +8,7 @@ banded Cholesky factor of the constant mass). In C
     dq/dt = v,   dv/dt = -M^-1 (sum_b J_b^T (w_b .* rho_b(J_b q, J_b v, 0, t, s_b, p_b)) + P q),
 
 rho_b the model's C kernel called by address once per block over its points. That function is the event loop's
-flow provider (``mgh_problem.flow`` in ``hybrid_loop.c``): the one DOP853 of mechgen.runtime.core.events_c steps
+flow provider (``mgh_problem.flow`` in ``hybrid_loop.c``): the one DOP853 of mechgen.runtime.integration.events_c steps
 it exactly as scipy's DOP853 steps FieldSystem.rhs (the same steps; the states agree to rounding, the sums taken
 in another order). A mass matrix that depends on the state, Lagrange multipliers (a DAE), kernels without C
 addresses and a mass that is not positive definite are refused (:func:`field_loop_problem` says why; simulate
@@ -25,7 +25,7 @@ import numpy as np
 import scipy.sparse as sps
 
 from mechgen.errors import BuildError, CompilerUnavailable
-from mechgen.runtime.core.events_c import LONG, integrate_hybrid_c
+from mechgen.runtime.integration.events_c import LONG, integrate_hybrid_c
 from mechgen.runtime.core.pattern import extent
 from mechgen.runtime.fields.operators import Block, Operators, blocks_of, field_operators
 
@@ -206,7 +206,7 @@ def field_loop_problem(system, rtol=1e-8, atol=1e-10, extra: int = 0) -> str | N
     constant mass matrix that is symmetric positive definite, no Lagrange multipliers, C kernels of the
     pointwise residual (and of each end term and part; with ``extra`` integrals their energy_rates too, whose g
     has ``extra`` entries), scalar tolerances and a C compiler for both loops."""
-    from mechgen.runtime.core.events_c import c_loop_problem
+    from mechgen.runtime.integration.events_c import c_loop_problem
 
     if getattr(system, "backend", None) != "c":
         return f"the system's kernels are {getattr(system, 'backend', 'unknown')} ones, not compiled C"
@@ -244,7 +244,7 @@ _EMPTY = _Empty()
 
 def integrate_field_c(system, x0, t_end: float, options, *, extra: int = 0) -> tuple[np.ndarray, np.ndarray, dict]:
     """(t, x rows at the options' ``t_eval``, counts {steps, nfev}) of a continuum integrated by the compiled
-    DOP853 loop (module doc; ``options``: mechgen.runtime.core.run_options.RunOptions, ``method`` and ``loop``
+    DOP853 loop (module doc; ``options``: mechgen.runtime.integration.run_options.RunOptions, ``method`` and ``loop``
     not read; ``extra`` > 0: the state (q, v) is followed by that many integrals of the energy_rates kernels' g,
     the energy balance's work and dissipated energy); failures raise the event loop's exceptions.
     CompilerUnavailable where :func:`field_loop_problem` gives a reason."""

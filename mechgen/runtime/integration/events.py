@@ -67,7 +67,7 @@ from mechgen.errors import ConvergenceError, InputError, KernelError
 from mechgen.runtime.core.budget import BudgetExceeded, Progress
 from mechgen.runtime.core.diagnose import explain_state
 from mechgen.runtime.core.integrate import IMPLICIT, METHODS
-from mechgen.runtime.core.run_options import EventRules, RunOptions
+from mechgen.runtime.integration.run_options import EventRules, RunOptions
 
 #: the event loops: this module's ("python"), the compiled one ("c"), or the compiled one where it applies
 LOOPS = ("auto", "python", "c")
@@ -282,20 +282,20 @@ def integrate_hybrid(system, x0, t_end: float, *, mode: int | None = None, optio
     """Integrate a :class:`~mechgen.runtime.core.hybrid_system.HybridSystem` from x0 at t = 0 in ``mode``
     (default its initial mode) to t_end or a terminal event, by the rules of the module doc.
 
-    ``options`` (mechgen.runtime.core.run_options.RunOptions; its fields may also be given as keywords, which
+    ``options`` (mechgen.runtime.integration.run_options.RunOptions; its fields may also be given as keywords, which
     change it): samples are taken at ``t_eval`` (sorted, in [0, t_end]), else at every step end and on both
     sides of every event. ``budget`` counts accepted steps; ``rules`` bound the events;
     ``stop_after(event)`` true ends the run after that event (an impact measured up to its release).
-    ``loop``: "python" (this loop), "c" (the compiled loop of mechgen.runtime.core.events_c: DOP853 on
+    ``loop``: "python" (this loop), "c" (the compiled loop of mechgen.runtime.integration.events_c: DOP853 on
     the C backend) or "auto" (the compiled one where it can run, else this one).
     """
     options = RunOptions.of(options, **changes)
     method, rtol, atol = options.method, options.rtol, options.atol
-    # -- loop dispatch: the compiled DOP853 loop (mechgen.runtime.core.events_c) where it applies ---------
+    # -- loop dispatch: the compiled DOP853 loop (mechgen.runtime.integration.events_c) where it applies ---------
     if options.loop not in LOOPS:
         raise ValueError(f"unknown loop {options.loop!r}; expected one of {LOOPS}")
     if options.loop != "python" and method in METHODS:
-        from mechgen.runtime.core.events_c import c_loop_problem, integrate_hybrid_c
+        from mechgen.runtime.integration.events_c import c_loop_problem, integrate_hybrid_c
 
         why = c_loop_problem(system, method, rtol, atol)
         if why is None:

@@ -1,4 +1,4 @@
-"""The compiled event loop: :func:`integrate_hybrid_c`, the rules of mechgen.runtime.core.events in C.
+"""The compiled event loop: :func:`integrate_hybrid_c`, the rules of mechgen.runtime.integration.events in C.
 
 A hybrid lumped system on the C backend is integrated by one C function (``mgh_run`` in
 mechgen/codegen/templates/c99/hybrid_loop.c, built once into the compile cache as ``libmghybrid``)
@@ -9,7 +9,7 @@ that calls the model's own kernels through their addresses: in mode i
 
 stepped by DOP853 exactly as scipy.integrate.DOP853 steps it (same coefficients, error norm, step
 control and initial step, 7th-order dense output), with the guards ``guards__i`` (g, g_t), the
-resets ``reset__j`` and every event rule of mechgen.runtime.core.events (sign tracking, splitting
+resets ``reset__j`` and every event rule of mechgen.runtime.integration.events (sign tracking, splitting
 of suspicious intervals, Brent location on the dense output, re-integration from the step's
 start, one Newton correction, start-of-mode rule, ties, max_events, Zeno). Its results agree
 with the Python loop's ``method="DOP853"`` to rounding; it is 10-100 times faster, since no
@@ -32,8 +32,8 @@ import numpy as np
 
 from mechgen.errors import BuildError, CompilerUnavailable, ConvergenceError, KernelError
 from mechgen.runtime.core.budget import BudgetExceeded, Progress
-from mechgen.runtime.core.events import ZENO_HINT, Event, HybridTrajectory, ZenoApproach, diagnosis
-from mechgen.runtime.core.run_options import RunOptions
+from mechgen.runtime.integration.events import ZENO_HINT, Event, HybridTrajectory, ZenoApproach, diagnosis
+from mechgen.runtime.integration.run_options import RunOptions
 from mechgen.runtime.core.pattern import extent
 
 log = logging.getLogger("mechgen")
@@ -318,7 +318,7 @@ class _Buffers:
 
 def integrate_hybrid_c(system, x0, t_end: float, *, mode: int | None = None, options: RunOptions | None = None,
                        **changes) -> HybridTrajectory:
-    """:func:`mechgen.runtime.core.events.integrate_hybrid` with ``method="DOP853"``, run by the C loop (module
+    """:func:`mechgen.runtime.integration.events.integrate_hybrid` with ``method="DOP853"``, run by the C loop (module
     doc); the same options (RunOptions; ``method`` and ``loop`` are not read) and the same HybridTrajectory
     (``extra["loop"] = "c"``; ``nfev`` counts every evaluation of dx/dt, ``guard_evaluations`` every one of the
     guards). CompilerUnavailable when the loop cannot run ``system`` (:func:`c_loop_problem` says why)."""

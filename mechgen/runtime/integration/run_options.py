@@ -1,10 +1,10 @@
 """The options of a time integration, one object for every loop: the Python event loop
-(mechgen.runtime.core.events), the compiled one (events_c) and the smooth model's compiled loop (smooth_c).
+(mechgen.runtime.integration.events), the compiled one (events_c) and the smooth model's compiled loop (smooth_c).
 
 :class:`RunOptions` holds how a run integrates (method, tolerances), what it samples, what bounds it
 (budget, event rules), what it shows (progress), how a failure is explained, when it stops early and which
 loop runs it; :class:`EventRules` the bounds of the events. The loops read these and nothing else, so the
-same options give the same run in either loop (their rules: mechgen.runtime.core.events' module doc).
+same options give the same run in either loop (their rules: mechgen.runtime.integration.events' module doc).
 """
 from __future__ import annotations
 

@@ -1,7 +1,7 @@
 """The compiled DOP853 loop for a smooth lumped model: the event loop with one mode and no guards.
 
 A smooth model is the hybrid case without guards, so one compiled loop serves both
-(mechgen.runtime.core.events_c, ``codegen/templates/c99/hybrid_loop.c``): in C, for x = (q, v, z),
+(mechgen.runtime.integration.events_c, ``codegen/templates/c99/hybrid_loop.c``): in C, for x = (q, v, z),
 
     dq/dt = v,   dv/dt = -M^-1 r(q, v, 0, z, t)   (M = dr/da from ``tangent``, LU with partial pivoting),
     dz/dt = rates(q, v, z, t),
@@ -62,7 +62,7 @@ def view_of(system, extra: int = 0) -> SmoothView:
 def smooth_loop_problem(system, rtol=1e-8, atol=1e-10, extra: int = 0) -> str | None:
     """Why the compiled loop cannot integrate ``system`` (None when it can): a smooth lumped system on the C
     backend, scalar tolerances, a C compiler for the loop's own library."""
-    from mechgen.runtime.core.events_c import c_loop_problem
+    from mechgen.runtime.integration.events_c import c_loop_problem
 
     if hasattr(system, "modes"):
         return "the system has modes (the event loop runs it)"
@@ -79,10 +79,10 @@ def smooth_loop_problem(system, rtol=1e-8, atol=1e-10, extra: int = 0) -> str | 
 
 def integrate_smooth_c(system, x0, t_end: float, options, *, extra: int = 0) -> tuple[np.ndarray, np.ndarray, dict]:
     """(t, x rows at the options' ``t_eval``, counts {steps, nfev}) of a smooth lumped system integrated by the
-    compiled DOP853 loop (module doc; ``options``: mechgen.runtime.core.run_options.RunOptions, ``method`` and
+    compiled DOP853 loop (module doc; ``options``: mechgen.runtime.integration.run_options.RunOptions, ``method`` and
     ``loop`` not read; ``extra``: :func:`view_of`); failures raise the exceptions (and messages) of the event
     loop."""
-    from mechgen.runtime.core.events_c import integrate_hybrid_c
+    from mechgen.runtime.integration.events_c import integrate_hybrid_c
 
     traj = integrate_hybrid_c(view_of(system, extra), x0, t_end, mode=0, options=options)
     return traj.t, traj.x, {"steps": traj.steps, "nfev": traj.nfev}
