@@ -192,7 +192,7 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("omega", "(frequencies,)", "rad/s", "The driving frequencies."),
         _o("input", "string", "-", "The coordinate the unit force drives."),
         _o("amplitude", "{coordinate: (frequencies,)}", "coordinate per unit force (m/N ...)",
-           "\|H_kj(omega)\|, the receptance's magnitude for each output coordinate k."),
+           "\\|H_kj(omega)\\|, the receptance's magnitude for each output coordinate k."),
         _o("phase", "{coordinate: (frequencies,)}", "rad", "arg H_kj(omega): the response's phase relative to "
            "the force."),
     ),
@@ -246,7 +246,7 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
     "stability_boundary": (
         _o("<parameter>_critical", "scalar", "the parameter's", "p_c, where the steady state loses its "
            "stability."),
-        _o("frequency_critical", "scalar", "rad/s", "\|Im s\| of the eigenvalue that crosses at p_c (0 for a "
+        _o("frequency_critical", "scalar", "rad/s", "\\|Im s\\| of the eigenvalue that crosses at p_c (0 for a "
            "real crossing)."),
         _o("crossing", "string", "-", "``complex`` (an oscillation sets in: a Hopf bifurcation) or ``real`` (a "
            "divergence)."),
@@ -278,7 +278,7 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("equivalent_stiffness", "scalar", "N/m", "k_eq = Re(F1 / X1), the first harmonic's stiffness."),
         _o("equivalent_damping", "scalar", "N s/m", "c_eq = Im(F1 / X1) / omega."),
         _o("steady_period", "scalar (int)", "-", "k: the period [(k-1)T, kT] used."),
-        _o("periodicity_error", "scalar", "the state's", "max \|y(kT) - y((k-1)T)\| over the state and the "
+        _o("periodicity_error", "scalar", "the state's", "max \\|y(kT) - y((k-1)T)\\| over the state and the "
            "loop point."),
         _o("cycle_events", "list of {t, from, to, guard}", "s", "The events of that period."),
         _o("displacement_series", "(samples,)", "m", "With ``curve``: the loop's displacement."),
@@ -289,7 +289,7 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("eigenvalues", "(6,)", "mixed (K's)", "K's eigenvalues, ascending."),
     ),
     "symplectic": (
-        _o("energy_error", "scalar", "-", "max \|E(t) - E(0)\| / \|E(0)\| over the outputs."),
+        _o("energy_error", "scalar", "-", "max \\|E(t) - E(0)\\| / \\|E(0)\\| over the outputs."),
         _o("steps_per_second", "scalar", "1/s", "The loop's steps over its wall time (transforms excluded)."),
         _o("bandwidth_fraction", "scalar", "-", "The memory-bandwidth bound of a step over its measured time."),
         _o("loop", "string", "-", "``c`` or ``numpy``."),
@@ -315,7 +315,7 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
            "rad", "Per load step of the continuation in the load factor."),
         _o("velocity", "(nodes, 6)", "m/s, rad/s", "eta = (R^T (Omega x r), R^T Omega) in the section frame "
            "(``frame_rate``)."),
-        _o("orthonormality_error", "scalar", "-", "max \|R^T R - I\|."),
+        _o("orthonormality_error", "scalar", "-", "max \\|R^T R - I\\|."),
         _o("iterations", "scalar (int)", "-", "Newton iterations of the last step."),
         _o("method", "string", "-", "``collocation`` or ``shooting``: what ran."),
         _o("elements", "scalar (int)", "-", "RKMK4 steps or collocation elements."),
@@ -329,8 +329,8 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("tip_orientation", "(3, 3)", "-", "The final tip rotation matrix."),
         _o("energy", "(saved,)", "J", "Kinetic plus elastic energy per saved point."),
         _o("work", "(saved,)", "J", "The work of the loads and the damping since t = 0."),
-        _o("energy_error", "scalar", "-", "max \|E - E(0) - W\| relative to max(\|E\|, \|W\|)."),
-        _o("orthonormality_error", "scalar", "-", "max \|R^T R - I\| over the final nodes."),
+        _o("energy_error", "scalar", "-", "max \\|E - E(0) - W\\| relative to max(\\|E\\|, \\|W\\|)."),
+        _o("orthonormality_error", "scalar", "-", "max \\|R^T R - I\\| over the final nodes."),
         _o("shape", "(nodes, 3)", "m", "The final centre line."),
         _o("shapes", "(shapes, nodes, 3)", "m", "The saved centre lines."),
         _o("strain", "(elements, 6)", "-, 1/m", "The final strain per element, eps = f - f0."),
