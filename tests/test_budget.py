@@ -65,25 +65,44 @@ def test_budget_wall_time_and_projection_from_the_first_units():
     clock = Clock()
     budget = Budget("sweep of modes", unit="points", seconds=10.0, clock=clock)
     clock.now = 1.0
-    budget.project(10, 1000)  # 1 s is below the 2 s after which an estimate is trusted
+    budget.project(10, 1000)  # the baseline: 10 points in 1 s
     clock.now = 2.0
-    budget.project(500, 1000)  # 4 s for all: within the budget
+    budget.project(500, 1000)  # 1 + 1 s x 990 / 490 = 3.0 s for all: within the budget
     with pytest.raises(BudgetExceeded) as err:
-        budget.project(100, 1000)  # 20 s for all at this rate: more than 10
-    assert "1,000 points would take about 20 s" in str(err.value) and err.value.key == "max_seconds"
+        budget.project(100, 1000)  # 1 + 1 s x 990 / 90 = 12 s for all at this rate: more than 10
+    assert "1,000 points would take about 12 s" in str(err.value) and err.value.key == "max_seconds"
     clock.now = 10.5
     with pytest.raises(BudgetExceeded, match="wall time"):
         budget.check_time()
 
 
+def test_a_first_unit_that_builds_something_does_not_set_the_rate():
+    """The first point of a sweep builds a library (4 s); the next ones take 0.1 s each: 170 of them take about
+    4 + 169 x 0.1 = 21 s, within a 60 s budget (the rate of the first alone would say 680 s)."""
+    clock = Clock()
+    budget = Budget("restitution impacts", unit="points", seconds=60.0, clock=clock)
+    clock.now = 4.0
+    budget.project(1, 170)
+    for done in range(2, 30):
+        clock.now = 4.0 + 0.1 * (done - 1)
+        budget.project(done, 170)  # never refused
+    clock.now = 4.0 + 0.5 * 29
+    with pytest.raises(BudgetExceeded, match="would take about 88 s"):
+        budget.project(30, 170)  # 4 + 14.5 x 169 / 29 = 88.5 s: the rate after the first is too slow now
+
+
 def test_an_accepted_long_estimate_is_said_once_on_stderr(capsys):
     clock = Clock()
     budget = Budget("sweep of stability", unit="points", seconds=600.0, clock=clock)
+    clock.now = 1.0
+    budget.project(10, 1000)  # the baseline
     clock.now = 2.0
-    budget.project(100, 1000)  # 20 s for all: below NOTICE_ABOVE, nothing said
+    budget.project(100, 1000)  # 1 + 1 x 990 / 90 = 12 s for all: below NOTICE_ABOVE, nothing said
     assert capsys.readouterr().err == ""
-    budget.project(10, 1000)  # 200 s for all: accepted (600 s budget) and announced once
-    budget.project(11, 1000)
+    clock.now = 21.0
+    budget.project(110, 1000)  # 1 + 20 x 990 / 100 = 199 s for all: accepted (600 s budget) and announced once
+    clock.now = 22.0
+    budget.project(111, 1000)
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "1,000 points will take about 3 min (max_seconds = 600)" in err
 

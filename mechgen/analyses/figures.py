@@ -26,21 +26,32 @@ def pyplot():
     return plt
 
 
+#: a spread of real parts below this fraction of the largest |Im s| is round-off (an undamped spectrum)
+ROUND_OFF = 1e-9
+
+
 def eigen(plt, a: dict, path: Path) -> None:
-    """The eigenvalues in the complex plane, or (without eigenvalues) the frequencies as bars."""
+    """The eigenvalues in the complex plane, or (without eigenvalues) the frequencies as bars. Real parts that
+    differ by round-off only (an undamped or conservative spectrum) are drawn on the axis at a readable scale
+    (+-5 % of the largest |Im s|), not at 1e-15."""
     fig, ax = plt.subplots(figsize=(5, 4))
     if "eigenvalues" in a["outputs"]:
         ev = a["outputs"]["eigenvalues"]
-        ax.plot([e[0] for e in ev], [e[1] for e in ev], "o")
-        ax.set_xlabel("Re s")
-        ax.set_ylabel("Im s")
+        re, im = [e[0] for e in ev], [e[1] for e in ev]
+        ax.plot(re, im, "o")
+        reach = max([abs(v) for v in re + im] + [0.0])
+        if reach == 0.0 or max(abs(v) for v in re) <= ROUND_OFF * reach:
+            ax.set_xlim(-0.05 * (reach or 1.0), 0.05 * (reach or 1.0))
+        ax.axvline(0.0, color="0.7", lw=0.5)
+        ax.set_xlabel("Re s (1/s)")
+        ax.set_ylabel("Im s (rad/s)")
         ax.set_title(f"{a['name']}: {a['outputs'].get('verdict', '')}")
     else:
         freqs = a["outputs"]["frequencies"]
         ax.bar(range(1, len(freqs) + 1), freqs)
         ax.set_xlabel("mode")
-        ax.set_ylabel("frequency")
-        ax.set_title(a["name"])
+        ax.set_ylabel("natural frequency (rad/s)")
+        ax.set_title(f"{a['name']}: natural frequencies")
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
@@ -53,15 +64,15 @@ def shapes(plt, a: dict, path: Path) -> bool:
     if key is None:
         return False
     fields = list(out[key])
-    fig, axes = plt.subplots(len(fields), 1, figsize=(6, 2.2 + 1.6 * len(fields)), squeeze=False)
-    for ax, f in zip(axes[:, 0], fields):
+    fig, axes = plt.subplots(len(fields), 1, figsize=(6, 2.2 + 1.6 * len(fields)), squeeze=False, sharex=True)
+    for row, (ax, f) in enumerate(zip(axes[:, 0], fields)):
         curves = out[key][f] if key == "shapes" else [out[key][f]]
-        for k, curve in enumerate(curves):
-            label = f"mode {k + 1}: {out['frequencies'][k]:.4g}" if key == "shapes" else None
+        for k, curve in enumerate(curves):  # one legend (the first panel's): the modes are the same in each
+            label = f"mode {k + 1}: {out['frequencies'][k]:.4g} rad/s" if key == "shapes" and row == 0 else None
             ax.plot(out["s"], curve, label=label)
         ax.axhline(0.0, color="0.6", lw=0.5)
         ax.set_ylabel(f)
-    axes[-1, 0].set_xlabel("s")
+    axes[-1, 0].set_xlabel("s (position along the continuum)")
     if key == "shapes":
         axes[0, 0].legend(fontsize=7, loc="best")
     axes[0, 0].set_title(f"{a['name']}: {'mode shapes' if key == 'shapes' else 'deflection'}")
@@ -129,6 +140,7 @@ def bars(plt, a: dict, path: Path) -> bool:
             ax.bar(x, values)
         ax.axhline(0.0, color="0.5", lw=0.5)
         ax.set_xticks(x, names, rotation=45 if len(names) > 4 else 0, fontsize=7)
+        ax.set_xlabel("coordinate", fontsize=7)
         ax.set_ylabel("Re X, Im X" if isinstance(values[0], dict) else "phi (mass-normalised)", fontsize=7)
         ax.set_title(f"mode {k + 1}: {out['frequencies'][k]:.4g} rad/s", fontsize=8)
     kind = "complex (Re, Im)" if isinstance(modes[0][names[0]], dict) else "mass-normalised"

@@ -147,14 +147,15 @@ def plot(plt, a: dict, path) -> list:
     hyst = hyst if isinstance(hyst, dict) else {"": hyst}
     if any(hyst.values()):
         second = path.with_name(path.stem + "_hysteresis" + path.suffix)
-        fig, axes = plt.subplots(1, len(hyst), figsize=(3.2 * len(hyst), 3.2), squeeze=False)
-        for ax, (key, curves) in zip(axes[0], hyst.items()):
-            for c in curves:
-                ax.plot(c["penetration"], c["force"], label=f"{name} = {c[name]:.3g}")
+        fig, axes = plt.subplots(1, len(hyst), figsize=(3.2 * len(hyst), 3.4), squeeze=False, sharey=True)
+        for col, (ax, (key, curves)) in enumerate(zip(axes[0], hyst.items())):
+            for c in curves:  # the same parameter values in every panel: one legend, the first panel's
+                ax.plot(c["penetration"], c["force"], label=f"{name} = {c[name]:.3g}" if col == 0 else None)
             ax.set_title(key, fontsize=9)
             ax.set_xlabel("penetration")
         axes[0, 0].set_ylabel("force")
         axes[0, 0].legend(fontsize=7)
+        fig.suptitle(f"{a['name']}: force against penetration", fontsize=9)
         fig.tight_layout()
         fig.savefig(second, dpi=120)
         plt.close(fig)

@@ -51,6 +51,7 @@ from mechgen.errors import ConvergenceError, SceneError
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget, BudgetExceeded
 from mechgen.runtime.core.integrate import MIN_RTOL, leapfrog
 from mechgen.runtime.core.splitting import require_separable
+from mechgen.runtime.core.sundials import cvodes_problem
 from mechgen.runtime.linear.modes import modes as solve_modes
 from mechgen.scene.values import fail, listing, show, type_name
 
@@ -266,6 +267,8 @@ def run_simulate(system, options: dict, context: dict) -> dict:
         if method == "auto":
             limit = budget_of(options, "DOP853").limit
             method = simulate_flow.chosen_method(system, x0, float(options["t_end"]), limit, rates=rates)
+            if method in ("Radau", "BDF") and cvodes_problem(system) is None:
+                method = "cvodes"  # stiff on the CasADi backend: SUNDIALS' BDF, compiled, with CasADi's Jacobian
         t, X, how = simulate_flow.adaptive_run(system, options, x0, method, budget_of(options, method), desc,
                                                rates=rates)
     n = system.n

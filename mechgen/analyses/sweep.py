@@ -144,20 +144,28 @@ def plot(plt, a: dict, path: Path) -> list[Path]:
     ax = axes[0, 0]
     verdicts = a["outputs"].get("verdict") or ["stable"] * len(x)
     colours = figures.VERDICT_COLOURS
-    for xi, freqs, verdict in zip(x, a["outputs"].get("frequencies", []), verdicts):
+    rows = a["outputs"].get("frequencies", [])
+    ordered = len(x) >= 3 and all(isinstance(v, (int, float)) for v in x) and all(
+        b > c for b, c in zip(x[1:], x[:-1]))
+    if ordered:  # the k-th lowest frequency joined across the ordered points (thin: a crossing is not tracked)
+        most = max((len(f) for f in rows if f is not None), default=0)
+        for k in range(most):
+            ys = [f[k] if f is not None and k < len(f) else float("nan") for f in rows]
+            ax.plot(x, ys, "-", color="0.6", lw=0.7, zorder=1)
+    for xi, freqs, verdict in zip(x, rows, verdicts):
         if freqs is None:  # a failed point
             continue
-        ax.plot([xi] * len(freqs), freqs, ".", color=colours.get(verdict, "k"), ms=3)
+        ax.plot([xi] * len(freqs), freqs, ".", color=colours.get(verdict, "k"), ms=3, zorder=2)
     if name == "Omega" and x and isinstance(x[0], (int, float)):
         ax.plot([min(x), max(x)], [min(x), max(x)], "r--", lw=1, label="1x (synchronous)")
         ax.legend(loc="upper left")
-    ax.set_ylabel("frequency")
+    ax.set_ylabel("frequency (rad/s)")
     ax.set_title(f"{a['name']}: frequencies vs {name}" + (" (red: flutter, blue: divergence, orange: unconverged)"
                                                           if growth else ""), fontsize=9)
     if growth:
         axes[1, 0].plot(x, [float("nan") if g is None else g for g in growth], "o-", ms=3)
         axes[1, 0].axhline(0.0, color="0.6", lw=0.5)
-        axes[1, 0].set_ylabel("growth rate max Re s")
+        axes[1, 0].set_ylabel("growth rate max Re s (1/s)")
     axes[-1, 0].set_xlabel(name)
     fig.tight_layout()
     fig.savefig(path, dpi=120)

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 #: the most coordinates drawn against t in one figure (a chain has thousands)
 MAX_CURVES = 8
 #: the most phase portraits in one figure
@@ -87,16 +89,32 @@ def phase_portrait(plt, a: dict, names: list[str], path: Path) -> Path:
 
 
 def energy(plt, a: dict, path: Path) -> Path:
-    """E(t) = T + V at the samples (its change, when it varies by less than its size's round-off)."""
+    """A run's energy: with a balance (forces, dissipation, resets that take energy), E(t) - E(0) beside the work
+    W(t) and the dissipated energy D(t) and their difference W - D, which it must follow; otherwise the drift
+    (E(t) - E(0)) / max(|T| + |V|), the run's error on the scale of its energy (E itself would be drawn at its
+    rounding noise)."""
     out = a["outputs"]
-    E = out["energy_series"]
+    traj = out.get("trajectory") or {}
+    t, E = np.asarray(out["t"], float), np.asarray(out["energy_series"], float)
     fig, ax = plt.subplots(figsize=(6, 3.5))
-    ax.plot(out["t"], E)
+    if "work" in traj and "dissipated" in traj:
+        W, D = np.asarray(traj["work"], float), np.asarray(traj["dissipated"], float)
+        ax.plot(t, E - E[0], label="E - E(0)")
+        ax.plot(t, W, label="W: work of the forces")
+        ax.plot(t, D, label="D: dissipated")
+        ax.plot(t, W - D, "k:", label="W - D")
+        ax.legend(fontsize=7)
+        ax.set_ylabel("energy (J, or the model's unit)")
+        ax.set_title(f"{a['name']}: energy balance (error {out.get('energy_balance_error', 0.0):.2g})")
+    else:
+        T, V = (np.asarray(traj.get(k, np.zeros_like(E)), float) for k in ("kinetic_energy", "potential_energy"))
+        scale = float(np.max(np.abs(T) + np.abs(V), initial=0.0)) or float(np.max(np.abs(E), initial=0.0)) or 1.0
+        ax.plot(t, (E - E[0]) / scale)
+        ax.set_ylabel("(E - E(0)) / max(|T| + |V|)")
+        ax.set_title(f"{a['name']}: energy drift" + (f" {out['energy_drift']:.2g}" if "energy_drift" in out else ""))
     _events(ax, out)
     ax.set_xlabel(TIME_LABEL)
-    ax.set_ylabel("energy T + V (J, or the model's unit)")
     ax.ticklabel_format(axis="y", useOffset=False, style="sci", scilimits=(-3, 4))
-    ax.set_title(f"{a['name']}: energy")
     return _save(plt, fig, path)
 
 

@@ -9,9 +9,10 @@ key to raise. Where the work is known before it starts (a fixed-step integration
 steps) :meth:`Budget.refuse` stops it up front; where it can be estimated from the first units (a
 sweep's points) :meth:`Budget.project` stops it once the estimate is reliable:
 
-    estimated total = elapsed * total / done        (seconds)
+    estimated total = e0 + (elapsed - e0) (total - d0) / (done - d0)        (seconds)
 
-after at least :data:`PROJECT_AFTER` seconds, refused when it exceeds ``seconds``. An accepted
+from the rate after the first d0 units (done at e0 s: they carry the one-time costs, a library built or a cache
+filled), after at least :data:`PROJECT_AFTER` seconds, refused when it exceeds ``seconds``. An accepted
 estimate above :data:`NOTICE_ABOVE` seconds is said once on stderr (the bar below is drawn only on a
 terminal), so that a long run through a pipe is not silent.
 
@@ -88,6 +89,8 @@ class Budget:
         self.used = 0
         self.started = clock()
         self.noticed = False
+        #: (units, seconds) at the first projection: the baseline of the estimate
+        self.first: tuple[int, float] | None = None
 
     def elapsed(self) -> float:
         """Wall seconds since the budget started."""
@@ -108,29 +111,36 @@ class Budget:
                                  f"{self.limit:,})", key=self.key, reached=_text(reached))
         self.check_time(reached)
 
-    def check_time(self, reached: Callable[[], str] | str = "") -> None:
-        """Raise when the wall time is spent."""
-        if self.seconds is not None and self.elapsed() > self.seconds:
-            raise BudgetExceeded(f"{self.what}: stopped after {self.elapsed():.1f} s of wall time "
+    def check_time(self, reached: Callable[[], str] | str = "", elapsed: float | None = None) -> None:
+        """Raise when the wall time is spent (``elapsed``: the caller's reading of the clock, so that one decision
+        reads one time)."""
+        elapsed = self.elapsed() if elapsed is None else elapsed
+        if self.seconds is not None and elapsed > self.seconds:
+            raise BudgetExceeded(f"{self.what}: stopped after {elapsed:.1f} s of wall time "
                                  f"({self.seconds_key} = {self.seconds:g})", key=self.seconds_key,
                                  reached=_text(reached))
 
     def project(self, done: int, total: int, reached: Callable[[], str] | str = "") -> None:
-        """After ``done`` of ``total`` units: refuse when the estimate elapsed * total / done exceeds the
-        wall-time budget (trusted after PROJECT_AFTER seconds; the budget itself is checked always)."""
+        """After ``done`` of ``total`` units: refuse when the estimate exceeds the wall-time budget. The first call
+        sets the baseline (d0 units at e0 s: the first units carry one-time costs, a library built or a cache
+        filled, that the others do not repeat); later ones estimate e0 + (elapsed - e0) (total - d0) / (done - d0),
+        trusted after PROJECT_AFTER seconds. The budget itself is checked always."""
         elapsed = self.elapsed()
-        if self.seconds is not None and done > 0 and elapsed >= min(PROJECT_AFTER, self.seconds) and done < total:
-            estimate = elapsed * total / done
+        if self.first is None and done > 0:
+            self.first = (done, elapsed)
+        d0, e0 = self.first if self.first is not None else (0, 0.0)
+        if self.seconds is not None and done > d0 and elapsed >= min(PROJECT_AFTER, self.seconds) and done < total:
+            estimate = e0 + (elapsed - e0) * (total - d0) / (done - d0)
             if estimate > self.seconds:
                 raise BudgetExceeded(f"{self.what}: {total:,} {self.unit} would take about {_duration(estimate)} "
-                                     f"at the rate of the first {done:,} ({elapsed:.1f} s), more than "
-                                     f"{self.seconds_key} = {self.seconds:g}", key=self.seconds_key,
+                                     f"at the rate of {done - d0:,} after the first {d0:,} ({elapsed:.1f} s in "
+                                     f"all), more than {self.seconds_key} = {self.seconds:g}", key=self.seconds_key,
                                      reached=_text(reached))
             if estimate > NOTICE_ABOVE and not self.noticed:
                 self.noticed = True
                 sys.stderr.write(f"mechgen: {self.what}: {total:,} {self.unit} will take about "
                                  f"{_duration(estimate)} ({self.seconds_key} = {self.seconds:g})\n")
-        self.check_time(reached)
+        self.check_time(reached, elapsed)  # the same reading: past the budget, the estimate (>= it) said so first
 
 
 def _text(reached: Callable[[], str] | str) -> str:

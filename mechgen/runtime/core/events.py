@@ -290,7 +290,7 @@ def integrate_hybrid(system, x0, t_end: float, *, mode: int | None = None, optio
     the C backend) or "auto" (the compiled one where it can run, else this one).
     """
     options = RunOptions.of(options, **changes)
-    method, rtol, atol, rules = options.method, options.rtol, options.atol, options.rules
+    method, rtol, atol = options.method, options.rtol, options.atol
     # -- loop dispatch: the compiled DOP853 loop (mechgen.runtime.core.events_c) where it applies ---------
     if options.loop not in LOOPS:
         raise ValueError(f"unknown loop {options.loop!r}; expected one of {LOOPS}")
@@ -306,111 +306,125 @@ def integrate_hybrid(system, x0, t_end: float, *, mode: int | None = None, optio
     # -- end of the loop dispatch ------------------------------------------------------------------------
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}; expected one of {METHODS}")
-    t_end = float(t_end)
+    run = _EventRun(system, float(t_end), options, np.size(x0))
     mode = system.initial_mode if mode is None else int(mode)
-    t_eval = options.samples()
-    zeno_span = rules.zeno_span if rules.zeno_span is not None else 1e-9 * t_end
-    names = system.modes
-    ts, xs, ms = [], [], []
-    events: list[Event] = []
-    recent: deque = deque(maxlen=max(2, rules.zeno_events + 1))
-    stats = {"steps": 0, "nfev": 0, "njev": 0}
-    counts = {"guards": 0, "rates": 0}
-    segments: dict[int, _Segment] = {}
-    i_eval = 0
     t, x = 0.0, np.array(x0, float)
-    terminated = False
-
-    def sample_until(t_hi: float, dense, seg: int, inclusive: bool) -> None:
-        nonlocal i_eval
-        if t_eval is None:
-            return
-        side = "right" if inclusive else "left"
-        i_new = int(np.searchsorted(t_eval, t_hi, side=side))
-        if i_new > i_eval:
-            chunk = t_eval[i_eval:i_new]
-            ts.append(chunk)
-            xs.append(np.atleast_2d(dense(chunk).T) if dense is not None else np.tile(x, (len(chunk), 1)))
-            ms.append(np.full(len(chunk), seg))
-            i_eval = i_new
-
-    def record(tk: float, xk: np.ndarray, seg: int) -> None:
-        if t_eval is None:
-            ts.append(np.array([tk]))
-            xs.append(np.array(xk, float)[None, :])
-            ms.append(np.array([seg]))
-
-    def where(tk: float, seg: int) -> str:
-        return f"t = {tk:.9g} of t_end = {t_end:.6g} in mode {names[seg]}"
-
-    def fire(seg: "_Segment", k: int, tk: float, xk: np.ndarray) -> tuple[int | None, np.ndarray]:
-        info = seg.guards[k]
-        x_after = xk if info.reset is None else system.reset(info.reset, tk, xk)
-        if not np.all(np.isfinite(x_after)):
-            raise KernelError(f"reset of guard {info.name} gave NaN/Inf at {where(tk, seg.index)}")
-        target = None if info.terminal else info.to
-        events.append(Event(tk, seg.index, target, info.name, np.array(xk), np.array(x_after)))
-        recent.append(tk)
-        if len(events) > rules.max_events:
-            raise BudgetExceeded(f"events: more than max_events = {rules.max_events:,} events", key="max_events",
-                                 reached=where(tk, seg.index))
-        if len(recent) == recent.maxlen and recent[-1] - recent[0] <= zeno_span:
-            raise ZenoApproach(f"events: {len(recent)} events within {recent[-1] - recent[0]:.3g} (more than "
-                               f"zeno_events = {rules.zeno_events} within zeno_span = {zeno_span:.3g}): a Zeno or "
-                               f"chattering approach (guard {info.name} of mode {names[seg.index]}); {ZENO_HINT}",
-                               key="zeno_events", reached=where(tk, seg.index))
-        return target, x_after
-
-    record(t, x, mode)
+    run.record(t, x, mode)
     try:
-        with Progress(t_end, desc=options.desc, unit="t", enabled=options.progress) as bar:
+        with Progress(run.t_end, desc=options.desc, unit="t", enabled=options.progress) as bar:
             while True:
-                if mode not in segments:
-                    segments[mode] = _Segment(system, mode, t_end, counts)
-                seg = segments[mode]
+                seg = run.segment(mode)
                 g0, d0 = seg.values(t, x)
-                sign, at_once = start_signs(g0, d0, seg.directions, time_tolerance(t, t_end))
-                if at_once:
-                    k = at_once[0]  # the guards are in priority order: terminal first, then declared order
-                    target, x = fire(seg, k, t, x)
-                    record(t, x, mode if target is None else target)
-                    if target is None or (options.stop_after is not None and options.stop_after(events[-1])):
-                        terminated = True
-                        mode = mode if target is None else target
+                sign, at_once = start_signs(g0, d0, seg.directions, time_tolerance(t, run.t_end))
+                if at_once:  # the guards are in priority order: terminal first, then declared order
+                    target, x = run.fire(seg, at_once[0], t, x)
+                    run.record(t, x, mode if target is None else target)
+                elif t >= run.t_end:
+                    break
+                else:
+                    hit = _integrate_segment(seg, (t, x), (g0, d0), sign, options, run.stats,
+                                             _Hooks(run.sample_until, run.record, bar, run.where))
+                    if hit is None:
+                        t, x = run.t_end, run.stats["y_end"]
                         break
-                    mode = target
-                    continue
-                if t >= t_end:
-                    break
-                hit = _integrate_segment(seg, (t, x), (g0, d0), sign, options, stats,
-                                         _Hooks(sample_until, record, bar, where))
-                if hit is None:
-                    t, x = t_end, stats["y_end"]
-                    break
-                k, t, x_before = hit
-                sample_until(t, stats["dense"], mode, inclusive=True)
-                target, x = fire(seg, k, t, x_before)
-                record(t, x_before, mode)
-                record(t, x, mode if target is None else target)
-                if target is None or (options.stop_after is not None and options.stop_after(events[-1])):
-                    terminated = True
+                    k, t, x_before = hit
+                    run.sample_until(t, run.stats["dense"], mode, inclusive=True)
+                    target, x = run.fire(seg, k, t, x_before)
+                    run.record(t, x_before, mode)
+                    run.record(t, x, mode if target is None else target)
+                if target is None or (options.stop_after is not None and options.stop_after(run.events[-1])):
+                    run.terminated = True
                     mode = mode if target is None else target
                     break
                 mode = target
     except ZenoApproach as exc:  # the run so far, up to the event that made it Zeno (on_zeno = "stop")
-        last = events[-1]
-        stats["zeno"] = exc
+        last = run.events[-1]
+        run.stats["zeno"] = exc
         mode = last.source if last.target is None else last.target
-        t, x, terminated = last.t, last.x_after, True
-    t_out = np.hstack(ts) if ts else np.empty(0)
-    x_out = np.vstack(xs) if xs else np.empty((0, np.size(x0)))
-    m_out = np.hstack(ms).astype(int) if ms else np.empty(0, int)
-    trajectory = HybridTrajectory(t_out, x_out, m_out, tuple(events), mode, float(t), np.array(x), terminated,
-                                  stats["steps"], stats["nfev"], stats["njev"], counts["guards"],
-                                  {"rate_evaluations": counts["rates"]})
-    if "zeno" in stats:
-        raise stats["zeno"].with_trajectory(trajectory)
+        t, x, run.terminated = last.t, last.x_after, True
+    trajectory = run.trajectory(mode, t, x)
+    if "zeno" in run.stats:
+        raise run.stats["zeno"].with_trajectory(trajectory)
     return trajectory
+
+
+class _EventRun:
+    """What the Python event loop has recorded so far: the samples (at t_eval, or at every step end and both
+    sides of every event), the events, the recent event times the Zeno rule reads, the counters; and the
+    event itself (:meth:`fire`: the reset, the log entry, the bounds of the events)."""
+
+    def __init__(self, system, t_end: float, options: RunOptions, size: int) -> None:
+        self.system, self.t_end, self.options, self.size = system, t_end, options, size
+        rules = options.rules
+        self.rules = rules
+        self.zeno_span = rules.zeno_span if rules.zeno_span is not None else 1e-9 * t_end
+        self.t_eval = options.samples()
+        self.ts: list = []
+        self.xs: list = []
+        self.ms: list = []
+        self.events: list[Event] = []
+        self.recent: deque = deque(maxlen=max(2, rules.zeno_events + 1))
+        self.stats = {"steps": 0, "nfev": 0, "njev": 0}
+        self.counts = {"guards": 0, "rates": 0}
+        self.segments: dict[int, _Segment] = {}
+        self.i_eval = 0
+        self.terminated = False
+
+    def segment(self, mode: int) -> "_Segment":
+        if mode not in self.segments:
+            self.segments[mode] = _Segment(self.system, mode, self.t_end, self.counts)
+        return self.segments[mode]
+
+    def sample_until(self, t_hi: float, dense, seg: int, inclusive: bool) -> None:
+        """The samples at t_eval up to t_hi (inclusive or not) from the last step's dense output."""
+        if self.t_eval is None:
+            return
+        i_new = int(np.searchsorted(self.t_eval, t_hi, side="right" if inclusive else "left"))
+        if i_new > self.i_eval:
+            chunk = self.t_eval[self.i_eval:i_new]
+            self.ts.append(chunk)
+            self.xs.append(np.atleast_2d(dense(chunk).T))
+            self.ms.append(np.full(len(chunk), seg))
+            self.i_eval = i_new
+
+    def record(self, tk: float, xk: np.ndarray, seg: int) -> None:
+        """A sample at (tk, xk) in mode seg, when samples are every step end (no t_eval)."""
+        if self.t_eval is None:
+            self.ts.append(np.array([tk]))
+            self.xs.append(np.array(xk, float)[None, :])
+            self.ms.append(np.array([seg]))
+
+    def where(self, tk: float, seg: int) -> str:
+        return f"t = {tk:.9g} of t_end = {self.t_end:.6g} in mode {self.system.modes[seg]}"
+
+    def fire(self, seg: "_Segment", k: int, tk: float, xk: np.ndarray) -> tuple[int | None, np.ndarray]:
+        """Guard k of seg fires at (tk, xk): (the mode entered, None for a terminal event; the state after it);
+        BudgetExceeded past max_events, ZenoApproach past zeno_events within zeno_span."""
+        info, rules, recent = seg.guards[k], self.rules, self.recent
+        x_after = xk if info.reset is None else self.system.reset(info.reset, tk, xk)
+        if not np.all(np.isfinite(x_after)):
+            raise KernelError(f"reset of guard {info.name} gave NaN/Inf at {self.where(tk, seg.index)}")
+        target = None if info.terminal else info.to
+        self.events.append(Event(tk, seg.index, target, info.name, np.array(xk), np.array(x_after)))
+        recent.append(tk)
+        if len(self.events) > rules.max_events:
+            raise BudgetExceeded(f"events: more than max_events = {rules.max_events:,} events", key="max_events",
+                                 reached=self.where(tk, seg.index))
+        if len(recent) == recent.maxlen and recent[-1] - recent[0] <= self.zeno_span:
+            raise ZenoApproach(f"events: {len(recent)} events within {recent[-1] - recent[0]:.3g} (more than "
+                               f"zeno_events = {rules.zeno_events} within zeno_span = {self.zeno_span:.3g}): a Zeno "
+                               f"or chattering approach (guard {info.name} of mode {self.system.modes[seg.index]}); "
+                               f"{ZENO_HINT}", key="zeno_events", reached=self.where(tk, seg.index))
+        return target, x_after
+
+    def trajectory(self, mode: int, t: float, x: np.ndarray) -> HybridTrajectory:
+        """The HybridTrajectory of the run, ended in ``mode`` at (t, x)."""
+        t_out = np.hstack(self.ts) if self.ts else np.empty(0)
+        x_out = np.vstack(self.xs) if self.xs else np.empty((0, self.size))
+        m_out = np.hstack(self.ms).astype(int) if self.ms else np.empty(0, int)
+        return HybridTrajectory(t_out, x_out, m_out, tuple(self.events), mode, float(t), np.array(x),
+                                self.terminated, self.stats["steps"], self.stats["nfev"], self.stats["njev"],
+                                self.counts["guards"], {"rate_evaluations": self.counts["rates"]})
 
 
 def start_signs(g0: np.ndarray, d0: np.ndarray, directions: np.ndarray, tol: float):

@@ -342,8 +342,8 @@ class System:
     def _solve(self, M, rhs):
         if sps.issparse(M):
             return spla.spsolve(M.tocsc(), rhs)
-        if M.shape[0] <= SMALL_DENSE:  # LAPACK's gesv without scipy's checks (tens of microseconds a call)
-            return np.linalg.solve(M, rhs)
+        if M.shape[0] <= SMALL_DENSE and np.isfinite(M).all() and np.isfinite(rhs).all():
+            return np.linalg.solve(M, rhs)  # LAPACK's gesv without scipy's other checks (tens of microseconds)
         return sla.solve(M, rhs, assume_a="sym") if rhs.ndim == 1 else sla.solve(M, rhs)
 
     def acceleration(self, q, v, z=None, t=0.0) -> tuple[np.ndarray, object]:
