@@ -1,10 +1,12 @@
 """The outputs of each analysis kind, for the reference pages (mechgen.analyses.reference).
 
 One :class:`OutputDoc` per output: its name (the key of ``Result[...]`` and of the scene JSON's entry), its
-shape, its unit and its meaning. Filled by hand from the kinds' module docstrings and the README until the
-kinds declare their outputs beside their schemas; a kind not listed in :data:`OUTPUTS` gets a pointer to its
-module docstring (:func:`outputs_of`). The names here are a contract: a test checks them against what the
-kinds return (tests/test_docs_site.py).
+shape, its unit and its meaning. Filled by hand from the kinds' module docstrings until the kinds declare their
+outputs beside their schemas; every registered kind has its table (a kind left out would get a pointer to its
+module docstring, :func:`outputs_of`, and fails the test). A name may hold placeholders: ``<output>`` (a model
+output), ``<parameter>``, ``<alias>`` (a name of the analysis's ``aliases``), ``<field>``, ``<shape output>``
+and ``<end>`` (start, end, max or min). The names here are a contract: tests/test_docs_site.py runs the shipped
+scenes and checks that every output a kind returns matches a documented name.
 """
 from __future__ import annotations
 
@@ -44,6 +46,10 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
            "A continuum's mode shapes at ``s`` (with ``count``); a lumped model's damped modes: the complex "
            "shape X of each mode (q(t) = Re(X e^{st})) as amplitude \\|X_i\\| and phase arg X_i, the first "
            "largest amplitude 1 with phase 0 (mechgen.analyses.whirl)."),
+        _o("modal_mass", "(count,)", "the model's mass unit (kg, kg m^2 ...)", "A lumped model's undamped modes: "
+           "phi^T M phi of each mass-normalised shape (1 to round-off)."),
+        _o("modal_stiffness", "(count,)", "(rad/s)^2 times the modal mass", "A lumped model's undamped modes: "
+           "phi^T K phi = omega^2."),
         _o("eigenvalues", "(modes, 2)", "1/s", "Damped modes only: the eigenvalues s as [re, im] pairs."),
         _o("log_dec", "(modes,)", "-", "Damped modes only: the logarithmic decrement of each mode."),
         _o("whirl", "(modes,)", "-", "Rotors only: each mode's whirl, ``forward`` (counter-clockwise about "
@@ -78,8 +84,25 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
            "``potential_energy`` and ``energy``) at the equilibrium (Newton), or at the ends and its extremes "
            "along s (a boundary value problem)."),
         _o("s", "(points,)", "m", "A continuum's stations along s."),
-        _o("deflection", "(points,)", MODEL_UNIT, "A continuum's steady deflection at ``s``."),
+        _o("deflection", "(points,) or {field: (points,)}", MODEL_UNIT, "A continuum's steady deflection at "
+           "``s`` (per field for a boundary value problem)."),
         _o("reactions", "table", MODEL_UNIT, "A continuum solved by Newton: the constraint reactions."),
+        _o("<output>_<end>", "scalar", "the output's", "A boundary value problem: each model output at the ends "
+           "(``_start``, ``_end``) and its extremes along s (``_max``, ``_min``), e.g. ``tension_start`` "
+           "(mechgen.analyses.bvp_states)."),
+        _o("<field>_s_<end>", "scalar", MODEL_UNIT, "A boundary value problem: each field's slope at the ends "
+           "(``x_s_start``, ``x_s_end``)."),
+        _o("<shape output>", "scalar", "-", "A boundary value problem: each shape output the model declares "
+           "(``Model.shape_output``: the balloon's ``loops``)."),
+        _o("<alias>", "as its target", "its target's", "Each name of ``aliases``: the output it names, reported "
+           "again under the scene's name."),
+        _o("method", "string", "-", "A boundary value problem: the method that solved it (``shooting``, "
+           "``multiple_shooting``, ``collocation``)."),
+        _o("verdict", "string", "-", "With ``stability``: the Galerkin verdict about the state (as "
+           ":doc:`stability`'s)."),
+        _o("frequencies", "(modes,)", "rad/s", "With ``stability``: the lowest frequencies of the linearisation "
+           "(at most 10)."),
+        _o("eigenvalues", "(n, 2)", "1/s", "With ``stability``: the eigenvalues as [re, im] pairs."),
     ),
     "simulate": (
         _o("t", "(samples,)", "s", "The sample times, from 0 to ``t_end`` (or to where the run stopped)."),
@@ -138,6 +161,186 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("method", "string", "-", "``exact`` or ``reduced``: what ran."),
         _o("exact_solves", "scalar (int)", "-", "How many full-size eigen-solves ran."),
         _o("executor", "string", "-", "Where the per-speed solves ran."),
+    ),
+    "continuation": (
+        _o("parameter", "string", "-", "The continued parameter's name."),
+        _o("branch", "list of {<parameter>, <output>_<end> ..., verdict}", "the outputs'",
+           "One entry per branch point: the parameter's value, the outputs (at the ends and extremes for a "
+           "boundary value problem, the model's outputs and ``coordinates`` for Newton), the shape outputs, "
+           "the aliases, ``verdict`` (with ``stability``), ``eigenvalues`` (with ``eigenvalues = true``) and "
+           "``start`` (with several starts)."),
+        _o("points", "scalar (int)", "-", "How many branch points."),
+        _o("status", "string, or {start: string}", "-", "Why the branch ended (``lam_max``, ``bounds``, "
+           "``max_points`` ...; per start with several)."),
+        _o("folds", "list of branch points", "the outputs'", "The turning points in the parameter."),
+        _o("stability_changes", "list of {..., from, to}", "the outputs'", "With ``stability``: where the "
+           "verdict changes between consecutive points, located by bisection along the branch."),
+        _o("shape_outputs", "list of strings", "-", "The shape outputs reported at every point."),
+        _o("at_<output>", "list of {<parameter>, <output>, ..., verdict, refinement}", "the outputs'",
+           "With ``at = {output = value}``: the points where the output crosses the value, sorted by the "
+           "parameter; the verdict holds when the model discretised with 2N and 4N terms agrees."),
+        _o("at_<output>_shapes", "list of {field: (101,)}", MODEL_UNIT, "The fields at each ``at_<output>`` "
+           "point (for plots)."),
+        _o("<output>_min", "scalar", "the output's", "With ``minimize``: the least value of the output along "
+           "the branch."),
+        _o("<parameter>_at_<output>_min", "scalar", "the parameter's", "With ``minimize``: the parameter where "
+           "the output is least."),
+        _o("<alias>", "as its target", "its target's", "Each name of ``aliases`` that names an analysis output "
+           "(``balloons_at_tension = \"at_p_e\"``)."),
+    ),
+    "response": (
+        _o("omega", "(frequencies,)", "rad/s", "The driving frequencies."),
+        _o("input", "string", "-", "The coordinate the unit force drives."),
+        _o("amplitude", "{coordinate: (frequencies,)}", "coordinate per unit force (m/N ...)",
+           "\\|H_kj(omega)\\|, the receptance's magnitude for each output coordinate k."),
+        _o("phase", "{coordinate: (frequencies,)}", "rad", "arg H_kj(omega): the response's phase relative to "
+           "the force."),
+    ),
+    "fit": (
+        _o("<parameter>", "scalar, or (groups,)", "the parameter's", "Each estimated parameter (a list per "
+           "group when grouped)."),
+        _o("<parameter>_stderr", "scalar, or (groups,)", "the parameter's", "Its standard error sqrt(diag C) "
+           "(null without a degree of freedom, or when the data cannot determine it)."),
+        _o("residuals", "(rows,)", "the observed column's", "y - f at the estimate, in row order."),
+        _o("fitted", "(rows,)", "the observed column's", "f at the estimate."),
+        _o("observed", "(rows,)", "the observed column's", "The observed column y."),
+        _o("rms", "scalar", "the observed column's", "The root mean square of the residuals, all rows."),
+        _o("dof", "scalar (int), or (groups,)", "-", "Degrees of freedom n - p (per group)."),
+        _o("covariance", "(p, p), or (groups, p, p)", "the parameters' squared", "C = s^2 (J^T J)^-1 (per "
+           "group)."),
+        _o("groups", "(groups,)", "the group column's", "With ``group``: the distinct values, in first-"
+           "appearance order."),
+        _o("group_rows", "(groups, rows)", "-", "With ``group``: the 1-based rows of each group."),
+        _o("converged", "bool", "-", "Whether least_squares reported convergence."),
+        _o("message", "string", "-", "least_squares' status message."),
+        _o("evaluations", "scalar (int)", "-", "Evaluations of the model on all rows (the Jacobian's "
+           "included)."),
+        _o("x_column", "string", "-", "The first input or column of the expression (the plot's abscissa)."),
+        _o("x_values", "(rows,)", "that column's", "Its values, in row order."),
+    ),
+    "impact": (
+        _o("restitution", "scalar", "-", "e = -v_r / v_c along ``coordinate`` (0 with no release)."),
+        _o("contact_duration", "scalar", "s", "t_r - t_c, from contact to release (to ``t_end`` with no "
+           "release)."),
+        _o("energy_lost", "scalar", "-", "1 - E(t_r) / E(t_c), the fraction of the energy at contact lost "
+           "(the contact's stored energy included)."),
+        _o("released", "bool", "-", "Whether the body left the contact before ``t_end``."),
+        _o("penetration_series", "(samples,)", MODEL_UNIT, "With ``curve``: the coordinate over the contact."),
+        _o("force_series", "(samples,)", "N (the output's)", "With ``curve``: the output ``force_output`` over "
+           "the contact (the force-penetration hysteresis)."),
+    ),
+    "restitution": (
+        _o("<parameter>", "(values,)", "the parameter's", "The numeric parameter's grid values, under its own "
+           "name (``zeta``)."),
+        _o("restitution", "{choice: (values,)} or (values,)", "-", "e per choice (``kelvin_voigt`` ...), "
+           "aligned with the numeric parameter (a plain list without a choice parameter)."),
+        _o("contact_duration", "{choice: (values,)} or (values,)", "s", "The contact durations, aligned as "
+           "``restitution``."),
+        _o("energy_lost", "{choice: (values,)} or (values,)", "-", "The fractions of the energy lost."),
+        _o("released", "{choice: (values,)} or (values,)", "-", "Whether each impact released."),
+        _o("hysteresis", "{choice: list of {<parameter>, penetration, force}}", "the model's; N",
+           "Force-penetration curves at ``hysteresis`` values of the numeric parameter."),
+        _o("impacts", "scalar (int)", "-", "How many impacts ran (the analysis's ``seconds`` over it: the time "
+           "per impact)."),
+    ),
+    "stability_boundary": (
+        _o("<parameter>_critical", "scalar", "the parameter's", "p_c, where the steady state loses its "
+           "stability."),
+        _o("frequency_critical", "scalar", "rad/s", "\\|Im s\\| of the eigenvalue that crosses at p_c (0 for a "
+           "real crossing)."),
+        _o("crossing", "string", "-", "``complex`` (an oscillation sets in: a Hopf bifurcation) or ``real`` (a "
+           "divergence)."),
+        _o("eigenvalues_critical", "(n, 2)", "1/s", "The eigenvalues at p_c as [re, im] pairs."),
+        _o("verdict", "string", "-", "At the system's own value of the parameter: stable, neutral, divergence "
+           "or flutter, or the scene's word for it (``labels``)."),
+        _o("growth_rate", "scalar", "1/s", "At the system's own value: max Re s."),
+        _o("eigenvalues", "(n, 2)", "1/s", "At the system's own value: the eigenvalues as [re, im] pairs."),
+        _o("iterations", "scalar (int)", "-", "Iterations of Brent's method or of the bisection."),
+        _o("method", "string", "-", "``growth_rate`` (Brent on max Re s) or ``bisection`` (on the verdict)."),
+    ),
+    "spectrum": (
+        _o("natural_frequencies", "(modes,)", "Hz", "The retained modes' natural frequencies."),
+        _o("spectrum_peaks", "(peaks,)", "Hz", "The most prominent maxima of the log amplitude below f_max, "
+           "ascending."),
+        _o("frequency_bin", "scalar", "Hz", "1 / record length."),
+        _o("impulses", "scalar (int)", "-", "How many blows."),
+        _o("impulse_rate", "scalar", "Hz", "v / lambda, the blows' rate."),
+        _o("frequency", "(bins,)", "Hz", "The spectrum's frequencies, up to f_max."),
+        _o("amplitude", "(bins,)", "the response's", "The windowed (Hann) spectrum's amplitude."),
+        _o("t", "(samples,)", "s", "The record's times (at most ``series`` points, evenly thinned)."),
+        _o("response", "(samples,)", "m (or m/s with ``signal = \"velocity\"``)", "The response u(t) at "
+           "``observe`` (or the coordinate ``output``)."),
+        _o("reference_frequencies", "(modes,)", "Hz", "With ``reference``: the frequencies given."),
+        _o("frequency_ratio", "(modes,)", "-", "With ``reference``: ours / theirs, mode by mode."),
+    ),
+    "periodic": (
+        _o("energy_per_cycle", "scalar", "J", "W = integral of f dx over the steady period (the loop area)."),
+        _o("equivalent_stiffness", "scalar", "N/m", "k_eq = Re(F1 / X1), the first harmonic's stiffness."),
+        _o("equivalent_damping", "scalar", "N s/m", "c_eq = Im(F1 / X1) / omega."),
+        _o("steady_period", "scalar (int)", "-", "k: the period [(k-1)T, kT] used."),
+        _o("periodicity_error", "scalar", "the state's", "max \\|y(kT) - y((k-1)T)\\| over the state and the "
+           "loop point."),
+        _o("cycle_events", "list of {t, from, to, guard}", "s", "The events of that period."),
+        _o("displacement_series", "(samples,)", "m", "With ``curve``: the loop's displacement."),
+        _o("force_series", "(samples,)", "N", "With ``curve``: the loop's force."),
+    ),
+    "cross_section": (
+        _o("K", "(6, 6)", "N, N m, N m^2", "The section's stiffness ordered [K_uu, K_uw; K_wu, K_ww]."),
+        _o("eigenvalues", "(6,)", "mixed (K's)", "K's eigenvalues, ascending."),
+    ),
+    "symplectic": (
+        _o("energy_error", "scalar", "-", "max \\|E(t) - E(0)\\| / \\|E(0)\\| over the outputs."),
+        _o("steps_per_second", "scalar", "1/s", "The loop's steps over its wall time (transforms excluded)."),
+        _o("bandwidth_fraction", "scalar", "-", "The memory-bandwidth bound of a step over its measured time."),
+        _o("loop", "string", "-", "``c`` or ``numpy``."),
+        _o("steps", "scalar (int)", "-", "Steps taken."),
+        _o("integrator", "string", "-", "The splitting that ran (leapfrog, yoshida4, yoshida6, aba864)."),
+        _o("recurrence_periods", "scalar or null", "periods T_1", "Fixed ends: the first return of the energy "
+           "to mode 1 (null when none within ``t_end``)."),
+        _o("recurrence_fraction", "scalar or null", "-", "Fixed ends: the share of the harmonic energy back in "
+           "mode 1 then."),
+        _o("t", "(outputs,)", "the model's time unit", "The output times."),
+        _o("mode_energies_series", "(outputs, modes)", "the model's energy unit", "Rows of the modal energies "
+           "E_1 .. E_modes."),
+    ),
+    "rod_statics": (
+        _o("tip_position", "(3,)", "m", "The tip's position [x, y, z]."),
+        _o("tip_rotation", "scalar", "rad", "The tip's rotation about ``bending_axis``, unwrapped."),
+        _o("tip_orientation", "(3, 3)", "-", "The tip's rotation matrix R."),
+        _o("s", "(nodes,)", "m", "The nodes along the rod."),
+        _o("shape", "(nodes, 3)", "m", "The centre line."),
+        _o("strain", "(nodes, 6)", "-, 1/m", "eps = f - f0 (u1 u2 u3 w1 w2 w3)."),
+        _o("stress_resultant", "(nodes, 6)", "N, N m", "sigma = (n, m) in the section frame."),
+        _o("branch", "list of {load, tip_force, tip_torque, tip_position, tip_rotation, shape}", "-, N, N m, m, "
+           "rad", "Per load step of the continuation in the load factor."),
+        _o("velocity", "(nodes, 6)", "m/s, rad/s", "eta = (R^T (Omega x r), R^T Omega) in the section frame "
+           "(``frame_rate``)."),
+        _o("orthonormality_error", "scalar", "-", "max \\|R^T R - I\\|."),
+        _o("iterations", "scalar (int)", "-", "Newton iterations of the last step."),
+        _o("method", "string", "-", "``collocation`` or ``shooting``: what ran."),
+        _o("elements", "scalar (int)", "-", "RKMK4 steps or collocation elements."),
+    ),
+    "rod_dynamics": (
+        _o("t", "(saved,)", "s", "The saved times."),
+        _o("tip_trajectory", "(saved, 3)", "m", "The tip's position at each saved time."),
+        _o("tip_rotations", "(saved,)", "rad", "The tip's rotation about ``bending_axis`` per saved point."),
+        _o("tip_position", "(3,)", "m", "The final tip position."),
+        _o("tip_rotation", "scalar", "rad", "The final tip rotation."),
+        _o("tip_orientation", "(3, 3)", "-", "The final tip rotation matrix."),
+        _o("energy", "(saved,)", "J", "Kinetic plus elastic energy per saved point."),
+        _o("work", "(saved,)", "J", "The work of the loads and the damping since t = 0."),
+        _o("energy_error", "scalar", "-", "max \\|E - E(0) - W\\| relative to max(\\|E\\|, \\|W\\|)."),
+        _o("orthonormality_error", "scalar", "-", "max \\|R^T R - I\\| over the final nodes."),
+        _o("shape", "(nodes, 3)", "m", "The final centre line."),
+        _o("shapes", "(shapes, nodes, 3)", "m", "The saved centre lines."),
+        _o("strain", "(elements, 6)", "-, 1/m", "The final strain per element, eps = f - f0."),
+        _o("stress_resultant", "(elements, 6)", "N, N m", "The final sigma = K eps per element."),
+        _o("steps", "scalar (int)", "-", "Time steps."),
+        _o("newton_iterations", "scalar (int)", "-", "Newton iterations, all steps."),
+        _o("jacobians", "scalar (int)", "-", "Jacobians assembled."),
+        _o("splits", "scalar (int)", "-", "Steps split in halves for Newton."),
+        _o("dt", "scalar", "s", "The time step."),
+        _o("elements", "scalar (int)", "-", "Elements."),
     ),
 }
 

@@ -292,27 +292,59 @@ class Model:
 
     # -- declarations ---------------------------------------------------
     def params(self, *params: Param) -> Namespace:
-        """Declare parameters; returns a namespace of their symbols."""
+        """Declare parameters (each a :class:`~mechgen.symbolic.params.Param`); returns a namespace of the symbols of
+        every parameter declared so far.
+
+        A numeric parameter is a real sympy symbol in the declared functions (``p.k``) until a scene or
+        :func:`mechgen.compile` fixes it, when it becomes a number folded into the kernels; a *size*
+        (``size=True``, a chain's site count) never enters an expression; a *choice* (a string default, or
+        ``choices=(...)``) is a string in the declared functions, so a model branches on it while it is declared
+        (``if p.law == "maxwell": ...``) and each choice derives its own kernels. Names must be identifiers
+        that are neither Python/C keywords nor names mechgen derives (``x_dot`` beside a coordinate ``x``).
+
+        Example: ``model.params(Param("m", 1.0, "kg", "mass", positive=True), Param("law", "linear",
+        choices=("linear", "cubic")))``.
+        """
         for prm in params:
             self._claim(prm.name, "parameter")
             self.param_list.append(prm)
         return Namespace({prm.name: prm.symbol for prm in self.param_list})
 
     def coordinates(self, *names: str) -> tuple[str, ...]:
-        """Declare generalized coordinates (their velocities are ``v.<name>``)."""
+        """Declare the generalized coordinates of a lumped model; returns their names.
+
+        Each coordinate ``x`` is ``q.x`` in the declared functions, its velocity dx/dt ``v.x``; the state and the
+        results name the velocity ``x_dot`` (and the acceleration ``x_ddot``). Example:
+        ``model.coordinates("r", "theta")``.
+        """
         for name in names:
             self._claim(name, "coordinate")
             self.coordinate_names.append(name)
         return tuple(names)
 
     def internal(self, name: str, rate: Callable, *, initial: float = 0.0, doc: str = "") -> None:
-        """Declare an internal variable with its evolution law dz/dt = rate(...)."""
+        """Declare an internal variable z with its own first-order law dz/dt = rate(q, v, z, p, t).
+
+        ``rate`` receives, by parameter name, any of ``q``, ``v``, ``z``, ``p``, ``t`` and returns one scalar
+        expression (the rate, in the variable's unit per second); the variable is ``z.<name>`` in every declared
+        function and part of the state after the velocities, starting at ``initial`` unless ``@model.initial``
+        or a scene says otherwise. A friction state, a viscoelastic element's internal displacement:
+        ``model.internal("y", lambda q, z, p: p.k / p.c * (q.x - z.y))``.
+        """
         self._claim(name, "internal variable")
         self.internals.append(Internal(name, rate, float(initial), doc))
 
     def output(self, name: str, fn: Callable, *, unit: str = "", doc: str = "") -> None:
-        """Declare a named output, a function of (q, v, z, p, t); not named like a built-in output or a result key
-        (:data:`mechgen.symbolic.names.BUILTIN_OUTPUTS`, :data:`~mechgen.symbolic.names.RESULT_KEYS`)."""
+        """Declare a named output: a scalar expression reported beside the state.
+
+        In a lumped model ``fn`` receives, by parameter name, any of ``q``, ``v``, ``z``, ``p``, ``t`` and returns
+        one scalar expression; ``simulate`` reports its time history (``trajectory[name]``), the other analyses its
+        value where they report a state. In a continuum ``fn`` receives ``u`` (jets), ``p``, ``s`` and ``n`` (the
+        stress resultants n = dV/du_s, a string's tension vector) and is reported on steady states. ``unit`` and
+        ``doc`` document it. The name must not be one mechgen reports itself
+        (:data:`mechgen.symbolic.names.BUILTIN_OUTPUTS`, :data:`~mechgen.symbolic.names.RESULT_KEYS`: ``energy``,
+        ``iterations`` ...). Example: ``model.output("height", lambda q, p: -p.l * sp.cos(q.theta), unit="m")``.
+        """
         self._claim(name, "output")
         self._unreported(name, "output")
         self.outputs.append(Output(name, fn, unit, doc))
@@ -339,10 +371,15 @@ class Model:
         self.shape_outputs.append(ShapeOutput(name, fn, start, doc))
 
     def section_stiffness(self, fn: Callable) -> Callable:
-        """Declare a rod cross-section's stiffness K(p): a 6 x 6 symmetric matrix of the parameters, ordered
-        [K_uu, K_uw; K_wu, K_ww] (twist order (v, w), mechgen.symbolic.liegroup), e.g. from
-        :func:`mechgen.symbolic.cross_section.cross_section_stiffness`. The ``section`` kernel evaluates it
-        and the ``cross_section`` analysis reports it (N, N m, N m^2)."""
+        """Decorator (rod): a cross-section's stiffness K(p), a 6 x 6 symmetric matrix.
+
+        The decorated function receives ``p`` and returns the matrix (a sympy Matrix or nested lists) of the
+        parameters, ordered [K_uu, K_uw; K_wu, K_ww] (twist order (v, w), mechgen.symbolic.liegroup), e.g. from
+        :func:`mechgen.symbolic.cross_section.cross_section_stiffness` (a section computed from Lame's lam, mu)
+        or :func:`mechgen.symbolic.rod.rod_stiffness`. The ``section`` kernel evaluates it, the
+        ``cross_section`` analysis reports it (N, N m, N m^2), and :meth:`rod` uses it when given no
+        ``stiffness``.
+        """
         if self.section_fn is not None:
             raise ModelError(f"model {self.name} declares its section stiffness twice", file=self.file,
                              key="section_stiffness", expected="one section_stiffness declaration")
@@ -354,15 +391,19 @@ class Model:
         """Declare a geometrically exact (Cosserat) rod with strain energy 1/2 int (f - f0)^T K (f - f0) ds,
         f = vee6(H^-1 H') = (nu, kappa) (mechgen.symbolic.rod).
 
-        ``length(p)``: the reference length L (m; default 1), e.g. ``lambda p: p.L``.
-        ``stiffness(p)``: K (6 x 6, [K_uu, K_uw; K_wu, K_ww]), e.g.
-        ``lambda p: rod_stiffness(p.EA, p.GA, p.GJ, p.EI)``; None uses the declared section
-        (:meth:`section_stiffness`); a given one also serves as the section (the cross_section analysis).
-        ``f0(p)``: the reference twist (6; default (1, 0, 0, 0, 0, 0), straight along the first section axis).
-        ``load(r, p)``: the distributed wrench per unit length in the spatial frame at the centre-line point
-        ``r`` (``r.x``, ``r.y``, ``r.z``): 3 force components (N/m) or 6 (force, torque N m/m).
-        ``inertia(p)``: the mass per unit length M (6 x 6, kinetic energy 1/2 int eta^T M eta ds), e.g.
-        ``lambda p: rod_inertia(p.rhoA, p.rhoJ, p.rhoI)`` (kg/m, kg m); needed by ``rod_dynamics``.
+        Every argument is a function that receives, by parameter name, ``p`` (and ``r`` for ``load``):
+
+        * ``length(p)``: the reference length L (m; default 1), e.g. ``lambda p: p.L``.
+        * ``stiffness(p)``: K (6 x 6, [K_uu, K_uw; K_wu, K_ww]), e.g.
+          ``lambda p: rod_stiffness(p.EA, p.GA, p.GJ, p.EI)``; None uses the declared section
+          (:meth:`section_stiffness`); a given one also serves as the section (the cross_section analysis).
+        * ``f0(p)``: the reference twist (6 entries; default (1, 0, 0, 0, 0, 0), straight along the first
+          section axis).
+        * ``load(r, p)``: the distributed wrench per unit length in the spatial frame at the centre-line point
+          ``r`` (``r.x``, ``r.y``, ``r.z``): 3 force components (N/m) or 6 (force, torque N m/m).
+        * ``inertia(p)``: the mass per unit length M (6 x 6, kinetic energy 1/2 int eta^T M eta ds), e.g.
+          ``lambda p: rod_inertia(p.rhoA, p.rhoJ, p.rhoI)`` (kg/m, kg m); needed by ``rod_dynamics``.
+
         The ``rod`` kernel evaluates sigma = K (f - f0), C = d sigma/df, W, f0, the load and d load/dr, L
         and M; the ``rod_statics`` analysis solves the rod's equilibrium, ``rod_dynamics`` its motion.
         """
@@ -376,10 +417,14 @@ class Model:
         self.rod_spec = RodSpec(stiffness, f0, load, length, doc, inertia)
 
     def chain(self, coordinate: str, *, sites: str, ends: str = "fixed") -> None:
-        """Declare a lattice of identical sites; ``sites`` names a size parameter.
+        """Declare a lattice (a chain) of identical sites; ``sites`` names a size parameter.
 
-        ``ends`` is ``"fixed"``, ``"periodic"`` or the name of a choice parameter among those two (the
-        scene picks the ends; the one bond energy serves both).
+        The chain's one coordinate ``coordinate`` is repeated at every site; its energies are
+        :meth:`site_kinetic`, :meth:`site_potential` and :meth:`bond_potential`, derived once for one site and
+        one bond, so the kernels do not grow with the number of sites. ``ends`` is ``"fixed"`` (ghost sites 0
+        and N+1 held at zero), ``"periodic"`` (site N+1 is site 1) or the name of a choice parameter among those
+        two (the scene picks the ends; the one bond energy serves both). Example:
+        ``model.chain("u", sites="N", ends="fixed")`` with ``Param("N", 32, size=True)``.
         """
         self._claim(coordinate, "coordinate")
         if ends not in ("fixed", "periodic"):
@@ -396,14 +441,17 @@ class Model:
     def field(self, *names: str, length: str = "L", discretisation: str = "hermite", N: int = 16) -> None:
         """Declare scalar fields on s in [0, p.<length>] (a continuum model).
 
-        Adds the discretisation parameters every continuum has: ``discretisation``
-        (a choice, see :data:`mechgen.runtime.fields.discretise.DISCRETISATIONS`), ``N``
+        The densities then receive the fields' *jets* ``u``: ``u.w`` (w), ``u.w_s`` (dw/ds), ``u.w_ss``,
+        ``u.w_t`` (dw/dt), ``u.w_st``, ``u.w_tt`` ... (mechgen.symbolic.field). ``length`` names the length
+        parameter (declared first). Adds the discretisation parameters every continuum has: ``discretisation``
+        (a choice, see :data:`mechgen.runtime.fields.discretise.DISCRETISATIONS`; the default given here), ``N``
         (elements, or basis functions per field), ``quadrature`` (Gauss points per
         element, 0 = chosen from the basis), ``constraints`` (``eliminate``,
         ``penalty`` or ``multiplier``) and ``joints`` (``assembly``: segments share
         their interface nodes; ``multiplier``: substructures joined by continuity
         constraints). Densities are then declared with :meth:`kinetic_density`,
-        :meth:`potential_density`, :meth:`dissipation_density` or :meth:`weak_form`.
+        :meth:`potential_density`, :meth:`dissipation_density` or :meth:`weak_form`; a model has either
+        coordinates or fields, not both.
         """
         from mechgen.symbolic.discretisations import DISCRETISATIONS
 
@@ -425,17 +473,29 @@ class Model:
                           choices=("assembly", "multiplier"), runtime=True))
 
     def kinetic_density(self, fn: Callable) -> Callable:
-        """Decorator (continuum): kinetic energy per unit length T(u, p, s, t) of the jets u."""
+        """Decorator (continuum): kinetic energy per unit length T(u, p, s, t) of the jets u.
+
+        The decorated function receives, by parameter name, any of ``u`` (the jets), ``p``, ``s`` (the position,
+        m) and ``t``, and returns one scalar expression (J/m), e.g. ``p.rhoA / 2 * u.w_t**2``.
+        """
         self.kinetic_fn = fn
         return fn
 
     def potential_density(self, fn: Callable) -> Callable:
-        """Decorator (continuum): strain/potential energy per unit length V(u, p, s, t)."""
+        """Decorator (continuum): strain/potential energy per unit length V(u, p, s, t).
+
+        Receives ``u``, ``p``, ``s``, ``t`` by name and returns one scalar expression (J/m), e.g.
+        ``p.EI / 2 * u.w_ss**2 - p.q * u.w``; the highest slope it uses sets the basis' continuity.
+        """
         self.potential_fn = fn
         return fn
 
     def dissipation_density(self, fn: Callable) -> Callable:
-        """Decorator (continuum): Rayleigh dissipation per unit length R(u, p, s)."""
+        """Decorator (continuum): Rayleigh dissipation per unit length R(u, p, s), the force density -dR/du_t.
+
+        Receives ``u``, ``p``, ``s``, ``t`` by name and returns one scalar expression (W/m), e.g.
+        ``p.c / 2 * u.w_t**2``.
+        """
         self.dissipation_fn = fn
         return fn
 
@@ -449,30 +509,45 @@ class Model:
         n_s = -dH/du (mechgen.symbolic.steady.derive_steady_hamiltonian), which
         stays well conditioned for stiff and constrained (inextensible) laws where
         the displacement form does not; a law without V (a constraint) declares C only.
+        The decorated function receives ``u``, ``n`` (a namespace with one entry per field), ``p`` and ``s`` by
+        name and returns one scalar expression.
         """
         self.complementary_fn = fn
         return fn
 
     def constraint_density(self, fn: Callable) -> Callable:
-        """Decorator (continuum): a pointwise constraint g(u, p) = 0 on the jets (an inextensible string:
-        (|r_s|^2 - 1)/2), held by a multiplier field mu(s) (the energy mu g). Returning 0 means none (a law
-        without it). Small motions about a steady state satisfy dg/dj . j' = 0 and feel the geometric
-        stiffness mu d2g/dj2 (mechgen.runtime.steady.constrained); steady states use the Hamiltonian form, with
-        n = mu dg/du_s.
+        """Decorator (continuum): a pointwise constraint g(u, p) = 0 on the jets.
+
+        An inextensible string: ``(u.x_s**2 + u.y_s**2 - 1) / 2``, held by a multiplier field mu(s) (the
+        energy mu g). The decorated function receives ``u``, ``p`` and ``s`` by name and returns one scalar
+        expression; returning 0 means none (a law without it). Small motions about a steady state satisfy
+        dg/dj . j' = 0 and feel the geometric stiffness mu d2g/dj2 (mechgen.runtime.steady.constrained); steady
+        states use the Hamiltonian form, with n = mu dg/du_s.
         """
         self.constraint_fn = fn
         return fn
 
     def strain_density(self, fn: Callable) -> Callable:
         """Decorator (continuum): the scalar strain measure g(u, p) through which the slopes enter the strain
-        energy (V = W(g, u): a string's stretch). With the runtime choice ``strain = "projected"`` the axial
-        stiffness W_gg g_j g_j^T is replaced by its projection on cos(k pi s/L) (a mixed, locking-free
-        Galerkin stiffness; mechgen.runtime.steady.constrained). Returning 0 means none."""
+        energy (V = W(g, u): a string's stretch).
+
+        The decorated function receives ``u``, ``p`` and ``s`` by name and returns one scalar expression;
+        returning 0 means none. With the runtime choice ``strain = "projected"`` the axial stiffness
+        W_gg g_j g_j^T is replaced by its projection on cos(k pi s/L) (a mixed, locking-free Galerkin stiffness;
+        mechgen.runtime.steady.constrained).
+        """
         self.strain_fn = fn
         return fn
 
     def weak_form(self, fn: Callable) -> Callable:
-        """Decorator (continuum): a residual density W(test, u, p, s, t), linear in the test jets."""
+        """Decorator (continuum): a residual density W(test, u, p, s, t), linear in the test jets.
+
+        For a model that is not variational (a follower load, a moving contact): the decorated function
+        receives ``test`` (the test jets, named like ``u``'s), ``u``, ``p``, ``s`` and ``t`` by name and returns one
+        scalar expression, a sum of test jets times expressions of the trial jets; dW/dtest is added to
+        the residual of Lagrange's equations. Example: ``test.w * p.c * u.w_t`` (viscous damping written
+        as a force).
+        """
         self.weak_fn = fn
         return fn
 
@@ -483,7 +558,11 @@ class Model:
         functions may ask for ``part``: a namespace of the part's own parameters
         ``params`` (each instance in the scene gives its own values). They are
         model parameters named ``<kind>_<name>``, always kept symbolic (kernel
-        inputs), so one kernel serves every instance.
+        inputs), so one kernel serves every instance. A scene places parts with
+        ``[[parts]]`` tables (``kind``, ``at`` = s in m, and the part's parameters) and cuts a stepped
+        continuum into ``[[segments]]`` (``length``, ``elements`` and per-segment values of numeric model
+        parameters); :func:`mechgen.compile` takes the same as ``parts=[...]`` and ``segments=[...]``.
+        Call :meth:`field` first.
         """
         if self.continuum is None:
             raise ModelError(f"part {kind!r} of model {self.name} declared before its fields", file=self.file,
@@ -505,7 +584,9 @@ class Model:
         A Timoshenko-type model with shear strain gamma = u_s - sign * psi. The
         two-node shaft element (discretisation ``timoshenko2``) interpolates each
         pair with the shape functions that solve the static, unloaded equations
-        exactly (Friedman & Kosmatka 1993; the usual rotordynamics shaft element).
+        exactly (Friedman & Kosmatka 1993; the usual rotordynamics shaft element), and the quintic
+        element splits the pair's slope dofs at segment interfaces and parts.
+        Example: ``model.shear_pair("ux", "psiy")``, ``model.shear_pair("uy", "psix", sign=-1)``.
         """
         for name in (displacement, rotation):
             if name not in self.field_names:
@@ -519,11 +600,12 @@ class Model:
         """Declare the lateral displacements (coordinates or fields) whose orbit classifies whirl.
 
         A mode whirls *forward* when its orbit turns from x towards y, the sense of a
-        positive spin about z = x cross y, and *backward* otherwise; modes analyses
-        of gyroscopic systems then report ``whirl`` per mode. A lumped model may call this
+        positive spin about z = x cross y, and *backward* otherwise; ``modes`` of
+        gyroscopic systems then reports ``whirl`` per mode, and ``campbell`` requires at least
+        one pair (it labels each branch of the diagram by its whirl). A lumped model may call this
         again to add stations (a disk's translations and its tilts): each mode is judged at
         the station where its orbit is largest. A continuum declares one pair (its stations
-        are the mesh's nodes).
+        are the mesh's nodes). Example: ``model.whirl_pair("x", "y")``.
         """
         names = set(self.coordinates_all) | set(self.field_names)
         for name in (x, y):
@@ -539,7 +621,7 @@ class Model:
         self.whirl = (self.whirl or ()) + (x, y)
 
     def part_params(self) -> tuple[str, ...]:
-        """Model parameter names of every part kind's parameters (always symbolic)."""
+        """Model parameter names of every part kind's parameters (``<kind>_<name>``, always symbolic)."""
         return tuple(f"{kind}_{name}" for kind, names in self.parts.items() for name in names)
 
     def _point(self, kind: str, at: str) -> Callable:
@@ -556,74 +638,135 @@ class Model:
     def point_kinetic(self, at: str) -> Callable:
         """Decorator (continuum): kinetic energy of a point mass/inertia at ``at`` ('start', 'end' or a part kind).
 
-        The function gets the jets ``u`` at the point, ``p`` and, for a part, ``part``.
+        The function receives, by parameter name, the jets ``u`` at the point, ``p``, ``s``, ``t`` and, for a
+        part, ``part`` (the part's own parameters); it returns one scalar expression (J), e.g. a disk's
+        ``part.m / 2 * (u.ux_t**2 + u.uy_t**2)``.
         """
         return self._point("kinetic", at)
 
     def point_potential(self, at: str) -> Callable:
-        """Decorator (continuum): potential energy at an end (a spring, a dead load), V(u, p)."""
+        """Decorator (continuum): potential energy at an end or a part, V(u, p) (J): a spring, a dead load.
+
+        Receives ``u``, ``p``, ``s``, ``t`` (and ``part``) like :meth:`point_kinetic`, e.g.
+        ``p.k_end / 2 * u.w**2``.
+        """
         return self._point("potential", at)
 
     def point_dissipation(self, at: str) -> Callable:
-        """Decorator (continuum): Rayleigh dissipation at an end (a dashpot), R(u, p)."""
+        """Decorator (continuum): Rayleigh dissipation at an end or a part, R(u, p) (W): a dashpot.
+
+        Receives ``u``, ``p``, ``s``, ``t`` (and ``part``) like :meth:`point_kinetic`, e.g.
+        ``p.c_end / 2 * u.w_t**2``.
+        """
         return self._point("dissipation", at)
 
     def point_weak_form(self, at: str) -> Callable:
-        """Decorator (continuum): a residual at an end, W(test, u, p), linear in the test jets (follower loads)."""
+        """Decorator (continuum): a residual at an end or a part, W(test, u, p), linear in the test jets.
+
+        Receives ``test``, ``u``, ``p``, ``s``, ``t`` (and ``part``): follower loads, a bearing's cross-coupled
+        forces ``test.ux * (part.kxx * u.ux + part.kxy * u.uy) + ...``.
+        """
         return self._point("weak", at)
 
     def boundary(self, fn: Callable) -> Callable:
-        """Decorator (continuum): essential boundary conditions fn(p) -> [fix(jet, 'start' | 'end'), ...]."""
+        """Decorator (continuum): essential boundary conditions.
+
+        The decorated function receives ``p`` and returns a list of :func:`~mechgen.symbolic.field.fix` entries:
+        ``[fix("w", "start"), fix("w_s", "start")]`` clamps the start (w = dw/ds = 0). A value other than 0
+        (``fix("z", "end", p.h)``) is for steady boundary value problems; perturbations (modes, stability) hold
+        the jet at 0. Conditions left out are natural (free). ``fix_ends(p.bc, {...})`` builds the list from a
+        'start-end' choice parameter.
+        """
         self.boundary_fn = fn
         return fn
 
     def initial(self, fn: Callable) -> Callable:
-        """Decorator: the initial state fn(p) -> {name: value} (coordinates, ``<x>_dot`` velocities, internal
-        variables; others 0), generated as the kernel ``initial`` (mechgen.symbolic.initial); a scene's
-        ``q0`` / ``v0`` replace the entries they name."""
+        """Decorator: the initial state as a function of the parameters.
+
+        The decorated function receives ``p`` (and ``t``, 0) by name and returns a dict {name: value}: a
+        coordinate ``x``, its velocity ``x_dot`` or an internal variable (others start at 0), e.g.
+        ``{"x_dot": p.v_in}``. It is generated as the kernel ``initial`` (mechgen.symbolic.initial), so a sweep or
+        a fit starts where the model says at every parameter value; a scene's ``q0`` / ``v0`` replace the
+        entries they name.
+        """
         self.initial_fn = fn
         return fn
 
     def kinetic(self, fn: Callable) -> Callable:
-        """Decorator: kinetic energy T(q, v, p, t)."""
+        """Decorator: kinetic energy T(q, v, z, p, t).
+
+        The decorated function receives, by parameter name, any of ``q``, ``v``, ``z``, ``p``, ``t`` and returns
+        one scalar expression (J), e.g. ``p.m / 2 * (v.r**2 + q.r**2 * v.theta**2)``. The mass matrix is its
+        Hessian in v, so it must be positive definite at the states an analysis visits.
+        """
         self.kinetic_fn = fn
         return fn
 
     def potential(self, fn: Callable) -> Callable:
-        """Decorator: potential (strain) energy V(q, p, t)."""
+        """Decorator: potential (strain) energy V(q, z, p, t).
+
+        Receives ``q``, ``v``, ``z``, ``p``, ``t`` by name (V should not depend on ``v``) and returns one scalar
+        expression (J), e.g. ``p.k / 2 * q.x**2 - p.m * p.g * q.y``; its gradient is the conservative force,
+        its Hessian the stiffness matrix.
+        """
         self.potential_fn = fn
         return fn
 
     def dissipation(self, fn: Callable) -> Callable:
-        """Decorator: Rayleigh dissipation function R(q, v, p), force -dR/dv."""
+        """Decorator: Rayleigh dissipation function R(q, v, p), the force -dR/dv.
+
+        Receives ``q``, ``v``, ``z``, ``p``, ``t`` by name and returns one scalar expression (W), e.g.
+        ``p.c / 2 * v.x**2`` for a dashpot c; v . dR/dv is the dissipated power the energy balance reports.
+        """
         self.dissipation_fn = fn
         return fn
 
     def forces(self, fn: Callable) -> Callable:
-        """Decorator: generalized non-conservative forces Q(q, v, z, p, t) as {coordinate: expr}."""
+        """Decorator: generalized non-conservative forces Q(q, v, z, p, t).
+
+        Receives ``q``, ``v``, ``z``, ``p``, ``t`` by name and returns a dict {coordinate: expression} (N for a
+        length, N m for an angle; coordinates left out get 0) or a list in the coordinates' order, e.g.
+        ``{"x": p.F * sp.cos(p.w * t)}``. They enter Lagrange's equations as d/dt dT/dv - dT/dq + dV/dq + dR/dv = Q.
+        """
         self.forces_fn = fn
         return fn
 
     def site_kinetic(self, fn: Callable) -> Callable:
-        """Decorator (lattice): kinetic energy of one site, fn(s, p) with s.q, s.v."""
+        """Decorator (lattice): kinetic energy of one site, fn(s, p) with ``s.q``, ``s.v`` the site's coordinate and
+        velocity; returns one scalar expression, e.g. ``s.v**2 / 2``.
+        """
         self.site_kinetic_fn = fn
         return fn
 
     def site_potential(self, fn: Callable) -> Callable:
-        """Decorator (lattice): on-site potential energy, fn(s, p)."""
+        """Decorator (lattice): on-site potential energy (a substrate), fn(s, p) with ``s.q``, ``s.v``; returns one
+        scalar expression, e.g. ``p.k0 * s.q**2 / 2``.
+        """
         self.site_potential_fn = fn
         return fn
 
     def bond_potential(self, fn: Callable) -> Callable:
-        """Decorator (lattice): energy of the bond between neighbours, fn(a, b, p)."""
+        """Decorator (lattice): energy of the bond between neighbours, fn(a, b, p) with ``a.q`` the left site's and
+        ``b.q`` the right site's coordinate; returns one scalar expression, e.g. the FPU bond
+        ``p.gamma * (b.q - a.q)**2 / 2 + p.alpha * (b.q - a.q)**3 / 3``.
+        """
         self.bond_potential_fn = fn
         return fn
 
     # -- hybrid models (mechgen.symbolic.hybrid) ---------------------------
     def mode(self, name: str, *, initial: bool = False):
-        """Declare a mode of a hybrid model; returns its :class:`~mechgen.symbolic.hybrid.ModeScope`, whose
-        decorators (kinetic, potential, dissipation, forces, internal, guard, terminal) act in that mode only.
-        The first mode declared is the initial one unless another says ``initial=True``."""
+        """Declare a mode of a hybrid model; returns its :class:`~mechgen.symbolic.hybrid.ModeScope`.
+
+        The scope's decorators (kinetic, potential, dissipation, forces, internal, output, guard, terminal) act in
+        that mode only, added to the model-wide declarations. The first mode declared is the initial one unless
+        another says ``initial=True``; a scene's ``mode`` key starts elsewhere. Example::
+
+            flight = model.mode("flight", initial=True)
+
+            @flight.guard(to="flight", direction="falling", reset=lambda v, p: {"y_dot": -p.e * v.y})
+            def floor(q):
+                return q.y
+        """
         from mechgen.symbolic.hybrid import ModeScope
 
         if self.continuum is not None or self.chain_spec is not None:
@@ -640,18 +783,34 @@ class Model:
         return scope
 
     def hybrid_internal(self, name: str, *, initial: float = 0.0, doc: str = "") -> None:
-        """Add internal variable ``name`` to the state (once; a mode's law declares it, frozen elsewhere)."""
+        """Add internal variable ``name`` to the state (once; a mode's law declares it, frozen elsewhere).
+
+        Called by :meth:`ModeScope.internal <mechgen.symbolic.hybrid.ModeScope.internal>`; a model file
+        declares a mode's internal law there, not with this.
+        """
         if any(i.name == name for i in self.internals):
             return
         self.internal(name, rate=lambda: 0, initial=initial, doc=doc)
 
     def add_guard(self, guard) -> None:
-        """Record a :class:`~mechgen.symbolic.hybrid.Guard` (declared through a mode or :meth:`terminal`)."""
+        """Record a :class:`~mechgen.symbolic.hybrid.Guard` (declared through a mode or :meth:`terminal`).
+
+        Called by the guard decorators; a model file declares guards with ``@mode.guard(...)``,
+        ``@mode.terminal(...)`` or ``@model.terminal(...)``.
+        """
         self.guards.append(guard)
 
     def terminal(self, *, direction: str = "both") -> Callable:
         """Decorator (hybrid): an event function g(q, v, z, p, t) that ends the run in every mode when it
-        changes sign in ``direction`` (rising, falling, both): a projectile at rest."""
+        changes sign in ``direction`` (rising, falling, both): a projectile at rest.
+
+        The decorated function receives ``q``, ``v``, ``z``, ``p``, ``t`` by name and returns one scalar
+        expression; its name names the event in ``events``. Example::
+
+            @model.terminal(direction="falling")
+            def at_rest(v):
+                return v.x
+        """
         from mechgen.symbolic.hybrid import Guard, DIRECTIONS
 
         def register(fn: Callable) -> Callable:
@@ -675,7 +834,7 @@ class Model:
 
     # -- queries ----------------------------------------------------------
     def param(self, name: str) -> Param:
-        """The parameter called ``name``."""
+        """The :class:`~mechgen.symbolic.params.Param` called ``name`` (ModelError when there is none)."""
         for prm in self.param_list:
             if prm.name == name:
                 return prm
@@ -710,7 +869,7 @@ class Model:
         return tuple(o.name for o in self.outputs) + ("kinetic_energy", "potential_energy", "energy")
 
     def summary(self) -> str:
-        """First line of the docstring."""
+        """The first line of the model's docstring (its name when it has none): what ``mechgen models`` lists."""
         return self.doc.splitlines()[0] if self.doc else self.name
 
     def _unreported(self, name: str, what: str) -> None:
