@@ -45,13 +45,14 @@ Runtime module: numbers only (no sympy); units are the model's (t in its time un
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
 
 from mechgen.errors import ConvergenceError
 from mechgen.runtime.core.budget import Budget, Progress
+from mechgen.runtime.core.options import Options
 
 #: Newton stops when its correction is below this many times the velocity scale (quadratic convergence
 #: puts the accepted point far below it), or when it stalls at round-off below STALL of the scale
@@ -264,7 +265,7 @@ def steps_for(t_end: float, dt: float) -> tuple[int, float]:
 
 
 @dataclass(frozen=True)
-class VariationalOptions:
+class VariationalOptions(Options):
     """How a variational run goes (run_variational).
 
     Attributes:
@@ -286,16 +287,6 @@ class VariationalOptions:
     progress: bool = False
     desc: str = "variational"
     loop: str = "auto"
-
-    @classmethod
-    def of(cls, options: "VariationalOptions | None" = None, **changes) -> "VariationalOptions":
-        """``options`` (default: the defaults) with ``changes`` (keyword names of the fields) applied."""
-        known = {f.name for f in fields(cls)}
-        unknown = set(changes) - known
-        if unknown:
-            raise TypeError(f"unknown variational options {sorted(unknown)}; expected some of {sorted(known)}")
-        base = cls() if options is None else options
-        return replace(base, **changes) if changes else base
 
 
 def run_variational(system, q0, v0, t_end: float, dt: float, *, options: VariationalOptions | None = None,

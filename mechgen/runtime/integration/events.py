@@ -181,12 +181,11 @@ class _Segment:
         return g, (g_t if with_rates else np.zeros_like(g))
 
 
-def _hermite(s: float, ga: float, da: float, gb: float, db: float, h: float) -> tuple[int, bool]:
-    """The cubic Hermite p(u), u in [0, 1], through (ga, h da) and (gb, h db): its sign changes counted along
-    its value at 0 (taken as the tracked sign ``s``), at its interior extrema and at 1; whether it has an
-    interior extremum."""
+def _interior_extrema(ga: float, da: float, gb: float, db: float, h: float) -> list[tuple[float, float]]:
+    """(u, p(u)) at the extrema in (0, 1), in order, of the cubic Hermite p(u) = ga + c1 u + c2 u^2 + c3 u^3
+    through (ga, h da) and (gb, h db): the roots of p'(u) = c1 + 2 c2 u + 3 c3 u^2 (the stable quadratic
+    formula)."""
     c1, c2, c3 = h * da, 3 * (gb - ga) - h * (2 * da + db), 2 * (ga - gb) + h * (da + db)
-    # p'(u) = c1 + 2 c2 u + 3 c3 u^2
     crit: list[float] = []
     if c3 != 0.0:
         disc = c2 * c2 - 3 * c1 * c3
@@ -195,9 +194,16 @@ def _hermite(s: float, ga: float, da: float, gb: float, db: float, h: float) -> 
             crit = [q / (3 * c3)] + ([c1 / q] if q != 0.0 else [])
     elif c2 != 0.0:
         crit = [-c1 / (2 * c2)]
-    inside = sorted(u for u in crit if 0.0 < u < 1.0)
+    return [(u, ga + u * (c1 + u * (c2 + u * c3))) for u in sorted(u for u in crit if 0.0 < u < 1.0)]
+
+
+def _hermite(s: float, ga: float, da: float, gb: float, db: float, h: float) -> tuple[int, bool]:
+    """The cubic Hermite p(u), u in [0, 1], through (ga, h da) and (gb, h db): its sign changes counted along
+    its value at 0 (taken as the tracked sign ``s``), at its interior extrema and at 1; whether it has an
+    interior extremum."""
+    inside = _interior_extrema(ga, da, gb, db, h)
     changes, last = 0, s
-    for value in [ga + u * (c1 + u * (c2 + u * c3)) for u in inside] + [gb]:
+    for value in [value for _, value in inside] + [gb]:
         if value != 0.0 and math.copysign(1.0, value) != last:
             changes, last = changes + 1, -last
     return changes, bool(inside)
@@ -236,17 +242,7 @@ def _dip(s: float, ga: float, da: float, gb: float, db: float, h: float) -> floa
     is past zero (sign -s) while both ends keep the sign s; None when it has none."""
     if ga == 0.0 or gb == 0.0 or math.copysign(1.0, ga) != s or math.copysign(1.0, gb) != s:
         return None
-    c1, c2, c3 = h * da, 3 * (gb - ga) - h * (2 * da + db), 2 * (ga - gb) + h * (da + db)
-    crit: list[float] = []
-    if c3 != 0.0:
-        disc = c2 * c2 - 3 * c1 * c3
-        if disc >= 0.0:
-            q = -(c2 + math.copysign(math.sqrt(disc), c2))
-            crit = [q / (3 * c3)] + ([c1 / q] if q != 0.0 else [])
-    elif c2 != 0.0:
-        crit = [-c1 / (2 * c2)]
-    for u in sorted(u for u in crit if 0.0 < u < 1.0):
-        value = ga + u * (c1 + u * (c2 + u * c3))
+    for u, value in _interior_extrema(ga, da, gb, db, h):
         if value != 0.0 and math.copysign(1.0, value) != s:
             return u
     return None

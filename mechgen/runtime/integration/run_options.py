@@ -8,10 +8,12 @@ same options give the same run in either loop (their rules: mechgen.runtime.inte
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass
 from typing import Any, Callable
 
 import numpy as np
+
+from mechgen.runtime.core.options import Options
 
 
 @dataclass(frozen=True)
@@ -25,7 +27,7 @@ class EventRules:
 
 
 @dataclass(frozen=True)
-class RunOptions:
+class RunOptions(Options):
     """How one time integration runs.
 
     Attributes:
@@ -51,16 +53,6 @@ class RunOptions:
     explain: Callable | None = None
     stop_after: Callable | None = None
     loop: str = "auto"
-
-    @classmethod
-    def of(cls, options: "RunOptions | None" = None, **changes) -> "RunOptions":
-        """``options`` (default: the defaults) with ``changes`` (keyword names of the fields) applied."""
-        known = {f.name for f in fields(cls)}
-        unknown = set(changes) - known
-        if unknown:
-            raise TypeError(f"unknown run options {sorted(unknown)}; expected some of {sorted(known)}")
-        base = cls() if options is None else options
-        return replace(base, **changes) if changes else base
 
     def samples(self) -> np.ndarray | None:
         """``t_eval`` as a float array (None when every step is kept)."""
