@@ -252,13 +252,38 @@ def test_documented_outputs_cover_a_rotors_modes_sweep_and_campbell():
 
 
 def test_option_meanings_come_from_the_schema_and_the_module():
-    """An option's row holds the kind docstring's parenthesis about it and its check's docstring."""
+    """An option's row holds its Option's ``doc`` and its check's docstring; an Option without a doc falls back
+    on the kind docstring's parenthesis about it."""
+    from mechgen.analyses.schema import Option, boolean
+
     text = reference.kind_page("simulate")
     row = text.split("* - ``series``", 1)[1].split("* - ", 1)[0]
-    assert "the time history; left out: kept while small" in row and "true or false" in row
+    assert "Keep the time history t and trajectory" in row and "true or false" in row
+    assert "*Described:*" not in row
+    assert reference.option_meaning(Option(boolean), "the time history") == (
+        "*Described:* the time history. *Accepts:* true or false.")
     assert reference.described("x ``a`` (b (c) d) e", "a") == "b (c) d"
     assert reference.described("x ``a`` b", "a") == ""
     assert reference.toml_literal({"a": [1.0, True], "b": "auto"}) == '{ a = [1.0, true], b = "auto" }'
+
+
+def option_rows(kind: str) -> dict[str, str]:
+    """Each scene key's row of the kind's reference page (its cells' text, joined)."""
+    text = reference.kind_page(kind).split("Scene keys\n----------\n", 1)[1].split("\nOutputs\n", 1)[0]
+    rows = text.split("   * - ")[2:]  # [0]: the directive, [1]: the header row
+    return {re.match(r"``(\w+)``", row).group(1): " ".join(row.split()) for row in rows}
+
+
+def test_every_option_of_every_kind_has_a_doc_shown_on_its_page():
+    """No key of a registered kind lands undocumented: each Option has a non-empty ``doc``, and the kind's
+    reference page shows it in that key's row (as a sentence, bars escaped)."""
+    for kind in kinds():
+        schema = get(kind).schema
+        rows = option_rows(kind) if schema else {}
+        assert set(rows) == set(schema), kind
+        for name, option in schema.items():
+            assert option.doc.strip(), f"{kind}.{name} has no doc"
+            assert reference.escape_bars(reference.sentence(option.doc)) in rows[name], (kind, name)
 
 
 def public_members_of_model() -> list[str]:

@@ -338,22 +338,24 @@ def symplectic(system, *, name: str | None = None, **options) -> Result:
 
 
 def option_lines(kind: str) -> list[str]:
-    """One line per option of ``kind``, from the schema the scene loader validates against: its name and its
-    default as the reference pages write it (mechgen.analyses.reference.default_text)."""
-    from mechgen.analyses.reference import default_text
+    """One line per option of ``kind``, from the schema the scene loader validates against: its name, its
+    default as the reference pages write it (mechgen.analyses.reference.default_text) and its meaning (the
+    Option's ``doc``, its bars escaped for reStructuredText as on the reference pages)."""
+    from mechgen.analyses.reference import default_text, escape_bars
 
-    return [f"``{name}``: {default_text(option).replace('**', '')}" for name, option in get(kind).schema.items()]
+    return [f"``{name}`` ({default_text(option).replace('**', '').replace(' (no default)', '')}): "
+            f"{escape_bars(option.doc)}".rstrip(": ") for name, option in get(kind).schema.items()]
 
 
 def _with_schema_options() -> None:
     """Append to each analysis function's docstring the options its kind's schema accepts (so that the
-    docstrings and the loader cannot disagree on names and defaults)."""
+    docstrings, the reference pages and the loader cannot disagree on names, defaults and meanings)."""
     functions = {name: globals()[name] for name in __all__ if name not in ("analysis", "option_lines")}
     for kind, function in functions.items():
         if kind in kinds():
             function.__doc__ = (function.__doc__ or "").rstrip() + (
-                "\n\n    Options accepted (from the scene schema of kind ``%s``): " % kind
-                + "; ".join(option_lines(kind)) + ".\n")
+                "\n\n    Options accepted (from the scene schema of kind ``%s``):\n\n" % kind
+                + "".join(f"    * {line}\n" for line in option_lines(kind)))
 
 
 _with_schema_options()

@@ -1,7 +1,8 @@
 """The reference pages of the analysis kinds, generated from the analyses registry (reStructuredText text).
 
 Each page comes from the objects the scene loader validates against: the kind's ``schema`` (option names,
-defaults, the ``expected`` text, the check function's docstring as the meaning), the kind's module docstring
+defaults, each Option's ``doc`` as the meaning, the ``expected`` text and the check function's docstring as
+what it accepts), the kind's module docstring
 (what it computes) and the outputs documented in :mod:`mechgen.analyses.outputs_doc`. Nothing here imports
 Sphinx; ``docs/_ext/mechgen_reference.py`` writes these strings into the documentation at build time, so
 the reference and the loader cannot disagree on names or defaults.
@@ -124,14 +125,23 @@ def check_meaning(check: Any) -> str:
     return ""
 
 
+def sentence(text: str) -> str:
+    """``text`` as a sentence: its first letter capitalised and a full stop at its end."""
+    text = " ".join(text.split())
+    if not text:
+        return ""
+    return text[0].upper() + text[1:] + ("" if text.endswith(".") else ".")
+
+
 def option_meaning(option: Option, said: str = "") -> str:
-    """An option's meaning: what the kind's docstring says of it (``said``), then what its check accepts and the
-    ``expected`` text where it says more."""
+    """An option's meaning: its ``doc`` (or, where that is empty, what the kind's docstring says of it: ``said``),
+    then what its check accepts and the ``expected`` text where it says more."""
     accepts = check_meaning(option.check)
     if option.expected and option.expected != "a value" and option.expected.lower() not in accepts.lower():
         accepts = (accepts + " " if accepts else "") + f"Expected: {option.expected}."
-    parts = [f"*Described:* {escape_bars(said)}." if said else "",
-             f"*Accepts:* {accepts}" if accepts else ""]
+    meaning = escape_bars(sentence(option.doc)) if option.doc else (
+        f"*Described:* {escape_bars(said)}." if said else "")
+    parts = [meaning, f"*Accepts:* {accepts}" if accepts else ""]
     return " ".join(p for p in parts if p) or "See the description above."
 
 
@@ -162,12 +172,12 @@ def title(text: str, underline: str) -> list[str]:
 
 
 def options_section(kind: str) -> list[str]:
-    """The scene keys of ``kind``: name, default, meaning, from its schema."""
+    """The scene keys of ``kind``: name, default, meaning (each Option's ``doc``), from its schema."""
     schema = get(kind).schema
     if not schema:
         return title("Scene keys", "-") + ["This kind takes no options.", ""]
     doc = importlib.import_module(module_of(kind)).__doc__ or ""
-    rows = [(f"``{name}``", default_text(option), option_meaning(option, described(doc, name)))
+    rows = [(f"``{name}``", default_text(option), option_meaning(option, "" if option.doc else described(doc, name)))
             for name, option in schema.items()]
     return title("Scene keys", "-") + table(("key", "default", "meaning"), rows, "18 18 64")
 
