@@ -286,6 +286,26 @@ def test_every_option_of_every_kind_has_a_doc_shown_on_its_page():
             assert reference.escape_bars(reference.sentence(option.doc)) in rows[name], (kind, name)
 
 
+def test_analysis_functions_list_their_options_and_outputs():
+    """``help(mechgen.<kind>)`` shows every option with its doc and default and every output of the kind's
+    table (mechgen.analyses.outputs_doc) with its unit: the sources the reference pages use."""
+    from mechgen.analyses import public
+
+    for kind in kinds():
+        doc = getattr(public, kind).__doc__
+        options = doc.split("Options accepted", 1)[1].split("Outputs (", 1)[0]
+        outputs = doc.split("Outputs (", 1)[1]
+        for name, option in get(kind).schema.items():
+            assert f"* ``{name}`` (" in options, (kind, name)
+            assert reference.escape_bars(option.doc) in " ".join(options.split()), (kind, name)
+        for output in outputs_of(kind):
+            assert f"* ``{output.name}``" in outputs, (kind, output.name)
+            if output.unit.strip() not in ("", "-"):
+                assert f"* ``{output.name}`` [{output.unit}]" in outputs, (kind, output.name)
+        assert not re.search(r":\w+:`", outputs), kind  # a role of the pages' own folder breaks elsewhere
+    assert reference.first_sentence("A list, e.g. a pair. Then more.") == "A list, e.g. a pair."
+
+
 def public_members_of_model() -> list[str]:
     """Every public method and property of mechgen.Model (the model author's declarations and queries)."""
     from mechgen import Model

@@ -12,6 +12,7 @@ from __future__ import annotations
 import importlib
 import inspect
 import json
+import re
 from pathlib import Path
 from typing import Any
 
@@ -98,6 +99,14 @@ def described(doc: str, name: str) -> str:
         if depth == 0:
             return text[i + 1:j]
     return ""
+
+
+def first_sentence(text: str) -> str:
+    """The first sentence of a meaning (up to the first full stop followed by a capital letter or the end;
+    "e.g." and "i.e." do not end one), its spaces joined."""
+    text = " ".join(text.split())
+    match = re.search(r"(?<!e\.g)(?<!i\.e)\.(\s+(?=[A-Z`(*])|$)", text)
+    return text[:match.start() + 1] if match else text
 
 
 def first_paragraph(text: str | None) -> str:
