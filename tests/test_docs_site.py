@@ -306,6 +306,22 @@ def test_analysis_functions_list_their_options_and_outputs():
     assert reference.first_sentence("A list, e.g. a pair. Then more.") == "A list, e.g. a pair."
 
 
+def test_a_dash_cell_renders_as_text_not_as_an_empty_bullet():
+    """A unit of "-" (no unit), an empty cell and a cell opening with "- " render, through docutils, as the em
+    dash in the table's cell and never as a nested bullet list (the reference pages' tables)."""
+    from docutils import nodes
+    from docutils.core import publish_doctree
+
+    lines = reference.table(("name", "unit", "meaning"),
+                            [("``a``", "-", ""), ("``b``", "- or rad", "x")], "30 30 40")
+    tree = publish_doctree("\n".join(lines), settings_overrides={"report_level": 5})
+    cells = [entry.astext() for entry in tree.findall(nodes.entry)]
+    assert cells == ["name", "unit", "meaning", "a", "\u2014", "\u2014", "b", "\u2014 or rad", "x"]
+    assert not [b for b in tree.findall(nodes.bullet_list) if b.parent.tagname == "entry"]
+    for kind in kinds():
+        assert not re.search(r"^ *- -( |$)", reference.kind_page(kind), re.M), kind
+
+
 def public_members_of_model() -> list[str]:
     """Every public method and property of mechgen.Model (the model author's declarations and queries)."""
     from mechgen import Model

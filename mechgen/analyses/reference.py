@@ -154,9 +154,20 @@ def option_meaning(option: Option, said: str = "") -> str:
     return " ".join(p for p in parts if p) or "See the description above."
 
 
+#: what a cell without content shows (a unit of "-", a dimensionless number or a label, too): an em dash, since
+#: a lone "-" (or one that opens the cell) in a list-table's cell would start a nested, empty bullet list
+NO_CONTENT = "\u2014"
+
+
 def cell(text: str) -> str:
-    """Text for one cell of a list-table (one line; an empty cell as a dash)."""
-    return " ".join(text.split()) or "-"
+    """Text for one cell of a list-table (one line; an empty cell, or one of a lone "-", as an em dash, and a
+    leading "- " as one too, so that no cell opens a bullet list)."""
+    text = " ".join(text.split())
+    if text in ("", "-"):
+        return NO_CONTENT
+    if text.startswith("- "):
+        return NO_CONTENT + text[1:]
+    return text
 
 
 def table(header: tuple[str, ...], rows: list[tuple[str, ...]], widths: str) -> list[str]:
