@@ -322,6 +322,34 @@ def test_a_dash_cell_renders_as_text_not_as_an_empty_bullet():
         assert not re.search(r"^ *- -( |$)", reference.kind_page(kind), re.M), kind
 
 
+def test_every_kind_a_shipped_scene_uses_shows_an_example_that_loads():
+    """A kind whose [[analysis]] table a shipped scene holds has that table on its page, and the scene it comes
+    from loads (mechgen.scene.load: the same checks as ``mechgen run``) with an analysis of that name and kind;
+    a kind no shipped scene uses says so."""
+    from mechgen import models
+    from mechgen.scene.info import lookup_model
+    from mechgen.scene.load import load_scene, tomllib
+
+    scenes = ROOT / "scenes"
+    used = {table["kind"] for path in scenes.glob("*.toml")
+            for table in tomllib.loads(path.read_text(encoding="utf-8")).get("analysis", [])}
+    loaded = {}
+    for kind in kinds():
+        page = reference.kind_page(kind, scenes)
+        example = page.split("Example\n-------\n", 1)[1]
+        if kind not in used:
+            assert "No shipped scene uses this kind" in example, kind
+            continue
+        name = re.search(r"``scenes/(\S+)``", example).group(1)
+        table = tomllib.loads("\n".join(line[3:] for line in example.splitlines()
+                                         if line.startswith("   ")))["analysis"][0]
+        assert table["kind"] == kind, kind
+        if name not in loaded:
+            loaded[name] = load_scene(str(scenes / name), lookup_model=lookup_model, model_names=models.known)
+        specs = {spec.name: spec.kind for spec in loaded[name].analyses}
+        assert specs[table["name"]] == kind, (kind, name)
+
+
 def public_members_of_model() -> list[str]:
     """Every public method and property of mechgen.Model (the model author's declarations and queries)."""
     from mechgen import Model

@@ -265,10 +265,14 @@ def example_scene(kind: str, scenes: Path | None) -> tuple[str, str] | None:
 
 
 def example_section(kind: str, scenes: Path | None) -> list[str]:
-    """A shipped scene's table of this kind, when one has it."""
+    """A shipped scene's table of this kind, or a line saying no shipped scene uses the kind (nothing without a
+    folder of scenes: an installed package has none)."""
+    if scenes is None or not scenes.is_dir():
+        return []
     found = example_scene(kind, scenes)
     if found is None:
-        return []
+        return title("Example", "-") + ["No shipped scene uses this kind (``scenes/*.toml``); the usage above "
+                                         "shows the keys it requires.", ""]
     name, table_text = found
     lines = title("Example", "-") + [f"From the shipped scene ``scenes/{name}``:", "", ".. code-block:: toml", ""]
     return lines + [f"   {line}" if line.strip() else "" for line in table_text.splitlines()] + [""]
