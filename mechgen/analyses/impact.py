@@ -66,7 +66,7 @@ SCHEMA = {
     "q0": Option(schema.coordinate_table, {}, doc="initial coordinates replacing those of the model's declared "
                  "initial state, coordinate = value"),
     "v0": Option(schema.coordinate_table, {}, doc="initial velocities replacing those of the model's declared "
-                 "initial state, coordinate = value (the coordinate's unit per s)"),
+                 "initial state, coordinate = value (the coordinate's unit per s; required without one)"),
     "coordinate": Option(_coordinate, ABSENT, doc="the coordinate along which restitution is measured (default "
                          "the first)"),
     "contact_mode": Option(schema.name, ABSENT, doc="the contact mode whose leaving ends the impact (default "
