@@ -221,8 +221,8 @@ def test_a_kind_registered_at_run_time_runs_through_the_scene_the_summary_and_th
         mats = system.linear(np.array([options["r"], 0.0]))
         return {"unknowns": system.n, "mass_trace": float(np.trace(mats["M"]))}
 
-    kind = registry.AnalysisKind("mass_trace", {"r": schema.Option(schema.positive, 1.0)}, run,
-                                 lambda options, *, internal: {"linear"}, summary.lines)
+    options = {"r": schema.Option(schema.positive, 1.0, doc="the pendulum's length r at which M is evaluated (m)")}
+    kind = registry.AnalysisKind("mass_trace", options, run, lambda options, *, internal: {"linear"}, summary.lines)
     registry.register(kind)
     try:
         assert registry.kinds()[-1] == "mass_trace"

@@ -252,13 +252,102 @@ def test_documented_outputs_cover_a_rotors_modes_sweep_and_campbell():
 
 
 def test_option_meanings_come_from_the_schema_and_the_module():
-    """An option's row holds the kind docstring's parenthesis about it and its check's docstring."""
+    """An option's row holds its Option's ``doc`` and its check's docstring; an Option without a doc falls back
+    on the kind docstring's parenthesis about it."""
+    from mechgen.analyses.schema import Option, boolean
+
     text = reference.kind_page("simulate")
     row = text.split("* - ``series``", 1)[1].split("* - ", 1)[0]
-    assert "the time history; left out: kept while small" in row and "true or false" in row
+    assert "Keep the time history t and trajectory" in row and "true or false" in row
+    assert "*Described:*" not in row
+    assert reference.option_meaning(Option(boolean), "the time history") == (
+        "*Described:* the time history. *Accepts:* true or false.")
     assert reference.described("x ``a`` (b (c) d) e", "a") == "b (c) d"
     assert reference.described("x ``a`` b", "a") == ""
     assert reference.toml_literal({"a": [1.0, True], "b": "auto"}) == '{ a = [1.0, true], b = "auto" }'
+
+
+def option_rows(kind: str) -> dict[str, str]:
+    """Each scene key's row of the kind's reference page (its cells' text, joined)."""
+    text = reference.kind_page(kind).split("Scene keys\n----------\n", 1)[1].split("\nOutputs\n", 1)[0]
+    rows = text.split("   * - ")[2:]  # [0]: the directive, [1]: the header row
+    return {re.match(r"``(\w+)``", row).group(1): " ".join(row.split()) for row in rows}
+
+
+def test_every_option_of_every_kind_has_a_doc_shown_on_its_page():
+    """No key of a registered kind lands undocumented: each Option has a non-empty ``doc``, and the kind's
+    reference page shows it in that key's row (as a sentence, bars escaped)."""
+    for kind in kinds():
+        schema = get(kind).schema
+        rows = option_rows(kind) if schema else {}
+        assert set(rows) == set(schema), kind
+        for name, option in schema.items():
+            assert option.doc.strip(), f"{kind}.{name} has no doc"
+            assert reference.escape_bars(reference.sentence(option.doc)) in rows[name], (kind, name)
+
+
+def test_analysis_functions_list_their_options_and_outputs():
+    """``help(mechgen.<kind>)`` shows every option with its doc and default and every output of the kind's
+    table (mechgen.analyses.outputs_doc) with its unit: the sources the reference pages use."""
+    from mechgen.analyses import public
+
+    for kind in kinds():
+        doc = getattr(public, kind).__doc__
+        options = doc.split("Options accepted", 1)[1].split("Outputs (", 1)[0]
+        outputs = doc.split("Outputs (", 1)[1]
+        for name, option in get(kind).schema.items():
+            assert f"* ``{name}`` (" in options, (kind, name)
+            assert reference.escape_bars(option.doc) in " ".join(options.split()), (kind, name)
+        for output in outputs_of(kind):
+            assert f"* ``{output.name}``" in outputs, (kind, output.name)
+            if output.unit.strip() not in ("", "-"):
+                assert f"* ``{output.name}`` [{output.unit}]" in outputs, (kind, output.name)
+        assert not re.search(r":\w+:`", outputs), kind  # a role of the pages' own folder breaks elsewhere
+    assert reference.first_sentence("A list, e.g. a pair. Then more.") == "A list, e.g. a pair."
+
+
+def test_a_dash_cell_renders_as_text_not_as_an_empty_bullet():
+    """A unit of "-" (no unit), an empty cell and a cell opening with "- " render, through docutils, as the em
+    dash in the table's cell and never as a nested bullet list (the reference pages' tables)."""
+    from docutils import nodes
+    from docutils.core import publish_doctree
+
+    lines = reference.table(("name", "unit", "meaning"),
+                            [("``a``", "-", ""), ("``b``", "- or rad", "x")], "30 30 40")
+    tree = publish_doctree("\n".join(lines), settings_overrides={"report_level": 5})
+    cells = [entry.astext() for entry in tree.findall(nodes.entry)]
+    assert cells == ["name", "unit", "meaning", "a", "\u2014", "\u2014", "b", "\u2014 or rad", "x"]
+    assert not [b for b in tree.findall(nodes.bullet_list) if b.parent.tagname == "entry"]
+    for kind in kinds():
+        assert not re.search(r"^ *- -( |$)", reference.kind_page(kind), re.M), kind
+
+
+def test_every_kind_a_shipped_scene_uses_shows_an_example_that_loads():
+    """A kind whose [[analysis]] table a shipped scene holds has that table on its page, and the scene it comes
+    from loads (mechgen.scene.load: the same checks as ``mechgen run``) with an analysis of that name and kind;
+    a kind no shipped scene uses says so."""
+    from mechgen import models
+    from mechgen.scene.info import lookup_model
+    from mechgen.scene.load import load_scene, tomllib
+
+    scenes = ROOT / "scenes"
+    used = {table["kind"] for path in scenes.glob("*.toml")
+            for table in tomllib.loads(path.read_text(encoding="utf-8")).get("analysis", [])}
+    loaded = {}
+    for kind in kinds():
+        page = reference.kind_page(kind, scenes)
+        example = page.split("Example\n-------\n", 1)[1]
+        if kind not in used:
+            assert "No shipped scene uses this kind" in example, kind
+            continue
+        name = re.search(r"``scenes/(\S+)``", example).group(1)
+        table = tomllib.loads("\n".join(line[3:] for line in example.splitlines()
+                                         if line.startswith("   ")))["analysis"][0]
+        assert table["kind"] == kind, kind
+        if name not in loaded:
+            loaded[name] = load_scene(str(scenes / name), lookup_model=lookup_model, model_names=models.known)
+        specs = {spec.name: spec.kind for spec in loaded[name].analyses}
+        assert specs[table["name"]] == kind, (kind, name)
 
 
 def public_members_of_model() -> list[str]:

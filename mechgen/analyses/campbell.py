@@ -53,11 +53,23 @@ def _multiples(ctx, key: str, value: object) -> list[float]:
     return [schema.positive(ctx, f"{key}[{i}]", v) for i, v in enumerate(value, 1)]
 
 
-SCHEMA = {"over": Option(_speeds, REQUIRED, "a table: parameter = [values] or {start, stop, num}"),
-          "count": Option(schema.count), "multiples": Option(_multiples, [1.0]),
-          "method": Option(schema.one_of("campbell method", ("auto", "exact", "reduced"))),
-          "about": Option(schema.about), "at": Option(schema.coordinate_table),
-          "max_seconds": Option(schema.positive, ABSENT), **schema.executor_options()}
+SCHEMA = {"over": Option(_speeds, REQUIRED, "a table: parameter = [values] or {start, stop, num}",
+                         doc="one numeric parameter (the spin speed, its unit) with two or more increasing "
+                         "values"),
+          "count": Option(schema.count, doc="how many modes to track (left out: min(8, the degrees of freedom); "
+                           "a larger count is refused)"),
+          "multiples": Option(_multiples, [1.0], doc="the multiples of the speed whose crossings with a whirl "
+                              "frequency are critical speeds"),
+          "method": Option(schema.one_of("campbell method", ("auto", "exact", "reduced")),
+                           doc="the eigen-solves: auto, exact (full size at every speed) or reduced (a basis "
+                           "grown from speed to speed, serial executor only)"),
+          "about": Option(schema.about, doc="the name of an earlier steady analysis whose state is the operating "
+                          "point"),
+          "at": Option(schema.coordinate_table, doc="the operating point's coordinates (a table coordinate = "
+                       "value; left out: zero)"),
+          "max_seconds": Option(schema.positive, ABSENT, doc="the wall-time budget (s, default 600): the exact "
+                                "path refuses once its first speeds project past it"),
+          **schema.executor_options()}
 
 
 def _executor(options: dict) -> SweepExecutor:

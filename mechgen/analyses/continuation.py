@@ -126,15 +126,35 @@ def _parameter(ctx, key: str, value: object) -> str:
     return value
 
 
-SCHEMA = {"about": Option(_starts, REQUIRED), "parameter": Option(_parameter, REQUIRED),
-          "stop": Option(schema.number, REQUIRED), "step": Option(schema.positive, 0.05),
-          "max_step": Option(schema.positive), "max_points": Option(schema.count, 200),
-          "method": Option(schema.one_of("continuation method", METHODS)), "stages": Option(schema.count),
-          "mesh": Option(schema.count, 100), "stability": Option(schema.boolean, True),
-          "minimize": Option(schema.name), "aliases": Option(schema.aliases, {}),
-          "direction": Option(schema.one_of("direction", DIRECTIONS)), "bounds": Option(_bounds),
-          "at": Option(_output_values), "eigenvalues": Option(schema.boolean, False),
-          "max_seconds": Option(schema.positive), "progress": Option(schema.boolean)}
+SCHEMA = {
+    "about": Option(_starts, REQUIRED, doc="the earlier steady analysis the branch starts from, or a list of them "
+                    "(one branch each)"),
+    "parameter": Option(_parameter, REQUIRED, doc="the numeric parameter the branch is followed in"),
+    "stop": Option(schema.number, REQUIRED, doc="the parameter's value where the branch ends (its unit)"),
+    "step": Option(schema.positive, 0.05, doc="the first pseudo-arclength step"),
+    "max_step": Option(schema.positive, doc="the largest pseudo-arclength step"),
+    "max_points": Option(schema.count, 200, doc="the most branch points (per half-branch with direction = "
+                         "\"both\")"),
+    "method": Option(schema.one_of("continuation method", METHODS), doc="the boundary value problem's "
+                     "discretisation: collocation, gauss or multiple_shooting"),
+    "stages": Option(schema.count, doc="Gauss-Legendre collocation points per interval (default 4: order 8)"),
+    "mesh": Option(schema.count, 100, doc="intervals (or nodes) along s of the boundary value problem"),
+    "stability": Option(schema.boolean, True, doc="give the Galerkin stability verdict at every branch point"),
+    "minimize": Option(schema.name, doc="an output whose least value along the branch is reported "
+                       "(<output>_min, <parameter>_at_<output>_min)"),
+    "aliases": Option(schema.aliases, {}, doc="outputs also reported under the scene's names: name = "
+                      "\"output\" (an analysis output too)"),
+    "direction": Option(schema.one_of("direction", DIRECTIONS), doc="the parameter's direction at the start: "
+                        "increasing, decreasing or both (default: towards stop)"),
+    "bounds": Option(_bounds, doc="output = [low, high]: the branch ends where an output leaves its range"),
+    "at": Option(_output_values, doc="output = value: the points where an output crosses the value, located "
+                 "along the branch (at_<output>)"),
+    "eigenvalues": Option(schema.boolean, False, doc="report every branch point's eigenvalues too"),
+    "max_seconds": Option(schema.positive, doc="the wall-time budget of the whole analysis (s, default 600), "
+                         "checked before every continuation step"),
+    "progress": Option(schema.boolean, doc="draw a bar of the branch points on stderr (default true, when it is "
+                       "a terminal and the branch takes over 2 s)"),
+}
 
 
 def _check_branch_outputs(ctx, base: str, options: dict) -> None:

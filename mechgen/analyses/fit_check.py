@@ -84,15 +84,34 @@ def _tol(ctx, key: str, value: object) -> float:
     return value
 
 
-SCHEMA = {"parameters": Option(_names, REQUIRED, "an array of the names of the parameters to estimate"),
-          "start": Option(_numbers), "data": Option(fit_data.load, REQUIRED, fit_data.TABLE),
-          "observed": Option(schema.name, REQUIRED, "the name of the data column the model reproduces"),
-          "sigma": Option(schema.name), "group": Option(schema.name),
-          "expression": Option(_expression), "constants": Option(_numbers),
-          "analysis": Option(_table), "output": Option(_output), "inputs": Option(_names),
-          "jacobian": Option(schema.one_of("jacobian", JACOBIANS)), "diff_step": Option(schema.positive),
-          "tol": Option(_tol, 1e-10), "max_seconds": Option(schema.positive, ABSENT),
-          "max_evaluations": Option(schema.count)}
+SCHEMA = {
+    "parameters": Option(_names, REQUIRED, "an array of the names of the parameters to estimate",
+                         doc="the names of the parameters to estimate"),
+    "start": Option(_numbers, doc="starting values, name = value (default the scene's values)"),
+    "data": Option(fit_data.load, REQUIRED, fit_data.TABLE, doc="the data: a table {column = [values]} or a CSV "
+                   "file's path, relative to the working directory"),
+    "observed": Option(schema.name, REQUIRED, "the name of the data column the model reproduces",
+                       doc="the data column the model reproduces (y)"),
+    "sigma": Option(schema.name, doc="a data column of standard deviations that weights the rows (in the "
+                    "observed column's unit; default 1)"),
+    "group": Option(schema.name, doc="a data column: the parameters are estimated separately for each of its "
+                    "distinct values"),
+    "expression": Option(_expression, doc="the model as a formula of data columns, constants and the "
+                         "parameters (instead of analysis)"),
+    "constants": Option(_numbers, doc="named numbers the expression uses, name = value"),
+    "analysis": Option(_table, doc="the model as an inner analysis table (modes, stability, steady or "
+                       "simulate), run once per row"),
+    "output": Option(_output, doc="the inner analysis's number output compared with observed, or name[i] "
+                     "(entry i, 1-based, of a list output)"),
+    "inputs": Option(_names, doc="data columns that set model parameters per row"),
+    "jacobian": Option(schema.one_of("jacobian", JACOBIANS), doc="finite differences of an analysis fit: "
+                       "3-point (the default) or 2-point"),
+    "diff_step": Option(schema.positive, doc="the finite differences' relative step (default 1e-6)"),
+    "tol": Option(_tol, 1e-10, doc="least_squares' ftol = xtol = gtol"),
+    "max_seconds": Option(schema.positive, ABSENT, doc="the wall-time budget (s, default 600)"),
+    "max_evaluations": Option(schema.count, doc="the most evaluations of the model on all rows of a group, the "
+                              "Jacobian's included (default none)"),
+}
 
 
 def frees(options: dict) -> list[str]:

@@ -57,13 +57,31 @@ def hybrid_only(ctx, base: str, options: dict) -> None:
                    "one of the model's modes: " + ", ".join(modes))
 
 
-SCHEMA = {"t_end": Option(schema.positive, REQUIRED, STEP), "method": Option(_method, "DOP853"),
-          "rtol": Option(schema.positive, 1e-10), "atol": Option(schema.positive, 1e-12),
-          "q0": Option(schema.coordinate_table, {}), "v0": Option(schema.coordinate_table, {}),
-          "coordinate": Option(_coordinate, ABSENT), "contact_mode": Option(schema.name, ABSENT),
-          "force_output": Option(schema.name, "force"), "curve": Option(schema.boolean, False),
-          "samples": Option(schema.count_within("samples"), 200), "max_steps": Option(schema.count, ABSENT),
-          "max_seconds": Option(schema.positive, ABSENT), "loop": Option(schema.one_of("loop", LOOPS), "auto")}
+SCHEMA = {
+    "t_end": Option(schema.positive, REQUIRED, STEP, doc="the latest end time of the run, reached when the body "
+                    "never leaves contact (s, or the model's time unit)"),
+    "method": Option(_method, "DOP853", doc="the integrator (as simulate's adaptive methods)"),
+    "rtol": Option(schema.positive, 1e-10, doc="the integrator's relative tolerance"),
+    "atol": Option(schema.positive, 1e-12, doc="the integrator's absolute tolerance (the state's units)"),
+    "q0": Option(schema.coordinate_table, {}, doc="initial coordinates replacing those of the model's declared "
+                 "initial state, coordinate = value"),
+    "v0": Option(schema.coordinate_table, {}, doc="initial velocities replacing those of the model's declared "
+                 "initial state, coordinate = value (the coordinate's unit per s; required without one)"),
+    "coordinate": Option(_coordinate, ABSENT, doc="the coordinate along which restitution is measured (default "
+                         "the first)"),
+    "contact_mode": Option(schema.name, ABSENT, doc="the contact mode whose leaving ends the impact (default "
+                           "the mode the first event enters)"),
+    "force_output": Option(schema.name, "force", doc="the model output that is the contact force (N) of the "
+                           "hysteresis curve"),
+    "curve": Option(schema.boolean, False, doc="also report the force-penetration hysteresis "
+                    "(penetration_series, force_series)"),
+    "samples": Option(schema.count_within("samples"), 200, doc="points of the hysteresis curve over the "
+                      "contact"),
+    "max_steps": Option(schema.count, ABSENT, doc="the work budget in integrator steps"),
+    "max_seconds": Option(schema.positive, ABSENT, doc="the wall-time budget (s, default 600)"),
+    "loop": Option(schema.one_of("loop", LOOPS), "auto", doc="the event loop: auto (compiled for DOP853 on the "
+                   "C backend, else Python), python or c"),
+}
 
 
 def needs(options: dict, *, internal: bool) -> set[str]:

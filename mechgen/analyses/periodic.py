@@ -40,16 +40,32 @@ from mechgen.analyses.schema import ABSENT, REQUIRED, Option
 from mechgen.errors import ConvergenceError, SceneError
 from mechgen.runtime.integration.events import LOOPS, integrate_hybrid
 
-SCHEMA = {"period": Option(schema.positive, REQUIRED, "a number > 0"),
-          "force_output": Option(schema.name, "force"), "displacement_output": Option(schema.name, "displacement"),
-          "max_periods": Option(schema.count, 64), "tolerance": Option(schema.positive, 1e-9),
-          "atol_periodic": Option(schema.positive, 1e-12), "mode": Option(schema.name, ABSENT),
-          "nodes": Option(schema.count, 16), "pieces": Option(schema.count, 4),
-          "method": Option(schema.name, "DOP853"), "rtol": Option(schema.positive, 1e-12),
-          "atol": Option(schema.positive, 1e-14), "curve": Option(schema.boolean, False),
-          "max_events": Option(schema.count, 10_000), "zeno_events": Option(schema.count, 100),
-          "max_steps": Option(schema.count, ABSENT), "max_seconds": Option(schema.positive, ABSENT),
-          "loop": Option(schema.one_of("loop", LOOPS), "auto")}
+SCHEMA = {
+    "period": Option(schema.positive, REQUIRED, "a number > 0", doc="the drive's period T (s, or the model's time "
+                     "unit)"),
+    "force_output": Option(schema.name, "force", doc="the model output that is the loop's force f (N)"),
+    "displacement_output": Option(schema.name, "displacement", doc="the model output that is the loop's "
+                                  "displacement x (m)"),
+    "max_periods": Option(schema.count, 64, doc="the most periods integrated while looking for the steady one"),
+    "tolerance": Option(schema.positive, 1e-9, doc="the relative periodicity tolerance of the state and loop "
+                        "point between consecutive periods"),
+    "atol_periodic": Option(schema.positive, 1e-12, doc="the absolute periodicity tolerance (the entries' units)"),
+    "mode": Option(schema.name, ABSENT, doc="the mode to start in (default the model's initial mode)"),
+    "nodes": Option(schema.count, 16, doc="Gauss-Legendre points per part of a smooth piece of the period"),
+    "pieces": Option(schema.count, 4, doc="equal parts each smooth piece of the period is split into for the "
+                     "quadratures"),
+    "method": Option(schema.name, "DOP853", doc="the integrator (as impact's)"),
+    "rtol": Option(schema.positive, 1e-12, doc="the integrator's relative tolerance"),
+    "atol": Option(schema.positive, 1e-14, doc="the integrator's absolute tolerance (the state's units)"),
+    "curve": Option(schema.boolean, False, doc="also report the loop: displacement_series and force_series"),
+    "max_events": Option(schema.count, 10_000, doc="the most events of the whole run"),
+    "zeno_events": Option(schema.count, 100, doc="more than this many events within 1e-9 times the run's end time "
+                          "is a Zeno approach"),
+    "max_steps": Option(schema.count, ABSENT, doc="the work budget in integrator steps"),
+    "max_seconds": Option(schema.positive, ABSENT, doc="the wall-time budget (s, default 600)"),
+    "loop": Option(schema.one_of("loop", LOOPS), "auto", doc="the event loop: auto (compiled for DOP853 on the "
+                   "C backend, else Python), python or c"),
+}
 
 
 def needs(options: dict, *, internal: bool) -> set[str]:

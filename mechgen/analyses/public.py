@@ -11,6 +11,7 @@ the same outputs, and ``Result.to_json()`` is the scene JSON's entry.
 """
 from __future__ import annotations
 
+import re
 from typing import Any, Mapping
 
 from mechgen.analyses.registry import get, kinds
@@ -338,22 +339,43 @@ def symplectic(system, *, name: str | None = None, **options) -> Result:
 
 
 def option_lines(kind: str) -> list[str]:
-    """One line per option of ``kind``, from the schema the scene loader validates against: its name and its
-    default as the reference pages write it (mechgen.analyses.reference.default_text)."""
-    from mechgen.analyses.reference import default_text
+    """One line per option of ``kind``, from the schema the scene loader validates against: its name, its
+    default as the reference pages write it (mechgen.analyses.reference.default_text) and its meaning (the
+    Option's ``doc``, its bars escaped for reStructuredText as on the reference pages)."""
+    from mechgen.analyses.reference import default_text, escape_bars
 
-    return [f"``{name}``: {default_text(option).replace('**', '')}" for name, option in get(kind).schema.items()]
+    return [f"``{name}`` ({default_text(option).replace('**', '').replace(' (no default)', '')}): "
+            f"{escape_bars(option.doc)}".rstrip(": ") for name, option in get(kind).schema.items()]
+
+
+def output_lines(kind: str) -> list[str]:
+    """One line per output of ``kind``, from the table the reference pages show (mechgen.analyses.outputs_doc):
+    its name, its unit (left out where it has none) and the first sentence of its meaning, a Sphinx role in it
+    written as a plain literal (a docstring is read outside the pages too, and from another page)."""
+    from mechgen.analyses.outputs_doc import outputs_of
+    from mechgen.analyses.reference import first_sentence
+
+    lines = []
+    for output in outputs_of(kind):
+        unit = " ".join(output.unit.split())
+        unit = "" if unit in ("", "-") else f" [{unit}]"
+        meaning = re.sub(r":\w+:`([^`<]*?)\s*(<[^>]*>)?`", r"``\1``", first_sentence(output.meaning))
+        lines.append(f"``{output.name}``{unit}: {meaning}")
+    return lines
 
 
 def _with_schema_options() -> None:
-    """Append to each analysis function's docstring the options its kind's schema accepts (so that the
-    docstrings and the loader cannot disagree on names and defaults)."""
+    """Append to each analysis function's docstring the options its kind's schema accepts and the outputs its
+    kind documents (so that the docstrings, the reference pages and the loader cannot disagree on names,
+    defaults and meanings)."""
     functions = {name: globals()[name] for name in __all__ if name not in ("analysis", "option_lines")}
     for kind, function in functions.items():
         if kind in kinds():
+            options = "".join(f"    * {line}\n" for line in option_lines(kind)) or "    * none\n"
             function.__doc__ = (function.__doc__ or "").rstrip() + (
-                "\n\n    Options accepted (from the scene schema of kind ``%s``): " % kind
-                + "; ".join(option_lines(kind)) + ".\n")
+                "\n\n    Options accepted (from the scene schema of kind ``%s``):\n\n" % kind + options
+                + "\n    Outputs (mechgen.analyses.outputs_doc; the reference page has their shapes):\n\n"
+                + "".join(f"    * {line}\n" for line in output_lines(kind)))
 
 
 _with_schema_options()

@@ -1,7 +1,8 @@
 """The reference pages of the analysis kinds, generated from the analyses registry (reStructuredText text).
 
 Each page comes from the objects the scene loader validates against: the kind's ``schema`` (option names,
-defaults, the ``expected`` text, the check function's docstring as the meaning), the kind's module docstring
+defaults, each Option's ``doc`` as the meaning, the ``expected`` text and the check function's docstring as
+what it accepts), the kind's module docstring
 (what it computes) and the outputs documented in :mod:`mechgen.analyses.outputs_doc`. Nothing here imports
 Sphinx; ``docs/_ext/mechgen_reference.py`` writes these strings into the documentation at build time, so
 the reference and the loader cannot disagree on names or defaults.
@@ -11,6 +12,7 @@ from __future__ import annotations
 import importlib
 import inspect
 import json
+import re
 from pathlib import Path
 from typing import Any
 
@@ -99,6 +101,14 @@ def described(doc: str, name: str) -> str:
     return ""
 
 
+def first_sentence(text: str) -> str:
+    """The first sentence of a meaning (up to the first full stop followed by a capital letter or the end;
+    "e.g." and "i.e." do not end one), its spaces joined."""
+    text = " ".join(text.split())
+    match = re.search(r"(?<!e\.g)(?<!i\.e)\.(\s+(?=[A-Z`(*])|$)", text)
+    return text[:match.start() + 1] if match else text
+
+
 def first_paragraph(text: str | None) -> str:
     """The first paragraph of a docstring, its lines joined (empty for none)."""
     paragraph = inspect.cleandoc(text or "").split("\n\n")[0]
@@ -124,20 +134,40 @@ def check_meaning(check: Any) -> str:
     return ""
 
 
+def sentence(text: str) -> str:
+    """``text`` as a sentence: its first letter capitalised and a full stop at its end."""
+    text = " ".join(text.split())
+    if not text:
+        return ""
+    return text[0].upper() + text[1:] + ("" if text.endswith(".") else ".")
+
+
 def option_meaning(option: Option, said: str = "") -> str:
-    """An option's meaning: what the kind's docstring says of it (``said``), then what its check accepts and the
-    ``expected`` text where it says more."""
+    """An option's meaning: its ``doc`` (or, where that is empty, what the kind's docstring says of it: ``said``),
+    then what its check accepts and the ``expected`` text where it says more."""
     accepts = check_meaning(option.check)
     if option.expected and option.expected != "a value" and option.expected.lower() not in accepts.lower():
         accepts = (accepts + " " if accepts else "") + f"Expected: {option.expected}."
-    parts = [f"*Described:* {escape_bars(said)}." if said else "",
-             f"*Accepts:* {accepts}" if accepts else ""]
+    meaning = escape_bars(sentence(option.doc)) if option.doc else (
+        f"*Described:* {escape_bars(said)}." if said else "")
+    parts = [meaning, f"*Accepts:* {accepts}" if accepts else ""]
     return " ".join(p for p in parts if p) or "See the description above."
 
 
+#: what a cell without content shows (a unit of "-", a dimensionless number or a label, too): an em dash, since
+#: a lone "-" (or one that opens the cell) in a list-table's cell would start a nested, empty bullet list
+NO_CONTENT = "\u2014"
+
+
 def cell(text: str) -> str:
-    """Text for one cell of a list-table (one line; an empty cell as a dash)."""
-    return " ".join(text.split()) or "-"
+    """Text for one cell of a list-table (one line; an empty cell, or one of a lone "-", as an em dash, and a
+    leading "- " as one too, so that no cell opens a bullet list)."""
+    text = " ".join(text.split())
+    if text in ("", "-"):
+        return NO_CONTENT
+    if text.startswith("- "):
+        return NO_CONTENT + text[1:]
+    return text
 
 
 def table(header: tuple[str, ...], rows: list[tuple[str, ...]], widths: str) -> list[str]:
@@ -162,12 +192,12 @@ def title(text: str, underline: str) -> list[str]:
 
 
 def options_section(kind: str) -> list[str]:
-    """The scene keys of ``kind``: name, default, meaning, from its schema."""
+    """The scene keys of ``kind``: name, default, meaning (each Option's ``doc``), from its schema."""
     schema = get(kind).schema
     if not schema:
         return title("Scene keys", "-") + ["This kind takes no options.", ""]
     doc = importlib.import_module(module_of(kind)).__doc__ or ""
-    rows = [(f"``{name}``", default_text(option), option_meaning(option, described(doc, name)))
+    rows = [(f"``{name}``", default_text(option), option_meaning(option, "" if option.doc else described(doc, name)))
             for name, option in schema.items()]
     return title("Scene keys", "-") + table(("key", "default", "meaning"), rows, "18 18 64")
 
@@ -235,10 +265,14 @@ def example_scene(kind: str, scenes: Path | None) -> tuple[str, str] | None:
 
 
 def example_section(kind: str, scenes: Path | None) -> list[str]:
-    """A shipped scene's table of this kind, when one has it."""
+    """A shipped scene's table of this kind, or a line saying no shipped scene uses the kind (nothing without a
+    folder of scenes: an installed package has none)."""
+    if scenes is None or not scenes.is_dir():
+        return []
     found = example_scene(kind, scenes)
     if found is None:
-        return []
+        return title("Example", "-") + ["No shipped scene uses this kind (``scenes/*.toml``); the usage above "
+                                         "shows the keys it requires.", ""]
     name, table_text = found
     lines = title("Example", "-") + [f"From the shipped scene ``scenes/{name}``:", "", ".. code-block:: toml", ""]
     return lines + [f"   {line}" if line.strip() else "" for line in table_text.splitlines()] + [""]

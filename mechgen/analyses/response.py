@@ -68,10 +68,16 @@ def check(ctx, base: str, options: dict) -> None:
                    "not named", "a lumped model or a chain")
 
 
-SCHEMA = {"input": Option(coordinate, REQUIRED, "a coordinate name"),
-          "omega": Option(frequencies, REQUIRED, "driving frequencies in rad/s"),
-          "outputs": Option(coordinates), "about": Option(about), "at": Option(coordinate_table),
-          "max_seconds": Option(positive)}
+SCHEMA = {"input": Option(coordinate, REQUIRED, "a coordinate name",
+                          doc="the coordinate driven by the unit harmonic generalized force"),
+          "omega": Option(frequencies, REQUIRED, "driving frequencies in rad/s",
+                          doc="the driving frequencies (rad/s): a list or {start, stop, num}"),
+          "outputs": Option(coordinates, doc="the coordinates whose response is reported (default all)"),
+          "about": Option(about, doc="the name of an earlier steady analysis whose state is the operating point"),
+          "at": Option(coordinate_table, doc="the operating point's coordinates (a table coordinate = value; "
+                       "left out: zero)"),
+          "max_seconds": Option(positive, doc="the wall-time budget (s, default 600), estimated from the first "
+                                "frequencies")}
 
 
 def needs(options: dict, *, internal: bool) -> set[str]:

@@ -29,9 +29,14 @@ from mechgen.scene.values import fail
 MEASURED = ("restitution", "contact_duration", "energy_lost", "released")
 
 SCHEMA = {**{k: v for k, v in IMPACT.items() if k != "curve"},
-          "over": Option(schema.over, schema.REQUIRED, "a table: parameter = [values] or {start, stop, num}"),
-          "hysteresis": Option(lambda ctx, key, value: _hysteresis(ctx, key, value), 4),
-          "progress": Option(schema.boolean, True)}
+          "over": Option(schema.over, schema.REQUIRED, "a table: parameter = [values] or {start, stop, num}",
+                         doc="the grid, as sweep's: at most one choice parameter (law) and one numeric one "
+                         "(zeta)"),
+          "hysteresis": Option(lambda ctx, key, value: _hysteresis(ctx, key, value), 4,
+                               doc="how many values of the numeric parameter, spread over its grid, also record "
+                               "the force-penetration curve (0: none), or a list of values"),
+          "progress": Option(schema.boolean, True, doc="draw a progress bar on stderr (when it is a terminal and "
+                             "the grid lasts over 2 s)")}
 
 
 def _hysteresis(ctx, key: str, value: object):

@@ -67,24 +67,40 @@ def _alpha(ctx, key: str, value: object) -> float:
 
 
 SCHEMA = {
-    "elements": Option(_elements),
-    "N": Option(_elements),
-    "base": Option(schema.one_of("end condition", ENDS), "clamped"),
-    "tip": Option(schema.one_of("end condition", ENDS), "free"),
-    "tip_force": Option(vector3, [0.0, 0.0, 0.0]),
-    "tip_torque": Option(vector3, [0.0, 0.0, 0.0]),
-    "dt": Option(schema.positive, schema.REQUIRED, "the time step (s), a number > 0"),
-    "t_end": Option(schema.positive, schema.REQUIRED, "the end time (s), a number > 0"),
-    "damping": Option(_non_negative, 0.0),
-    "initial_velocity": Option(vector3, [0.0, 0.0, 0.0]),
-    "initial_angular_velocity": Option(vector3, [0.0, 0.0, 0.0]),
-    "save_every": Option(lambda ctx, key, v: schema.int_at_least(ctx, key, v, 1), 1),
-    "shape_every": Option(lambda ctx, key, v: schema.int_at_least(ctx, key, v, 0), 0),
-    "tol": Option(schema.positive, 1e-10),
-    "alpha": Option(_alpha, 0.5),
-    "bending_axis": Option(schema.one_of("axis", tuple(AXES)), "z"),
-    "jacobian": Option(schema.one_of("Jacobian method", ("ad", "fd")), "ad"),
+    "elements": Option(_elements, doc="two-node elements along the rod (default 20)"),
+    "N": Option(_elements, doc="the same as elements"),
+    "base": Option(schema.one_of("end condition", ENDS), "clamped", doc="the end condition at s = 0: clamped, "
+                   "pinned or free"),
+    "tip": Option(schema.one_of("end condition", ENDS), "free", doc="the end condition at s = L: clamped, "
+                  "pinned or free (free/free: a rod in free flight)"),
+    "tip_force": Option(vector3, [0.0, 0.0, 0.0], doc="the dead tip force [x, y, z], spatial, applied at t = 0 "
+                        "(N)"),
+    "tip_torque": Option(vector3, [0.0, 0.0, 0.0], doc="the dead tip torque [x, y, z], spatial, applied at "
+                         "t = 0 (N m)"),
+    "dt": Option(schema.positive, schema.REQUIRED, "the time step (s), a number > 0", doc="the time step (s)"),
+    "t_end": Option(schema.positive, schema.REQUIRED, "the end time (s), a number > 0",
+                    doc="end time of the run (s)"),
+    "damping": Option(_non_negative, 0.0, doc="the mass-proportional damping rate c (1/s): v' = ... - c v, "
+                      "omega' = ... - c omega"),
+    "initial_velocity": Option(vector3, [0.0, 0.0, 0.0], doc="the rigid initial velocity v0 [x, y, z], "
+                               "spatial (m/s)"),
+    "initial_angular_velocity": Option(vector3, [0.0, 0.0, 0.0], doc="the rigid initial angular velocity w0 "
+                                       "[x, y, z], spatial (rad/s): v(s) = v0 + w0 x r(s) at t = 0"),
+    "save_every": Option(lambda ctx, key, v: schema.int_at_least(ctx, key, v, 1), 1,
+                         doc="steps between saved points"),
+    "shape_every": Option(lambda ctx, key, v: schema.int_at_least(ctx, key, v, 0), 0,
+                          doc="saved points between saved shapes (0: only the final shape)"),
+    "tol": Option(schema.positive, 1e-10, doc="Newton's increment at which a step has converged (in units of L "
+                  "and rad)"),
+    "alpha": Option(_alpha, 0.5, doc="the step weight: 0.5 the energy-conserving midpoint rule (order 2), up to "
+                    "1 backward Euler (numerical dissipation of the stiff shear/axial modes a sudden load excites, "
+                    "order 1)"),
+    "bending_axis": Option(schema.one_of("axis", tuple(AXES)), "z", doc="the axis (x, y or z) tip_rotation "
+                           "turns about"),
+    "jacobian": Option(schema.one_of("Jacobian method", ("ad", "fd")), "ad", doc="the step's Jacobian: ad "
+                       "(CasADi's algorithmic derivatives) or fd (finite differences)"),
 }
+
 
 
 def check(ctx, base: str, options: dict) -> None:

@@ -72,20 +72,30 @@ _elements = bounded(2, MAX_ELEMENTS)
 
 
 SCHEMA = {
-    "method": Option(schema.one_of("rod statics method", ("collocation", "shooting")), "collocation"),
-    "elements": Option(_elements),
-    "N": Option(_elements),
-    "base": Option(schema.one_of("end condition", ENDS), "clamped"),
-    "tip": Option(schema.one_of("end condition", ENDS), "free"),
-    "tip_force": Option(vector3, [0.0, 0.0, 0.0]),
-    "tip_torque": Option(vector3, [0.0, 0.0, 0.0]),
-    "steps": Option(bounded(1, MAX_STEPS), 10),
-    "tol": Option(schema.positive, 1e-10),
-    "min_step": Option(schema.positive, 1e-4),
-    "bending_axis": Option(schema.one_of("axis", tuple(AXES)), "z"),
-    "frame_rate": Option(vector3, [0.0, 0.0, 0.0]),
-    "jacobian": Option(schema.one_of("Jacobian method", ("ad", "fd")), "ad"),
+    "method": Option(schema.one_of("rod statics method", ("collocation", "shooting")), "collocation",
+                     doc="collocation (Lie-group midpoint, order 2, robust at any load) or shooting (RKMK4, "
+                     "order 4; single shooting stalls beyond PL^2/EI ~ 100 - 1000 and is slow there)"),
+    "elements": Option(_elements, doc="RKMK4 steps or collocation elements along the rod (default 40)"),
+    "N": Option(_elements, doc="the same as elements"),
+    "base": Option(schema.one_of("end condition", ENDS), "clamped", doc="the end condition at s = 0: clamped, "
+                   "pinned or free"),
+    "tip": Option(schema.one_of("end condition", ENDS), "free", doc="the end condition at s = L: clamped, "
+                  "pinned or free"),
+    "tip_force": Option(vector3, [0.0, 0.0, 0.0], doc="the dead tip force [x, y, z] in the spatial frame (N; numbers "
+                        "or expressions of the parameters)"),
+    "tip_torque": Option(vector3, [0.0, 0.0, 0.0], doc="the dead tip torque [x, y, z] in the spatial frame "
+                         "(N m; numbers or expressions of the parameters)"),
+    "steps": Option(bounded(1, MAX_STEPS), 10, doc="the initial number of load continuation steps"),
+    "tol": Option(schema.positive, 1e-10, doc="the scaled Newton residual at which a load step has converged"),
+    "min_step": Option(schema.positive, 1e-4, doc="the smallest load-factor step before giving up"),
+    "bending_axis": Option(schema.one_of("axis", tuple(AXES)), "z", doc="the axis (x, y or z) tip_rotation "
+                           "turns about"),
+    "frame_rate": Option(vector3, [0.0, 0.0, 0.0], doc="the angular velocity [x, y, z] of the frame the state is "
+                         "steady in, for velocity (rad/s)"),
+    "jacobian": Option(schema.one_of("Jacobian method", ("ad", "fd")), "ad", doc="Newton's Jacobian: ad "
+                       "(CasADi's algorithmic derivatives) or fd (finite differences)"),
 }
+
 
 
 def check(ctx, base: str, options: dict) -> None:

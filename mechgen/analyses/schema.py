@@ -45,11 +45,14 @@ class AnalysisSpec:
 
 @dataclass(frozen=True)
 class Option:
-    """One option of a kind: its check, its default and (for a required one) what is expected."""
+    """One option of a kind: its check, its default, (for a required one) what is expected, and ``doc``: what
+    the key means, one sentence with its units (the reference pages and the Python functions' docstrings show
+    it: mechgen.analyses.reference, mechgen.analyses.public)."""
 
     check: Callable[["OptionContext", str, object], Any]
     default: Any = ABSENT
     expected: str = "a value"
+    doc: str = ""
 
 
 @dataclass
@@ -327,7 +330,13 @@ def no_check(ctx: OptionContext, base: str, options: dict) -> None:
 
 
 #: the options of the linear analyses (modes, stability): where to linearise and how many modes
-LINEAR_OPTIONS = {"about": Option(about), "at": Option(coordinate_table), "count": Option(count)}
+LINEAR_OPTIONS = {
+    "about": Option(about, doc="the name of an earlier steady analysis whose state is the operating point "
+                    "to linearise about"),
+    "at": Option(coordinate_table, doc="the operating point's coordinates (a table coordinate = value; left "
+                 "out: zero), re-solved by Newton when it is not an equilibrium"),
+    "count": Option(count, doc="how many of the lowest (elastic) modes to compute; left out: all of them"),
+}
 
 
 # ------------------------------------------------------------------------ where a grid's points run
@@ -352,8 +361,13 @@ def executor_options() -> dict[str, Option]:
     ``workers`` (0: two) and ``scheduler`` (with dask: a running scheduler instead of a LocalCluster)."""
     from mechgen.runtime.core.sweep import EXECUTORS
 
-    return {"executor": Option(one_of("executor", EXECUTORS), ABSENT), "workers": Option(workers, 0),
-            "scheduler": Option(scheduler, ABSENT)}
+    return {"executor": Option(one_of("executor", EXECUTORS), ABSENT,
+                               doc="where the independent points run: serial, processes or dask (left out: "
+                               "processes when workers > 1, else serial)"),
+            "workers": Option(workers, 0, doc="how many local processes, or Dask LocalCluster workers, run the "
+                              "points (0: two)"),
+            "scheduler": Option(scheduler, ABSENT, doc="with executor = \"dask\": the address of a running Dask "
+                                "scheduler (tcp://host:port) to use instead of a LocalCluster")}
 
 
 def check_executor(ctx: OptionContext, base: str, options: dict) -> None:

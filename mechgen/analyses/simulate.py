@@ -119,19 +119,50 @@ def _method(ctx, key: str, value: object) -> str:
     return value
 
 
-SCHEMA = {"t_end": Option(schema.positive, REQUIRED, STEP), "method": Option(_method, "auto"),
-          "dt": Option(schema.positive, ABSENT), "rtol": Option(schema.positive, 1e-8),
-          "atol": Option(schema.positive, 1e-10), "q0": Option(schema.coordinate_table, {}),
-          "v0": Option(schema.coordinate_table, {}), "initial_mode": Option(schema.count),
-          "amplitude": Option(schema.number, 1.0), "outputs": Option(_outputs, ALL_OUTPUTS),
-          "series": Option(schema.boolean, ABSENT), "samples": Option(schema.count_within("samples"), 201),
-          "save_every": Option(schema.count, ABSENT), "plot": Option(schema.one_of("plot", PLOTS), ABSENT),
-          "on_zeno": Option(_on_zeno, ABSENT),
-          "max_steps": Option(schema.count, ABSENT), "max_seconds": Option(schema.positive, ABSENT),
-          "progress": Option(schema.boolean, ABSENT), "mode": Option(_mode, ABSENT),
-          "max_events": Option(schema.count, ABSENT), "zeno_events": Option(schema.count, ABSENT),
-          "zeno_span": Option(schema.positive, ABSENT), "loop": Option(_loop, ABSENT),
-          "stages": Option(schema.count, ABSENT)}
+SCHEMA = {
+    "t_end": Option(schema.positive, REQUIRED, STEP, doc="end time of the run (s, or the model's time unit)"),
+    "method": Option(_method, "auto", doc="the integrator: auto (DOP853 in the compiled loop, or Radau for a "
+                     "stiff start), BDF, Radau, LSODA, RK45, DOP853 (scipy's), leapfrog with dt (q'' = M^-1 (-dV/dq) "
+                     "with a constant diagonal M only), variational with dt and stages (the model's own "
+                     "Lagrangian), or cvodes (SUNDIALS' BDF, a lumped model built with backend = \"casadi\")"),
+    "dt": Option(schema.positive, ABSENT, doc="the fixed time step of leapfrog and variational (s, or the model's "
+                 "time unit)"),
+    "rtol": Option(schema.positive, 1e-8, doc="relative tolerance of the adaptive integrators (at least 2.2e-14)"),
+    "atol": Option(schema.positive, 1e-10, doc="absolute tolerance of the adaptive integrators (the state's units)"),
+    "q0": Option(schema.coordinate_table, {}, doc="initial coordinates, a table coordinate = value (left out: "
+                 "zero, or the model's declared initial state)"),
+    "v0": Option(schema.coordinate_table, {}, doc="initial velocities, a table coordinate = value (the "
+                 "coordinate's unit per s; left out: zero)"),
+    "initial_mode": Option(schema.count, doc="start from this linear mode (1: the lowest) instead of q0"),
+    "amplitude": Option(schema.number, 1.0, doc="the initial mode's amplitude (its largest entry, in the "
+                        "coordinate's unit)"),
+    "outputs": Option(_outputs, ALL_OUTPUTS, doc="which model outputs to report and keep in the trajectory"),
+    "series": Option(schema.boolean, ABSENT, doc="keep the time history t and trajectory (left out: kept while "
+                     "(states + outputs) x samples <= 10^6 values)"),
+    "samples": Option(schema.count_within("samples"), 201, doc="how many equally spaced sample times the time "
+                      "history holds"),
+    "save_every": Option(schema.count, ABSENT, doc="with leapfrog or variational: keep every this many steps as "
+                         "a sample"),
+    "plot": Option(schema.one_of("plot", PLOTS), ABSENT, doc="the default figure with --plot: time (q(t) and "
+                   "the energy) or phase (phase portraits)"),
+    "on_zeno": Option(_on_zeno, ABSENT, doc="a hybrid model at a Zeno accumulation of events: error (the "
+                      "default, exit 1) or stop there with zeno = true"),
+    "max_steps": Option(schema.count, ABSENT, doc="the work budget in integrator steps (default 10^7 leapfrog "
+                        "steps, 10^5 accepted adaptive steps)"),
+    "max_seconds": Option(schema.positive, ABSENT, doc="the wall-time budget of the run (s, default 600)"),
+    "progress": Option(schema.boolean, ABSENT, doc="draw a progress bar with the remaining time on stderr "
+                       "(default true, when stderr is a terminal and the run lasts over 2 s)"),
+    "mode": Option(_mode, ABSENT, doc="a hybrid model's mode to start in (default its initial mode)"),
+    "max_events": Option(schema.count, ABSENT, doc="a hybrid run's most events before it ends (default 10^4)"),
+    "zeno_events": Option(schema.count, ABSENT, doc="more than this many events within zeno_span is a Zeno or "
+                          "chattering approach (default 100)"),
+    "zeno_span": Option(schema.positive, ABSENT, doc="the time window of the Zeno test (s, or the model's time "
+                        "unit; default 1e-9 t_end)"),
+    "loop": Option(_loop, ABSENT, doc="the loop that steps the integrator: auto (compiled where it can run), "
+                   "python (scipy's steppers) or c (compiled, else an input error)"),
+    "stages": Option(schema.count, ABSENT, doc="with method = \"variational\": Gauss-Legendre points per step, "
+                     "1, 2 or 3 (orders 2, 4, 6; default 1)"),
+}
 
 
 def check(ctx, base: str, options: dict) -> None:

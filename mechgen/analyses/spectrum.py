@@ -84,19 +84,36 @@ def field_name(ctx, key: str, value: object) -> str:
     return value
 
 
-SCHEMA = {"speed": Option(positive, REQUIRED, "the sliding velocity in m/s (a number or expression)"),
-          "spacing": Option(positive, REQUIRED, "the distance between impulses in m (a corrugation's wavelength)"),
-          "t_end": Option(positive, REQUIRED, "the record length in s"),
-          "sample_rate": Option(positive, REQUIRED, "samples per second (Hz), above twice the highest mode's"),
-          "impulse": Option(impulse, {"text": "1", "values": {}}),
-          "couple": Option(impulse),
-          "start": Option(number, 0.0), "stop": Option(number),
-          "field": Option(field_name), "observe": Option(number),
-          "input": Option(coordinate), "output": Option(coordinate),
-          "modes": Option(count, 8), "damping": Option(damping_ratio, 0.01),
-          "peaks": Option(count, 4), "f_max": Option(positive), "series": Option(count, 2000),
-          "signal": Option(one_of("signal", SIGNALS), "displacement"), "separation": Option(count, 10),
-          "reference": Option(frequencies_hz)}
+SCHEMA = {
+    "speed": Option(positive, REQUIRED, "the sliding velocity in m/s (a number or expression)",
+                    doc="the contact point's speed v (m/s)"),
+    "spacing": Option(positive, REQUIRED, "the distance between impulses in m (a corrugation's wavelength)",
+                      doc="the distance lambda between blows (m, a corrugation's wavelength)"),
+    "t_end": Option(positive, REQUIRED, "the record length in s", doc="the record length (s)"),
+    "sample_rate": Option(positive, REQUIRED, "samples per second (Hz), above twice the highest mode's",
+                          doc="samples per second of the record (Hz), above twice the highest mode's frequency"),
+    "impulse": Option(impulse, {"text": "1", "values": {}}, doc="each blow's force impulse J (N s): a number or an "
+                      "expression of the contact position x and the parameters"),
+    "couple": Option(impulse, doc="each blow's angular impulse on the field's slope (N m s), an expression of x "
+                     "like impulse"),
+    "start": Option(number, 0.0, doc="where the contact starts, x_0 (m)"),
+    "stop": Option(number, doc="where the contact stops (m; default the field's length)"),
+    "field": Option(field_name, doc="the field the blows strike (default the model's only field)"),
+    "observe": Option(number, doc="where the field's response is observed (m; default a tenth of the length)"),
+    "input": Option(coordinate, doc="a lumped model's coordinate the unit force drives"),
+    "output": Option(coordinate, doc="a lumped model's coordinate whose response is analysed (default input)"),
+    "modes": Option(count, 8, doc="how many of the lowest mass-normalised modes the response is projected on"),
+    "damping": Option(damping_ratio, 0.01, doc="the modal damping ratio zeta (0 <= zeta < 1, dimensionless)"),
+    "peaks": Option(count, 4, doc="how many of the most prominent spectrum maxima to report"),
+    "f_max": Option(positive, doc="the highest frequency of the spectrum and its peaks (Hz; default 1.1 x the "
+                    "highest natural frequency)"),
+    "series": Option(count, 2000, doc="the most points of the record t, response reported for plots"),
+    "signal": Option(one_of("signal", SIGNALS), "displacement", doc="the analysed signal: displacement or "
+                     "velocity"),
+    "separation": Option(count, 10, doc="the fewest frequency bins between two reported peaks"),
+    "reference": Option(frequencies_hz, doc="reference frequencies (Hz, e.g. published ones) compared mode by "
+                        "mode"),
+}
 
 
 def check(ctx, base: str, options: dict) -> None:

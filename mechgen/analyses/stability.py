@@ -34,8 +34,12 @@ from mechgen.runtime.linear.stability import stability_first_order, stability_sp
 #: above this many unknowns, a stability analysis with a ``count`` of sparse matrices uses shift-invert
 SPARSE_STABILITY_N = 400
 
-SCHEMA = {**LINEAR_OPTIONS, "tolerance": Option(schema.positive), "refine": Option(schema.boolean, True),
-          "refine_rtol": Option(schema.positive, 1e-2)}
+SCHEMA = {**LINEAR_OPTIONS,
+          "tolerance": Option(schema.positive, doc="a fixed growth threshold, times the spectrum's scale max |s| "
+                              "(left out: each eigenvalue's own error bound)"),
+          "refine": Option(schema.boolean, True, doc="check a continuum's verdict again at twice the size"),
+          "refine_rtol": Option(schema.positive, 1e-2, doc="the relative agreement of the growth rates at N and "
+                                "2N that counts as converged")}
 
 
 def needs(options: dict, *, internal: bool) -> set[str]:

@@ -70,10 +70,19 @@ def _labels(ctx, key: str, value: object) -> dict[str, str]:
     return dict(value)
 
 
-SCHEMA = {"parameter": Option(_parameter, REQUIRED), "bracket": Option(_bracket, REQUIRED),
-          "about": Option(schema.about), "guess": Option(schema.coordinate_table, {}),
-          "rtol": Option(schema.positive, 1e-12), "tol": Option(schema.positive, 1e-10),
-          "max_iter": Option(schema.count, 100), "labels": Option(_labels, ABSENT)}
+SCHEMA = {"parameter": Option(_parameter, REQUIRED, doc="the numeric parameter p whose critical value is "
+                              "sought"),
+          "bracket": Option(_bracket, REQUIRED, doc="[p_lo, p_hi]: values of the parameter (its unit) with a "
+                            "stable and an unstable verdict"),
+          "about": Option(schema.about, doc="an earlier steady analysis whose state starts Newton at every p"),
+          "guess": Option(schema.coordinate_table, {}, doc="Newton's starting coordinates without about, "
+                          "coordinate = value"),
+          "rtol": Option(schema.positive, 1e-12, doc="the relative accuracy of the critical value p_c "
+                         "(dimensionless)"),
+          "tol": Option(schema.positive, 1e-10, doc="the residual norm of Newton's equilibrium at every p"),
+          "max_iter": Option(schema.count, 100, doc="the most iterations of Brent's method or the bisection"),
+          "labels": Option(_labels, ABSENT, doc="the scene's words for the verdicts, verdict = \"word\" "
+                           "(flutter = \"stick_slip\")")}
 
 
 def frees(options: dict) -> list[str]:

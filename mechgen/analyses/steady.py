@@ -125,12 +125,27 @@ def _shape(ctx, key: str, value: object) -> dict[str, float]:
     return {name: schema.number(ctx, join(key, name), number)}
 
 
-SCHEMA = {"guess": Option(schema.coordinate_table, {}), "tol": Option(schema.positive, 1e-10),
-          "max_iter": Option(schema.count, 50), "method": Option(schema.one_of("steady method", METHODS)),
-          "bulge": Option(_bulge), "mesh": Option(schema.count), "nodes": Option(schema.count),
-          "aliases": Option(schema.aliases), "form": Option(_form), "params": Option(_params),
-          "shape": Option(_shape), "hold": Option(_hold), "free": Option(_free), "stability": Option(schema.boolean),
-          "max_seconds": Option(schema.positive)}
+SCHEMA = {
+    "guess": Option(schema.coordinate_table, {}, doc="Newton's starting coordinates, a table coordinate = value "
+                    "(left out: zero)"),
+    "tol": Option(schema.positive, 1e-10, doc="the residual norm at which the solve has converged"),
+    "max_iter": Option(schema.count, 50, doc="the most Newton iterations"),
+    "method": Option(schema.one_of("steady method", METHODS), doc="a continuum's boundary value problem in s: "
+                     "shooting, multiple_shooting or collocation (left out: Newton on the discretised system)"),
+    "bulge": Option(_bulge, doc="sine amplitudes added to the boundary value problem's starting guess"),
+    "mesh": Option(schema.count, doc="collocation or multiple-shooting intervals along s"),
+    "nodes": Option(schema.count, doc="the boundary value problem's nodes along s (instead of mesh)"),
+    "aliases": Option(schema.aliases, doc="outputs also reported under the scene's names: name = \"output\""),
+    "form": Option(_form, doc="the boundary value problem's form: lagrangian, or hamiltonian (the stress form)"),
+    "params": Option(_params, doc="this analysis's own values of numeric parameters, made free in the kernels "
+                     "(lambda0 = 0.3)"),
+    "shape": Option(_shape, doc="start from the model's declared guess with this value of a shape output "
+                    "(loops = 2)"),
+    "hold": Option(_hold, doc="an end value to hold, output = value, met by solving for the parameter named by free"),
+    "free": Option(_free, doc="the parameter solved for so that hold is met"),
+    "stability": Option(schema.boolean, doc="also give the Galerkin stability verdict about the steady state"),
+    "max_seconds": Option(schema.positive, doc="the wall-time budget of Newton (s, default 600)"),
+}
 
 
 def check(ctx, base: str, options: dict) -> None:

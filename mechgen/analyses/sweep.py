@@ -42,10 +42,19 @@ def _inner(ctx, key: str, value: object) -> AnalysisSpec:
     return AnalysisSpec(ctx.current, kind, options)
 
 
-SCHEMA = {"over": Option(schema.over, REQUIRED, "a table: parameter = [values] or {start, stop, num}"),
-          "analysis": Option(_inner, REQUIRED, "a table with kind and its options"),
-          "progress": Option(schema.boolean, True), "max_seconds": Option(schema.positive, ABSENT),
-          **schema.executor_options(), "on_error": Option(schema.one_of("on_error", ON_ERROR), "record")}
+SCHEMA = {"over": Option(schema.over, REQUIRED, "a table: parameter = [values] or {start, stop, num}",
+                         doc="the grid: parameter = [values] or {start, stop, num}; several parameters give "
+                         "their cartesian product, the first outermost; at most 10^6 points"),
+          "analysis": Option(_inner, REQUIRED, "a table with kind and its options",
+                             doc="the inner analysis, a table with its kind (modes, stability, steady or "
+                             "simulate) and its keys"),
+          "progress": Option(schema.boolean, True, doc="draw a progress bar with the remaining time on stderr "
+                             "(when it is a terminal and the sweep lasts over 2 s)"),
+          "max_seconds": Option(schema.positive, ABSENT, doc="the wall-time budget of the whole grid (s, default "
+                                "600), estimated from its first points"),
+          **schema.executor_options(),
+          "on_error": Option(schema.one_of("on_error", ON_ERROR), "record", doc="a failed point: record its "
+                             "error in status and go on, or raise (stop the sweep)")}
 
 
 def check(ctx, base: str, options: dict) -> None:

@@ -40,12 +40,21 @@ from mechgen.scene.values import fail
 
 STEP = "a number > 0 (or an expression)"
 LOOPS = ("auto", "c", "numpy")
-SCHEMA = {"integrator": Option(schema.one_of("integrator", tuple(METHODS)), "leapfrog"),
-          "dt": Option(schema.positive, REQUIRED, STEP), "t_end": Option(schema.positive, REQUIRED, STEP),
-          "stride": Option(lambda ctx, key, value: schema.int_at_least(ctx, key, value, 0), 0),
-          "initial_mode": Option(schema.count, 1), "amplitude": Option(schema.number, 1.0),
-          "modes": Option(schema.count, 8), "loop": Option(schema.one_of("loop", LOOPS), "auto"),
-          "max_steps": Option(schema.count, 1_000_000_000)}
+SCHEMA = {
+    "integrator": Option(schema.one_of("integrator", tuple(METHODS)), "leapfrog", doc="the splitting: leapfrog, "
+                         "yoshida4, yoshida6 or aba864 (orders 2, 4, 6, 4); a chain that is not separable is "
+                         "refused here"),
+    "dt": Option(schema.positive, REQUIRED, STEP, doc="the time step (the model's time unit)"),
+    "t_end": Option(schema.positive, REQUIRED, STEP, doc="end time of the run (the model's time unit)"),
+    "stride": Option(lambda ctx, key, value: schema.int_at_least(ctx, key, value, 0), 0,
+                     doc="steps between outputs (0: about 40 outputs per period of the lowest linear mode)"),
+    "initial_mode": Option(schema.count, 1, doc="the linear mode the chain starts in (1: the lowest)"),
+    "amplitude": Option(schema.number, 1.0, doc="the initial mode's largest displacement (the coordinates' unit): "
+                        "fixed ends sin(n k pi/(N+1)), periodic ends cos(2 pi k n / N)"),
+    "modes": Option(schema.count, 8, doc="how many modal energies are reported per output"),
+    "loop": Option(schema.one_of("loop", LOOPS), "auto", doc="where the steps run: auto, c or numpy"),
+    "max_steps": Option(schema.count, 1_000_000_000, doc="the work budget in steps, refused up front"),
+}
 
 
 def check(ctx, base: str, options: dict) -> None:
