@@ -23,6 +23,7 @@ import numpy as np
 
 from mechgen.errors import BuildError, CompilerUnavailable, ConvergenceError, KernelError
 from mechgen.runtime.core.budget import BudgetExceeded, Progress
+from mechgen.runtime.core.integrate import CHECK_EVERY, project_steps, reached_at
 from mechgen.runtime.core.pattern import extent
 from mechgen.runtime.integration.events_c import INPUTS
 
@@ -30,8 +31,9 @@ log = logging.getLogger("mechgen")
 
 SOURCE = Path(__file__).resolve().parent.parent.parent / "codegen" / "templates" / "c99" / "radau_loop.c"
 STEM = "mgradau"
-#: the C loop hands back to Python (budget clock, progress bar) after this many steps
-SLICE = 5_000
+#: the C loop hands back to Python (budget clock and projection, progress bar) after this many steps: the Python
+#: path's CHECK_EVERY, so that the step-size projection (integrate.project_steps) refuses at the same step
+SLICE = CHECK_EVERY
 #: the largest first-order state (2n + m + integrals) the loop's dense O(nx^3) LUs take
 MAX_STATES = 200
 PORTS, PICKS = 8, 4
@@ -65,7 +67,8 @@ class CState(ctypes.Structure):
 
     _fields_ = [("t", c_double), ("x", c_void_p), ("steps", c_long), ("nfev", c_long), ("njev", c_long),
                 ("nlu", c_long), ("i_eval", c_long), ("counted", c_long), ("err_kind", c_long),
-                ("err_rc", c_long), ("err_t", c_double), ("err_x", c_void_p), ("work", c_void_p)]
+                ("err_rc", c_long), ("err_t", c_double), ("err_x", c_void_p), ("work", c_void_p),
+                ("h_last", c_double)]
 
 
 LAYOUT = (CKernel, CProblem, CState)
@@ -193,7 +196,7 @@ def integrate_radau_c(system, x0, t_end: float, options, *, extra: int = 0) -> t
     budget = options.budget
 
     def where(t: float) -> str:
-        return f"t = {t:.9g} of t_end = {t_end:.6g}"
+        return reached_at(t, t_end, int(state.steps))
 
     try:
         with Progress(t_end, desc=options.desc, unit="t", enabled=options.progress) as bar:
@@ -204,7 +207,9 @@ def integrate_radau_c(system, x0, t_end: float, options, *, extra: int = 0) -> t
                 if state.counted and budget is not None:
                     budget.spend(state.counted, lambda: where(state.t))
                 if rc < 0:
-                    raise failure(rc, system, state, keep["err_x"], where, options)
+                    raise failure(rc, system, state, keep, t_end, options)
+                if rc == SLICED and budget is not None:
+                    project_steps(budget, "Radau", int(state.steps), state.t, state.h_last, t_end)
                 bar.to(state.t)
                 if rc == DONE:
                     break
@@ -215,29 +220,44 @@ def integrate_radau_c(system, x0, t_end: float, options, *, extra: int = 0) -> t
     return t_eval.copy(), keep["s_x"][:state.i_eval].copy(), counts
 
 
-def failure(rc: int, system, state: CState, err_x: np.ndarray, where, options) -> Exception:
-    """The exception for the C loop's error code ``rc``, worded as the Python path's (scipy's Radau)."""
-    t, model, size = float(state.err_t), system.metadata.model, 2 * system.n + system.m
-    x = err_x[:size].copy()
-    why = options.explain(t, x) if options.explain is not None and rc in (E_RHS, E_JAC, E_SINGULAR) else ""
-    tail = f"; {why}" if why else ""
+def explanation(rc: int, system, state: CState, keep: dict, options) -> str:
+    """``options.explain`` at the failing state, or at the last accepted one when that is not finite (as the
+    Python path explains), for the failures a state can explain; "" otherwise."""
+    if options.explain is None or rc not in (E_RHS, E_JAC, E_SINGULAR):
+        return ""
+    size = 2 * system.n + system.m
+    x = keep["err_x"][:size].copy()
+    if np.all(np.isfinite(x)):
+        return options.explain(float(state.err_t), x)
+    return options.explain(float(state.t), keep["x"][:size].copy())
+
+
+def failure(rc: int, system, state: CState, keep: dict, t_end: float, options) -> Exception:
+    """The exception for the C loop's error code ``rc``, worded as the Python path's (scipy's Radau stepped by
+    mechgen.runtime.core.integrate)."""
+    t, model = float(state.err_t), system.metadata.model
+    x = keep["err_x"][:2 * system.n + system.m]
+    where = reached_at(t, t_end, int(state.steps))
+    why = explanation(rc, system, state, keep, options)
     if rc == E_KERNEL:
         return KernelError(f"kernel {KERNELS[state.err_kind][0]} of {model} returned error code {state.err_rc} at "
-                           f"{where(t)}")
+                           f"{where}")
     if rc == E_RHS:
+        if why:
+            return KernelError(f"Radau at t = {t:.6g} of t_end = {t_end:.6g}: {why}")
         return KernelError(f"kernel residual/tangent of {model} gave NaN/Inf at t = {t}, x = {x[:6]} (Radau at "
-                           f"{where(t)}){tail}")
+                           f"{where})")
+    tail = f"; {why}" if why else ""
     if rc == E_JAC:
-        return ConvergenceError(f"Radau failed at {where(t)}: the Jacobian (tangent, rates_tangent) is NaN/Inf at "
+        return ConvergenceError(f"Radau failed at {where}: the Jacobian (tangent, rates_tangent) is NaN/Inf at "
                                 f"x = {x[:6]}{tail}")
     if rc == E_SINGULAR:
         what = "the mass matrix M = dr/da" if state.err_kind == 0 else "Radau's Newton matrix"
-        return ConvergenceError(f"Radau failed at {where(t)} (Singular matrix: {what}){tail}")
+        return ConvergenceError(f"Radau failed at {where} (Singular matrix: {what}){tail}")
     if rc == E_SMALL:
-        return ConvergenceError(f"Radau stopped at {where(t)}: Required step size is less than spacing between "
-                                "numbers")
+        return ConvergenceError(f"Radau stopped at {where}: Required step size is less than spacing between numbers")
     if rc == E_BUDGET:
-        return BudgetExceeded("Radau steps: stopped by the step budget", key="max_steps", reached=where(t))
+        return BudgetExceeded("Radau steps: stopped by the step budget", key="max_steps", reached=where)
     if rc == E_MEMORY:
         return MemoryError("the C Radau loop could not allocate its workspace")
     return RuntimeError(f"the C Radau loop refused its input (code {rc})")

@@ -83,6 +83,7 @@ typedef struct {
     double err_t;
     double *err_x;             /* nx */
     void *work;                /* the workspace kept between calls (NULL before the first) */
+    double h_last;             /* the latest accepted step's size */
 } mgr_state;
 
 long mgr_layout(long which);
@@ -774,6 +775,7 @@ int mgr_run(const mgr_problem *P_, mgr_state *S)
         S->counted++;
         sample(P_, S, w);
         S->t = w->t;
+        S->h_last = w->t - w->t_old;
         memcpy(S->x, w->y, (size_t)w->nx * sizeof(double));
         if (P_->budget_left >= 0 && S->counted > P_->budget_left)
             return MGR_E_BUDGET;
