@@ -158,6 +158,29 @@ def test_refused_where_it_cannot_run():
     assert mechgen.simulate(system, t_end=0.1, q0={"x": 1.0}, method="Radau", samples=3)["loop"] == "python"
 
 
+def test_without_a_compiler_radau_falls_back_to_scipys(monkeypatch, tmp_path):
+    """No C compiler for the loop's library: auto / Radau run scipy's Radau (loop "python"), loop "c" is refused."""
+    from mechgen.codegen import build
+    from mechgen.runtime.integration import radau_c
+
+    system = compiled(two_rates())  # built while the compiler works
+    monkeypatch.setenv("CC", "/nonexistent/cc")
+    monkeypatch.setenv("MECHGEN_CACHE", str(tmp_path))  # an empty cache: the loop library is not there built
+    build.reset_compiler_cache()
+    radau_c.forget_library()
+    try:
+        assert "cannot be built" in radau_loop_problem(system)
+        options = dict(t_end=0.1, q0={"x": 1.0, "y": 1.0}, method="Radau", samples=3)
+        assert mechgen.simulate(system, **options)["loop"] == "python"
+        with pytest.raises(mechgen.InputError, match="cannot be built"):
+            mechgen.simulate(system, loop="c", **options)
+    finally:
+        monkeypatch.undo()
+        build.reset_compiler_cache()
+        radau_c.forget_library()
+    assert radau_loop_problem(system) is None
+
+
 def test_step_budget():
     """max_steps bounds the compiled loop's accepted steps as it bounds scipy's (the Python path's message)."""
     system = compiled(two_rates())

@@ -96,6 +96,11 @@ def library():
     return lib, None
 
 
+def forget_library() -> None:
+    """Forget the loaded (or refused) library: the next run builds or finds it again (tests change CC)."""
+    library.cache_clear()
+
+
 def loop_kernels(system, extra: int) -> dict:
     """The kernels the loop calls, by its names (module doc): ``rates`` is ``energy_rates`` when the state carries
     ``extra`` integrals; ``flow`` when the system has it, else ``residual``."""
