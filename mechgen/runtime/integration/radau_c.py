@@ -198,31 +198,34 @@ def integrate_radau_c(system, x0, t_end: float, options, *, extra: int = 0) -> t
     t_end = float(t_end)
     problem, keep = problem_of(system, x0, t_end, options, extra)
     state = CState(t=0.0, x=keep["x"].ctypes.data, err_x=keep["err_x"].ctypes.data)
-    budget = options.budget
-
-    def where(t: float) -> str:
-        return reached_at(t, t_end, int(state.steps))
-
     try:
-        with Progress(t_end, desc=options.desc, unit="t", enabled=options.progress) as bar:
-            while True:
-                if budget is not None and budget.limit is not None:
-                    problem.budget_left = max(0, budget.limit - budget.used)
-                rc = lib.mgr_run(ctypes.byref(problem), ctypes.byref(state))
-                if state.counted and budget is not None:
-                    budget.spend(state.counted, lambda: where(state.t))
-                if rc < 0:
-                    raise failure(rc, system, state, keep, t_end, options)
-                if rc == SLICED and budget is not None:
-                    project_steps(budget, "Radau", int(state.steps), state.t, state.h_last, t_end)
-                bar.to(state.t)
-                if rc == DONE:
-                    break
+        drive(lib, system, problem, state, keep, options)
     finally:
         lib.mgr_free(ctypes.byref(state))
     t_eval = keep["t_eval"][:state.i_eval]
     counts = {"steps": int(state.steps), "nfev": int(state.nfev), "njev": int(state.njev), "nlu": int(state.nlu)}
     return t_eval.copy(), keep["s_x"][:state.i_eval].copy(), counts
+
+
+def drive(lib, system, problem: CProblem, state: CState, keep: dict, options) -> None:
+    """Call the C loop until t_end, between calls counting the budget's steps and clock, projecting the steps
+    still needed at the latest step size (as the Python path every CHECK_EVERY steps) and moving the progress bar;
+    an error code raises its exception (:func:`failure`)."""
+    budget, t_end = options.budget, problem.t_end
+    with Progress(t_end, desc=options.desc, unit="t", enabled=options.progress) as bar:
+        while True:
+            if budget is not None and budget.limit is not None:
+                problem.budget_left = max(0, budget.limit - budget.used)
+            rc = lib.mgr_run(ctypes.byref(problem), ctypes.byref(state))
+            if state.counted and budget is not None:
+                budget.spend(state.counted, lambda: reached_at(state.t, t_end, int(state.steps)))
+            if rc < 0:
+                raise failure(rc, system, state, keep, t_end, options)
+            if rc == SLICED and budget is not None:
+                project_steps(budget, "Radau", int(state.steps), state.t, state.h_last, t_end)
+            bar.to(state.t)
+            if rc == DONE:
+                return
 
 
 def explanation(rc: int, system, state: CState, keep: dict, options) -> str:

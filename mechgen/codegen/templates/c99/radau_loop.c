@@ -551,69 +551,88 @@ static int newton(const mgr_problem *P_, mgr_state *S, mgr_work *w, double t, do
     }
 }
 
-/* one accepted step of scipy's Radau._step_impl (max_step = inf) */
-static int radau_step(const mgr_problem *P_, mgr_state *S, mgr_work *w)
+/* a step being tried: its size and what its Newton solve and error estimate gave */
+typedef struct {
+    double t_new, h_abs, h_abs_old, err_old, error_norm, safety, rate;
+    int has_old, n_iter;
+} mgr_trial;
+
+/* scipy's Radau._step_impl up to an accepted step (max_step = inf): Newton at h, halving h when it fails,
+ * the error estimate, and the step shrunk by the predicted factor while the error exceeds 1 */
+static int attempt(const mgr_problem *P_, mgr_state *S, mgr_work *w, mgr_trial *tr)
 {
-    long nx = w->nx, i, j;
-    double t = w->t, t_new, h, h_abs = w->h_abs, h_abs_old = w->h_abs_old, err_old = w->err_old;
-    double min_step = 10.0 * fabs(nextafter(t, INFINITY) - t), error_norm = 0.0, safety = 1.0, rate, factor;
+    double t = w->t, h, min_step = 10.0 * fabs(nextafter(t, INFINITY) - t);
     double tol = fmax(10.0 * DBL_EPSILON / P_->rtol, fmin(0.03, sqrt(P_->rtol)));
-    int has_old = w->has_old, rejected = 0, converged, n_iter = 0, recompute_jac, rc;
-    if (h_abs < min_step) {
-        h_abs = min_step;
-        has_old = 0;
+    int rejected = 0, converged, rc;
+    tr->h_abs = w->h_abs;
+    tr->h_abs_old = w->h_abs_old;
+    tr->err_old = w->err_old;
+    tr->has_old = w->has_old;
+    if (tr->h_abs < min_step) {
+        tr->h_abs = min_step;
+        tr->has_old = 0;
     }
     for (;;) {
-        if (h_abs < min_step) {
+        if (tr->h_abs < min_step) {
             S->err_t = t;
             return MGR_E_SMALL;
         }
-        t_new = t + h_abs;
-        if (t_new - P_->t_end > 0)
-            t_new = P_->t_end;
-        h = t_new - t;
-        h_abs = fabs(h);
+        tr->t_new = t + tr->h_abs;
+        if (tr->t_new - P_->t_end > 0)
+            tr->t_new = P_->t_end;
+        h = tr->t_new - t;
+        tr->h_abs = fabs(h);
         predict_stages(w, t, h);
-        if ((rc = newton(P_, S, w, t, h, tol, &converged, &n_iter, &rate)) != 0)
+        if ((rc = newton(P_, S, w, t, h, tol, &converged, &tr->n_iter, &tr->rate)) != 0)
             return rc;
         if (!converged) {
-            h_abs *= 0.5;
+            tr->h_abs *= 0.5;
             w->lu_valid = 0;
             continue;
         }
-        safety = 0.9 * (2 * MGR_NEWTON_MAXITER + 1) / (2 * MGR_NEWTON_MAXITER + n_iter);
-        if ((rc = error_estimate(P_, S, w, t, h, rejected, &error_norm)) != 0)
+        tr->safety = 0.9 * (2 * MGR_NEWTON_MAXITER + 1) / (2 * MGR_NEWTON_MAXITER + tr->n_iter);
+        if ((rc = error_estimate(P_, S, w, t, h, rejected, &tr->error_norm)) != 0)
             return rc;
-        if (error_norm <= 1.0)
-            break;
-        h_abs *= fmax(MGR_MIN_FACTOR, safety * predict_factor(h_abs, h_abs_old, has_old, error_norm, err_old));
+        if (tr->error_norm <= 1.0)
+            return 0;
+        tr->h_abs *= fmax(MGR_MIN_FACTOR, tr->safety * predict_factor(tr->h_abs, tr->h_abs_old, tr->has_old,
+                                                                      tr->error_norm, tr->err_old));
         w->lu_valid = 0;
         rejected = 1;
     }
-    recompute_jac = n_iter > 2 && rate > 1e-3;
-    factor = fmin(MGR_MAX_FACTOR, safety * predict_factor(h_abs, h_abs_old, has_old, error_norm, err_old));
+}
+
+/* one accepted step of scipy's Radau._step_impl: attempt(), then the next step size, when to redo J and the LUs,
+ * f at the new point and the collocation polynomial Q = Z^T P of the dense output */
+static int radau_step(const mgr_problem *P_, mgr_state *S, mgr_work *w)
+{
+    long nx = w->nx, i, j;
+    double factor;
+    int recompute_jac, rc;
+    mgr_trial tr;
+    if ((rc = attempt(P_, S, w, &tr)) != 0)
+        return rc;
+    recompute_jac = tr.n_iter > 2 && tr.rate > 1e-3;
+    factor = fmin(MGR_MAX_FACTOR, tr.safety * predict_factor(tr.h_abs, tr.h_abs_old, tr.has_old, tr.error_norm,
+                                                             tr.err_old));
     if (!recompute_jac && factor < 1.2)
         factor = 1.0;
     else
         w->lu_valid = 0;
-    if ((rc = rhs(P_, S, w, t_new, w->y_new, w->f_new)) != 0)
+    if ((rc = rhs(P_, S, w, tr.t_new, w->y_new, w->f_new)) != 0)
         return rc;
-    if (recompute_jac) {
-        if ((rc = jacobian(P_, S, w, t_new, w->y_new, w->f_new)) != 0)
-            return rc;
-        w->current_jac = 1;
-    } else {
-        w->current_jac = 0;
-    }
+    if (recompute_jac && (rc = jacobian(P_, S, w, tr.t_new, w->y_new, w->f_new)) != 0)
+        return rc;
+    w->current_jac = recompute_jac;
     w->h_abs_old = w->h_abs;
-    w->err_old = error_norm;
+    w->err_old = tr.error_norm;
     w->has_old = 1;
-    w->h_abs = h_abs * factor;
+    w->h_abs = tr.h_abs * factor;
     memcpy(w->y_old, w->y, (size_t)nx * sizeof(double));
     memcpy(w->y, w->y_new, (size_t)nx * sizeof(double));
     memcpy(w->f, w->f_new, (size_t)nx * sizeof(double));
-    w->t_old = t;
-    w->t = t_new;
+    w->t_old = w->t;
+    w->t = tr.t_new;
     for (j = 0; j < nx; ++j)   /* Q = Z^T P */
         for (i = 0; i < 3; ++i)
             w->Q[3 * j + i] = w->Z[j] * P[0][i] + w->Z[nx + j] * P[1][i] + w->Z[2 * nx + j] * P[2][i];
