@@ -9,6 +9,7 @@ so samples are compared at 1e-10 relative to the state's size at rtol 1e-10 (obs
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -149,13 +150,29 @@ def test_simulate_runs_it_for_auto_and_radau_with_the_energy_integrals():
     np.testing.assert_allclose(c["dissipated"], py["dissipated"], rtol=SAME)
 
 
+def test_a_parameter_change_reaches_the_compiled_loop():
+    """with_params copies share the kernels; each run reads its own parameters: k1 = 4 gives x = e^{-t/2}(cos wd t
+    + sin wd t / (2 wd)) with wd = sqrt(k1 - 1/4) (1e-8: the integrator's error at rtol 1e-10)."""
+    system = compiled(two_rates())
+    for k1 in (1.0, 4.0):
+        r = mechgen.simulate(system.with_params(k1=k1), t_end=1.0, q0={"x": 1.0, "y": 1.0}, method="Radau",
+                             rtol=1e-10, atol=1e-12, samples=21)
+        assert r["loop"] == "c"
+        t, wd = r["t"], math.sqrt(k1 - 0.25)
+        np.testing.assert_allclose(r["trajectory"]["x"], np.exp(-t / 2) * (np.cos(wd * t) + np.sin(wd * t) / (2 * wd)),
+                                   rtol=0, atol=1e-8)
+
+
 def test_refused_where_it_cannot_run():
-    """The numpy backend: loop 'c' with method Radau is an InputError at the key; 'auto' runs scipy's."""
+    """The numpy backend: loop 'c' with method Radau is an InputError at the key; 'auto' runs scipy's. A hybrid
+    model (its modes: the event loops run it) is refused too."""
     system = mechgen.compile(two_rates(), backend="numpy")
     assert "numpy" in radau_loop_problem(system)
     with pytest.raises(mechgen.InputError, match="loop"):
         mechgen.simulate(system, t_end=1.0, q0={"x": 1.0}, method="Radau", loop="c")
     assert mechgen.simulate(system, t_end=0.1, q0={"x": 1.0}, method="Radau", samples=3)["loop"] == "python"
+    hybrid = mechgen.compile(str(Path(__file__).resolve().parent / "models" / "bouncing_ball.py"))
+    assert "modes" in radau_loop_problem(hybrid)
 
 
 def test_without_a_compiler_radau_falls_back_to_scipys(monkeypatch, tmp_path):
