@@ -218,4 +218,14 @@ def blow_up() -> Model:
 def test_nan_right_hand_side_names_t():
     system = compiled(blow_up())
     with pytest.raises(mechgen.KernelError, match=r"NaN/Inf at t = .*Radau at t = "):
-        integrate_radau_c(system, [1.0, -10.0], 1.0, RunOptions(rtol=1e-8, atol=1e-10))
+        integrate_radau_c(system, [1.0, -10.0], 1.0, RunOptions(rtol=1e-8, atol=1e-10, t_eval=np.linspace(0, 1, 11)))
+
+
+def test_singular_mass_is_named():
+    """m = 0 in x'' of the two-rate model (T = m x'^2 / 2): M = dr/da is singular at the start."""
+    model = two_rates()
+    model.params(Param("mx", 0.0))
+    model.kinetic(lambda v, p: p.mx * v.x**2 / 2 + v.y**2 / 2)
+    system = compiled(model)
+    with pytest.raises(mechgen.errors.ConvergenceError, match=r"Radau failed at t = 0 .*Singular matrix: the mass"):
+        integrate_radau_c(system, [1.0, 1.0, 0.0, 0.0], 1.0, RunOptions(t_eval=np.linspace(0, 1, 3)))

@@ -191,6 +191,8 @@ def integrate_radau_c(system, x0, t_end: float, options, *, extra: int = 0) -> t
     why = radau_loop_problem(system, options.rtol, options.atol, extra)
     if why is not None:
         raise CompilerUnavailable(why)
+    if options.t_eval is None:
+        raise ValueError("the compiled Radau loop samples at t_eval only (give the sample times)")
     lib = library()[0]
     x0 = np.array(x0, dtype=float).reshape(-1)
     if x0.size != 2 * system.n + system.m + extra:
