@@ -11,9 +11,11 @@
   sparse-friendly implicit method.
 * ``DOP853`` on the C backend runs in the compiled loop (mechgen.runtime.integration.smooth_c for a lumped model,
   mechgen.runtime.fields.flow_c for a continuum with a constant mass: no Python between the steps; the same steps
-  as scipy's DOP853) unless ``loop = "python"``; every other method (``BDF``,
-  ``Radau``, ``LSODA``, ``RK45``, and ``DOP853`` on the numpy or CasADi backends) is scipy's, stepped in
-  Python (mechgen.runtime.core.integrate), and ``cvodes`` SUNDIALS' (mechgen.runtime.core.sundials).
+  as scipy's DOP853) unless ``loop = "python"``; so does ``Radau`` for a lumped model on the C backend
+  (mechgen.runtime.integration.radau_c: scipy's Radau step for step, Newton on the generated Jacobian), so that
+  ``auto``'s stiff choice runs compiled there; every other method (``BDF``, ``LSODA``, ``RK45``, ``Radau`` on a
+  continuum, and both on the numpy or CasADi backends) is scipy's, stepped in Python
+  (mechgen.runtime.core.integrate), and ``cvodes`` SUNDIALS' (mechgen.runtime.core.sundials).
 
 The outputs ``method`` and ``loop`` say what ran.
 """
@@ -30,6 +32,8 @@ from mechgen.runtime.core.integrate import integrate_first_order
 from mechgen.runtime.core.memory import dense_bytes, require
 from mechgen.runtime.integration.run_options import RunOptions
 
+#: the methods with a compiled loop on the C backend (DOP853: lumped models and continua; Radau: lumped models)
+COMPILED = ("DOP853", "Radau")
 #: an explicit method needing more steps than this for stability alone makes ``auto`` choose Radau
 STIFF_STEPS = 10_000
 #: DOP853's stability interval on the negative real axis, doubled (steps >= t_end |lambda| / c)
@@ -126,15 +130,15 @@ def adaptive_run(system, options: dict, x0: np.ndarray, method: str, budget: Bud
                      budget=budget, progress=bool(options.get("progress", True)), desc=desc,
                      explain=lambda t, x: explain_state(system, t, np.asarray(x)[:size]),
                      loop=options.get("loop", "auto"))
-    if method == "DOP853" and run.loop != "python":
+    if method in COMPILED and run.loop != "python":
         why = compiled_loop_problem(system, run, extra)
         if why is None:
             t, X = compiled_run(system, x0, t_end, run, extra)
             return t, X, {"method": method, "loop": "c", "_extra": extra}
         if run.loop == "c":
             raise InputError(f"loop 'c' cannot run here: {why}", key="loop",
-                             expected="method DOP853 (or auto) on the C backend with a C compiler, or loop "
-                                      "'auto' / 'python'")
+                             expected="method DOP853, Radau (or auto) on the C backend with a C compiler (Radau: a "
+                                      "lumped model), or loop 'auto' / 'python'")
     if method == "cvodes":
         traj = cvodes_run(system, x0, t_end, run)
     else:
@@ -145,8 +149,13 @@ def adaptive_run(system, options: dict, x0: np.ndarray, method: str, budget: Bud
 
 
 def compiled_loop_problem(system, run: RunOptions, extra: int) -> str | None:
-    """Why the compiled DOP853 loop cannot run ``system`` (None when it can): mechgen.runtime.integration.smooth_c for a
-    lumped model, mechgen.runtime.fields.flow_c for a continuum."""
+    """Why the compiled loop of ``run.method`` cannot run ``system`` (None when it can): DOP853's
+    (mechgen.runtime.integration.smooth_c for a lumped model, mechgen.runtime.fields.flow_c for a continuum) or
+    Radau's (mechgen.runtime.integration.radau_c, lumped models)."""
+    if run.method == "Radau":
+        from mechgen.runtime.integration.radau_c import radau_loop_problem
+
+        return radau_loop_problem(system, run.rtol, run.atol, extra)
     if system.is_field:
         from mechgen.runtime.fields.flow_c import field_loop_problem
 
@@ -157,7 +166,13 @@ def compiled_loop_problem(system, run: RunOptions, extra: int) -> str | None:
 
 
 def compiled_run(system, x0: np.ndarray, t_end: float, run: RunOptions, extra: int) -> tuple[np.ndarray, np.ndarray]:
-    """(t, x rows at the samples) of the compiled DOP853 loop (where :func:`compiled_loop_problem` says it can)."""
+    """(t, x rows at the samples) of the compiled loop of ``run.method`` (where :func:`compiled_loop_problem` says
+    it can)."""
+    if run.method == "Radau":
+        from mechgen.runtime.integration.radau_c import integrate_radau_c
+
+        t, X, _ = integrate_radau_c(system, x0, t_end, run, extra=extra)
+        return t, X
     if system.is_field:
         from mechgen.runtime.fields.flow_c import integrate_field_c
 

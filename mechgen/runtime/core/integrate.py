@@ -57,7 +57,8 @@ def _solver_class(method: str):
     return {"BDF": si.BDF, "Radau": si.Radau, "LSODA": si.LSODA, "RK45": si.RK45, "DOP853": si.DOP853}[method]
 
 
-def _where(t: float, t_end: float, steps: int) -> str:
+def reached_at(t: float, t_end: float, steps: int) -> str:
+    """How far a run got: t, t_end and the accepted steps (the budget's and failures' ``reached``)."""
     return f"t = {t:.6g} of t_end = {t_end:.6g} after {steps:,} steps"
 
 
@@ -116,7 +117,7 @@ def integrate_first_order(rhs, x0, t_end: float, *, jac=None, options: RunOption
                 with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # finiteness is checked here
                     message = solver.step()
                 if solver.status == "failed":
-                    raise ConvergenceError(failed(f"stopped at {_where(solver.t, t_end, steps)}: "
+                    raise ConvergenceError(failed(f"stopped at {reached_at(solver.t, t_end, steps)}: "
                                                   f"{str(message).rstrip('.')}"))
                 steps += 1
                 t = solver.t
@@ -131,9 +132,9 @@ def integrate_first_order(rhs, x0, t_end: float, *, jac=None, options: RunOption
                         ys.append(solver.dense_output()(t_eval[i_eval:i_new]).T)
                         i_eval = i_new
                 if budget is not None:
-                    budget.spend(1, lambda: _where(t, t_end, steps))
+                    budget.spend(1, lambda: reached_at(t, t_end, steps))
                     if steps % CHECK_EVERY == 0:
-                        _project(budget, method, steps, t, t - solver.t_old, t_end)
+                        project_steps(budget, method, steps, t, t - solver.t_old, t_end)
                 bar.to(t)
     except (LinAlgError, ZeroDivisionError, ValueError) as exc:  # a singular M; a NaN met by a check_finite solve
         raise ConvergenceError(failed(f"failed at t = {last[0]:.6g} of t_end = {t_end:.6g} ({exc})")) from exc
@@ -153,7 +154,7 @@ def integrate_first_order(rhs, x0, t_end: float, *, jac=None, options: RunOption
                       message="The solver successfully reached the end of the integration interval.", steps=steps)
 
 
-def _project(budget: Budget, method: str, steps: int, t: float, h: float, t_end: float) -> None:
+def project_steps(budget: Budget, method: str, steps: int, t: float, h: float, t_end: float) -> None:
     """Once a tenth of the step budget is spent: refuse when the steps so far plus (t_end - t) / h at the
     latest step size h exceed PROJECT_MARGIN times the budget (a step size that stopped growing: a fast
     mode resolved over the whole interval); a margin that an early transient's short steps cannot reach."""
@@ -164,7 +165,7 @@ def _project(budget: Budget, method: str, steps: int, t: float, h: float, t_end:
         raise BudgetExceeded(f"{method} steps: at the step size of the latest step (h = {h:.3g}) t_end = {t_end:.6g} "
                              f"needs about {estimate:.3g} steps, more than {PROJECT_MARGIN:g} x max_steps = "
                              f"{budget.limit:,} (a fast mode resolved over the whole interval: shorten t_end, or "
-                             "raise max_steps)", key=budget.key, reached=_where(t, t_end, steps))
+                             "raise max_steps)", key=budget.key, reached=reached_at(t, t_end, steps))
 
 
 def leapfrog(acceleration, q0, v0, dt: float, n_steps: int, *, record_every: int = 1, energy=None,
@@ -210,7 +211,7 @@ def leapfrog(acceleration, q0, v0, dt: float, n_steps: int, *, record_every: int
                 if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
                     raise unstable(step)
                 if budget is not None:
-                    budget.check_time(lambda: _where(step * dt, t_end, step))
+                    budget.check_time(lambda: reached_at(step * dt, t_end, step))
                 bar.to(step)
     if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
         raise unstable(n_steps)

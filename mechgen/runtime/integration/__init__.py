@@ -7,5 +7,6 @@ Python loop there (scipy's steppers) and the compiled DOP853 loop of :mod:`mechg
 :class:`~mechgen.runtime.integration.run_options.RunOptions`; a smooth model is the case without guards
 (:mod:`~mechgen.runtime.integration.smooth_c`), a continuum a flow provider of the same C loop
 (:mod:`mechgen.runtime.fields.flow_c`). :mod:`~mechgen.runtime.integration.augmented` carries the energy
-balance's integrals with the state in either loop.
+balance's integrals with the state in either loop. A smooth lumped model's implicit method has its compiled loop
+too: :mod:`~mechgen.runtime.integration.radau_c` (scipy's Radau step for step, ``codegen/templates/c99/radau_loop.c``).
 """
