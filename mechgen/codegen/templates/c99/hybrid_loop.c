@@ -216,6 +216,9 @@ typedef struct {
     double *mem;
     double *zeros, *M, *b, *K, *F;
     double **kout;             /* (4 nmodes + nresets) x MGH_PORTS: each kernel's own outputs (kout_of) */
+    const double **kin;        /* the same slots: each kernel's inputs as last set (kcall) */
+    const double **kin_x, **kin_a;  /* per slot: the state and acceleration those inputs point into */
+    double t_in;               /* the time input every kernel reads */
     double *y_old, *f_old, *y_new, *f_new, *ytmp, *xm, *fm, *xd, *fd, *xa, *xs, *fy, *ff, *fy2, *ff2;
     double *g_new, *d_new, *gm, *dm, *gt, *gtt, *ca, *cda, *cb, *cdb, *roots, *t_his;
     double *st_g;              /* MGH_STACK entries of 4 * max_guards: ga, da, gb, db */
@@ -243,21 +246,28 @@ static double *const *kout_of(const mgh_ctx *c, long kind, long where)
 
 static int kcall(mgh_ctx *c, const mgh_kernel *k, long kind, long where, const double *x, const double *a, double t)
 {
-    const double *in[MGH_PORTS];
-    double *const *out = kout_of(c, kind, where);
-    double tt = t;
+    long slot = kind == MGH_K_RESET ? 4 * c->P->nmodes + where : 4 * where + kind;
+    const double **in = c->kin + slot * MGH_PORTS;
+    double *const *out = c->kout + slot * MGH_PORTS;
     long sizes = 0, i;
     int rc;
-    for (i = 0; i < k->nin; ++i) {
-        switch (k->ports[i]) {
-        case MGH_IN_Q: in[i] = x; break;
-        case MGH_IN_V: in[i] = x + MGH_N(c); break;
-        case MGH_IN_A: in[i] = a != NULL ? a : c->zeros; break;
-        case MGH_IN_Z: in[i] = MGH_M(c) ? x + 2 * MGH_N(c) : c->zeros; break;
-        case MGH_IN_T: in[i] = &tt; break;
-        default: in[i] = c->P->p != NULL ? c->P->p : c->zeros; break;
+    /* the inputs point into x and a: set again only when the caller's buffers change (most calls of a step
+     * pass the same stage buffer); the time is read from c->t_in */
+    if (x != c->kin_x[slot] || a != c->kin_a[slot]) {
+        for (i = 0; i < k->nin; ++i) {
+            switch (k->ports[i]) {
+            case MGH_IN_Q: in[i] = x; break;
+            case MGH_IN_V: in[i] = x + MGH_N(c); break;
+            case MGH_IN_A: in[i] = a != NULL ? a : c->zeros; break;
+            case MGH_IN_Z: in[i] = MGH_M(c) ? x + 2 * MGH_N(c) : c->zeros; break;
+            case MGH_IN_T: in[i] = &c->t_in; break;
+            default: in[i] = c->P->p != NULL ? c->P->p : c->zeros; break;
+            }
         }
+        c->kin_x[slot] = x;
+        c->kin_a[slot] = a;
     }
+    c->t_in = t;
     rc = k->fn(in, out, &sizes, 1);
     if (rc != 0) {
         c->S->err_kind = kind;
@@ -1286,9 +1296,11 @@ static void release(mgh_ctx *c)
     free(c->mem);
     free(c->flags);
     free(c->kout);
+    free((void *)c->kin);
     c->mem = NULL;
     c->flags = NULL;
     c->kout = NULL;
+    c->kin = NULL;
 }
 
 static int setup(mgh_ctx *c, const mgh_problem *P, mgh_state *S)
@@ -1335,10 +1347,13 @@ static int setup(mgh_ctx *c, const mgh_problem *P, mgh_state *S)
     c->mem = (double *)calloc((size_t)total, sizeof(double));
     c->flags = (long *)calloc((size_t)(2 * ng), sizeof(long));
     c->kout = (double **)calloc((size_t)(nk * MGH_PORTS), sizeof(double *));
-    if (c->mem == NULL || c->flags == NULL || c->kout == NULL) {
+    c->kin = (const double **)calloc((size_t)(nk * MGH_PORTS + 2 * nk), sizeof(double *));
+    if (c->mem == NULL || c->flags == NULL || c->kout == NULL || c->kin == NULL) {
         release(c);
         return MGH_E_MEMORY;
     }
+    c->kin_x = c->kin + nk * MGH_PORTS;   /* all NULL: the first call of each kernel sets its inputs */
+    c->kin_a = c->kin_x + nk;
     p = c->mem;
 #define MGH_TAKE(name, count) do { c->name = p; p += (count); } while (0)
     MGH_TAKE(zeros, nx);
