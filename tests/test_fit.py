@@ -2,7 +2,7 @@
 
 References, each independent of mechgen's solver:
 
-* the limestone penetration data of Frew, Forrestal & Hanchak (2002), J. Appl. Mech. 69,
+* the limestone penetration data of Frew, Forrestal & Hanchak (2000), J. Appl. Mech. 67,
   "Penetration experiments with limestone targets and ogive-nose steel projectiles", eq. (3):
   R = K + k (2a0 / 2a), K = 607 MPa, k = 86 MPa, 2a0 = 25.4 mm; R = 913, 787, 693 MPa for
   2a = 7.1, 12.7, 25.4 mm. The model is linear in (K, k), so the estimate is the closed form of

@@ -1,7 +1,7 @@
 """Ogive-nose penetration (ogive_penetration) against the closed form, and the fit of the target resistance.
 
-Reference: Frew, Forrestal & Hanchak (2002), "Penetration experiments with limestone targets and ogive-nose
-steel projectiles", J. Appl. Mech. 69, eqs. 1a-1b (after Forrestal, Altman, Cargile & Hanchak 1994):
+Reference: Frew, Forrestal & Hanchak (2000), "Penetration experiments with limestone targets and ogive-nose
+steel projectiles", J. Appl. Mech. 67 (December 2000; the seed file), eqs. 1a-1b (after Forrestal, Altman, Cargile & Hanchak 1994):
 P = m/(2 pi a^2 rho N) ln(1 + N rho V1^2/R) + 4a, V1^2 = (m Vs^2 - 4 pi a^3 R)/(m + 4 pi a^3 N rho),
 N = (8 psi - 1)/(24 psi^2); the projectile stops in the crater when m Vs^2 < 4 pi a^3 R, at
 P = Vs sqrt(m/c), c = pi a R / 4 (derived in tests/impact_reference.py). Eq. 3: R = K + k (2a0/2a),

@@ -1,7 +1,7 @@
 """Write limestone_synthetic.csv: depths of penetration from the closed form at the paper's resistances.
 
-Frew, Forrestal & Hanchak (2002), "Penetration experiments with limestone targets and ogive-nose steel
-projectiles", J. Appl. Mech. 69: three projectile scales (2a = 7.1 mm, 0.020 kg; 12.7 mm, 0.117 kg;
+Frew, Forrestal & Hanchak (2000), "Penetration experiments with limestone targets and ogive-nose steel
+projectiles", J. Appl. Mech. 67 (December 2000): three projectile scales (2a = 7.1 mm, 0.020 kg; 12.7 mm, 0.117 kg;
 25.4 mm, 0.931 kg; psi = 3) with fitted strength constants R = 913, 787 and 693 MPa. The measured
 (Vs, P) tables did not survive the text extraction of the paper, so these rows are SYNTHETIC: the depth
 P of eqs. (1a)-(1b) (P = m/(2 pi a^2 rho N) ln(1 + N rho V1^2 / R) + 4a) at striking velocities spread
