@@ -3,9 +3,9 @@
 Each figure must have a title (an axes title or a suptitle); every panel that draws data has both axis labels;
 a panel with two or more labelled curves has a legend; no linear axis spans less than 1e-9 of its own magnitude
 (an axis scaled to round-off, such as E(t) of a conservative run drawn at its rounding noise, or the real parts
-of an undamped spectrum at 1e-15). The scenes are the shipped ones that run in a few seconds; the others draw
-with the same kinds' plot functions. (cross_section and stability_boundary draw nothing: a 6 x 6 stiffness and a
-located parameter value are numbers, which the summary prints.)
+of an undamped spectrum at 1e-15). Every shipped scene with figures is checked (the long ones marked slow); the
+two without (cross_section and stability_boundary draw nothing: a 6 x 6 stiffness and a located parameter value
+are numbers, which the summary prints) are left out.
 """
 from __future__ import annotations
 
@@ -19,6 +19,9 @@ SCENES = ("beam_modes", "beck_column", "fpu_chain", "fpu_recurrence", "friction_
           "impact_models", "laval_rotor", "moving_string", "penetration_limestone", "rod_dynamics", "rod_end_torque",
           "rod_tip_load", "rotating_beam", "rotating_string", "spring_pendulum", "stick_slip_element",
           "timoshenko_modes", "balloon_stability")
+#: the shipped scenes that take 7 to 25 s each (the rest of the shipped scenes with figures)
+SLOW_SCENES = ("balloon_branches", "balloon_frequencies", "rate_state_stick_slip", "ross_example_rotor",
+               "stepped_rotor", "fpu_large")
 
 
 def _has_data(ax) -> bool:
@@ -62,7 +65,7 @@ def audit(fig) -> list[str]:
     return problems
 
 
-@pytest.mark.parametrize("scene", SCENES)
+@pytest.mark.parametrize("scene", list(SCENES) + [pytest.param(name, marks=pytest.mark.slow) for name in SLOW_SCENES])
 def test_shipped_scene_figures_are_complete(scene, tmp_path, monkeypatch):
     pytest.importorskip("matplotlib")
     from matplotlib.figure import Figure
