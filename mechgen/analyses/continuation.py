@@ -454,7 +454,7 @@ def _branch(plt, a: dict, path: Path) -> bool:
                 plt.Line2D([], [], ls="", marker="d", mfc="none", color="tab:orange", label="stability change"),
                 plt.Line2D([], [], ls="", marker="o", mfc="none", color="tab:green", label="at")]
     ax.legend(handles=handles, fontsize=7, loc="best")
-    ax.set_xlabel(name)
+    ax.set_xlabel(figures.labelled(a, name))
     ax.set_ylabel(output)
     ax.set_title(f"{a['name']}: {output} against {name}", fontsize=9)
     fig.tight_layout()
@@ -506,8 +506,8 @@ def _frequencies_along(plt, a: dict, path: Path) -> bool:
                 lw=1.0)
     if min(lam) > 0 and max(lam) / min(lam) > 100:
         ax.set_xscale("log")
-    ax.set_xlabel(name)
-    ax.set_ylabel("frequency")
+    ax.set_xlabel(figures.labelled(a, name))
+    ax.set_ylabel("frequency (rad/s)")
     ax.set_title(f"{a['name']}: the lowest frequencies along the branch", fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=120)

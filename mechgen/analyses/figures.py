@@ -13,6 +13,13 @@ from mechgen.errors import InputError
 VERDICT_COLOURS = {"stable": "k", "neutral": "tab:green", "divergence": "tab:blue", "flutter": "tab:red", "unconverged": "tab:orange"}
 
 
+def labelled(a: dict, name: str) -> str:
+    """An axis label for the model's parameter ``name``: with its declared unit (the entry's ``units``) when it
+    has one, e.g. "P (N)"."""
+    unit = (a.get("units") or {}).get(name)
+    return f"{name} ({unit})" if unit else name
+
+
 def pyplot():
     """matplotlib.pyplot on the Agg backend, or an InputError saying how to install it."""
     try:

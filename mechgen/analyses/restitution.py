@@ -16,7 +16,7 @@ result, divided by it, is the time per impact).
 """
 from __future__ import annotations
 
-from mechgen.analyses import schema, summary
+from mechgen.analyses import figures, schema, summary
 from mechgen.analyses.context import NAME, POINTS, PointRunner, public
 from mechgen.analyses.impact import SCHEMA as IMPACT, hybrid_only, needs
 from mechgen.analyses.parameters import with_free_params
@@ -140,7 +140,7 @@ def plot(plt, a: dict, path) -> list:
     fig, ax = plt.subplots(figsize=(6, 4))
     for key, es in table.items():
         ax.plot(x, es, label=key)
-    ax.set_xlabel(name)
+    ax.set_xlabel(figures.labelled(a, name))
     ax.set_ylabel("coefficient of restitution e")
     ax.legend(fontsize=8)
     ax.set_title(a["name"])

@@ -92,7 +92,8 @@ class Result:
         plt = pyplot()
         folder = Path(directory)
         folder.mkdir(parents=True, exist_ok=True)
-        return draw(plt, self.to_json(), folder / f"{stem or self.name}.png")
+        entry = {**self.to_json(), "units": self.working.get("units", {})}  # the parameters' units, for the axes
+        return draw(plt, entry, folder / f"{stem or self.name}.png")
 
 
 def as_arrays(value):
@@ -146,7 +147,22 @@ def run_analysis(name: str, kind: str, system, options: dict, context: dict) -> 
         raise exc.named(f"{kind} '{name}'") from None
     shown = public(outputs)
     working = {k: v for k, v in outputs.items() if k not in shown}
+    working.setdefault("units", parameter_units(system))
     return Result(name, kind, shown, time.perf_counter() - clock, working)
+
+
+def parameter_units(system) -> dict[str, str]:
+    """{parameter: declared unit} of the system's model (its compiled facts, else looked up by its reference;
+    empty when neither is had), for the figures' axes."""
+    facts = getattr(system, "facts", None)
+    if facts is None:
+        from mechgen.scene.info import lookup_model
+
+        try:
+            facts = lookup_model(system.metadata.reference) if system.metadata.reference else None
+        except Exception:  # a system built by hand: no units, the figures label the names alone
+            facts = None
+    return facts.units() if facts is not None else {}
 
 
 def _unknowns(system) -> int:

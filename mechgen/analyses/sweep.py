@@ -175,7 +175,7 @@ def plot(plt, a: dict, path: Path) -> list[Path]:
         axes[1, 0].plot(x, [float("nan") if g is None else g for g in growth], "o-", ms=3)
         axes[1, 0].axhline(0.0, color="0.6", lw=0.5)
         axes[1, 0].set_ylabel("growth rate max Re s (1/s)")
-    axes[-1, 0].set_xlabel(name)
+    axes[-1, 0].set_xlabel(figures.labelled(a, name))
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)

@@ -48,6 +48,8 @@ class ParamInfo:
     positive: bool = False
     minimum: float | None = None
     maximum: float | None = None
+    #: the declared unit ("kg", "N/m"; "" for a nondimensional one): figures label their axes with it
+    unit: str = ""
 
 
 @dataclass(frozen=True)
@@ -79,6 +81,10 @@ class ModelInfo:
     file: str | None = field(default=None, compare=False)
     #: the canonical reference of the model (mechgen.models.resolve): what a scene's run compiles
     key: str = field(default="", compare=False)
+
+    def units(self) -> dict[str, str]:
+        """{parameter: its declared unit} for the parameters that declare one."""
+        return {k: p.unit for k, p in self.params.items() if p.unit}
 
     def param(self, name: str) -> ParamInfo:
         """The ParamInfo of ``name`` (InputError naming the model when there is none)."""
@@ -117,7 +123,7 @@ def info_of_model(model) -> ModelInfo:
     if cont is not None:
         counts.add("N")
     params = {p.name: ParamInfo(p.default, p.choices, p.integer, p.below, p.is_numeric, p.runtime,
-                                p.positive, *declared_range(p, counts))
+                                p.positive, *declared_range(p, counts), unit=p.unit or "")
               for p in model.param_list}
     coords = model.coordinates_all
     chain = None
@@ -145,7 +151,7 @@ def info_from_json(data: dict, *, file: str | None = None) -> ModelInfo:
         return tuple(v) if v is not None else None
 
     params = {k: ParamInfo(v["default"], tup(v["choices"]), v["integer"], v["below"], v["numeric"], v["runtime"],
-                           v["positive"], v["minimum"], v["maximum"])
+                           v["positive"], v["minimum"], v["maximum"], v.get("unit", ""))
               for k, v in data["params"]}
     parts = {k: tuple(v) for k, v in data["parts"]} if data.get("parts") is not None else None
     return ModelInfo(data["name"], params, tuple(data["coordinates"]), tuple(data["outputs"]), data["continuum"],

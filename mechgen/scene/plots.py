@@ -19,5 +19,6 @@ def plot_results(results: dict, folder: Path) -> list[Path]:
     for a in results["analyses"]:
         draw = get(a["kind"]).plot
         if draw is not None and "error" not in a:  # a failed analysis (its error in the summary) has nothing
-            written += draw(plt, a, folder / f"{Path(results['scene']).stem}_{a['name']}.png")
+            entry = {**a, "units": results.get("units", {})}  # the parameters' units, for the axes
+            written += draw(plt, entry, folder / f"{Path(results['scene']).stem}_{a['name']}.png")
     return written

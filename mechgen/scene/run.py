@@ -113,7 +113,8 @@ def _run_loaded(scn, backend: str | None) -> dict:
     layout = Layout(scn.segments, scn.parts)
     system = laid_out(system, layout)
     results = {"scene": Path(scn.path).name, "title": scn.title, "model": scn.model, "backend": report.backend,
-               "params": dict(scn.params), "build": report.to_json(), "analyses": []}
+               "params": dict(scn.params), "units": model_info(scn.source).units() if scn.source else {},
+               "build": report.to_json(), "analyses": []}
     results["build"]["seconds_total"] = time.perf_counter() - started
     scene_inputs = (plan.source.key, plan.main, fixed)
     context: dict = {POINTS: PointRunner(sweep_point, partial(_point_task, scene_inputs, layout))}
