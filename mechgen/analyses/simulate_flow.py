@@ -148,39 +148,33 @@ def adaptive_run(system, options: dict, x0: np.ndarray, method: str, budget: Bud
     return np.asarray(traj.t, float), np.asarray(xs, float), {"method": method, "loop": "python", "_extra": extra}
 
 
-def compiled_loop_problem(system, run: RunOptions, extra: int) -> str | None:
-    """Why the compiled loop of ``run.method`` cannot run ``system`` (None when it can): DOP853's
-    (mechgen.runtime.integration.smooth_c for a lumped model, mechgen.runtime.fields.flow_c for a continuum) or
-    Radau's (mechgen.runtime.integration.radau_c, lumped models)."""
-    if run.method == "Radau":
-        from mechgen.runtime.integration.radau_c import radau_loop_problem
+def compiled_loop(system, method: str) -> tuple:
+    """(why-not function, run function) of the compiled loop of ``method``: Radau's
+    (mechgen.runtime.integration.radau_c, lumped models), DOP853's for a continuum (mechgen.runtime.fields.flow_c)
+    or for a lumped model (mechgen.runtime.integration.smooth_c). Each why-not function takes (system, rtol,
+    atol, extra) and each run function (system, x0, t_end, run options, extra=...) -> (t, X, counts)."""
+    if method == "Radau":
+        from mechgen.runtime.integration.radau_c import integrate_radau_c, radau_loop_problem
 
-        return radau_loop_problem(system, run.rtol, run.atol, extra)
+        return radau_loop_problem, integrate_radau_c
     if system.is_field:
-        from mechgen.runtime.fields.flow_c import field_loop_problem
+        from mechgen.runtime.fields.flow_c import field_loop_problem, integrate_field_c
 
-        return field_loop_problem(system, run.rtol, run.atol, extra)
-    from mechgen.runtime.integration.smooth_c import smooth_loop_problem
+        return field_loop_problem, integrate_field_c
+    from mechgen.runtime.integration.smooth_c import integrate_smooth_c, smooth_loop_problem
 
-    return smooth_loop_problem(system, run.rtol, run.atol, extra)
+    return smooth_loop_problem, integrate_smooth_c
+
+
+def compiled_loop_problem(system, run: RunOptions, extra: int) -> str | None:
+    """Why the compiled loop of ``run.method`` cannot run ``system`` (None when it can; :func:`compiled_loop`)."""
+    return compiled_loop(system, run.method)[0](system, run.rtol, run.atol, extra)
 
 
 def compiled_run(system, x0: np.ndarray, t_end: float, run: RunOptions, extra: int) -> tuple[np.ndarray, np.ndarray]:
     """(t, x rows at the samples) of the compiled loop of ``run.method`` (where :func:`compiled_loop_problem` says
     it can)."""
-    if run.method == "Radau":
-        from mechgen.runtime.integration.radau_c import integrate_radau_c
-
-        t, X, _ = integrate_radau_c(system, x0, t_end, run, extra=extra)
-        return t, X
-    if system.is_field:
-        from mechgen.runtime.fields.flow_c import integrate_field_c
-
-        t, X, _ = integrate_field_c(system, x0, t_end, run, extra=extra)
-        return t, X
-    from mechgen.runtime.integration.smooth_c import integrate_smooth_c
-
-    t, X, _ = integrate_smooth_c(system, x0, t_end, run, extra=extra)
+    t, X, _ = compiled_loop(system, run.method)[1](system, x0, t_end, run, extra=extra)
     return t, X
 
 

@@ -202,23 +202,32 @@ class _Tables:
         return out
 
 
+def kernel_call_problem(name: str, kernel, outputs) -> str | None:
+    """Why a compiled loop cannot call ``kernel`` (named ``name``) by address for ``outputs`` (None when it can):
+    a C function address, at most PORTS inputs and outputs, inputs among q, v, a, z, t, p (the event loop and
+    radau_c read lumped kernels so; fields.flow_c's pointwise kernels also take s, and it checks them itself)."""
+    if kernel.address is None:
+        return f"kernel {name} has no C function address"
+    spec = kernel.spec
+    if len(spec["inputs"]) > PORTS or len(spec["outputs"]) > PORTS:
+        return f"kernel {name} has more than {PORTS} ports"
+    if any(p["name"] not in INPUTS or p.get("integer") for p in spec["inputs"]):
+        return f"kernel {name} has inputs other than q, v, a, z, t, p"
+    names = {p["name"] for p in spec["outputs"]}
+    if any(p not in names for p in outputs):
+        return f"kernel {name} lacks the outputs {', '.join(dict.fromkeys(outputs))}"
+    return None
+
+
 def _supported(system) -> str | None:
     """Why the kernels of ``system`` cannot be called from the C loop (None when they can)."""
     for name, kernel in system.kernels.items():
         base = name.rpartition("__")[0]
         if base not in KINDS and base != "flow":
             continue
-        picks = PICKS["flow_r"] + PICKS["flow_M"] if base == "flow" else PICKS[base]
-        if kernel.address is None:
-            return f"kernel {name} has no C function address"
-        spec = kernel.spec
-        if len(spec["inputs"]) > PORTS or len(spec["outputs"]) > PORTS:
-            return f"kernel {name} has more than {PORTS} ports"
-        if any(p["name"] not in INPUTS or p.get("integer") for p in spec["inputs"]):
-            return f"kernel {name} has inputs other than q, v, a, z, t, p"
-        names = [p["name"] for p in spec["outputs"]]
-        if any(p not in names for p in picks):
-            return f"kernel {name} lacks the outputs {', '.join(dict.fromkeys(picks))}"
+        why = kernel_call_problem(name, kernel, PICKS["flow_r"] + PICKS["flow_M"] if base == "flow" else PICKS[base])
+        if why is not None:
+            return why
     provided = getattr(system, "flow", None) is not None  # a flow provider gives all of dx/dt
     for i in range(len(system.modes)):
         lumped = () if provided else (("residual", "tangent") if system.n else ()) + (("rates",) if system.m else ())

@@ -25,7 +25,7 @@ from mechgen.errors import BuildError, CompilerUnavailable, ConvergenceError, Ke
 from mechgen.runtime.core.budget import BudgetExceeded, Progress
 from mechgen.runtime.core.integrate import CHECK_EVERY, project_steps, reached_at
 from mechgen.runtime.core.pattern import extent
-from mechgen.runtime.integration.events_c import INPUTS
+from mechgen.runtime.integration.events_c import INPUTS, kernel_call_problem
 
 log = logging.getLogger("mechgen")
 
@@ -120,17 +120,9 @@ def kernel_problem(system, names: dict) -> str | None:
         kernel = system.kernels.get(name)
         if kernel is None:
             return f"the system has no {name} kernel"
-        if kernel.address is None:
-            return f"kernel {name} has no C function address"
-        spec = kernel.spec
-        if len(spec["inputs"]) > PORTS or len(spec["outputs"]) > PORTS:
-            return f"kernel {name} has more than {PORTS} ports"
-        if any(p["name"] not in INPUTS or p.get("integer") for p in spec["inputs"]):
-            return f"kernel {name} has inputs other than q, v, a, z, t, p"
-        outputs = {p["name"] for p in spec["outputs"]}
-        wanted = [p for p in picks[slot] if not (p == "r_z" and not system.m)]
-        if not set(wanted) <= outputs:
-            return f"kernel {name} lacks the outputs {', '.join(wanted)}"
+        why = kernel_call_problem(name, kernel, [p for p in picks[slot] if not (p == "r_z" and not system.m)])
+        if why is not None:
+            return why
     return None
 
 
