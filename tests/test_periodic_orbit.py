@@ -1,0 +1,288 @@
+"""``periodic_orbit`` (issue 27, item 1): periodic orbits of smooth lumped models by harmonic balance and shooting.
+
+References, each independent of mechgen:
+* the forced Duffing oscillator x'' + c x' + x + k3 x^3 = F cos(w t): first-order harmonic balance is the
+  frequency-amplitude equation ((1 - w^2 + 3/4 k3 A^2)^2 + (c w)^2) A^2 = F^2 (closed form, a cubic in A^2);
+  the converged orbit by scipy's DOP853 shooting with fsolve on the hand-written right-hand side, its harmonics by
+  numpy's FFT; its monodromy by central differences of scipy's flow; Liouville's formula det Phi(T) = exp(-c T);
+* the van der Pol oscillator x'' - mu (1 - x^2) x' + x = 0: the small-mu expansion T = 2 pi (1 + mu^2/16 - 5 mu^4 /
+  3072 + ...) and amplitude 2 + O(mu^2) (Andersen & Geer, SIAM J. Appl. Math. 42 (1982)); for mu = 1 scipy shooting
+  in the test and the known period 6.6632868593231 (same source); its non-trivial multiplier
+  exp(mu int_0^T (1 - x^2) dt) (Liouville: the trace of the Jacobian), the integral carried by scipy beside the
+  state.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import scipy.integrate as si
+import scipy.optimize as so
+
+import mechgen
+from mechgen.errors import ConvergenceError, InputError
+
+DUFFING = '''\
+"""Forced Duffing: x'' + c x' + x + k3 x^3 = F cos(w t)."""
+import sympy as sp
+
+from mechgen import Model, Param
+
+model = Model("user_orbit_duffing", doc=__doc__)
+model.params(Param("c", 0.05), Param("k3", 0.5), Param("F", 0.3), Param("w", 1.2))
+model.coordinates("x")
+
+
+@model.kinetic
+def kinetic(v):
+    return v.x**2 / 2
+
+
+@model.potential
+def potential(q, p):
+    return q.x**2 / 2 + p.k3 * q.x**4 / 4
+
+
+@model.dissipation
+def dissipation(v, p):
+    return p.c * v.x**2 / 2
+
+
+@model.forces
+def forces(p, t):
+    return {"x": p.F * sp.cos(p.w * t)}
+'''
+
+VAN_DER_POL = '''\
+"""van der Pol: x'' - mu (1 - x^2) x' + x = 0."""
+from mechgen import Model, Param
+
+model = Model("user_orbit_van_der_pol", doc=__doc__)
+model.params(Param("mu", 1.0))
+model.coordinates("x")
+
+
+@model.kinetic
+def kinetic(v):
+    return v.x**2 / 2
+
+
+@model.potential
+def potential(q):
+    return q.x**2 / 2
+
+
+@model.forces
+def forces(q, v, p):
+    return {"x": p.mu * (1 - q.x**2) * v.x}
+'''
+
+#: the van der Pol period at mu = 1 (Andersen & Geer 1982; also the scipy shooting below)
+VDP_PERIOD_MU1 = 6.6632868593231
+BOUNCING = Path(__file__).resolve().parent / "models" / "bouncing_ball.py"
+
+
+@pytest.fixture(scope="module")
+def folder(tmp_path_factory):
+    path = tmp_path_factory.mktemp("periodic_orbit_models")
+    (path / "duffing.py").write_text(DUFFING)
+    (path / "vdp.py").write_text(VAN_DER_POL)
+    return path
+
+
+@pytest.fixture(scope="module")
+def duffing(folder):
+    return mechgen.compile(str(folder / "duffing.py"))
+
+
+@pytest.fixture(scope="module")
+def vdp(folder):
+    return mechgen.compile(str(folder / "vdp.py"))
+
+
+# ----------------------------------------------------------------------------------------- independent references
+
+def duffing_rhs(c, k3, F, w):
+    return lambda t, x: [x[1], F * math.cos(w * t) - c * x[1] - x[0] - k3 * x[0] ** 3]
+
+
+def scipy_flow(rhs, x0, T, t_eval=None):
+    sol = si.solve_ivp(rhs, (0.0, T), x0, method="DOP853", rtol=1e-13, atol=1e-14, t_eval=t_eval)
+    assert sol.success
+    return sol
+
+
+def duffing_reference(c, k3, F, w, x0):
+    """The forced orbit by scipy shooting: fsolve on phi_T(x0) - x0, T = 2 pi / w."""
+    rhs, T = duffing_rhs(c, k3, F, w), 2 * math.pi / w
+    x0 = so.fsolve(lambda x: scipy_flow(rhs, x, T).y[:, -1] - x, x0, xtol=1e-13)
+    return x0, T, rhs
+
+
+def fft_harmonics(samples):
+    """(a_k, b_k), k = 0.., of q = a_0 + sum a_k cos + b_k sin from N equally spaced samples over [0, T)."""
+    N = len(samples)
+    spec = np.fft.rfft(samples) / N
+    return 2 * spec.real, -2 * spec.imag
+
+
+def vdp_reference(mu, x0, T):
+    """The limit cycle by scipy shooting on (x(0), T) with v(0) = 0, and int_0^T (1 - x^2) dt carried as a third
+    state."""
+    def rhs(t, y):
+        return [y[1], mu * (1 - y[0] ** 2) * y[1] - y[0], 1 - y[0] ** 2]
+
+    def residual(u):
+        end = scipy_flow(rhs, [u[0], 0.0, 0.0], u[1]).y[:, -1]
+        return [end[0] - u[0], end[1]]
+
+    a, T = so.fsolve(residual, [x0, T], xtol=1e-13)
+    trace = scipy_flow(rhs, [a, 0.0, 0.0], T).y[2, -1]
+    return a, T, math.exp(mu * trace)
+
+
+def nontrivial(result):
+    """The multiplier of an autonomous orbit that is not the trivial 1."""
+    mu = np.array([complex(*m) for m in result["multipliers"]])
+    return np.delete(mu, np.argmin(np.abs(mu - 1)))
+
+
+# ----------------------------------------------------------------------------------------------- forced Duffing
+
+def test_first_order_harmonic_balance_is_the_frequency_amplitude_equation(duffing):
+    """H = 1 projects k3 x^3 onto the first harmonic exactly (3/4 k3 A^3; the 16 phases alias nothing below the
+    third harmonic), so its amplitude is the closed form's root to Newton's tolerance (1e-10 on A ~ 0.3); in the
+    weak-nonlinearity limit (k3 = 0.01) the converged orbit (H = 7) differs from it by the third harmonic only,
+    O(k3 A^3 / 32) ~ 1e-5."""
+    c, k3, F, w = 0.1, 0.01, 0.1, 1.1
+    system = duffing.with_params(c=c, k3=k3, F=F, w=w)
+    first = mechgen.periodic_orbit(system, frequency="w", harmonics=1, q0={"x": 0.3})
+    s = np.roots([(0.75 * k3) ** 2, 2 * (1 - w**2) * 0.75 * k3, (1 - w**2) ** 2 + (c * w) ** 2, -F**2])
+    A2 = [r.real for r in s if abs(r.imag) < 1e-12 and r.real > 0]
+    assert len(A2) == 1  # one orbit at these values (below the fold of the resonance curve)
+    A = math.sqrt(A2[0])
+    assert first["method"] == "harmonic_balance"
+    assert first["harmonics"]["x"]["amplitude"][0] == pytest.approx(A, rel=0, abs=1e-10)
+    converged = mechgen.periodic_orbit(system, frequency="w", harmonics=7, q0={"x": 0.3})
+    assert converged["amplitude"]["x"] == pytest.approx(A, rel=0, abs=k3 * A**3 / 32 * 2)
+
+
+def test_multi_harmonic_orbit_by_both_methods_against_scipy_shooting(duffing):
+    """A strongly nonlinear forced orbit (k3 = 0.5, A ~ 1.3): mechgen's shooting matches scipy's to the two
+    integrations' errors (1e-8 on the start state); harmonic balance with H = 7 matches it to within ten times the
+    first harmonic it leaves out (the 9th, |c_9| from the reference's FFT: the truncation error's size)."""
+    c, k3, F, w = 0.05, 0.5, 0.3, 1.2
+    x0, T, rhs = duffing_reference(c, k3, F, w, [1.3, 0.5])
+    N = 256
+    ref = scipy_flow(rhs, x0, T, t_eval=T * np.arange(N) / N).y[0]
+    a, b = fft_harmonics(ref)
+    truncation = 10 * math.hypot(a[9], b[9])
+    assert 1e-12 < truncation < 1e-4  # the bound is meaningful: small, and above round-off
+    shot = mechgen.periodic_orbit(duffing, frequency="w", method="shooting", q0={"x": 1.3}, v0={"x": 0.5})
+    assert shot["period"] == pytest.approx(T, rel=1e-15)
+    np.testing.assert_allclose([shot["trajectory"]["x"][0], shot["trajectory"]["x_dot"][0]], x0, rtol=0, atol=1e-8)
+    hb = mechgen.periodic_orbit(duffing, frequency="w", harmonics=7, q0={"x": 1.3}, v0={"x": 0.5})
+    h = hb["harmonics"]["x"]
+    np.testing.assert_allclose(h["cos"], a[1:8], rtol=0, atol=truncation)
+    np.testing.assert_allclose(h["sin"], b[1:8], rtol=0, atol=truncation)
+    assert h["mean"] == pytest.approx(a[0] / 2, abs=truncation)
+    # the orbit itself, at the reported times
+    t = np.array(hb["t"])
+    exact = scipy_flow(rhs, x0, T, t_eval=t).y[0]
+    np.testing.assert_allclose(hb["trajectory"]["x"], exact, rtol=0, atol=2 * truncation)
+    assert hb["amplitude"]["x"] == pytest.approx(shot["amplitude"]["x"], abs=2 * truncation)
+
+
+def test_floquet_multipliers_of_a_stable_forced_orbit(duffing):
+    """The multipliers against the eigenvalues of scipy's monodromy by central differences of its flow (step 1e-5:
+    truncation ~1e-10, rounding 1e-13 / 1e-5 = 1e-8 -> 1e-7 allowed); their product is exp(-c T) (Liouville:
+    trace J = -c), which mechgen's variational equations hold to the integrator's error (1e-9). Harmonic balance with
+    H = 15, whose truncation leaves ~1e-13 in the start state (H = 7 leaves 1e-6 there, and so in the multipliers of
+    the monodromy integrated from it)."""
+    c, k3, F, w = 0.05, 0.5, 0.3, 1.2
+    x0, T, rhs = duffing_reference(c, k3, F, w, [1.3, 0.5])
+    h = 1e-5
+    columns = []
+    for j in range(2):
+        e = np.zeros(2)
+        e[j] = h
+        columns.append((scipy_flow(rhs, x0 + e, T).y[:, -1] - scipy_flow(rhs, x0 - e, T).y[:, -1]) / (2 * h))
+    expected = np.sort_complex(np.linalg.eigvals(np.array(columns).T))
+    for method in ("shooting", "harmonic_balance"):
+        r = mechgen.periodic_orbit(duffing, frequency="w", method=method, q0={"x": 1.3}, v0={"x": 0.5}, harmonics=15)
+        mu = np.array([complex(*m) for m in r["multipliers"]])
+        np.testing.assert_allclose(np.sort_complex(mu), expected, rtol=0, atol=1e-7)
+        assert np.prod(mu).real == pytest.approx(math.exp(-c * T), rel=1e-9)
+        assert abs(np.prod(mu).imag) < 1e-12
+        assert r["stability"] == "stable" and max(abs(mu)) < 1
+
+
+# ------------------------------------------------------------------------------------------------- van der Pol
+
+@pytest.mark.parametrize("method", ["shooting", "harmonic_balance"])
+def test_van_der_pol_small_mu_expansion(vdp, method):
+    """mu = 0.1: T = 2 pi (1 + mu^2/16) to the next term, 2 pi 5 mu^4 / 3072 = 1.0e-6 (allowed 3e-6); amplitude
+    2 to O(mu^2) = 0.01 (the expansion's next term; the coefficient is below 1)."""
+    mu = 0.1
+    r = mechgen.periodic_orbit(vdp.with_params(mu=mu), method=method, period=6.3, q0={"x": 2.0}, harmonics=9)
+    assert r["method"] == method
+    assert r["period"] == pytest.approx(2 * math.pi * (1 + mu**2 / 16), rel=0, abs=3e-6)
+    assert abs(r["period"] - 2 * math.pi * (1 + mu**2 / 16)) > 1e-8  # the mu^4 term is there: not the expansion itself
+    assert r["amplitude"]["x"] == pytest.approx(2.0, abs=mu**2)
+
+
+def test_van_der_pol_limit_cycle_against_scipy_shooting(vdp):
+    """mu = 1: shooting's period and amplitude against scipy's shooting (1e-9: two integrations at 1e-11 / 1e-13)
+    and the cited period; harmonic balance with H = 30 against the same (1e-8: its truncation, the 31st harmonic of
+    a relaxation-like cycle); the non-trivial multiplier against exp(mu int (1 - x^2) dt) (1e-7 relative: the
+    variational equations' error on a multiplier of 1e-3), the trivial one 1."""
+    a, T, expected = vdp_reference(1.0, 2.0, 6.6)
+    assert T == pytest.approx(VDP_PERIOD_MU1, abs=1e-10)
+    assert expected < 1
+    shot = mechgen.periodic_orbit(vdp, period=6.5, q0={"x": 2.0})
+    assert shot["method"] == "shooting" and shot["stability"] == "stable"
+    assert shot["period"] == pytest.approx(T, abs=1e-9)
+    assert shot["amplitude"]["x"] == pytest.approx(a, abs=1e-9)
+    hb = mechgen.periodic_orbit(vdp, period=6.5, q0={"x": 2.0}, harmonics=30)
+    assert hb["period"] == pytest.approx(T, abs=1e-8)
+    assert hb["amplitude"]["x"] == pytest.approx(a, abs=1e-8)
+    for r in (shot, hb):
+        mu = np.array([complex(*m) for m in r["multipliers"]])
+        assert np.min(np.abs(mu - 1)) < 1e-6
+        assert nontrivial(r)[0].real == pytest.approx(expected, rel=1e-7)
+
+
+# ------------------------------------------------------------------------------------------------------ bad input
+
+def test_bad_input_names_the_key(duffing, vdp):
+    """Each mistake is an InputError naming its key."""
+    cases = [(vdp, dict(period=-1.0, q0={"x": 2.0}), "period"),
+             (vdp, dict(period=6.0, q0={"x": 2.0}, harmonics=0), "harmonics"),
+             (vdp, dict(q0={"x": 2.0}), "period"),
+             (duffing, dict(frequency="w", period=5.0), "period"),
+             (duffing, dict(frequency=0.0), "frequency"),
+             (duffing, dict(period=5.0, q0={"x": 1.0}), "frequency"),
+             (vdp, dict(period=6.0), "q0"),
+             (vdp, dict(period=6.0, q0={"x": 2.0}, method="collocation"), "method"),
+             (vdp, dict(period=6.0, q0={"y": 2.0}), "q0.y")]
+    for system, options, key in cases:
+        with pytest.raises(InputError) as err:
+            mechgen.periodic_orbit(system, **options)
+        assert err.value.key is not None and err.value.key.endswith(key), (options, err.value)
+
+
+def test_hybrid_model_is_refused_naming_method():
+    ball = mechgen.compile(str(BOUNCING))
+    with pytest.raises(InputError) as err:
+        mechgen.periodic_orbit(ball, frequency=1.0)
+    assert err.value.key.endswith("method") and "hybrid" in str(err.value)
+
+
+def test_non_convergence_names_the_residual_and_what_to_try(duffing):
+    """Two Newton steps from far away: a ConvergenceError (exit 1) naming the residual and what to try."""
+    with pytest.raises(ConvergenceError) as err:
+        mechgen.periodic_orbit(duffing, frequency="w", method="harmonic_balance", q0={"x": 20.0}, max_iterations=2)
+    text = str(err.value)
+    assert "residual" in text and "try" in text and "max_iterations" in text
