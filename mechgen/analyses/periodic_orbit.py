@@ -297,7 +297,7 @@ def plot(plt, a: dict, path) -> list:
 
 def summary_lines(outputs: dict) -> list[str]:
     """Every output but the series and the harmonic tables, then the first harmonic's amplitude per coordinate."""
-    lines = summary.output_lines(outputs, skip=("harmonics",))
+    lines = summary.output_lines(outputs, skip=("harmonics", "trajectory", "t"))
     first = {c: round(h["amplitude"][0], 6) if h["amplitude"] else 0.0 for c, h in outputs["harmonics"].items()}
     return lines + [f"    first harmonic amplitude: {first}"] + time_series.summary_lines(outputs)
 
