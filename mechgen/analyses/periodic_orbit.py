@@ -287,7 +287,8 @@ def plot(plt, a: dict, path) -> list:
     axes[0].set_ylabel("coordinates")
     axes[1].set_xlabel("q")
     axes[1].set_ylabel("dq/dt")
-    axes[1].legend(fontsize="small")
+    for ax in axes if len(names) > 1 else ():
+        ax.legend(fontsize="small")
     fig.suptitle(f"{a['name']}: T = {out['period']:.6g}, {out['stability']} ({out['method']})")
     fig.tight_layout()
     fig.savefig(path, dpi=120)
