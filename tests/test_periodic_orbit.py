@@ -286,3 +286,30 @@ def test_non_convergence_names_the_residual_and_what_to_try(duffing):
         mechgen.periodic_orbit(duffing, frequency="w", method="harmonic_balance", q0={"x": 20.0}, max_iterations=2)
     text = str(err.value)
     assert "residual" in text and "try" in text and "max_iterations" in text
+
+
+def test_a_start_from_an_earlier_simulate(duffing, vdp):
+    """``from`` a simulate that settled onto the orbit: the same orbit as from a guess (the forced start state to
+    1e-8, the limit cycle's period to 1e-9: Newton's and the integrators' tolerances), the autonomous period's
+    guess taken from the run."""
+    settle = mechgen.simulate(vdp, t_end=40.0, q0={"x": 0.5}, samples=801, name="settle")
+    cycle = mechgen.periodic_orbit(vdp, **{"from": settle})
+    assert cycle["period"] == pytest.approx(VDP_PERIOD_MU1, abs=1e-9)
+    forced = mechgen.simulate(duffing, t_end=300.0, q0={"x": 1.0}, samples=3001, name="forced")
+    orbit = mechgen.periodic_orbit(duffing, frequency="w", **{"from": forced})
+    x0, _, _ = duffing_reference(0.05, 0.5, 0.3, 1.2, [1.3, 0.5])
+    np.testing.assert_allclose([orbit["trajectory"]["x"][0], orbit["trajectory"]["x_dot"][0]], x0, atol=1e-8)
+
+
+def test_from_needs_a_simulate_with_its_trajectory(duffing):
+    short = mechgen.simulate(duffing, t_end=3.0, series=False, name="short")
+    with pytest.raises(InputError) as err:
+        mechgen.periodic_orbit(duffing, frequency="w", **{"from": short})
+    assert err.value.key == "from" and "series = true" in str(err.value)
+    with pytest.raises(InputError) as err:
+        mechgen.periodic_orbit(duffing, frequency="w", q0={"x": 1.0}, **{"from": short})
+    assert err.value.key.endswith("from")
+    steady = mechgen.steady(duffing, name="rest")
+    with pytest.raises(InputError) as err:
+        mechgen.periodic_orbit(duffing, frequency="w", **{"from": steady})
+    assert err.value.key.endswith("from") and "not simulate" in str(err.value)

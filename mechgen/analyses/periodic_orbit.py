@@ -6,7 +6,10 @@ parameters such as ``"omega"`` or ``"2*omega"``): the orbit of period T = 2 pi /
 origin. *Autonomous* (``frequency`` left out): a limit cycle, whose period is an unknown found beside the orbit,
 from the starting guess ``period``; a phase condition fixes where t = 0 lies on it (below). Either way the
 starting guess is ``q0`` / ``v0`` (tables of coordinates, the state at t = 0; left out: zero, or the model's
-declared initial state).
+declared initial state), or ``from`` an earlier ``simulate`` that kept its trajectory: forced, its sample nearest a
+multiple of T within its last period; autonomous, its sample at the last maximum of the coordinate that varies most
+over the run's second half, with the time between the last two maxima as the period's guess (unless ``period`` is
+given).
 
 Methods (``method``; left out: ``harmonic_balance`` when ``harmonics`` is given, ``shooting`` otherwise; the output
 ``method`` says which ran):
@@ -56,7 +59,7 @@ from mechgen.runtime.periodic.flow import states_at, variational_flow
 from mechgen.runtime.periodic.harmonic_balance import HarmonicBalance
 from mechgen.runtime.periodic.newton import NewtonSettings, newton
 from mechgen.runtime.periodic.shooting import Shooting
-from mechgen.scene.values import fail
+from mechgen.scene.values import fail, listing, show
 
 METHODS = ("harmonic_balance", "shooting", "collocation")
 #: the harmonics of harmonic balance, and those reported by shooting, when ``harmonics`` is left out
@@ -81,6 +84,21 @@ def harmonics_count(ctx, key: str, value: object) -> int:
     return H
 
 
+def earlier_simulate(ctx, key: str, value: object) -> str:
+    """The name of an earlier simulate analysis."""
+    runs = [n for n, k in ctx.earlier.items() if k == "simulate"]
+    expected = "the name of an earlier simulate analysis: " + (listing(runs) if runs else "none in this scene")
+    if ctx.swept:
+        raise fail(ctx.file, key, "'from' is not available inside a sweep", "no 'from' key")
+    if not isinstance(value, str) or value not in ctx.earlier:
+        later = isinstance(value, str) and value in ctx.all_names
+        what = f"analysis {show(value)} comes later in the scene" if later else f"no earlier analysis {show(value)}"
+        raise fail(ctx.file, key, what, expected)
+    if ctx.earlier[value] != "simulate":
+        raise fail(ctx.file, key, f"analysis '{value}' is a {ctx.earlier[value]} analysis, not simulate", expected)
+    return value
+
+
 SCHEMA = {
     "method": Option(schema.one_of("method", METHODS), ABSENT, doc="harmonic_balance or shooting (left out: "
                      "harmonic_balance when harmonics is given, else shooting; collocation is not available yet)"),
@@ -95,6 +113,9 @@ SCHEMA = {
                  "coordinate = value (left out: zero, or the model's declared initial state)"),
     "v0": Option(schema.coordinate_table, {}, doc="the starting guess of the velocities at t = 0, a table "
                  "coordinate = value"),
+    "from": Option(earlier_simulate, ABSENT, doc="an earlier simulate analysis (with its trajectory) whose "
+                   "motion near its end is the starting guess instead of q0 / v0 (and, for an autonomous orbit, the "
+                   "period between its last two maxima the period's)"),
     "rtol": Option(schema.positive, 1e-9, doc="Newton's relative tolerance on the unknowns (shooting integrates "
                    "at 1/100 of it)"),
     "atol": Option(schema.positive, 1e-12, doc="Newton's absolute tolerance on the unknowns (the coordinates' "
@@ -120,7 +141,10 @@ def check(ctx, base: str, options: dict) -> None:
     if "frequency" in options and "period" in options:
         raise fail(ctx.file, f"{base}.period", "a forced orbit's period is 2 pi / frequency; period is the guess of "
                    "an autonomous one", "period or frequency, not both")
-    if "frequency" not in options and "period" not in options:
+    if "from" in options and ({"q0", "v0"} & {k for k, v in options.items() if v}):
+        raise fail(ctx.file, f"{base}.from", "a starting guess both from a simulate and from q0 / v0",
+                   "from, or q0 / v0")
+    if "frequency" not in options and "period" not in options and "from" not in options:
         raise fail(ctx.file, f"{base}.period", "an autonomous orbit (no frequency) needs a starting guess of its "
                    "period", "period = a number > 0 (or frequency = the forcing's, for a forced orbit)")
 
@@ -162,6 +186,41 @@ def guess(system, options: dict) -> np.ndarray:
 
     q0, v0 = initial_state(system, options)
     return np.concatenate([q0, v0])
+
+
+def simulated_states(system, options: dict, context: dict) -> tuple[np.ndarray, np.ndarray]:
+    """(t, states as rows) of the ``from`` simulate's trajectory; a SceneError when it kept none."""
+    name = options["from"]
+    earlier = context.get(name, {})
+    trajectory = earlier.get("trajectory")
+    names = time_series.state_names(system)[:2 * system.n]
+    if not trajectory or any(k not in trajectory for k in names) or len(earlier.get("t", ())) < 3:
+        raise SceneError(f"periodic_orbit: simulate analysis '{name}' kept no trajectory to start from", key="from",
+                         expected="a simulate analysis with series = true (and at least 3 samples)")
+    return np.asarray(earlier["t"], float), np.column_stack([trajectory[k] for k in names]).astype(float)
+
+
+def guess_from_simulate(system, options: dict, context: dict, omega) -> tuple[np.ndarray, float | None, int | None]:
+    """(x0, period guess or None, phase coordinate or None) from the ``from`` simulate: forced, the sample whose time is nearest a multiple of
+    T = 2 pi / omega among the last period's; autonomous, the sample at the last maximum of the coordinate that
+    varies most over the run's second half, and the time between its last two maxima."""
+    t, X = simulated_states(system, options, context)
+    if omega is not None:
+        T = 2 * np.pi / omega
+        last = t >= t[-1] - T
+        phase = np.abs(((t + T / 2) % T) - T / 2)
+        k = int(np.flatnonzero(last)[np.argmin(phase[last])])
+        return X[k], None, None
+    half = t >= (t[0] + t[-1]) / 2
+    p = int(np.argmax(np.ptp(X[half, :system.n], axis=0)))
+    q = X[:, p]
+    peaks = np.flatnonzero((q[1:-1] >= q[:-2]) & (q[1:-1] > q[2:])) + 1
+    if peaks.size < 2:
+        raise SceneError(f"periodic_orbit: simulate analysis '{options['from']}' shows fewer than two maxima of "
+                         f"'{system.coordinates[p]}' (no oscillation to start from)", key="from",
+                         expected="a simulate run over at least two periods of the orbit (a longer t_end)")
+    x0 = X[peaks[-1]].copy()
+    return x0, float(t[peaks[-1]] - t[peaks[-2]]), p
 
 
 def settings(options: dict, method: str) -> NewtonSettings:
@@ -222,14 +281,20 @@ def run_periodic_orbit(system, options: dict, context: dict) -> dict:
     """See the module doc."""
     refuse_unsupported(system)
     method = chosen_method(options)
-    x0 = guess(system, options)
     omega = options.get("frequency")
+    phase = None
+    if "from" in options:
+        x0, period, phase = guess_from_simulate(system, options, context, omega)
+        if omega is None and "period" not in options:
+            options = {**options, "period": period}
+    else:
+        x0 = guess(system, options)
     if omega is None:
         refuse_time_dependent(system, x0)
         if not np.any(x0[:system.n]) and not np.any(x0[system.n:]):
             raise SceneError("periodic_orbit: an autonomous orbit from a zero starting guess would find the "
                              "equilibrium", key="q0", expected="a starting guess on or near the orbit (q0, v0)")
-    phase = int(np.argmax(np.abs(x0[:system.n])))
+    phase = int(np.argmax(np.abs(x0[:system.n]))) if phase is None else phase
     solve = solve_harmonic_balance if method == "harmonic_balance" else solve_shooting
     found = solve(system, options, x0, omega, phase)
     return report(system, options, found, method, autonomous=omega is None)
