@@ -180,9 +180,13 @@ def test_multi_harmonic_orbit_by_both_methods_against_scipy_shooting(duffing):
     a, b = fft_harmonics(ref)
     truncation = 10 * math.hypot(a[9], b[9])
     assert 1e-12 < truncation < 1e-4  # the bound is meaningful: small, and above round-off
-    shot = mechgen.periodic_orbit(duffing, frequency="w", method="shooting", q0={"x": 1.3}, v0={"x": 0.5})
-    assert shot["period"] == pytest.approx(T, rel=1e-15)
-    np.testing.assert_allclose([shot["trajectory"]["x"][0], shot["trajectory"]["x_dot"][0]], x0, rtol=0, atol=1e-8)
+    for loop in ("auto", "python"):  # the compiled loop's flow (Newton's Jacobian by its differences), scipy's
+        shot = mechgen.periodic_orbit(duffing, frequency="w", method="shooting", q0={"x": 1.3}, v0={"x": 0.5},
+                                      loop=loop)
+        assert shot["loop"] == ("python" if loop == "python" or duffing.backend != "c" else "c")
+        assert shot["period"] == pytest.approx(T, rel=1e-15)
+        np.testing.assert_allclose([shot["trajectory"]["x"][0], shot["trajectory"]["x_dot"][0]], x0, rtol=0,
+                                   atol=1e-8)
     hb = mechgen.periodic_orbit(duffing, frequency="w", harmonics=7, q0={"x": 1.3}, v0={"x": 0.5})
     h = hb["harmonics"]["x"]
     np.testing.assert_allclose(h["cos"], a[1:8], rtol=0, atol=truncation)

@@ -306,6 +306,9 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("residual", "scalar", "force units (harmonic balance) or the state's (shooting)", "\\|\\|R\\|\\|_inf "
            "at the solution."),
         _o("iterations", "scalar (int)", "-", "Newton steps taken."),
+        _o("loop", "string", "-", "``c``: shooting's integrations ran in the compiled DOP853 loop (the monodromy "
+           "for Newton by central differences of it); ``python``: in scipy's DOP853 (harmonic balance's "
+           "multipliers, and ``loop = \"python\"``)."),
     ),
     "cross_section": (
         _o("K", "(6, 6)", "N, N m, N m^2", "The section's stiffness ordered [K_uu, K_uw; K_wu, K_ww]."),

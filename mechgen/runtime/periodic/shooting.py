@@ -6,7 +6,8 @@ u = x0 = (q(0), v(0)) and
     R(u) = phi_T(x0) - x0,                 dR/du = Phi(T) - I,
 
 phi_T the flow over [0, T] and Phi(T) its monodromy matrix (mechgen.runtime.periodic.flow: the variational
-equations with the generated tangent kernel's Jacobian). Autonomous (T unknown): u = (x0, T) and
+equations with the generated tangent kernel's Jacobian, or, with ``compiled``, the compiled loop's flow and its
+central differences). Autonomous (T unknown): u = (x0, T) and
 
     R(u) = (phi_T(x0) - x0,  v_p(0)),      dR/du = [[Phi(T) - I, f(phi_T(x0))], [e_{n+p}^T, 0]],
 
@@ -17,10 +18,11 @@ forced orbit at fixed model parameters, -f(T, x(T)) 2 pi / omega^2 (the period a
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
-from mechgen.runtime.periodic.flow import variational_flow
+from mechgen.runtime.periodic.flow import differenced_flow, variational_flow
 
 
 @dataclass(frozen=True)
@@ -33,6 +35,8 @@ class Shooting:
     phase: int = 0
     rtol: float = 1e-11
     atol: float = 1e-13
+    #: mechgen.runtime.periodic.flow.compiled_flow's run, or None: the variational equations
+    compiled: Callable | None = None
 
     @property
     def autonomous(self) -> bool:
@@ -50,10 +54,13 @@ class Shooting:
         return u, 2 * np.pi / self.omega
 
     def flow(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(x(T), Phi(T)) from x0."""
+        """(x(T), Phi(T)) from x0: the compiled flow and its central differences when ``compiled`` is given, else the
+        variational equations (mechgen.runtime.periodic.flow)."""
         x0, T = self.split(u)
         if not (np.isfinite(T) and T > 0):
             raise FloatingPointError(f"period {T} is not positive")
+        if self.compiled is not None:
+            return differenced_flow(self.compiled, x0, T)
         return variational_flow(self.system, x0, 0.0, T, self.rtol, self.atol)
 
     def residual_jacobian(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
