@@ -317,3 +317,102 @@ def test_from_needs_a_simulate_with_its_trajectory(duffing):
     with pytest.raises(InputError) as err:
         mechgen.periodic_orbit(duffing, frequency="w", **{"from": steady})
     assert err.value.key.endswith("from") and "not simulate" in str(err.value)
+
+
+TWO_DOF = '''\
+"""Two forced masses, a cubic spring and a mass that depends on q: M = diag(1, 1 + b x1^2)."""
+import sympy as sp
+
+from mechgen import Model, Param
+
+model = Model("user_orbit_two_dof", doc=__doc__)
+model.params(Param("c", 0.1), Param("k3", 0.3), Param("b", 0.2), Param("F", 1.0), Param("w", 0.8))
+model.coordinates("x1", "x2")
+
+
+@model.kinetic
+def kinetic(q, v, p):
+    return v.x1**2 / 2 + (1 + p.b * q.x1**2) * v.x2**2 / 2
+
+
+@model.potential
+def potential(q, p):
+    return q.x1**2 / 2 + (q.x2 - q.x1) ** 2 / 2 + p.k3 * q.x1**4 / 4
+
+
+@model.dissipation
+def dissipation(v, p):
+    return p.c * (v.x1**2 + v.x2**2) / 2
+
+
+@model.forces
+def forces(p, t):
+    return {"x1": p.F * sp.cos(p.w * t)}
+'''
+
+
+@pytest.fixture(scope="module")
+def two_dof(folder):
+    (folder / "two_dof.py").write_text(TWO_DOF)
+    return mechgen.compile(str(folder / "two_dof.py"))
+
+
+def central_jacobian(fun, u, h=1e-6):
+    """dR/du by central differences (step h: error ~h^2 R''' + eps R / h ~ 1e-10 here)."""
+    cols = []
+    for j in range(u.size):
+        e = np.zeros(u.size)
+        e[j] = h
+        cols.append((fun(u + e) - fun(u - e)) / (2 * h))
+    return np.array(cols).T
+
+
+def test_harmonic_balance_jacobian_is_the_derivative_of_its_residual(two_dof, vdp):
+    """The assembled Galerkin Jacobian (two coordinates, a mass that depends on q; and the autonomous one with its
+    frequency column and phase row) against central differences of the residual at a random point (1e-7)."""
+    from mechgen.runtime.periodic.fourier import basis
+    from mechgen.runtime.periodic.harmonic_balance import HarmonicBalance
+
+    rng = np.random.default_rng(7)
+    for system, omega in ((two_dof, 0.8), (vdp, None)):
+        problem = HarmonicBalance(system, basis(4), omega, 0)
+        u = 0.5 * rng.standard_normal(9 * system.n + (omega is None))
+        if omega is None:
+            u[-1] = 0.9
+        R, J = problem.residual_jacobian(u)
+        np.testing.assert_allclose(J, central_jacobian(problem.residual, u), rtol=0, atol=1e-7)
+
+
+def test_two_coordinates_and_a_configuration_dependent_mass(two_dof):
+    """Both methods on a two-mass forced orbit with M(q): shooting against scipy's shooting of the hand-written
+    equations (1e-8); harmonic balance (H = 15) against shooting within 10 times its first left-out harmonic (from
+    the reference's FFT); the multipliers' product against Liouville, exp(int trace J dt), trace J = -c (1/M11 +
+    1/M22) integrated by scipy beside the state (1e-8)."""
+    c, k3, b, F, w = 0.1, 0.3, 0.2, 1.0, 0.8
+    T = 2 * math.pi / w
+
+    def rhs(t, y):
+        x1, x2, v1, v2, _ = y
+        m2 = 1 + b * x1**2
+        a1 = F * math.cos(w * t) - c * v1 - x1 + (x2 - x1) - k3 * x1**3 + b * x1 * v2**2
+        a2 = (-c * v2 - (x2 - x1) - 2 * b * x1 * v1 * v2) / m2
+        return [v1, v2, a1, a2, -c * (1 + 1 / m2)]
+
+    def end(x):
+        return si.solve_ivp(rhs, (0, T), [*x, 0.0], method="DOP853", rtol=1e-13, atol=1e-14).y[:, -1]
+
+    x0 = so.fsolve(lambda x: end(x)[:4] - x, [0.5, 0.5, 0.0, 0.0], xtol=1e-13)
+    liouville = math.exp(end(x0)[4])
+    shot = mechgen.periodic_orbit(two_dof, frequency="w", method="shooting", q0={"x1": 0.5, "x2": 0.5})
+    got = [shot["trajectory"][k][0] for k in ("x1", "x2", "x1_dot", "x2_dot")]
+    np.testing.assert_allclose(got, x0, rtol=0, atol=1e-8)
+    mu = np.array([complex(*m) for m in shot["multipliers"]])
+    assert np.prod(mu).real == pytest.approx(liouville, rel=1e-8)
+    N = 256
+    ref = si.solve_ivp(rhs, (0, T), [*x0, 0.0], method="DOP853", rtol=1e-13, atol=1e-14,
+                       t_eval=T * np.arange(N) / N).y
+    truncation = 10 * max(math.hypot(*(c[16] for c in fft_harmonics(ref[i]))) for i in range(2))
+    assert truncation < 1e-5
+    hb = mechgen.periodic_orbit(two_dof, frequency="w", harmonics=15, q0={"x1": 0.5, "x2": 0.5})
+    for k in ("x1", "x2"):
+        np.testing.assert_allclose(hb["trajectory"][k], shot["trajectory"][k], rtol=0, atol=truncation + 1e-8)
