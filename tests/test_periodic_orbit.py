@@ -416,3 +416,35 @@ def test_two_coordinates_and_a_configuration_dependent_mass(two_dof):
     hb = mechgen.periodic_orbit(two_dof, frequency="w", harmonics=15, q0={"x1": 0.5, "x2": 0.5})
     for k in ("x1", "x2"):
         np.testing.assert_allclose(hb["trajectory"][k], shot["trajectory"][k], rtol=0, atol=truncation + 1e-8)
+
+
+def test_the_continuation_interface_derivatives(duffing):
+    """What a continuation of orbits builds on (mechgen.runtime.periodic): dR/dF of harmonic balance is exactly
+    -1 on the first cosine coefficient and 0 elsewhere (r = x'' + ... - F cos(w t)), to the central differences'
+    rounding (1e-9); shooting's dR/domega at fixed parameters against central differences of its residual in omega
+    (1e-6: differences of a flow integrated at rtol 1e-11 with step 1e-4)."""
+    from mechgen.runtime.periodic.fourier import basis
+    from mechgen.runtime.periodic.harmonic_balance import HarmonicBalance
+    from mechgen.runtime.periodic.parameters import parameter_derivative
+    from mechgen.runtime.periodic.shooting import Shooting
+
+    u = np.array([0.1, 1.3, 0.0, 0.02, 0.5, 0.0, 0.01])
+    dF = parameter_derivative(lambda s: HarmonicBalance(s, basis(3), 1.2), duffing, u, "F")
+    expected = np.zeros(7)
+    expected[1] = -1.0
+    np.testing.assert_allclose(dF, expected, rtol=0, atol=1e-9)
+    x0 = np.array([1.3, 0.5])
+    shooting = Shooting(duffing, 1.2, 0, 1e-13, 1e-14)
+    h = 1e-4
+    differences = (Shooting(duffing, 1.2 + h, 0, 1e-13, 1e-14).residual_jacobian(x0)[0]
+                   - Shooting(duffing, 1.2 - h, 0, 1e-13, 1e-14).residual_jacobian(x0)[0]) / (2 * h)
+    np.testing.assert_allclose(shooting.frequency_derivative(x0), differences, rtol=0, atol=1e-6)
+
+
+def test_frequency_as_a_parameter_expression(duffing):
+    """``frequency = "w"`` is the parameter's value: the same orbit as the number 1.2."""
+    by_name = mechgen.periodic_orbit(duffing, frequency="w", harmonics=5, q0={"x": 1.3})
+    by_value = mechgen.periodic_orbit(duffing, frequency=1.2, harmonics=5, q0={"x": 1.3})
+    assert by_name["period"] == by_value["period"] == 2 * math.pi / 1.2
+    for part in ("cos", "sin"):
+        np.testing.assert_array_equal(by_name["harmonics"]["x"][part], by_value["harmonics"]["x"][part])
