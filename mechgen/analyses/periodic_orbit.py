@@ -83,7 +83,7 @@ MAX_HARMONICS = 1000
 
 
 def harmonics_count(ctx, key: str, value: object) -> int:
-    """An integer from 1 to MAX_HARMONICS."""
+    """An integer from 1 to 1000 (a guard against typos)."""
     H = schema.int_at_least(ctx, key, value, 1)
     if H > MAX_HARMONICS:
         raise fail(ctx.file, key, f"harmonics {H} is above {MAX_HARMONICS}", f"an integer from 1 to {MAX_HARMONICS}")
