@@ -302,13 +302,13 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
            "im] pairs, by decreasing modulus."),
         _o("stability", "string", "-", "``stable`` (every multiplier \\|mu\\| <= 1 + 1e-6, an autonomous "
            "orbit's trivial one set aside) or ``unstable``."),
-        _o("method", "string", "-", "``harmonic_balance`` or ``shooting``: the method that ran."),
-        _o("residual", "scalar", "force units (harmonic balance) or the state's (shooting)", "\\|\\|R\\|\\|_inf "
-           "at the solution."),
+        _o("method", "string", "-", "``harmonic_balance``, ``shooting`` or ``collocation``: the method that ran."),
+        _o("residual", "scalar", "force units (harmonic balance), the state's (shooting), mixed (collocation: "
+           "q's rate and force units)", "\\|\\|R\\|\\|_inf at the solution."),
         _o("iterations", "scalar (int)", "-", "Newton steps taken."),
         _o("loop", "string", "-", "``c``: shooting's integrations ran in the compiled DOP853 loop (the monodromy "
-           "for Newton by central differences of it); ``python``: in scipy's DOP853 (harmonic balance's "
-           "multipliers, and ``loop = \"python\"``)."),
+           "for Newton by central differences of it); ``python``: in scipy's DOP853 (harmonic balance's and "
+           "collocation's multipliers, and ``loop = \"python\"``)."),
     ),
     "cross_section": (
         _o("K", "(6, 6)", "N, N m, N m^2", "The section's stiffness ordered [K_uu, K_uw; K_wu, K_ww]."),

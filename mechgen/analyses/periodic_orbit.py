@@ -1,5 +1,5 @@
-"""``periodic_orbit``: a periodic orbit of a smooth lumped model, forced or autonomous, by harmonic balance or by
-shooting, with its Floquet multipliers and stability.
+"""``periodic_orbit``: a periodic orbit of a smooth lumped model, forced or autonomous, by harmonic balance,
+shooting or orthogonal collocation, with its Floquet multipliers and stability.
 
 *Forced* (``frequency`` given: the forcing's angular frequency omega, rad/s, a number or an expression of the
 parameters such as ``"omega"`` or ``"2*omega"``): the orbit of period T = 2 pi / omega, t = 0 the forcing's time
@@ -11,8 +11,8 @@ multiple of T within its last period; autonomous, its sample at the last maximum
 over the run's second half, with the time between the last two maxima as the period's guess (unless ``period`` is
 given).
 
-Methods (``method``; left out: ``harmonic_balance`` when ``harmonics`` is given, ``shooting`` otherwise; the output
-``method`` says which ran):
+Methods (``method``; left out: ``harmonic_balance`` when ``harmonics`` is given, ``collocation`` when ``mesh`` is,
+``shooting`` otherwise; the output ``method`` says which ran):
 
 * ``harmonic_balance``: each coordinate a Fourier series of H = ``harmonics`` harmonics (default 7); the residual
   r(q, v, a, t) of the model's generated kernel is evaluated in one batched call at N = 8 (H + 1) phases
@@ -28,7 +28,12 @@ Methods (``method``; left out: ``harmonic_balance`` when ``harmonics`` is given,
   cannot run) both come from the variational equations (the Jacobian from the generated ``tangent`` kernel) by
   scipy's DOP853. Autonomous: the period is an unknown and the phase condition is v_p(0) = 0 (the
   orbit starts at an extremum of q_p). Its error is the integrator's.
-* ``collocation`` is not available yet (an input error).
+* ``collocation``: orthogonal collocation (mechgen.runtime.periodic.collocation): ``mesh`` equal intervals
+  (default 40) of t / T, on each a polynomial of degree 4 in q and v collocated at the 4 Gauss points in the model's
+  implicit form dq/dtau = T v, r(q, v, (dv/dtau) / T, t) = 0 (the residual kernel at all points in one batched
+  call, the exact Jacobian from the tangent kernel; no mass matrix inverted). Autonomous: the period is an unknown
+  and the phase condition v_p(0) = 0, as shooting's. Its error falls as mesh^-8 at the mesh points (the order 2m
+  of Gauss collocation); the mesh is uniform (no adaptation yet).
 
 Newton stops after a step ||du||_inf <= ``atol`` + ``rtol`` ||u||_inf (u the unknowns), and raises a
 ConvergenceError after ``max_iterations`` steps, naming the residual. Stability comes from the monodromy matrix
@@ -43,7 +48,7 @@ to T, named as simulate's: each coordinate, ``<coordinate>_dot`` and the model's
 neighbours), ``harmonics`` (per coordinate: ``mean``, ``cos`` a_k and
 ``sin`` b_k, ``amplitude`` sqrt(a_k^2 + b_k^2) and ``phase`` atan2(-b_k, a_k), k = 1..H, so that
 q = mean + sum_k a_k cos(k omega t) + b_k sin(k omega t) = mean + sum_k amplitude_k cos(k omega t + phase_k); for
-shooting H = ``harmonics`` or 7, projected from 4096 samples of the orbit), ``multipliers`` ([re, im] pairs, by
+shooting and collocation H = ``harmonics`` or 7, projected from 4096 samples of the orbit), ``multipliers`` ([re, im] pairs, by
 decreasing modulus), ``stability``, ``method``, ``residual`` (||R||_inf at the solution: force units for harmonic
 balance, the state's for shooting), ``iterations`` and ``loop`` (``c``: shooting's integrations ran in the
 compiled loop; ``python``: in scipy's).
@@ -60,6 +65,7 @@ from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import ABSENT, Option
 from mechgen.errors import ConvergenceError, SceneError
 from mechgen.runtime.periodic import floquet, fourier
+from mechgen.runtime.periodic.collocation import Collocation
 from mechgen.runtime.periodic.flow import compiled_flow, states_at, variational_flow
 from mechgen.runtime.periodic.harmonic_balance import HarmonicBalance
 from mechgen.runtime.periodic.newton import NewtonSettings, newton
@@ -70,6 +76,8 @@ METHODS = ("harmonic_balance", "shooting", "collocation")
 LOOPS = ("auto", "python", "c")
 #: the harmonics of harmonic balance, and those reported by shooting, when ``harmonics`` is left out
 DEFAULT_HARMONICS = 7
+#: collocation's intervals when ``mesh`` is left out
+DEFAULT_MESH = 40
 #: phases at which amplitudes and a shooting orbit's harmonics are taken
 FINE = 4096
 #: shooting's Newton steps are at most this times (1 + ||u||_inf) (mechgen.runtime.periodic.newton: a full step from a
@@ -105,9 +113,21 @@ def earlier_simulate(ctx, key: str, value: object) -> str:
     return value
 
 
+#: the most collocation intervals (a guard against typos: the dense Jacobian has (8 mesh n)^2 entries)
+MAX_MESH = 2000
+
+
+def mesh_count(ctx, key: str, value: object) -> int:
+    """An integer from 2 to 2000 (a guard against typos)."""
+    count = schema.int_at_least(ctx, key, value, 2)
+    if count > MAX_MESH:
+        raise fail(ctx.file, key, f"mesh {count} is above {MAX_MESH}", f"an integer from 2 to {MAX_MESH}")
+    return count
+
+
 SCHEMA = {
-    "method": Option(schema.one_of("method", METHODS), ABSENT, doc="harmonic_balance or shooting (left out: "
-                     "harmonic_balance when harmonics is given, else shooting; collocation is not available yet)"),
+    "method": Option(schema.one_of("method", METHODS), ABSENT, doc="harmonic_balance, shooting or collocation "
+                     "(left out: harmonic_balance when harmonics is given, collocation when mesh is, else shooting)"),
     "frequency": Option(schema.positive, ABSENT, doc="the forcing's angular frequency omega (rad/s): a number or an "
                         "expression of parameters such as \"omega\"; the period is 2 pi / omega (left out: an "
                         "autonomous orbit, its period found)"),
@@ -115,6 +135,8 @@ SCHEMA = {
                      "model's time unit; required without frequency)"),
     "harmonics": Option(harmonics_count, ABSENT, doc="harmonic balance's number of harmonics H "
                         "(default 7); with shooting, how many harmonics are reported"),
+    "mesh": Option(mesh_count, ABSENT, doc="collocation's number of mesh intervals (default 40), each with a "
+                   "polynomial of degree 4 collocated at 4 Gauss points"),
     "q0": Option(schema.coordinate_table, {}, doc="the starting guess of the coordinates at t = 0, a table "
                  "coordinate = value (left out: zero, or the model's declared initial state)"),
     "v0": Option(schema.coordinate_table, {}, doc="the starting guess of the velocities at t = 0, a table "
@@ -136,7 +158,8 @@ SCHEMA = {
 
 
 def check(ctx, base: str, options: dict) -> None:
-    """A smooth lumped model; collocation refused; an autonomous orbit needs a period guess, a forced one none."""
+    """A smooth lumped model; not both harmonics and mesh without a method; an autonomous orbit needs a period guess,
+    a forced one none."""
     model = ctx.model
     why = ("has modes (a hybrid model)" if getattr(model, "modes", ()) else "is a continuum"
            if getattr(model, "continuum", False) else "is a chain" if getattr(model, "chain", None)
@@ -144,9 +167,9 @@ def check(ctx, base: str, options: dict) -> None:
     if why:
         raise fail(ctx.file, f"{base}.method", f"model {model.name} {why}: periodic_orbit's methods need a smooth "
                    "lumped model", "a smooth lumped model (a hybrid model's periodic response: kind periodic)")
-    if options.get("method") == "collocation":
-        raise fail(ctx.file, f"{base}.method", "method 'collocation' is not available yet",
-                   "harmonic_balance or shooting")
+    if "harmonics" in options and "mesh" in options and "method" not in options:
+        raise fail(ctx.file, f"{base}.method", "both harmonics (harmonic balance) and mesh (collocation) are given",
+                   "method = \"harmonic_balance\" or \"collocation\" beside them, or one of the two keys")
     if "frequency" in options and "period" in options:
         raise fail(ctx.file, f"{base}.period", "a forced orbit's period is 2 pi / frequency; period is the guess of "
                    "an autonomous one", "period or frequency, not both")
@@ -165,7 +188,9 @@ def needs(options: dict, *, internal: bool) -> set[str]:
 
 def chosen_method(options: dict) -> str:
     """The method that runs (module doc)."""
-    return options.get("method") or ("harmonic_balance" if "harmonics" in options else "shooting")
+    if options.get("method"):
+        return options["method"]
+    return "harmonic_balance" if "harmonics" in options else "collocation" if "mesh" in options else "shooting"
 
 
 def refuse_unsupported(system) -> None:
@@ -257,6 +282,25 @@ def solve_harmonic_balance(system, options: dict, x0: np.ndarray, omega, phase: 
     return {"U": U, "omega": w, "x0": start, "residual": sol.residual, "iterations": sol.iterations}
 
 
+def solve_collocation(system, options: dict, x0: np.ndarray, omega, phase: int) -> dict:
+    """Collocation from the guess (the first harmonic through x0, as harmonic balance's): {problem, u, x0, omega,
+    residual, iterations}."""
+    problem = Collocation(system, int(options.get("mesh", DEFAULT_MESH)), omega, phase)
+    w = float(omega if omega is not None else 2 * np.pi / options["period"])
+    n = system.n
+    theta = 2 * np.pi * np.arange(problem.nodes) / problem.nodes
+    start = x0.copy()
+    if problem.autonomous:
+        start[n + phase] = 0.0
+    q = np.outer(np.cos(theta), start[:n]) + np.outer(np.sin(theta), start[n:] / w)
+    v = w * (-np.outer(np.sin(theta), start[:n]) + np.outer(np.cos(theta), start[n:] / w))
+    sol = newton(problem.residual_jacobian, problem.unknowns(np.hstack([q, v]), 2 * np.pi / w),
+                 settings(options, "collocation"))
+    X, T = problem.split(sol.u)
+    return {"problem": problem, "u": sol.u, "x0": X[0].copy(), "omega": 2 * np.pi / T, "residual": sol.residual,
+            "iterations": sol.iterations}
+
+
 def compiled_run(system, options: dict):
     """The compiled flow (mechgen.runtime.periodic.flow.compiled_flow) that ``loop`` asks for, or None."""
     if options.get("loop", "auto") == "python":
@@ -293,6 +337,8 @@ def integrator_tolerances(options: dict) -> tuple[float, float]:
 
 def orbit_samples(system, options: dict, found: dict, method: str, times: np.ndarray) -> np.ndarray:
     """The states (rows) at ``times`` within [0, T]: the series of harmonic balance, the flow of shooting."""
+    if method == "collocation":
+        return found["problem"].states_at(found["u"], times)
     if method == "harmonic_balance":
         theta = found["omega"] * times
         q = fourier.evaluate(found["U"], theta)
@@ -321,7 +367,7 @@ def run_periodic_orbit(system, options: dict, context: dict) -> dict:
             raise SceneError("periodic_orbit: an autonomous orbit from a zero starting guess would find the "
                              "equilibrium", key="q0", expected="a starting guess on or near the orbit (q0, v0)")
     phase = int(np.argmax(np.abs(x0[:system.n]))) if phase is None else phase
-    solve = solve_harmonic_balance if method == "harmonic_balance" else solve_shooting
+    solve = {"harmonic_balance": solve_harmonic_balance, "collocation": solve_collocation}.get(method, solve_shooting)
     found = solve(system, options, x0, omega, phase)
     return report(system, options, found, method, autonomous=omega is None)
 
@@ -337,7 +383,7 @@ def report(system, options: dict, found: dict, method: str, *, autonomous: bool)
     if autonomous and np.max(np.ptp(fine[:, :n], axis=0)) <= 1e3 * float(options["atol"]):
         raise ConvergenceError(f"periodic_orbit ({method}): Newton converged to an equilibrium (the orbit's "
                                "coordinates do not vary); try a starting guess nearer the limit cycle (q0, v0, period)")
-    U = found["U"] if method == "harmonic_balance" else fourier.coefficients_of_samples(
+    U = found["U"] if method == "harmonic_balance" else fourier.coefficients_of_samples(  # shooting, collocation
         fine[:, :n], int(options.get("harmonics", DEFAULT_HARMONICS)))
     _, Phi = variational_flow(system, found["x0"], 0.0, T, *integrator_tolerances(options))
     mu = floquet.multipliers(Phi)
