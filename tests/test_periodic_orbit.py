@@ -469,3 +469,35 @@ def test_collocation_converges_at_order_eight(vdp, duffing):
     assert col["trajectory"]["x"][-1] == pytest.approx(x0[0], abs=1e-9)  # periodic: the last sample is t = T
     shot = mechgen.periodic_orbit(duffing, frequency="w", q0={"x": 1.3}, v0={"x": 0.5})
     np.testing.assert_allclose(col["multipliers"], shot["multipliers"], rtol=0, atol=1e-7)
+
+
+def test_three_coexisting_orbits_and_the_unstable_one(duffing):
+    """Above resonance (w = 1.4) the hardening Duffing oscillator has three orbits; started from the first-order
+    closed form's amplitude and phase (a1 = A cos phi, b1 = A sin phi from (1 - w^2 + 3/4 k3 A^2) A = F cos phi,
+    c w A = F sin phi), each method finds each orbit: the start state against scipy's shooting from the same guess
+    (1e-7: harmonic balance's H = 11 truncation, collocation's mesh-40 error and shooting's 1e-9 are below it), the
+    outer two stable and the middle one a saddle, its real multiplier > 1 against the eigenvalues of scipy's
+    monodromy by central differences (1e-6: step 1e-5)."""
+    c, k3, F, w = 0.05, 0.5, 0.3, 1.4
+    system = duffing.with_params(w=w)
+    roots = np.roots([(0.75 * k3) ** 2, 2 * (1 - w**2) * 0.75 * k3, (1 - w**2) ** 2 + (c * w) ** 2, -F**2])
+    amplitudes = sorted(math.sqrt(r.real) for r in roots if abs(r.imag) < 1e-12)
+    assert len(amplitudes) == 3
+    for A, verdict in zip(amplitudes, ("stable", "unstable", "stable")):
+        cos_phi, sin_phi = (1 - w**2 + 0.75 * k3 * A**2) * A / F, c * w * A / F
+        guess = [A * cos_phi, w * A * sin_phi]
+        x0, T, rhs = duffing_reference(c, k3, F, w, guess)
+        for method, extra in (("harmonic_balance", {"harmonics": 11}), ("shooting", {}), ("collocation", {})):
+            r = mechgen.periodic_orbit(system, frequency="w", method=method, q0={"x": guess[0]},
+                                       v0={"x": guess[1]}, **extra)
+            start = [r["trajectory"]["x"][0], r["trajectory"]["x_dot"][0]]
+            np.testing.assert_allclose(start, x0, rtol=0, atol=1e-7, err_msg=f"{method} at A = {A}")
+            assert r["stability"] == verdict, (method, A)
+        if verdict == "unstable":
+            h = 1e-5
+            Phi = np.array([(scipy_flow(rhs, x0 + e, T).y[:, -1] - scipy_flow(rhs, x0 - e, T).y[:, -1]) / (2 * h)
+                            for e in h * np.eye(2)]).T
+            expected = np.sort(np.linalg.eigvals(Phi).real)
+            mu = np.sort([m[0] for m in r["multipliers"]])
+            assert expected[1] > 1
+            np.testing.assert_allclose(mu, expected, rtol=0, atol=1e-6)
