@@ -387,8 +387,9 @@ def test_harmonic_balance_jacobian_is_the_derivative_of_its_residual(two_dof, vd
 def test_two_coordinates_and_a_configuration_dependent_mass(two_dof):
     """Both methods on a two-mass forced orbit with M(q): shooting against scipy's shooting of the hand-written
     equations (1e-8); harmonic balance (H = 15) against shooting within 10 times its first left-out harmonic (from
-    the reference's FFT); the multipliers' product against Liouville, exp(int trace J dt), trace J = -c (1/M11 +
-    1/M22) integrated by scipy beside the state (1e-8)."""
+    the reference's FFT) plus shooting's own 1e-8; the multipliers' product against Liouville, exp(int trace J dt):
+    trace J = -c (1 + 1/m2) - 2 b x1 v1 / m2 (m2 = 1 + b x1^2), whose last term is -d/dt ln(m2) and integrates to
+    zero over a period, so the first term is integrated by scipy beside the state (1e-8)."""
     c, k3, b, F, w = 0.1, 0.3, 0.2, 1.0, 0.8
     T = 2 * math.pi / w
 

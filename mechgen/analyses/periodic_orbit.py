@@ -64,6 +64,7 @@ from mechgen.analyses import schema, summary, time_series
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import ABSENT, Option
 from mechgen.errors import ConvergenceError, SceneError
+from mechgen.runtime.core.memory import dense_bytes, require
 from mechgen.runtime.periodic import floquet, fourier
 from mechgen.runtime.periodic.collocation import Collocation
 from mechgen.runtime.periodic.flow import compiled_flow, states_at, variational_flow
@@ -269,6 +270,9 @@ def settings(options: dict, method: str) -> NewtonSettings:
 def solve_harmonic_balance(system, options: dict, x0: np.ndarray, omega, phase: int) -> dict:
     """Harmonic balance from the guess: {U, omega, x0 (the state at t = 0), residual, iterations}."""
     H = int(options.get("harmonics", DEFAULT_HARMONICS))
+    size = (2 * H + 1) * system.n
+    require(dense_bytes(size, size) + dense_bytes(fourier.sample_count(H), size, system.n), f"harmonic balance's "
+            f"dense {size} x {size} Jacobian (H = {H}, {system.n} coordinates)", key="harmonics")
     problem = HarmonicBalance(system, fourier.basis(H), omega, phase)
     w = float(omega if omega is not None else 2 * np.pi / options["period"])
     n = system.n
@@ -286,6 +290,8 @@ def solve_collocation(system, options: dict, x0: np.ndarray, omega, phase: int) 
     """Collocation from the guess (the first harmonic through x0, as harmonic balance's): {problem, u, x0, omega,
     residual, iterations}."""
     problem = Collocation(system, int(options.get("mesh", DEFAULT_MESH)), omega, phase)
+    size = problem.nodes * 2 * system.n + 1
+    require(dense_bytes(size, size), f"collocation's dense {size} x {size} Jacobian", key="mesh")
     w = float(omega if omega is not None else 2 * np.pi / options["period"])
     n = system.n
     theta = 2 * np.pi * np.arange(problem.nodes) / problem.nodes
