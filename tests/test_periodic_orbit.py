@@ -502,3 +502,35 @@ def test_three_coexisting_orbits_and_the_unstable_one(duffing):
             mu = np.sort([m[0] for m in r["multipliers"]])
             assert expected[1] > 1
             np.testing.assert_allclose(mu, expected, rtol=0, atol=1e-6)
+
+
+SCENE = """model = "van_der_pol"
+[params]
+mu = 1.0
+[[analysis]]
+name = "cycle"
+kind = "periodic_orbit"
+{body}
+"""
+
+
+@pytest.mark.parametrize("body, code, words", [
+    ('period = -1.0\nq0 = { x = 2.0 }', 2, ["analysis[1].period", "not positive"]),
+    ('period = 6.5\nq0 = { x = 2.0 }\nharmonics = 0', 2, ["analysis[1].harmonics", "below 1"]),
+    ('period = 6.5\nq0 = { x = 2.0 }\nmethod = "spline"', 2, ["analysis[1].method", "harmonic_balance"]),
+    ('period = 6.5\nq0 = { x = 20.0 }\nharmonics = 5\nmax_iterations = 1', 1, ["residual", "try"]),
+    ('period = 6.5\nq0 = { x = 2.0 }\nmesh = 20', 0, []),
+])
+def test_the_command_line_exit_codes(body, code, words, tmp_path, capsys):
+    """A scene's mistakes exit 2 naming the file and the key; a starting guess that does not converge exits 1
+    naming the residual and what to try; a good one runs."""
+    from mechgen.cli import main
+
+    path = tmp_path / "orbit.toml"
+    path.write_text(SCENE.format(body=body))
+    assert main(["run", str(path)]) == code
+    err = capsys.readouterr().err
+    for word in words:
+        assert word in err, err
+    if code == 2:
+        assert str(path) in err or "orbit.toml" in err
