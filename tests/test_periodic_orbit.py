@@ -534,3 +534,20 @@ def test_the_command_line_exit_codes(body, code, words, tmp_path, capsys):
         assert word in err, err
     if code == 2:
         assert str(path) in err or "orbit.toml" in err
+
+
+def test_multiple_shooting_on_an_unstable_cycle_and_a_forced_orbit(vdp, duffing):
+    """mu = -1 reverses time: the van der Pol cycle becomes unstable, same period, its non-trivial multiplier the
+    reciprocal of mu = +1's (about 1163), exp(-int (1 - x^2) dt) from scipy's reference at mu = 1 (1e-6 relative:
+    the multiplier's sensitivity is ~1e3 times the integrations' 1e-11). Multiple shooting (8 segments, in both loops)
+    and single shooting agree; a forced orbit by 3 segments matches scipy's start state (1e-8)."""
+    _, T, decay = vdp_reference(1.0, 2.0, 6.6)
+    unstable = vdp.with_params(mu=-1.0)
+    for segments, loop in ((1, "auto"), (8, "auto"), (8, "python")):
+        r = mechgen.periodic_orbit(unstable, period=6.5, q0={"x": 2.0}, segments=segments, loop=loop)
+        assert r["period"] == pytest.approx(T, abs=1e-9)
+        assert r["stability"] == "unstable"
+        assert nontrivial(r)[0].real == pytest.approx(1 / decay, rel=1e-6)
+    x0, _, _ = duffing_reference(0.05, 0.5, 0.3, 1.2, [1.3, 0.5])
+    r = mechgen.periodic_orbit(duffing, frequency="w", q0={"x": 1.3}, v0={"x": 0.5}, segments=3)
+    np.testing.assert_allclose([r["trajectory"]["x"][0], r["trajectory"]["x_dot"][0]], x0, rtol=0, atol=1e-8)

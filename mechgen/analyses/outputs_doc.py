@@ -307,7 +307,8 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
            "q's rate and force units)", "\\|\\|R\\|\\|_inf at the solution."),
         _o("iterations", "scalar (int)", "-", "Newton steps taken."),
         _o("loop", "string", "-", "``c``: shooting's integrations ran in the compiled DOP853 loop (the monodromy "
-           "for Newton by central differences of it); ``python``: in scipy's DOP853 (harmonic balance's and "
+           "for Newton by central differences of it; a forced orbit's later segments, with ``segments`` > 1, in "
+           "scipy's); ``python``: in scipy's DOP853 (harmonic balance's and "
            "collocation's multipliers, and ``loop = \"python\"``)."),
     ),
     "cross_section": (

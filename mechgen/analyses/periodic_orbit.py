@@ -22,7 +22,8 @@ Methods (``method``; left out: ``harmonic_balance`` when ``harmonics`` is given,
   coordinate p with the largest |q0|). Its error is the truncation of the series (it falls fast with H for a smooth
   orbit).
 * ``shooting``: Newton on x(T) - x(0) = 0 (mechgen.runtime.periodic.shooting, .flow: DOP853 at 1/100 of ``rtol``
-  and ``atol``). With ``loop = "auto"`` (the default) on the C backend, x(T) comes from the compiled DOP853 loop
+  and ``atol``); with ``segments`` S > 1, multiple shooting: the period split into S segments, each from its own
+  unknown start state (on the first harmonic through the guess to begin with), for unstable or stiff orbits. With ``loop = "auto"`` (the default) on the C backend, x(T) comes from the compiled DOP853 loop
   (mechgen.runtime.integration.smooth_c) and Newton's Jacobian, the monodromy matrix, from central differences of
   it (4n + 1 compiled runs, about 1e-10 from the exact one); with ``loop = "python"`` (or where the compiled loop
   cannot run) both come from the variational equations (the Jacobian from the generated ``tangent`` kernel) by
@@ -145,6 +146,8 @@ SCHEMA = {
     "from": Option(earlier_simulate, ABSENT, doc="an earlier simulate analysis (with its trajectory) whose "
                    "motion near its end is the starting guess instead of q0 / v0 (and, for an autonomous orbit, the "
                    "period between its last two maxima the period's)"),
+    "segments": Option(schema.count, 1, doc="shooting's number of segments S of the period (1: single shooting; more: "
+                       "multiple shooting, for unstable or stiff orbits)"),
     "rtol": Option(schema.positive, 1e-9, doc="Newton's relative tolerance on the unknowns (shooting integrates "
                    "at 1/100 of it)"),
     "atol": Option(schema.positive, 1e-12, doc="Newton's absolute tolerance on the unknowns (the coordinates' "
@@ -294,13 +297,11 @@ def solve_collocation(system, options: dict, x0: np.ndarray, omega, phase: int) 
     require(dense_bytes(size, size), f"collocation's dense {size} x {size} Jacobian", key="mesh")
     w = float(omega if omega is not None else 2 * np.pi / options["period"])
     n = system.n
-    theta = 2 * np.pi * np.arange(problem.nodes) / problem.nodes
     start = x0.copy()
     if problem.autonomous:
         start[n + phase] = 0.0
-    q = np.outer(np.cos(theta), start[:n]) + np.outer(np.sin(theta), start[n:] / w)
-    v = w * (-np.outer(np.sin(theta), start[:n]) + np.outer(np.cos(theta), start[n:] / w))
-    sol = newton(problem.residual_jacobian, problem.unknowns(np.hstack([q, v]), 2 * np.pi / w),
+    times = 2 * np.pi / w * np.arange(problem.nodes) / problem.nodes
+    sol = newton(problem.residual_jacobian, problem.unknowns(first_harmonic_states(start, w, times, n), 2 * np.pi / w),
                  settings(options, "collocation"))
     X, T = problem.split(sol.u)
     return {"problem": problem, "u": sol.u, "x0": X[0].copy(), "omega": 2 * np.pi / T, "residual": sol.residual,
@@ -321,18 +322,30 @@ def compiled_run(system, options: dict):
     return run
 
 
+def first_harmonic_states(x0: np.ndarray, omega: float, times: np.ndarray, n: int) -> np.ndarray:
+    """The states (rows) at ``times`` of q = q0 cos(omega t) + (v0 / omega) sin(omega t): the first harmonic through
+    the guess x0 = (q0, v0), the starting guess of harmonic balance, collocation and multiple shooting."""
+    c, s = np.cos(omega * times)[:, None], np.sin(omega * times)[:, None]
+    q0, b = x0[None, :n], x0[None, n:] / omega
+    return np.hstack([q0 * c + b * s, omega * (b * c - q0 * s)])
+
+
 def solve_shooting(system, options: dict, x0: np.ndarray, omega, phase: int) -> dict:
-    """Shooting from the guess: {x0, omega, residual, iterations, loop}."""
+    """Shooting from the guess (``segments`` S > 1: the segments' starts on the first harmonic through it): {x0,
+    omega, residual, iterations, run}."""
     rtol, atol = integrator_tolerances(options)
     run = compiled_run(system, options)
-    problem = Shooting(system, omega, phase, rtol, atol, run)
+    S = int(options.get("segments", 1))
+    problem = Shooting(system, omega, phase, rtol, atol, run, S)
+    x0 = x0.copy()
     if problem.autonomous:
-        x0 = x0.copy()
         x0[system.n + phase] = 0.0
     period = float(options["period"]) if omega is None else 2 * np.pi / omega
-    sol = newton(problem.residual_jacobian, problem.unknowns(x0, period), settings(options, "shooting"))
-    start, T = problem.split(sol.u)
-    return {"x0": np.asarray(start, float), "omega": 2 * np.pi / T, "residual": sol.residual,
+    X = first_harmonic_states(x0, 2 * np.pi / period, period * np.arange(S) / S, system.n)
+    X[0] = x0
+    sol = newton(problem.residual_jacobian, problem.unknowns(X, period), settings(options, "shooting"))
+    starts, T = problem.split(sol.u)
+    return {"x0": np.asarray(starts[0], float), "omega": 2 * np.pi / T, "residual": sol.residual,
             "iterations": sol.iterations, "run": run}
 
 
