@@ -551,3 +551,12 @@ def test_multiple_shooting_on_an_unstable_cycle_and_a_forced_orbit(vdp, duffing)
     x0, _, _ = duffing_reference(0.05, 0.5, 0.3, 1.2, [1.3, 0.5])
     r = mechgen.periodic_orbit(duffing, frequency="w", q0={"x": 1.3}, v0={"x": 0.5}, segments=3)
     np.testing.assert_allclose([r["trajectory"]["x"][0], r["trajectory"]["x_dot"][0]], x0, rtol=0, atol=1e-8)
+
+
+@pytest.mark.parametrize("name, what", [("fpu_chain", "a chain"), ("euler_bernoulli_beam", "a continuum"),
+                                        ("rate_state_slider", "internal variables")])
+def test_models_outside_the_methods_assumptions_are_refused(name, what):
+    """A chain, a continuum and a model with internal variables: exit 2 at ``method``, saying which."""
+    with pytest.raises(InputError) as err:
+        mechgen.periodic_orbit(mechgen.compile(name), frequency=1.0)
+    assert err.value.key.endswith("method") and what in str(err.value)
