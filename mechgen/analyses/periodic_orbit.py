@@ -6,9 +6,11 @@ parameters such as ``"omega"`` or ``"2*omega"``): the orbit of period T = 2 pi /
 origin. *Autonomous* (``frequency`` left out): a limit cycle, whose period is an unknown found beside the orbit,
 from the starting guess ``period``; a phase condition fixes where t = 0 lies on it (below). Either way the
 starting guess is ``q0`` / ``v0`` (tables of coordinates, the state at t = 0; left out: zero, or the model's
-declared initial state), or ``from`` an earlier ``simulate`` that kept its trajectory: forced, its sample nearest a
-multiple of T within its last period; autonomous, its sample at the last maximum of the coordinate that varies most
-over the run's second half, with the time between the last two maxima as the period's guess (unless ``period`` is
+declared initial state; each method starts from the first harmonic through them), or ``from`` an earlier
+``simulate`` that kept its trajectory: its motion over one period (a cubic spline through its samples) starts each
+method (harmonic balance its projection, collocation its values at the nodes, shooting its states at the segments'
+starts): forced, its last whole period [m T, (m + 1) T]; autonomous, from the second-to-last to the last maximum of
+the coordinate that varies most over the run's second half, their distance the period's guess (unless ``period`` is
 given).
 
 Methods (``method``; left out: ``harmonic_balance`` when ``harmonics`` is given, ``collocation`` when ``mesh`` is,
@@ -34,7 +36,9 @@ Methods (``method``; left out: ``harmonic_balance`` when ``harmonics`` is given,
   implicit form dq/dtau = T v, r(q, v, (dv/dtau) / T, t) = 0 (the residual kernel at all points in one batched
   call, the exact Jacobian from the tangent kernel; no mass matrix inverted). Autonomous: the period is an unknown
   and the phase condition v_p(0) = 0, as shooting's. Its error falls as mesh^-8 at the mesh points (the order 2m
-  of Gauss collocation); the mesh is uniform (no adaptation yet).
+  of Gauss collocation). With ``adapt`` = k > 0 the mesh is adapted k times after the uniform solve: its intervals
+  moved so that each holds an equal share of the monitor |x^(5)|^(1/5) (AUTO's rule: small intervals where the orbit
+  turns fast), the orbit interpolated onto them and solved again.
 
 Newton stops after a step ||du||_inf <= ``atol`` + ``rtol`` ||u||_inf (u the unknowns), and raises a
 ConvergenceError after ``max_iterations`` steps, naming the residual. Stability comes from the monodromy matrix
@@ -58,6 +62,9 @@ Only smooth lumped models without internal variables: a hybrid model, a continuu
 variables is refused (key ``method``).
 """
 from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -127,6 +134,14 @@ def mesh_count(ctx, key: str, value: object) -> int:
     return count
 
 
+def adapt_count(ctx, key: str, value: object) -> int:
+    """An integer from 0 to 10."""
+    count = schema.int_at_least(ctx, key, value, 0)
+    if count > 10:
+        raise fail(ctx.file, key, f"adapt {count} is above 10", "an integer from 0 to 10")
+    return count
+
+
 SCHEMA = {
     "method": Option(schema.one_of("method", METHODS), ABSENT, doc="harmonic_balance, shooting or collocation "
                      "(left out: harmonic_balance when harmonics is given, collocation when mesh is, else shooting)"),
@@ -139,6 +154,10 @@ SCHEMA = {
                         "(default 7); with shooting, how many harmonics are reported"),
     "mesh": Option(mesh_count, ABSENT, doc="collocation's number of mesh intervals (default 40), each with a "
                    "polynomial of degree 4 collocated at 4 Gauss points"),
+    "adapt": Option(adapt_count, 0,
+                    doc="collocation's mesh adaptations: after each solve the intervals are moved so that each holds "
+                    "an equal share of |x^(5)|^(1/5) (AUTO's monitor) and the orbit is solved again (0: the uniform "
+                    "mesh)"),
     "q0": Option(schema.coordinate_table, {}, doc="the starting guess of the coordinates at t = 0, a table "
                  "coordinate = value (left out: zero, or the model's declared initial state)"),
     "v0": Option(schema.coordinate_table, {}, doc="the starting guess of the velocities at t = 0, a table "
@@ -218,12 +237,35 @@ def refuse_time_dependent(system, x: np.ndarray) -> None:
                          expected="the forcing's angular frequency (rad/s), a number or a parameter expression")
 
 
-def guess(system, options: dict) -> np.ndarray:
-    """x0 = (q0, v0): the tables over the declared initial state (zero when none)."""
+@dataclass(frozen=True)
+class Guess:
+    """A starting guess: the state ``x0`` at t = 0, the ``period``, the ``phase`` coordinate p of an autonomous
+    orbit's phase condition, and ``curve``: times in [0, period] -> the guessed states there (rows)."""
+
+    x0: np.ndarray
+    period: float
+    phase: int
+    curve: Callable[[np.ndarray], np.ndarray]
+
+
+def first_harmonic_states(x0: np.ndarray, omega: float, times: np.ndarray, n: int) -> np.ndarray:
+    """The states (rows) at ``times`` of q = q0 cos(omega t) + (v0 / omega) sin(omega t): the first harmonic through
+    the guess x0 = (q0, v0)."""
+    c, s = np.cos(omega * times)[:, None], np.sin(omega * times)[:, None]
+    q0, b = x0[None, :n], x0[None, n:] / omega
+    return np.hstack([q0 * c + b * s, omega * (b * c - q0 * s)])
+
+
+def guess(system, options: dict, omega) -> Guess:
+    """The guess of ``q0`` / ``v0`` (tables over the declared initial state, zero when none): the first harmonic
+    through them, of the forcing's period or the guessed one; p the coordinate with the largest |q0|."""
     from mechgen.analyses.simulate import initial_state
 
     q0, v0 = initial_state(system, options)
-    return np.concatenate([q0, v0])
+    x0 = np.concatenate([q0, v0])
+    period = 2 * np.pi / omega if omega is not None else float(options["period"])
+    w, n = 2 * np.pi / period, system.n
+    return Guess(x0, period, int(np.argmax(np.abs(q0))), lambda times: first_harmonic_states(x0, w, times, n))
 
 
 def simulated_states(system, options: dict, context: dict) -> tuple[np.ndarray, np.ndarray]:
@@ -232,33 +274,42 @@ def simulated_states(system, options: dict, context: dict) -> tuple[np.ndarray, 
     earlier = context.get(name, {})
     trajectory = earlier.get("trajectory")
     names = time_series.state_names(system)[:2 * system.n]
-    if not trajectory or any(k not in trajectory for k in names) or len(earlier.get("t", ())) < 3:
+    if not trajectory or any(k not in trajectory for k in names) or len(earlier.get("t", ())) < 4:
         raise SceneError(f"periodic_orbit: simulate analysis '{name}' kept no trajectory to start from", key="from",
-                         expected="a simulate analysis with series = true (and at least 3 samples)")
+                         expected="a simulate analysis with series = true (and at least 4 samples)")
     return np.asarray(earlier["t"], float), np.column_stack([trajectory[k] for k in names]).astype(float)
 
 
-def guess_from_simulate(system, options: dict, context: dict, omega) -> tuple[np.ndarray, float | None, int | None]:
-    """(x0, period guess or None, phase coordinate or None) from the ``from`` simulate: forced, the sample whose time is nearest a multiple of
-    T = 2 pi / omega among the last period's; autonomous, the sample at the last maximum of the coordinate that
-    varies most over the run's second half, and the time between its last two maxima."""
+def too_short(options: dict, what: str) -> SceneError:
+    """The ``from`` simulate does not hold what its guess needs."""
+    return SceneError(f"periodic_orbit: simulate analysis '{options['from']}' {what}", key="from",
+                      expected="a simulate run over at least two periods of the orbit (a longer t_end)")
+
+
+def guess_from_simulate(system, options: dict, context: dict, omega) -> Guess:
+    """The guess of the ``from`` simulate: its motion over one period, by a cubic spline through its samples.
+    Forced: the last whole period [m T, (m + 1) T] within the run (T = 2 pi / omega). Autonomous: from its
+    second-to-last maximum of the coordinate p that varies most over the run's second half to its last, whose
+    distance is the period's guess (unless ``period`` is given)."""
+    from scipy.interpolate import CubicSpline
+
     t, X = simulated_states(system, options, context)
+    spline = CubicSpline(t, X, axis=0)
     if omega is not None:
         T = 2 * np.pi / omega
-        last = t >= t[-1] - T
-        phase = np.abs(((t + T / 2) % T) - T / 2)
-        k = int(np.flatnonzero(last)[np.argmin(phase[last])])
-        return X[k], None, None
+        start = (np.floor((t[-1] + 1e-9 * T) / T) - 1) * T
+        if start < t[0]:
+            raise too_short(options, f"ends at t = {t[-1]:.6g}, before a whole period T = {T:.6g} of the forcing")
+        return Guess(spline(start), T, 0, lambda times: spline(start + np.asarray(times)))
     half = t >= (t[0] + t[-1]) / 2
     p = int(np.argmax(np.ptp(X[half, :system.n], axis=0)))
     q = X[:, p]
     peaks = np.flatnonzero((q[1:-1] >= q[:-2]) & (q[1:-1] > q[2:])) + 1
     if peaks.size < 2:
-        raise SceneError(f"periodic_orbit: simulate analysis '{options['from']}' shows fewer than two maxima of "
-                         f"'{system.coordinates[p]}' (no oscillation to start from)", key="from",
-                         expected="a simulate run over at least two periods of the orbit (a longer t_end)")
-    x0 = X[peaks[-1]].copy()
-    return x0, float(t[peaks[-1]] - t[peaks[-2]]), p
+        raise too_short(options, f"shows fewer than two maxima of '{system.coordinates[p]}'")
+    start = t[peaks[-2]]
+    period = float(options.get("period", t[peaks[-1]] - start))
+    return Guess(spline(start), period, p, lambda times: spline(start + np.asarray(times)))
 
 
 def settings(options: dict, method: str) -> NewtonSettings:
@@ -270,40 +321,47 @@ def settings(options: dict, method: str) -> NewtonSettings:
                           advice=advice, trust=SHOOTING_TRUST if method == "shooting" else np.inf)
 
 
-def solve_harmonic_balance(system, options: dict, x0: np.ndarray, omega, phase: int) -> dict:
-    """Harmonic balance from the guess: {U, omega, x0 (the state at t = 0), residual, iterations}."""
+def solve_harmonic_balance(system, options: dict, start: Guess, omega) -> dict:
+    """Harmonic balance from the guess (its curve projected onto the harmonics): {U, omega, x0 (the state at t = 0), residual, iterations}."""
     H = int(options.get("harmonics", DEFAULT_HARMONICS))
     size = (2 * H + 1) * system.n
     require(dense_bytes(size, size) + dense_bytes(fourier.sample_count(H), size, system.n), f"harmonic balance's "
             f"dense {size} x {size} Jacobian (H = {H}, {system.n} coordinates)", key="harmonics")
-    problem = HarmonicBalance(system, fourier.basis(H), omega, phase)
-    w = float(omega if omega is not None else 2 * np.pi / options["period"])
-    n = system.n
-    U = np.zeros((2 * H + 1, n))
-    U[1], U[H + 1] = x0[:n], x0[n:] / w
+    problem = HarmonicBalance(system, fourier.basis(H), omega, start.phase)
+    w = 2 * np.pi / start.period
+    n, N = system.n, problem.basis.theta.size
+    U = fourier.coefficients_of_samples(start.curve(start.period * np.arange(N) / N)[:, :n], H)
     if problem.autonomous:
-        U[H + 1, phase] = 0.0
+        U[H + 1, start.phase] = 0.0
     sol = newton(problem.residual_jacobian, problem.unknowns(U, w), settings(options, "harmonic_balance"))
-    U, w = problem.split(sol.u)
-    start, _ = problem.start_state(sol.u)
-    return {"U": U, "omega": w, "x0": start, "residual": sol.residual, "iterations": sol.iterations}
+    u = sol.u.copy()
+    if problem.autonomous and u[-1] < 0:  # the same orbit with omega -> -omega and b_k -> -b_k (no t in r)
+        u[(H + 1) * n:-1] *= -1
+        u[-1] = -u[-1]
+    U, w = problem.split(u)
+    if not w > 0:
+        raise ConvergenceError("periodic_orbit (harmonic_balance): Newton converged to frequency 0 (an "
+                               "equilibrium); try a starting guess nearer the limit cycle (q0, v0, period)")
+    x0, _ = problem.start_state(u)
+    return {"U": U, "omega": w, "x0": x0, "residual": sol.residual, "iterations": sol.iterations}
 
 
-def solve_collocation(system, options: dict, x0: np.ndarray, omega, phase: int) -> dict:
-    """Collocation from the guess (the first harmonic through x0, as harmonic balance's): {problem, u, x0, omega,
-    residual, iterations}."""
-    problem = Collocation(system, int(options.get("mesh", DEFAULT_MESH)), omega, phase)
+def solve_collocation(system, options: dict, start: Guess, omega) -> dict:
+    """Collocation from the guess (its curve at the nodes): {problem, u, x0, omega, residual, iterations}."""
+    problem = Collocation(system, int(options.get("mesh", DEFAULT_MESH)), omega, start.phase)
     size = problem.nodes * 2 * system.n + 1
     require(dense_bytes(size, size), f"collocation's dense {size} x {size} Jacobian", key="mesh")
-    w = float(omega if omega is not None else 2 * np.pi / options["period"])
-    n = system.n
-    start = x0.copy()
+    X = start.curve(start.period * np.arange(problem.nodes) / problem.nodes)
     if problem.autonomous:
-        start[n + phase] = 0.0
-    times = 2 * np.pi / w * np.arange(problem.nodes) / problem.nodes
-    sol = newton(problem.residual_jacobian, problem.unknowns(first_harmonic_states(start, w, times, n), 2 * np.pi / w),
-                 settings(options, "collocation"))
+        X[0, system.n + start.phase] = 0.0
+    sol = newton(problem.residual_jacobian, problem.unknowns(X, start.period), settings(options, "collocation"))
+    for _ in range(int(options.get("adapt", 0))):
+        problem, u = problem.adapted(sol.u)
+        sol = newton(problem.residual_jacobian, u, settings(options, "collocation"))
     X, T = problem.split(sol.u)
+    if not T > 0:
+        raise ConvergenceError(f"periodic_orbit (collocation): Newton converged to the period {T:.6g}; try a better "
+                               "starting guess (period, q0, v0, or from a simulate)")
     return {"problem": problem, "u": sol.u, "x0": X[0].copy(), "omega": 2 * np.pi / T, "residual": sol.residual,
             "iterations": sol.iterations}
 
@@ -322,28 +380,18 @@ def compiled_run(system, options: dict):
     return run
 
 
-def first_harmonic_states(x0: np.ndarray, omega: float, times: np.ndarray, n: int) -> np.ndarray:
-    """The states (rows) at ``times`` of q = q0 cos(omega t) + (v0 / omega) sin(omega t): the first harmonic through
-    the guess x0 = (q0, v0), the starting guess of harmonic balance, collocation and multiple shooting."""
-    c, s = np.cos(omega * times)[:, None], np.sin(omega * times)[:, None]
-    q0, b = x0[None, :n], x0[None, n:] / omega
-    return np.hstack([q0 * c + b * s, omega * (b * c - q0 * s)])
-
-
-def solve_shooting(system, options: dict, x0: np.ndarray, omega, phase: int) -> dict:
-    """Shooting from the guess (``segments`` S > 1: the segments' starts on the first harmonic through it): {x0,
-    omega, residual, iterations, run}."""
+def solve_shooting(system, options: dict, start: Guess, omega) -> dict:
+    """Shooting from the guess (``segments`` S > 1: the segments' starts on its curve): {x0, omega, residual,
+    iterations, run}."""
     rtol, atol = integrator_tolerances(options)
     run = compiled_run(system, options)
     S = int(options.get("segments", 1))
-    problem = Shooting(system, omega, phase, rtol, atol, run, S)
-    x0 = x0.copy()
+    problem = Shooting(system, omega, start.phase, rtol, atol, run, S)
+    X = start.curve(start.period * np.arange(S) / S)
+    X[0] = start.x0
     if problem.autonomous:
-        x0[system.n + phase] = 0.0
-    period = float(options["period"]) if omega is None else 2 * np.pi / omega
-    X = first_harmonic_states(x0, 2 * np.pi / period, period * np.arange(S) / S, system.n)
-    X[0] = x0
-    sol = newton(problem.residual_jacobian, problem.unknowns(X, period), settings(options, "shooting"))
+        X[0, system.n + start.phase] = 0.0
+    sol = newton(problem.residual_jacobian, problem.unknowns(X, start.period), settings(options, "shooting"))
     starts, T = problem.split(sol.u)
     return {"x0": np.asarray(starts[0], float), "omega": 2 * np.pi / T, "residual": sol.residual,
             "iterations": sol.iterations, "run": run}
@@ -373,21 +421,14 @@ def run_periodic_orbit(system, options: dict, context: dict) -> dict:
     refuse_unsupported(system)
     method = chosen_method(options)
     omega = options.get("frequency")
-    phase = None
-    if "from" in options:
-        x0, period, phase = guess_from_simulate(system, options, context, omega)
-        if omega is None and "period" not in options:
-            options = {**options, "period": period}
-    else:
-        x0 = guess(system, options)
+    start = guess_from_simulate(system, options, context, omega) if "from" in options else guess(system, options, omega)
     if omega is None:
-        refuse_time_dependent(system, x0)
-        if not np.any(x0[:system.n]) and not np.any(x0[system.n:]):
+        refuse_time_dependent(system, start.x0)
+        if not np.any(start.x0):
             raise SceneError("periodic_orbit: an autonomous orbit from a zero starting guess would find the "
                              "equilibrium", key="q0", expected="a starting guess on or near the orbit (q0, v0)")
-    phase = int(np.argmax(np.abs(x0[:system.n]))) if phase is None else phase
     solve = {"harmonic_balance": solve_harmonic_balance, "collocation": solve_collocation}.get(method, solve_shooting)
-    found = solve(system, options, x0, omega, phase)
+    found = solve(system, options, start, omega)
     return report(system, options, found, method, autonomous=omega is None)
 
 

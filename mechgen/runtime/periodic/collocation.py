@@ -15,11 +15,15 @@ Jacobian from the ``tangent`` kernel (one batched call):
 
 l the node's Lagrange polynomial. No mass matrix is inverted. Forced: T = 2 pi / omega fixed. Autonomous: T is an
 unknown, the phase condition is v_p(0) = 0 (as shooting's), and dE/dT = (-v, -r_a (dv/dtau) / T^2). Gauss
-collocation of degree m is of order 2m at the nodes (superconvergence); the mesh is uniform (no adaptation).
+collocation of degree m is of order 2m at the nodes (superconvergence). The mesh starts uniform; ``adapted``
+redistributes its intervals so that each holds an equal share of the monitor |x^(m+1)|^(1/(m+1)) (AUTO's rule), for
+orbits with fast and slow phases.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
+
+from math import factorial as math_factorial
 
 import numpy as np
 
@@ -64,6 +68,18 @@ class Collocation:
     mesh: int
     omega: float | None
     phase: int = 0
+    #: the mesh's edges in tau (mesh + 1 values from 0 to 1, increasing); None: uniform
+    edges: tuple | None = None
+
+    @property
+    def widths(self) -> np.ndarray:
+        """h_i, the intervals' widths in tau."""
+        return np.diff(self.edge_array)
+
+    @property
+    def edge_array(self) -> np.ndarray:
+        """The mesh's edges (uniform when ``edges`` is None)."""
+        return np.linspace(0.0, 1.0, self.mesh + 1) if self.edges is None else np.asarray(self.edges, float)
 
     @property
     def autonomous(self) -> bool:
@@ -94,11 +110,11 @@ class Collocation:
     def points(self, X: np.ndarray, T: float) -> dict:
         """q, v, dq/dtau, dv/dtau at the Gauss points (mesh * m rows) and tau there."""
         zeta, L, D = interval_tables()
-        n, h = self.system.n, 1.0 / self.mesh
+        n, h = self.system.n, self.widths
         local = X[self.node_index()]  # mesh x (m + 1) x 2n
         values = np.einsum("kj,ijd->ikd", L, local).reshape(-1, 2 * n)
-        slopes = np.einsum("kj,ijd->ikd", D, local).reshape(-1, 2 * n) / h
-        tau = ((np.arange(self.mesh)[:, None] + zeta[None, :]) * h).ravel()
+        slopes = (np.einsum("kj,ijd->ikd", D, local) / h[:, None, None]).reshape(-1, 2 * n)
+        tau = (self.edge_array[:-1, None] + zeta[None, :] * h[:, None]).ravel()
         return {"q": values[:, :n], "v": values[:, n:], "dq": slopes[:, :n], "dv": slopes[:, n:], "tau": tau}
 
     def kernel(self, name: str, at: dict, T: float) -> dict:
@@ -123,7 +139,7 @@ class Collocation:
         """(R(u), dR/du) (module doc), dense."""
         X, T = self.split(u)
         at = self.points(X, T)
-        n, h, m = self.system.n, 1.0 / self.mesh, DEGREE
+        n, widths, m = self.system.n, self.widths, DEGREE
         _, L, D = interval_tables()
         tan = self.kernel("tangent", at, T)
         rq, rv, ra = (np.asarray(tan[k], float).reshape(-1, n, n) for k in ("r_q", "r_v", "r_a"))
@@ -132,6 +148,7 @@ class Collocation:
         eye = np.eye(n)
         index = self.node_index()
         for i in range(self.mesh):
+            h = widths[i]
             for k in range(m):
                 c = i * m + k
                 rows = slice(c * 2 * n, c * 2 * n + n), slice(c * 2 * n + n, (c + 1) * 2 * n)
@@ -151,14 +168,38 @@ class Collocation:
     def frequency_derivative(self, u: np.ndarray) -> np.ndarray:
         """dR/domega of a forced orbit at fixed parameters (central differences, step 1e-6 omega)."""
         h = 1e-6 * self.omega
-        up = Collocation(self.system, self.mesh, self.omega + h, self.phase).residual(u)
-        down = Collocation(self.system, self.mesh, self.omega - h, self.phase).residual(u)
+        up = Collocation(self.system, self.mesh, self.omega + h, self.phase, self.edges).residual(u)
+        down = Collocation(self.system, self.mesh, self.omega - h, self.phase, self.edges).residual(u)
         return (up - down) / (2 * h)
 
     def states_at(self, u: np.ndarray, times: np.ndarray) -> np.ndarray:
         """The collocation polynomials' states at ``times`` (0 <= t <= T; rows)."""
         X, T = self.split(u)
-        tau = np.clip(np.asarray(times, float) / T, 0.0, 1.0) * self.mesh
-        i = np.minimum(tau.astype(int), self.mesh - 1)
-        values = lagrange_values(tau - i)
+        tau = np.clip(np.asarray(times, float) / T, 0.0, 1.0)
+        edges = self.edge_array
+        i = np.clip(np.searchsorted(edges, tau, side="right") - 1, 0, self.mesh - 1)
+        values = lagrange_values((tau - edges[i]) / self.widths[i])
         return np.einsum("sj,sjd->sd", values, X[self.node_index()[i]])
+
+    def adapted(self, u: np.ndarray) -> tuple["Collocation", np.ndarray]:
+        """(the problem on a new mesh of as many intervals, u interpolated onto it): the mesh that equidistributes
+        the monitor |x^(m+1)|^(1/(m+1)) (as AUTO's), x^(m+1) estimated on each interval from the jumps of the
+        polynomials' m-th derivatives (constant on an interval) between its neighbours, the largest component of
+        the state scaled by its range."""
+        X, T = self.split(u)
+        local = X[self.node_index()]  # mesh x (m + 1) x d
+        m, h = DEGREE, self.widths
+        nodes = np.arange(m + 1) / m
+        # the m-th derivative of the interpolant in tau: m! times the leading coefficient (divided differences)
+        weights = np.array([1.0 / np.prod(nodes[j] - np.delete(nodes, j)) for j in range(m + 1)])
+        top = math_factorial(m) * np.einsum("j,ijd->id", weights, local) / h[:, None] ** m
+        scale = np.ptp(X, axis=0) + 1e-300
+        jump = (np.abs(np.roll(top, -1, axis=0) - top) / (0.5 * (h + np.roll(h, -1)))[:, None]
+                + np.abs(top - np.roll(top, 1, axis=0)) / (0.5 * (h + np.roll(h, 1)))[:, None]) / 2
+        monitor = np.max(jump / scale, axis=1) ** (1.0 / (m + 1)) + 1e-12
+        mass = np.concatenate([[0.0], np.cumsum(monitor * h)])
+        edges = np.interp(np.linspace(0.0, mass[-1], self.mesh + 1), mass, self.edge_array)
+        edges[0], edges[-1] = 0.0, 1.0
+        new = Collocation(self.system, self.mesh, self.omega, self.phase, tuple(edges))
+        node_tau = (edges[:-1, None] + nodes[None, :-1] * np.diff(edges)[:, None]).ravel()
+        return new, new.unknowns(self.states_at(u, node_tau * T), T)
