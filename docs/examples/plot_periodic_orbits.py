@@ -28,9 +28,9 @@ By Liouville's formula the product of the two Floquet multipliers is exp(−c T)
 
 (the built-in model ``van_der_pol``; ``scenes/van_der_pol_limit_cycle.toml``) has a limit cycle whose period is
 unknown: it is found beside the orbit, with a phase condition, here by shooting, harmonic balance and orthogonal
-collocation (degree-4 polynomials at Gauss points on 40 intervals). References: T = 6.6632868593231 at μ = 1 and the
-small-μ expansion T = 2π (1 + μ²/16 − 5μ⁴/3072 + …), amplitude 2 + O(μ²) (Andersen & Geer, SIAM J. Appl. Math.
-42, 1982); the non-trivial multiplier is exp(μ ∮ (1 − x²) dt) (the trace of the Jacobian integrated over the
+collocation (degree-4 polynomials at Gauss points on 40 intervals). References: T = 6.6632868593231 at μ = 1 and
+the small-μ expansion T = 2π (1 + μ²/16 − 5μ⁴/3072 + …), amplitude 2 + O(μ²) (Andersen & Geer, SIAM J. Appl.
+Math. 42, 1982); the non-trivial multiplier is exp(μ ∮ (1 − x²) dt) (the trace of the Jacobian integrated over the
 orbit), computed here by scipy beside the state.
 """
 import math

@@ -25,7 +25,8 @@ Methods (``method``; left out: ``harmonic_balance`` when ``harmonics`` is given,
   orbit).
 * ``shooting``: Newton on x(T) - x(0) = 0 (mechgen.runtime.periodic.shooting, .flow: DOP853 at 1/100 of ``rtol``
   and ``atol``); with ``segments`` S > 1, multiple shooting: the period split into S segments, each from its own
-  unknown start state (on the first harmonic through the guess to begin with), for unstable or stiff orbits. With ``loop = "auto"`` (the default) on the C backend, x(T) comes from the compiled DOP853 loop
+  unknown start state (on the guess's curve to begin with), for unstable or stiff orbits. With ``loop = "auto"``
+  (the default) on the C backend, x(T) comes from the compiled DOP853 loop
   (mechgen.runtime.integration.smooth_c) and Newton's Jacobian, the monodromy matrix, from central differences of
   it (4n + 1 compiled runs, about 1e-10 from the exact one); with ``loop = "python"`` (or where the compiled loop
   cannot run) both come from the variational equations (the Jacobian from the generated ``tangent`` kernel) by
@@ -53,9 +54,9 @@ to T, named as simulate's: each coordinate, ``<coordinate>_dot`` and the model's
 neighbours), ``harmonics`` (per coordinate: ``mean``, ``cos`` a_k and
 ``sin`` b_k, ``amplitude`` sqrt(a_k^2 + b_k^2) and ``phase`` atan2(-b_k, a_k), k = 1..H, so that
 q = mean + sum_k a_k cos(k omega t) + b_k sin(k omega t) = mean + sum_k amplitude_k cos(k omega t + phase_k); for
-shooting and collocation H = ``harmonics`` or 7, projected from 4096 samples of the orbit), ``multipliers`` ([re, im] pairs, by
-decreasing modulus), ``stability``, ``method``, ``residual`` (||R||_inf at the solution: force units for harmonic
-balance, the state's for shooting), ``iterations`` and ``loop`` (``c``: shooting's integrations ran in the
+shooting and collocation H = ``harmonics`` or 7, projected from 4096 samples of the orbit), ``multipliers``
+([re, im] pairs, by decreasing modulus), ``stability``, ``method``, ``residual`` (||R||_inf at the solution:
+force units for harmonic balance, the state's for shooting, both for collocation), ``iterations`` and ``loop`` (``c``: shooting's integrations ran in the
 compiled loop; ``python``: in scipy's).
 
 Only smooth lumped models without internal variables: a hybrid model, a continuum, a chain or a model with internal
@@ -322,7 +323,8 @@ def settings(options: dict, method: str) -> NewtonSettings:
 
 
 def solve_harmonic_balance(system, options: dict, start: Guess, omega) -> dict:
-    """Harmonic balance from the guess (its curve projected onto the harmonics): {U, omega, x0 (the state at t = 0), residual, iterations}."""
+    """Harmonic balance from the guess (its curve projected onto the harmonics): {U, omega, x0 (the state at
+    t = 0), residual, iterations}."""
     H = int(options.get("harmonics", DEFAULT_HARMONICS))
     size = (2 * H + 1) * system.n
     require(dense_bytes(size, size) + dense_bytes(fourier.sample_count(H), size, system.n), f"harmonic balance's "
