@@ -56,8 +56,8 @@ neighbours), ``harmonics`` (per coordinate: ``mean``, ``cos`` a_k and
 q = mean + sum_k a_k cos(k omega t) + b_k sin(k omega t) = mean + sum_k amplitude_k cos(k omega t + phase_k); for
 shooting and collocation H = ``harmonics`` or 7, projected from 4096 samples of the orbit), ``multipliers``
 ([re, im] pairs, by decreasing modulus), ``stability``, ``method``, ``residual`` (||R||_inf at the solution:
-force units for harmonic balance, the state's for shooting, both for collocation), ``iterations`` and ``loop`` (``c``: shooting's integrations ran in the
-compiled loop; ``python``: in scipy's).
+force units for harmonic balance, the state's for shooting, both for collocation), ``iterations`` and ``loop``
+(``c``: shooting's integrations ran in the compiled loop; ``python``: in scipy's).
 
 Only smooth lumped models without internal variables: a hybrid model, a continuum, a chain or a model with internal
 variables is refused (key ``method``).
