@@ -587,3 +587,27 @@ def test_collocation_mesh_adaptation_on_a_relaxation_cycle(vdp):
     # it reports the orbit with its positive frequency (H = 20 truncates this cycle: measured 1.0e-2 in T)
     hb = mechgen.periodic_orbit(system, harmonics=20, **{"from": settle})
     assert hb["frequency"] > 0 and hb["period"] == pytest.approx(T, abs=0.05)
+
+
+def test_hills_method_gives_the_monodromy_multipliers(duffing, vdp):
+    """Hill's method (floquet = "hill", no integration) against the monodromy matrix's multipliers: the stable forced
+    orbit (complex pair) and the saddle above resonance (real, one > 1), 1e-7 with H = 11 (the truncation's effect
+    on the multipliers, like the orbit's); the van der Pol cycle at H = 30: the trivial 1 and exp(mu int (1 - x^2)
+    dt) from scipy (1e-7 relative). Asked of another method it is refused at ``floquet``."""
+    A, c, k3, F, w = 1.42496445, 0.05, 0.5, 0.3, 1.4  # the saddle's first-order amplitude and phase (closed form)
+    saddle = {"q0": {"x": (1 - w**2 + 0.75 * k3 * A**2) * A**2 / F}, "v0": {"x": c * w**2 * A**2 / F}}
+    for w, guess in ((1.2, {"q0": {"x": 1.3}, "v0": {"x": 0.5}}), (1.4, saddle)):
+        system = duffing.with_params(w=w)
+        hill = mechgen.periodic_orbit(system, frequency="w", harmonics=11, floquet="hill", **guess)
+        shot = mechgen.periodic_orbit(system, frequency="w", **guess)
+        assert hill["amplitude"]["x"] == pytest.approx(shot["amplitude"]["x"], abs=1e-7)  # the same orbit
+        np.testing.assert_allclose(hill["multipliers"], shot["multipliers"], rtol=0, atol=1e-7)
+    assert hill["stability"] == "unstable"
+    _, _, expected = vdp_reference(1.0, 2.0, 6.6)
+    cycle = mechgen.periodic_orbit(vdp, period=6.5, q0={"x": 2.0}, harmonics=30, floquet="hill")
+    mu = np.array([complex(*m) for m in cycle["multipliers"]])
+    assert np.min(np.abs(mu - 1)) < 1e-7
+    assert nontrivial(cycle)[0].real == pytest.approx(expected, rel=1e-7)
+    with pytest.raises(InputError) as err:
+        mechgen.periodic_orbit(vdp, period=6.5, q0={"x": 2.0}, floquet="hill")
+    assert err.value.key.endswith("floquet")

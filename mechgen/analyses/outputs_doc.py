@@ -299,7 +299,7 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
            "sin(k omega t) = mean + sum_k amplitude_k cos(k omega t + phase_k) (``cos`` a_k, ``sin`` b_k, "
            "``amplitude`` sqrt(a_k^2 + b_k^2), ``phase`` atan2(-b_k, a_k))."),
         _o("multipliers", "(2n, 2)", "-", "The Floquet multipliers (eigenvalues of the monodromy matrix) as [re, "
-           "im] pairs, by decreasing modulus."),
+           "im] pairs, by decreasing modulus (a conjugate pair: the positive imaginary part first)."),
         _o("stability", "string", "-", "``stable`` (every multiplier \\|mu\\| <= 1 + 1e-6, an autonomous "
            "orbit's trivial one set aside) or ``unstable``."),
         _o("method", "string", "-", "``harmonic_balance``, ``shooting`` or ``collocation``: the method that ran."),

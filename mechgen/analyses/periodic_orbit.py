@@ -43,10 +43,13 @@ Methods (``method``; left out: ``harmonic_balance`` when ``harmonics`` is given,
 
 Newton stops after a step ||du||_inf <= ``atol`` + ``rtol`` ||u||_inf (u the unknowns), and raises a
 ConvergenceError after ``max_iterations`` steps, naming the residual. Stability comes from the monodromy matrix
-Phi(T) of the converged orbit, always from the variational equations (for harmonic balance: integrated over one
-period from the series' state at t = 0):
-the Floquet multipliers are its eigenvalues, and the orbit is ``stable`` when each |mu| <= 1 + 1e-6 (an autonomous
-orbit's trivial multiplier, the one nearest 1, set aside) (mechgen.runtime.periodic.floquet).
+Phi(T) of the converged orbit, always from the variational equations (for harmonic balance and collocation:
+integrated over one period from the orbit's state at t = 0): the Floquet multipliers are its eigenvalues. With
+``floquet = "hill"`` (harmonic balance only) they come from Hill's method instead
+(mechgen.runtime.periodic.harmonic_balance.hill_exponents: the quadratic eigenproblem of the linearisation on the
+harmonics, the 2n exponents whose eigenvectors weigh most on the low harmonics kept; no integration). The orbit is
+``stable`` when each |mu| <= 1 + 1e-6 (an autonomous orbit's trivial multiplier, the one nearest 1, set aside)
+(mechgen.runtime.periodic.floquet).
 
 Outputs: ``period`` (T), ``frequency`` (2 pi / T), ``t`` and ``trajectory`` (one period, ``samples`` times from 0
 to T, named as simulate's: each coordinate, ``<coordinate>_dot`` and the model's outputs), ``amplitude``
@@ -77,13 +80,14 @@ from mechgen.runtime.core.memory import dense_bytes, require
 from mechgen.runtime.periodic import floquet, fourier
 from mechgen.runtime.periodic.collocation import Collocation
 from mechgen.runtime.periodic.flow import compiled_flow, states_at, variational_flow
-from mechgen.runtime.periodic.harmonic_balance import HarmonicBalance
+from mechgen.runtime.periodic.harmonic_balance import HarmonicBalance, hill_multipliers
 from mechgen.runtime.periodic.newton import NewtonSettings, newton
 from mechgen.runtime.periodic.shooting import Shooting
 from mechgen.scene.values import fail, listing, show
 
 METHODS = ("harmonic_balance", "shooting", "collocation")
 LOOPS = ("auto", "python", "c")
+FLOQUET = ("monodromy", "hill")
 #: the harmonics of harmonic balance, and those reported by shooting, when ``harmonics`` is left out
 DEFAULT_HARMONICS = 7
 #: collocation's intervals when ``mesh`` is left out
@@ -173,6 +177,9 @@ SCHEMA = {
     "atol": Option(schema.positive, 1e-12, doc="Newton's absolute tolerance on the unknowns (the coordinates' "
                    "units; shooting integrates at 1/100 of it)"),
     "max_iterations": Option(schema.count, 50, doc="the most Newton steps before a convergence error"),
+    "floquet": Option(schema.one_of("floquet", FLOQUET), "monodromy", doc="how the multipliers are found: monodromy "
+                      "(the eigenvalues of the monodromy matrix of the converged orbit) or hill (harmonic balance "
+                      "only: Hill's method on the harmonics, no integration)"),
     "loop": Option(schema.one_of("loop", LOOPS), "auto", doc="shooting's integrations: auto (the compiled DOP853 "
                    "loop where it can run: the C backend), python (scipy's DOP853 and the variational equations "
                    "throughout) or c (compiled, else an input error)"),
@@ -194,6 +201,9 @@ def check(ctx, base: str, options: dict) -> None:
     if "harmonics" in options and "mesh" in options and "method" not in options:
         raise fail(ctx.file, f"{base}.method", "both harmonics (harmonic balance) and mesh (collocation) are given",
                    "method = \"harmonic_balance\" or \"collocation\" beside them, or one of the two keys")
+    if options.get("floquet") == "hill" and chosen_method(options) != "harmonic_balance":
+        raise fail(ctx.file, f"{base}.floquet", f"Hill's method needs harmonic balance, and the method is "
+                   f"{chosen_method(options)}", "floquet = \"monodromy\", or method = \"harmonic_balance\"")
     if "frequency" in options and "period" in options:
         raise fail(ctx.file, f"{base}.period", "a forced orbit's period is 2 pi / frequency; period is the guess of "
                    "an autonomous one", "period or frequency, not both")
@@ -345,7 +355,8 @@ def solve_harmonic_balance(system, options: dict, start: Guess, omega) -> dict:
         raise ConvergenceError("periodic_orbit (harmonic_balance): Newton converged to frequency 0 (an "
                                "equilibrium); try a starting guess nearer the limit cycle (q0, v0, period)")
     x0, _ = problem.start_state(u)
-    return {"U": U, "omega": w, "x0": x0, "residual": sol.residual, "iterations": sol.iterations}
+    return {"U": U, "omega": w, "x0": x0, "residual": sol.residual, "iterations": sol.iterations,
+            "problem": problem, "u": u}
 
 
 def solve_collocation(system, options: dict, start: Guess, omega) -> dict:
@@ -447,8 +458,11 @@ def report(system, options: dict, found: dict, method: str, *, autonomous: bool)
                                "coordinates do not vary); try a starting guess nearer the limit cycle (q0, v0, period)")
     U = found["U"] if method == "harmonic_balance" else fourier.coefficients_of_samples(  # shooting, collocation
         fine[:, :n], int(options.get("harmonics", DEFAULT_HARMONICS)))
-    _, Phi = variational_flow(system, found["x0"], 0.0, T, *integrator_tolerances(options))
-    mu = floquet.multipliers(Phi)
+    if options.get("floquet") == "hill":
+        mu = hill_multipliers(found["problem"], found["u"])
+    else:
+        _, Phi = variational_flow(system, found["x0"], 0.0, T, *integrator_tolerances(options))
+        mu = floquet.multipliers(Phi)
     t = np.linspace(0.0, T, int(options["samples"]))
     X = orbit_samples(system, options, found, method, t)
     series = time_series.sampled_outputs(system, t, X)
