@@ -207,3 +207,75 @@ def test_shipped_rotor_scene_reports_the_onset_speed():
     assert h["type"] == "H" and h["Omega"] == pytest.approx(250.0, rel=1e-8)
     assert h["frequency"] == pytest.approx(200.0, rel=1e-8)
     assert h["criticality"] == "degenerate"
+    curve = mechgen.run(str(scene))["analyses"][2]["outputs"]["curve"]
+    c_i = np.array([p["c_i"] for p in curve])
+    assert c_i[-1] == 320.0
+    assert np.max(np.abs(np.array([p["Omega"] for p in curve]) / (200.0 * (1 + 20.0 / c_i)) - 1)) < 1e-8
+
+
+CUSP = '''"""x'' + c x' + x^3 - mu x - lam = 0: V = x^4/4 - mu x^2/2 - lam x."""
+from mechgen import Model, Param
+
+model = Model("cusp", doc=__doc__)
+model.params(Param("lam", -1.0), Param("mu", 1.0), Param("c", 0.2))
+model.coordinates("x")
+model.kinetic(lambda v: v.x**2 / 2)
+model.potential(lambda q, p: q.x**4 / 4 - p.mu * q.x**2 / 2 - p.lam * q.x)
+model.dissipation(lambda v, p: p.c * v.x**2 / 2)
+'''
+
+
+def curve_scene(tmp_path, model: str, name: str, guess: str, first: str, first_stop: float, second: str,
+                second_stop: float, extra: str = "") -> str:
+    path = scene(tmp_path, model, name, guess, first, first_stop, extra)
+    with open(path, "a") as f:
+        f.write(f'''[[analysis]]
+name = "curve"
+kind = "continuation"
+about = "cont"
+special_point = 1
+parameter = "{second}"
+stop = {second_stop}
+max_step = 0.2
+''')
+    return path
+
+
+def test_fold_curve_of_the_cusp(tmp_path):
+    """The fold curve of x^3 - mu x - lam = 0 in (lam, mu): 3 x^2 = mu and lam = -2 x^3 (so lam^2 = 4 (mu/3)^3),
+    every point to 1e-9 (the corrector's 1e-10 on the augmented residual, whose g is a bordered solve)."""
+    out = mechgen.run(curve_scene(tmp_path, CUSP, "cusp", "x = -1.3", "lam", 1.0, "mu", 3.0))["analyses"][2]["outputs"]
+    assert out["type"] == "LP" and out["parameters"] == ["lam", "mu"] and out["status"] == "lam_max"
+    x = np.array([p["coordinates"]["x"] for p in out["curve"]])
+    mu = np.array([p["mu"] for p in out["curve"]])
+    lam = np.array([p["lam"] for p in out["curve"]])
+    assert mu[-1] == 3.0 and len(mu) > 5
+    assert np.max(np.abs(3 * x**2 - mu)) < 1e-9
+    assert np.max(np.abs(lam + 2 * x**3)) < 1e-9
+
+
+def test_hopf_curve_of_the_rotor_onset_speed(tmp_path):
+    """The onset speed W = w_n (1 + c_e / c_i) of a Jeffcott rotor with internal damping, followed in c_i from 1.6
+    to 4 (to 1e-8 relative at every point), the whirl frequency w_n = 20 rad/s all along."""
+    path = curve_scene(tmp_path, ROTOR, "rotor", "x = 0.0, y = 0.0", "W", 40.0, "c_i", 4.0, "max_step = 2.0")
+    out = mechgen.run(path)["analyses"][2]["outputs"]
+    assert out["type"] == "H" and out["status"] == "lam_max"
+    c_i = np.array([p["c_i"] for p in out["curve"]])
+    W = np.array([p["W"] for p in out["curve"]])
+    assert c_i[-1] == 4.0 and len(c_i) > 3
+    assert np.max(np.abs(W / (20.0 * (1 + 0.4 / c_i)) - 1)) < 1e-8
+    assert np.max(np.abs(np.array([p["frequency"] for p in out["curve"]]) - 20.0)) < 1e-7
+
+
+def test_special_point_curve_refuses_a_branch_point_and_a_missing_index(tmp_path, capsys):
+    """special_point naming a BP, or past the list: exit 2 at the key; special_point about a steady: exit 2."""
+    from mechgen.cli import main
+
+    path = curve_scene(tmp_path, PITCHFORK, "pitchfork", "x = 0.0", "P", 2.0, "a", 3.0)
+    assert main(["run", path]) == 2
+    err = capsys.readouterr().err
+    assert "special_point" in err and "BP" in err and "Traceback" not in err
+    text = open(path).read()
+    open(path, "w").write(text.replace('about = "cont"\nspecial_point = 1', 'about = "eq"\nspecial_point = 1'))
+    assert main(["run", path]) == 2
+    assert "special_point" in capsys.readouterr().err

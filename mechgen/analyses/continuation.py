@@ -53,6 +53,10 @@ det [[F_y, F_p], [chord]], with the other branch's ``direction``) and, with ``st
 (``H``, sign changes of the bialternate product of the eigenvalues, with ``frequency``, the first Lyapunov
 coefficient ``lyapunov`` and ``criticality``). ``switch_branches = true`` follows the other branch from every BP,
 both ways (``switched_branches``).
+
+Curves of special points (mechgen.analyses.special_curves): with ``about`` an earlier continuation and
+``special_point`` the position of one of its LP or H points, the continuation follows that point in two
+parameters (the earlier one and ``parameter``, up to ``stop``): output ``curve``, ``type``, ``parameters``.
 """
 
 from __future__ import annotations
@@ -65,6 +69,7 @@ from mechgen.analyses import figures, schema, summary
 from mechgen.analyses.bvp_states import (bvp_summary, shape_declarations, shape_values, stability_about,
                                          stability_of_each)
 from mechgen.analyses.newton_branch import newton_branch
+from mechgen.analyses.special_curves import run_curve
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import REQUIRED, Option
 from mechgen.errors import SceneError
@@ -81,7 +86,10 @@ DIRECTIONS = ("increasing", "decreasing", "both")
 # --------------------------------------------------------------------------- schema
 
 def _starts(ctx, key: str, value: object) -> str | list[str]:
-    """One earlier steady analysis, or an array of them (one branch each)."""
+    """One earlier steady analysis, or an array of them (one branch each); or one earlier continuation (the curve
+    of one of its special points, with ``special_point``)."""
+    if isinstance(value, str) and ctx.earlier.get(value) == "continuation":
+        return value
     if not isinstance(value, list):
         return schema.about(ctx, key, value)
     if not value:
@@ -160,6 +168,9 @@ SCHEMA = {
     "special_points": Option(schema.boolean, True, doc="locate and report the branch's special points: folds (LP), "
                              "and on a Newton steady state's branch branch points (BP) and, with stability, Hopf "
                              "points (H, with the first Lyapunov coefficient)"),
+    "special_point": Option(schema.count, doc="with about an earlier continuation: the position (from 1) of the "
+                            "fold (LP) or Hopf point (H) in its special_points whose curve in two parameters is "
+                            "followed (parameter: the second one)"),
     "switch_branches": Option(schema.boolean, False, doc="also follow the other branch through every branch point "
                               "(BP), both ways (output switched_branches; a Newton steady state's branch)"),
     "max_seconds": Option(schema.positive, doc="the wall-time budget of the whole analysis (s, default 600), "
@@ -184,7 +195,17 @@ def _check_branch_outputs(ctx, base: str, options: dict) -> None:
 
 
 def check(ctx, base: str, options: dict) -> None:
-    """minimize follows one start; ``at`` and ``bounds`` name branch outputs; ``stop`` below the parameter's bound."""
+    """minimize follows one start; ``at`` and ``bounds`` name branch outputs; ``stop`` below the parameter's bound;
+    ``special_point`` with, and only with, ``about`` an earlier continuation."""
+    about = options["about"]
+    curve = isinstance(about, str) and ctx.earlier.get(about) == "continuation"
+    if curve != ("special_point" in options):
+        raise fail(ctx.file, f"{base}.special_point" if curve else f"{base}.about",
+                   "a curve of special points needs both 'about' an earlier continuation and 'special_point'",
+                   "special_point = <position in its special_points> with about = \"<continuation>\"" if curve
+                   else "about = an earlier steady analysis (special_point goes with about = a continuation)")
+    if curve:
+        return
     if isinstance(options["about"], list) and "minimize" in options:
         raise fail(ctx.file, f"{base}.minimize", "minimize follows one branch; 'about' lists several starts",
                    "one start (about = \"name\") with minimize")
@@ -363,6 +384,7 @@ def _newton_continuation(system, starts: list[str], options: dict, context: dict
            "points": sum(len(b["points"]) for b in branches), "folds": [f for b in branches for f in b["folds"]]}
     if options.get("special_points", True):
         out["special_points"] = [s for b in branches for s in b["special_points"]]
+        out["_special_x"] = [x for b in branches for x in b["_special_x"]]
     if options.get("switch_branches"):
         out["switched_branches"] = [s for b in branches for s in b["switched_branches"]]
     if options.get("stability", True):
@@ -377,6 +399,8 @@ def run_continuation(system, options: dict, context: dict) -> dict:
     starts = about if isinstance(about, list) else [about]
     name, aliases = options["parameter"], options.get("aliases", {})
     budget = Budget("continuation", unit="points", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
+    if "special_point" in options:
+        return run_curve(system, options, context[about])
     if newton_starts(starts, context):
         return _newton_continuation(system, starts, options, context, budget)
     if options.get("switch_branches"):
@@ -500,9 +524,36 @@ def _branch(plt, a: dict, path: Path) -> bool:
     return True
 
 
+def _curve(plt, a: dict, path: Path) -> bool:
+    """A special point's curve: the first parameter against the second (LP: fold curve; H: Hopf curve, the
+    frequency on a second axis)."""
+    out = a["outputs"]
+    if not out.get("curve"):
+        return False
+    first, second = out["parameters"]
+    b, p = [c[second] for c in out["curve"]], [c[first] for c in out["curve"]]
+    fig, ax = plt.subplots(figsize=(7, 5))
+    ax.plot(b, p, "k.-", ms=3, lw=1.0, label=f"{out['type']} curve")
+    if out["type"] == "H":
+        twin = ax.twinx()
+        freq = [c["frequency"] for c in out["curve"]]
+        twin.plot(b, freq, "--", color="tab:blue", lw=0.8)
+        twin.set_ylabel("frequency at the Hopf point (rad per unit time)", color="tab:blue")
+        middle, half = (max(freq) + min(freq)) / 2, max((max(freq) - min(freq)) / 2 * 1.1, 0.01 * max(freq))
+        twin.set_ylim(middle - half, middle + half)   # a frequency constant along the curve: +-1 %, not round-off
+    ax.set_xlabel(figures.labelled(a, second))
+    ax.set_ylabel(figures.labelled(a, first))
+    ax.legend(fontsize=7, loc="best")
+    ax.set_title(f"{a['name']}: the {out['type']} point in ({first}, {second})", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return True
+
+
 def _eigenvalues_along(plt, a: dict, path: Path, count: int = 4) -> bool:
     """Real and imaginary parts of the eigenvalues with the smallest |Im| (Im >= 0) at every branch point."""
-    points = a["outputs"]["branch"]
+    points = a["outputs"].get("branch")
     if not points or "eigenvalues" not in points[0]:
         return False
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
@@ -557,7 +608,7 @@ def plot(plt, a: dict, path: Path) -> list[Path]:
     outputs such as the loop count written where they change, folds, stability changes and the ``at``
     crossings marked), the shapes of the ``at`` points (first field against the last), with ``eigenvalues``
     their real and imaginary parts along the branch, and the lowest frequencies against the parameter."""
-    written = [path] if _branch(plt, a, path) else []
+    written = [path] if _branch(plt, a, path) or _curve(plt, a, path) else []
     out = a["outputs"]
     name = out.get("parameter", "parameter")
     for key in [k[3:] for k in out if k.startswith("at_") and not k.endswith("_shapes")]:

@@ -136,7 +136,8 @@ def special(system, eqs, X: np.ndarray, branch, options: dict, steps: Continuati
         return point(system, name, y, p, quiet)
 
     found = special_points.located(system, eqs, X, branch, name, hopf=options.get("stability", True))
-    out = {"special_points": [special_points.record(system, name, s, at) for s in found]}
+    out = {"special_points": [special_points.record(system, name, s, at) for s in found],
+           "_special_x": [s.x.copy() for s in found]}   # (y, p) of each: a curve of special points starts there
     if options.get("switch_branches"):
         full = {**options, "stability": options.get("stability", True)}
         out["switched_branches"] = special_points.switched(

@@ -186,6 +186,13 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("switched_branches", "list of {at, half, branch, status}", "the outputs'", "With "
            "``switch_branches = true``: the other branch through every BP, both ways (``half`` ``+`` or ``-``; "
            "``at``: the BP's position in ``special_points``, from 1; ``branch``: its points as in ``branch``)."),
+        _o("curve", "list of {<first>, <second>, coordinates, ..., frequency}", "the outputs'", "With "
+           "``special_point`` (``about`` an earlier continuation): the curve of its LP or H in two parameters, "
+           "one entry per point with both parameters, ``coordinates``, the model's outputs and, on an H curve, "
+           "``frequency`` (omega of the pair +-i omega)."),
+        _o("type", "string", "-", "With ``special_point``: ``LP`` or ``H``, the kind of point the curve follows."),
+        _o("parameters", "list of two strings", "-", "With ``special_point``: the earlier continuation's "
+           "parameter and the second one."),
         _o("shape_outputs", "list of strings", "-", "The shape outputs reported at every point."),
         _o("at_<output>", "list of {<parameter>, <output>, ..., verdict, refinement}", "the outputs'",
            "With ``at = {output = value}``: the points where the output crosses the value, sorted by the "
