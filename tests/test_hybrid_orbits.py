@@ -1,0 +1,138 @@
+"""Periodic orbits of hybrid models through their events (issue 27, item 6): saltation matrices from the generated
+guard and reset derivatives, the monodromy of an impact oscillator's orbit, shooting, grazing.
+
+The impact oscillator (Shaw & Holmes, J. Appl. Mech. 50, 1983): x'' + c x' + x = F cos(w t) for x < d; at x = d
+the velocity resets to -e x'. References:
+
+* the saltation matrix of this impact in closed form: with g = x - d, g_x = (1, 0), R_x = diag(1, -e) and
+  f- = (v, a-), f+ = (-e v, a+), S = R_x + (f+ - R_x f-) g_x^T / v = [[-e, 0], [(a+ + e a-) / v, -e]];
+* det S = e^2, so the monodromy of an orbit with k impacts per period has det = e^(2k) exp(-c T) (Liouville's
+  formula between the impacts) - a closed form;
+* the monodromy against central differences of an independent event-driven flow written here by hand (scipy's
+  solve_ivp, DOP853 at rtol 1e-12, a terminal event at x = d, the reset applied by hand).
+"""
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+import mechgen
+from mechgen.runtime.integration.hybrid_monodromy import flow_jacobian, periodic_orbit
+
+C, F, W, D, E = 0.05, 0.6, 0.8, 0.5, 0.7
+T = 2 * math.pi / W
+
+MODEL = f'''"""Impact oscillator: x'' + c x' + x = F cos(w t) for x < d; at x = d, x' -> -e x'."""
+import sympy as sp
+from mechgen import Model, Param
+
+model = Model("impact_orbit", doc=__doc__)
+model.params(Param("c", {C}), Param("F", {F}), Param("w", {W}), Param("d", {D}), Param("cor", {E}))
+model.coordinates("x")
+free = model.mode("free")
+model.kinetic(lambda v: v.x**2 / 2)
+model.potential(lambda q: q.x**2 / 2)
+model.dissipation(lambda v, p: p.c * v.x**2 / 2)
+
+
+@model.forces
+def drive(p, t):
+    return {{"x": p.F * sp.cos(p.w * t)}}
+
+
+@free.guard(to="free", direction="rising", reset=lambda v, p: {{"x_dot": -p.cor * v.x}})
+def stop(q, p):
+    return q.x - p.d
+'''
+
+
+@pytest.fixture(scope="module")
+def oscillator(tmp_path_factory):
+    path = tmp_path_factory.mktemp("impact") / "impact_orbit.py"
+    path.write_text(MODEL)
+    return mechgen.compile(str(path))
+
+
+def hand_flow(x0, t_end: float) -> np.ndarray:
+    """The independent event-driven flow map: solve_ivp from impact to impact, the reset applied by hand."""
+    def rhs(t, y):
+        return [y[1], F * math.cos(W * t) - C * y[1] - y[0]]
+
+    def hit(t, y):
+        return y[0] - D
+
+    hit.terminal, hit.direction = True, 1
+    t, y = 0.0, np.asarray(x0, float)
+    while t < t_end:
+        sol = solve_ivp(rhs, (t, t_end), y, method="DOP853", rtol=1e-12, atol=1e-14, events=hit)
+        t, y = sol.t[-1], sol.y[:, -1].copy()
+        if sol.status == 1:
+            y[1] = -E * y[1]
+            y[0] = D - 1e-13  # just below the stop: the event is not found again at once
+    return y
+
+
+def settled(oscillator) -> np.ndarray:
+    """The state at t = 60 T (a guess of the period-1 orbit at phase 0)."""
+    run = mechgen.simulate(oscillator, t_end=60 * T, samples=2, q0={"x": 0.0})
+    return np.array([run["trajectory"]["x"][-1], run["trajectory"]["x_dot"][-1]], float)
+
+
+def test_saltation_matrix_of_an_impact(oscillator):
+    """S at an impact against its closed form [[-e, 0], [(a+ + e a-) / v, -e]] (to 1e-12)."""
+    t, v = 1.3, 0.8
+    x = np.array([D, v])
+    a_minus = F * math.cos(W * t) - C * v - D
+    a_plus = F * math.cos(W * t) + C * E * v - D
+    S = oscillator.saltation(0, 0, t, x)
+    assert S == pytest.approx(np.array([[-E, 0.0], [(a_plus + E * a_minus) / v, -E]]), abs=1e-12)
+
+
+def test_periodic_orbit_and_its_monodromy(oscillator):
+    """Shooting converges to the period-1 orbit (the hand flow maps it onto itself to 1e-9); its monodromy equals
+    central differences of the hand flow (to 1e-6: difference step 1e-6, flows at rtol 1e-12) and its determinant
+    is e^2 exp(-c T) (one impact per period; to 1e-9)."""
+    orbit = periodic_orbit(oscillator, settled(oscillator), T)
+    assert len(orbit.events) == 1 and not orbit.grazing
+    assert np.max(np.abs(hand_flow(orbit.x0, T) - orbit.x0)) < 1e-9
+    h = 1e-6
+    columns = [(hand_flow(orbit.x0 + h * e, T) - hand_flow(orbit.x0 - h * e, T)) / (2 * h) for e in np.eye(2)]
+    assert orbit.monodromy == pytest.approx(np.column_stack(columns), abs=1e-6)
+    assert np.linalg.det(orbit.monodromy) == pytest.approx(E**2 * math.exp(-C * T), rel=1e-9)
+    assert np.prod(orbit.multipliers).real == pytest.approx(E**2 * math.exp(-C * T), rel=1e-9)
+    assert np.max(np.abs(orbit.multipliers)) < 1  # a stable orbit (the run settled onto it)
+
+
+def test_flow_jacobian_over_several_impacts(oscillator):
+    """From a start off the orbit, over 3 periods (several impacts): the Jacobian equals central differences of the
+    hand flow (to 1e-5) and its determinant is e^(2k) exp(-3 c T) with k the impacts met."""
+    x0 = np.array([0.1, 0.3])
+    fj = flow_jacobian(oscillator, x0, 3 * T)
+    k = len(fj.events)
+    assert k >= 2
+    h = 1e-6
+    columns = [(hand_flow(x0 + h * e, 3 * T) - hand_flow(x0 - h * e, 3 * T)) / (2 * h) for e in np.eye(2)]
+    assert fj.phi == pytest.approx(np.column_stack(columns), abs=1e-5, rel=1e-5)
+    assert np.linalg.det(fj.phi) == pytest.approx(E ** (2 * k) * math.exp(-3 * C * T), rel=1e-8)
+
+
+def test_a_grazing_impact_is_reported(tmp_path):
+    """Unforced and undamped, x = A cos t with A = d (1 + 1e-8) reaches the stop at t ~ 2 pi with
+    v = A sin(theta), cos(theta) = d / A: v ~ d sqrt(2e-8) = 7e-5, so |dg/dt| / (|g_x| |f|) ~ v / d = 1.4e-4 <
+    1e-3, a grazing event (the saltation matrix grows like 1/v there); the orbit of the forced oscillator, which
+    hits the stop at |v| ~ 0.85, is not."""
+    path = tmp_path / "graze.py"
+    path.write_text(MODEL.replace('"impact_orbit"', '"graze"'))
+    system = mechgen.compile(str(path), {"F": 0.0, "c": 0.0})
+    fj = flow_jacobian(system, np.array([D * (1 + 1e-8), 0.0]), 7.0)
+    assert fj.grazing == (0,)
+
+
+def test_shooting_that_cannot_converge_says_so(oscillator):
+    """Newton limited to one step from a poor guess: a ConvergenceError naming the residual and what to try."""
+    from mechgen.errors import ConvergenceError
+
+    with pytest.raises(ConvergenceError) as err:
+        periodic_orbit(oscillator, np.array([-2.0, 0.0]), T, max_iter=1)
+    assert "|x(T) - x0|" in str(err.value) and "guess" in str(err.value)
