@@ -2,7 +2,8 @@
 
 The Bode plot ``<name>.png``: the amplitude |X_k| (log scale) and the phase arg X_k (degrees, unwrapped
 along the frequencies) of each output coordinate against the driving frequency or speed, in the analysis's
-``speed_unit``; coordinates that do not move at any frequency are left out (the title says how many). The orbit
+``speed_unit``; coordinates that do not move at any frequency are left out (the title says how many), and a
+zero amplitude (at speed 0, an unbalance's force is zero) is a gap in the log-scale curve. The orbit
 figure ``<name>_orbits.png`` (when the response reports orbits): one panel per frequency of ``orbit_at``, each
 pair's ellipse x = Re(X_x e^{i theta}), y = Re(X_y e^{i theta}) over theta in [0, 2 pi], a dot at theta = 0
 (t = 0) and the whirl label.
@@ -43,8 +44,12 @@ def bode(plt, entry: dict, path: Path) -> Path:
     moving = [n for n, a in out["amplitude"].items() if max(a) > AT_REST * top]
     fig, (amp, phase) = plt.subplots(2, 1, figsize=(6.5, 5.5), sharex=True)
     for k, name in enumerate(moving):
-        amp.semilogy(x, np.maximum(out["amplitude"][name], 1e-300), color=f"C{k % 10}", label=name)
-        phase.plot(x, np.rad2deg(np.unwrap(out["phase"][name])), color=f"C{k % 10}", label=name)
+        a = np.asarray(out["amplitude"][name], dtype=float)
+        seen = a > AT_REST * top  # a zero amplitude has no phase: a gap in both curves
+        ph = np.full(len(a), np.nan)
+        ph[seen] = np.rad2deg(np.unwrap(np.asarray(out["phase"][name])[seen]))
+        amp.semilogy(x, np.where(seen, a, np.nan), color=f"C{k % 10}", label=name)
+        phase.plot(x, ph, color=f"C{k % 10}", label=name)
     per = f"per unit force at {out['input']}" if out.get("input") else "amplitude"
     amp.set_ylabel(f"|X| ({per})" if out.get("input") else "|X| (coordinate units)")
     phase.set_ylabel("phase (deg)")
