@@ -134,14 +134,16 @@ def speed_range(ctx, key: str, value: object) -> dict[str, list[float]]:
 def pairs(ctx, key: str, value: object) -> list[list[str]]:
     """An array of coordinate pairs [[x, y], ...] whose orbits are reported."""
     if not isinstance(value, list) or not value:
-        raise fail(ctx.file, key, f"value is {type_name(value)}", "an array of pairs [[x, y], ...]")
+        raise fail(ctx.file, key, "empty array" if value == [] else f"value is {type_name(value)}",
+                   "an array of pairs [[x, y], ...]")
     return [_pair(ctx, f"{key}[{i}]", v) for i, v in enumerate(value, 1)]
 
 
 def speed_values(ctx, key: str, value: object) -> list[float]:
     """A non-empty array of numbers >= 0 (speeds or frequencies, in speed_unit)."""
     if not isinstance(value, list) or not value:
-        raise fail(ctx.file, key, f"value is {type_name(value)}", "a non-empty array of numbers (speed_unit)")
+        raise fail(ctx.file, key, "empty array" if value == [] else f"value is {type_name(value)}",
+                   "a non-empty array of numbers (speed_unit)")
     values = [schema.number(ctx, f"{key}[{i}]", v) for i, v in enumerate(value, 1)]
     if min(values) < 0:
         raise fail(ctx.file, key, "a value is negative", "numbers >= 0 (speed_unit)")
@@ -189,9 +191,10 @@ def unbalance_force(n: int, names, items: list[dict], speed: float) -> np.ndarra
     f = np.zeros(n, dtype=complex)
     for u in items:
         ix, iy = (names.index(c) for c in u["coordinates"])
-        size = u["mass"] * u["eccentricity"] * speed**2 * np.exp(1j * np.deg2rad(u["phase"]))
-        f[ix] += size
-        f[iy] += -1j * size
+        with np.errstate(over="ignore", invalid="ignore"):  # an overflow is refused by the solve (not finite)
+            size = u["mass"] * u["eccentricity"] * np.float64(speed) ** 2 * np.exp(1j * np.deg2rad(u["phase"]))
+            f[ix] += size
+            f[iy] += -1j * size
     return f
 
 

@@ -32,7 +32,13 @@ def harmonic_solve(M, C, K, omega: float, f: np.ndarray) -> np.ndarray:
     import scipy.sparse as sps
     import scipy.sparse.linalg as spla
 
-    A = K - omega**2 * M + 1j * omega * C
+    w = np.float64(omega)
+    with np.errstate(over="ignore", invalid="ignore"):  # a huge omega: inf entries, refused below
+        A = K - w**2 * M + 1j * w * C
+    values = A.data if sps.issparse(A) else np.asarray(A)
+    if not np.all(np.isfinite(values)) or not np.all(np.isfinite(f)):
+        raise ConvergenceError(f"response: the dynamic stiffness or the force is not finite at omega = {omega:g} "
+                               "rad/s (overflow); drive at smaller frequencies or scale the model")
     if sps.issparse(A):
         x = spla.spsolve(sps.csc_matrix(A, dtype=complex), f)
     else:
