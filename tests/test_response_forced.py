@@ -289,3 +289,39 @@ def test_the_scene_draws_a_bode_plot_and_orbits(tmp_path):
     assert main(["run", str(scene), "--plot", str(tmp_path)]) == 0
     names = sorted(p.name for p in tmp_path.glob("*.png"))
     assert names == ["jeffcott_unbalance_unbalance.png", "jeffcott_unbalance_unbalance_orbits.png"]
+
+
+def test_a_scene_with_a_bad_unbalance_exits_2_naming_the_file_and_key(tmp_path, capsys):
+    """From the command line: a negative eccentricity, and input beside force, are exit 2 with the key."""
+    from mechgen.cli import main
+
+    for table, key in (('unbalance = { coordinates = ["x", "y"], mass = 0.01, eccentricity = -0.01 }\n'
+                        'over = { Omega = [100.0, 200.0] }\n', "analysis[1].unbalance.eccentricity"),
+                       ('input = "x"\nforce = { x = 1.0 }\nomega = [1.0]\n', "analysis[1].force")):
+        scene = tmp_path / "bad.toml"
+        scene.write_text(f'model = "laval_rotor"\n\n[[analysis]]\nname = "u"\nkind = "response"\n{table}')
+        assert main(["run", str(scene)]) == 2
+        err = capsys.readouterr().err
+        assert "bad.toml" in err and key in err, err
+
+
+def test_a_folded_speed_parameter_is_refused(files):
+    """A system compiled with the speed folded into its kernels cannot be re-linearised at other speeds."""
+    system = mechgen.compile(str(files / "jeffcott.py"), free=["M"], backend="numpy")
+    with pytest.raises(InputError, match="over"):
+        mechgen.response(system, unbalance=UNB, over={"Omega": [1.0, 2.0]})
+
+
+def test_a_rotating_force_pattern_on_a_whirl_pair_reports_its_orbit():
+    """The Laval rotor's translations driven by F_x = cos(w t), F_y = sin(w t) (phase -90 degrees): the pattern
+    drives both coordinates of the declared whirl pair (x, y), so its orbit is reported: a forward circle of
+    radius |1 / (k_t - m w^2 + i c w)| (x and y decoupled and alike); 1e-12 relative: round-off."""
+    p = {"m": 10.0, "k_t": 4.0e5, "c": 40.0}
+    rotor = mechgen.compile("laval_rotor", p, backend="numpy")
+    W = np.linspace(50.0, 400.0, 15)
+    r = mechgen.response(rotor, force={"x": 1.0, "y": {"amplitude": 1.0, "phase": -90.0}}, omega=W.tolist())
+    radius = abs(1.0 / (p["k_t"] - p["m"] * W**2 + 1j * p["c"] * W))
+    assert list(r["orbit"]) == ["x,y"]  # the tilts are not driven: (theta_x, theta_y) is left out
+    np.testing.assert_allclose(r["orbit"]["x,y"]["major"], radius, rtol=1e-12)
+    np.testing.assert_allclose(r["orbit"]["x,y"]["minor"], radius, rtol=1e-12)
+    assert set(r["orbit"]["x,y"]["whirl"]) == {"forward"}
