@@ -50,8 +50,7 @@ def bode(plt, entry: dict, path: Path) -> Path:
         ph[seen] = np.rad2deg(np.unwrap(np.asarray(out["phase"][name])[seen]))
         amp.semilogy(x, np.where(seen, a, np.nan), color=f"C{k % 10}", label=name)
         phase.plot(x, ph, color=f"C{k % 10}", label=name)
-    per = f"per unit force at {out['input']}" if out.get("input") else "amplitude"
-    amp.set_ylabel(f"|X| ({per})" if out.get("input") else "|X| (coordinate units)")
+    amp.set_ylabel(f"|H| (per unit force at {out['input']})" if out.get("input") else "|X| (coordinate units)")
     phase.set_ylabel("phase (deg)")
     phase.set_xlabel(_axis_label(out))
     rest = len(out["amplitude"]) - len(moving)
