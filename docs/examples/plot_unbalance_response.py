@@ -117,18 +117,20 @@ print(f"max relative error of X: {error:.1e}; backward whirl from {backward.min(
       "(critical speeds 20 and 30 rad/s)")
 assert error < 1e-12 and list(expected) == res["orbit"]["x,y"]["whirl"]
 
-fig, axes = plt.subplots(1, 3, figsize=(9, 3.4))
+fig, axes = plt.subplots(1, 3, figsize=(10, 3.8))
 theta = np.linspace(0.0, 2 * np.pi, 181)
+got_y = np.asarray(res["amplitude"]["y"]) * np.exp(1j * np.asarray(res["phase"]["y"]))
 for ax, w in zip(axes, res["orbit_at"]):
     i = int(np.argmin(np.abs(speeds - w)))
     ax.plot((X[i] * np.exp(1j * theta)).real, (Y[i] * np.exp(1j * theta)).real, label="closed form")
-    ax.plot(got_x[i].real, (res["amplitude"]["y"][i] * np.exp(1j * res["phase"]["y"][i])).real, "o",
-            label="mechgen, t = 0")
+    ax.plot((got_x[i] * np.exp(1j * theta[::12])).real, (got_y[i] * np.exp(1j * theta[::12])).real, "o", ms=4,
+            label="mechgen")
     ax.set_aspect("equal", adjustable="datalim")
+    ax.ticklabel_format(style="sci", scilimits=(0, 0))
     ax.set_title(f"{w:.1f} rad/s: {res['orbit']['x,y']['whirl'][i]}", fontsize=9)
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, loc="lower right")
 fig.suptitle("anisotropic Jeffcott rotor: orbits below, between and above the critical speeds")
 fig.tight_layout()
 plt.show()
