@@ -46,6 +46,13 @@ consecutive points, located by bisection along the branch to 1e-9 of the segment
 (mechgen.runtime.steady.branch_scan.switch): {parameter, aliased and shape outputs,
 ``from``, ``to``}. ``aliases`` may also name an analysis output:
 ``balloons_at_tension = "at_p_e"``.
+
+Special points (``special_points``, default true; mechgen.analyses.special_points): every branch reports its
+folds as ``LP``; a Newton steady state's branch also its branch points (``BP``, the sign changes of
+det [[F_y, F_p], [chord]], with the other branch's ``direction``) and, with ``stability``, its Hopf points
+(``H``, sign changes of the bialternate product of the eigenvalues, with ``frequency``, the first Lyapunov
+coefficient ``lyapunov`` and ``criticality``). ``switch_branches = true`` follows the other branch from every BP,
+both ways (``switched_branches``).
 """
 
 from __future__ import annotations
@@ -150,6 +157,11 @@ SCHEMA = {
     "at": Option(_output_values, doc="output = value: the points where an output crosses the value, located "
                  "along the branch (at_<output>)"),
     "eigenvalues": Option(schema.boolean, False, doc="report every branch point's eigenvalues too"),
+    "special_points": Option(schema.boolean, True, doc="locate and report the branch's special points: folds (LP), "
+                             "and on a Newton steady state's branch branch points (BP) and, with stability, Hopf "
+                             "points (H, with the first Lyapunov coefficient)"),
+    "switch_branches": Option(schema.boolean, False, doc="also follow the other branch through every branch point "
+                              "(BP), both ways (output switched_branches; a Newton steady state's branch)"),
     "max_seconds": Option(schema.positive, doc="the wall-time budget of the whole analysis (s, default 600), "
                          "checked before every continuation step"),
     "progress": Option(schema.boolean, doc="draw a bar of the branch points on stderr (default true, when it is "
@@ -343,12 +355,16 @@ def _newton_continuation(system, starts: list[str], options: dict, context: dict
     for s in starts:
         b = newton_branch(system, context[s], options, budget)
         if several:
-            for item in b["points"] + b["folds"] + b["stability_changes"]:
+            for item in b["points"] + b["folds"] + b["stability_changes"] + b.get("special_points", []):
                 item["start"] = s
         branches.append(b)
     out = {"parameter": name, "shape_outputs": [], "branch": [p for b in branches for p in b["points"]],
            "status": branches[0]["status"] if not several else {s: b["status"] for s, b in zip(starts, branches)},
            "points": sum(len(b["points"]) for b in branches), "folds": [f for b in branches for f in b["folds"]]}
+    if options.get("special_points", True):
+        out["special_points"] = [s for b in branches for s in b["special_points"]]
+    if options.get("switch_branches"):
+        out["switched_branches"] = [s for b in branches for s in b["switched_branches"]]
     if options.get("stability", True):
         out["stability_changes"] = [c for b in branches for c in b["stability_changes"]]
     return out
@@ -363,10 +379,17 @@ def run_continuation(system, options: dict, context: dict) -> dict:
     budget = Budget("continuation", unit="points", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
     if newton_starts(starts, context):
         return _newton_continuation(system, starts, options, context, budget)
+    if options.get("switch_branches"):
+        raise SceneError("switch_branches follows the branches of Newton steady states only; this continuation "
+                         "starts from a boundary-value steady state (its branch reports folds, LP)",
+                         key="switch_branches", expected="switch_branches = false (or a Newton steady state as the "
+                         "start)")
     branches = [_one_branch(system, context[s], options, s if isinstance(about, list) else None, budget)
                 for s in starts]
     out = {"parameter": name, "shape_outputs": [d.name for d in shape_declarations(system)],
            "branch": [p for b in branches for p in b["points"]],
+           "special_points": [{"type": "LP", **f} for b in branches for f in b["folds"]]
+           if options.get("special_points", True) else [],
            "status": branches[0]["status"] if len(branches) == 1 else
            {s: b["status"] for s, b in zip(starts, branches)},
            "points": sum(len(b["points"]) for b in branches),
@@ -419,8 +442,13 @@ def _families(points: list) -> list[list[dict]]:
     return list(groups.values())
 
 
+#: the markers of the special points besides folds (BP: square, H: star)
+_SPECIAL_MARKS = {"BP": "s", "H": "*"}
+
+
 def _branch(plt, a: dict, path: Path) -> bool:
-    """p_e (or another output) against the parameter: verdict colours, loop counts, folds, changes, crossings."""
+    """p_e (or another output) against the parameter: verdict colours, loop counts, folds, changes, crossings,
+    branch and Hopf points (labelled) and the branches switched onto (dashed)."""
     out = a["outputs"]
     if not out.get("branch"):
         return False
@@ -449,6 +477,15 @@ def _branch(plt, a: dict, path: Path) -> bool:
     for key in [k[3:] for k in out if k.startswith("at_") and not k.endswith("_shapes")]:
         for p in out[f"at_{key}"]:
             ax.plot(p[name], p[key], "o", ms=8, mfc="none", color="tab:green")
+    for half in out.get("switched_branches", []):
+        ax.plot([p[name] for p in half["branch"]], [p.get(output, float("nan")) for p in half["branch"]], "--",
+                color="0.45", lw=0.8, zorder=1)
+    for special in out.get("special_points", []):
+        if special["type"] in _SPECIAL_MARKS:
+            ax.plot(special[name], special.get(output, float("nan")), _SPECIAL_MARKS[special["type"]], ms=8,
+                    mfc="none", color="k")
+            ax.annotate(special["type"], (special[name], special.get(output, float("nan"))), fontsize=7,
+                        xytext=(5, -9), textcoords="offset points")
     handles = [plt.Line2D([], [], ls="", marker=".", color=c, label=v) for v, c in colours.items()]
     handles += [plt.Line2D([], [], ls="", marker="x", color="tab:purple", label="fold"),
                 plt.Line2D([], [], ls="", marker="d", mfc="none", color="tab:orange", label="stability change"),

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from mechgen.analyses import special_points
 from mechgen.analyses.stability_boundary import own_value, spectrum
 from mechgen.analyses.steady import equilibrium_functions, newton_aliases
 from mechgen.errors import SceneError
@@ -106,9 +107,11 @@ def newton_branch(system, start: dict, options: dict, budget: Budget) -> dict:
     quiet = {**options, "stability": False}
     out = {"points": points, "status": branch.status,
            "folds": [point(system, name, f.u, f.lam, quiet) for f in branch.folds], "stability_changes": []}
+    X = np.hstack([branch.u, branch.lam[:, None]])
+    n = X.shape[1] - 1
+    if options.get("special_points", True):
+        out.update(special(system, eqs, X, branch, options, _steps(system, name, options, here, budget)))
     if options.get("stability", True):
-        X = np.hstack([branch.u, branch.lam[:, None]])
-        n = X.shape[1] - 1
 
         def verdict(x):
             return spectrum(system.with_params(**{name: float(x[n])}), x[:n]).verdict
@@ -118,4 +121,24 @@ def newton_branch(system, start: dict, options: dict, budget: Budget) -> dict:
             if a != b:
                 x = branch_scan.switch(eqs, X[i], X[i + 1], verdict, a)
                 out["stability_changes"].append({**point(system, name, x[:n], x[n], quiet), "from": a, "to": b})
+    return out
+
+
+def special(system, eqs, X: np.ndarray, branch, options: dict, steps: ContinuationOptions) -> dict:
+    """``special_points`` (LP, BP and, with ``stability``, H) and with ``switch_branches`` the ``switched_branches``
+    (mechgen.analyses.special_points)."""
+    name = options["parameter"]
+    require_dense(X.shape[1], 8, "the branch-point test function (a dense determinant at every branch point)",
+                  key="special_points", expected="special_points = false for a system this large")
+    quiet = {**options, "stability": False}
+
+    def at(y, p):
+        return point(system, name, y, p, quiet)
+
+    found = special_points.located(system, eqs, X, branch, name, hopf=options.get("stability", True))
+    out = {"special_points": [special_points.record(system, name, s, at) for s in found]}
+    if options.get("switch_branches"):
+        full = {**options, "stability": options.get("stability", True)}
+        out["switched_branches"] = special_points.switched(
+            eqs, found, steps, lambda y, p: point(system, name, y, p, full))
     return out

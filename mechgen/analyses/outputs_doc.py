@@ -175,6 +175,17 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("folds", "list of branch points", "the outputs'", "The turning points in the parameter."),
         _o("stability_changes", "list of {..., from, to}", "the outputs'", "With ``stability``: where the "
            "verdict changes between consecutive points, located by bisection along the branch."),
+        _o("special_points", "list of {type, <parameter>, coordinates, ...}", "the outputs'",
+           "With ``special_points`` (default): the located special points in branch order, ``type`` ``LP`` "
+           "(fold), ``BP`` (branch point, with ``direction``: the other branch's unit direction per coordinate "
+           "and the parameter) or ``H`` (Hopf, with stability: ``frequency`` of the critical pair +-i omega in "
+           "rad per unit of the model's time, ``lyapunov`` the first Lyapunov coefficient l1 with Kuznetsov's "
+           "normalisation, ``criticality`` ``supercritical`` (l1 < 0), ``subcritical`` (l1 > 0) or "
+           "``degenerate`` (l1 zero to working precision: a linear model)); a boundary value "
+           "problem's branch reports its folds (LP)."),
+        _o("switched_branches", "list of {at, half, branch, status}", "the outputs'", "With "
+           "``switch_branches = true``: the other branch through every BP, both ways (``half`` ``+`` or ``-``; "
+           "``at``: the BP's position in ``special_points``, from 1; ``branch``: its points as in ``branch``)."),
         _o("shape_outputs", "list of strings", "-", "The shape outputs reported at every point."),
         _o("at_<output>", "list of {<parameter>, <output>, ..., verdict, refinement}", "the outputs'",
            "With ``at = {output = value}``: the points where the output crosses the value, sorted by the "

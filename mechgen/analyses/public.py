@@ -272,13 +272,14 @@ def campbell(system, *, name: str | None = None, **options) -> Result:
 
 
 def continuation(system, about, *, name: str | None = None, **options) -> Result:
-    """The branch of steady states through ``about`` (a steady Result of a continuum, or a list of them)
-    as ``parameter`` goes to ``stop``.
+    """The branch of steady states through ``about`` (a steady Result, or a list of them) as ``parameter`` goes
+    to ``stop``, with its special points (folds LP, branch points BP, Hopf points H with the first Lyapunov
+    coefficient).
 
     Options: ``parameter`` and ``stop`` (required), ``step``, ``max_step``, ``max_points``, ``method``,
     ``stages``, ``mesh``, ``stability``, ``minimize``, ``aliases``, ``direction``, ``bounds``, ``at``,
-    ``eigenvalues``. Outputs: ``branch`` (points with the parameter, outputs and ``verdict``), ``folds``,
-    ``status``, ``points`` ...
+    ``eigenvalues``, ``special_points``, ``switch_branches``. Outputs: ``branch`` (points with the parameter,
+    outputs and ``verdict``), ``folds``, ``special_points``, ``switched_branches``, ``status``, ``points`` ...
     """
     return _run("continuation", system, {"about": about, **options}, name)
 

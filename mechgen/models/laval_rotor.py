@@ -9,10 +9,14 @@ omega = (theta_x' cos(theta_y), theta_y', Omega + theta_x' sin(theta_y)) and
     T = m/2 (x'^2 + y'^2) + Id/2 (omega_1^2 + omega_2^2) + Ip/2 omega_3^2
     V = k_t/2 (x^2 + y^2) + k_r/2 (theta_x^2 + theta_y^2)
     R = c/2 (x'^2 + y'^2) + c_r/2 (theta_x'^2 + theta_y'^2)   (non-rotating damping)
+        + c_i/2 ((x' + Omega y)^2 + (y' - Omega x)^2)             (internal damping, in the rotating frame)
 
 Linearised about rest: translations vibrate at sqrt(k_t/m); the tilts whirl at
 omega_f,b = (+-Ip Omega + sqrt(Ip^2 Omega^2 + 4 Id k_r)) / (2 Id), forward and
 backward, so omega_f - omega_b = Ip Omega / Id (the gyroscopic moment Ip Omega).
+Internal (rotating) damping c_i acts on the centre's velocity seen from the shaft, r' - Omega x r: it drives the
+forward whirl of the translations unstable above the onset speed Omega = sqrt(k_t/m) (1 + c/c_i) (Crandall;
+Genta, Dynamics of Rotating Systems, sec. 8.3), a Hopf point of the rest state in Omega.
 Whirl is judged at two stations, the centre's (x, y) and the tilts (theta_x, theta_y): the disk normal is
 n = (theta_y, -theta_x, 1), a rotation of (theta_x, theta_y) by -90 degrees, so a counter-clockwise tilt
 orbit is a counter-clockwise (forward) whirl of the normal.
@@ -34,6 +38,7 @@ model.params(
     Param("Omega", 0.0, "rad/s", "spin speed"),
     Param("c", 0.0, "N s/m", "translational damping"),
     Param("c_r", 0.0, "N m s/rad", "tilt damping"),
+    Param("c_i", 0.0, "N s/m", "internal (rotating) damping of the translations"),
 )
 model.coordinates("x", "y", "theta_x", "theta_y")
 model.whirl_pair("x", "y")
@@ -52,8 +57,9 @@ def potential(q, p):
 
 
 @model.dissipation
-def dissipation(v, p):
-    return p.c / 2 * (v.x**2 + v.y**2) + p.c_r / 2 * (v.theta_x**2 + v.theta_y**2)
+def dissipation(q, v, p):
+    return (p.c / 2 * (v.x**2 + v.y**2) + p.c_r / 2 * (v.theta_x**2 + v.theta_y**2)
+            + p.c_i / 2 * ((v.x + p.Omega * q.y) ** 2 + (v.y - p.Omega * q.x) ** 2))
 
 
 model.output("orbit_radius", lambda q: sp.sqrt(q.x**2 + q.y**2), unit="m", doc="disk-centre orbit radius")
