@@ -207,12 +207,33 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
            "(``balloons_at_tension = \"at_p_e\"``)."),
     ),
     "response": (
-        _o("omega", "(frequencies,)", "rad/s", "The driving frequencies."),
-        _o("input", "string", "-", "The coordinate the unit force drives."),
-        _o("amplitude", "{coordinate: (frequencies,)}", "coordinate per unit force (m/N ...)",
-           "\\|H_kj(omega)\\|, the receptance's magnitude for each output coordinate k."),
-        _o("phase", "{coordinate: (frequencies,)}", "rad", "arg H_kj(omega): the response's phase relative to "
-           "the force."),
+        _o("omega", "(frequencies,)", "rad/s", "The driving frequencies (with ``unbalance``: the spin speeds), in "
+           "rad/s whatever ``speed_unit`` the scene writes them in."),
+        _o("input", "string", "-", "With ``input``: the coordinate the unit force drives."),
+        _o("amplitude", "{coordinate: (frequencies,)}", "coordinate per unit force (m/N ...) with ``input``; the "
+           "coordinate's (m, rad) with ``force`` or ``unbalance``",
+           "\\|X_k\\| of the response q_k(t) = \\|X_k\\| cos(omega t + phase_k) for each output coordinate k: "
+           "with ``input`` the receptance's magnitude \\|H_kj(omega)\\|, else \\|(H(omega) f)_k\\|."),
+        _o("phase", "{coordinate: (frequencies,)}", "rad", "arg X_k: the response's phase relative to the "
+           "forcing's reference cos(omega t) (the unit force, a force pattern's phase 0, an unbalance's shaft angle "
+           "Omega t); negative: the response lags."),
+        _o("forcing", "string", "-", "Which forcing was applied: ``input``, ``force`` or ``unbalance``."),
+        _o("speed_unit", "string", "-", "The unit the scene wrote its frequencies or speeds in (``rad/s``, "
+           "``Hz`` or ``rpm``)."),
+        _o("omega_in_unit", "(frequencies,)", "``speed_unit``", "``omega`` expressed in ``speed_unit`` (the plots' "
+           "axis)."),
+        _o("speeds", "(frequencies,)", "rad/s", "With ``unbalance``: the spin speeds (equal to ``omega``: an "
+           "unbalance drives at the speed), as campbell names them."),
+        _o("parameter", "string", "-", "With ``unbalance``: the speed parameter the matrices were re-linearised "
+           "in at each speed."),
+        _o("orbit", "{\"x,y\": {major, minor, angle, whirl, whirl_ratio: (frequencies,)}}",
+           "the coordinates' (m); angle rad", "Per coordinate pair (``orbits``; default the unbalances' pairs): "
+           "the ellipse x = Re(X_x e^{i omega t}), y = Re(X_y e^{i omega t}) at each frequency: ``major`` and "
+           "``minor`` semi-axes, ``angle`` of the major axis from x towards y, ``whirl`` forward, backward (the "
+           "sign of the angular momentum x y' - y x'), linear (a straight line) or none (at rest), "
+           "``whirl_ratio`` the signed minor / major."),
+        _o("orbit_at", "(picked,)", "rad/s", "The frequencies whose orbits the orbit figure draws (the computed "
+           "ones nearest the scene's ``orbit_at``, else up to five spread over the range and the largest)."),
     ),
     "fit": (
         _o("<parameter>", "scalar, or (groups,)", "the parameter's", "Each estimated parameter (a list per "

@@ -187,12 +187,16 @@ def periodic(system, *, name: str | None = None, **options) -> Result:
 
 
 def response(system, *, name: str | None = None, **options) -> Result:
-    """The steady harmonic response to a unit force at one coordinate: the receptance
-    H(omega) = (K - omega^2 M + i omega (D + G))^-1 about an operating point (mechgen.analyses.response).
+    """The steady harmonic response X(omega) = H(omega) f, H(omega) = (K - omega^2 M + i omega (D + G))^-1,
+    about an operating point (mechgen.analyses.response), to a unit force (``input``), a force pattern
+    (``force``: ``{"x": 1.0, "y": {"amplitude": 1.0, "phase": 90}}``, phases in degrees) or an unbalance
+    (``unbalance``: ``{"coordinates": ["x", "y"], "mass": kg, "eccentricity": m}``, over the speeds ``over``
+    with the matrices re-linearised at each speed).
 
-    Options: ``input`` (the driven coordinate) and ``omega`` (rad/s: a list or {start, stop, num}) required,
-    ``outputs``, ``about``, ``at``, ``max_seconds``. Outputs: ``omega``, ``amplitude`` and ``phase`` per output
-    coordinate (``abs(H_kj)``, ``arg(H_kj)`` in rad).
+    Options: one of ``input``, ``force``, ``unbalance``; ``omega`` (with input or force) or ``over`` (with
+    unbalance); ``speed_unit`` (rad/s, Hz, rpm), ``outputs``, ``orbits``, ``orbit_at``, ``about``, ``at``,
+    ``max_seconds``. Outputs: ``omega`` (rad/s), ``amplitude`` and ``phase`` per output coordinate (rad),
+    ``forcing``, ``speed_unit``, ``omega_in_unit``, and with orbits ``orbit`` per coordinate pair.
     """
     return _run("response", system, options, name)
 
