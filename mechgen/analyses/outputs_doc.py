@@ -323,6 +323,32 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("displacement_series", "(samples,)", "m", "With ``curve``: the loop's displacement."),
         _o("force_series", "(samples,)", "N", "With ``curve``: the loop's force."),
     ),
+    "periodic_orbit": (
+        _o("period", "scalar", "s (or the model's time unit)", "T: 2 pi / ``frequency`` of a forced orbit; found "
+           "with an autonomous one."),
+        _o("frequency", "scalar", "rad/s", "omega = 2 pi / T: the forcing's, or the limit cycle's found."),
+        _o("t", "(samples,)", "s (or the model's time unit)", "One period, ``samples`` equally spaced times from 0 "
+           "to T."),
+        _o("trajectory", "{name: (samples,)}", MODEL_UNIT, "The orbit at ``t``, named as simulate's: each "
+           "coordinate, ``<coordinate>_dot`` and the model's outputs."),
+        _o("amplitude", "{coordinate: value}", MODEL_UNIT, "max \\|q\\| over the period (the largest of 4096 phases, "
+           "refined by the parabola through it and its neighbours)."),
+        _o("harmonics", "{coordinate: {mean, cos, sin, amplitude, phase}}", "the coordinate's; phase in rad",
+           "The Fourier coefficients of each coordinate, k = 1..H: q = mean + sum_k a_k cos(k omega t) + b_k "
+           "sin(k omega t) = mean + sum_k amplitude_k cos(k omega t + phase_k) (``cos`` a_k, ``sin`` b_k, "
+           "``amplitude`` sqrt(a_k^2 + b_k^2), ``phase`` atan2(-b_k, a_k))."),
+        _o("multipliers", "(2n, 2)", "-", "The Floquet multipliers (eigenvalues of the monodromy matrix) as [re, "
+           "im] pairs, by decreasing modulus."),
+        _o("stability", "string", "-", "``stable`` (every multiplier \\|mu\\| <= 1 + 1e-6, an autonomous "
+           "orbit's trivial one set aside) or ``unstable``."),
+        _o("method", "string", "-", "``harmonic_balance`` or ``shooting``: the method that ran."),
+        _o("residual", "scalar", "force units (harmonic balance) or the state's (shooting)", "\\|\\|R\\|\\|_inf "
+           "at the solution."),
+        _o("iterations", "scalar (int)", "-", "Newton steps taken."),
+        _o("loop", "string", "-", "``c``: shooting's integrations ran in the compiled DOP853 loop (the monodromy "
+           "for Newton by central differences of it); ``python``: in scipy's DOP853 (harmonic balance's "
+           "multipliers, and ``loop = \"python\"``)."),
+    ),
     "cross_section": (
         _o("K", "(6, 6)", "N, N m, N m^2", "The section's stiffness ordered [K_uu, K_uw; K_wu, K_ww]."),
         _o("eigenvalues", "(6,)", "mixed (K's)", "K's eigenvalues, ascending."),

@@ -1,0 +1,397 @@
+"""``periodic_orbit``: a periodic orbit of a smooth lumped model, forced or autonomous, by harmonic balance or by
+shooting, with its Floquet multipliers and stability.
+
+*Forced* (``frequency`` given: the forcing's angular frequency omega, rad/s, a number or an expression of the
+parameters such as ``"omega"`` or ``"2*omega"``): the orbit of period T = 2 pi / omega, t = 0 the forcing's time
+origin. *Autonomous* (``frequency`` left out): a limit cycle, whose period is an unknown found beside the orbit,
+from the starting guess ``period``; a phase condition fixes where t = 0 lies on it (below). Either way the
+starting guess is ``q0`` / ``v0`` (tables of coordinates, the state at t = 0; left out: zero, or the model's
+declared initial state), or ``from`` an earlier ``simulate`` that kept its trajectory: forced, its sample nearest a
+multiple of T within its last period; autonomous, its sample at the last maximum of the coordinate that varies most
+over the run's second half, with the time between the last two maxima as the period's guess (unless ``period`` is
+given).
+
+Methods (``method``; left out: ``harmonic_balance`` when ``harmonics`` is given, ``shooting`` otherwise; the output
+``method`` says which ran):
+
+* ``harmonic_balance``: each coordinate a Fourier series of H = ``harmonics`` harmonics (default 7); the residual
+  r(q, v, a, t) of the model's generated kernel is evaluated in one batched call at N = 8 (H + 1) phases
+  (alternating frequency-time) and projected onto the harmonics; Newton on the coefficients with the exact
+  Jacobian from the generated ``tangent`` kernel (mechgen.runtime.periodic.harmonic_balance). Autonomous: the
+  frequency is an unknown and the phase condition is b_1(q_p) = 0 (no sine part in the first harmonic of the
+  coordinate p with the largest |q0|). Its error is the truncation of the series (it falls fast with H for a smooth
+  orbit).
+* ``shooting``: Newton on x(T) - x(0) = 0 (mechgen.runtime.periodic.shooting, .flow: DOP853 at 1/100 of ``rtol``
+  and ``atol``). With ``loop = "auto"`` (the default) on the C backend, x(T) comes from the compiled DOP853 loop
+  (mechgen.runtime.integration.smooth_c) and Newton's Jacobian, the monodromy matrix, from central differences of
+  it (4n + 1 compiled runs, about 1e-10 from the exact one); with ``loop = "python"`` (or where the compiled loop
+  cannot run) both come from the variational equations (the Jacobian from the generated ``tangent`` kernel) by
+  scipy's DOP853. Autonomous: the period is an unknown and the phase condition is v_p(0) = 0 (the
+  orbit starts at an extremum of q_p). Its error is the integrator's.
+* ``collocation`` is not available yet (an input error).
+
+Newton stops after a step ||du||_inf <= ``atol`` + ``rtol`` ||u||_inf (u the unknowns), and raises a
+ConvergenceError after ``max_iterations`` steps, naming the residual. Stability comes from the monodromy matrix
+Phi(T) of the converged orbit, always from the variational equations (for harmonic balance: integrated over one
+period from the series' state at t = 0):
+the Floquet multipliers are its eigenvalues, and the orbit is ``stable`` when each |mu| <= 1 + 1e-6 (an autonomous
+orbit's trivial multiplier, the one nearest 1, set aside) (mechgen.runtime.periodic.floquet).
+
+Outputs: ``period`` (T), ``frequency`` (2 pi / T), ``t`` and ``trajectory`` (one period, ``samples`` times from 0
+to T, named as simulate's: each coordinate, ``<coordinate>_dot`` and the model's outputs), ``amplitude``
+({coordinate: max |q| over the period}: the largest of 4096 phases, refined by the parabola through it and its
+neighbours), ``harmonics`` (per coordinate: ``mean``, ``cos`` a_k and
+``sin`` b_k, ``amplitude`` sqrt(a_k^2 + b_k^2) and ``phase`` atan2(-b_k, a_k), k = 1..H, so that
+q = mean + sum_k a_k cos(k omega t) + b_k sin(k omega t) = mean + sum_k amplitude_k cos(k omega t + phase_k); for
+shooting H = ``harmonics`` or 7, projected from 4096 samples of the orbit), ``multipliers`` ([re, im] pairs, by
+decreasing modulus), ``stability``, ``method``, ``residual`` (||R||_inf at the solution: force units for harmonic
+balance, the state's for shooting), ``iterations`` and ``loop`` (``c``: shooting's integrations ran in the
+compiled loop; ``python``: in scipy's).
+
+Only smooth lumped models without internal variables: a hybrid model, a continuum, a chain or a model with internal
+variables is refused (key ``method``).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from mechgen.analyses import schema, summary, time_series
+from mechgen.analyses.registry import AnalysisKind, register
+from mechgen.analyses.schema import ABSENT, Option
+from mechgen.errors import ConvergenceError, SceneError
+from mechgen.runtime.periodic import floquet, fourier
+from mechgen.runtime.periodic.flow import compiled_flow, states_at, variational_flow
+from mechgen.runtime.periodic.harmonic_balance import HarmonicBalance
+from mechgen.runtime.periodic.newton import NewtonSettings, newton
+from mechgen.runtime.periodic.shooting import Shooting
+from mechgen.scene.values import fail, listing, show
+
+METHODS = ("harmonic_balance", "shooting", "collocation")
+LOOPS = ("auto", "python", "c")
+#: the harmonics of harmonic balance, and those reported by shooting, when ``harmonics`` is left out
+DEFAULT_HARMONICS = 7
+#: phases at which amplitudes and a shooting orbit's harmonics are taken
+FINE = 4096
+#: shooting's Newton steps are at most this times (1 + ||u||_inf) (mechgen.runtime.periodic.newton: a full step from a
+#: poor guess leaves for states whose flow is far from periodic); harmonic balance's are not limited
+SHOOTING_TRUST = 0.5
+#: the shooting integrator's tolerances are these fractions of Newton's rtol / atol
+INTEGRATOR_SHARE = 1e-2
+
+#: the most harmonics (a guard against typos: harmonic balance's Jacobian has ((2H + 1) n)^2 entries)
+MAX_HARMONICS = 1000
+
+
+def harmonics_count(ctx, key: str, value: object) -> int:
+    """An integer from 1 to 1000 (a guard against typos)."""
+    H = schema.int_at_least(ctx, key, value, 1)
+    if H > MAX_HARMONICS:
+        raise fail(ctx.file, key, f"harmonics {H} is above {MAX_HARMONICS}", f"an integer from 1 to {MAX_HARMONICS}")
+    return H
+
+
+def earlier_simulate(ctx, key: str, value: object) -> str:
+    """The name of an earlier simulate analysis."""
+    runs = [n for n, k in ctx.earlier.items() if k == "simulate"]
+    expected = "the name of an earlier simulate analysis: " + (listing(runs) if runs else "none in this scene")
+    if ctx.swept:
+        raise fail(ctx.file, key, "'from' is not available inside a sweep", "no 'from' key")
+    if not isinstance(value, str) or value not in ctx.earlier:
+        later = isinstance(value, str) and value in ctx.all_names
+        what = f"analysis {show(value)} comes later in the scene" if later else f"no earlier analysis {show(value)}"
+        raise fail(ctx.file, key, what, expected)
+    if ctx.earlier[value] != "simulate":
+        raise fail(ctx.file, key, f"analysis '{value}' is a {ctx.earlier[value]} analysis, not simulate", expected)
+    return value
+
+
+SCHEMA = {
+    "method": Option(schema.one_of("method", METHODS), ABSENT, doc="harmonic_balance or shooting (left out: "
+                     "harmonic_balance when harmonics is given, else shooting; collocation is not available yet)"),
+    "frequency": Option(schema.positive, ABSENT, doc="the forcing's angular frequency omega (rad/s): a number or an "
+                        "expression of parameters such as \"omega\"; the period is 2 pi / omega (left out: an "
+                        "autonomous orbit, its period found)"),
+    "period": Option(schema.positive, ABSENT, doc="the starting guess of an autonomous orbit's period (s, or the "
+                     "model's time unit; required without frequency)"),
+    "harmonics": Option(harmonics_count, ABSENT, doc="harmonic balance's number of harmonics H "
+                        "(default 7); with shooting, how many harmonics are reported"),
+    "q0": Option(schema.coordinate_table, {}, doc="the starting guess of the coordinates at t = 0, a table "
+                 "coordinate = value (left out: zero, or the model's declared initial state)"),
+    "v0": Option(schema.coordinate_table, {}, doc="the starting guess of the velocities at t = 0, a table "
+                 "coordinate = value"),
+    "from": Option(earlier_simulate, ABSENT, doc="an earlier simulate analysis (with its trajectory) whose "
+                   "motion near its end is the starting guess instead of q0 / v0 (and, for an autonomous orbit, the "
+                   "period between its last two maxima the period's)"),
+    "rtol": Option(schema.positive, 1e-9, doc="Newton's relative tolerance on the unknowns (shooting integrates "
+                   "at 1/100 of it)"),
+    "atol": Option(schema.positive, 1e-12, doc="Newton's absolute tolerance on the unknowns (the coordinates' "
+                   "units; shooting integrates at 1/100 of it)"),
+    "max_iterations": Option(schema.count, 50, doc="the most Newton steps before a convergence error"),
+    "loop": Option(schema.one_of("loop", LOOPS), "auto", doc="shooting's integrations: auto (the compiled DOP853 "
+                   "loop where it can run: the C backend), python (scipy's DOP853 and the variational equations "
+                   "throughout) or c (compiled, else an input error)"),
+    "samples": Option(schema.count_within("samples"), 201, doc="how many equally spaced times from 0 to T the "
+                      "reported orbit (t, trajectory) has"),
+}
+
+
+def check(ctx, base: str, options: dict) -> None:
+    """A smooth lumped model; collocation refused; an autonomous orbit needs a period guess, a forced one none."""
+    model = ctx.model
+    why = ("has modes (a hybrid model)" if getattr(model, "modes", ()) else "is a continuum"
+           if getattr(model, "continuum", False) else "is a chain" if getattr(model, "chain", None)
+           else "has internal variables" if getattr(model, "internals", False) else None)
+    if why:
+        raise fail(ctx.file, f"{base}.method", f"model {model.name} {why}: periodic_orbit's methods need a smooth "
+                   "lumped model", "a smooth lumped model (a hybrid model's periodic response: kind periodic)")
+    if options.get("method") == "collocation":
+        raise fail(ctx.file, f"{base}.method", "method 'collocation' is not available yet",
+                   "harmonic_balance or shooting")
+    if "frequency" in options and "period" in options:
+        raise fail(ctx.file, f"{base}.period", "a forced orbit's period is 2 pi / frequency; period is the guess of "
+                   "an autonomous one", "period or frequency, not both")
+    if "from" in options and ({"q0", "v0"} & {k for k, v in options.items() if v}):
+        raise fail(ctx.file, f"{base}.from", "a starting guess both from a simulate and from q0 / v0",
+                   "from, or q0 / v0")
+    if "frequency" not in options and "period" not in options and "from" not in options:
+        raise fail(ctx.file, f"{base}.period", "an autonomous orbit (no frequency) needs a starting guess of its "
+                   "period", "period = a number > 0 (or frequency = the forcing's, for a forced orbit)")
+
+
+def needs(options: dict, *, internal: bool) -> set[str]:
+    """The residual and its tangent (the flow's dx/dt and Jacobian), the outputs for the trajectory."""
+    return {"residual", "tangent", "flow", "outputs"}
+
+
+def chosen_method(options: dict) -> str:
+    """The method that runs (module doc)."""
+    return options.get("method") or ("harmonic_balance" if "harmonics" in options else "shooting")
+
+
+def refuse_unsupported(system) -> None:
+    """A system the methods cannot run: hybrid, continuum, chain, internal variables (key method)."""
+    why = ("has modes (a hybrid model)" if hasattr(system, "modes") else "is a continuum"
+           if getattr(system, "is_field", False) else "is a chain" if getattr(system, "is_lattice", False)
+           else "has internal variables" if system.m else None)
+    if why:
+        raise SceneError(f"periodic_orbit: model {system.metadata.model} {why}", key="method",
+                         expected="a smooth lumped model (a hybrid model's periodic response: kind periodic)")
+
+
+def refuse_time_dependent(system, x: np.ndarray) -> None:
+    """An autonomous orbit needs a residual without t: compared at t = 0 and t = 1.2345 at the guess."""
+    n = system.n
+    r0 = system.residual(x[:n], x[n:], t=0.0)
+    r1 = system.residual(x[:n], x[n:], t=1.2345)
+    if not np.allclose(r0, r1, rtol=1e-12, atol=1e-14):
+        raise SceneError(f"periodic_orbit: model {system.metadata.model}'s equations depend on t (a forcing) and no "
+                         "frequency is given", key="frequency",
+                         expected="the forcing's angular frequency (rad/s), a number or a parameter expression")
+
+
+def guess(system, options: dict) -> np.ndarray:
+    """x0 = (q0, v0): the tables over the declared initial state (zero when none)."""
+    from mechgen.analyses.simulate import initial_state
+
+    q0, v0 = initial_state(system, options)
+    return np.concatenate([q0, v0])
+
+
+def simulated_states(system, options: dict, context: dict) -> tuple[np.ndarray, np.ndarray]:
+    """(t, states as rows) of the ``from`` simulate's trajectory; a SceneError when it kept none."""
+    name = options["from"]
+    earlier = context.get(name, {})
+    trajectory = earlier.get("trajectory")
+    names = time_series.state_names(system)[:2 * system.n]
+    if not trajectory or any(k not in trajectory for k in names) or len(earlier.get("t", ())) < 3:
+        raise SceneError(f"periodic_orbit: simulate analysis '{name}' kept no trajectory to start from", key="from",
+                         expected="a simulate analysis with series = true (and at least 3 samples)")
+    return np.asarray(earlier["t"], float), np.column_stack([trajectory[k] for k in names]).astype(float)
+
+
+def guess_from_simulate(system, options: dict, context: dict, omega) -> tuple[np.ndarray, float | None, int | None]:
+    """(x0, period guess or None, phase coordinate or None) from the ``from`` simulate: forced, the sample whose time is nearest a multiple of
+    T = 2 pi / omega among the last period's; autonomous, the sample at the last maximum of the coordinate that
+    varies most over the run's second half, and the time between its last two maxima."""
+    t, X = simulated_states(system, options, context)
+    if omega is not None:
+        T = 2 * np.pi / omega
+        last = t >= t[-1] - T
+        phase = np.abs(((t + T / 2) % T) - T / 2)
+        k = int(np.flatnonzero(last)[np.argmin(phase[last])])
+        return X[k], None, None
+    half = t >= (t[0] + t[-1]) / 2
+    p = int(np.argmax(np.ptp(X[half, :system.n], axis=0)))
+    q = X[:, p]
+    peaks = np.flatnonzero((q[1:-1] >= q[:-2]) & (q[1:-1] > q[2:])) + 1
+    if peaks.size < 2:
+        raise SceneError(f"periodic_orbit: simulate analysis '{options['from']}' shows fewer than two maxima of "
+                         f"'{system.coordinates[p]}' (no oscillation to start from)", key="from",
+                         expected="a simulate run over at least two periods of the orbit (a longer t_end)")
+    x0 = X[peaks[-1]].copy()
+    return x0, float(t[peaks[-1]] - t[peaks[-2]]), p
+
+
+def settings(options: dict, method: str) -> NewtonSettings:
+    """Newton's tolerances and its failure's advice."""
+    advice = ("a better starting guess (q0, v0" + (", period" if "frequency" not in options else "") + ")"
+              + (", more harmonics" if method == "harmonic_balance" else "") + " or the other method")
+    return NewtonSettings(rtol=float(options["rtol"]), atol=float(options["atol"]),
+                          max_iterations=int(options["max_iterations"]), what=f"periodic_orbit ({method})",
+                          advice=advice, trust=SHOOTING_TRUST if method == "shooting" else np.inf)
+
+
+def solve_harmonic_balance(system, options: dict, x0: np.ndarray, omega, phase: int) -> dict:
+    """Harmonic balance from the guess: {U, omega, x0 (the state at t = 0), residual, iterations}."""
+    H = int(options.get("harmonics", DEFAULT_HARMONICS))
+    problem = HarmonicBalance(system, fourier.basis(H), omega, phase)
+    w = float(omega if omega is not None else 2 * np.pi / options["period"])
+    n = system.n
+    U = np.zeros((2 * H + 1, n))
+    U[1], U[H + 1] = x0[:n], x0[n:] / w
+    if problem.autonomous:
+        U[H + 1, phase] = 0.0
+    sol = newton(problem.residual_jacobian, problem.unknowns(U, w), settings(options, "harmonic_balance"))
+    U, w = problem.split(sol.u)
+    start, _ = problem.start_state(sol.u)
+    return {"U": U, "omega": w, "x0": start, "residual": sol.residual, "iterations": sol.iterations}
+
+
+def compiled_run(system, options: dict):
+    """The compiled flow (mechgen.runtime.periodic.flow.compiled_flow) that ``loop`` asks for, or None."""
+    if options.get("loop", "auto") == "python":
+        return None
+    run = compiled_flow(system, *integrator_tolerances(options))
+    if run is None and options.get("loop") == "c":
+        from mechgen.runtime.integration.smooth_c import smooth_loop_problem
+
+        raise SceneError(f"periodic_orbit: loop 'c' cannot run here: "
+                         f"{smooth_loop_problem(system, *integrator_tolerances(options))}", key="loop",
+                         expected="auto or python, or a system on the C backend with a C compiler")
+    return run
+
+
+def solve_shooting(system, options: dict, x0: np.ndarray, omega, phase: int) -> dict:
+    """Shooting from the guess: {x0, omega, residual, iterations, loop}."""
+    rtol, atol = integrator_tolerances(options)
+    run = compiled_run(system, options)
+    problem = Shooting(system, omega, phase, rtol, atol, run)
+    if problem.autonomous:
+        x0 = x0.copy()
+        x0[system.n + phase] = 0.0
+    period = float(options["period"]) if omega is None else 2 * np.pi / omega
+    sol = newton(problem.residual_jacobian, problem.unknowns(x0, period), settings(options, "shooting"))
+    start, T = problem.split(sol.u)
+    return {"x0": np.asarray(start, float), "omega": 2 * np.pi / T, "residual": sol.residual,
+            "iterations": sol.iterations, "run": run}
+
+
+def integrator_tolerances(options: dict) -> tuple[float, float]:
+    """DOP853's rtol, atol: INTEGRATOR_SHARE of Newton's."""
+    return float(options["rtol"]) * INTEGRATOR_SHARE, float(options["atol"]) * INTEGRATOR_SHARE
+
+
+def orbit_samples(system, options: dict, found: dict, method: str, times: np.ndarray) -> np.ndarray:
+    """The states (rows) at ``times`` within [0, T]: the series of harmonic balance, the flow of shooting."""
+    if method == "harmonic_balance":
+        theta = found["omega"] * times
+        q = fourier.evaluate(found["U"], theta)
+        v = found["omega"] * fourier.evaluate(found["U"], theta, 1)
+        return np.hstack([q, v])
+    if found.get("run") is not None:
+        return found["run"](found["x0"], times)
+    return states_at(system, found["x0"], 0.0, times, *integrator_tolerances(options))
+
+
+def run_periodic_orbit(system, options: dict, context: dict) -> dict:
+    """See the module doc."""
+    refuse_unsupported(system)
+    method = chosen_method(options)
+    omega = options.get("frequency")
+    phase = None
+    if "from" in options:
+        x0, period, phase = guess_from_simulate(system, options, context, omega)
+        if omega is None and "period" not in options:
+            options = {**options, "period": period}
+    else:
+        x0 = guess(system, options)
+    if omega is None:
+        refuse_time_dependent(system, x0)
+        if not np.any(x0[:system.n]) and not np.any(x0[system.n:]):
+            raise SceneError("periodic_orbit: an autonomous orbit from a zero starting guess would find the "
+                             "equilibrium", key="q0", expected="a starting guess on or near the orbit (q0, v0)")
+    phase = int(np.argmax(np.abs(x0[:system.n]))) if phase is None else phase
+    solve = solve_harmonic_balance if method == "harmonic_balance" else solve_shooting
+    found = solve(system, options, x0, omega, phase)
+    return report(system, options, found, method, autonomous=omega is None)
+
+
+def report(system, options: dict, found: dict, method: str, *, autonomous: bool) -> dict:
+    """The outputs (module doc) of a converged orbit."""
+    w = found["omega"]
+    T = 2 * np.pi / w
+    names = list(system.coordinates)
+    n = system.n
+    fine_t = T * np.arange(FINE) / FINE
+    fine = orbit_samples(system, options, found, method, fine_t)
+    if autonomous and np.max(np.ptp(fine[:, :n], axis=0)) <= 1e3 * float(options["atol"]):
+        raise ConvergenceError(f"periodic_orbit ({method}): Newton converged to an equilibrium (the orbit's "
+                               "coordinates do not vary); try a starting guess nearer the limit cycle (q0, v0, period)")
+    U = found["U"] if method == "harmonic_balance" else fourier.coefficients_of_samples(
+        fine[:, :n], int(options.get("harmonics", DEFAULT_HARMONICS)))
+    _, Phi = variational_flow(system, found["x0"], 0.0, T, *integrator_tolerances(options))
+    mu = floquet.multipliers(Phi)
+    t = np.linspace(0.0, T, int(options["samples"]))
+    X = orbit_samples(system, options, found, method, t)
+    series = time_series.sampled_outputs(system, t, X)
+    trajectory = time_series.time_history(system, t, X, series, None)
+    return {"period": float(T), "frequency": float(w), "t": trajectory["t"], "trajectory": trajectory["trajectory"],
+            "amplitude": {c: peak(fine[:, i]) for i, c in enumerate(names)},
+            "harmonics": fourier.harmonics_table(U, names), "multipliers": floquet.as_pairs(mu),
+            "stability": floquet.stability(mu, autonomous), "method": method, "residual": float(found["residual"]),
+            "iterations": int(found["iterations"]), "loop": "c" if found.get("run") is not None else "python"}
+
+
+def peak(values: np.ndarray) -> float:
+    """max |q| of a periodic signal at equally spaced phases, refined by the parabola through the largest sample
+    and its two neighbours (wrapping around the period): the grid's O(h^2) error becomes O(h^3)."""
+    y = np.abs(np.asarray(values, float))
+    k = int(np.argmax(y))
+    a, b, c = y[k - 1], y[k], y[(k + 1) % y.size]
+    curvature = a - 2 * b + c
+    if curvature >= 0:
+        return float(b)
+    shift = 0.5 * (a - c) / curvature
+    return float(b - 0.25 * (a - c) * shift)
+
+
+def plot(plt, a: dict, path) -> list:
+    """The orbit: each coordinate against t over one period, and the phase portrait of each (up to 4)."""
+    out = a["outputs"]
+    traj = out["trajectory"]
+    names = [c for c in traj if f"{c}_dot" in traj][:4]
+    fig, axes = plt.subplots(1, 2, figsize=(9, 3.6))
+    for c in names:
+        axes[0].plot(out["t"], traj[c], label=c)
+        axes[1].plot(traj[c], traj[f"{c}_dot"], label=c)
+    axes[0].set_xlabel("t (s, or the model's time unit)")
+    axes[0].set_ylabel("coordinates")
+    axes[1].set_xlabel("q")
+    axes[1].set_ylabel("dq/dt")
+    for ax in axes if len(names) > 1 else ():
+        ax.legend(fontsize="small")
+    fig.suptitle(f"{a['name']}: T = {out['period']:.6g}, {out['stability']} ({out['method']})")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return [path]
+
+
+def summary_lines(outputs: dict) -> list[str]:
+    """Every output but the series and the harmonic tables, then the first harmonic's amplitude per coordinate."""
+    lines = summary.output_lines(outputs, skip=("harmonics", "trajectory", "t"))
+    first = {c: round(h["amplitude"][0], 6) if h["amplitude"] else 0.0 for c, h in outputs["harmonics"].items()}
+    return lines + [f"    first harmonic amplitude: {first}"] + time_series.summary_lines(outputs)
+
+
+register(AnalysisKind("periodic_orbit", SCHEMA, run_periodic_orbit, needs, summary_lines, check=check, plot=plot))
