@@ -69,6 +69,7 @@ from mechgen.analyses import figures, schema, summary
 from mechgen.analyses.bvp_states import (bvp_summary, shape_declarations, shape_values, stability_about,
                                          stability_of_each)
 from mechgen.analyses.newton_branch import newton_branch
+from mechgen.analyses.orbit_branch import run_orbit_branch
 from mechgen.analyses.special_curves import run_curve
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import REQUIRED, Option
@@ -88,7 +89,7 @@ DIRECTIONS = ("increasing", "decreasing", "both")
 def _starts(ctx, key: str, value: object) -> str | list[str]:
     """One earlier steady analysis, or an array of them (one branch each); or one earlier continuation (the curve
     of one of its special points, with ``special_point``)."""
-    if isinstance(value, str) and ctx.earlier.get(value) == "continuation":
+    if isinstance(value, str) and ctx.earlier.get(value) in ("continuation", "periodic_orbit"):
         return value
     if not isinstance(value, list):
         return schema.about(ctx, key, value)
@@ -143,7 +144,8 @@ def _parameter(ctx, key: str, value: object) -> str:
 
 SCHEMA = {
     "about": Option(_starts, REQUIRED, doc="the earlier steady analysis the branch starts from, or a list of them "
-                    "(one branch each)"),
+                    "(one branch each); or an earlier periodic_orbit (a branch of orbits), or an earlier "
+                    "continuation (with special_point: the curve of one of its special points)"),
     "parameter": Option(_parameter, REQUIRED, doc="the numeric parameter the branch is followed in"),
     "stop": Option(schema.number, REQUIRED, doc="the parameter's value where the branch ends (its unit)"),
     "step": Option(schema.positive, 0.05, doc="the first pseudo-arclength step"),
@@ -204,7 +206,7 @@ def check(ctx, base: str, options: dict) -> None:
                    "a curve of special points needs both 'about' an earlier continuation and 'special_point'",
                    "special_point = <position in its special_points> with about = \"<continuation>\"" if curve
                    else "about = an earlier steady analysis (special_point goes with about = a continuation)")
-    if curve:
+    if curve or (isinstance(about, str) and ctx.earlier.get(about) == "periodic_orbit"):
         return
     if isinstance(options["about"], list) and "minimize" in options:
         raise fail(ctx.file, f"{base}.minimize", "minimize follows one branch; 'about' lists several starts",
@@ -401,6 +403,8 @@ def run_continuation(system, options: dict, context: dict) -> dict:
     budget = Budget("continuation", unit="points", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
     if "special_point" in options:
         return run_curve(system, options, context[about])
+    if isinstance(about, str) and "_orbit" in context[about]:
+        return run_orbit_branch(system, options, context[about])
     if newton_starts(starts, context):
         return _newton_continuation(system, starts, options, context, budget)
     if options.get("switch_branches"):

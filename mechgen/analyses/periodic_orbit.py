@@ -108,7 +108,7 @@ def earlier_simulate(ctx, key: str, value: object) -> str:
 SCHEMA = {
     "method": Option(schema.one_of("method", METHODS), ABSENT, doc="harmonic_balance or shooting (left out: "
                      "harmonic_balance when harmonics is given, else shooting; collocation is not available yet)"),
-    "frequency": Option(schema.positive, ABSENT, doc="the forcing's angular frequency omega (rad/s): a number or an "
+    "frequency": Option(schema.positive_expression, ABSENT, doc="the forcing's angular frequency omega (rad/s): a number or an "
                         "expression of parameters such as \"omega\"; the period is 2 pi / omega (left out: an "
                         "autonomous orbit, its period found)"),
     "period": Option(schema.positive, ABSENT, doc="the starting guess of an autonomous orbit's period (s, or the "
@@ -323,7 +323,10 @@ def run_periodic_orbit(system, options: dict, context: dict) -> dict:
     phase = int(np.argmax(np.abs(x0[:system.n]))) if phase is None else phase
     solve = solve_harmonic_balance if method == "harmonic_balance" else solve_shooting
     found = solve(system, options, x0, omega, phase)
-    return report(system, options, found, method, autonomous=omega is None)
+    out = report(system, options, found, method, autonomous=omega is None)
+    # what a continuation of the orbit starts from (mechgen.analyses.orbit_branch)
+    out["_orbit"] = {"method": method, "phase": phase, "found": found, "options": dict(options)}
+    return out
 
 
 def report(system, options: dict, found: dict, method: str, *, autonomous: bool) -> dict:
