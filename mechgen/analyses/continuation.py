@@ -528,6 +528,40 @@ def _branch(plt, a: dict, path: Path) -> bool:
     return True
 
 
+def _orbit_branch(plt, a: dict, path: Path) -> bool:
+    """A branch of periodic orbits: each coordinate's amplitude against the parameter (stable solid, unstable
+    dashed), its cyclic folds, period doublings and torus points marked."""
+    out = a["outputs"]
+    points = out.get("branch") or []
+    if not points or not isinstance(points[0].get("amplitude"), dict):
+        return False
+    name = out["parameter"]
+    fig, ax = plt.subplots(figsize=(7, 5))
+    for coordinate in points[0]["amplitude"]:
+        lam = np.array([p[name] for p in points])
+        amp = np.array([p["amplitude"][coordinate] for p in points])
+        for style, label in (("-", "stable"), ("--", "unstable")):
+            shown = np.where([p["stability"] == label for p in points], amp, np.nan)
+            ax.plot(lam, shown, style, lw=1.2, label=f"{coordinate}, {label}")
+        for special in out.get("special_points", []):
+            ax.plot(special[name], special["amplitude"][coordinate], _ORBIT_MARKS.get(special["type"], "o"), ms=7,
+                    mfc="none", color="k")
+            ax.annotate(special["type"], (special[name], special["amplitude"][coordinate]), fontsize=7,
+                        xytext=(5, 4), textcoords="offset points")
+    ax.set_xlabel(figures.labelled(a, name))
+    ax.set_ylabel("amplitude max |q| over the period")
+    ax.legend(fontsize=7, loc="best")
+    ax.set_title(f"{a['name']}: periodic orbits against {name} ({out.get('method', '')})", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return True
+
+
+#: markers of the special points of a branch of orbits
+_ORBIT_MARKS = {"LPC": "x", "PD": "s", "NS": "D"}
+
+
 def _curve(plt, a: dict, path: Path) -> bool:
     """A special point's curve: the first parameter against the second (LP: fold curve; H: Hopf curve, the
     frequency on a second axis)."""
@@ -612,7 +646,7 @@ def plot(plt, a: dict, path: Path) -> list[Path]:
     outputs such as the loop count written where they change, folds, stability changes and the ``at``
     crossings marked), the shapes of the ``at`` points (first field against the last), with ``eigenvalues``
     their real and imaginary parts along the branch, and the lowest frequencies against the parameter."""
-    written = [path] if _branch(plt, a, path) or _curve(plt, a, path) else []
+    written = [path] if _orbit_branch(plt, a, path) or _branch(plt, a, path) or _curve(plt, a, path) else []
     out = a["outputs"]
     name = out.get("parameter", "parameter")
     for key in [k[3:] for k in out if k.startswith("at_") and not k.endswith("_shapes")]:

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from mechgen.analyses.newton_branch import arclength_steps
 from mechgen.analyses.periodic_orbit import DEFAULT_HARMONICS, compiled_run, integrator_tolerances, peak
 from mechgen.analyses.schema import ParamExpression
 from mechgen.analyses.stability_boundary import own_value
@@ -28,7 +29,7 @@ from mechgen.runtime.periodic.branch import OrbitBranch
 from mechgen.runtime.periodic.flow import differenced_flow, states_at, variational_flow
 from mechgen.runtime.periodic.harmonic_balance import HarmonicBalance
 from mechgen.runtime.periodic.shooting import Shooting
-from mechgen.runtime.steady.continuation import ContinuationOptions, continuation
+from mechgen.runtime.steady.continuation import continuation
 from mechgen.runtime.steady.cycle_points import cycle_points
 
 #: keys of a continuation that an orbit branch does not take
@@ -120,16 +121,6 @@ def record(orbits: Orbits, branch: OrbitBranch, u: np.ndarray, p: float) -> dict
             "multipliers": floquet.as_pairs(mu), "stability": floquet.stability(mu, orbits.autonomous)}
 
 
-def steps(options: dict, here: float) -> ContinuationOptions:
-    """Towards ``stop``, bounded by it (as the equilibrium branches)."""
-    stop = float(options["stop"])
-    budget = Budget("continuation", unit="points", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
-    return ContinuationOptions(ds=options.get("step", 0.05), ds_max=options.get("max_step", max(0.1, abs(stop - here) / 20)),
-                               direction=1 if stop >= here else -1, max_points=options.get("max_points", 200),
-                               budget=budget, progress=options.get("progress", True),
-                               **({"lam_max": stop} if stop >= here else {"lam_min": stop}))
-
-
 def run_orbit_branch(system, options: dict, earlier: dict) -> dict:
     """The branch of orbits through an earlier periodic_orbit (module doc)."""
     for key in ORBIT_REFUSES:
@@ -142,7 +133,8 @@ def run_orbit_branch(system, options: dict, earlier: dict) -> dict:
     branch = OrbitBranch(orbits.make, name)
     u0 = orbits.start(branch.problem(here), earlier["_orbit"]["found"])
     eqs = branch.equations()
-    found = continuation(eqs, u0, here, steps(options, here))
+    budget = Budget("continuation", unit="points", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
+    found = continuation(eqs, u0, here, arclength_steps(options, here, budget, smallest_span=0.1))
     points = [record(orbits, branch, u, p) for u, p in zip(found.u, found.lam)]
     X = np.hstack([found.u, found.lam[:, None]])
 

@@ -186,6 +186,14 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("switched_branches", "list of {at, half, branch, status}", "the outputs'", "With "
            "``switch_branches = true``: the other branch through every BP, both ways (``half`` ``+`` or ``-``; "
            "``at``: the BP's position in ``special_points``, from 1; ``branch``: its points as in ``branch``)."),
+        _o("method", "string", "-", "About a ``periodic_orbit``: the orbit's method (``harmonic_balance`` or "
+           "``shooting``) the branch is continued by."),
+        _o("branch (orbits)", "list of {<parameter>, period, frequency, amplitude, start, multipliers, stability}",
+           "s, rad/s, coordinates'", "About a ``periodic_orbit``: one entry per orbit of the branch: the parameter, "
+           "the period T, 2 pi / T, ``amplitude`` ({coordinate: max \|q\| over the period}), ``start`` (the state "
+           "at t = 0: each coordinate and ``<coordinate>_dot``), the Floquet ``multipliers`` ([re, im] by "
+           "decreasing modulus) and ``stability``; its ``special_points`` are ``LPC`` (cyclic fold), ``PD`` (period "
+           "doubling: a multiplier through -1) and ``NS`` (a complex pair through the unit circle, with ``angle``)."),
         _o("curve", "list of {<first>, <second>, coordinates, ..., frequency}", "the outputs'", "With "
            "``special_point`` (``about`` an earlier continuation): the curve of its LP or H in two parameters, "
            "one entry per point with both parameters, ``coordinates``, the model's outputs and, on an H curve, "

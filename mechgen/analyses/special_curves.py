@@ -13,11 +13,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from mechgen.analyses.newton_branch import arclength_steps
 from mechgen.analyses.steady import equilibrium_functions
 from mechgen.errors import SceneError
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget
 from mechgen.runtime.steady import codim2
-from mechgen.runtime.steady.continuation import ContinuationOptions, continuation
+from mechgen.runtime.steady.continuation import continuation
 
 #: keys of a continuation that a curve of special points does not take
 CURVE_REFUSES = ("method", "stages", "bounds", "at", "minimize", "switch_branches", "eigenvalues")
@@ -92,13 +93,8 @@ def run_curve(system, options: dict, earlier: dict) -> dict:
         G, u0 = codim2.fold_system(model.residual, model.jacobian, y0, a0, b0)
     else:
         G, u0 = codim2.hopf_system(model.residual, model.state_jacobian, y0, a0, b0)
-    stop = float(options["stop"])
     budget = Budget("continuation", unit="points", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
-    steps = ContinuationOptions(ds=options.get("step", 0.05),
-                                ds_max=options.get("max_step", max(1.0, abs(stop - b0) / 20)),
-                                direction=1 if stop >= b0 else -1, max_points=options.get("max_points", 200),
-                                budget=budget, progress=options.get("progress", True),
-                                **({"lam_max": stop} if stop >= b0 else {"lam_min": stop}))
+    steps = arclength_steps(options, b0, budget)
     branch = continuation(codim2.equations(G, f"the {kind} curve in ({first}, {second})"), u0, b0, steps)
     curve = [point(system, first, second, u, b, kind) for u, b in zip(branch.u, branch.lam)]
     return {"type": kind, "parameters": [first, second], "curve": curve, "points": len(curve),
