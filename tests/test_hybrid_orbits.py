@@ -204,3 +204,33 @@ def test_cycle_test_functions():
     assert ns_value(np.append(inside, 0.2)) * ns_value(np.append(outside, 0.2)) < 0
     assert is_ns(np.exp(1j * np.array([0.7, -0.7]))) and not is_ns(np.array([2.0, 0.5]))
     assert list(without_trivial(np.array([0.3, 1.0 + 1e-9, -0.2]), True)) == [0.3, -0.2]
+
+
+def test_hybrid_orbit_outputs_and_branch_with_the_doubled_orbit(tmp_path):
+    """The analysis layer (mechgen.analyses.hybrid_orbit): the forced orbit's outputs (one impact per period, the
+    multipliers' product e^2 exp(-c T), no grazing), and the branch in w through the PD point (multiplier -1 to
+    1e-9) with the doubled orbit past it (period 2 T at its own w, two impacts, stable)."""
+    from mechgen.analyses.hybrid_orbit import run_hybrid_orbit
+    from mechgen.analyses.orbit_branch import run_orbit_branch
+    from mechgen.analyses.schema import ParamExpression
+
+    path = tmp_path / "flip.py"
+    path.write_text(MODEL.replace('"impact_orbit"', '"flip_kind"'))
+    system = mechgen.compile(str(path), {"d": 0.0, "F": 1.0, "c": 0.05, "cor": 0.8, "w": 2.5})
+    run = mechgen.simulate(system, t_end=80 * 2 * math.pi / 2.5, samples=2, q0={"x": -0.5})
+    guess = np.array([run["trajectory"]["x"][-1], run["trajectory"]["x_dot"][-1]])
+    options = {"frequency": ParamExpression(2.5, "w"), "rtol": 1e-9, "atol": 1e-12, "max_iterations": 50,
+               "samples": 201}
+    out = run_hybrid_orbit(system, options, guess)
+    T = 2 * math.pi / 2.5
+    assert out["period"] == pytest.approx(T, rel=1e-15) and len(out["events"]) == 1 and out["grazing"] == []
+    product = np.prod([complex(*mu) for mu in out["multipliers"]]).real
+    assert product == pytest.approx(0.8**2 * math.exp(-0.05 * T), rel=1e-9)
+    assert set(out["trajectory"]["mode_series"]) == {0}
+    branch = run_orbit_branch(system, {"parameter": "w", "stop": 2.8, "max_step": 0.05, "switch_branches": True,
+                                       "progress": False}, {"_orbit": out["_orbit"]})
+    (pd,) = [s for s in branch["special_points"] if s["type"] == "PD"]
+    assert min(mu[0] for mu in pd["multipliers"]) == pytest.approx(-1.0, abs=1e-9)
+    (doubled,) = branch["doubled"]
+    assert doubled["period"] == pytest.approx(2 * 2 * math.pi / doubled["w"], rel=1e-14)
+    assert doubled["events_per_period"] == 2 and doubled["stability"] == "stable"

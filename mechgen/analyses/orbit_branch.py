@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from mechgen.analyses.hybrid_orbit import run_hybrid_branch
 from mechgen.analyses.newton_branch import arclength_steps
 from mechgen.analyses.periodic_orbit import DEFAULT_HARMONICS, compiled_run, integrator_tolerances, peak
 from mechgen.analyses.schema import ParamExpression
@@ -122,11 +123,15 @@ def record(orbits: Orbits, branch: OrbitBranch, u: np.ndarray, p: float) -> dict
 
 
 def run_orbit_branch(system, options: dict, earlier: dict) -> dict:
-    """The branch of orbits through an earlier periodic_orbit (module doc)."""
+    """The branch of orbits through an earlier periodic_orbit (module doc; a hybrid model's:
+    mechgen.analyses.hybrid_orbit.run_hybrid_branch, which also takes ``switch_branches``)."""
+    hybrid = bool(earlier["_orbit"].get("hybrid"))
     for key in ORBIT_REFUSES:
-        if options.get(key):
+        if options.get(key) and not (hybrid and key == "switch_branches"):
             raise SceneError(f"{key} does not apply to a branch of periodic orbits", key=key,
                              expected=f"no {key} (a continuation about a steady state takes it)")
+    if hybrid:
+        return run_hybrid_branch(system, options, earlier["_orbit"])
     name = options["parameter"]
     orbits = Orbits(system, name, earlier["_orbit"])
     here = float(own_value(system, name))
