@@ -198,7 +198,8 @@ def test_folds_are_special_points_and_nothing_else_is(tmp_path):
 def test_shipped_rotor_scene_reports_the_onset_speed():
     """scenes/rotor_internal_damping.toml (the built-in laval_rotor with c_i): H at Omega = sqrt(k_t/m)(1 + c/c_i)
     = 250 rad/s with the whirl frequency 200 rad/s (to 1e-8 relative: bisection to 1e-10 of a segment, then the
-    secant on Re of the critical pair); a linear model: no criticality is claimed."""
+    secant on Re of the critical pair); the hardening shaft (k_t3 > 0) makes it supercritical (l1 < 0: the bounded
+    whirl of scenes/rotor_whirl_limit_cycle.toml is born there)."""
     from pathlib import Path
 
     scene = Path(__file__).resolve().parents[1] / "scenes" / "rotor_internal_damping.toml"
@@ -206,7 +207,7 @@ def test_shipped_rotor_scene_reports_the_onset_speed():
     (h,) = out["special_points"]
     assert h["type"] == "H" and h["Omega"] == pytest.approx(250.0, rel=1e-8)
     assert h["frequency"] == pytest.approx(200.0, rel=1e-8)
-    assert h["criticality"] == "degenerate"
+    assert h["criticality"] == "supercritical" and h["lyapunov"] < 0
     curve = mechgen.run(str(scene))["analyses"][2]["outputs"]["curve"]
     c_i = np.array([p["c_i"] for p in curve])
     assert c_i[-1] == 320.0
@@ -279,3 +280,18 @@ def test_special_point_curve_refuses_a_branch_point_and_a_missing_index(tmp_path
     open(path, "w").write(text.replace('about = "cont"\nspecial_point = 1', 'about = "eq"\nspecial_point = 1'))
     assert main(["run", path]) == 2
     assert "special_point" in capsys.readouterr().err
+
+
+def test_rotor_whirl_limit_cycle_beyond_the_onset():
+    """scenes/rotor_whirl_limit_cycle.toml: at Omega = 300 rad/s the whirl is the circle r = R exp(i w t) with
+    w = c_i Omega / (c + c_i) = 240 rad/s and R^2 = (m w^2 - k_t) / k_t3 = 1e-4 m^2 (closed form: the damping
+    forces and the elastic and centripetal forces balance on the circle), to 1e-8 relative (shooting at Newton rtol
+    1e-9); the tilts stay at rest and the whirl is stable."""
+    from pathlib import Path
+
+    scene = Path(__file__).resolve().parents[1] / "scenes" / "rotor_whirl_limit_cycle.toml"
+    out = mechgen.run(str(scene))["analyses"][0]["outputs"]
+    assert out["frequency"] == pytest.approx(240.0, rel=1e-8)
+    assert out["amplitude"]["x"] == pytest.approx(0.01, rel=1e-8)
+    assert out["amplitude"]["y"] == pytest.approx(0.01, rel=1e-8)
+    assert out["amplitude"]["theta_x"] < 1e-12 and out["stability"] == "stable"
