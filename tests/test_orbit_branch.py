@@ -169,3 +169,53 @@ def test_orbit_branch_refuses_equilibrium_keys(tmp_path, capsys):
     assert main(["run", frc_scene(tmp_path, "shooting", 'minimize = "x"')]) == 2
     err = capsys.readouterr().err
     assert "minimize" in err and "Traceback" not in err
+
+
+def test_fold_curve_of_the_response_in_frequency_and_forcing(tmp_path):
+    """The upper cyclic fold of the Duffing curve followed in (w, F) by harmonic balance (H = 9): at every point a
+    multiplier is 1 (to 1e-5: harmonic balance's truncation at the largest amplitudes; a fold of a converged orbit
+    has one exactly); F has a minimum along the curve, the cusp where the two folds are born, near first-order
+    harmonic balance's cusp F = 0.0516, w = 1.0904 (d^2 = 3 c^2 w^2 with d = 1 - w^2, Nayfeh & Mook sec. 4.1;
+    to 6 %: the first order's neglected terms at A ~ 0.4); past it the curve returns along the lower fold, which
+    at F = 0.3 lies at the lower fold of the response curve (w = 1.3242362, to 1e-3: linear interpolation
+    between curve points)."""
+    scene = tmp_path / "cusp.toml"
+    (tmp_path / "duffing.py").write_text(DUFFING)
+    scene.write_text('''model = "duffing.py"
+backend = "c"
+[[analysis]]
+name = "orbit"
+kind = "periodic_orbit"
+method = "harmonic_balance"
+harmonics = 9
+frequency = "w"
+[[analysis]]
+name = "frc"
+kind = "continuation"
+about = "orbit"
+parameter = "w"
+stop = 2.5
+max_step = 0.05
+max_points = 400
+[[analysis]]
+name = "fold_curve"
+kind = "continuation"
+about = "frc"
+special_point = 1
+parameter = "F"
+stop = 0.0
+max_step = 0.02
+max_points = 130
+''')
+    out = mechgen.run(str(scene))["analyses"][2]["outputs"]
+    assert out["type"] == "LPC" and out["parameters"] == ["w", "F"]
+    curve = out["curve"]
+    F = np.array([p["F"] for p in curve])
+    w = np.array([p["w"] for p in curve])
+    for p in curve:
+        assert max(abs(complex(*mu)) for mu in p["multipliers"]) == pytest.approx(1.0, abs=1e-5)
+    k = int(np.argmin(F))
+    assert 0 < k < len(F) - 1 and F[-1] > 0.3
+    assert F[k] == pytest.approx(0.0516, rel=0.06) and w[k] == pytest.approx(1.0904, rel=0.01)
+    back = slice(k, None)
+    assert np.interp(0.3, F[back], w[back]) == pytest.approx(1.3242362, abs=1e-3)

@@ -150,12 +150,15 @@ def run_orbit_branch(system, options: dict, earlier: dict) -> dict:
     if options.get("special_points", True):
         specials += [(s.type, s.x, s.index, s.data) for s in cycle_points(eqs, X, multipliers,
                                                                            trivial=orbits.autonomous)]
-    records = []
+    records, located = [], []
     for kind, x, index, data in sorted(specials, key=lambda s: s[2]):
         rec = {"type": kind, **record(orbits, branch, x[:-1], x[-1])}
         if kind == "NS":
             rec["angle"] = data["angle"]
         records.append(rec)
+        located.append(np.asarray(x, float))
     return {"parameter": name, "method": orbits.method, "branch": points, "points": len(points),
             "status": found.status, "folds": [r for r in records if r["type"] == "LPC"],
-            "special_points": records, "shape_outputs": []}
+            "special_points": records, "shape_outputs": [],
+            # a curve of one of these points in two parameters starts here (mechgen.analyses.orbit_curves)
+            "_orbit": earlier["_orbit"], "_special_x": located}

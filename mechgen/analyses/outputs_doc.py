@@ -197,7 +197,8 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("curve", "list of {<first>, <second>, coordinates, ..., frequency}", "the outputs'", "With "
            "``special_point`` (``about`` an earlier continuation): the curve of its LP or H in two parameters, "
            "one entry per point with both parameters, ``coordinates``, the model's outputs and, on an H curve, "
-           "``frequency`` (omega of the pair +-i omega)."),
+           "``frequency`` (omega of the pair +-i omega); about a branch of orbits, the curve of its LPC, each "
+           "point with both parameters and the orbit's ``period``, ``amplitude``, ``start``, ``multipliers``."),
         _o("type", "string", "-", "With ``special_point``: ``LP`` or ``H``, the kind of point the curve follows."),
         _o("parameters", "list of two strings", "-", "With ``special_point``: the earlier continuation's "
            "parameter and the second one."),

@@ -77,6 +77,10 @@ def start_of(earlier: dict, index: int) -> tuple[str, np.ndarray, str]:
 def run_curve(system, options: dict, earlier: dict) -> dict:
     """The curve of a special point in two parameters (module doc)."""
     refuse_keys(options)
+    if "_orbit" in earlier:  # a branch of periodic orbits: the curve of its cyclic fold
+        from mechgen.analyses.orbit_curves import run_orbit_curve
+
+        return run_orbit_curve(system, options, earlier)
     if "_special_x" not in earlier:
         raise SceneError("the earlier continuation followed a boundary-value branch; special-point curves follow "
                          "Newton steady states' branches", key="about",
