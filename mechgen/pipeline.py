@@ -164,6 +164,8 @@ def all_kernels(model: Model) -> tuple[str, ...]:
                    and (k != "lagrangian" or not (model.is_hybrid or model.internals)))
     if not model.coordinate_names and not model.internals:  # no state: a section's stiffness, a rod, the outputs
         return tuple(k for k in lumped if k in ("outputs", "section", "rod"))
+    if model.is_hybrid:  # the event derivatives of saltation matrices (lower_hybrid)
+        lumped = lumped + (SALTATION,)
     if model.internals:  # a model of internal variables only (no coordinate) has no potential force
         return tuple(k for k in lumped if k != "force" or model.coordinate_names)
     return tuple(k for k in lumped if not k.startswith("rates"))
@@ -230,9 +232,11 @@ def lower_hybrid(model: Model, eqs, kernels, *, cse: bool = True) -> list[Kernel
 
     from mechgen.codegen.lower_lumped import lower_lumped, lower_matrices
 
-    wanted = [k for k in all_kernels(model) if k in kernels]
+    wanted = [k for k in all_kernels(model) if k in kernels and k != SALTATION]
     irs = [replace(lower_lumped(mode_eqs, k, cse=cse), name=f"{k}__{i}")
            for k in wanted for i, mode_eqs in enumerate(eqs.equations)]
+    if SALTATION in kernels:
+        irs += saltation_kernels(eqs, cse)
     if {"residual", "force"} & set(kernels):
         for i, (mode_eqs, guards) in enumerate(zip(eqs.equations, eqs.guards)):
             if not guards:
@@ -248,6 +252,33 @@ def lower_hybrid(model: Model, eqs, kernels, *, cse: bool = True) -> list[Kernel
     meta = eqs.meta()
     for ir in irs:
         ir.meta["hybrid"] = meta
+    return irs
+
+
+#: the pseudo-kernel of a hybrid model that asks for the derivatives its saltation matrices need
+SALTATION = "saltation"
+
+
+def saltation_kernels(eqs, cse: bool) -> list[KernelIR]:
+    """The derivatives of a hybrid model's events, for the saltation matrices of its periodic orbits
+    (mechgen.runtime.core.hybrid_system.HybridSystem.saltation): ``guard_jacobian__i`` g_x = dg/dx of the
+    guards leaving mode i (x = (q, v, z)), ``reset_jacobian__j`` R_x = dx+/dx and R_t = dx+/dt of reset j."""
+    import sympy as sp
+
+    from mechgen.codegen.lower_lumped import lower_matrices
+    from mechgen.symbolic.derive import TIME
+
+    first = eqs.equations[0]
+    x = sp.Matrix(list(first.q) + list(first.v) + list(first.z))
+    irs = []
+    for i, (mode_eqs, guards) in enumerate(zip(eqs.equations, eqs.guards)):
+        if guards:
+            g = sp.Matrix([ge.g for ge in guards])
+            irs.append(lower_matrices(mode_eqs, f"guard_jacobian__{i}", f"dg/dx of the guards leaving mode {i}",
+                                      {"g_x": g.jacobian(x)}, cse=cse))
+    for j, column in enumerate(eqs.resets):
+        irs.append(lower_matrices(first, f"reset_jacobian__{j}", f"dx+/dx and dx+/dt of reset {j}",
+                                  {"R_x": column.jacobian(x), "R_t": column.diff(TIME)}, cse=cse))
     return irs
 
 

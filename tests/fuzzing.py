@@ -70,6 +70,7 @@ CHEAP = {
     "fpu_large": {("params", "N"): 1000, ("analysis", 0, "t_end"): 10.0},
     "spring_pendulum": {("analysis", 2, "t_end"): 2.0},
     "laval_rotor": {("analysis", 1, "over", "Omega", "num"): 4},
+    "jeffcott_unbalance": {("analysis", 0, "over", "Omega", "num"): 20},
     "beam_modes": {("params", "N"): 4},
     "timoshenko_modes": {("params", "N"): 4},
     "beck_column": {("params", "N"): 8, ("analysis", 1, "over", "P", "num"): 4},

@@ -27,15 +27,19 @@ def test_spring_pendulum_residual_matches_hand_derivation():
 
 def test_laval_linear_matrices():
     """Linearised Laval rotor: M = diag(m, m, Id, Id), G = Ip Omega [[0, 1], [-1, 0]] on the tilts,
-    K = diag(k_t, k_t, k_r, k_r), D = diag(c, c, c_r, c_r) (Genta, Dynamics of Rotating Systems, ch. 4)."""
+    K = diag(k_t, k_t, k_r, k_r) + c_i Omega [[0, 1], [-1, 0]] on the translations (the circulatory matrix of
+    internal damping), D = diag(c + c_i, c + c_i, c_r, c_r) (Genta, Dynamics of Rotating Systems, ch. 4 and
+    sec. 8.3)."""
     model = models.get("laval_rotor")
     eqs = derive_lumped(model, all_free(model))
     p = {s.name: s for s in eqs.params}
     rest = {s: 0 for s in eqs.q + eqs.v}
     mats = {k: sp.simplify(v.subs(rest)) for k, v in eqs.linear_matrices().items()}
     assert mats["M"] == sp.diag(p["m"], p["m"], p["Id"], p["Id"])
-    assert mats["K"] == sp.diag(p["k_t"], p["k_t"], p["k_r"], p["k_r"])
-    assert mats["D"] == sp.diag(p["c"], p["c"], p["c_r"], p["c_r"])
+    circulatory = sp.zeros(4, 4)
+    circulatory[0, 1], circulatory[1, 0] = p["c_i"] * p["Omega"], -p["c_i"] * p["Omega"]
+    assert sp.simplify(mats["K"] - sp.diag(p["k_t"], p["k_t"], p["k_r"], p["k_r"]) - circulatory) == sp.zeros(4, 4)
+    assert sp.simplify(mats["D"] - sp.diag(p["c"] + p["c_i"], p["c"] + p["c_i"], p["c_r"], p["c_r"])) == sp.zeros(4, 4)
     G = sp.zeros(4, 4)
     G[2, 3], G[3, 2] = p["Ip"] * p["Omega"], -p["Ip"] * p["Omega"]
     assert mats["G"] == G

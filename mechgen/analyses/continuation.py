@@ -46,6 +46,17 @@ consecutive points, located by bisection along the branch to 1e-9 of the segment
 (mechgen.runtime.steady.branch_scan.switch): {parameter, aliased and shape outputs,
 ``from``, ``to``}. ``aliases`` may also name an analysis output:
 ``balloons_at_tension = "at_p_e"``.
+
+Special points (``special_points``, default true; mechgen.analyses.special_points): every branch reports its
+folds as ``LP``; a Newton steady state's branch also its branch points (``BP``, the sign changes of
+det [[F_y, F_p], [chord]], with the other branch's ``direction``) and, with ``stability``, its Hopf points
+(``H``, sign changes of the bialternate product of the eigenvalues, with ``frequency``, the first Lyapunov
+coefficient ``lyapunov`` and ``criticality``). ``switch_branches = true`` follows the other branch from every BP,
+both ways (``switched_branches``).
+
+Curves of special points (mechgen.analyses.special_curves): with ``about`` an earlier continuation and
+``special_point`` the position of one of its LP or H points, the continuation follows that point in two
+parameters (the earlier one and ``parameter``, up to ``stop``): output ``curve``, ``type``, ``parameters``.
 """
 
 from __future__ import annotations
@@ -58,6 +69,8 @@ from mechgen.analyses import figures, schema, summary
 from mechgen.analyses.bvp_states import (bvp_summary, shape_declarations, shape_values, stability_about,
                                          stability_of_each)
 from mechgen.analyses.newton_branch import newton_branch
+from mechgen.analyses.orbit_branch import run_orbit_branch
+from mechgen.analyses.special_curves import run_curve
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import REQUIRED, Option
 from mechgen.errors import SceneError
@@ -74,7 +87,10 @@ DIRECTIONS = ("increasing", "decreasing", "both")
 # --------------------------------------------------------------------------- schema
 
 def _starts(ctx, key: str, value: object) -> str | list[str]:
-    """One earlier steady analysis, or an array of them (one branch each)."""
+    """One earlier steady analysis, or an array of them (one branch each); or one earlier continuation (the curve
+    of one of its special points, with ``special_point``)."""
+    if isinstance(value, str) and ctx.earlier.get(value) in ("continuation", "periodic_orbit"):
+        return value
     if not isinstance(value, list):
         return schema.about(ctx, key, value)
     if not value:
@@ -128,7 +144,8 @@ def _parameter(ctx, key: str, value: object) -> str:
 
 SCHEMA = {
     "about": Option(_starts, REQUIRED, doc="the earlier steady analysis the branch starts from, or a list of them "
-                    "(one branch each)"),
+                    "(one branch each); or an earlier periodic_orbit (a branch of orbits), or an earlier "
+                    "continuation (with special_point: the curve of one of its special points)"),
     "parameter": Option(_parameter, REQUIRED, doc="the numeric parameter the branch is followed in"),
     "stop": Option(schema.number, REQUIRED, doc="the parameter's value where the branch ends (its unit)"),
     "step": Option(schema.positive, 0.05, doc="the first pseudo-arclength step"),
@@ -150,6 +167,14 @@ SCHEMA = {
     "at": Option(_output_values, doc="output = value: the points where an output crosses the value, located "
                  "along the branch (at_<output>)"),
     "eigenvalues": Option(schema.boolean, False, doc="report every branch point's eigenvalues too"),
+    "special_points": Option(schema.boolean, True, doc="locate and report the branch's special points: folds (LP), "
+                             "and on a Newton steady state's branch branch points (BP) and, with stability, Hopf "
+                             "points (H, with the first Lyapunov coefficient)"),
+    "special_point": Option(schema.count, doc="with about an earlier continuation: the position (from 1) of the "
+                            "fold (LP) or Hopf point (H) in its special_points whose curve in two parameters is "
+                            "followed (parameter: the second one)"),
+    "switch_branches": Option(schema.boolean, False, doc="also follow the other branch through every branch point "
+                              "(BP), both ways (output switched_branches; a Newton steady state's branch)"),
     "max_seconds": Option(schema.positive, doc="the wall-time budget of the whole analysis (s, default 600), "
                          "checked before every continuation step"),
     "progress": Option(schema.boolean, doc="draw a bar of the branch points on stderr (default true, when it is "
@@ -172,7 +197,17 @@ def _check_branch_outputs(ctx, base: str, options: dict) -> None:
 
 
 def check(ctx, base: str, options: dict) -> None:
-    """minimize follows one start; ``at`` and ``bounds`` name branch outputs; ``stop`` below the parameter's bound."""
+    """minimize follows one start; ``at`` and ``bounds`` name branch outputs; ``stop`` below the parameter's bound;
+    ``special_point`` with, and only with, ``about`` an earlier continuation."""
+    about = options["about"]
+    curve = isinstance(about, str) and ctx.earlier.get(about) == "continuation"
+    if curve != ("special_point" in options):
+        raise fail(ctx.file, f"{base}.special_point" if curve else f"{base}.about",
+                   "a curve of special points needs both 'about' an earlier continuation and 'special_point'",
+                   "special_point = <position in its special_points> with about = \"<continuation>\"" if curve
+                   else "about = an earlier steady analysis (special_point goes with about = a continuation)")
+    if curve or (isinstance(about, str) and ctx.earlier.get(about) == "periodic_orbit"):
+        return
     if isinstance(options["about"], list) and "minimize" in options:
         raise fail(ctx.file, f"{base}.minimize", "minimize follows one branch; 'about' lists several starts",
                    "one start (about = \"name\") with minimize")
@@ -343,12 +378,17 @@ def _newton_continuation(system, starts: list[str], options: dict, context: dict
     for s in starts:
         b = newton_branch(system, context[s], options, budget)
         if several:
-            for item in b["points"] + b["folds"] + b["stability_changes"]:
+            for item in b["points"] + b["folds"] + b["stability_changes"] + b.get("special_points", []):
                 item["start"] = s
         branches.append(b)
     out = {"parameter": name, "shape_outputs": [], "branch": [p for b in branches for p in b["points"]],
            "status": branches[0]["status"] if not several else {s: b["status"] for s, b in zip(starts, branches)},
            "points": sum(len(b["points"]) for b in branches), "folds": [f for b in branches for f in b["folds"]]}
+    if options.get("special_points", True):
+        out["special_points"] = [s for b in branches for s in b["special_points"]]
+        out["_special_x"] = [x for b in branches for x in b["_special_x"]]
+    if options.get("switch_branches"):
+        out["switched_branches"] = [s for b in branches for s in b["switched_branches"]]
     if options.get("stability", True):
         out["stability_changes"] = [c for b in branches for c in b["stability_changes"]]
     return out
@@ -361,12 +401,23 @@ def run_continuation(system, options: dict, context: dict) -> dict:
     starts = about if isinstance(about, list) else [about]
     name, aliases = options["parameter"], options.get("aliases", {})
     budget = Budget("continuation", unit="points", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
+    if "special_point" in options:
+        return run_curve(system, options, context[about])
+    if isinstance(about, str) and "_orbit" in context[about]:
+        return run_orbit_branch(system, options, context[about])
     if newton_starts(starts, context):
         return _newton_continuation(system, starts, options, context, budget)
+    if options.get("switch_branches"):
+        raise SceneError("switch_branches follows the branches of Newton steady states only; this continuation "
+                         "starts from a boundary-value steady state (its branch reports folds, LP)",
+                         key="switch_branches", expected="switch_branches = false (or a Newton steady state as the "
+                         "start)")
     branches = [_one_branch(system, context[s], options, s if isinstance(about, list) else None, budget)
                 for s in starts]
     out = {"parameter": name, "shape_outputs": [d.name for d in shape_declarations(system)],
            "branch": [p for b in branches for p in b["points"]],
+           "special_points": [{"type": "LP", **f} for b in branches for f in b["folds"]]
+           if options.get("special_points", True) else [],
            "status": branches[0]["status"] if len(branches) == 1 else
            {s: b["status"] for s, b in zip(starts, branches)},
            "points": sum(len(b["points"]) for b in branches),
@@ -419,8 +470,13 @@ def _families(points: list) -> list[list[dict]]:
     return list(groups.values())
 
 
+#: the markers of the special points besides folds (BP: square, H: star)
+_SPECIAL_MARKS = {"BP": "s", "H": "*"}
+
+
 def _branch(plt, a: dict, path: Path) -> bool:
-    """p_e (or another output) against the parameter: verdict colours, loop counts, folds, changes, crossings."""
+    """p_e (or another output) against the parameter: verdict colours, loop counts, folds, changes, crossings,
+    branch and Hopf points (labelled) and the branches switched onto (dashed)."""
     out = a["outputs"]
     if not out.get("branch"):
         return False
@@ -449,6 +505,15 @@ def _branch(plt, a: dict, path: Path) -> bool:
     for key in [k[3:] for k in out if k.startswith("at_") and not k.endswith("_shapes")]:
         for p in out[f"at_{key}"]:
             ax.plot(p[name], p[key], "o", ms=8, mfc="none", color="tab:green")
+    for half in out.get("switched_branches", []):
+        ax.plot([p[name] for p in half["branch"]], [p.get(output, float("nan")) for p in half["branch"]], "--",
+                color="0.45", lw=0.8, zorder=1)
+    for special in out.get("special_points", []):
+        if special["type"] in _SPECIAL_MARKS:
+            ax.plot(special[name], special.get(output, float("nan")), _SPECIAL_MARKS[special["type"]], ms=8,
+                    mfc="none", color="k")
+            ax.annotate(special["type"], (special[name], special.get(output, float("nan"))), fontsize=7,
+                        xytext=(5, -9), textcoords="offset points")
     handles = [plt.Line2D([], [], ls="", marker=".", color=c, label=v) for v, c in colours.items()]
     handles += [plt.Line2D([], [], ls="", marker="x", color="tab:purple", label="fold"),
                 plt.Line2D([], [], ls="", marker="d", mfc="none", color="tab:orange", label="stability change"),
@@ -463,9 +528,70 @@ def _branch(plt, a: dict, path: Path) -> bool:
     return True
 
 
+def _orbit_branch(plt, a: dict, path: Path) -> bool:
+    """A branch of periodic orbits: each coordinate's amplitude against the parameter (stable solid, unstable
+    dashed), its cyclic folds, period doublings and torus points marked."""
+    out = a["outputs"]
+    points = out.get("branch") or []
+    if not points or not isinstance(points[0].get("amplitude"), dict):
+        return False
+    name = out["parameter"]
+    fig, ax = plt.subplots(figsize=(7, 5))
+    for coordinate in points[0]["amplitude"]:
+        lam = np.array([p[name] for p in points])
+        amp = np.array([p["amplitude"][coordinate] for p in points])
+        for style, label in (("-", "stable"), ("--", "unstable")):
+            shown = np.where([p["stability"] == label for p in points], amp, np.nan)
+            ax.plot(lam, shown, style, lw=1.2, label=f"{coordinate}, {label}")
+        for special in out.get("special_points", []):
+            ax.plot(special[name], special["amplitude"][coordinate], _ORBIT_MARKS.get(special["type"], "o"), ms=7,
+                    mfc="none", color="k")
+            ax.annotate(special["type"], (special[name], special["amplitude"][coordinate]), fontsize=7,
+                        xytext=(5, 4), textcoords="offset points")
+    ax.set_xlabel(figures.labelled(a, name))
+    ax.set_ylabel("amplitude max |q| over the period")
+    ax.legend(fontsize=7, loc="best")
+    ax.set_title(f"{a['name']}: periodic orbits against {name} ({out.get('method', '')})", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return True
+
+
+#: markers of the special points of a branch of orbits
+_ORBIT_MARKS = {"LPC": "x", "PD": "s", "NS": "D"}
+
+
+def _curve(plt, a: dict, path: Path) -> bool:
+    """A special point's curve: the first parameter against the second (LP: fold curve; H: Hopf curve, the
+    frequency on a second axis)."""
+    out = a["outputs"]
+    if not out.get("curve"):
+        return False
+    first, second = out["parameters"]
+    b, p = [c[second] for c in out["curve"]], [c[first] for c in out["curve"]]
+    fig, ax = plt.subplots(figsize=(7, 5))
+    ax.plot(b, p, "k.-", ms=3, lw=1.0, label=f"{out['type']} curve")
+    if out["type"] == "H":
+        twin = ax.twinx()
+        freq = [c["frequency"] for c in out["curve"]]
+        twin.plot(b, freq, "--", color="tab:blue", lw=0.8)
+        twin.set_ylabel("frequency at the Hopf point (rad per unit time)", color="tab:blue")
+        middle, half = (max(freq) + min(freq)) / 2, max((max(freq) - min(freq)) / 2 * 1.1, 0.01 * max(freq))
+        twin.set_ylim(middle - half, middle + half)   # a frequency constant along the curve: +-1 %, not round-off
+    ax.set_xlabel(figures.labelled(a, second))
+    ax.set_ylabel(figures.labelled(a, first))
+    ax.legend(fontsize=7, loc="best")
+    ax.set_title(f"{a['name']}: the {out['type']} point in ({first}, {second})", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return True
+
+
 def _eigenvalues_along(plt, a: dict, path: Path, count: int = 4) -> bool:
     """Real and imaginary parts of the eigenvalues with the smallest |Im| (Im >= 0) at every branch point."""
-    points = a["outputs"]["branch"]
+    points = a["outputs"].get("branch")
     if not points or "eigenvalues" not in points[0]:
         return False
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
@@ -520,7 +646,7 @@ def plot(plt, a: dict, path: Path) -> list[Path]:
     outputs such as the loop count written where they change, folds, stability changes and the ``at``
     crossings marked), the shapes of the ``at`` points (first field against the last), with ``eigenvalues``
     their real and imaginary parts along the branch, and the lowest frequencies against the parameter."""
-    written = [path] if _branch(plt, a, path) else []
+    written = [path] if _orbit_branch(plt, a, path) or _branch(plt, a, path) or _curve(plt, a, path) else []
     out = a["outputs"]
     name = out.get("parameter", "parameter")
     for key in [k[3:] for k in out if k.startswith("at_") and not k.endswith("_shapes")]:

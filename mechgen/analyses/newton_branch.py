@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from mechgen.analyses import special_points
 from mechgen.analyses.stability_boundary import own_value, spectrum
 from mechgen.analyses.steady import equilibrium_functions, newton_aliases
 from mechgen.errors import SceneError
@@ -83,13 +84,16 @@ def point(system, name: str, y: np.ndarray, p: float, options: dict) -> dict:
     return out
 
 
-def _steps(system, name: str, options: dict, here: float, budget: Budget) -> ContinuationOptions:
-    """The step control: towards ``stop`` (or the given ``direction``), bounded by it."""
+def arclength_steps(options: dict, here: float, budget: Budget, *,
+                    smallest_span: float = 1.0) -> ContinuationOptions:
+    """The step control of a continuation from the parameter value ``here``: towards ``stop`` (or the given
+    ``direction``), bounded by it; the first step ``step`` (default 0.05; at most ``max_step``) and the largest
+    ``max_step`` (default max(smallest_span, |stop - here| / 20))."""
     stop = float(options["stop"])
     rising = options.get("direction", "increasing" if stop >= here else "decreasing") == "increasing"
     bound = {"lam_max": stop} if stop >= here else {"lam_min": stop}
-    largest = options.get("max_step", max(1.0, abs(stop - here) / 20))
-    return ContinuationOptions(ds=options.get("step", 0.05), ds_max=largest,
+    largest = options.get("max_step", max(smallest_span, abs(stop - here) / 20))
+    return ContinuationOptions(ds=min(options.get("step", 0.05), largest), ds_max=largest,
                                direction=1 if rising else -1, max_points=options.get("max_points", 200), **bound,
                                budget=budget, progress=options.get("progress", True))
 
@@ -101,14 +105,16 @@ def newton_branch(system, start: dict, options: dict, budget: Budget) -> dict:
     here = float(own_value(system, name))
     eqs = equations(system, name)
     y0 = np.concatenate([np.asarray(start["_q"], float), np.asarray(start["_z"], float).ravel()])
-    branch = continuation(eqs, y0, here, _steps(system, name, options, here, budget))
+    branch = continuation(eqs, y0, here, arclength_steps(options, here, budget))
     points = [point(system, name, u, lam, options) for u, lam in zip(branch.u, branch.lam)]
     quiet = {**options, "stability": False}
     out = {"points": points, "status": branch.status,
            "folds": [point(system, name, f.u, f.lam, quiet) for f in branch.folds], "stability_changes": []}
+    X = np.hstack([branch.u, branch.lam[:, None]])
+    n = X.shape[1] - 1
+    if options.get("special_points", True):
+        out.update(special(system, eqs, X, branch, options, arclength_steps(options, here, budget)))
     if options.get("stability", True):
-        X = np.hstack([branch.u, branch.lam[:, None]])
-        n = X.shape[1] - 1
 
         def verdict(x):
             return spectrum(system.with_params(**{name: float(x[n])}), x[:n]).verdict
@@ -118,4 +124,25 @@ def newton_branch(system, start: dict, options: dict, budget: Budget) -> dict:
             if a != b:
                 x = branch_scan.switch(eqs, X[i], X[i + 1], verdict, a)
                 out["stability_changes"].append({**point(system, name, x[:n], x[n], quiet), "from": a, "to": b})
+    return out
+
+
+def special(system, eqs, X: np.ndarray, branch, options: dict, steps: ContinuationOptions) -> dict:
+    """``special_points`` (LP, BP and, with ``stability``, H) and with ``switch_branches`` the ``switched_branches``
+    (mechgen.analyses.special_points)."""
+    name = options["parameter"]
+    require_dense(X.shape[1], 8, "the branch-point test function (a dense determinant at every branch point)",
+                  key="special_points", expected="special_points = false for a system this large")
+    quiet = {**options, "stability": False}
+
+    def at(y, p):
+        return point(system, name, y, p, quiet)
+
+    found = special_points.located(system, eqs, X, branch, name, hopf=options.get("stability", True))
+    out = {"special_points": [special_points.record(system, name, s, at) for s in found],
+           "_special_x": [s.x.copy() for s in found]}   # (y, p) of each: a curve of special points starts there
+    if options.get("switch_branches"):
+        full = {**options, "stability": options.get("stability", True)}
+        out["switched_branches"] = special_points.switched(
+            eqs, found, steps, lambda y, p: point(system, name, y, p, full))
     return out

@@ -175,6 +175,33 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("folds", "list of branch points", "the outputs'", "The turning points in the parameter."),
         _o("stability_changes", "list of {..., from, to}", "the outputs'", "With ``stability``: where the "
            "verdict changes between consecutive points, located by bisection along the branch."),
+        _o("special_points", "list of {type, <parameter>, coordinates, ...}", "the outputs'",
+           "With ``special_points`` (default): the located special points in branch order, ``type`` ``LP`` "
+           "(fold), ``BP`` (branch point, with ``direction``: the other branch's unit direction per coordinate "
+           "and the parameter) or ``H`` (Hopf, with stability: ``frequency`` of the critical pair +-i omega in "
+           "rad per unit of the model's time, ``lyapunov`` the first Lyapunov coefficient l1 with Kuznetsov's "
+           "normalisation, ``criticality`` ``supercritical`` (l1 < 0), ``subcritical`` (l1 > 0) or "
+           "``degenerate`` (l1 zero to working precision: a linear model)); a boundary value "
+           "problem's branch reports its folds (LP)."),
+        _o("switched_branches", "list of {at, half, branch, status}", "the outputs'", "With "
+           "``switch_branches = true``: the other branch through every BP, both ways (``half`` ``+`` or ``-``; "
+           "``at``: the BP's position in ``special_points``, from 1; ``branch``: its points as in ``branch``)."),
+        _o("method", "string", "-", "About a ``periodic_orbit``: the orbit's method (``harmonic_balance`` or "
+           "``shooting``) the branch is continued by."),
+        _o("branch (orbits)", "list of {<parameter>, period, frequency, amplitude, start, multipliers, stability}",
+           "s, rad/s, coordinates'", "About a ``periodic_orbit``: one entry per orbit of the branch: the parameter, "
+           "the period T, 2 pi / T, ``amplitude`` ({coordinate: max \|q\| over the period}), ``start`` (the state "
+           "at t = 0: each coordinate and ``<coordinate>_dot``), the Floquet ``multipliers`` ([re, im] by "
+           "decreasing modulus) and ``stability``; its ``special_points`` are ``LPC`` (cyclic fold), ``PD`` (period "
+           "doubling: a multiplier through -1) and ``NS`` (a complex pair through the unit circle, with ``angle``)."),
+        _o("curve", "list of {<first>, <second>, coordinates, ..., frequency}", "the outputs'", "With "
+           "``special_point`` (``about`` an earlier continuation): the curve of its LP or H in two parameters, "
+           "one entry per point with both parameters, ``coordinates``, the model's outputs and, on an H curve, "
+           "``frequency`` (omega of the pair +-i omega); about a branch of orbits, the curve of its LPC, each "
+           "point with both parameters and the orbit's ``period``, ``amplitude``, ``start``, ``multipliers``."),
+        _o("type", "string", "-", "With ``special_point``: ``LP`` or ``H``, the kind of point the curve follows."),
+        _o("parameters", "list of two strings", "-", "With ``special_point``: the earlier continuation's "
+           "parameter and the second one."),
         _o("shape_outputs", "list of strings", "-", "The shape outputs reported at every point."),
         _o("at_<output>", "list of {<parameter>, <output>, ..., verdict, refinement}", "the outputs'",
            "With ``at = {output = value}``: the points where the output crosses the value, sorted by the "
@@ -189,12 +216,33 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
            "(``balloons_at_tension = \"at_p_e\"``)."),
     ),
     "response": (
-        _o("omega", "(frequencies,)", "rad/s", "The driving frequencies."),
-        _o("input", "string", "-", "The coordinate the unit force drives."),
-        _o("amplitude", "{coordinate: (frequencies,)}", "coordinate per unit force (m/N ...)",
-           "\\|H_kj(omega)\\|, the receptance's magnitude for each output coordinate k."),
-        _o("phase", "{coordinate: (frequencies,)}", "rad", "arg H_kj(omega): the response's phase relative to "
-           "the force."),
+        _o("omega", "(frequencies,)", "rad/s", "The driving frequencies (with ``unbalance``: the spin speeds), in "
+           "rad/s whatever ``speed_unit`` the scene writes them in."),
+        _o("input", "string", "-", "With ``input``: the coordinate the unit force drives."),
+        _o("amplitude", "{coordinate: (frequencies,)}", "coordinate per unit force (m/N ...) with ``input``; the "
+           "coordinate's (m, rad) with ``force`` or ``unbalance``",
+           "\\|X_k\\| of the response q_k(t) = \\|X_k\\| cos(omega t + phase_k) for each output coordinate k: "
+           "with ``input`` the receptance's magnitude \\|H_kj(omega)\\|, else \\|(H(omega) f)_k\\|."),
+        _o("phase", "{coordinate: (frequencies,)}", "rad", "arg X_k: the response's phase relative to the "
+           "forcing's reference cos(omega t) (the unit force, a force pattern's phase 0, an unbalance's shaft angle "
+           "Omega t); negative: the response lags."),
+        _o("forcing", "string", "-", "Which forcing was applied: ``input``, ``force`` or ``unbalance``."),
+        _o("speed_unit", "string", "-", "The unit the scene wrote its frequencies or speeds in (``rad/s``, "
+           "``Hz`` or ``rpm``)."),
+        _o("omega_in_unit", "(frequencies,)", "``speed_unit``", "``omega`` expressed in ``speed_unit`` (the plots' "
+           "axis)."),
+        _o("speeds", "(frequencies,)", "rad/s", "With ``unbalance``: the spin speeds (equal to ``omega``: an "
+           "unbalance drives at the speed), as campbell names them."),
+        _o("parameter", "string", "-", "With ``unbalance``: the speed parameter the matrices were re-linearised "
+           "in at each speed."),
+        _o("orbit", "{\"x,y\": {major, minor, angle, whirl, whirl_ratio: (frequencies,)}}",
+           "the coordinates' (m); angle rad", "Per coordinate pair (``orbits``; default the unbalances' pairs): "
+           "the ellipse x = Re(X_x e^{i omega t}), y = Re(X_y e^{i omega t}) at each frequency: ``major`` and "
+           "``minor`` semi-axes, ``angle`` of the major axis from x towards y, ``whirl`` forward, backward (the "
+           "sign of the angular momentum x y' - y x'), linear (a straight line) or none (at rest), "
+           "``whirl_ratio`` the signed minor / major."),
+        _o("orbit_at", "(picked,)", "rad/s", "The frequencies whose orbits the orbit figure draws (the computed "
+           "ones nearest the scene's ``orbit_at``, else up to five spread over the range and the largest)."),
     ),
     "fit": (
         _o("<parameter>", "scalar, or (groups,)", "the parameter's", "Each estimated parameter (a list per "

@@ -150,7 +150,7 @@ def adapt_count(ctx, key: str, value: object) -> int:
 SCHEMA = {
     "method": Option(schema.one_of("method", METHODS), ABSENT, doc="harmonic_balance, shooting or collocation "
                      "(left out: harmonic_balance when harmonics is given, collocation when mesh is, else shooting)"),
-    "frequency": Option(schema.positive, ABSENT, doc="the forcing's angular frequency omega (rad/s): a number or an "
+    "frequency": Option(schema.positive_expression, ABSENT, doc="the forcing's angular frequency omega (rad/s): a number or an "
                         "expression of parameters such as \"omega\"; the period is 2 pi / omega (left out: an "
                         "autonomous orbit, its period found)"),
     "period": Option(schema.positive, ABSENT, doc="the starting guess of an autonomous orbit's period (s, or the "
@@ -405,8 +405,8 @@ def solve_shooting(system, options: dict, start: Guess, omega) -> dict:
     if problem.autonomous:
         X[0, system.n + start.phase] = 0.0
     sol = newton(problem.residual_jacobian, problem.unknowns(X, start.period), settings(options, "shooting"))
-    starts, T = problem.split(sol.u)
-    return {"x0": np.asarray(starts[0], float), "omega": 2 * np.pi / T, "residual": sol.residual,
+    x0, T = problem.split(sol.u)
+    return {"x0": np.asarray(x0, float), "omega": 2 * np.pi / T, "residual": sol.residual,
             "iterations": sol.iterations, "run": run}
 
 
@@ -442,7 +442,10 @@ def run_periodic_orbit(system, options: dict, context: dict) -> dict:
                              "equilibrium", key="q0", expected="a starting guess on or near the orbit (q0, v0)")
     solve = {"harmonic_balance": solve_harmonic_balance, "collocation": solve_collocation}.get(method, solve_shooting)
     found = solve(system, options, start, omega)
-    return report(system, options, found, method, autonomous=omega is None)
+    out = report(system, options, found, method, autonomous=omega is None)
+    # what a continuation of the orbit starts from (mechgen.analyses.orbit_branch)
+    out["_orbit"] = {"method": method, "phase": start.phase, "found": found, "options": dict(options)}
+    return out
 
 
 def report(system, options: dict, found: dict, method: str, *, autonomous: bool) -> dict:

@@ -198,12 +198,16 @@ def periodic_orbit(system, *, name: str | None = None, **options) -> Result:
 
 
 def response(system, *, name: str | None = None, **options) -> Result:
-    """The steady harmonic response to a unit force at one coordinate: the receptance
-    H(omega) = (K - omega^2 M + i omega (D + G))^-1 about an operating point (mechgen.analyses.response).
+    """The steady harmonic response X(omega) = H(omega) f, H(omega) = (K - omega^2 M + i omega (D + G))^-1,
+    about an operating point (mechgen.analyses.response), to a unit force (``input``), a force pattern
+    (``force``: ``{"x": 1.0, "y": {"amplitude": 1.0, "phase": 90}}``, phases in degrees) or an unbalance
+    (``unbalance``: ``{"coordinates": ["x", "y"], "mass": kg, "eccentricity": m}``, over the speeds ``over``
+    with the matrices re-linearised at each speed).
 
-    Options: ``input`` (the driven coordinate) and ``omega`` (rad/s: a list or {start, stop, num}) required,
-    ``outputs``, ``about``, ``at``, ``max_seconds``. Outputs: ``omega``, ``amplitude`` and ``phase`` per output
-    coordinate (``abs(H_kj)``, ``arg(H_kj)`` in rad).
+    Options: one of ``input``, ``force``, ``unbalance``; ``omega`` (with input or force) or ``over`` (with
+    unbalance); ``speed_unit`` (rad/s, Hz, rpm), ``outputs``, ``orbits``, ``orbit_at``, ``about``, ``at``,
+    ``max_seconds``. Outputs: ``omega`` (rad/s), ``amplitude`` and ``phase`` per output coordinate (rad),
+    ``forcing``, ``speed_unit``, ``omega_in_unit``, and with orbits ``orbit`` per coordinate pair.
     """
     return _run("response", system, options, name)
 
@@ -279,12 +283,15 @@ def campbell(system, *, name: str | None = None, **options) -> Result:
 
 
 def continuation(system, about, *, name: str | None = None, **options) -> Result:
-    """The branch of steady states through ``about`` (a steady Result of a continuum, or a list of them)
-    as ``parameter`` goes to ``stop``.
+    """The branch of steady states through ``about`` (a steady Result, or a list of them) as ``parameter`` goes
+    to ``stop``, with its special points (folds LP, branch points BP, Hopf points H with the first Lyapunov
+    coefficient); or, with ``about`` a continuation Result and ``special_point``, the curve of one of its LP or H
+    points in two parameters.
 
     Options: ``parameter`` and ``stop`` (required), ``step``, ``max_step``, ``max_points``, ``method``,
     ``stages``, ``mesh``, ``stability``, ``minimize``, ``aliases``, ``direction``, ``bounds``, ``at``,
-    ``eigenvalues``. Outputs: ``branch`` (points with the parameter, outputs and ``verdict``), ``folds``,
+    ``eigenvalues``, ``special_points``, ``switch_branches``, ``special_point``. Outputs: ``branch`` (points with
+    the parameter, outputs and ``verdict``), ``folds``, ``special_points``, ``switched_branches``, ``curve``,
     ``status``, ``points`` ...
     """
     return _run("continuation", system, {"about": about, **options}, name)

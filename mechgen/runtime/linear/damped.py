@@ -332,9 +332,7 @@ def orbit_kappa(shapes, x_index, y_index) -> np.ndarray:
     S = |X|^2 + |Y|^2 the semi-axes satisfy a^2 + b^2 = S, a b = |P|, so kappa = P / a^2 with
     a^2 = (S + sqrt(S^2 - 4 P^2)) / 2.
     """
-    P, S, _, _ = _orbits(shapes, x_index, y_index)
-    a2 = 0.5 * (S + np.sqrt(np.maximum(S * S - 4.0 * P * P, 0.0)))
-    return np.where(a2 > 0, P / np.where(a2 > 0, a2, 1.0), 0.0)
+    return orbit_axes(shapes, x_index, y_index)["kappa"]
 
 
 def orbit_axes(shapes, x_index, y_index) -> dict[str, np.ndarray]:
@@ -357,8 +355,11 @@ def orbit_axes(shapes, x_index, y_index) -> dict[str, np.ndarray]:
     X, Y = Q[xi[dom], np.arange(Q.shape[1])], Q[yi[dom], np.arange(Q.shape[1])]
     P, C = np.imag(X * np.conj(Y)), np.real(X * np.conj(Y))
     S = np.abs(X) ** 2 + np.abs(Y) ** 2
-    root = np.sqrt(np.maximum(S * S - 4.0 * P * P, 0.0))
-    a2, b2 = 0.5 * (S + root), np.maximum(0.5 * (S - root), 0.0)
+    # S^2 - 4 P^2 = (|X|^2 - |Y|^2)^2 + 4 C^2, free of cancellation (a circle: both terms vanish), and
+    # b = |P| / a (not sqrt((S - root) / 2), which cancels for a near-straight line)
+    root = np.hypot(np.abs(X) ** 2 - np.abs(Y) ** 2, 2.0 * C)
+    a2 = 0.5 * (S + root)
+    b2 = np.where(a2 > 0, P * P / np.where(a2 > 0, a2, 1.0), 0.0)
     angle = 0.5 * np.arctan2(2.0 * C, np.abs(X) ** 2 - np.abs(Y) ** 2)
     angle = np.where(angle <= -np.pi / 2 + 1e-9, angle + np.pi, angle) + 0.0
     kappa = np.where(a2 > 0, P / np.where(a2 > 0, a2, 1.0), 0.0)

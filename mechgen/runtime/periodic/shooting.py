@@ -56,12 +56,17 @@ class Shooting:
         X = np.asarray(X, float).ravel()
         return np.append(X, period) if self.autonomous else X.copy()
 
-    def split(self, u: np.ndarray) -> tuple[np.ndarray, float]:
+    def starts(self, u: np.ndarray) -> tuple[np.ndarray, float]:
         """(X: the segments' start states, S x 2n, T) of the unknowns."""
         d = 2 * self.system.n
         if self.autonomous:
             return u[:-1].reshape(self.segments, d), float(u[-1])
         return u.reshape(self.segments, d), 2 * np.pi / self.omega
+
+    def split(self, u: np.ndarray) -> tuple[np.ndarray, float]:
+        """(x0: the state at t = 0, T) of the unknowns (the first segment's start)."""
+        X, T = self.starts(u)
+        return X[0], T
 
     def segment_flow(self, x: np.ndarray, k: int, T: float) -> tuple[np.ndarray, np.ndarray]:
         """(x(t_k + T/S), Phi_k) from x(t_k) = x (module doc)."""
@@ -74,7 +79,7 @@ class Shooting:
 
     def flow(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(x(T), the monodromy matrix Phi_{S-1} ... Phi_0) of the segments' flows (x(T) from the last segment)."""
-        X, T = self.split(u)
+        X, T = self.starts(u)
         Phi = np.eye(X.shape[1])
         for k in range(self.segments):
             end, step = self.segment_flow(X[k], k, T)
@@ -83,7 +88,7 @@ class Shooting:
 
     def residual_jacobian(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(R(u), dR/du) (module doc)."""
-        X, T = self.split(u)
+        X, T = self.starts(u)
         S, d = X.shape
         R = np.empty(S * d)
         J = np.zeros((S * d + self.autonomous, S * d + self.autonomous))
@@ -105,7 +110,7 @@ class Shooting:
         """dR/domega of a forced orbit at fixed parameters: single shooting's f(T, x(T)) dT/domega, dT/domega =
         -2 pi / omega^2 (the period alone moves); multiple shooting's by central differences (step 1e-6 omega)."""
         if self.segments == 1:
-            X, T = self.split(u)
+            X, T = self.starts(u)
             end, _ = self.segment_flow(X[0], 0, T)
             return self.system.rhs(T, end) * (-2 * np.pi / self.omega**2)
         h = 1e-6 * self.omega

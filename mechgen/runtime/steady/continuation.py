@@ -380,7 +380,7 @@ def _check_system(system, u, lam):
 
 
 def continuation(system, u0, lam0: float, options: ContinuationOptions | None = None, *,
-                 callback: Callable | None = None, **overrides) -> Branch:
+                 callback: Callable | None = None, start_tangent: np.ndarray | None = None, **overrides) -> Branch:
     """Continue F(u, lam) = 0 from (u0, lam0) in the direction of increasing lam
     (``direction=+1``) or decreasing lam (-1).
 
@@ -388,13 +388,13 @@ def continuation(system, u0, lam0: float, options: ContinuationOptions | None = 
     start is first corrected at fixed lam0 (Newton). ``options`` (a :class:`ContinuationOptions`,
     its defaults when None) set the steps and the stopping rules; keyword ``overrides`` replace
     single options (``continuation(F, u0, lam0, ds=0.1, lam_max=2.0)``). ``callback(u, lam)`` is
-    called at every accepted point and its values are kept in ``Branch.data``.
+    called at every accepted point and its values are kept in ``Branch.data``. ``start_tangent``: a start
+    already on the branch (a branch point, mechgen.runtime.steady.special_points) and the direction of the first
+    step, used as given (no correction at fixed lam, no orientation by ``direction``).
     """
     opts = ContinuationOptions.of(options, **overrides)
     opts.check()
-    ds, ds_min, ds_max, direction, max_points = opts.ds, opts.ds_min, opts.ds_max, opts.direction, opts.max_points
-    lam_min, lam_max, tol, max_corrector, grow = opts.lam_min, opts.lam_max, opts.tol, opts.max_corrector, opts.grow
-    max_turn, locate_folds = opts.max_turn, opts.locate_folds
+    lam_min, lam_max, tol, max_corrector = opts.lam_min, opts.lam_max, opts.tol, opts.max_corrector
     lam0 = float(lam0)
     u = _check_system(system, u0, lam0)
     if not lam_min <= lam0 <= lam_max:
@@ -404,6 +404,8 @@ def continuation(system, u0, lam0: float, options: ContinuationOptions | None = 
     w = _weights(system, n + 1)
     e_lam = np.zeros(n + 1)
     e_lam[-1] = 1.0
+    if start_tangent is not None:
+        return _run(system, np.append(u, lam0), _unit(w, start_tangent), callback, opts)
     got = _correct(system, np.append(u, lam0), e_lam, lam0, tol=tol, max_iter=4 * max_corrector)
     if got is None:
         F = _eval(system, u, lam0, jac=False)[0]
@@ -421,8 +423,25 @@ def continuation(system, u0, lam0: float, options: ContinuationOptions | None = 
     if t is None:
         raise ConvergenceError("continuation: no tangent at the start ([F_u, F_lam] is rank deficient: a "
                                "branch point)")
-    if t[-1] * direction < 0:
+    if t[-1] * opts.direction < 0:
         t = -t
+    return _run(system, x, t, callback, opts)
+
+
+def _unit(w, t) -> np.ndarray:
+    t = np.asarray(t, float)
+    return t / _norm(w, t)
+
+
+def _run(system, x, t, callback, opts: ContinuationOptions) -> Branch:
+    """The steps of :func:`continuation` from the point x on the branch with the unit tangent t."""
+    ds, ds_min, ds_max, max_points = opts.ds, opts.ds_min, opts.ds_max, opts.max_points
+    lam_min, lam_max, tol, max_corrector, grow = opts.lam_min, opts.lam_max, opts.tol, opts.max_corrector, opts.grow
+    max_turn, locate_folds = opts.max_turn, opts.locate_folds
+    n = x.size - 1
+    w = _weights(system, n + 1)
+    e_lam = np.zeros(n + 1)
+    e_lam[-1] = 1.0
     xs, ts, arc = [x], [t], [0.0]
     data = [callback(x[:n].copy(), x[n]) if callback else None]
     folds = []

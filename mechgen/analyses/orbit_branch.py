@@ -1,0 +1,164 @@
+"""``continuation`` about a ``periodic_orbit``: the branch of periodic orbits in a parameter, with its cyclic folds,
+period doublings and torus points.
+
+The earlier orbit's method (harmonic balance or shooting) is continued in ``parameter`` up to ``stop`` by
+pseudo-arclength (mechgen.runtime.periodic.branch; mechgen.runtime.steady.continuation), so a frequency-response
+curve is followed round its folds: both stable branches and the unstable one between. A forced orbit whose
+``frequency`` is an expression of the continued parameter (``frequency = "w"``, continued in ``w``) has its period
+follow it; otherwise the forcing's frequency stays as it was.
+
+Outputs: ``branch`` (per point: the parameter, ``period``, ``frequency``, ``amplitude`` ({coordinate: max |q|
+over the period}), ``start`` (the state at t = 0: each coordinate and ``<coordinate>_dot``), ``multipliers`` ([re, im] by decreasing modulus) and ``stability``), ``points``, ``status``,
+``method``, ``folds`` and ``special_points``: ``LPC`` (a cyclic fold: the branch turns in the parameter),
+``PD`` (period doubling: a multiplier through -1) and ``NS`` (Neimark-Sacker: a complex pair through the unit
+circle, with ``angle``), each with the parameter, period, amplitude and multipliers there
+(mechgen.runtime.steady.cycle_points).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from mechgen.analyses.hybrid_orbit import run_hybrid_branch
+from mechgen.analyses.newton_branch import arclength_steps
+from mechgen.analyses.periodic_orbit import DEFAULT_HARMONICS, compiled_run, integrator_tolerances, peak
+from mechgen.analyses.schema import ParamExpression
+from mechgen.analyses.stability_boundary import own_value
+from mechgen.errors import SceneError
+from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget
+from mechgen.runtime.periodic import floquet, fourier
+from mechgen.runtime.periodic.branch import OrbitBranch
+from mechgen.runtime.periodic.flow import differenced_flow, states_at, variational_flow
+from mechgen.runtime.periodic.harmonic_balance import HarmonicBalance
+from mechgen.runtime.periodic.shooting import Shooting
+from mechgen.runtime.steady.continuation import continuation
+from mechgen.runtime.steady.cycle_points import cycle_points
+
+#: keys of a continuation that an orbit branch does not take
+ORBIT_REFUSES = ("method", "stages", "bounds", "at", "minimize", "switch_branches", "special_point", "eigenvalues",
+                 "aliases")
+#: phases at which a branch point's amplitudes are taken
+PHASES = 4096
+
+
+class Orbits:
+    """The orbits of one earlier ``periodic_orbit`` moved along ``name``: problems, states and multipliers."""
+
+    def __init__(self, system, name: str, orbit: dict) -> None:
+        self.system, self.name = system, name
+        self.method, self.phase, self.options = orbit["method"], orbit["phase"], orbit["options"]
+        self.frequency = self.options.get("frequency")
+        self.autonomous = self.frequency is None
+        self.memo: dict = {}
+
+    def omega(self, p: float) -> float | None:
+        """The forcing's angular frequency at p (module doc)."""
+        if self.frequency is None:
+            return None
+        if isinstance(self.frequency, ParamExpression):
+            return self.frequency.at({**self.system.param_values(), self.name: float(p)})
+        return float(self.frequency)
+
+    def make(self, p: float):
+        moved = self.system.with_params(**{self.name: float(p)})
+        if self.method == "harmonic_balance":
+            H = int(self.options.get("harmonics", DEFAULT_HARMONICS))
+            return HarmonicBalance(moved, fourier.basis(H), self.omega(p), self.phase)
+        return Shooting(moved, self.omega(p), self.phase, *integrator_tolerances(self.options),
+                        compiled_run(moved, self.options))
+
+    def start(self, problem, found: dict) -> np.ndarray:
+        """The unknowns u of the earlier orbit."""
+        if self.method == "harmonic_balance":
+            return problem.unknowns(found["U"], found["omega"])
+        return problem.unknowns(found["x0"], 2 * np.pi / found["omega"])
+
+    def states(self, problem, u: np.ndarray, times: np.ndarray) -> np.ndarray:
+        """The orbit's states at ``times`` in [0, T] (rows (q, v))."""
+        if self.method == "harmonic_balance":
+            U, w = problem.split(u)
+            return np.hstack([fourier.evaluate(U, w * times), w * fourier.evaluate(U, w * times, 1)])
+        x0, _ = problem.split(u)
+        if problem.compiled is not None:
+            return problem.compiled(x0, times)
+        return states_at(problem.system, x0, 0.0, times, problem.rtol, problem.atol)
+
+    def period(self, problem, u: np.ndarray) -> float:
+        return float(2 * np.pi / problem.split(u)[1]) if self.method == "harmonic_balance" else float(
+            problem.split(u)[1])
+
+    def multipliers(self, problem, u: np.ndarray, p: float) -> np.ndarray:
+        """The Floquet multipliers of the orbit u at p: the eigenvalues of its monodromy, by central differences of
+        the compiled flow where it runs (4n + 1 runs, about 1e-10 from the exact one:
+        mechgen.runtime.periodic.flow.differenced_flow), else from the variational equations; kept per orbit (a
+        branch point's are asked twice)."""
+        key = (float(p), np.asarray(u, float).tobytes())
+        if key not in self.memo:
+            if len(self.memo) > 1024:
+                self.memo.clear()
+            self.memo[key] = self.monodromy_eigenvalues(problem, u)
+        return self.memo[key]
+
+    def monodromy_eigenvalues(self, problem, u: np.ndarray) -> np.ndarray:
+        T = self.period(problem, u)
+        x0 = self.states(problem, u, np.array([0.0]))[0] if self.method == "harmonic_balance" else problem.split(u)[0]
+        run = compiled_run(problem.system, self.options)
+        if run is not None:
+            _, Phi = differenced_flow(run, x0, T)
+        else:
+            _, Phi = variational_flow(problem.system, x0, 0.0, T, *integrator_tolerances(self.options))
+        return floquet.multipliers(Phi)
+
+
+def record(orbits: Orbits, branch: OrbitBranch, u: np.ndarray, p: float) -> dict:
+    """One branch point's outputs (module doc)."""
+    problem = branch.problem(p)
+    T = orbits.period(problem, u)
+    X = orbits.states(problem, u, T * np.arange(PHASES) / PHASES)
+    mu = orbits.multipliers(problem, u, p)
+    names = list(orbits.system.coordinates)
+    start = dict(zip(names + [f"{c}_dot" for c in names], (float(v) for v in X[0])))
+    return {orbits.name: float(p), "period": T, "frequency": float(2 * np.pi / T),
+            "amplitude": {c: peak(X[:, i]) for i, c in enumerate(names)}, "start": start,
+            "multipliers": floquet.as_pairs(mu), "stability": floquet.stability(mu, orbits.autonomous)}
+
+
+def run_orbit_branch(system, options: dict, earlier: dict) -> dict:
+    """The branch of orbits through an earlier periodic_orbit (module doc; a hybrid model's:
+    mechgen.analyses.hybrid_orbit.run_hybrid_branch, which also takes ``switch_branches``)."""
+    hybrid = bool(earlier["_orbit"].get("hybrid"))
+    for key in ORBIT_REFUSES:
+        if options.get(key) and not (hybrid and key == "switch_branches"):
+            raise SceneError(f"{key} does not apply to a branch of periodic orbits", key=key,
+                             expected=f"no {key} (a continuation about a steady state takes it)")
+    if hybrid:
+        return run_hybrid_branch(system, options, earlier["_orbit"])
+    name = options["parameter"]
+    orbits = Orbits(system, name, earlier["_orbit"])
+    here = float(own_value(system, name))
+    branch = OrbitBranch(orbits.make, name)
+    u0 = orbits.start(branch.problem(here), earlier["_orbit"]["found"])
+    eqs = branch.equations()
+    budget = Budget("continuation", unit="points", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
+    found = continuation(eqs, u0, here, arclength_steps(options, here, budget, smallest_span=0.1))
+    points = [record(orbits, branch, u, p) for u, p in zip(found.u, found.lam)]
+    X = np.hstack([found.u, found.lam[:, None]])
+
+    def multipliers(x):
+        return orbits.multipliers(branch.problem(x[-1]), x[:-1], x[-1])
+
+    specials = [("LPC", np.append(f.u, f.lam), f.index, {}) for f in found.folds]
+    if options.get("special_points", True):
+        specials += [(s.type, s.x, s.index, s.data) for s in cycle_points(eqs, X, multipliers,
+                                                                           trivial=orbits.autonomous)]
+    records, located = [], []
+    for kind, x, index, data in sorted(specials, key=lambda s: s[2]):
+        rec = {"type": kind, **record(orbits, branch, x[:-1], x[-1])}
+        if kind == "NS":
+            rec["angle"] = data["angle"]
+        records.append(rec)
+        located.append(np.asarray(x, float))
+    return {"parameter": name, "method": orbits.method, "branch": points, "points": len(points),
+            "status": found.status, "folds": [r for r in records if r["type"] == "LPC"],
+            "special_points": records, "shape_outputs": [],
+            # a curve of one of these points in two parameters starts here (mechgen.analyses.orbit_curves)
+            "_orbit": earlier["_orbit"], "_special_x": located}

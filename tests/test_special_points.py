@@ -1,0 +1,297 @@
+"""Special points of equilibrium branches (issue 27, item 3): folds (LP), branch points (BP, with switching) and
+Hopf points (H, with the first Lyapunov coefficient), on models the tests write.
+
+References (closed forms):
+
+* Pitchfork: x'' + c x' + (k - P) x + a x^3 = 0. The trivial branch x = 0 meets the side branch
+  x^2 = (P - k) / a at P = k (a BP). Along the side branch F_y = k - P + 3 a x^2 = 2 a x^2 >= 0 never changes
+  sign, so a test that counts unstable eigenvalues misses the BP there (BifurcationKit #223); the bordered
+  determinant does not.
+* Hopf: the Rayleigh oscillator x'' + w0^2 x = (mu + beta x^2) x'. Its equilibrium x = 0 loses stability at
+  mu = 0 through the pair +-i w0. Averaging (x = r cos phi, x' = -r w0 sin phi) gives dr/dt = mu r / 2 +
+  beta r^3 / 8, so the cycle is born supercritically for beta < 0 and subcritically for beta > 0. The first
+  Lyapunov coefficient with Kuznetsov's normalisation (<q, q> = 1, q = (1, i w0) / sqrt(1 + w0^2), so that
+  x's amplitude is r = 2 |z| / sqrt(1 + w0^2)) is l1 = Re c1 / w0 = beta / (2 w0 (1 + w0^2)).
+* Rotor with internal (rotating) damping: the Jeffcott rotor m r'' + (c_e + c_i) r' + k r - i c_i W r = 0 in
+  complex form (r = x + i y) becomes unstable at the onset speed W = w_n (1 + c_e / c_i), w_n = sqrt(k / m)
+  (Crandall; Genta, Dynamics of Rotating Systems, sec. 8.3): a Hopf point in the speed with the whirl frequency
+  w_n.
+"""
+import numpy as np
+import pytest
+
+import mechgen
+from mechgen.runtime.steady.special_points import first_lyapunov, hopf_sign
+
+PITCHFORK = '''"""x'' + c x' + (k - P) x + a x^3 = 0."""
+from mechgen import Model, Param
+
+model = Model("pitchfork", doc=__doc__)
+model.params(Param("P", 0.5), Param("k", 1.0), Param("a", 2.0), Param("c", 0.1))
+model.coordinates("x")
+model.kinetic(lambda v: v.x**2 / 2)
+model.potential(lambda q, p: (p.k - p.P) * q.x**2 / 2 + p.a * q.x**4 / 4)
+model.dissipation(lambda v, p: p.c * v.x**2 / 2)
+'''
+
+RAYLEIGH = '''"""x'' + w0^2 x = (mu + beta x^2) x'."""
+from mechgen import Model, Param
+
+model = Model("rayleigh", doc=__doc__)
+model.params(Param("mu", -0.5), Param("w0", 1.5), Param("beta", -1.0))
+model.coordinates("x")
+model.kinetic(lambda v: v.x**2 / 2)
+model.potential(lambda q, p: p.w0**2 * q.x**2 / 2)
+
+
+@model.forces
+def forces(q, v, p):
+    return {"x": (p.mu + p.beta * q.x**2) * v.x}
+'''
+
+ROTOR = '''"""Jeffcott rotor with external damping c_e and internal (rotating) damping c_i at speed W."""
+from mechgen import Model, Param
+
+model = Model("jeffcott_internal", doc=__doc__)
+model.params(Param("m", 2.0), Param("k", 800.0), Param("c_e", 0.4), Param("c_i", 1.6), Param("W", 5.0))
+model.coordinates("x", "y")
+model.kinetic(lambda v, p: p.m * (v.x**2 + v.y**2) / 2)
+model.potential(lambda q, p: p.k * (q.x**2 + q.y**2) / 2)
+
+
+@model.dissipation
+def dissipation(q, v, p):
+    # external damping on the absolute velocity, internal damping on the velocity seen in the rotating frame
+    return p.c_e * (v.x**2 + v.y**2) / 2 + p.c_i * ((v.x + p.W * q.y)**2 + (v.y - p.W * q.x)**2) / 2
+'''
+
+
+def scene(tmp_path, model: str, name: str, guess: str, parameter: str, stop: float, extra: str = "") -> str:
+    (tmp_path / f"{name}.py").write_text(model)
+    path = tmp_path / f"{name}.toml"
+    path.write_text(f'''model = "{name}.py"
+backend = "numpy"
+[[analysis]]
+name = "eq"
+kind = "steady"
+guess = {{ {guess} }}
+[[analysis]]
+name = "cont"
+kind = "continuation"
+about = "eq"
+parameter = "{parameter}"
+stop = {stop}
+{extra}
+''')
+    return str(path)
+
+
+def continuation_outputs(path: str) -> dict:
+    return mechgen.run(path)["analyses"][1]["outputs"]
+
+
+def test_pitchfork_found_on_the_trivial_branch_and_switched(tmp_path):
+    """The BP at P = k to 1e-8 (bisection to 1e-10 of a segment of length <= 0.1); switching follows the side
+    branch, whose every point satisfies x^2 = (P - k) / a to the corrector's 1e-10."""
+    out = continuation_outputs(scene(tmp_path, PITCHFORK, "pitchfork", "x = 0.0", "P", 2.0,
+                                     "switch_branches = true\nmax_step = 0.1"))
+    bps = [s for s in out["special_points"] if s["type"] == "BP"]
+    assert len(bps) == 1 and bps[0]["P"] == pytest.approx(1.0, abs=1e-8)
+    # the other branch leaves the BP perpendicular to the parameter (a pitchfork: dP/dx = 0 at x = 0)
+    assert abs(bps[0]["direction"]["x"]) == pytest.approx(1.0, abs=1e-6)
+    halves = out["switched_branches"]
+    assert [h["half"] for h in halves] == ["+", "-"]
+    for h in halves:
+        xs = np.array([p["coordinates"]["x"] for p in h["branch"]])
+        P = np.array([p["P"] for p in h["branch"]])
+        assert len(xs) > 5 and np.all(np.sign(xs) == np.sign(xs[0]))
+        assert np.max(np.abs(xs**2 - (P - 1.0) / 2.0)) < 1e-9
+    assert not [s for s in out["special_points"] if s["type"] in ("H", "LP")]
+
+
+def test_pitchfork_found_along_the_side_branch_where_no_eigenvalue_changes_sign(tmp_path):
+    """Starting on the side branch at P = 2 and going down, F_y = 2 a x^2 >= 0 all along (no eigenvalue changes
+    sign), yet the bordered determinant finds the BP at P = k, x = 0 (to 1e-6 in x: it is a point of the side
+    branch where P - k = a x^2, so P is met to a x^2 ~ 1e-12)."""
+    out = continuation_outputs(scene(tmp_path, PITCHFORK.replace('Param("P", 0.5)', 'Param("P", 2.0)'),
+                                     "side", "x = 0.7", "P", 0.5, "max_points = 80\nmax_step = 0.1"))
+    xs = [p["coordinates"]["x"] for p in out["branch"]]
+    assert min(xs) < 0 < max(xs)   # the branch passed through the BP onto the other half
+    assert [s["type"] for s in out["special_points"]] == ["BP"]   # the turn of P at the BP is no fold
+    bps = out["special_points"]
+    assert bps[0]["coordinates"]["x"] == pytest.approx(0.0, abs=1e-6)
+    assert bps[0]["P"] == pytest.approx(1.0, abs=1e-8)
+
+
+@pytest.mark.parametrize("beta", [-1.0, 0.5])
+def test_hopf_point_and_its_first_lyapunov_coefficient(tmp_path, beta):
+    """H at mu = 0 (to 1e-8), omega = w0 (to 1e-8), l1 = beta / (2 w0 (1 + w0^2)) (to 1e-6: central differences
+    of the exact Jacobian with step 1e-3; the field is cubic, so they are exact up to round-off ~1e-10) and its
+    criticality from the sign."""
+    model = RAYLEIGH.replace('Param("beta", -1.0)', f'Param("beta", {beta})')
+    out = continuation_outputs(scene(tmp_path, model, "rayleigh", "x = 0.0", "mu", 0.5))
+    (h,) = [s for s in out["special_points"] if s["type"] == "H"]
+    w0 = 1.5
+    assert h["mu"] == pytest.approx(0.0, abs=1e-8)
+    assert h["frequency"] == pytest.approx(w0, rel=1e-8)
+    assert h["lyapunov"] == pytest.approx(beta / (2 * w0 * (1 + w0**2)), rel=1e-6)
+    assert h["criticality"] == ("supercritical" if beta < 0 else "subcritical")
+    change = out["stability_changes"][0]
+    assert change["mu"] == pytest.approx(0.0, abs=1e-7) and change["to"] == "flutter"
+
+
+def test_rotor_onset_speed_of_internal_damping_is_a_hopf_point(tmp_path):
+    """The whirl instability's onset W = w_n (1 + c_e / c_i) = 20 * 1.25 = 25 rad/s (to 1e-7 relative) with the
+    frequency w_n = 20 rad/s (the forward whirl that loses its damping)."""
+    out = continuation_outputs(scene(tmp_path, ROTOR, "rotor", "x = 0.0, y = 0.0", "W", 40.0, "max_step = 2.0"))
+    hopf = [s for s in out["special_points"] if s["type"] == "H"]
+    assert len(hopf) == 1
+    assert hopf[0]["W"] == pytest.approx(25.0, rel=1e-7)
+    assert hopf[0]["frequency"] == pytest.approx(20.0, rel=1e-7)
+
+
+def test_lyapunov_coefficient_of_the_normal_form():
+    """x' = -w y + s x r^2, y' = w x + s y r^2 is z' = i w z + s z |z|^2 (z = x + i y); with <q, q> = 1 the
+    state's z is sqrt(2) times Kuznetsov's, so l1 = 2 s / w exactly (a cubic field: the differences are exact)."""
+    s, w = -0.3, 1.7
+
+    def jacobian(v):
+        x, y = v
+        r2 = x * x + y * y
+        return np.array([[s * (r2 + 2 * x * x), -w + 2 * s * x * y], [w + 2 * s * x * y, s * (r2 + 2 * y * y)]])
+
+    omega, l1 = first_lyapunov(jacobian, np.zeros(2))
+    assert omega == pytest.approx(w, rel=1e-12)
+    assert l1 == pytest.approx(2 * s / w, rel=1e-8)
+
+
+def test_hopf_test_function_ignores_a_neutral_saddle():
+    """The bialternate product's sign: a pair crossing the axis flips it; +-mu real keeps the product of the
+    others' sign but vanishes (a neutral saddle is a zero, told apart by is_hopf at the located point)."""
+    assert hopf_sign([-0.1 + 1j, -0.1 - 1j, -2.0]) == -hopf_sign([0.1 + 1j, 0.1 - 1j, -2.0])
+    assert hopf_sign([1.0, -1.0, -3.0]) == 0
+
+
+def test_switch_branches_is_refused_for_a_boundary_value_branch():
+    """switch_branches about a boundary-value steady state: a SceneError (exit 2) at the key, before any work."""
+    from mechgen.analyses.continuation import run_continuation
+    from mechgen.errors import SceneError
+
+    with pytest.raises(SceneError) as err:
+        run_continuation(None, {"about": "start", "parameter": "lambda0", "stop": 0.2, "switch_branches": True},
+                         {"start": {"_bvp": object(), "_result": object()}})
+    assert err.value.key == "switch_branches" and "Newton steady states only" in str(err.value)
+
+
+def test_folds_are_special_points_and_nothing_else_is(tmp_path):
+    """The snap-through branch lam = x^3 - x (tests/test_newton_continuation.py): two LP at lam = +-2/(3 sqrt 3)
+    (to 1e-10, the folds' own accuracy), no BP and no H (the spectrum is real on this undamped branch: +-i w or
+    +-mu pairs, whose sums never change sign except through the folds' zero eigenvalue, no pair +-i w there)."""
+    from test_newton_continuation import snap_scene
+
+    out = mechgen.run(snap_scene(tmp_path))["analyses"][1]["outputs"]
+    assert [s["type"] for s in out["special_points"]] == ["LP", "LP"]
+    fold = 2 / 3**1.5
+    assert [s["lam"] for s in out["special_points"]] == pytest.approx([fold, -fold], abs=1e-10)
+
+
+def test_shipped_rotor_scene_reports_the_onset_speed():
+    """scenes/rotor_internal_damping.toml (the built-in laval_rotor with c_i): H at Omega = sqrt(k_t/m)(1 + c/c_i)
+    = 250 rad/s with the whirl frequency 200 rad/s (to 1e-8 relative: bisection to 1e-10 of a segment, then the
+    secant on Re of the critical pair); the hardening shaft (k_t3 > 0) makes it supercritical (l1 < 0: the bounded
+    whirl of scenes/rotor_whirl_limit_cycle.toml is born there)."""
+    from pathlib import Path
+
+    scene = Path(__file__).resolve().parents[1] / "scenes" / "rotor_internal_damping.toml"
+    out = mechgen.run(str(scene))["analyses"][1]["outputs"]
+    (h,) = out["special_points"]
+    assert h["type"] == "H" and h["Omega"] == pytest.approx(250.0, rel=1e-8)
+    assert h["frequency"] == pytest.approx(200.0, rel=1e-8)
+    assert h["criticality"] == "supercritical" and h["lyapunov"] < 0
+    curve = mechgen.run(str(scene))["analyses"][2]["outputs"]["curve"]
+    c_i = np.array([p["c_i"] for p in curve])
+    assert c_i[-1] == 320.0
+    assert np.max(np.abs(np.array([p["Omega"] for p in curve]) / (200.0 * (1 + 20.0 / c_i)) - 1)) < 1e-8
+
+
+CUSP = '''"""x'' + c x' + x^3 - mu x - lam = 0: V = x^4/4 - mu x^2/2 - lam x."""
+from mechgen import Model, Param
+
+model = Model("cusp", doc=__doc__)
+model.params(Param("lam", -1.0), Param("mu", 1.0), Param("c", 0.2))
+model.coordinates("x")
+model.kinetic(lambda v: v.x**2 / 2)
+model.potential(lambda q, p: q.x**4 / 4 - p.mu * q.x**2 / 2 - p.lam * q.x)
+model.dissipation(lambda v, p: p.c * v.x**2 / 2)
+'''
+
+
+def curve_scene(tmp_path, model: str, name: str, guess: str, first: str, first_stop: float, second: str,
+                second_stop: float, extra: str = "") -> str:
+    path = scene(tmp_path, model, name, guess, first, first_stop, extra)
+    with open(path, "a") as f:
+        f.write(f'''[[analysis]]
+name = "curve"
+kind = "continuation"
+about = "cont"
+special_point = 1
+parameter = "{second}"
+stop = {second_stop}
+max_step = 0.2
+''')
+    return path
+
+
+def test_fold_curve_of_the_cusp(tmp_path):
+    """The fold curve of x^3 - mu x - lam = 0 in (lam, mu): 3 x^2 = mu and lam = -2 x^3 (so lam^2 = 4 (mu/3)^3),
+    every point to 1e-9 (the corrector's 1e-10 on the augmented residual, whose g is a bordered solve)."""
+    out = mechgen.run(curve_scene(tmp_path, CUSP, "cusp", "x = -1.3", "lam", 1.0, "mu", 3.0))["analyses"][2]["outputs"]
+    assert out["type"] == "LP" and out["parameters"] == ["lam", "mu"] and out["status"] == "lam_max"
+    x = np.array([p["coordinates"]["x"] for p in out["curve"]])
+    mu = np.array([p["mu"] for p in out["curve"]])
+    lam = np.array([p["lam"] for p in out["curve"]])
+    assert mu[-1] == 3.0 and len(mu) > 5
+    assert np.max(np.abs(3 * x**2 - mu)) < 1e-9
+    assert np.max(np.abs(lam + 2 * x**3)) < 1e-9
+
+
+def test_hopf_curve_of_the_rotor_onset_speed(tmp_path):
+    """The onset speed W = w_n (1 + c_e / c_i) of a Jeffcott rotor with internal damping, followed in c_i from 1.6
+    to 4 (to 1e-8 relative at every point), the whirl frequency w_n = 20 rad/s all along."""
+    path = curve_scene(tmp_path, ROTOR, "rotor", "x = 0.0, y = 0.0", "W", 40.0, "c_i", 4.0, "max_step = 2.0")
+    out = mechgen.run(path)["analyses"][2]["outputs"]
+    assert out["type"] == "H" and out["status"] == "lam_max"
+    c_i = np.array([p["c_i"] for p in out["curve"]])
+    W = np.array([p["W"] for p in out["curve"]])
+    assert c_i[-1] == 4.0 and len(c_i) > 3
+    assert np.max(np.abs(W / (20.0 * (1 + 0.4 / c_i)) - 1)) < 1e-8
+    assert np.max(np.abs(np.array([p["frequency"] for p in out["curve"]]) - 20.0)) < 1e-7
+
+
+def test_special_point_curve_refuses_a_branch_point_and_a_missing_index(tmp_path, capsys):
+    """special_point naming a BP, or past the list: exit 2 at the key; special_point about a steady: exit 2."""
+    from mechgen.cli import main
+
+    path = curve_scene(tmp_path, PITCHFORK, "pitchfork", "x = 0.0", "P", 2.0, "a", 3.0)
+    assert main(["run", path]) == 2
+    err = capsys.readouterr().err
+    assert "special_point" in err and "BP" in err and "Traceback" not in err
+    text = open(path).read()
+    open(path, "w").write(text.replace('about = "cont"\nspecial_point = 1', 'about = "eq"\nspecial_point = 1'))
+    assert main(["run", path]) == 2
+    assert "special_point" in capsys.readouterr().err
+
+
+def test_rotor_whirl_limit_cycle_beyond_the_onset():
+    """scenes/rotor_whirl_limit_cycle.toml: at Omega = 300 rad/s the whirl is the circle r = R exp(i w t) with
+    w = c_i Omega / (c + c_i) = 240 rad/s and R^2 = (m w^2 - k_t) / k_t3 = 1e-4 m^2 (closed form: the damping
+    forces and the elastic and centripetal forces balance on the circle), to 1e-8 relative (shooting at Newton rtol
+    1e-9); the tilts stay at rest and the whirl is stable."""
+    from pathlib import Path
+
+    scene = Path(__file__).resolve().parents[1] / "scenes" / "rotor_whirl_limit_cycle.toml"
+    out = mechgen.run(str(scene))["analyses"][0]["outputs"]
+    assert out["frequency"] == pytest.approx(240.0, rel=1e-8)
+    assert out["amplitude"]["x"] == pytest.approx(0.01, rel=1e-8)
+    assert out["amplitude"]["y"] == pytest.approx(0.01, rel=1e-8)
+    assert out["amplitude"]["theta_x"] < 1e-12 and out["stability"] == "stable"
