@@ -190,7 +190,7 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
            "``shooting``) the branch is continued by."),
         _o("branch (orbits)", "list of {<parameter>, period, frequency, amplitude, start, multipliers, stability}",
            "s, rad/s, coordinates'", "About a ``periodic_orbit``: one entry per orbit of the branch: the parameter, "
-           "the period T, 2 pi / T, ``amplitude`` ({coordinate: max \|q\| over the period}), ``start`` (the state "
+           "the period T, 2 pi / T, ``amplitude`` ({coordinate: max \\|q\\| over the period}), ``start`` (the state "
            "at t = 0: each coordinate and ``<coordinate>_dot``), the Floquet ``multipliers`` ([re, im] by "
            "decreasing modulus) and ``stability``; its ``special_points`` are ``LPC`` (cyclic fold), ``PD`` (period "
            "doubling: a multiplier through -1) and ``NS`` (a complex pair through the unit circle, with ``angle``)."),
