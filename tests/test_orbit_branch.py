@@ -219,3 +219,69 @@ max_points = 130
     assert F[k] == pytest.approx(0.0516, rel=0.06) and w[k] == pytest.approx(1.0904, rel=0.01)
     back = slice(k, None)
     assert np.interp(0.3, F[back], w[back]) == pytest.approx(1.3242362, abs=1e-3)
+
+
+FORCED_VDP = '''"""x'' - mu (1 - x^2) x' + x = F cos(w t)."""
+import sympy as sp
+from mechgen import Model, Param
+
+model = Model("forced_vdp", doc=__doc__)
+model.params(Param("mu", 0.2), Param("F", 0.5), Param("w", 1.1))
+model.coordinates("x")
+model.kinetic(lambda v: v.x**2 / 2)
+model.potential(lambda q: q.x**2 / 2)
+
+
+@model.forces
+def forces(q, v, p, t):
+    return {"x": p.mu * (1 - q.x**2) * v.x + p.F * sp.cos(p.w * t)}
+'''
+
+
+def test_torus_point_of_the_forced_van_der_pol_oscillator(tmp_path):
+    """The entrained orbit of x'' - mu (1 - x^2) x' + x = F cos(w t) (mu = 0.2, w = 1.1), followed down in F, loses
+    stability through a Neimark-Sacker point: a complex pair of multipliers on the unit circle. Liouville's formula
+    det Phi = exp(mu int (1 - x^2) dt) makes |mu_1 mu_2| = 1 there exactly when the orbit's mean of x^2 is 1: checked
+    on the orbit integrated here by scipy from the point's start state (to 1e-6), and the pair's modulus from a
+    hand-written monodromy (central differences of scipy's flow) to 1e-6."""
+    (tmp_path / "fvdp.py").write_text(FORCED_VDP)
+    scene = tmp_path / "ns.toml"
+    scene.write_text('''model = "fvdp.py"
+backend = "c"
+[[analysis]]
+name = "orbit"
+kind = "periodic_orbit"
+method = "shooting"
+frequency = "w"
+q0 = { x = 2.0 }
+[[analysis]]
+name = "branch"
+kind = "continuation"
+about = "orbit"
+parameter = "F"
+stop = 0.1
+max_step = 0.02
+''')
+    out = mechgen.run(str(scene))["analyses"][1]["outputs"]
+    (ns,) = [s for s in out["special_points"] if s["type"] == "NS"]
+    F_ns, T = ns["F"], ns["period"]
+    assert T == pytest.approx(2 * math.pi / 1.1, rel=1e-14)
+
+    def rhs(t, y):
+        return [y[1], 0.2 * (1 - y[0] ** 2) * y[1] - y[0] + F_ns * math.cos(1.1 * t)]
+
+    x0 = np.array([ns["start"]["x"], ns["start"]["x_dot"]])
+    sol = solve_ivp(rhs, (0.0, T), x0, method="DOP853", rtol=1e-12, atol=1e-14, dense_output=True)
+    assert np.max(np.abs(sol.y[:, -1] - x0)) < 1e-8  # a periodic orbit of the hand-written equation
+    t = np.linspace(0.0, T, 20001)
+    x = sol.sol(t)[0]
+    from scipy.integrate import simpson
+
+    mean_square = simpson(x**2, x=t) / T
+    assert mean_square == pytest.approx(1.0, abs=1e-6)
+    h = 1e-6
+    J = np.column_stack([(solve_ivp(rhs, (0.0, T), x0 + h * e, method="DOP853", rtol=1e-12, atol=1e-14).y[:, -1]
+                          - solve_ivp(rhs, (0.0, T), x0 - h * e, method="DOP853", rtol=1e-12, atol=1e-14).y[:, -1])
+                         / (2 * h) for e in np.eye(2)])
+    mu = np.linalg.eigvals(J)
+    assert abs(mu[0].imag) > 1e-3 and np.abs(mu) == pytest.approx([1.0, 1.0], abs=1e-6)

@@ -55,7 +55,7 @@ class Orbits:
         if self.frequency is None:
             return None
         if isinstance(self.frequency, ParamExpression):
-            return self.frequency.at({**self.system.param_values(), self.name: float(p)})
+            return self.frequency.moved(self.name, p, self.system.param_values())
         return float(self.frequency)
 
     def make(self, p: float):
