@@ -285,3 +285,51 @@ max_step = 0.02
                          / (2 * h) for e in np.eye(2)])
     mu = np.linalg.eigvals(J)
     assert abs(mu[0].imag) > 1e-3 and np.abs(mu) == pytest.approx([1.0, 1.0], abs=1e-6)
+
+
+def test_period_doubling_of_the_double_well_duffing_and_a_closed_branch(tmp_path):
+    """x'' + 0.3 x' - x + x^3 = F cos(1.2 t) (Holmes 1979's double-well oscillator), its orbit in one well followed
+    up in F: a PD point (a multiplier -1) near F = 0.2656, checked by a hand-written shooting and monodromy at the
+    located F (the real multiplier -1 to 1e-6); the branch, an isola symmetric in F -> -F, closes on itself and the
+    continuation says so (status 'closed') instead of running to max_points."""
+    scene = tmp_path / "well.toml"
+    scene.write_text('''model = "duffing"
+backend = "c"
+[params]
+c = 0.3
+k = -1.0
+k3 = 1.0
+F = 0.05
+w = 1.2
+[[analysis]]
+name = "orbit"
+kind = "periodic_orbit"
+method = "shooting"
+frequency = "w"
+q0 = { x = 1.0 }
+[[analysis]]
+name = "branch"
+kind = "continuation"
+about = "orbit"
+parameter = "F"
+stop = 3.0
+max_step = 0.05
+max_points = 400
+''')
+    out = mechgen.run(str(scene))["analyses"][1]["outputs"]
+    assert out["status"] == "closed" and out["points"] < 400
+    pd = min((s for s in out["special_points"] if s["type"] == "PD" and s["F"] > 0), key=lambda s: s["F"])
+    F_pd, T = pd["F"], 2 * math.pi / 1.2
+    assert F_pd == pytest.approx(0.2656, abs=1e-3)
+
+    def rhs(t, y):
+        return [y[1], F_pd * math.cos(1.2 * t) - 0.3 * y[1] + y[0] - y[0] ** 3]
+
+    def flow(x):
+        return solve_ivp(rhs, (0.0, T), x, method="DOP853", rtol=1e-12, atol=1e-14).y[:, -1]
+
+    x0 = fsolve(lambda x: flow(x) - x, [pd["start"]["x"], pd["start"]["x_dot"]], xtol=1e-13)
+    h = 1e-6
+    J = np.column_stack([(flow(x0 + h * e) - flow(x0 - h * e)) / (2 * h) for e in np.eye(2)])
+    mu = np.linalg.eigvals(J)
+    assert np.min(mu.real) == pytest.approx(-1.0, abs=1e-6) and np.all(np.abs(mu.imag) < 1e-9)
