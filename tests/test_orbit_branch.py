@@ -333,3 +333,45 @@ max_points = 400
     J = np.column_stack([(flow(x0 + h * e) - flow(x0 - h * e)) / (2 * h) for e in np.eye(2)])
     mu = np.linalg.eigvals(J)
     assert np.min(mu.real) == pytest.approx(-1.0, abs=1e-6) and np.all(np.abs(mu.imag) < 1e-9)
+
+
+def test_doubled_orbit_past_the_period_doubling(tmp_path):
+    """switch_branches on the double-well Duffing branch: past its first PD point the doubled orbit has period 2T,
+    and the hand-written flow maps its start onto itself over 2T (to 1e-8) but not over T."""
+    scene = tmp_path / "well2.toml"
+    scene.write_text('''model = "duffing"
+backend = "c"
+[params]
+c = 0.3
+k = -1.0
+k3 = 1.0
+F = 0.05
+w = 1.2
+[[analysis]]
+name = "orbit"
+kind = "periodic_orbit"
+method = "shooting"
+frequency = "w"
+q0 = { x = 1.0 }
+[[analysis]]
+name = "branch"
+kind = "continuation"
+about = "orbit"
+parameter = "F"
+stop = 0.5
+max_step = 0.02
+switch_branches = true
+''')
+    out = mechgen.run(str(scene))["analyses"][1]["outputs"]
+    first = out["doubled"][0]
+    F_d, T = first["F"], 2 * math.pi / 1.2
+    assert first["period"] == pytest.approx(2 * T, rel=1e-14)
+
+    def flow(x, span):
+        def rhs(t, y):
+            return [y[1], F_d * math.cos(1.2 * t) - 0.3 * y[1] + y[0] - y[0] ** 3]
+        return solve_ivp(rhs, (0.0, span), x, method="DOP853", rtol=1e-12, atol=1e-14).y[:, -1]
+
+    x0 = np.array([first["start"]["x"], first["start"]["x_dot"]])
+    assert np.max(np.abs(flow(x0, 2 * T) - x0)) < 1e-8
+    assert np.max(np.abs(flow(x0, T) - x0)) > 1e-4
