@@ -269,7 +269,8 @@ def test_bad_input_names_the_key(duffing, vdp):
              (duffing, dict(frequency=0.0), "frequency"),
              (duffing, dict(period=5.0, q0={"x": 1.0}), "frequency"),
              (vdp, dict(period=6.0), "q0"),
-             (vdp, dict(period=6.0, q0={"x": 2.0}, method="collocation"), "method"),
+             (vdp, dict(period=6.0, q0={"x": 2.0}, harmonics=5, mesh=10), "method"),
+             (vdp, dict(period=6.0, q0={"x": 2.0}, mesh=1), "mesh"),
              (vdp, dict(period=6.0, q0={"y": 2.0}), "q0.y")]
     for system, options, key in cases:
         with pytest.raises(InputError) as err:
@@ -386,8 +387,9 @@ def test_harmonic_balance_jacobian_is_the_derivative_of_its_residual(two_dof, vd
 def test_two_coordinates_and_a_configuration_dependent_mass(two_dof):
     """Both methods on a two-mass forced orbit with M(q): shooting against scipy's shooting of the hand-written
     equations (1e-8); harmonic balance (H = 15) against shooting within 10 times its first left-out harmonic (from
-    the reference's FFT); the multipliers' product against Liouville, exp(int trace J dt), trace J = -c (1/M11 +
-    1/M22) integrated by scipy beside the state (1e-8)."""
+    the reference's FFT) plus shooting's own 1e-8; the multipliers' product against Liouville, exp(int trace J dt):
+    trace J = -c (1 + 1/m2) - 2 b x1 v1 / m2 (m2 = 1 + b x1^2), whose last term is -d/dt ln(m2) and integrates to
+    zero over a period, so the first term is integrated by scipy beside the state (1e-8)."""
     c, k3, b, F, w = 0.1, 0.3, 0.2, 1.0, 0.8
     T = 2 * math.pi / w
 
@@ -448,3 +450,164 @@ def test_frequency_as_a_parameter_expression(duffing):
     assert by_name["period"] == by_value["period"] == 2 * math.pi / 1.2
     for part in ("cos", "sin"):
         np.testing.assert_array_equal(by_name["harmonics"]["x"][part], by_value["harmonics"]["x"][part])
+
+
+def test_collocation_converges_at_order_eight(vdp, duffing):
+    """Orthogonal collocation (degree 4, Gauss points): the van der Pol period's error against the cited value falls
+    by about 2^8 = 256 from mesh 20 to mesh 40 (order 2m = 8 at the mesh points; measured 4.1e-7 -> 1.3e-9, ratio
+    in [100, 600]: the asymptotic rate with room for the next term), and mesh 80 is within 1e-10; the forced Duffing
+    start state against scipy's shooting (1e-9 at mesh 40); the multipliers as shooting's (1e-7)."""
+    errors = []
+    for mesh in (20, 40, 80):
+        r = mechgen.periodic_orbit(vdp, period=6.5, q0={"x": 2.0}, mesh=mesh)
+        assert r["method"] == "collocation"
+        errors.append(abs(r["period"] - VDP_PERIOD_MU1))
+    assert 100 < errors[0] / errors[1] < 600
+    assert errors[2] < 1e-10
+    x0, T, _ = duffing_reference(0.05, 0.5, 0.3, 1.2, [1.3, 0.5])
+    col = mechgen.periodic_orbit(duffing, frequency="w", method="collocation", q0={"x": 1.3}, v0={"x": 0.5})
+    np.testing.assert_allclose([col["trajectory"]["x"][0], col["trajectory"]["x_dot"][0]], x0, rtol=0, atol=1e-9)
+    assert col["trajectory"]["x"][-1] == pytest.approx(x0[0], abs=1e-9)  # periodic: the last sample is t = T
+    shot = mechgen.periodic_orbit(duffing, frequency="w", q0={"x": 1.3}, v0={"x": 0.5})
+    np.testing.assert_allclose(col["multipliers"], shot["multipliers"], rtol=0, atol=1e-7)
+
+
+def test_three_coexisting_orbits_and_the_unstable_one(duffing):
+    """Above resonance (w = 1.4) the hardening Duffing oscillator has three orbits; started from the first-order
+    closed form's amplitude and phase (a1 = A cos phi, b1 = A sin phi from (1 - w^2 + 3/4 k3 A^2) A = F cos phi,
+    c w A = F sin phi), each method finds each orbit: the start state against scipy's shooting from the same guess
+    (1e-7: harmonic balance's H = 11 truncation, collocation's mesh-40 error and shooting's 1e-9 are below it), the
+    outer two stable and the middle one a saddle, its real multiplier > 1 against the eigenvalues of scipy's
+    monodromy by central differences (1e-6: step 1e-5)."""
+    c, k3, F, w = 0.05, 0.5, 0.3, 1.4
+    system = duffing.with_params(w=w)
+    roots = np.roots([(0.75 * k3) ** 2, 2 * (1 - w**2) * 0.75 * k3, (1 - w**2) ** 2 + (c * w) ** 2, -F**2])
+    amplitudes = sorted(math.sqrt(r.real) for r in roots if abs(r.imag) < 1e-12)
+    assert len(amplitudes) == 3
+    for A, verdict in zip(amplitudes, ("stable", "unstable", "stable")):
+        cos_phi, sin_phi = (1 - w**2 + 0.75 * k3 * A**2) * A / F, c * w * A / F
+        guess = [A * cos_phi, w * A * sin_phi]
+        x0, T, rhs = duffing_reference(c, k3, F, w, guess)
+        for method, extra in (("harmonic_balance", {"harmonics": 11}), ("shooting", {}), ("collocation", {})):
+            r = mechgen.periodic_orbit(system, frequency="w", method=method, q0={"x": guess[0]},
+                                       v0={"x": guess[1]}, **extra)
+            start = [r["trajectory"]["x"][0], r["trajectory"]["x_dot"][0]]
+            np.testing.assert_allclose(start, x0, rtol=0, atol=1e-7, err_msg=f"{method} at A = {A}")
+            assert r["stability"] == verdict, (method, A)
+        if verdict == "unstable":
+            h = 1e-5
+            Phi = np.array([(scipy_flow(rhs, x0 + e, T).y[:, -1] - scipy_flow(rhs, x0 - e, T).y[:, -1]) / (2 * h)
+                            for e in h * np.eye(2)]).T
+            expected = np.sort(np.linalg.eigvals(Phi).real)
+            mu = np.sort([m[0] for m in r["multipliers"]])
+            assert expected[1] > 1
+            np.testing.assert_allclose(mu, expected, rtol=0, atol=1e-6)
+
+
+SCENE = """model = "van_der_pol"
+[params]
+mu = 1.0
+[[analysis]]
+name = "cycle"
+kind = "periodic_orbit"
+{body}
+"""
+
+
+@pytest.mark.parametrize("body, code, words", [
+    ('period = -1.0\nq0 = { x = 2.0 }', 2, ["analysis[1].period", "not positive"]),
+    ('period = 6.5\nq0 = { x = 2.0 }\nharmonics = 0', 2, ["analysis[1].harmonics", "below 1"]),
+    ('period = 6.5\nq0 = { x = 2.0 }\nmethod = "spline"', 2, ["analysis[1].method", "harmonic_balance"]),
+    ('period = 6.5\nq0 = { x = 20.0 }\nharmonics = 5\nmax_iterations = 1', 1, ["residual", "try"]),
+    ('period = 6.5\nq0 = { x = 2.0 }\nmesh = 20', 0, []),
+])
+def test_the_command_line_exit_codes(body, code, words, tmp_path, capsys):
+    """A scene's mistakes exit 2 naming the file and the key; a starting guess that does not converge exits 1
+    naming the residual and what to try; a good one runs."""
+    from mechgen.cli import main
+
+    path = tmp_path / "orbit.toml"
+    path.write_text(SCENE.format(body=body))
+    assert main(["run", str(path)]) == code
+    err = capsys.readouterr().err
+    for word in words:
+        assert word in err, err
+    if code == 2:
+        assert str(path) in err or "orbit.toml" in err
+
+
+def test_multiple_shooting_on_an_unstable_cycle_and_a_forced_orbit(vdp, duffing):
+    """mu = -1 reverses time: the van der Pol cycle becomes unstable, same period, its non-trivial multiplier the
+    reciprocal of mu = +1's (about 1163), exp(-int (1 - x^2) dt) from scipy's reference at mu = 1 (1e-6 relative:
+    the multiplier's sensitivity is ~1e3 times the integrations' 1e-11). Multiple shooting (8 segments, in both loops)
+    and single shooting agree; a forced orbit by 3 segments matches scipy's start state (1e-8)."""
+    _, T, decay = vdp_reference(1.0, 2.0, 6.6)
+    unstable = vdp.with_params(mu=-1.0)
+    for segments, loop in ((1, "auto"), (8, "auto"), (8, "python")):
+        r = mechgen.periodic_orbit(unstable, period=6.5, q0={"x": 2.0}, segments=segments, loop=loop)
+        assert r["period"] == pytest.approx(T, abs=1e-9)
+        assert r["stability"] == "unstable"
+        assert nontrivial(r)[0].real == pytest.approx(1 / decay, rel=1e-6)
+    x0, _, _ = duffing_reference(0.05, 0.5, 0.3, 1.2, [1.3, 0.5])
+    r = mechgen.periodic_orbit(duffing, frequency="w", q0={"x": 1.3}, v0={"x": 0.5}, segments=3)
+    np.testing.assert_allclose([r["trajectory"]["x"][0], r["trajectory"]["x_dot"][0]], x0, rtol=0, atol=1e-8)
+
+
+@pytest.mark.parametrize("name, what", [("fpu_chain", "a chain"), ("euler_bernoulli_beam", "a continuum"),
+                                        ("rate_state_slider", "internal variables")])
+def test_models_outside_the_methods_assumptions_are_refused(name, what):
+    """A chain, a continuum and a model with internal variables: exit 2 at ``method``, saying which."""
+    with pytest.raises(InputError) as err:
+        mechgen.periodic_orbit(mechgen.compile(name), frequency=1.0)
+    assert err.value.key.endswith("method") and what in str(err.value)
+
+
+def test_collocation_mesh_adaptation_on_a_relaxation_cycle(vdp):
+    """mu = 5: a relaxation oscillation, slow drifts and fast jumps. From a simulate's motion, 40 uniform intervals
+    leave a period error of about 4e-3 against scipy's shooting; two adaptations (AUTO's equidistributed monitor)
+    bring the same 40 intervals below 1e-6 (measured 1e-7): more than a thousandfold."""
+    mu = 5.0
+    system = vdp.with_params(mu=mu)
+
+    def rhs(t, y):
+        return [y[1], mu * (1 - y[0] ** 2) * y[1] - y[0]]
+
+    def residual(u):
+        end = scipy_flow(rhs, [u[0], 0.0], u[1]).y[:, -1]
+        return [end[0] - u[0], end[1]]
+
+    a, T = so.fsolve(residual, [2.0, 11.6], xtol=1e-13)
+    settle = mechgen.simulate(system, t_end=60.0, q0={"x": 2.0}, samples=3001, name="settle")
+    uniform = mechgen.periodic_orbit(system, mesh=40, **{"from": settle})
+    adapted = mechgen.periodic_orbit(system, mesh=40, adapt=2, **{"from": settle})
+    error_uniform, error_adapted = abs(uniform["period"] - T), abs(adapted["period"] - T)
+    assert error_adapted < 1e-6 and error_adapted < error_uniform / 1000
+    assert adapted["amplitude"]["x"] == pytest.approx(a, abs=1e-6)
+    # harmonic balance may converge to the mirrored solution (omega < 0, b_k -> -b_k: the same autonomous orbit);
+    # it reports the orbit with its positive frequency (H = 20 truncates this cycle: measured 1.0e-2 in T)
+    hb = mechgen.periodic_orbit(system, harmonics=20, **{"from": settle})
+    assert hb["frequency"] > 0 and hb["period"] == pytest.approx(T, abs=0.05)
+
+
+def test_hills_method_gives_the_monodromy_multipliers(duffing, vdp):
+    """Hill's method (floquet = "hill", no integration) against the monodromy matrix's multipliers: the stable forced
+    orbit (complex pair) and the saddle above resonance (real, one > 1), 1e-7 with H = 11 (the truncation's effect
+    on the multipliers, like the orbit's); the van der Pol cycle at H = 30: the trivial 1 and exp(mu int (1 - x^2)
+    dt) from scipy (1e-7 relative). Asked of another method it is refused at ``floquet``."""
+    A, c, k3, F, w = 1.42496445, 0.05, 0.5, 0.3, 1.4  # the saddle's first-order amplitude and phase (closed form)
+    saddle = {"q0": {"x": (1 - w**2 + 0.75 * k3 * A**2) * A**2 / F}, "v0": {"x": c * w**2 * A**2 / F}}
+    for w, guess in ((1.2, {"q0": {"x": 1.3}, "v0": {"x": 0.5}}), (1.4, saddle)):
+        system = duffing.with_params(w=w)
+        hill = mechgen.periodic_orbit(system, frequency="w", harmonics=11, floquet="hill", **guess)
+        shot = mechgen.periodic_orbit(system, frequency="w", **guess)
+        assert hill["amplitude"]["x"] == pytest.approx(shot["amplitude"]["x"], abs=1e-7)  # the same orbit
+        np.testing.assert_allclose(hill["multipliers"], shot["multipliers"], rtol=0, atol=1e-7)
+    assert hill["stability"] == "unstable"
+    _, _, expected = vdp_reference(1.0, 2.0, 6.6)
+    cycle = mechgen.periodic_orbit(vdp, period=6.5, q0={"x": 2.0}, harmonics=30, floquet="hill")
+    mu = np.array([complex(*m) for m in cycle["multipliers"]])
+    assert np.min(np.abs(mu - 1)) < 1e-7
+    assert nontrivial(cycle)[0].real == pytest.approx(expected, rel=1e-7)
+    with pytest.raises(InputError) as err:
+        mechgen.periodic_orbit(vdp, period=6.5, q0={"x": 2.0}, floquet="hill")
+    assert err.value.key.endswith("floquet")

@@ -27,9 +27,10 @@ By Liouville's formula the product of the two Floquet multipliers is exp(−c T)
     \\ddot x - \\mu (1 - x^2) \\dot x + x = 0
 
 (the built-in model ``van_der_pol``; ``scenes/van_der_pol_limit_cycle.toml``) has a limit cycle whose period is
-unknown: it is found beside the orbit, with a phase condition. References: T = 6.6632868593231 at μ = 1 and the
-small-μ expansion T = 2π (1 + μ²/16 − 5μ⁴/3072 + …), amplitude 2 + O(μ²) (Andersen & Geer, SIAM J. Appl. Math.
-42, 1982); the non-trivial multiplier is exp(μ ∮ (1 − x²) dt) (the trace of the Jacobian integrated over the
+unknown: it is found beside the orbit, with a phase condition, here by shooting, harmonic balance and orthogonal
+collocation (degree-4 polynomials at Gauss points on 40 intervals). References: T = 6.6632868593231 at μ = 1 and
+the small-μ expansion T = 2π (1 + μ²/16 − 5μ⁴/3072 + …), amplitude 2 + O(μ²) (Andersen & Geer, SIAM J. Appl.
+Math. 42, 1982); the non-trivial multiplier is exp(μ ∮ (1 − x²) dt) (the trace of the Jacobian integrated over the
 orbit), computed here by scipy beside the state.
 """
 import math
@@ -113,9 +114,11 @@ assert abs(np.prod(mu).real - math.exp(-c * T)) < 1e-9
 vdp = mechgen.compile("van_der_pol")
 cycle = mechgen.periodic_orbit(vdp, period=6.5, q0={"x": 2.0})
 cycle_hb = mechgen.periodic_orbit(vdp, period=6.5, q0={"x": 2.0}, harmonics=30)
+cycle_col = mechgen.periodic_orbit(vdp, period=6.5, q0={"x": 2.0}, mesh=40)
 T_REF = 6.6632868593231
 print(f"van der Pol mu = 1: T shooting {cycle['period']:.12f}, harmonic balance (H = 30) "
-      f"{cycle_hb['period']:.12f}, reference {T_REF}; amplitude {cycle['amplitude']['x']:.9f}")
+      f"{cycle_hb['period']:.12f}, collocation (40 intervals) {cycle_col['period']:.12f}, reference {T_REF}; "
+      f"amplitude {cycle['amplitude']['x']:.9f}")
 
 
 def vdp_rhs(t, y, m=1.0):
@@ -128,6 +131,7 @@ trace = solve_ivp(vdp_rhs, (0.0, cycle["period"]), [a, 0.0, 0.0], method="DOP853
 mus = np.array([complex(*m) for m in cycle["multipliers"]])
 print(f"multipliers {np.round(mus.real, 10)}; exp(mu int (1 - x^2) dt) = {math.exp(trace):.10f}")
 assert abs(cycle["period"] - T_REF) < 1e-9 and abs(cycle_hb["period"] - T_REF) < 1e-8
+assert abs(cycle_col["period"] - T_REF) < 1e-8
 assert abs(mus[1].real - math.exp(trace)) < 1e-9
 
 small = mechgen.periodic_orbit(vdp.with_params(mu=0.1), period=6.3, q0={"x": 2.0})

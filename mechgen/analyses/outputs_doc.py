@@ -352,16 +352,17 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
            "sin(k omega t) = mean + sum_k amplitude_k cos(k omega t + phase_k) (``cos`` a_k, ``sin`` b_k, "
            "``amplitude`` sqrt(a_k^2 + b_k^2), ``phase`` atan2(-b_k, a_k))."),
         _o("multipliers", "(2n, 2)", "-", "The Floquet multipliers (eigenvalues of the monodromy matrix) as [re, "
-           "im] pairs, by decreasing modulus."),
+           "im] pairs, by decreasing modulus (a conjugate pair: the positive imaginary part first)."),
         _o("stability", "string", "-", "``stable`` (every multiplier \\|mu\\| <= 1 + 1e-6, an autonomous "
            "orbit's trivial one set aside) or ``unstable``."),
-        _o("method", "string", "-", "``harmonic_balance`` or ``shooting``: the method that ran."),
-        _o("residual", "scalar", "force units (harmonic balance) or the state's (shooting)", "\\|\\|R\\|\\|_inf "
-           "at the solution."),
+        _o("method", "string", "-", "``harmonic_balance``, ``shooting`` or ``collocation``: the method that ran."),
+        _o("residual", "scalar", "force units (harmonic balance), the state's (shooting), mixed (collocation: "
+           "q's rate and force units)", "\\|\\|R\\|\\|_inf at the solution."),
         _o("iterations", "scalar (int)", "-", "Newton steps taken."),
         _o("loop", "string", "-", "``c``: shooting's integrations ran in the compiled DOP853 loop (the monodromy "
-           "for Newton by central differences of it); ``python``: in scipy's DOP853 (harmonic balance's "
-           "multipliers, and ``loop = \"python\"``)."),
+           "for Newton by central differences of it; a forced orbit's later segments, with ``segments`` > 1, in "
+           "scipy's); ``python``: in scipy's DOP853 (harmonic balance's and "
+           "collocation's multipliers, and ``loop = \"python\"``)."),
     ),
     "cross_section": (
         _o("K", "(6, 6)", "N, N m, N m^2", "The section's stiffness ordered [K_uu, K_uw; K_wu, K_ww]."),

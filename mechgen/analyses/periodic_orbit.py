@@ -1,18 +1,20 @@
-"""``periodic_orbit``: a periodic orbit of a smooth lumped model, forced or autonomous, by harmonic balance or by
-shooting, with its Floquet multipliers and stability.
+"""``periodic_orbit``: a periodic orbit of a smooth lumped model, forced or autonomous, by harmonic balance,
+shooting or orthogonal collocation, with its Floquet multipliers and stability.
 
 *Forced* (``frequency`` given: the forcing's angular frequency omega, rad/s, a number or an expression of the
 parameters such as ``"omega"`` or ``"2*omega"``): the orbit of period T = 2 pi / omega, t = 0 the forcing's time
 origin. *Autonomous* (``frequency`` left out): a limit cycle, whose period is an unknown found beside the orbit,
 from the starting guess ``period``; a phase condition fixes where t = 0 lies on it (below). Either way the
 starting guess is ``q0`` / ``v0`` (tables of coordinates, the state at t = 0; left out: zero, or the model's
-declared initial state), or ``from`` an earlier ``simulate`` that kept its trajectory: forced, its sample nearest a
-multiple of T within its last period; autonomous, its sample at the last maximum of the coordinate that varies most
-over the run's second half, with the time between the last two maxima as the period's guess (unless ``period`` is
+declared initial state; each method starts from the first harmonic through them), or ``from`` an earlier
+``simulate`` that kept its trajectory: its motion over one period (a cubic spline through its samples) starts each
+method (harmonic balance its projection, collocation its values at the nodes, shooting its states at the segments'
+starts): forced, its last whole period [m T, (m + 1) T]; autonomous, from the second-to-last to the last maximum of
+the coordinate that varies most over the run's second half, their distance the period's guess (unless ``period`` is
 given).
 
-Methods (``method``; left out: ``harmonic_balance`` when ``harmonics`` is given, ``shooting`` otherwise; the output
-``method`` says which ran):
+Methods (``method``; left out: ``harmonic_balance`` when ``harmonics`` is given, ``collocation`` when ``mesh`` is,
+``shooting`` otherwise; the output ``method`` says which ran):
 
 * ``harmonic_balance``: each coordinate a Fourier series of H = ``harmonics`` harmonics (default 7); the residual
   r(q, v, a, t) of the model's generated kernel is evaluated in one batched call at N = 8 (H + 1) phases
@@ -22,20 +24,32 @@ Methods (``method``; left out: ``harmonic_balance`` when ``harmonics`` is given,
   coordinate p with the largest |q0|). Its error is the truncation of the series (it falls fast with H for a smooth
   orbit).
 * ``shooting``: Newton on x(T) - x(0) = 0 (mechgen.runtime.periodic.shooting, .flow: DOP853 at 1/100 of ``rtol``
-  and ``atol``). With ``loop = "auto"`` (the default) on the C backend, x(T) comes from the compiled DOP853 loop
+  and ``atol``); with ``segments`` S > 1, multiple shooting: the period split into S segments, each from its own
+  unknown start state (on the guess's curve to begin with), for unstable or stiff orbits. With ``loop = "auto"``
+  (the default) on the C backend, x(T) comes from the compiled DOP853 loop
   (mechgen.runtime.integration.smooth_c) and Newton's Jacobian, the monodromy matrix, from central differences of
   it (4n + 1 compiled runs, about 1e-10 from the exact one); with ``loop = "python"`` (or where the compiled loop
   cannot run) both come from the variational equations (the Jacobian from the generated ``tangent`` kernel) by
   scipy's DOP853. Autonomous: the period is an unknown and the phase condition is v_p(0) = 0 (the
   orbit starts at an extremum of q_p). Its error is the integrator's.
-* ``collocation`` is not available yet (an input error).
+* ``collocation``: orthogonal collocation (mechgen.runtime.periodic.collocation): ``mesh`` equal intervals
+  (default 40) of t / T, on each a polynomial of degree 4 in q and v collocated at the 4 Gauss points in the model's
+  implicit form dq/dtau = T v, r(q, v, (dv/dtau) / T, t) = 0 (the residual kernel at all points in one batched
+  call, the exact Jacobian from the tangent kernel; no mass matrix inverted). Autonomous: the period is an unknown
+  and the phase condition v_p(0) = 0, as shooting's. Its error falls as mesh^-8 at the mesh points (the order 2m
+  of Gauss collocation). With ``adapt`` = k > 0 the mesh is adapted k times after the uniform solve: its intervals
+  moved so that each holds an equal share of the monitor |x^(5)|^(1/5) (AUTO's rule: small intervals where the orbit
+  turns fast), the orbit interpolated onto them and solved again.
 
 Newton stops after a step ||du||_inf <= ``atol`` + ``rtol`` ||u||_inf (u the unknowns), and raises a
 ConvergenceError after ``max_iterations`` steps, naming the residual. Stability comes from the monodromy matrix
-Phi(T) of the converged orbit, always from the variational equations (for harmonic balance: integrated over one
-period from the series' state at t = 0):
-the Floquet multipliers are its eigenvalues, and the orbit is ``stable`` when each |mu| <= 1 + 1e-6 (an autonomous
-orbit's trivial multiplier, the one nearest 1, set aside) (mechgen.runtime.periodic.floquet).
+Phi(T) of the converged orbit, always from the variational equations (for harmonic balance and collocation:
+integrated over one period from the orbit's state at t = 0): the Floquet multipliers are its eigenvalues. With
+``floquet = "hill"`` (harmonic balance only) they come from Hill's method instead
+(mechgen.runtime.periodic.harmonic_balance.hill_exponents: the quadratic eigenproblem of the linearisation on the
+harmonics, the 2n exponents whose eigenvectors weigh most on the low harmonics kept; no integration). The orbit is
+``stable`` when each |mu| <= 1 + 1e-6 (an autonomous orbit's trivial multiplier, the one nearest 1, set aside)
+(mechgen.runtime.periodic.floquet).
 
 Outputs: ``period`` (T), ``frequency`` (2 pi / T), ``t`` and ``trajectory`` (one period, ``samples`` times from 0
 to T, named as simulate's: each coordinate, ``<coordinate>_dot`` and the model's outputs), ``amplitude``
@@ -43,15 +57,18 @@ to T, named as simulate's: each coordinate, ``<coordinate>_dot`` and the model's
 neighbours), ``harmonics`` (per coordinate: ``mean``, ``cos`` a_k and
 ``sin`` b_k, ``amplitude`` sqrt(a_k^2 + b_k^2) and ``phase`` atan2(-b_k, a_k), k = 1..H, so that
 q = mean + sum_k a_k cos(k omega t) + b_k sin(k omega t) = mean + sum_k amplitude_k cos(k omega t + phase_k); for
-shooting H = ``harmonics`` or 7, projected from 4096 samples of the orbit), ``multipliers`` ([re, im] pairs, by
-decreasing modulus), ``stability``, ``method``, ``residual`` (||R||_inf at the solution: force units for harmonic
-balance, the state's for shooting), ``iterations`` and ``loop`` (``c``: shooting's integrations ran in the
-compiled loop; ``python``: in scipy's).
+shooting and collocation H = ``harmonics`` or 7, projected from 4096 samples of the orbit), ``multipliers``
+([re, im] pairs, by decreasing modulus), ``stability``, ``method``, ``residual`` (||R||_inf at the solution:
+force units for harmonic balance, the state's for shooting, both for collocation), ``iterations`` and ``loop``
+(``c``: shooting's integrations ran in the compiled loop; ``python``: in scipy's).
 
 Only smooth lumped models without internal variables: a hybrid model, a continuum, a chain or a model with internal
 variables is refused (key ``method``).
 """
 from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -59,17 +76,22 @@ from mechgen.analyses import schema, summary, time_series
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import ABSENT, Option
 from mechgen.errors import ConvergenceError, SceneError
+from mechgen.runtime.core.memory import dense_bytes, require
 from mechgen.runtime.periodic import floquet, fourier
+from mechgen.runtime.periodic.collocation import Collocation
 from mechgen.runtime.periodic.flow import compiled_flow, states_at, variational_flow
-from mechgen.runtime.periodic.harmonic_balance import HarmonicBalance
+from mechgen.runtime.periodic.harmonic_balance import HarmonicBalance, hill_multipliers
 from mechgen.runtime.periodic.newton import NewtonSettings, newton
 from mechgen.runtime.periodic.shooting import Shooting
 from mechgen.scene.values import fail, listing, show
 
 METHODS = ("harmonic_balance", "shooting", "collocation")
 LOOPS = ("auto", "python", "c")
+FLOQUET = ("monodromy", "hill")
 #: the harmonics of harmonic balance, and those reported by shooting, when ``harmonics`` is left out
 DEFAULT_HARMONICS = 7
+#: collocation's intervals when ``mesh`` is left out
+DEFAULT_MESH = 40
 #: phases at which amplitudes and a shooting orbit's harmonics are taken
 FINE = 4096
 #: shooting's Newton steps are at most this times (1 + ||u||_inf) (mechgen.runtime.periodic.newton: a full step from a
@@ -105,9 +127,29 @@ def earlier_simulate(ctx, key: str, value: object) -> str:
     return value
 
 
+#: the most collocation intervals (a guard against typos: the dense Jacobian has (8 mesh n)^2 entries)
+MAX_MESH = 2000
+
+
+def mesh_count(ctx, key: str, value: object) -> int:
+    """An integer from 2 to 2000 (a guard against typos)."""
+    count = schema.int_at_least(ctx, key, value, 2)
+    if count > MAX_MESH:
+        raise fail(ctx.file, key, f"mesh {count} is above {MAX_MESH}", f"an integer from 2 to {MAX_MESH}")
+    return count
+
+
+def adapt_count(ctx, key: str, value: object) -> int:
+    """An integer from 0 to 10."""
+    count = schema.int_at_least(ctx, key, value, 0)
+    if count > 10:
+        raise fail(ctx.file, key, f"adapt {count} is above 10", "an integer from 0 to 10")
+    return count
+
+
 SCHEMA = {
-    "method": Option(schema.one_of("method", METHODS), ABSENT, doc="harmonic_balance or shooting (left out: "
-                     "harmonic_balance when harmonics is given, else shooting; collocation is not available yet)"),
+    "method": Option(schema.one_of("method", METHODS), ABSENT, doc="harmonic_balance, shooting or collocation "
+                     "(left out: harmonic_balance when harmonics is given, collocation when mesh is, else shooting)"),
     "frequency": Option(schema.positive_expression, ABSENT, doc="the forcing's angular frequency omega (rad/s): a number or an "
                         "expression of parameters such as \"omega\"; the period is 2 pi / omega (left out: an "
                         "autonomous orbit, its period found)"),
@@ -115,6 +157,12 @@ SCHEMA = {
                      "model's time unit; required without frequency)"),
     "harmonics": Option(harmonics_count, ABSENT, doc="harmonic balance's number of harmonics H "
                         "(default 7); with shooting, how many harmonics are reported"),
+    "mesh": Option(mesh_count, ABSENT, doc="collocation's number of mesh intervals (default 40), each with a "
+                   "polynomial of degree 4 collocated at 4 Gauss points"),
+    "adapt": Option(adapt_count, 0,
+                    doc="collocation's mesh adaptations: after each solve the intervals are moved so that each holds "
+                    "an equal share of |x^(5)|^(1/5) (AUTO's monitor) and the orbit is solved again (0: the uniform "
+                    "mesh)"),
     "q0": Option(schema.coordinate_table, {}, doc="the starting guess of the coordinates at t = 0, a table "
                  "coordinate = value (left out: zero, or the model's declared initial state)"),
     "v0": Option(schema.coordinate_table, {}, doc="the starting guess of the velocities at t = 0, a table "
@@ -122,11 +170,16 @@ SCHEMA = {
     "from": Option(earlier_simulate, ABSENT, doc="an earlier simulate analysis (with its trajectory) whose "
                    "motion near its end is the starting guess instead of q0 / v0 (and, for an autonomous orbit, the "
                    "period between its last two maxima the period's)"),
+    "segments": Option(schema.count, 1, doc="shooting's number of segments S of the period (1: single shooting; more: "
+                       "multiple shooting, for unstable or stiff orbits)"),
     "rtol": Option(schema.positive, 1e-9, doc="Newton's relative tolerance on the unknowns (shooting integrates "
                    "at 1/100 of it)"),
     "atol": Option(schema.positive, 1e-12, doc="Newton's absolute tolerance on the unknowns (the coordinates' "
                    "units; shooting integrates at 1/100 of it)"),
     "max_iterations": Option(schema.count, 50, doc="the most Newton steps before a convergence error"),
+    "floquet": Option(schema.one_of("floquet", FLOQUET), "monodromy", doc="how the multipliers are found: monodromy "
+                      "(the eigenvalues of the monodromy matrix of the converged orbit) or hill (harmonic balance "
+                      "only: Hill's method on the harmonics, no integration)"),
     "loop": Option(schema.one_of("loop", LOOPS), "auto", doc="shooting's integrations: auto (the compiled DOP853 "
                    "loop where it can run: the C backend), python (scipy's DOP853 and the variational equations "
                    "throughout) or c (compiled, else an input error)"),
@@ -136,7 +189,8 @@ SCHEMA = {
 
 
 def check(ctx, base: str, options: dict) -> None:
-    """A smooth lumped model; collocation refused; an autonomous orbit needs a period guess, a forced one none."""
+    """A smooth lumped model; not both harmonics and mesh without a method; an autonomous orbit needs a period guess,
+    a forced one none."""
     model = ctx.model
     why = ("has modes (a hybrid model)" if getattr(model, "modes", ()) else "is a continuum"
            if getattr(model, "continuum", False) else "is a chain" if getattr(model, "chain", None)
@@ -144,9 +198,12 @@ def check(ctx, base: str, options: dict) -> None:
     if why:
         raise fail(ctx.file, f"{base}.method", f"model {model.name} {why}: periodic_orbit's methods need a smooth "
                    "lumped model", "a smooth lumped model (a hybrid model's periodic response: kind periodic)")
-    if options.get("method") == "collocation":
-        raise fail(ctx.file, f"{base}.method", "method 'collocation' is not available yet",
-                   "harmonic_balance or shooting")
+    if "harmonics" in options and "mesh" in options and "method" not in options:
+        raise fail(ctx.file, f"{base}.method", "both harmonics (harmonic balance) and mesh (collocation) are given",
+                   "method = \"harmonic_balance\" or \"collocation\" beside them, or one of the two keys")
+    if options.get("floquet") == "hill" and chosen_method(options) != "harmonic_balance":
+        raise fail(ctx.file, f"{base}.floquet", f"Hill's method needs harmonic balance, and the method is "
+                   f"{chosen_method(options)}", "floquet = \"monodromy\", or method = \"harmonic_balance\"")
     if "frequency" in options and "period" in options:
         raise fail(ctx.file, f"{base}.period", "a forced orbit's period is 2 pi / frequency; period is the guess of "
                    "an autonomous one", "period or frequency, not both")
@@ -165,7 +222,9 @@ def needs(options: dict, *, internal: bool) -> set[str]:
 
 def chosen_method(options: dict) -> str:
     """The method that runs (module doc)."""
-    return options.get("method") or ("harmonic_balance" if "harmonics" in options else "shooting")
+    if options.get("method"):
+        return options["method"]
+    return "harmonic_balance" if "harmonics" in options else "collocation" if "mesh" in options else "shooting"
 
 
 def refuse_unsupported(system) -> None:
@@ -189,12 +248,35 @@ def refuse_time_dependent(system, x: np.ndarray) -> None:
                          expected="the forcing's angular frequency (rad/s), a number or a parameter expression")
 
 
-def guess(system, options: dict) -> np.ndarray:
-    """x0 = (q0, v0): the tables over the declared initial state (zero when none)."""
+@dataclass(frozen=True)
+class Guess:
+    """A starting guess: the state ``x0`` at t = 0, the ``period``, the ``phase`` coordinate p of an autonomous
+    orbit's phase condition, and ``curve``: times in [0, period] -> the guessed states there (rows)."""
+
+    x0: np.ndarray
+    period: float
+    phase: int
+    curve: Callable[[np.ndarray], np.ndarray]
+
+
+def first_harmonic_states(x0: np.ndarray, omega: float, times: np.ndarray, n: int) -> np.ndarray:
+    """The states (rows) at ``times`` of q = q0 cos(omega t) + (v0 / omega) sin(omega t): the first harmonic through
+    the guess x0 = (q0, v0)."""
+    c, s = np.cos(omega * times)[:, None], np.sin(omega * times)[:, None]
+    q0, b = x0[None, :n], x0[None, n:] / omega
+    return np.hstack([q0 * c + b * s, omega * (b * c - q0 * s)])
+
+
+def guess(system, options: dict, omega) -> Guess:
+    """The guess of ``q0`` / ``v0`` (tables over the declared initial state, zero when none): the first harmonic
+    through them, of the forcing's period or the guessed one; p the coordinate with the largest |q0|."""
     from mechgen.analyses.simulate import initial_state
 
     q0, v0 = initial_state(system, options)
-    return np.concatenate([q0, v0])
+    x0 = np.concatenate([q0, v0])
+    period = 2 * np.pi / omega if omega is not None else float(options["period"])
+    w, n = 2 * np.pi / period, system.n
+    return Guess(x0, period, int(np.argmax(np.abs(q0))), lambda times: first_harmonic_states(x0, w, times, n))
 
 
 def simulated_states(system, options: dict, context: dict) -> tuple[np.ndarray, np.ndarray]:
@@ -203,33 +285,42 @@ def simulated_states(system, options: dict, context: dict) -> tuple[np.ndarray, 
     earlier = context.get(name, {})
     trajectory = earlier.get("trajectory")
     names = time_series.state_names(system)[:2 * system.n]
-    if not trajectory or any(k not in trajectory for k in names) or len(earlier.get("t", ())) < 3:
+    if not trajectory or any(k not in trajectory for k in names) or len(earlier.get("t", ())) < 4:
         raise SceneError(f"periodic_orbit: simulate analysis '{name}' kept no trajectory to start from", key="from",
-                         expected="a simulate analysis with series = true (and at least 3 samples)")
+                         expected="a simulate analysis with series = true (and at least 4 samples)")
     return np.asarray(earlier["t"], float), np.column_stack([trajectory[k] for k in names]).astype(float)
 
 
-def guess_from_simulate(system, options: dict, context: dict, omega) -> tuple[np.ndarray, float | None, int | None]:
-    """(x0, period guess or None, phase coordinate or None) from the ``from`` simulate: forced, the sample whose time is nearest a multiple of
-    T = 2 pi / omega among the last period's; autonomous, the sample at the last maximum of the coordinate that
-    varies most over the run's second half, and the time between its last two maxima."""
+def too_short(options: dict, what: str) -> SceneError:
+    """The ``from`` simulate does not hold what its guess needs."""
+    return SceneError(f"periodic_orbit: simulate analysis '{options['from']}' {what}", key="from",
+                      expected="a simulate run over at least two periods of the orbit (a longer t_end)")
+
+
+def guess_from_simulate(system, options: dict, context: dict, omega) -> Guess:
+    """The guess of the ``from`` simulate: its motion over one period, by a cubic spline through its samples.
+    Forced: the last whole period [m T, (m + 1) T] within the run (T = 2 pi / omega). Autonomous: from its
+    second-to-last maximum of the coordinate p that varies most over the run's second half to its last, whose
+    distance is the period's guess (unless ``period`` is given)."""
+    from scipy.interpolate import CubicSpline
+
     t, X = simulated_states(system, options, context)
+    spline = CubicSpline(t, X, axis=0)
     if omega is not None:
         T = 2 * np.pi / omega
-        last = t >= t[-1] - T
-        phase = np.abs(((t + T / 2) % T) - T / 2)
-        k = int(np.flatnonzero(last)[np.argmin(phase[last])])
-        return X[k], None, None
+        start = (np.floor((t[-1] + 1e-9 * T) / T) - 1) * T
+        if start < t[0]:
+            raise too_short(options, f"ends at t = {t[-1]:.6g}, before a whole period T = {T:.6g} of the forcing")
+        return Guess(spline(start), T, 0, lambda times: spline(start + np.asarray(times)))
     half = t >= (t[0] + t[-1]) / 2
     p = int(np.argmax(np.ptp(X[half, :system.n], axis=0)))
     q = X[:, p]
     peaks = np.flatnonzero((q[1:-1] >= q[:-2]) & (q[1:-1] > q[2:])) + 1
     if peaks.size < 2:
-        raise SceneError(f"periodic_orbit: simulate analysis '{options['from']}' shows fewer than two maxima of "
-                         f"'{system.coordinates[p]}' (no oscillation to start from)", key="from",
-                         expected="a simulate run over at least two periods of the orbit (a longer t_end)")
-    x0 = X[peaks[-1]].copy()
-    return x0, float(t[peaks[-1]] - t[peaks[-2]]), p
+        raise too_short(options, f"shows fewer than two maxima of '{system.coordinates[p]}'")
+    start = t[peaks[-2]]
+    period = float(options.get("period", t[peaks[-1]] - start))
+    return Guess(spline(start), period, p, lambda times: spline(start + np.asarray(times)))
 
 
 def settings(options: dict, method: str) -> NewtonSettings:
@@ -241,20 +332,51 @@ def settings(options: dict, method: str) -> NewtonSettings:
                           advice=advice, trust=SHOOTING_TRUST if method == "shooting" else np.inf)
 
 
-def solve_harmonic_balance(system, options: dict, x0: np.ndarray, omega, phase: int) -> dict:
-    """Harmonic balance from the guess: {U, omega, x0 (the state at t = 0), residual, iterations}."""
+def solve_harmonic_balance(system, options: dict, start: Guess, omega) -> dict:
+    """Harmonic balance from the guess (its curve projected onto the harmonics): {U, omega, x0 (the state at
+    t = 0), residual, iterations}."""
     H = int(options.get("harmonics", DEFAULT_HARMONICS))
-    problem = HarmonicBalance(system, fourier.basis(H), omega, phase)
-    w = float(omega if omega is not None else 2 * np.pi / options["period"])
-    n = system.n
-    U = np.zeros((2 * H + 1, n))
-    U[1], U[H + 1] = x0[:n], x0[n:] / w
+    size = (2 * H + 1) * system.n
+    require(dense_bytes(size, size) + dense_bytes(fourier.sample_count(H), size, system.n), f"harmonic balance's "
+            f"dense {size} x {size} Jacobian (H = {H}, {system.n} coordinates)", key="harmonics")
+    problem = HarmonicBalance(system, fourier.basis(H), omega, start.phase)
+    w = 2 * np.pi / start.period
+    n, N = system.n, problem.basis.theta.size
+    U = fourier.coefficients_of_samples(start.curve(start.period * np.arange(N) / N)[:, :n], H)
     if problem.autonomous:
-        U[H + 1, phase] = 0.0
+        U[H + 1, start.phase] = 0.0
     sol = newton(problem.residual_jacobian, problem.unknowns(U, w), settings(options, "harmonic_balance"))
-    U, w = problem.split(sol.u)
-    start, _ = problem.start_state(sol.u)
-    return {"U": U, "omega": w, "x0": start, "residual": sol.residual, "iterations": sol.iterations}
+    u = sol.u.copy()
+    if problem.autonomous and u[-1] < 0:  # the same orbit with omega -> -omega and b_k -> -b_k (no t in r)
+        u[(H + 1) * n:-1] *= -1
+        u[-1] = -u[-1]
+    U, w = problem.split(u)
+    if not w > 0:
+        raise ConvergenceError("periodic_orbit (harmonic_balance): Newton converged to frequency 0 (an "
+                               "equilibrium); try a starting guess nearer the limit cycle (q0, v0, period)")
+    x0, _ = problem.start_state(u)
+    return {"U": U, "omega": w, "x0": x0, "residual": sol.residual, "iterations": sol.iterations,
+            "problem": problem, "u": u}
+
+
+def solve_collocation(system, options: dict, start: Guess, omega) -> dict:
+    """Collocation from the guess (its curve at the nodes): {problem, u, x0, omega, residual, iterations}."""
+    problem = Collocation(system, int(options.get("mesh", DEFAULT_MESH)), omega, start.phase)
+    size = problem.nodes * 2 * system.n + 1
+    require(dense_bytes(size, size), f"collocation's dense {size} x {size} Jacobian", key="mesh")
+    X = start.curve(start.period * np.arange(problem.nodes) / problem.nodes)
+    if problem.autonomous:
+        X[0, system.n + start.phase] = 0.0
+    sol = newton(problem.residual_jacobian, problem.unknowns(X, start.period), settings(options, "collocation"))
+    for _ in range(int(options.get("adapt", 0))):
+        problem, u = problem.adapted(sol.u)
+        sol = newton(problem.residual_jacobian, u, settings(options, "collocation"))
+    X, T = problem.split(sol.u)
+    if not T > 0:
+        raise ConvergenceError(f"periodic_orbit (collocation): Newton converged to the period {T:.6g}; try a better "
+                               "starting guess (period, q0, v0, or from a simulate)")
+    return {"problem": problem, "u": sol.u, "x0": X[0].copy(), "omega": 2 * np.pi / T, "residual": sol.residual,
+            "iterations": sol.iterations}
 
 
 def compiled_run(system, options: dict):
@@ -271,18 +393,20 @@ def compiled_run(system, options: dict):
     return run
 
 
-def solve_shooting(system, options: dict, x0: np.ndarray, omega, phase: int) -> dict:
-    """Shooting from the guess: {x0, omega, residual, iterations, loop}."""
+def solve_shooting(system, options: dict, start: Guess, omega) -> dict:
+    """Shooting from the guess (``segments`` S > 1: the segments' starts on its curve): {x0, omega, residual,
+    iterations, run}."""
     rtol, atol = integrator_tolerances(options)
     run = compiled_run(system, options)
-    problem = Shooting(system, omega, phase, rtol, atol, run)
+    S = int(options.get("segments", 1))
+    problem = Shooting(system, omega, start.phase, rtol, atol, run, S)
+    X = start.curve(start.period * np.arange(S) / S)
+    X[0] = start.x0
     if problem.autonomous:
-        x0 = x0.copy()
-        x0[system.n + phase] = 0.0
-    period = float(options["period"]) if omega is None else 2 * np.pi / omega
-    sol = newton(problem.residual_jacobian, problem.unknowns(x0, period), settings(options, "shooting"))
-    start, T = problem.split(sol.u)
-    return {"x0": np.asarray(start, float), "omega": 2 * np.pi / T, "residual": sol.residual,
+        X[0, system.n + start.phase] = 0.0
+    sol = newton(problem.residual_jacobian, problem.unknowns(X, start.period), settings(options, "shooting"))
+    x0, T = problem.split(sol.u)
+    return {"x0": np.asarray(x0, float), "omega": 2 * np.pi / T, "residual": sol.residual,
             "iterations": sol.iterations, "run": run}
 
 
@@ -293,6 +417,8 @@ def integrator_tolerances(options: dict) -> tuple[float, float]:
 
 def orbit_samples(system, options: dict, found: dict, method: str, times: np.ndarray) -> np.ndarray:
     """The states (rows) at ``times`` within [0, T]: the series of harmonic balance, the flow of shooting."""
+    if method == "collocation":
+        return found["problem"].states_at(found["u"], times)
     if method == "harmonic_balance":
         theta = found["omega"] * times
         q = fourier.evaluate(found["U"], theta)
@@ -308,24 +434,17 @@ def run_periodic_orbit(system, options: dict, context: dict) -> dict:
     refuse_unsupported(system)
     method = chosen_method(options)
     omega = options.get("frequency")
-    phase = None
-    if "from" in options:
-        x0, period, phase = guess_from_simulate(system, options, context, omega)
-        if omega is None and "period" not in options:
-            options = {**options, "period": period}
-    else:
-        x0 = guess(system, options)
+    start = guess_from_simulate(system, options, context, omega) if "from" in options else guess(system, options, omega)
     if omega is None:
-        refuse_time_dependent(system, x0)
-        if not np.any(x0[:system.n]) and not np.any(x0[system.n:]):
+        refuse_time_dependent(system, start.x0)
+        if not np.any(start.x0):
             raise SceneError("periodic_orbit: an autonomous orbit from a zero starting guess would find the "
                              "equilibrium", key="q0", expected="a starting guess on or near the orbit (q0, v0)")
-    phase = int(np.argmax(np.abs(x0[:system.n]))) if phase is None else phase
-    solve = solve_harmonic_balance if method == "harmonic_balance" else solve_shooting
-    found = solve(system, options, x0, omega, phase)
+    solve = {"harmonic_balance": solve_harmonic_balance, "collocation": solve_collocation}.get(method, solve_shooting)
+    found = solve(system, options, start, omega)
     out = report(system, options, found, method, autonomous=omega is None)
     # what a continuation of the orbit starts from (mechgen.analyses.orbit_branch)
-    out["_orbit"] = {"method": method, "phase": phase, "found": found, "options": dict(options)}
+    out["_orbit"] = {"method": method, "phase": start.phase, "found": found, "options": dict(options)}
     return out
 
 
@@ -340,10 +459,13 @@ def report(system, options: dict, found: dict, method: str, *, autonomous: bool)
     if autonomous and np.max(np.ptp(fine[:, :n], axis=0)) <= 1e3 * float(options["atol"]):
         raise ConvergenceError(f"periodic_orbit ({method}): Newton converged to an equilibrium (the orbit's "
                                "coordinates do not vary); try a starting guess nearer the limit cycle (q0, v0, period)")
-    U = found["U"] if method == "harmonic_balance" else fourier.coefficients_of_samples(
+    U = found["U"] if method == "harmonic_balance" else fourier.coefficients_of_samples(  # shooting, collocation
         fine[:, :n], int(options.get("harmonics", DEFAULT_HARMONICS)))
-    _, Phi = variational_flow(system, found["x0"], 0.0, T, *integrator_tolerances(options))
-    mu = floquet.multipliers(Phi)
+    if options.get("floquet") == "hill":
+        mu = hill_multipliers(found["problem"], found["u"])
+    else:
+        _, Phi = variational_flow(system, found["x0"], 0.0, T, *integrator_tolerances(options))
+        mu = floquet.multipliers(Phi)
     t = np.linspace(0.0, T, int(options["samples"]))
     X = orbit_samples(system, options, found, method, t)
     series = time_series.sampled_outputs(system, t, X)

@@ -188,7 +188,8 @@ def periodic(system, *, name: str | None = None, **options) -> Result:
 
 def periodic_orbit(system, *, name: str | None = None, **options) -> Result:
     """A periodic orbit of a smooth lumped model, forced (``frequency``) or autonomous (``period`` the guess), by
-    harmonic balance or shooting, with its Floquet multipliers and stability (mechgen.analyses.periodic_orbit).
+    harmonic balance, shooting or collocation, with its Floquet multipliers and stability
+    (mechgen.analyses.periodic_orbit).
 
     ``from`` is a Python keyword: start from an earlier simulate with ``periodic_orbit(system, **{"from": run})``
     (``run`` the simulate's Result, kept with its trajectory).

@@ -4,13 +4,15 @@ continuation of orbits in a parameter.
 The interface a continuation builds on, one problem object per method, each holding a compiled system:
 
 * :class:`~mechgen.runtime.periodic.harmonic_balance.HarmonicBalance` (unknowns u: the Fourier coefficients, and
-  the frequency omega when autonomous) and :class:`~mechgen.runtime.periodic.shooting.Shooting` (u: the start
-  state x0, and the period T when autonomous) each give
+  the frequency omega when autonomous), :class:`~mechgen.runtime.periodic.shooting.Shooting` (u: the start
+  state x0, and the period T when autonomous) and :class:`~mechgen.runtime.periodic.collocation.Collocation` (u: the
+  states at the mesh's nodes, and T when autonomous) each give
 
   - ``residual_jacobian(u) -> (R, dR/du)``: the residual, with the phase condition appended when autonomous, and
     its exact Jacobian (square);
   - ``frequency_derivative(u) -> dR/domega`` of a forced orbit at fixed model parameters;
-  - ``unknowns(...)`` / ``split(u)``: between u and the orbit's (coefficients or start state, frequency or period).
+  - ``unknowns(...)`` / ``split(u)``: between u and the orbit's (coefficients, start state or node states;
+    frequency or period).
 
 * dR/d(model parameter) is :func:`mechgen.runtime.periodic.parameters.parameter_derivative`: central differences of
   R through ``system.with_params`` (a new system per value; the kernels are those of the compiled model).

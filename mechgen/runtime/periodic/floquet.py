@@ -15,10 +15,16 @@ import numpy as np
 NEUTRAL = 1e-6
 
 
+def ordered(mu: np.ndarray) -> np.ndarray:
+    """Multipliers by decreasing modulus (equal to 1e-9 relative: a conjugate pair), then decreasing imaginary part."""
+    mu = np.asarray(mu, complex)
+    modulus = np.round(np.abs(mu) / max(float(np.max(np.abs(mu), initial=0.0)), 1e-300), 9)
+    return mu[np.lexsort((-mu.imag, -modulus))]
+
+
 def multipliers(monodromy: np.ndarray) -> np.ndarray:
-    """The eigenvalues of the monodromy matrix, by decreasing modulus."""
-    mu = np.linalg.eigvals(np.asarray(monodromy, float))
-    return mu[np.argsort(-np.abs(mu), kind="stable")]
+    """The eigenvalues of the monodromy matrix, :func:`ordered`."""
+    return ordered(np.linalg.eigvals(np.asarray(monodromy, float)))
 
 
 def nontrivial(mu: np.ndarray, autonomous: bool) -> np.ndarray:

@@ -114,3 +114,56 @@ class HarmonicBalance:
         q0 = U[0] + U[1:H + 1].sum(axis=0)
         v0 = omega * (k[:, None] * U[H + 1:]).sum(axis=0)
         return np.concatenate([q0, v0]), 2 * np.pi / omega
+
+
+def hill_exponents(problem: HarmonicBalance, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(lambda, weights): the Floquet exponents of the orbit u by Hill's method, and each one's share of its
+    eigenvector on the first harmonics (the sorting's key).
+
+    A perturbation dq = exp(lambda t) p(t), p with the orbit's H harmonics (coefficients P), of the linearised
+    r_q dq + r_v dq' + r_a dq'' = 0 gives the quadratic eigenproblem (Galerkin on the harmonics)
+
+        (A0 + lambda A1 + lambda^2 A2) P = 0,
+        A0 = P(r_q G0 + omega r_v G1 + omega^2 r_a G2),  A1 = P(r_v G0 + 2 omega r_a G1),  A2 = P(r_a G0),
+
+    (A0 is the harmonic balance Jacobian at fixed omega), solved as a generalised eigenproblem of twice its size.
+    Each exponent appears once per harmonic shift (lambda + i k omega); the physical 2n are those whose eigenvectors
+    weigh most on the harmonics |k| <= 1 and the mean (``weights``: that share of |P|^2), the sorting of Lazarus &
+    Thomas (2010) that keeps the physical multipliers."""
+    U, omega = problem.split(u)
+    b, n = problem.basis, problem.system.n
+    N, size = b.theta.size, b.size
+    tan = problem.evaluate("tangent", problem.samples(U, omega))
+    rq, rv, ra = (np.asarray(tan[k], float).reshape(N, n, n) for k in ("r_q", "r_v", "r_a"))
+
+    def galerkin(M, G):
+        return np.einsum("ks,sij,sl->kilj", b.projector, M, G, optimize=True).reshape(size * n, size * n)
+
+    A0 = galerkin(rq, b.values) + omega * galerkin(rv, b.slopes) + omega**2 * galerkin(ra, b.curvatures)
+    A1 = galerkin(rv, b.values) + 2 * omega * galerkin(ra, b.slopes)
+    A2 = galerkin(ra, b.values)
+    m = size * n
+    eye, zero = np.eye(m), np.zeros((m, m))
+    left = np.block([[zero, eye], [-A0, -A1]])
+    right = np.block([[eye, zero], [zero, A2]])
+    import scipy.linalg as sla
+
+    lam, vectors = sla.eig(left, right)
+    P = vectors[:m].reshape(size, n, -1)
+    H = b.harmonics
+    low = np.abs(P[0]) ** 2 + np.abs(P[1]) ** 2 + np.abs(P[H + 1]) ** 2
+    weights = low.sum(axis=0) / np.maximum((np.abs(P) ** 2).sum(axis=(0, 1)), 1e-300)
+    return lam, weights
+
+
+def hill_multipliers(problem: HarmonicBalance, u: np.ndarray) -> np.ndarray:
+    """The 2n Floquet multipliers exp(lambda T) of the exponents with the largest ``weights``
+    (:func:`hill_exponents`), ordered as mechgen.runtime.periodic.floquet.ordered."""
+    lam, weights = hill_exponents(problem, u)
+    finite = np.isfinite(lam)
+    lam, weights = lam[finite], weights[finite]
+    keep = np.argsort(-weights, kind="stable")[:2 * problem.system.n]
+    _, omega = problem.split(u)
+    from mechgen.runtime.periodic.floquet import ordered
+
+    return ordered(np.exp(lam[keep] * 2 * np.pi / omega))

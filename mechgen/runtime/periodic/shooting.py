@@ -1,19 +1,25 @@
-"""Single shooting for a periodic orbit of a smooth lumped model: the unknowns, the residual and its Jacobian.
+"""Single and multiple shooting for a periodic orbit of a smooth lumped model: the unknowns, the residual and its
+Jacobian.
 
-Forced (the period T = 2 pi / omega fixed by the forcing's angular frequency omega, rad/s): the unknowns are
-u = x0 = (q(0), v(0)) and
+The period [0, T] is split into S = ``segments`` equal segments [t_k, t_k + T/S], t_k = k T / S, each started from
+its own unknown state x_k (S = 1: single shooting). Forced (T = 2 pi / omega fixed by the forcing's angular
+frequency omega, rad/s): u = (x_0, ..., x_{S-1}) and
 
-    R(u) = phi_T(x0) - x0,                 dR/du = Phi(T) - I,
+    R_k(u) = phi_k(x_k) - x_{k+1 mod S},      dR_k/dx_k = Phi_k,   dR_k/dx_{k+1} = -I,
 
-phi_T the flow over [0, T] and Phi(T) its monodromy matrix (mechgen.runtime.periodic.flow: the variational
+phi_k the flow over segment k and Phi_k its state transition matrix (mechgen.runtime.periodic.flow: the variational
 equations with the generated tangent kernel's Jacobian, or, with ``compiled``, the compiled loop's flow and its
-central differences). Autonomous (T unknown): u = (x0, T) and
+central differences). Autonomous (T unknown): u = (x_0, ..., x_{S-1}, T), the columns dR_k/dT =
+f(phi_k(x_k)) / S, and the phase condition v_p(0) = 0 (the velocity of coordinate p zero at t = 0: the orbit starts
+at an extremum of q_p, which every non-constant orbit has) as the last row. Multiple shooting keeps each segment's
+flow short, so an unstable orbit (a multiplier mu > 1 grows a start error by mu per period) or a stiff one stays
+within reach of Newton: the sensitivity is per segment, about mu^(1/S). The monodromy matrix is
+Phi_{S-1} ... Phi_0. ``frequency_derivative`` gives dR/domega of a forced orbit at fixed model parameters: for single
+shooting -f(T, x(T)) 2 pi / omega^2 (the period alone moves), for multiple shooting by central differences (step
+1e-6 omega; the segments' start times move with omega).
 
-    R(u) = (phi_T(x0) - x0,  v_p(0)),      dR/du = [[Phi(T) - I, f(phi_T(x0))], [e_{n+p}^T, 0]],
-
-the phase condition v_p(0) = 0 (the velocity of coordinate p zero at t = 0: the orbit starts at an extremum of
-q_p, which every non-constant orbit has) making the solution isolated. ``frequency_derivative`` gives dR/domega of a
-forced orbit at fixed model parameters, -f(T, x(T)) 2 pi / omega^2 (the period alone moves).
+The compiled loop integrates from t = 0, so it runs the segments of an autonomous orbit (whose equations do not
+depend on t) and single shooting's one segment; a forced orbit's later segments use the variational equations.
 """
 from __future__ import annotations
 
@@ -28,7 +34,8 @@ from mechgen.runtime.periodic.flow import differenced_flow, variational_flow
 @dataclass(frozen=True)
 class Shooting:
     """The shooting problem of ``system`` (module doc): ``omega`` the forcing's angular frequency (None:
-    autonomous), ``phase`` the coordinate p of the phase condition, integrator tolerances ``rtol``/``atol``."""
+    autonomous), ``phase`` the coordinate p of the phase condition, integrator tolerances ``rtol``/``atol``,
+    ``segments`` S (1: single shooting)."""
 
     system: object
     omega: float | None
@@ -37,48 +44,76 @@ class Shooting:
     atol: float = 1e-13
     #: mechgen.runtime.periodic.flow.compiled_flow's run, or None: the variational equations
     compiled: Callable | None = None
+    segments: int = 1
 
     @property
     def autonomous(self) -> bool:
         """Whether the period is an unknown."""
         return self.omega is None
 
-    def unknowns(self, x0: np.ndarray, period: float) -> np.ndarray:
-        """u from a starting state and period."""
-        return np.append(x0, period) if self.autonomous else np.asarray(x0, float).copy()
+    def unknowns(self, X: np.ndarray, period: float) -> np.ndarray:
+        """u from the segments' start states (rows; one row or a vector for single shooting) and the period."""
+        X = np.asarray(X, float).ravel()
+        return np.append(X, period) if self.autonomous else X.copy()
+
+    def starts(self, u: np.ndarray) -> tuple[np.ndarray, float]:
+        """(X: the segments' start states, S x 2n, T) of the unknowns."""
+        d = 2 * self.system.n
+        if self.autonomous:
+            return u[:-1].reshape(self.segments, d), float(u[-1])
+        return u.reshape(self.segments, d), 2 * np.pi / self.omega
 
     def split(self, u: np.ndarray) -> tuple[np.ndarray, float]:
-        """(x0, T) of the unknowns."""
-        if self.autonomous:
-            return u[:-1], float(u[-1])
-        return u, 2 * np.pi / self.omega
+        """(x0: the state at t = 0, T) of the unknowns (the first segment's start)."""
+        X, T = self.starts(u)
+        return X[0], T
 
-    def flow(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(x(T), Phi(T)) from x0: the compiled flow and its central differences when ``compiled`` is given, else the
-        variational equations (mechgen.runtime.periodic.flow)."""
-        x0, T = self.split(u)
+    def segment_flow(self, x: np.ndarray, k: int, T: float) -> tuple[np.ndarray, np.ndarray]:
+        """(x(t_k + T/S), Phi_k) from x(t_k) = x (module doc)."""
         if not (np.isfinite(T) and T > 0):
             raise FloatingPointError(f"period {T} is not positive")
-        if self.compiled is not None:
-            return differenced_flow(self.compiled, x0, T)
-        return variational_flow(self.system, x0, 0.0, T, self.rtol, self.atol)
+        span = T / self.segments
+        if self.compiled is not None and (k == 0 or self.autonomous):
+            return differenced_flow(self.compiled, x, span)
+        return variational_flow(self.system, x, k * span, span, self.rtol, self.atol)
+
+    def flow(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(x(T), the monodromy matrix Phi_{S-1} ... Phi_0) of the segments' flows (x(T) from the last segment)."""
+        X, T = self.starts(u)
+        Phi = np.eye(X.shape[1])
+        for k in range(self.segments):
+            end, step = self.segment_flow(X[k], k, T)
+            Phi = step @ Phi
+        return end, Phi
 
     def residual_jacobian(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(R(u), dR/du) (module doc)."""
-        x0, T = self.split(u)
-        xT, Phi = self.flow(u)
-        R = xT - x0
-        J = Phi - np.eye(x0.size)
+        X, T = self.starts(u)
+        S, d = X.shape
+        R = np.empty(S * d)
+        J = np.zeros((S * d + self.autonomous, S * d + self.autonomous))
+        for k in range(S):
+            end, Phi = self.segment_flow(X[k], k, T)
+            rows = slice(k * d, (k + 1) * d)
+            nxt = (k + 1) % S
+            R[rows] = end - X[nxt]
+            J[rows, k * d:(k + 1) * d] += Phi
+            J[rows, nxt * d:(nxt + 1) * d] -= np.eye(d)
+            if self.autonomous:
+                J[rows, -1] = self.system.rhs((k + 1) * T / S, end) / S
         if not self.autonomous:
             return R, J
-        n = self.system.n
-        fT = self.system.rhs(T, xT)
-        row = np.zeros(u.size)
-        row[n + self.phase] = 1.0
-        return np.append(R, x0[n + self.phase]), np.vstack([np.hstack([J, fT[:, None]]), row])
+        J[-1, self.system.n + self.phase] = 1.0
+        return np.append(R, X[0, self.system.n + self.phase]), J
 
     def frequency_derivative(self, u: np.ndarray) -> np.ndarray:
-        """dR/domega of a forced orbit at fixed parameters: f(T, x(T)) dT/domega, dT/domega = -2 pi / omega^2."""
-        x0, T = self.split(u)
-        xT, _ = self.flow(u)
-        return self.system.rhs(T, xT) * (-2 * np.pi / self.omega**2)
+        """dR/domega of a forced orbit at fixed parameters: single shooting's f(T, x(T)) dT/domega, dT/domega =
+        -2 pi / omega^2 (the period alone moves); multiple shooting's by central differences (step 1e-6 omega)."""
+        if self.segments == 1:
+            X, T = self.starts(u)
+            end, _ = self.segment_flow(X[0], 0, T)
+            return self.system.rhs(T, end) * (-2 * np.pi / self.omega**2)
+        h = 1e-6 * self.omega
+        shifted = [Shooting(self.system, w, self.phase, self.rtol, self.atol, self.compiled, self.segments)
+                   for w in (self.omega + h, self.omega - h)]
+        return (shifted[0].residual_jacobian(u)[0] - shifted[1].residual_jacobian(u)[0]) / (2 * h)
