@@ -219,3 +219,159 @@ max_points = 130
     assert F[k] == pytest.approx(0.0516, rel=0.06) and w[k] == pytest.approx(1.0904, rel=0.01)
     back = slice(k, None)
     assert np.interp(0.3, F[back], w[back]) == pytest.approx(1.3242362, abs=1e-3)
+
+
+FORCED_VDP = '''"""x'' - mu (1 - x^2) x' + x = F cos(w t)."""
+import sympy as sp
+from mechgen import Model, Param
+
+model = Model("forced_vdp", doc=__doc__)
+model.params(Param("mu", 0.2), Param("F", 0.5), Param("w", 1.1))
+model.coordinates("x")
+model.kinetic(lambda v: v.x**2 / 2)
+model.potential(lambda q: q.x**2 / 2)
+
+
+@model.forces
+def forces(q, v, p, t):
+    return {"x": p.mu * (1 - q.x**2) * v.x + p.F * sp.cos(p.w * t)}
+'''
+
+
+def test_torus_point_of_the_forced_van_der_pol_oscillator(tmp_path):
+    """The entrained orbit of x'' - mu (1 - x^2) x' + x = F cos(w t) (mu = 0.2, w = 1.1), followed down in F, loses
+    stability through a Neimark-Sacker point: a complex pair of multipliers on the unit circle. Liouville's formula
+    det Phi = exp(mu int (1 - x^2) dt) makes |mu_1 mu_2| = 1 there exactly when the orbit's mean of x^2 is 1: checked
+    on the orbit integrated here by scipy from the point's start state (to 1e-6), and the pair's modulus from a
+    hand-written monodromy (central differences of scipy's flow) to 1e-6."""
+    (tmp_path / "fvdp.py").write_text(FORCED_VDP)
+    scene = tmp_path / "ns.toml"
+    scene.write_text('''model = "fvdp.py"
+backend = "c"
+[[analysis]]
+name = "orbit"
+kind = "periodic_orbit"
+method = "shooting"
+frequency = "w"
+q0 = { x = 2.0 }
+[[analysis]]
+name = "branch"
+kind = "continuation"
+about = "orbit"
+parameter = "F"
+stop = 0.1
+max_step = 0.02
+''')
+    out = mechgen.run(str(scene))["analyses"][1]["outputs"]
+    (ns,) = [s for s in out["special_points"] if s["type"] == "NS"]
+    F_ns, T = ns["F"], ns["period"]
+    assert T == pytest.approx(2 * math.pi / 1.1, rel=1e-14)
+
+    def rhs(t, y):
+        return [y[1], 0.2 * (1 - y[0] ** 2) * y[1] - y[0] + F_ns * math.cos(1.1 * t)]
+
+    x0 = np.array([ns["start"]["x"], ns["start"]["x_dot"]])
+    sol = solve_ivp(rhs, (0.0, T), x0, method="DOP853", rtol=1e-12, atol=1e-14, dense_output=True)
+    assert np.max(np.abs(sol.y[:, -1] - x0)) < 1e-8  # a periodic orbit of the hand-written equation
+    t = np.linspace(0.0, T, 20001)
+    x = sol.sol(t)[0]
+    from scipy.integrate import simpson
+
+    mean_square = simpson(x**2, x=t) / T
+    assert mean_square == pytest.approx(1.0, abs=1e-6)
+    h = 1e-6
+    J = np.column_stack([(solve_ivp(rhs, (0.0, T), x0 + h * e, method="DOP853", rtol=1e-12, atol=1e-14).y[:, -1]
+                          - solve_ivp(rhs, (0.0, T), x0 - h * e, method="DOP853", rtol=1e-12, atol=1e-14).y[:, -1])
+                         / (2 * h) for e in np.eye(2)])
+    mu = np.linalg.eigvals(J)
+    assert abs(mu[0].imag) > 1e-3 and np.abs(mu) == pytest.approx([1.0, 1.0], abs=1e-6)
+
+
+def test_period_doubling_of_the_double_well_duffing_and_a_closed_branch(tmp_path):
+    """x'' + 0.3 x' - x + x^3 = F cos(1.2 t) (Holmes 1979's double-well oscillator), its orbit in one well followed
+    up in F: a PD point (a multiplier -1) near F = 0.2656, checked by a hand-written shooting and monodromy at the
+    located F (the real multiplier -1 to 1e-6); the branch, an isola symmetric in F -> -F, closes on itself and the
+    continuation says so (status 'closed') instead of running to max_points."""
+    scene = tmp_path / "well.toml"
+    scene.write_text('''model = "duffing"
+backend = "c"
+[params]
+c = 0.3
+k = -1.0
+k3 = 1.0
+F = 0.05
+w = 1.2
+[[analysis]]
+name = "orbit"
+kind = "periodic_orbit"
+method = "shooting"
+frequency = "w"
+q0 = { x = 1.0 }
+[[analysis]]
+name = "branch"
+kind = "continuation"
+about = "orbit"
+parameter = "F"
+stop = 3.0
+max_step = 0.05
+max_points = 400
+''')
+    out = mechgen.run(str(scene))["analyses"][1]["outputs"]
+    assert out["status"] == "closed" and out["points"] < 400
+    pd = min((s for s in out["special_points"] if s["type"] == "PD" and s["F"] > 0), key=lambda s: s["F"])
+    F_pd, T = pd["F"], 2 * math.pi / 1.2
+    assert F_pd == pytest.approx(0.2656, abs=1e-3)
+
+    def rhs(t, y):
+        return [y[1], F_pd * math.cos(1.2 * t) - 0.3 * y[1] + y[0] - y[0] ** 3]
+
+    def flow(x):
+        return solve_ivp(rhs, (0.0, T), x, method="DOP853", rtol=1e-12, atol=1e-14).y[:, -1]
+
+    x0 = fsolve(lambda x: flow(x) - x, [pd["start"]["x"], pd["start"]["x_dot"]], xtol=1e-13)
+    h = 1e-6
+    J = np.column_stack([(flow(x0 + h * e) - flow(x0 - h * e)) / (2 * h) for e in np.eye(2)])
+    mu = np.linalg.eigvals(J)
+    assert np.min(mu.real) == pytest.approx(-1.0, abs=1e-6) and np.all(np.abs(mu.imag) < 1e-9)
+
+
+def test_doubled_orbit_past_the_period_doubling(tmp_path):
+    """switch_branches on the double-well Duffing branch: past its first PD point the doubled orbit has period 2T,
+    and the hand-written flow maps its start onto itself over 2T (to 1e-8) but not over T."""
+    scene = tmp_path / "well2.toml"
+    scene.write_text('''model = "duffing"
+backend = "c"
+[params]
+c = 0.3
+k = -1.0
+k3 = 1.0
+F = 0.05
+w = 1.2
+[[analysis]]
+name = "orbit"
+kind = "periodic_orbit"
+method = "shooting"
+frequency = "w"
+q0 = { x = 1.0 }
+[[analysis]]
+name = "branch"
+kind = "continuation"
+about = "orbit"
+parameter = "F"
+stop = 0.5
+max_step = 0.02
+switch_branches = true
+''')
+    out = mechgen.run(str(scene))["analyses"][1]["outputs"]
+    first = out["doubled"][0]
+    F_d, T = first["F"], 2 * math.pi / 1.2
+    assert first["period"] == pytest.approx(2 * T, rel=1e-14)
+
+    def flow(x, span):
+        def rhs(t, y):
+            return [y[1], F_d * math.cos(1.2 * t) - 0.3 * y[1] + y[0] - y[0] ** 3]
+        return solve_ivp(rhs, (0.0, span), x, method="DOP853", rtol=1e-12, atol=1e-14).y[:, -1]
+
+    x0 = np.array([first["start"]["x"], first["start"]["x_dot"]])
+    assert np.max(np.abs(flow(x0, 2 * T) - x0)) < 1e-8
+    assert np.max(np.abs(flow(x0, T) - x0)) > 1e-4

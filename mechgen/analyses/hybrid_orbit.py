@@ -86,7 +86,7 @@ def run_hybrid_branch(system, options: dict, orbit: dict) -> dict:
     rtol, atol = float(orbit["options"]["rtol"]) * 1e-2, float(orbit["options"]["atol"]) * 1e-2
 
     def period(p: float) -> float:
-        w = frequency.at({**system.param_values(), name: p}) if isinstance(frequency, ParamExpression) else frequency
+        w = frequency.moved(name, p, system.param_values()) if isinstance(frequency, ParamExpression) else frequency
         return 2 * np.pi / float(w)
 
     family = OrbitFamily(system, name, period, orbit["mode"], rtol=rtol, atol=atol)

@@ -12,7 +12,8 @@ over the period}), ``start`` (the state at t = 0: each coordinate and ``<coordin
 ``method``, ``folds`` and ``special_points``: ``LPC`` (a cyclic fold: the branch turns in the parameter),
 ``PD`` (period doubling: a multiplier through -1) and ``NS`` (Neimark-Sacker: a complex pair through the unit
 circle, with ``angle``), each with the parameter, period, amplitude and multipliers there
-(mechgen.runtime.steady.cycle_points).
+(mechgen.runtime.steady.cycle_points); with ``switch_branches`` (a forced orbit by shooting) ``doubled``, the
+period-2T orbit just past every PD point.
 """
 from __future__ import annotations
 
@@ -35,7 +36,7 @@ from mechgen.runtime.steady.cycle_points import cycle_points
 
 #: keys of a continuation that an orbit branch does not take
 ORBIT_REFUSES = ("method", "stages", "bounds", "at", "minimize", "switch_branches", "special_point", "eigenvalues",
-                 "aliases")
+                 "aliases")  # switch_branches: taken by a forced orbit found by shooting (and a hybrid model's)
 #: phases at which a branch point's amplitudes are taken
 PHASES = 4096
 
@@ -55,7 +56,7 @@ class Orbits:
         if self.frequency is None:
             return None
         if isinstance(self.frequency, ParamExpression):
-            return self.frequency.at({**self.system.param_values(), self.name: float(p)})
+            return self.frequency.moved(self.name, p, self.system.param_values())
         return float(self.frequency)
 
     def make(self, p: float):
@@ -126,8 +127,10 @@ def run_orbit_branch(system, options: dict, earlier: dict) -> dict:
     """The branch of orbits through an earlier periodic_orbit (module doc; a hybrid model's:
     mechgen.analyses.hybrid_orbit.run_hybrid_branch, which also takes ``switch_branches``)."""
     hybrid = bool(earlier["_orbit"].get("hybrid"))
+    switchable = hybrid or (earlier["_orbit"]["method"] == "shooting"
+                            and earlier["_orbit"]["options"].get("frequency") is not None)
     for key in ORBIT_REFUSES:
-        if options.get(key) and not (hybrid and key == "switch_branches"):
+        if options.get(key) and not (switchable and key == "switch_branches"):
             raise SceneError(f"{key} does not apply to a branch of periodic orbits", key=key,
                              expected=f"no {key} (a continuation about a steady state takes it)")
     if hybrid:
@@ -157,8 +160,54 @@ def run_orbit_branch(system, options: dict, earlier: dict) -> dict:
             rec["angle"] = data["angle"]
         records.append(rec)
         located.append(np.asarray(x, float))
+    doubled = {}
+    if options.get("switch_branches"):
+        doubled["doubled"] = [doubled_record(orbits, branch, X, x, index, k + 1)
+                              for k, (kind, x, index, _) in enumerate(sorted(specials, key=lambda s: s[2]))
+                              if kind == "PD"]
     return {"parameter": name, "method": orbits.method, "branch": points, "points": len(points),
             "status": found.status, "folds": [r for r in records if r["type"] == "LPC"],
-            "special_points": records, "shape_outputs": [],
+            "special_points": records, "shape_outputs": [], **doubled,
             # a curve of one of these points in two parameters starts here (mechgen.analyses.orbit_curves)
             "_orbit": earlier["_orbit"], "_special_x": located}
+
+
+def doubled_record(orbits: Orbits, branch: OrbitBranch, X: np.ndarray, x_pd: np.ndarray, index: int,
+                   at: int) -> dict:
+    """The doubled orbit (period 2T) past the PD point x_pd of a forced orbit found by shooting: at the parameter
+    half-way to the neighbouring branch point whose orbit has a multiplier below -1, by shooting over 2T from the
+    period-T orbit there displaced along the eigenvector of the multiplier nearest -1 (both ways, 1e-3 to 1e-1 of
+    the state's size), the first start that converges to an orbit other than the period-T one."""
+    from mechgen.analyses.periodic_orbit import settings
+    from mechgen.errors import ConvergenceError
+    from mechgen.runtime.periodic.newton import newton
+
+    def most_negative(x):
+        return float(np.min(orbits.multipliers(branch.problem(x[-1]), x[:-1], x[-1]).real))
+
+    side = min((X[index], X[index + 1]), key=most_negative)
+    p = float(x_pd[-1]) + 0.5 * (float(side[-1]) - float(x_pd[-1]))
+    single = newton(branch.problem(p).residual_jacobian, np.asarray(x_pd[:-1], float),
+                    settings(orbits.options, "shooting")).u
+    values, vectors = np.linalg.eig(branch.residual_jacobian(single, p)[1] + np.eye(single.size))
+    v = np.real(vectors[:, int(np.argmin(np.abs(values + 1.0)))])
+    v = v / np.linalg.norm(v)
+    moved = orbits.system.with_params(**{orbits.name: p})
+    double = Shooting(moved, orbits.omega(p) / 2, orbits.phase, *integrator_tolerances(orbits.options),
+                      compiled_run(moved, orbits.options))
+    scale = 1.0 + float(np.max(np.abs(single)))
+    for size in (1e-3, 1e-2, 1e-1):
+        for sign in (1.0, -1.0):
+            try:
+                u = newton(double.residual_jacobian, single + sign * size * scale * v,
+                           settings(orbits.options, "shooting")).u
+            except ConvergenceError:
+                continue
+            if np.max(np.abs(u - single)) > 1e-6 * scale:
+                mu = floquet.multipliers(double.residual_jacobian(u)[1] + np.eye(u.size))
+                names = list(orbits.system.coordinates)
+                return {"at": at, orbits.name: p, "period": 2 * 2 * np.pi / orbits.omega(p),
+                        "start": dict(zip(names + [f"{c}_dot" for c in names], (float(c) for c in u))),
+                        "multipliers": floquet.as_pairs(mu), "stability": floquet.stability(mu, False)}
+    raise ConvergenceError(f"no doubled orbit found at {orbits.name} = {p:.10g} past the PD point (shooting over 2T "
+                           "returned the period-T orbit or did not converge); try a smaller max_step near it")

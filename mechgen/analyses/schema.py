@@ -154,11 +154,25 @@ class ParamExpression(float):
     def __reduce__(self):
         return ParamExpression, (float(self), self.text)
 
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The parameter names the expression uses."""
+        from mechgen.scene.expr import parse_expression
+
+        return tuple(parse_expression(self.text).names)
+
     def at(self, values: Mapping[str, float]) -> float:
         """The expression's value with the parameters ``values``."""
         from mechgen.scene.expr import parse_expression
 
         return float(parse_expression(self.text).evaluate(values))
+
+    def moved(self, name: str, value: float, values: Mapping[str, float]) -> float:
+        """Its value with the parameter ``name`` at ``value`` (the others as when it was given, or ``values``
+        where a continuation keeps them free): itself when it does not use ``name``."""
+        if name not in self.names:
+            return float(self)
+        return self.at({**values, name: float(value)})
 
 
 def positive_expression(ctx: OptionContext, key: str, value: object) -> float:
