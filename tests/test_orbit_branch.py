@@ -51,7 +51,7 @@ name = "orbit"
 kind = "periodic_orbit"
 method = "{method}"
 frequency = "w"
-harmonics = 9
+{"mesh = 40" if method == "collocation" else "harmonics = 9"}
 [[analysis]]
 name = "frc"
 kind = "continuation"
@@ -90,19 +90,22 @@ def hand_orbit(w: float, x0: np.ndarray) -> tuple[np.ndarray, float]:
 @pytest.fixture(scope="module")
 def curves(tmp_path_factory):
     folder = tmp_path_factory.mktemp("frc")
-    return {m: mechgen.run(frc_scene(folder, m))["analyses"][1]["outputs"] for m in ("shooting", "harmonic_balance")}
+    return {m: mechgen.run(frc_scene(folder, m))["analyses"][1]["outputs"]
+            for m in ("shooting", "harmonic_balance", "collocation")}
 
 
 def test_duffing_response_curve_folds(curves):
     """Two cyclic folds on each method's curve; at shooting's the largest multiplier is 1 (to 1e-6: the monodromy
     by central differences of the compiled flow, ~1e-10, at a fold located by Brent to ~1e-14 in arclength); the
-    two methods' folds agree to 1e-6 in w (harmonic balance with H = 9: its truncation, measured 5e-10)."""
+    three methods' folds agree to 1e-6 in w (harmonic balance with H = 9: its truncation, measured 5e-10;
+    collocation on 40 intervals)."""
     folds = {m: [s for s in out["special_points"] if s["type"] == "LPC"] for m, out in curves.items()}
     assert all(len(f) == 2 for f in folds.values())
     for fold in folds["shooting"]:
         assert max(abs(complex(*mu)) for mu in fold["multipliers"]) == pytest.approx(1.0, abs=1e-6)
-    for a, b in zip(folds["shooting"], folds["harmonic_balance"]):
+    for a, b, c in zip(folds["shooting"], folds["harmonic_balance"], folds["collocation"]):
         assert a["w"] == pytest.approx(b["w"], abs=1e-6)
+        assert a["w"] == pytest.approx(c["w"], abs=1e-6)  # collocation, 40 intervals of degree 4 (order 8)
     assert sorted(f["w"] for f in folds["shooting"]) == pytest.approx([1.3242362, 1.7797195], abs=1e-6)
 
 

@@ -27,7 +27,8 @@ from mechgen.analyses.stability_boundary import own_value
 from mechgen.errors import SceneError
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget
 from mechgen.runtime.periodic import floquet, fourier
-from mechgen.runtime.periodic.branch import OrbitBranch
+from mechgen.runtime.periodic.branch import OrbitBranch, node_weights
+from mechgen.runtime.periodic.collocation import Collocation
 from mechgen.runtime.periodic.flow import differenced_flow, states_at, variational_flow
 from mechgen.runtime.periodic.harmonic_balance import HarmonicBalance
 from mechgen.runtime.periodic.shooting import Shooting
@@ -50,6 +51,8 @@ class Orbits:
         self.frequency = self.options.get("frequency")
         self.autonomous = self.frequency is None
         self.memo: dict = {}
+        #: the earlier collocation's mesh (its edges, adapted or uniform), kept along the branch
+        self.mesh = orbit["found"].get("problem") if self.method == "collocation" else None
 
     def omega(self, p: float) -> float | None:
         """The forcing's angular frequency at p (module doc)."""
@@ -60,32 +63,50 @@ class Orbits:
         return float(self.frequency)
 
     def make(self, p: float):
+        """The method's problem at p (the earlier orbit's mesh, harmonics or segments)."""
         moved = self.system.with_params(**{self.name: float(p)})
         if self.method == "harmonic_balance":
             H = int(self.options.get("harmonics", DEFAULT_HARMONICS))
             return HarmonicBalance(moved, fourier.basis(H), self.omega(p), self.phase)
+        if self.method == "collocation":
+            return Collocation(moved, self.mesh.mesh, self.omega(p), self.phase, self.mesh.edges)
         return Shooting(moved, self.omega(p), self.phase, *integrator_tolerances(self.options),
-                        compiled_run(moved, self.options))
+                        compiled_run(moved, self.options), int(self.options.get("segments", 1)))
 
     def start(self, problem, found: dict) -> np.ndarray:
         """The unknowns u of the earlier orbit."""
         if self.method == "harmonic_balance":
             return problem.unknowns(found["U"], found["omega"])
-        return problem.unknowns(found["x0"], 2 * np.pi / found["omega"])
+        if self.method == "collocation":
+            return np.asarray(found["u"], float)
+        T = 2 * np.pi / found["omega"]
+        S = getattr(problem, "segments", 1)
+        X = self.flow_states(problem, found["x0"], T * np.arange(S) / S) if S > 1 else found["x0"]
+        return problem.unknowns(X, T)
+
+    def flow_states(self, problem, x0: np.ndarray, times: np.ndarray) -> np.ndarray:
+        """The states from x0 at ``times`` (ascending, from 0) by the problem's flow."""
+        if problem.compiled is not None:
+            return problem.compiled(np.asarray(x0, float), np.asarray(times, float))
+        return states_at(problem.system, x0, 0.0, times, problem.rtol, problem.atol)
 
     def states(self, problem, u: np.ndarray, times: np.ndarray) -> np.ndarray:
         """The orbit's states at ``times`` in [0, T] (rows (q, v))."""
         if self.method == "harmonic_balance":
             U, w = problem.split(u)
             return np.hstack([fourier.evaluate(U, w * times), w * fourier.evaluate(U, w * times, 1)])
+        if self.method == "collocation":
+            return problem.states_at(u, times)
         x0, _ = problem.split(u)
         if problem.compiled is not None:
             return problem.compiled(x0, times)
         return states_at(problem.system, x0, 0.0, times, problem.rtol, problem.atol)
 
     def period(self, problem, u: np.ndarray) -> float:
-        return float(2 * np.pi / problem.split(u)[1]) if self.method == "harmonic_balance" else float(
-            problem.split(u)[1])
+        """T of the orbit u (harmonic balance's unknowns hold the frequency, the others' the period)."""
+        if self.method == "harmonic_balance":
+            return float(2 * np.pi / problem.split(u)[1])
+        return float(problem.split(u)[1])
 
     def multipliers(self, problem, u: np.ndarray, p: float) -> np.ndarray:
         """The Floquet multipliers of the orbit u at p: the eigenvalues of its monodromy, by central differences of
@@ -101,7 +122,7 @@ class Orbits:
 
     def monodromy_eigenvalues(self, problem, u: np.ndarray) -> np.ndarray:
         T = self.period(problem, u)
-        x0 = self.states(problem, u, np.array([0.0]))[0] if self.method == "harmonic_balance" else problem.split(u)[0]
+        x0 = problem.split(u)[0] if self.method == "shooting" else self.states(problem, u, np.array([0.0]))[0]
         run = compiled_run(problem.system, self.options)
         if run is not None:
             _, Phi = differenced_flow(run, x0, T)
@@ -139,8 +160,10 @@ def run_orbit_branch(system, options: dict, earlier: dict) -> dict:
     orbits = Orbits(system, name, earlier["_orbit"])
     here = float(own_value(system, name))
     branch = OrbitBranch(orbits.make, name)
-    u0 = orbits.start(branch.problem(here), earlier["_orbit"]["found"])
-    eqs = branch.equations()
+    problem = branch.problem(here)
+    u0 = orbits.start(problem, earlier["_orbit"]["found"])
+    repeats = problem.nodes if orbits.method == "collocation" else getattr(problem, "segments", 1)
+    eqs = branch.equations(node_weights(u0.size, repeats, int(orbits.autonomous)) if repeats > 1 else None)
     budget = Budget("continuation", unit="points", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
     found = continuation(eqs, u0, here, arclength_steps(options, here, budget, smallest_span=0.1))
     points = [record(orbits, branch, u, p) for u, p in zip(found.u, found.lam)]

@@ -28,6 +28,8 @@ def residual_only(problem, u: np.ndarray) -> np.ndarray:
     """R(u) without dR/du where the problem allows it (module doc)."""
     if hasattr(problem, "residual"):
         return problem.residual(u)
+    if getattr(problem, "segments", 1) > 1:  # multiple shooting: every segment's flow
+        return problem.residual_jacobian(u)[0]
     x0, T = problem.split(u)
     if problem.compiled is not None:
         xT = problem.compiled(x0, np.array([0.0, T]))[-1]
@@ -74,6 +76,26 @@ class OrbitBranch:
         u = np.asarray(u, float)
         return (residual_only(self.problem(p + h), u) - residual_only(self.problem(p - h), u)) / (2 * h)
 
-    def equations(self) -> ParametricEquations:
-        return ParametricEquations(self.F, lambda u, p: self.residual_jacobian(u, p)[1], self.F_p,
-                                   name=f"the periodic orbits in {self.name}")
+    def equations(self, weights: np.ndarray | None = None):
+        """F, F_u, F_p for mechgen.runtime.steady.continuation; ``weights`` (u's size + 1, the parameter last):
+        the arclength's inner product (an orbit given by its states at many nodes weighs each node's state by
+        1 / nodes, so that a step measures the orbit's mean change, not the number of nodes)."""
+        eqs = ParametricEquations(self.F, lambda u, p: self.residual_jacobian(u, p)[1], self.F_p,
+                                  name=f"the periodic orbits in {self.name}")
+        return eqs if weights is None else WeightedEquations(eqs, np.asarray(weights, float))
+
+
+class WeightedEquations:
+    """ParametricEquations with the continuation's ``arclength_weights``."""
+
+    def __init__(self, eqs: ParametricEquations, weights: np.ndarray) -> None:
+        self.F, self.F_u, self.F_lam, self.name = eqs.F, eqs.F_u, eqs.F_lam, eqs.name
+        self.arclength_weights = weights
+
+
+def node_weights(size: int, repeats: int, trailing: int) -> np.ndarray:
+    """Weights of unknowns made of ``repeats`` equal blocks (node or segment states) followed by ``trailing``
+    scalars (a period) and the parameter: 1 / repeats on the blocks, 1 on the rest."""
+    w = np.ones(size + 1)
+    w[:size - trailing] = 1.0 / repeats
+    return w
