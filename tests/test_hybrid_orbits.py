@@ -234,3 +234,41 @@ def test_hybrid_orbit_outputs_and_branch_with_the_doubled_orbit(tmp_path):
     (doubled,) = branch["doubled"]
     assert doubled["period"] == pytest.approx(2 * 2 * math.pi / doubled["w"], rel=1e-14)
     assert doubled["events_per_period"] == 2 and doubled["stability"] == "stable"
+
+
+def test_impact_oscillator_scene_through_the_period_doubling():
+    """scenes/impact_oscillator_bifurcation.toml (the built-in impact_oscillator, the kinds periodic_orbit and
+    continuation): the PD point at the w the branch test above checks against the hand-written computation (to
+    1e-6), its multiplier -1 (to 1e-9), the two-impact orbit of period 2T past it."""
+    from pathlib import Path
+
+    scene = Path(__file__).resolve().parents[1] / "scenes" / "impact_oscillator_bifurcation.toml"
+    orbit, flip = (a["outputs"] for a in mechgen.run(str(scene))["analyses"])
+    assert len(orbit["events"]) == 1 and orbit["grazing"] == [] and orbit["stability"] == "stable"
+    (pd,) = [s for s in flip["special_points"] if s["type"] == "PD"]
+    assert pd["w"] == pytest.approx(2.6561773, abs=1e-6)
+    assert min(mu[0] for mu in pd["multipliers"]) == pytest.approx(-1.0, abs=1e-9)
+    (doubled,) = flip["doubled"]
+    assert doubled["events_per_period"] == 2 and doubled["period"] == pytest.approx(4 * math.pi / doubled["w"])
+
+
+@pytest.mark.parametrize("extra, key", [('method = "harmonic_balance"', "method"), ("segments = 2", "segments"),
+                                        (None, "frequency")])
+def test_hybrid_orbit_refuses_what_it_cannot_do(tmp_path, capsys, extra, key):
+    """A hybrid model's orbit by harmonic balance, multiple shooting, or without a forcing frequency: exit 2 naming
+    the key, no traceback."""
+    from pathlib import Path
+
+    from mechgen.cli import main
+
+    text = (Path(__file__).resolve().parents[1] / "scenes" / "impact_oscillator_bifurcation.toml").read_text()
+    text = text.split("[[analysis]]\nname = \"flip\"")[0]
+    if extra is None:
+        text = text.replace('frequency = "w"\n', "period = 2.5\n")
+    else:
+        text = text.replace('frequency = "w"\n', f'frequency = "w"\n{extra}\n')
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    assert main(["run", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert f".{key}" in err and "Traceback" not in err

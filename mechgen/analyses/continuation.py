@@ -541,8 +541,14 @@ def _orbit_branch(plt, a: dict, path: Path) -> bool:
         lam = np.array([p[name] for p in points])
         amp = np.array([p["amplitude"][coordinate] for p in points])
         for style, label in (("-", "stable"), ("--", "unstable")):
-            shown = np.where([p["stability"] == label for p in points], amp, np.nan)
+            mask = np.array([p["stability"] == label for p in points])
+            mask[:-1] |= mask[1:]  # each run of points joined to its neighbours: no gap where stability changes
+            shown = np.where(mask, amp, np.nan)
             ax.plot(lam, shown, style, lw=1.2, label=f"{coordinate}, {label}")
+        doubled = [d for d in out.get("doubled", []) if coordinate in d.get("amplitude", {})]
+        if doubled:
+            ax.plot([d[name] for d in doubled], [d["amplitude"][coordinate] for d in doubled], "o", mfc="none",
+                    color="tab:purple", label=f"{coordinate}, doubled orbit (period 2T)")
         for special in out.get("special_points", []):
             ax.plot(special[name], special["amplitude"][coordinate], _ORBIT_MARKS.get(special["type"], "o"), ms=7,
                     mfc="none", color="k")

@@ -135,9 +135,14 @@ def doubled_record(family, X: np.ndarray, x_pd: np.ndarray, index: int, at: int)
     from mechgen.runtime.integration.hybrid_orbit_branch import doubled_orbit
 
     side = max((X[index], X[index + 1]), key=lambda x: -float(np.min(family.multipliers(x).real)))
-    orbit = doubled_orbit(family, x_pd, 0.5 * (float(side[-1]) - float(x_pd[-1])))
+    p = float(x_pd[-1]) + 0.5 * (float(side[-1]) - float(x_pd[-1]))
+    orbit = doubled_orbit(family, x_pd, p - float(x_pd[-1]))
     names = list(family.system.coordinates)
-    return {"at": at, family.name: float(x_pd[-1]) + 0.5 * (float(side[-1]) - float(x_pd[-1])),
+    fine, _ = orbit_states(family.system.with_params(**{family.name: p}), orbit.x0, orbit.period,
+                           orbit.period * np.arange(1024) / 1024, family.rtol, family.atol)
+    from mechgen.analyses.periodic_orbit import peak
+
+    return {"at": at, family.name: p, "amplitude": {c: peak(fine[:, i]) for i, c in enumerate(names)},
             "period": orbit.period, "start": dict(zip(names + [f"{c}_dot" for c in names],
                                                       (float(v) for v in orbit.x0))),
             "multipliers": floquet.as_pairs(orbit.multipliers), "stability": floquet.stability(orbit.multipliers, False),

@@ -229,7 +229,10 @@ def doubled_record(orbits: Orbits, branch: OrbitBranch, X: np.ndarray, x_pd: np.
             if np.max(np.abs(u - single)) > 1e-6 * scale:
                 mu = floquet.multipliers(double.residual_jacobian(u)[1] + np.eye(u.size))
                 names = list(orbits.system.coordinates)
-                return {"at": at, orbits.name: p, "period": 2 * 2 * np.pi / orbits.omega(p),
+                T2 = 2 * 2 * np.pi / orbits.omega(p)
+                X = orbits.flow_states(double, u, T2 * np.arange(PHASES) / PHASES)
+                return {"at": at, orbits.name: p, "period": T2,
+                        "amplitude": {c: peak(X[:, i]) for i, c in enumerate(names)},
                         "start": dict(zip(names + [f"{c}_dot" for c in names], (float(c) for c in u))),
                         "multipliers": floquet.as_pairs(mu), "stability": floquet.stability(mu, False)}
     raise ConvergenceError(f"no doubled orbit found at {orbits.name} = {p:.10g} past the PD point (shooting over 2T "

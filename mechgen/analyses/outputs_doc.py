@@ -194,7 +194,7 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
            "at t = 0: each coordinate and ``<coordinate>_dot``), the Floquet ``multipliers`` ([re, im] by "
            "decreasing modulus) and ``stability``; its ``special_points`` are ``LPC`` (cyclic fold), ``PD`` (period "
            "doubling: a multiplier through -1) and ``NS`` (a complex pair through the unit circle, with ``angle``)."),
-        _o("doubled", "list of {at, <parameter>, period, start, multipliers, stability}", "the outputs'",
+        _o("doubled", "list of {at, <parameter>, amplitude, period, start, multipliers, stability}", "the outputs'",
            "About a forced ``periodic_orbit`` found by shooting (or a hybrid model's), with ``switch_branches = "
            "true``: the period-2T orbit just past every PD point (``at``: the PD's position in ``special_points``, "
            "from 1), at the parameter half-way to the next branch point on the side where the period-T orbit has a "

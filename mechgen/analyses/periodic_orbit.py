@@ -62,8 +62,12 @@ shooting and collocation H = ``harmonics`` or 7, projected from 4096 samples of 
 force units for harmonic balance, the state's for shooting, both for collocation), ``iterations`` and ``loop``
 (``c``: shooting's integrations ran in the compiled loop; ``python``: in scipy's).
 
-Only smooth lumped models without internal variables: a hybrid model, a continuum, a chain or a model with internal
-variables is refused (key ``method``).
+Smooth lumped models without internal variables, and forced hybrid models: a hybrid model's orbit (impacts,
+stick-slip) is found by single shooting through its events, the monodromy built from the modes'
+state-transition matrices and the saltation matrices of the events (generated from the guards and resets;
+mechgen.analyses.hybrid_orbit), with ``events`` (one period's) and ``grazing`` besides the outputs above; harmonic
+balance, collocation, multiple shooting and an autonomous hybrid orbit are refused for it (exit 2 at the key). A
+continuum, a chain or a model with internal variables is refused (key ``method``).
 """
 from __future__ import annotations
 
@@ -192,8 +196,10 @@ def check(ctx, base: str, options: dict) -> None:
     """A smooth lumped model; not both harmonics and mesh without a method; an autonomous orbit needs a period guess,
     a forced one none."""
     model = ctx.model
-    why = ("has modes (a hybrid model)" if getattr(model, "modes", ()) else "is a continuum"
-           if getattr(model, "continuum", False) else "is a chain" if getattr(model, "chain", None)
+    if getattr(model, "modes", ()):
+        check_hybrid(ctx, base, options)
+        return
+    why = ("is a continuum" if getattr(model, "continuum", False) else "is a chain" if getattr(model, "chain", None)
            else "has internal variables" if getattr(model, "internals", False) else None)
     if why:
         raise fail(ctx.file, f"{base}.method", f"model {model.name} {why}: periodic_orbit's methods need a smooth "
@@ -215,9 +221,29 @@ def check(ctx, base: str, options: dict) -> None:
                    "period", "period = a number > 0 (or frequency = the forcing's, for a forced orbit)")
 
 
+def check_hybrid(ctx, base: str, options: dict) -> None:
+    """A hybrid model's orbit: forced, by single shooting through its events (mechgen.analyses.hybrid_orbit)."""
+    model = ctx.model
+    if options.get("method", "shooting") != "shooting" or "harmonics" in options and "method" not in options or \
+            "mesh" in options and "method" not in options:
+        raise fail(ctx.file, f"{base}.method", f"model {model.name} has modes (a hybrid model): its orbit is found by "
+                   "shooting through its events", "method = \"shooting\" (or no method, harmonics or mesh)")
+    if int(options.get("segments", 1)) != 1:
+        raise fail(ctx.file, f"{base}.segments", "a hybrid model's orbit is found by single shooting",
+                   "segments = 1 (or no segments)")
+    if "frequency" not in options:
+        raise fail(ctx.file, f"{base}.frequency", f"an autonomous periodic orbit of a hybrid model ({model.name}) is "
+                   "not available yet", "the forcing's frequency (a forced hybrid model's orbit)")
+    if options.get("floquet") == "hill" or "from" in options:
+        key = "floquet" if options.get("floquet") == "hill" else "from"
+        raise fail(ctx.file, f"{base}.{key}", f"{key} does not apply to a hybrid model's orbit",
+                   f"no {key} (q0 / v0 as the starting guess)")
+
+
 def needs(options: dict, *, internal: bool) -> set[str]:
-    """The residual and its tangent (the flow's dx/dt and Jacobian), the outputs for the trajectory."""
-    return {"residual", "tangent", "flow", "outputs"}
+    """The residual and its tangent (the flow's dx/dt and Jacobian), the outputs for the trajectory; for a hybrid
+    model the event derivatives of its saltation matrices (ignored by a smooth model)."""
+    return {"residual", "tangent", "flow", "outputs", "saltation"}
 
 
 def chosen_method(options: dict) -> str:
@@ -229,9 +255,8 @@ def chosen_method(options: dict) -> str:
 
 def refuse_unsupported(system) -> None:
     """A system the methods cannot run: hybrid, continuum, chain, internal variables (key method)."""
-    why = ("has modes (a hybrid model)" if hasattr(system, "modes") else "is a continuum"
-           if getattr(system, "is_field", False) else "is a chain" if getattr(system, "is_lattice", False)
-           else "has internal variables" if system.m else None)
+    why = ("is a continuum" if getattr(system, "is_field", False) else "is a chain"
+           if getattr(system, "is_lattice", False) else "has internal variables" if system.m else None)
     if why:
         raise SceneError(f"periodic_orbit: model {system.metadata.model} {why}", key="method",
                          expected="a smooth lumped model (a hybrid model's periodic response: kind periodic)")
@@ -432,6 +457,10 @@ def orbit_samples(system, options: dict, found: dict, method: str, times: np.nda
 def run_periodic_orbit(system, options: dict, context: dict) -> dict:
     """See the module doc."""
     refuse_unsupported(system)
+    if hasattr(system, "modes"):  # a hybrid model: event-aware shooting (mechgen.analyses.hybrid_orbit)
+        from mechgen.analyses.hybrid_orbit import run_hybrid_orbit
+
+        return run_hybrid_orbit(system, options, guess(system, options, options.get("frequency")).x0)
     method = chosen_method(options)
     omega = options.get("frequency")
     start = guess_from_simulate(system, options, context, omega) if "from" in options else guess(system, options, omega)
