@@ -279,9 +279,11 @@ def test_bad_input_names_the_key(duffing, vdp):
 
 
 def test_hybrid_model_is_refused_naming_method():
+    """A hybrid model's orbit is found by shooting through its events (tests/test_hybrid_orbits.py): harmonic
+    balance is refused at method."""
     ball = mechgen.compile(str(BOUNCING))
     with pytest.raises(InputError) as err:
-        mechgen.periodic_orbit(ball, frequency=1.0)
+        mechgen.periodic_orbit(ball, frequency=1.0, method="harmonic_balance")
     assert err.value.key.endswith("method") and "hybrid" in str(err.value)
 
 

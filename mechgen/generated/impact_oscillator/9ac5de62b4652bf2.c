@@ -154,41 +154,6 @@ int mg_linear__0(const double *const *in, double *const *out, const long *sizes,
     return 0;
 }
 
-/* energy_rates__0: internal rates and the energy balance's powers
- *   in[0]  q: length 1 per state
- *   in[1]  v: length 1 per state
- *   in[2]  z: length 0 per state
- *   in[3]  t: length 1 per state
- *   in[4]  p: length 1
- *   out[0] g: length 3 per state shape (3, 1)
- *   out[1] excess: length 1 per state shape (1, 1)
- */
-int mg_energy_rates__0(const double *const *in, double *const *out, const long *sizes, long nbatch)
-{
-    (void)sizes;
-    const long len_in1 = 1;
-    const long len_in3 = 1;
-    const double *const in4 = in[4];
-    const long len_out0 = 3;
-    const long len_out1 = 1;
-    for (long b = 0; b < nbatch; ++b) {
-        const double *const in1 = in[1] + b * len_in1;
-        const double *const in3 = in[3] + b * len_in3;
-        double *const out0 = out[0] + b * len_out0;
-        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
-        double *const out1 = out[1] + b * len_out1;
-        for (long i = 0; i < len_out1; ++i) out1[i] = 0.0;
-        {
-            const double g0 = in1[0];
-            const double g1 = in3[0];
-            const double g2 = in4[0];
-            out0[0] = g0*cos(g1*g2);
-            out0[1] = 0.05*(g0*g0);
-        }
-    }
-    return 0;
-}
-
 /* outputs__0: named outputs
  *   in[0]  q: length 1 per state
  *   in[1]  v: length 1 per state
