@@ -295,3 +295,50 @@ def test_rotor_whirl_limit_cycle_beyond_the_onset():
     assert out["amplitude"]["x"] == pytest.approx(0.01, rel=1e-8)
     assert out["amplitude"]["y"] == pytest.approx(0.01, rel=1e-8)
     assert out["amplitude"]["theta_x"] < 1e-12 and out["stability"] == "stable"
+
+
+def test_limit_cycles_born_at_a_hopf_point(tmp_path):
+    """The Rayleigh oscillator x'' + x = (mu + beta x^2) x' (beta = -1): continuing its Hopf point in mu itself
+    starts the branch of limit cycles from the normal form and follows it to mu = 0.5. Averaging gives the cycle
+    x = 2 sqrt(-mu/beta) cos t + O(mu) with the period 2 pi (1 + mu^2/16 + O(mu^4)): the amplitudes to
+    1e-2 mu^2 relative (the next averaging order, measured 5e-3 mu^2) and the periods to 2 pi mu^4 / 100
+    (measured 2 pi 1.1e-4 at mu = 0.5 = 2 pi 1.7e-3 mu^4); all stable (a supercritical point: l1 = -1/4)."""
+    model = RAYLEIGH.replace('Param("w0", 1.5)', 'Param("w0", 1.0)')
+    path = scene(tmp_path, model, "rayleigh", "x = 0.0", "mu", 0.5)
+    with open(path, "a") as f:
+        f.write('''[[analysis]]
+name = "cycles"
+kind = "continuation"
+about = "cont"
+special_point = 1
+parameter = "mu"
+stop = 0.5
+max_step = 0.05
+''')
+    out = mechgen.run(path)["analyses"][2]["outputs"]
+    assert out["hopf"]["lyapunov"] == pytest.approx(-0.25, rel=1e-6) and out["status"] == "lam_max"
+    for p in out["branch"]:
+        mu = p["mu"]
+        assert p["amplitude"]["x"] / (2 * mu**0.5) - 1 == pytest.approx(0.0, abs=1e-2 * mu**2 + 1e-7)
+        assert p["period"] == pytest.approx(2 * np.pi * (1 + mu**2 / 16), abs=2 * np.pi * mu**4 / 100 + 1e-8)
+        assert p["stability"] == "stable"
+
+
+def test_no_cycles_from_a_degenerate_hopf_point(tmp_path, capsys):
+    """The linear rotor's Hopf point (l1 = 0: no cycle is born) cannot start a branch of cycles: exit 2 at
+    special_point."""
+    from mechgen.cli import main
+
+    path = scene(tmp_path, ROTOR, "rotor", "x = 0.0, y = 0.0", "W", 40.0, "max_step = 2.0")
+    with open(path, "a") as f:
+        f.write('''[[analysis]]
+name = "cycles"
+kind = "continuation"
+about = "cont"
+special_point = 1
+parameter = "W"
+stop = 40.0
+''')
+    assert main(["run", path]) == 2
+    err = capsys.readouterr().err
+    assert "special_point" in err and "degenerate" in err and "Traceback" not in err

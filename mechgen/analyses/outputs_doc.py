@@ -205,6 +205,10 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
            "``frequency`` (omega of the pair +-i omega); about a branch of orbits, the curve of its LPC, each "
            "point with both parameters and the orbit's ``period``, ``amplitude``, ``start``, ``multipliers``."),
         _o("type", "string", "-", "With ``special_point``: ``LP`` or ``H``, the kind of point the curve follows."),
+        _o("hopf", "{<parameter>, frequency, lyapunov, growth_rate_slope, start_parameter}", "the parameter's, "
+           "rad/s", "With ``special_point`` an H point and ``parameter`` the earlier continuation's own: the Hopf "
+           "point the branch of limit cycles (``branch``, as about a ``periodic_orbit``) starts from, d Re(lambda)/dp "
+           "there and the parameter of the first cycle."),
         _o("parameters", "list of two strings", "-", "With ``special_point``: the earlier continuation's "
            "parameter and the second one."),
         _o("shape_outputs", "list of strings", "-", "The shape outputs reported at every point."),

@@ -3,7 +3,8 @@ parameters.
 
 ``about`` names the earlier continuation (of a Newton steady state), ``special_point`` the point (its position in
 that continuation's ``special_points``, from 1: an LP or an H), ``parameter`` the second parameter b and ``stop``
-its end value; the first parameter a (the earlier continuation's) becomes an unknown. The curve is the branch of
+its end value (with ``parameter`` the earlier continuation's own and an H point: the branch of limit cycles born
+there, mechgen.analyses.hopf_cycles); the first parameter a (the earlier continuation's) becomes an unknown. The curve is the branch of
 the extended system of mechgen.runtime.steady.codim2 in b (pseudo-arclength, so a curve that turns in b is
 followed round), reported as ``curve``: one entry per point with both parameters, ``coordinates`` (lumped), the
 model's outputs and for an H curve ``frequency`` (omega of the pair +-i omega); with ``type`` (LP or H),
@@ -87,6 +88,10 @@ def run_curve(system, options: dict, earlier: dict) -> dict:
                          expected="a continuation about a Newton steady state")
     kind, x, first = start_of(earlier, int(options["special_point"]))
     second = options["parameter"]
+    if second == first and kind == "H":  # the limit cycles born at the Hopf point (mechgen.analyses.hopf_cycles)
+        from mechgen.analyses.hopf_cycles import run_hopf_cycles
+
+        return run_hopf_cycles(system, options, earlier, x, earlier["special_points"][int(options["special_point"]) - 1])
     if second == first:
         raise SceneError(f"parameter {second!r} is the earlier continuation's own", key="parameter",
                          expected=f"a second parameter, other than {first!r}")
