@@ -342,3 +342,28 @@ stop = 40.0
     assert main(["run", path]) == 2
     err = capsys.readouterr().err
     assert "special_point" in err and "degenerate" in err and "Traceback" not in err
+
+
+def test_van_der_pol_limit_cycle_from_its_hopf_point():
+    """scenes/van_der_pol_from_hopf.toml: x'' - (mu - x^2) x' + x = 0 is van der Pol's equation for y = x / sqrt(mu),
+    so the cycle followed from the Hopf point at mu = 0 reaches at mu = 1 van der Pol's period 6.6632868593
+    (Andersen & Geer 1982; to 1e-8) and amplitude, the van der Pol cycle's max |y| at mu = 1, computed here by
+    scipy (the settled cycle's maximum located on the dense output; to 1e-8)."""
+    from scipy.integrate import solve_ivp
+    from scipy.optimize import minimize_scalar
+    from pathlib import Path
+
+    scene = Path(__file__).resolve().parents[1] / "scenes" / "van_der_pol_from_hopf.toml"
+    _, onset, cycles = (a["outputs"] for a in mechgen.run(str(scene))["analyses"])
+    (h,) = onset["special_points"]
+    assert h["type"] == "H" and h["mu"] == pytest.approx(0.0, abs=1e-9) and h["criticality"] == "supercritical"
+    last = cycles["branch"][-1]
+    assert last["mu"] == 1.0
+    assert last["period"] == pytest.approx(6.6632868593, abs=1e-8)
+    sol = solve_ivp(lambda t, y: [y[1], (1 - y[0] ** 2) * y[1] - y[0]], (0.0, 120.0), [2.0, 0.0], method="DOP853",
+                    rtol=1e-12, atol=1e-14, dense_output=True)
+    t = np.linspace(100.0, 100.0 + 6.7, 6701)
+    k = int(np.argmax(np.abs(sol.sol(t)[0])))
+    best = minimize_scalar(lambda s: -abs(sol.sol(s)[0]), bounds=(t[k - 1], t[k + 1]), method="bounded",
+                           options={"xatol": 1e-12})
+    assert last["amplitude"]["x"] == pytest.approx(-best.fun, abs=1e-8)

@@ -542,6 +542,8 @@ def _orbit_branch(plt, a: dict, path: Path) -> bool:
         amp = np.array([p["amplitude"][coordinate] for p in points])
         for style, label in (("-", "stable"), ("--", "unstable")):
             mask = np.array([p["stability"] == label for p in points])
+            if not mask.any():
+                continue
             mask[:-1] |= mask[1:]  # each run of points joined to its neighbours: no gap where stability changes
             shown = np.where(mask, amp, np.nan)
             ax.plot(lam, shown, style, lw=1.2, label=f"{coordinate}, {label}")
