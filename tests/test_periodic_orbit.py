@@ -555,12 +555,15 @@ def test_multiple_shooting_on_an_unstable_cycle_and_a_forced_orbit(vdp, duffing)
     np.testing.assert_allclose([r["trajectory"]["x"][0], r["trajectory"]["x_dot"][0]], x0, rtol=0, atol=1e-8)
 
 
-@pytest.mark.parametrize("name, what", [("fpu_chain", "a chain"), ("euler_bernoulli_beam", "a continuum"),
-                                        ("rate_state_slider", "internal variables")])
-def test_models_outside_the_methods_assumptions_are_refused(name, what):
-    """A chain, a continuum and a model with internal variables: exit 2 at ``method``, saying which."""
+@pytest.mark.parametrize("name, what, options", [("fpu_chain", "a chain", {}),
+                                                  ("euler_bernoulli_beam", "a continuum", {}),
+                                                  ("rate_state_slider", "internal variables",
+                                                   {"method": "harmonic_balance"})])
+def test_models_outside_the_methods_assumptions_are_refused(name, what, options):
+    """A chain, a continuum, and a model with internal variables by harmonic balance (its residual holds the
+    coordinates only; shooting carries them): exit 2 at ``method``, saying which."""
     with pytest.raises(InputError) as err:
-        mechgen.periodic_orbit(mechgen.compile(name), frequency=1.0)
+        mechgen.periodic_orbit(mechgen.compile(name), frequency=1.0, **options)
     assert err.value.key.endswith("method") and what in str(err.value)
 
 
@@ -613,3 +616,40 @@ def test_hills_method_gives_the_monodromy_multipliers(duffing, vdp):
     with pytest.raises(InputError) as err:
         mechgen.periodic_orbit(vdp, period=6.5, q0={"x": 2.0}, floquet="hill")
     assert err.value.key.endswith("floquet")
+
+
+HOPF_NORMAL_FORM = '''"""z1' = mu z1 - w z2 - z1 (z1^2 + z2^2), z2' = w z1 + mu z2 - z2 (z1^2 + z2^2): internal variables only."""
+from mechgen import Model, Param
+
+model = Model("hopf_normal_form", doc=__doc__)
+model.params(Param("mu", 0.25), Param("w", 2.0))
+model.internal("z1", lambda z, p: p.mu * z.z1 - p.w * z.z2 - z.z1 * (z.z1**2 + z.z2**2))
+model.internal("z2", lambda z, p: p.w * z.z1 + p.mu * z.z2 - z.z2 * (z.z1**2 + z.z2**2))
+'''
+
+
+def test_limit_cycle_of_a_model_of_internal_variables(tmp_path):
+    """Shooting carries the internal variables (x = (q, v, z)): the Hopf normal form's cycle is the circle
+    r^2 = mu with period 2 pi / w (closed form) - the amplitude of z1 to 1e-8 and the period to 1e-9; harmonic
+    balance is refused for it (its residual holds the coordinates only)."""
+    path = tmp_path / "normal_form.py"
+    path.write_text(HOPF_NORMAL_FORM)
+    system = mechgen.compile(str(path))
+    r = mechgen.periodic_orbit(system, method="shooting", period=3.0, z0={"z1": 0.4})
+    assert r["period"] == pytest.approx(np.pi, abs=1e-9)
+    assert r["amplitude"]["z1"] == pytest.approx(0.5, abs=1e-8) and r["amplitude"]["z2"] == pytest.approx(0.5, abs=1e-8)
+    assert r["stability"] == "stable"
+
+
+def test_internal_variables_guess_and_refusals(tmp_path):
+    """z0 naming no internal variable: exit 2 at z0.<name>, listing the names; harmonic balance on a model of
+    internal variables: exit 2 at method."""
+    path = tmp_path / "normal_form.py"
+    path.write_text(HOPF_NORMAL_FORM)
+    system = mechgen.compile(str(path))
+    with pytest.raises(InputError) as err:
+        mechgen.periodic_orbit(system, method="shooting", period=3.0, z0={"z3": 0.4})
+    assert err.value.key.endswith("z0.z3") and "z1, z2" in str(err.value)
+    with pytest.raises(InputError) as err:
+        mechgen.periodic_orbit(system, method="harmonic_balance", period=3.0, z0={"z1": 0.4})
+    assert err.value.key.endswith("method") and "internal variables" in str(err.value)

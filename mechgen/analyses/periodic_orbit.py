@@ -67,7 +67,10 @@ stick-slip) is found by single shooting through its events, the monodromy built 
 state-transition matrices and the saltation matrices of the events (generated from the guards and resets;
 mechgen.analyses.hybrid_orbit), with ``events`` (one period's) and ``grazing`` besides the outputs above; harmonic
 balance, collocation, multiple shooting and an autonomous hybrid orbit are refused for it (exit 2 at the key). A
-continuum, a chain or a model with internal variables is refused (key ``method``).
+model with internal variables z is solved by shooting, whose flow carries them (``z0`` their guess; the phase
+condition of a model of internal variables only is dz_p/dt = 0 at t = 0; ``amplitude`` and ``harmonics`` list them
+after the coordinates); harmonic balance and collocation, whose residual holds the coordinates only, are refused
+for it. A continuum or a chain is refused (key ``method``).
 """
 from __future__ import annotations
 
@@ -114,6 +117,18 @@ def harmonics_count(ctx, key: str, value: object) -> int:
     if H > MAX_HARMONICS:
         raise fail(ctx.file, key, f"harmonics {H} is above {MAX_HARMONICS}", f"an integer from 1 to {MAX_HARMONICS}")
     return H
+
+
+def internal_table(ctx, key: str, value: object) -> dict[str, float]:
+    """A table internal variable -> number (the names are checked against the compiled model's at run time)."""
+    if not isinstance(value, dict):
+        raise fail(ctx.file, key, f"value is {show(value)}", "a table of internal variable = value")
+    out = {}
+    for name, item in value.items():
+        if not isinstance(name, str) or not name.isidentifier():
+            raise fail(ctx.file, f"{key}.{name}", f"{show(name)} is not a name", "an internal variable's name")
+        out[name] = schema.number(ctx, f"{key}.{name}", item)
+    return out
 
 
 def earlier_simulate(ctx, key: str, value: object) -> str:
@@ -169,6 +184,8 @@ SCHEMA = {
                     "mesh)"),
     "q0": Option(schema.coordinate_table, {}, doc="the starting guess of the coordinates at t = 0, a table "
                  "coordinate = value (left out: zero, or the model's declared initial state)"),
+    "z0": Option(internal_table, {}, doc="the starting guess of the internal variables at t = 0, a table "
+                 "name = value (left out: the model's declared initial values, else zero)"),
     "v0": Option(schema.coordinate_table, {}, doc="the starting guess of the velocities at t = 0, a table "
                  "coordinate = value"),
     "from": Option(earlier_simulate, ABSENT, doc="an earlier simulate analysis (with its trajectory) whose "
@@ -200,7 +217,11 @@ def check(ctx, base: str, options: dict) -> None:
         check_hybrid(ctx, base, options)
         return
     why = ("is a continuum" if getattr(model, "continuum", False) else "is a chain" if getattr(model, "chain", None)
-           else "has internal variables" if getattr(model, "internals", False) else None)
+           else None)
+    if getattr(model, "internals", False) and chosen_method(options) != "shooting":
+        raise fail(ctx.file, f"{base}.method", f"model {model.name} has internal variables, which "
+                   f"{chosen_method(options)} does not carry (its residual is the coordinates')",
+                   "method = \"shooting\" (the flow carries the internal variables)")
     if why:
         raise fail(ctx.file, f"{base}.method", f"model {model.name} {why}: periodic_orbit's methods need a smooth "
                    "lumped model", "a smooth lumped model (a hybrid model's periodic response: kind periodic)")
@@ -242,8 +263,9 @@ def check_hybrid(ctx, base: str, options: dict) -> None:
 
 def needs(options: dict, *, internal: bool) -> set[str]:
     """The residual and its tangent (the flow's dx/dt and Jacobian), the outputs for the trajectory; for a hybrid
-    model the event derivatives of its saltation matrices (ignored by a smooth model)."""
-    return {"residual", "tangent", "flow", "outputs", "saltation"}
+    model the event derivatives of its saltation matrices (ignored by a smooth model); the internal variables'
+    rates and their Jacobians."""
+    return {"residual", "tangent", "flow", "outputs", "saltation"} | ({"rates", "rates_tangent"} if internal else set())
 
 
 def chosen_method(options: dict) -> str:
@@ -256,7 +278,7 @@ def chosen_method(options: dict) -> str:
 def refuse_unsupported(system) -> None:
     """A system the methods cannot run: hybrid, continuum, chain, internal variables (key method)."""
     why = ("is a continuum" if getattr(system, "is_field", False) else "is a chain"
-           if getattr(system, "is_lattice", False) else "has internal variables" if system.m else None)
+           if getattr(system, "is_lattice", False) else None)
     if why:
         raise SceneError(f"periodic_orbit: model {system.metadata.model} {why}", key="method",
                          expected="a smooth lumped model (a hybrid model's periodic response: kind periodic)")
@@ -264,9 +286,8 @@ def refuse_unsupported(system) -> None:
 
 def refuse_time_dependent(system, x: np.ndarray) -> None:
     """An autonomous orbit needs a residual without t: compared at t = 0 and t = 1.2345 at the guess."""
-    n = system.n
-    r0 = system.residual(x[:n], x[n:], t=0.0)
-    r1 = system.residual(x[:n], x[n:], t=1.2345)
+    r0 = system.rhs(0.0, x)
+    r1 = system.rhs(1.2345, x)
     if not np.allclose(r0, r1, rtol=1e-12, atol=1e-14):
         raise SceneError(f"periodic_orbit: model {system.metadata.model}'s equations depend on t (a forcing) and no "
                          "frequency is given", key="frequency",
@@ -288,8 +309,9 @@ def first_harmonic_states(x0: np.ndarray, omega: float, times: np.ndarray, n: in
     """The states (rows) at ``times`` of q = q0 cos(omega t) + (v0 / omega) sin(omega t): the first harmonic through
     the guess x0 = (q0, v0)."""
     c, s = np.cos(omega * times)[:, None], np.sin(omega * times)[:, None]
-    q0, b = x0[None, :n], x0[None, n:] / omega
-    return np.hstack([q0 * c + b * s, omega * (b * c - q0 * s)])
+    q0, b = x0[None, :n], x0[None, n:2 * n] / omega
+    z = np.repeat(x0[None, 2 * n:], np.size(times), axis=0)  # internal variables held at their guess
+    return np.hstack([q0 * c + b * s, omega * (b * c - q0 * s), z])
 
 
 def guess(system, options: dict, omega) -> Guess:
@@ -298,10 +320,28 @@ def guess(system, options: dict, omega) -> Guess:
     from mechgen.analyses.simulate import initial_state
 
     q0, v0 = initial_state(system, options)
-    x0 = np.concatenate([q0, v0])
+    x0 = np.concatenate([q0, v0, internal_start(system, options.get("z0"))])
     period = 2 * np.pi / omega if omega is not None else float(options["period"])
     w, n = 2 * np.pi / period, system.n
-    return Guess(x0, period, int(np.argmax(np.abs(q0))), lambda times: first_harmonic_states(x0, w, times, n))
+    phase = int(np.argmax(np.abs(q0))) if n else int(np.argmax(np.abs(x0)))
+    return Guess(x0, period, phase, lambda times: first_harmonic_states(x0, w, times, n))
+
+
+def internal_start(system, table: dict | None = None) -> np.ndarray:
+    """The internal variables' guess: ``table`` (``z0``) over their declared initial values (zero when none are
+    declared); an unknown name is a SceneError at ``z0``."""
+    from mechgen.analyses.simulate import declared_start
+
+    start = declared_start(system)
+    z = np.zeros(system.m) if start is None or not system.m else np.asarray(start[2 * system.n:], float).copy()
+    names = time_series.state_names(system)[2 * system.n:]
+    for name, value in (table or {}).items():
+        if name not in names:
+            raise SceneError(f"periodic_orbit: z0 names {name!r}, not an internal variable of "
+                             f"{system.metadata.model}", key=f"z0.{name}",
+                             expected="one of: " + (", ".join(names) or "(the model has none)"))
+        z[names.index(name)] = float(value)
+    return z
 
 
 def simulated_states(system, options: dict, context: dict) -> tuple[np.ndarray, np.ndarray]:
@@ -309,7 +349,7 @@ def simulated_states(system, options: dict, context: dict) -> tuple[np.ndarray, 
     name = options["from"]
     earlier = context.get(name, {})
     trajectory = earlier.get("trajectory")
-    names = time_series.state_names(system)[:2 * system.n]
+    names = time_series.state_names(system)
     if not trajectory or any(k not in trajectory for k in names) or len(earlier.get("t", ())) < 4:
         raise SceneError(f"periodic_orbit: simulate analysis '{name}' kept no trajectory to start from", key="from",
                          expected="a simulate analysis with series = true (and at least 4 samples)")
@@ -338,11 +378,12 @@ def guess_from_simulate(system, options: dict, context: dict, omega) -> Guess:
             raise too_short(options, f"ends at t = {t[-1]:.6g}, before a whole period T = {T:.6g} of the forcing")
         return Guess(spline(start), T, 0, lambda times: spline(start + np.asarray(times)))
     half = t >= (t[0] + t[-1]) / 2
-    p = int(np.argmax(np.ptp(X[half, :system.n], axis=0)))
-    q = X[:, p]
+    first = X[:, :system.n] if system.n else X[:, 2 * system.n:]  # the coordinates, or the internal variables
+    p = int(np.argmax(np.ptp(first[half], axis=0)))
+    q = first[:, p]
     peaks = np.flatnonzero((q[1:-1] >= q[:-2]) & (q[1:-1] > q[2:])) + 1
     if peaks.size < 2:
-        raise too_short(options, f"shows fewer than two maxima of '{system.coordinates[p]}'")
+        raise too_short(options, f"shows fewer than two maxima of '{time_series.state_names(system)[p + 2 * system.n if not system.n else p]}'")
     start = t[peaks[-2]]
     period = float(options.get("period", t[peaks[-1]] - start))
     return Guess(spline(start), period, p, lambda times: spline(start + np.asarray(times)))
@@ -427,7 +468,7 @@ def solve_shooting(system, options: dict, start: Guess, omega) -> dict:
     problem = Shooting(system, omega, start.phase, rtol, atol, run, S)
     X = start.curve(start.period * np.arange(S) / S)
     X[0] = start.x0
-    if problem.autonomous:
+    if problem.autonomous and system.n:
         X[0, system.n + start.phase] = 0.0
     sol = newton(problem.residual_jacobian, problem.unknowns(X, start.period), settings(options, "shooting"))
     x0, T = problem.split(sol.u)
@@ -481,15 +522,17 @@ def report(system, options: dict, found: dict, method: str, *, autonomous: bool)
     """The outputs (module doc) of a converged orbit."""
     w = found["omega"]
     T = 2 * np.pi / w
-    names = list(system.coordinates)
     n = system.n
+    # the coordinates, then the internal variables (a model's state x = (q, v, z))
+    columns = list(range(n)) + list(range(2 * n, 2 * n + system.m))
+    names = list(system.coordinates) + time_series.state_names(system)[2 * n:]
     fine_t = T * np.arange(FINE) / FINE
-    fine = orbit_samples(system, options, found, method, fine_t)
-    if autonomous and np.max(np.ptp(fine[:, :n], axis=0)) <= 1e3 * float(options["atol"]):
+    fine = orbit_samples(system, options, found, method, fine_t)[:, columns]
+    if autonomous and np.max(np.ptp(fine, axis=0)) <= 1e3 * float(options["atol"]):
         raise ConvergenceError(f"periodic_orbit ({method}): Newton converged to an equilibrium (the orbit's "
                                "coordinates do not vary); try a starting guess nearer the limit cycle (q0, v0, period)")
     U = found["U"] if method == "harmonic_balance" else fourier.coefficients_of_samples(  # shooting, collocation
-        fine[:, :n], int(options.get("harmonics", DEFAULT_HARMONICS)))
+        fine, int(options.get("harmonics", DEFAULT_HARMONICS)))
     if options.get("floquet") == "hill":
         mu = hill_multipliers(found["problem"], found["u"])
     else:

@@ -11,7 +11,8 @@ phi_k the flow over segment k and Phi_k its state transition matrix (mechgen.run
 equations with the generated tangent kernel's Jacobian, or, with ``compiled``, the compiled loop's flow and its
 central differences). Autonomous (T unknown): u = (x_0, ..., x_{S-1}, T), the columns dR_k/dT =
 f(phi_k(x_k)) / S, and the phase condition v_p(0) = 0 (the velocity of coordinate p zero at t = 0: the orbit starts
-at an extremum of q_p, which every non-constant orbit has) as the last row. Multiple shooting keeps each segment's
+at an extremum of q_p, which every non-constant orbit has; for a model of internal variables only, dz_p/dt = 0 at
+t = 0) as the last row. The state is x = (q, v, z), internal variables after the coordinates and velocities. Multiple shooting keeps each segment's
 flow short, so an unstable orbit (a multiplier mu > 1 grows a start error by mu per period) or a stiff one stays
 within reach of Newton: the sensitivity is per segment, about mu^(1/S). The monodromy matrix is
 Phi_{S-1} ... Phi_0. ``frequency_derivative`` gives dR/domega of a forced orbit at fixed model parameters: for single
@@ -57,8 +58,8 @@ class Shooting:
         return np.append(X, period) if self.autonomous else X.copy()
 
     def starts(self, u: np.ndarray) -> tuple[np.ndarray, float]:
-        """(X: the segments' start states, S x 2n, T) of the unknowns."""
-        d = 2 * self.system.n
+        """(X: the segments' start states, S x (2n + m), T) of the unknowns."""
+        d = 2 * self.system.n + self.system.m
         if self.autonomous:
             return u[:-1].reshape(self.segments, d), float(u[-1])
         return u.reshape(self.segments, d), 2 * np.pi / self.omega
@@ -103,8 +104,19 @@ class Shooting:
                 J[rows, -1] = self.system.rhs((k + 1) * T / S, end) / S
         if not self.autonomous:
             return R, J
-        J[-1, self.system.n + self.phase] = 1.0
-        return np.append(R, X[0, self.system.n + self.phase]), J
+        value, row = self.phase_condition(X[0])
+        J[-1, :d] = row
+        return np.append(R, value), J
+
+    def phase_condition(self, x0: np.ndarray) -> tuple[float, np.ndarray]:
+        """(f_p(x0), its gradient): the p-th state component's rate zero at t = 0 - the velocity v_p of coordinate
+        p (gradient e_{n+p}), or, for a model of internal variables only (n = 0), the rate of z_p."""
+        n = self.system.n
+        if n:
+            row = np.zeros(x0.size)
+            row[n + self.phase] = 1.0
+            return float(x0[n + self.phase]), row
+        return float(self.system.rhs(0.0, x0)[self.phase]), np.asarray(self.system.jacobian(0.0, x0), float)[self.phase]
 
     def frequency_derivative(self, u: np.ndarray) -> np.ndarray:
         """dR/domega of a forced orbit at fixed parameters: single shooting's f(T, x(T)) dT/domega, dT/domega =
