@@ -18,7 +18,6 @@ needs only approximately), and the variational equations run once, for the conve
 from __future__ import annotations
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from mechgen.errors import ConvergenceError
 
@@ -54,6 +53,8 @@ def augmented_rhs(system, bound: float = np.inf):
 
 def variational_flow(system, x0: np.ndarray, t0: float, span: float, rtol: float, atol: float) -> tuple:
     """(x(t0 + span), Phi(t0 + span)) from x(t0) = x0 (module doc); a failed integration is a ConvergenceError."""
+    from scipy.integrate import solve_ivp  # loaded on use (a scene's start imports no scipy.integrate)
+
     x0 = np.asarray(x0, float)
     d = x0.size
     y0 = np.concatenate([x0, np.eye(d).ravel()])
@@ -69,6 +70,8 @@ def variational_flow(system, x0: np.ndarray, t0: float, span: float, rtol: float
 
 def states_at(system, x0: np.ndarray, t0: float, times: np.ndarray, rtol: float, atol: float) -> np.ndarray:
     """The states x(t) (rows) at ``times`` (>= t0, ascending) from x(t0) = x0, by DOP853."""
+    from scipy.integrate import solve_ivp  # loaded on use (a scene's start imports no scipy.integrate)
+
     times = np.asarray(times, float)
     sol = solve_ivp(system.rhs, (t0, float(times[-1])), np.asarray(x0, float), method="DOP853",
                     rtol=max(rtol, MIN_RTOL), atol=atol, t_eval=times)
