@@ -27,6 +27,9 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--backend", choices=None)
     run.add_argument("--json", dest="json_path")
     run.add_argument("--plot", dest="plot_dir")
+    run.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
+                     help="run the analyses with executor = \"dask\" on this running Dask scheduler (it is trusted "
+                          "to run code in this process; a scene file cannot name one)")
     regen = sub.add_parser("regen", help="rewrite mechgen/generated for the built-in models")
     regen.add_argument("--check", action="store_true", help="fail if mechgen/generated is stale")
     bench = sub.add_parser("bench", help="run the benchmarks")
@@ -102,15 +105,17 @@ def _write_json(path: str, results: dict) -> None:
 
 def _cmd_run(args) -> int:
     from mechgen.scene.report import summary
-    from mechgen.scene.run import check_backend, run_scene
+    from mechgen.scene.run import check_backend, check_scheduler, run_scene
 
     check_backend(args.backend)
+    if args.scheduler is not None:
+        check_scheduler("--scheduler", args.scheduler)
     if args.json_path is not None:
         check_output("--json", args.json_path, folder=False)
     if args.plot_dir is not None:
         check_output("--plot", args.plot_dir, folder=True)
     try:
-        results = run_scene(args.scene, overrides=args.overrides, backend=args.backend)
+        results = run_scene(args.scene, overrides=args.overrides, backend=args.backend, scheduler=args.scheduler)
     except MechgenError as exc:  # the analyses before the failed one are printed and written, then the error
         partial = getattr(exc, "partial_results", None)
         if partial is not None:

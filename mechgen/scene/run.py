@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Mapping
 
 from mechgen import models
-from mechgen.analyses.context import NAME, POINTS, PointRunner, public
+from mechgen.analyses.context import NAME, POINTS, SCHEDULER, PointRunner, public
 from mechgen.analyses.registry import get
 from mechgen.analyses.result import run_analysis
 from mechgen.errors import InputError, MechgenError, SceneError
@@ -69,12 +69,21 @@ def _point_task(scene: tuple, layout, kind: str, options: dict, point: dict) -> 
     return (*scene, kind, options, point, layout)
 
 
-def run_scene(scene, *, overrides=(), backend: str | None = None) -> dict:
-    """Run every analysis of a scene (a file, or a dict of its contents) and return the results dict."""
+def run_scene(scene, *, overrides=(), backend: str | None = None, scheduler: str | None = None) -> dict:
+    """Run every analysis of a scene (a file, or a dict of its contents) and return the results dict.
+
+    ``scheduler``: a running Dask scheduler's address (tcp://host:port) for the analyses with executor = "dask"
+    (the user's choice: ``mechgen run --scheduler``; a scene cannot name one)."""
+    if scheduler is not None:
+        check_scheduler("scheduler", scheduler)
     scn = load_scene(scene if isinstance(scene, Mapping) else str(scene), overrides=list(overrides),
                      lookup_model=lookup_model, model_names=models.known)
+    if scheduler is not None and not any(a.options.get("executor") == "dask" for a in scn.analyses):
+        raise InputError(f"a scheduler is given but no analysis of {scn.path} has executor = \"dask\"",
+                         key="scheduler", expected="executor = \"dask\" in the sweep or campbell analyses that "
+                         "should run on the scheduler, or no scheduler")
     try:
-        return _run_loaded(scn, backend)
+        return _run_loaded(scn, backend, scheduler)
     except InputError as exc:
         if exc.file is not None:
             raise
@@ -104,7 +113,7 @@ def placed(exc: InputError, scn) -> SceneError:
     return SceneError(exc.message.rstrip(".") + note, file=scn.path, key=exc.key, expected=exc.expected)
 
 
-def _run_loaded(scn, backend: str | None) -> dict:
+def _run_loaded(scn, backend: str | None, scheduler: str | None = None) -> dict:
     """Compile and run a loaded scene."""
     plan = plan_scene(scn, backend=backend)
     fixed = tuple(sorted((k, v) for k, v in scn.params.items()))
@@ -118,6 +127,8 @@ def _run_loaded(scn, backend: str | None) -> dict:
     results["build"]["seconds_total"] = time.perf_counter() - started
     scene_inputs = (plan.source.key, plan.main, fixed)
     context: dict = {POINTS: PointRunner(sweep_point, partial(_point_task, scene_inputs, layout))}
+    if scheduler is not None:
+        context[SCHEDULER] = scheduler
     for analysis in scn.analyses:
         context[NAME] = analysis.name
         try:
@@ -141,6 +152,17 @@ def with_partial(exc: MechgenError, results: dict, analysis, scn) -> MechgenErro
                                 "error": f"{type(exc).__name__}: {message}"})
     exc.partial_results = results
     return exc
+
+
+def check_scheduler(key: str, address: str) -> str:
+    """Validate a Dask scheduler address the user gave (``--scheduler``, ``scheduler=``) before anything connects."""
+    from mechgen.runtime.core.sweep import SCHEDULER_FORM, scheduler_address
+
+    try:
+        return scheduler_address(address)
+    except ValueError as exc:
+        raise InputError(f"{address[:80]!r} is not a scheduler address: {exc}", key=key,
+                         expected=SCHEDULER_FORM) from None
 
 
 def check_backend(name: str | None) -> None:

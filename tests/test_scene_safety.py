@@ -1,0 +1,145 @@
+"""A scene is data (issue 33): it cannot make mechgen connect anywhere or run code, and the outputs write only
+what the user named, as regular files.
+
+Each probe of the issue is a test here: a hostile scene or flag ends with the stated exit code, one message naming
+the file or flag and the key, no traceback, no stray file, and (for schedulers) no connection attempted at all:
+``socket.socket.connect`` is replaced by a recorder, so a test proves that nothing was dialled, not that nothing
+answered. The one test that connects starts its own Dask scheduler on the loopback and closes it.
+"""
+from __future__ import annotations
+
+import os
+import socket
+import stat
+from pathlib import Path
+
+import pytest
+
+import mechgen
+from mechgen.cli import main
+from mechgen.errors import InputError, SceneError
+
+SWEEP = ('model = "laval_rotor"\n[[analysis]]\nname = "g"\nkind = "sweep"\nover = {{ Omega = [0.0, 1.0, 2.0] }}\n'
+         'analysis = {{ kind = "stability" }}\nprogress = false\n{extra}\n')
+#: addresses a scene named in the probe: a hostile scheduler, a port probe, and the ones that ended in tracebacks
+HOSTILE_SCHEDULERS = ["tcp://127.0.0.1:8786", "tcp://203.0.113.7:8786", "inproc://x", "tls://127.0.0.1:8786",
+                      "tcp://127.0.0.1", "file:///etc/passwd"]
+
+
+@pytest.fixture
+def dialled(monkeypatch) -> list:
+    """Every address a socket of this process tries to connect to (none is let through)."""
+    calls: list = []
+
+    def refuse(self, address):
+        calls.append(address)
+        raise ConnectionRefusedError("test: no connection may be attempted")
+
+    monkeypatch.setattr(socket.socket, "connect", refuse)
+    monkeypatch.setattr(socket.socket, "connect_ex", refuse)
+    return calls
+
+
+def _run(argv, capsys) -> tuple[int, str]:
+    code = main(argv)
+    err = capsys.readouterr().err
+    assert "Traceback" not in err, err
+    return code, err
+
+
+# ----------------------------------------------------------------------------- item 1: schedulers
+
+
+@pytest.mark.parametrize("address", HOSTILE_SCHEDULERS)
+def test_a_scene_cannot_name_a_scheduler(tmp_path, capsys, dialled, address):
+    """executor = "dask" with a scheduler in the file is refused at load, exit 2 at the key, nothing dialled."""
+    scene = tmp_path / "hostile.toml"
+    scene.write_text(SWEEP.format(extra=f'executor = "dask"\nscheduler = "{address}"'))
+    code, err = _run(["run", str(scene), "--backend", "numpy"], capsys)
+    assert code == 2
+    assert "hostile.toml" in err and "analysis[1].scheduler" in err and "--scheduler" in err, err
+    assert dialled == []
+
+
+def test_a_scene_dict_cannot_name_a_scheduler(dialled):
+    """A scene given to mechgen.run as a dict is a scene too: the scheduler= argument is the Python way."""
+    scene = {"model": "laval_rotor", "analysis": [
+        {"name": "g", "kind": "sweep", "executor": "dask", "scheduler": "tcp://127.0.0.1:8786",
+         "over": {"Omega": [0.0, 1.0]}, "analysis": {"kind": "stability"}}]}
+    with pytest.raises(SceneError) as info:
+        mechgen.run(scene)
+    assert info.value.key == "analysis[1].scheduler" and "scheduler=" in str(info.value)
+    assert dialled == []
+
+
+@pytest.mark.parametrize("address", ["inproc://x", "tls://127.0.0.1", "tcp://127.0.0.1", "file:///etc/passwd",
+                                     "tcp://127.0.0.1:99999", "tcp://user@127.0.0.1:8786", "tcp://a b:1",
+                                     "tcp://127.0.0.1:8786/path", "localhost:8786", "x" * 400])
+def test_the_scheduler_flag_is_checked_before_anything_connects(tmp_path, capsys, dialled, address):
+    scene = tmp_path / "ok.toml"
+    scene.write_text(SWEEP.format(extra='executor = "dask"'))
+    code, err = _run(["run", str(scene), "--backend", "numpy", "--scheduler", address], capsys)
+    assert code == 2 and "--scheduler" in err and "tcp://host:port" in err, err
+    assert len(err) < 600  # a 400-character value is not echoed whole
+    assert dialled == []
+
+
+def test_a_scheduler_flag_for_a_scene_without_dask_is_refused(tmp_path, capsys, dialled):
+    scene = tmp_path / "serial.toml"
+    scene.write_text(SWEEP.format(extra=""))
+    code, err = _run(["run", str(scene), "--backend", "numpy", "--scheduler", "tcp://127.0.0.1:8786"], capsys)
+    assert code == 2 and "scheduler" in err and 'executor = "dask"' in err, err
+    assert dialled == []
+
+
+def test_python_scheduler_argument_is_checked(dialled):
+    """The scheduler= argument of the Python functions is the user's choice, and still checked before use."""
+    from mechgen.runtime.core.sweep import SweepExecutor
+
+    system = mechgen.compile("laval_rotor", free=["Omega"], backend="numpy")
+    with pytest.raises(InputError) as info:
+        mechgen.sweep(system, "stability", {"Omega": [0.0, 1.0]}, executor="dask", scheduler="inproc://x")
+    assert "scheduler" in info.value.key and "tcp://" in info.value.expected
+    with pytest.raises(InputError) as info:
+        SweepExecutor("dask", scheduler="file:///etc/passwd")
+    assert info.value.key == "scheduler"
+    assert dialled == []
+
+
+def test_dask_configuration_address_is_checked(dialled):
+    """Dask's own scheduler-address setting (DASK_SCHEDULER_ADDRESS) is the environment's choice: honoured,
+    and checked before the first point runs."""
+    dask = pytest.importorskip("dask")
+    pytest.importorskip("distributed")
+    from mechgen.runtime.core.sweep import SweepExecutor, sweep_points
+
+    ran = []
+    with dask.config.set({"scheduler-address": "inproc://x"}):
+        with pytest.raises(InputError) as info:
+            sweep_points(ran.append, [1.0, 2.0, 3.0], executor=SweepExecutor("dask"), progress=False)
+    assert info.value.key == "DASK_SCHEDULER_ADDRESS" and ran == []
+    assert dialled == []
+
+
+def test_the_scheduler_flag_runs_on_the_users_scheduler(tmp_path, capsys):
+    """--scheduler at a running scheduler (started here, loopback) gives the serial numbers bit for bit."""
+    distributed = pytest.importorskip("distributed")
+    scene = tmp_path / "grid.toml"
+    scene.write_text(SWEEP.format(extra='executor = "dask"').replace("[0.0, 1.0, 2.0]", "[0.0, 500.0, 1000.0, 1500.0]"))
+    serial = mechgen.run({**_toml(scene), "analysis": [{**_toml(scene)["analysis"][0], "executor": "serial"}]})
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                  dashboard_address=None, silence_logs=40) as cluster:
+        out = tmp_path / "out.json"
+        code, err = _run(["run", str(scene), "--scheduler", cluster.scheduler_address, "--json", str(out)], capsys)
+    assert code == 0, err
+    import json
+
+    got = json.loads(out.read_text())["analyses"][0]["outputs"]
+    assert got["executor"] == "dask"
+    assert got["frequencies"] == serial["analyses"][0]["outputs"]["frequencies"]
+
+
+def _toml(path: Path) -> dict:
+    import tomllib
+
+    return tomllib.loads(path.read_text())
