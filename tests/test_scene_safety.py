@@ -143,3 +143,94 @@ def _toml(path: Path) -> dict:
     import tomllib
 
     return tomllib.loads(path.read_text())
+
+
+# ----------------------------------------------------------------------------- item 2: output targets
+
+SMALL = ('model = "spring_pendulum"\n[[analysis]]\nname = "eq"\nkind = "steady"\nguess = { r = 1.0 }\n'
+         '[[analysis]]\nname = "small"\nkind = "modes"\nabout = "eq"\n')
+
+
+@pytest.fixture
+def small(tmp_path) -> Path:
+    scene = tmp_path / "sp.toml"
+    scene.write_text(SMALL)
+    return scene
+
+
+def _nodes(folder: Path) -> dict[str, Path]:
+    """A FIFO, a socket and (as root) a character device equal to /dev/null, all made here: never the
+    system's own nodes."""
+    folder.mkdir(exist_ok=True)
+    made = {"FIFO": folder / "fifo.json"}
+    os.mkfifo(made["FIFO"])
+    sock = socket.socket(socket.AF_UNIX)
+    made["socket"] = folder / "sock.json"
+    sock.bind(str(made["socket"]))
+    sock.close()
+    if os.geteuid() == 0:
+        made["character device"] = folder / "null.json"
+        os.mknod(made["character device"], stat.S_IFCHR | 0o666, os.makedev(1, 3))
+    return made
+
+
+def _mode(path: Path) -> int:
+    return stat.S_IFMT(os.lstat(path).st_mode)
+
+
+def test_json_never_replaces_a_device_fifo_or_socket(tmp_path, small, capsys):
+    """--json onto a node that is not a regular file is refused before anything runs, and the node stays."""
+    for what, node in _nodes(tmp_path / "nodes").items():
+        before = _mode(node)
+        code, err = _run(["run", str(small), "--json", str(node)], capsys)
+        assert code == 2 and "--json" in err and what in err, (what, err)
+        assert _mode(node) == before, what
+    assert not [p for p in (tmp_path / "nodes").iterdir() if p.name.startswith(".tmp")]
+
+
+def test_json_replaces_a_link_and_leaves_its_target(tmp_path, small, capsys):
+    victim = tmp_path / "victim.txt"
+    victim.write_text("keep me")
+    link = tmp_path / "out.json"
+    link.symlink_to(victim)
+    code, err = _run(["run", str(small), "--json", str(link)], capsys)
+    assert code == 0, err
+    assert victim.read_text() == "keep me" and not link.is_symlink() and '"analyses"' in link.read_text()
+
+
+def test_plot_never_follows_a_link_planted_in_the_folder(tmp_path, small, capsys):
+    """A link at a figure's name inside --plot DIR is replaced by the figure; its target is untouched."""
+    pytest.importorskip("matplotlib")
+    victim = tmp_path / "victim.txt"
+    victim.write_text("keep me")
+    plots = tmp_path / "plots"
+    plots.mkdir()
+    planted = plots / "sp_small_shapes.png"
+    planted.symlink_to(victim)
+    code, err = _run(["run", str(small), "--plot", str(plots)], capsys)
+    assert code == 0, err
+    assert victim.read_text() == "keep me"
+    assert not planted.is_symlink() and planted.read_bytes()[:4] == b"\x89PNG"
+    assert sorted(p.name for p in plots.iterdir()) == ["sp_small.png", "sp_small_shapes.png"]  # no stray file
+
+
+def test_plot_refuses_a_node_at_a_figure_name(tmp_path, small, capsys):
+    """A FIFO (or a folder) holding a figure's name is refused at --plot, not opened (a FIFO would block)."""
+    pytest.importorskip("matplotlib")
+    plots = tmp_path / "plots"
+    plots.mkdir()
+    os.mkfifo(plots / "sp_small.png")
+    (plots / "sp_small_shapes.png").mkdir()
+    code, err = _run(["run", str(small), "--plot", str(plots)], capsys)
+    assert code == 2 and "--plot" in err and ("FIFO" in err or "is a folder" in err), err
+    assert stat.S_ISFIFO(os.lstat(plots / "sp_small.png").st_mode)
+    assert sorted(p.name for p in plots.iterdir()) == ["sp_small.png", "sp_small_shapes.png"]
+
+
+@pytest.mark.parametrize("flag", ["--json", "--plot"])
+def test_an_overlong_name_is_refused_at_the_flag(tmp_path, small, capsys, flag):
+    for path in (tmp_path / ("x" * 300), tmp_path / ("y" * 300) / "out.json", Path("/" + "z/" * 2100)):
+        code, err = _run(["run", str(small), flag, str(path)], capsys)
+        assert code == 2 and flag in err and "long" in err, err
+        assert len(err) < 800  # the name is not echoed whole
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["sp.toml"]
