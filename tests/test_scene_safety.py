@@ -234,3 +234,91 @@ def test_an_overlong_name_is_refused_at_the_flag(tmp_path, small, capsys, flag):
         assert code == 2 and flag in err and "long" in err, err
         assert len(err) < 800  # the name is not echoed whole
     assert sorted(p.name for p in tmp_path.iterdir()) == ["sp.toml"]
+
+
+# ----------------------------------------------------------------------------- item 4: data files
+
+FIT = """model = "spring_pendulum"
+[[analysis]]
+name = "f"
+kind = "fit"
+parameters = ["K", "k"]
+start = { K = 500.0, k = 50.0 }
+data = "DATA"
+observed = "R"
+expression = "K + k * (d0 / d)"
+constants = { d0 = 25.4 }
+"""
+SECRET = "root:x:0:0:root:/root:/bin/bash"
+
+
+def _fit(tmp_path, data: str, capsys) -> tuple[int, str]:
+    scene = tmp_path / "scenes" / "fit.toml"
+    scene.parent.mkdir(exist_ok=True)
+    scene.write_text(FIT.replace("DATA", data))
+    return _run(["run", str(scene)], capsys)
+
+
+def _ctx(tmp_path, rows: int = 10):
+    from types import SimpleNamespace
+
+    return SimpleNamespace(file=str(tmp_path / "s.toml"), limits={"rows": rows})
+
+
+@pytest.mark.parametrize("where", ["absolute", "relative"])
+def test_a_data_file_is_never_echoed(tmp_path, capsys, where):
+    """A file that is not CSV data (a passwd-like file of the test's own, by an absolute or a ../ path): the
+    message names the line and column and shows at most a 10-character excerpt of the one cell."""
+    secret = tmp_path / "passwd"
+    secret.write_text(SECRET + "\ndaemon:x:1:1:daemon:/usr/sbin:/usr/sbin/nologin\n")
+    code, err = _fit(tmp_path, str(secret) if where == "absolute" else "../passwd", capsys)
+    assert code == 2 and "analysis[1].data" in err and "line 1" in err and "column 1" in err, err
+    assert SECRET not in err and "root:x:0:0:r" not in err and "daemon" not in err, err
+
+
+def test_cells_and_headers_are_excerpted(tmp_path, capsys):
+    data = tmp_path / "scenes" / "d.csv"
+    data.parent.mkdir()
+    for text, words in [("d,R\n1,2\n3,topsecretvalue123\n", "'topsecretv'…"),
+                        ("d,R,password_is_hunter2\n1,2,3\n4,5\n", "has 2 cells, the header 3"),
+                        ("d,R\n1,2\n" + "x" * 2_000_000, "longer than")]:
+        data.write_text(text)
+        code, err = _fit(tmp_path, "d.csv", capsys)
+        assert code == 2 and words in err and "line 3" in err, err
+        assert "topsecretvalue" not in err and "hunter2" not in err and "xxxxxxxxxxx" not in err, err
+
+
+def test_the_row_limit_is_checked_while_reading(tmp_path):
+    """A 4 MB file of 10^6 rows against a limit of 10 rows: refused after reading a few lines, with a peak
+    of well under the file's size (the whole file split into a list took 11 GiB for 250 MB)."""
+    import tracemalloc
+
+    from mechgen.analyses import fit_data
+
+    big = tmp_path / "big.csv"
+    big.write_bytes(b"d,R\n" + b"1,2\n" * 1_000_000)
+    blank = tmp_path / "blank.csv"
+    blank.write_bytes(b"d,R\n" + b"\n" * 4_000_000)
+    for path, words in [(big, "more than 10 rows"), (blank, "more than 10020 lines")]:
+        tracemalloc.start()
+        with pytest.raises(SceneError) as info:
+            fit_data.load(_ctx(tmp_path), "analysis[1].data", str(path))
+        peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+        assert words in str(info.value)
+        assert peak < 1_000_000, peak  # bytes; the file is 4 MB
+
+
+def test_folders_fifos_and_devices_are_named_as_what_they_are(tmp_path):
+    from mechgen.analyses import fit_data
+
+    (tmp_path / "folder.csv").mkdir()
+    os.mkfifo(tmp_path / "fifo.csv")
+    cases = {"folder.csv": "is a folder", "fifo.csv": "is a FIFO", "missing.csv": "not found"}
+    if os.geteuid() == 0:  # a node of the test's own, equal to /dev/zero (endless zero bytes)
+        os.mknod(tmp_path / "zero.csv", stat.S_IFCHR | 0o444, os.makedev(1, 5))
+        cases["zero.csv"] = "is a character device"
+    for name, words in cases.items():
+        with pytest.raises(SceneError) as info:  # a FIFO without a writer must not block
+            fit_data.load(_ctx(tmp_path), "analysis[1].data", str(tmp_path / name))
+        assert words in str(info.value) and info.value.key == "analysis[1].data", (name, str(info.value))
