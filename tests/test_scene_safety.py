@@ -322,3 +322,47 @@ def test_folders_fifos_and_devices_are_named_as_what_they_are(tmp_path):
         with pytest.raises(SceneError) as info:  # a FIFO without a writer must not block
             fit_data.load(_ctx(tmp_path), "analysis[1].data", str(tmp_path / name))
         assert words in str(info.value) and info.value.key == "analysis[1].data", (name, str(info.value))
+
+
+# ----------------------------------------------------------------------------- item 6: model references
+
+OSC = '''from mechgen import Model, Param
+print("model says hello")
+model = Model("osc_s33", doc="x'' = -k/m x")
+model.params(Param("m", 1.0, "kg"), Param("k", 4.0, "N/m"))
+model.coordinates("x")
+model.kinetic(lambda q, v, p: p.m * v.x**2 / 2)
+model.potential(lambda q, p: p.k * q.x**2 / 2)
+'''
+
+
+def _model_scene(tmp_path, ref: str) -> Path:
+    scene = tmp_path / "m.toml"
+    scene.write_text(f'model = "{ref}"\n[[analysis]]\nname = "m"\nkind = "modes"\n')
+    return scene
+
+
+@pytest.mark.parametrize("code_line", ["raise SystemExit(0)", "import sys; sys.exit()", "raise SystemExit('bye')"])
+def test_a_model_that_exits_on_import_is_exit_2(tmp_path, capsys, code_line):
+    (tmp_path / "quits.py").write_text(f'print("SECRET-PRINT")\n{code_line}\n')
+    code = main(["run", str(_model_scene(tmp_path, "quits.py"))])
+    out = capsys.readouterr()
+    assert code == 2 and "quits.py" in out.err and "SystemExit" in out.err and "Traceback" not in out.err, out.err
+    assert "SECRET-PRINT" not in out.out + out.err
+
+
+def test_a_module_without_a_model_prints_nothing(tmp_path, capsys, monkeypatch):
+    """package.module:attribute of a module that is not a model (as `this:model` printed the Zen of Python)."""
+    (tmp_path / "chatty_s33.py").write_text('print("SECRET-PRINT")\nvalue = 1\n')
+    monkeypatch.syspath_prepend(str(tmp_path))
+    code = main(["run", str(_model_scene(tmp_path, "chatty_s33:model"))])
+    out = capsys.readouterr()
+    assert code == 2 and "defines no Model" in out.err and "SECRET-PRINT" not in out.out + out.err, out
+
+
+def test_a_models_own_prints_go_to_stderr(tmp_path, capsys):
+    (tmp_path / "osc_s33.py").write_text(OSC)
+    code = main(["run", str(_model_scene(tmp_path, "osc_s33.py")), "--backend", "numpy"])
+    out = capsys.readouterr()
+    assert code == 0, out.err
+    assert "model says hello" in out.err and "model says hello" not in out.out
