@@ -8,6 +8,7 @@ answered. The one test that connects starts its own Dask scheduler on the loopba
 """
 from __future__ import annotations
 
+import math
 import os
 import socket
 import stat
@@ -366,3 +367,53 @@ def test_a_models_own_prints_go_to_stderr(tmp_path, capsys):
     out = capsys.readouterr()
     assert code == 0, out.err
     assert "model says hello" in out.err and "model says hello" not in out.out
+
+
+# ----------------------------------------------------------------------------- item 3: unnoticed crossings
+
+BALL = str(Path(__file__).resolve().parent / "models" / "bouncing_ball.py")
+G = 9.81  # the test model's default g (m/s^2)
+
+
+def _drop(y0: float, cor: float, loop: str, **extra) -> dict:
+    return mechgen.run({"model": BALL, "params": {"cor": cor}, "analysis": [
+        {"name": "drop", "kind": "simulate", "method": "DOP853", "t_end": 10.0, "q0": {"y": y0}, "loop": loop,
+         "progress": False, **extra}]})
+
+
+@pytest.mark.parametrize("loop", ["python", "c"])
+def test_a_ball_at_rest_on_the_floor_never_falls_through_silently(loop):
+    """y = 0, y' = 0: the floor guard (falling) has g = g_t = 0; the ball leaves it downwards at once."""
+    with pytest.raises(mechgen.ConvergenceError) as info:
+        _drop(0.0, 0.5, loop)
+    assert "guard floor of mode flight" in str(info.value) and "t = 0 and" in str(info.value)
+
+
+@pytest.mark.parametrize("loop", ["python", "c"])
+def test_a_zeno_accumulation_with_a_huge_zeno_limit_is_stopped_at_the_accumulation_time(loop):
+    """The probe's case: zeno_events so large that the Zeno test never fires. The impacts accumulate at
+    T = t1 (1 + e) / (1 - e), t1 = sqrt(2 h / g) (the model's docstring); there the resets no longer lift the
+    ball and it left the floor downwards (3 596 J of kinetic energy at t = 10 s, exit 0, before the fix). Now the
+    run ends there with exit 1 naming the guard and the time; the time agrees with T to 1e-6 relative (the last
+    located impacts are within the integrator's tolerance of the closed form's geometric sequence)."""
+    import re
+
+    h, e = 1.0, 0.5
+    T = math.sqrt(2 * h / G) * (1 + e) / (1 - e)
+    with pytest.raises(mechgen.ConvergenceError) as info:
+        _drop(h, e, loop, zeno_events=100_000, max_events=100_000)
+    text = str(info.value)
+    assert "guard floor of mode flight" in text, text
+    t_hi = float(re.search(r"between t = \S+ and (\S+) \(", text).group(1))
+    assert abs(t_hi - T) < 1e-6 * T, (t_hi, T)
+
+
+def test_event_limits_beyond_the_budget_are_refused_up_front(tmp_path, capsys):
+    (tmp_path / "ball.py").write_text(Path(BALL).read_text())
+    scene = tmp_path / "ball.toml"
+    base = 'model = "ball.py"\n[[analysis]]\nname = "d"\nkind = "simulate"\nt_end = 10.0\nq0 = { y = 1.0 }\n'
+    for extra, key in [("zeno_events = 1_000_000_000\nmax_events = 1_000_000_000\n", "analysis[1].max_events"),
+                       ("zeno_events = 20_000\n", "analysis[1].zeno_events")]:
+        scene.write_text(base + extra)
+        code, err = _run(["run", str(scene)], capsys)
+        assert code == 2 and key in err and "ball.toml" in err, err
