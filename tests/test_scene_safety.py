@@ -8,6 +8,7 @@ answered. The one test that connects starts its own Dask scheduler on the loopba
 """
 from __future__ import annotations
 
+import json
 import math
 import os
 import socket
@@ -417,3 +418,66 @@ def test_event_limits_beyond_the_budget_are_refused_up_front(tmp_path, capsys):
         scene.write_text(base + extra)
         code, err = _run(["run", str(scene)], capsys)
         assert code == 2 and key in err and "ball.toml" in err, err
+
+
+# ----------------------------------------------------------------------------- item 7: one build per key
+
+def _first_run(args: tuple) -> int:
+    """In a worker process: compile a model of the test's own into an empty cache; its compiler runs."""
+    root, model_file = args
+    os.environ["MECHGEN_CACHE"] = root
+    import mechgen as mg
+    from mechgen.codegen.build import STATS
+
+    system = mg.compile(model_file, backend="c")
+    assert system.n == 1
+    return STATS["compile"]
+
+
+def test_concurrent_first_runs_derive_and_compile_once(tmp_path):
+    """Four processes compile one model into one empty cache at once: the build lock lets one derive and
+    compile it; the others wait, then load its cache entries (no compiler run of their own)."""
+    import multiprocessing
+
+    from mechgen.codegen.build import find_compiler
+
+    if find_compiler() is None:
+        pytest.skip("no C compiler")
+    (tmp_path / "osc_s33.py").write_text(OSC)
+    args = (str(tmp_path / "cache"), str(tmp_path / "osc_s33.py"))
+    with multiprocessing.get_context("spawn").Pool(4) as pool:
+        runs = pool.map(_first_run, [args] * 4)
+    assert sorted(runs)[:3] == [0, 0, 0] and runs.count(0) == 3, runs  # one process compiled (kernels, caller)
+    assert not list((tmp_path / "cache" / "locks").iterdir())
+
+
+def test_a_lock_left_by_a_killed_process_is_broken(tmp_path, monkeypatch):
+    """A lock naming a process that no longer exists (a child started and reaped here) is broken at once; a
+    lock of a live process (this one) is waited on (here the wait is cut to 0.2 s); an empty lock whose writer
+    died before writing it is broken after EMPTY_SECONDS."""
+    import subprocess
+    import time
+
+    from mechgen import buildlock
+
+    monkeypatch.setenv("MECHGEN_CACHE", str(tmp_path / "cache"))
+    dead = subprocess.Popen(["true"])
+    dead.wait()
+    path = buildlock.lock_path("k1")
+    path.write_text(json.dumps({"pid": dead.pid, "host": socket.gethostname(), "time": time.time()}))
+    started = time.monotonic()
+    with buildlock.held("k1") as mine:
+        assert mine and json.loads(path.read_text())["pid"] == os.getpid()
+    assert time.monotonic() - started < 1 and not path.exists()
+    live = buildlock.lock_path("k2")
+    live.write_text(json.dumps({"pid": os.getpid(), "host": socket.gethostname(), "time": time.time()}))
+    started = time.monotonic()
+    assert buildlock.acquire("k2", wait=0.2) is None and live.exists()
+    assert 0.2 <= time.monotonic() - started < 2
+    empty = buildlock.lock_path("k3")
+    empty.write_text("")
+    os.utime(empty, (time.time() - 2 * buildlock.EMPTY_SECONDS,) * 2)
+    lock = buildlock.acquire("k3", wait=0.2)
+    assert lock == empty and json.loads(empty.read_text())["pid"] == os.getpid()
+    buildlock.release(lock)
+    assert sorted(p.name for p in path.parent.iterdir()) == ["k2"]  # nothing stray
