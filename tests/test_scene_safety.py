@@ -481,3 +481,24 @@ def test_a_lock_left_by_a_killed_process_is_broken(tmp_path, monkeypatch):
     assert lock == empty and json.loads(empty.read_text())["pid"] == os.getpid()
     buildlock.release(lock)
     assert sorted(p.name for p in path.parent.iterdir()) == ["k2"]  # nothing stray
+
+
+# ----------------------------------------------------------------------------- item 5: edge values, singular modes
+
+def test_a_parameter_at_the_edge_of_the_float_range_is_named(capsys):
+    """k_r = DBL_MAX: the stiffness matrix overflows; exit 2 at the flag that set it, not a ValueError traceback."""
+    scene = Path(__file__).resolve().parent.parent / "scenes" / "laval_rotor.toml"
+    code, err = _run(["run", str(scene), "--backend", "numpy", "--set", "k_r=1.7976931348623157e308"], capsys)
+    assert code == 2 and "'--set k_r'" in err and "edge of the floating-point range" in err, err
+
+
+@pytest.mark.parametrize("loop", ["python", "c"])
+def test_a_zero_mass_in_a_hybrid_mode_is_diagnosed(tmp_path, loop):
+    """m = 0 in the ball's only mode (its bound positive=True removed): M = 0 is singular where the mode starts;
+    a ConvergenceError naming the coordinate, in both loops (the Python loop raised a bare LinAlgError)."""
+    (tmp_path / "ball0.py").write_text(Path(BALL).read_text().replace(', positive=True), Param("g"',
+                                                                      '), Param("g"', 1))
+    with pytest.raises(mechgen.ConvergenceError) as info:
+        mechgen.run({"model": str(tmp_path / "ball0.py"), "params": {"m": 0.0}, "analysis": [
+            {"name": "d", "kind": "simulate", "method": "DOP853", "t_end": 1.0, "q0": {"y": 1.0}, "loop": loop}]})
+    assert "no inertia along coordinate 'y'" in str(info.value), str(info.value)

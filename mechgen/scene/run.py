@@ -17,7 +17,7 @@ from typing import Mapping
 from mechgen import models
 from mechgen.analyses.context import NAME, POINTS, SCHEDULER, PointRunner, public
 from mechgen.analyses.registry import get
-from mechgen.analyses.result import run_analysis
+from mechgen.analyses.result import NumericalFailure, run_analysis
 from mechgen.errors import InputError, MechgenError, SceneError
 from mechgen.pipeline import compile_request, file_digest
 from mechgen.runtime.fields.mesh import Layout
@@ -133,11 +133,33 @@ def _run_loaded(scn, backend: str | None, scheduler: str | None = None) -> dict:
         context[NAME] = analysis.name
         try:
             result = run_analysis(analysis.name, analysis.kind, system, dict(analysis.options), context)
+        except NumericalFailure as exc:
+            raise with_partial(edge_parameters(exc, scn), results, analysis, scn) from None
         except MechgenError as exc:
             raise with_partial(exc, results, analysis, scn) from None
         context[analysis.name] = result.state
         results["analyses"].append(result.to_json())
     return results
+
+
+#: a parameter beyond this magnitude (or nonzero below its inverse) is at the edge of the floating-point range:
+#: its square, or its product with another such value, leaves it
+EDGE = 1e150
+
+
+def edge_parameters(exc: MechgenError, scn) -> MechgenError:
+    """A numerical failure of a scene whose parameters hold values at the edge of the floating-point range
+    (|x| > EDGE or 0 < |x| < 1/EDGE) is that value's fault: a SceneError (exit 2) at the key that wrote it
+    (``params.k_r``, ``--set k_r``); otherwise the failure itself."""
+    edge = [n for n, v in scn.params.items() if isinstance(v, (int, float)) and not isinstance(v, bool)
+            and (abs(v) > EDGE or 0 < abs(v) < 1 / EDGE)]
+    if not edge:
+        return exc
+    name = edge[0]
+    return SceneError(f"{name} = {scn.params[name]!r} is at the edge of the floating-point range and the "
+                      f"computation overflowed: {exc}", file=scn.path, key=scn.written.get(name, f"params.{name}"),
+                      expected=f"a value of magnitude between {1 / EDGE:.0e} and {EDGE:.0e} (or 0); change the "
+                               "model's units if the physics needs more")
 
 
 def with_partial(exc: MechgenError, results: dict, analysis, scn) -> MechgenError:

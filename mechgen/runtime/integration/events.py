@@ -314,7 +314,7 @@ def integrate_hybrid(system, x0, t_end: float, *, mode: int | None = None, optio
         with Progress(run.t_end, desc=options.desc, unit="t", enabled=options.progress) as bar:
             while True:
                 seg = run.segment(mode)
-                g0, d0 = seg.values(t, x)
+                g0, d0 = _start_values(seg, t, x, method, run.where)
                 sign, at_once = start_signs(g0, d0, seg.directions, time_tolerance(t, run.t_end))
                 if at_once:  # the guards are in priority order: terminal first, then declared order
                     target, x = run.fire(seg, at_once[0], t, x)
@@ -455,6 +455,19 @@ class _Hooks:
     record: Callable
     bar: Progress
     where: Callable
+
+
+def _start_values(seg, t: float, x: np.ndarray, method: str, where) -> tuple:
+    """The guards' (g, g_t) where a mode starts; a singular mass there (a zero mass in that mode) is a
+    ConvergenceError with its diagnosis, as inside a step, never a bare LinAlgError."""
+    from numpy.linalg import LinAlgError
+
+    try:
+        return seg.values(t, x)
+    except (LinAlgError, ZeroDivisionError) as exc:
+        why = diagnosis(seg.system, seg.index, t, np.array(x))
+        raise ConvergenceError(f"{method} failed near {where(t, seg.index)} ({exc})" + (f"; {why}" if why else "")) \
+            from None
 
 
 def _integrate_segment(seg, state: tuple, start, sign, options: RunOptions, stats: dict, hooks: _Hooks):
