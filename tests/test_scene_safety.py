@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import socket
 import stat
 from pathlib import Path
@@ -502,3 +503,68 @@ def test_a_zero_mass_in_a_hybrid_mode_is_diagnosed(tmp_path, loop):
         mechgen.run({"model": str(tmp_path / "ball0.py"), "params": {"m": 0.0}, "analysis": [
             {"name": "d", "kind": "simulate", "method": "DOP853", "t_end": 1.0, "q0": {"y": 1.0}, "loop": loop}]})
     assert "no inertia along coordinate 'y'" in str(info.value), str(info.value)
+
+
+def test_every_kind_has_a_wall_time_budget():
+    """max_seconds is a key of every kind, and a kind whose runner has no budget of its own (here a test kind
+    that computes for 30 s) is stopped by the backstop at max_seconds x 1.1, exit 1 naming the key."""
+    import time
+
+    from mechgen.analyses import registry, summary
+    from mechgen.analyses.public import analysis
+    from mechgen.runtime.core.budget import BudgetExceeded
+
+    assert all("max_seconds" in registry.get(k).schema for k in registry.kinds())
+
+    def endless(system, options, context):
+        stop = time.monotonic() + 30
+        while time.monotonic() < stop:
+            sum(range(1000))
+        return {}
+
+    registry.register(registry.AnalysisKind("endless_s33", {}, endless, lambda o, *, internal: set(), summary.lines))
+    try:
+        system = mechgen.compile("spring_pendulum", backend="numpy")
+        started = time.monotonic()
+        with pytest.raises(BudgetExceeded) as info:
+            analysis("endless_s33", system, max_seconds=0.3)
+        assert info.value.key == "max_seconds" and "endless_s33" in str(info.value)
+        assert 0.3 < time.monotonic() - started < 3
+    finally:
+        registry.unregister("endless_s33")
+
+
+@pytest.mark.parametrize("scene, per_element", [("rod_tip_load.toml", 48_000), ("rod_dynamics.toml", 32_000)])
+def test_a_huge_rod_is_refused_before_it_starts(tmp_path, capsys, monkeypatch, scene, per_element):
+    """elements = 100 000 under a 2 GiB memory limit: the estimate (the measured bytes per element times the
+    elements) is refused at the key up front, in seconds (it took 1.7 GiB within 15 s and ran on)."""
+    import time
+
+    text = (Path(__file__).resolve().parent.parent / "scenes" / scene).read_text()
+    text = re.sub(r"elements = \d+", "elements = 100000", text)
+    (tmp_path / scene).write_text(text)
+    monkeypatch.setenv("MECHGEN_MEMORY_LIMIT", "2GiB")
+    started = time.monotonic()
+    code, err = _run(["run", str(tmp_path / scene)], capsys)
+    assert code == 2 and "'elements'" in err and f"{100_000 * per_element / 2**30:.3g} GiB" in err, err
+    assert time.monotonic() - started < 30
+
+
+@pytest.mark.parametrize("exc", [MemoryError(), SystemError("SuperLU: out of memory"),
+                                 ValueError("array must not contain infs or NaNs"), ZeroDivisionError("x")])
+def test_a_runners_stray_numerical_exception_is_exit_1(exc, capsys, tmp_path):
+    """What a runner raises from numpy/scipy (as SuperLU did under an address-space limit) is a ConvergenceError
+    naming the analysis: exit 1, one message, no traceback."""
+    from mechgen.analyses import registry, summary
+
+    def failing(system, options, context):
+        raise exc
+
+    registry.register(registry.AnalysisKind("failing_s33", {}, failing, lambda o, *, internal: set(), summary.lines))
+    try:
+        scene = tmp_path / "f.toml"
+        scene.write_text('model = "spring_pendulum"\n[[analysis]]\nname = "f"\nkind = "failing_s33"\n')
+        code, err = _run(["run", str(scene), "--backend", "numpy"], capsys)
+        assert code == 1 and "failing_s33 'f'" in err and type(exc).__name__ in err, err
+    finally:
+        registry.unregister("failing_s33")

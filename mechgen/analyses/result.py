@@ -149,15 +149,20 @@ NUMERICAL = (np.linalg.LinAlgError, FloatingPointError, OverflowError, ZeroDivis
 def run_analysis(name: str, kind: str, system, options: dict, context: dict) -> Result:
     """Run a validated analysis through its kind's runner and time it (a spent work budget is named by the
     analysis: ``simulate 'swing': ...``)."""
-    from mechgen.runtime.core.budget import BudgetExceeded
+    from mechgen.runtime.core.budget import DEFAULT_SECONDS, BudgetExceeded, wall_clock
     from mechgen.runtime.core.threads import blas_threads_for
 
     clock = time.perf_counter()
     try:
-        with blas_threads_for(_unknowns(system)):
+        with blas_threads_for(_unknowns(system)), \
+                wall_clock(float(options.get("max_seconds", DEFAULT_SECONDS)), "wall time"):
             outputs = get(kind).run(system, options, context)
     except BudgetExceeded as exc:
         raise exc.named(f"{kind} '{name}'") from None
+    except (MemoryError, SystemError) as exc:  # an allocation no estimate foresaw (SuperLU's fill-in)
+        raise NumericalFailure(f"{kind} '{name}' ran out of memory ({type(exc).__name__}: {str(exc)[:200]}); a "
+                               "smaller size (N, elements, count) or a memory limit that allows it "
+                               "(MECHGEN_MEMORY_LIMIT)") from None
     except NUMERICAL as exc:
         if isinstance(exc, ValueError) and not any(w in str(exc).lower() for w in ("inf", "nan", "finite")):
             raise
