@@ -1,5 +1,6 @@
-"""A scene is data (issue 33): it cannot make mechgen connect anywhere or run code, and the outputs write only
-what the user named, as regular files.
+"""A scene is data (issue 33): it cannot make mechgen connect anywhere or run code, the outputs write only
+what the user named, as regular files, data files are streamed and never echoed, no event-driven run is silently
+wrong, every run is bounded, and concurrent first runs build once.
 
 Each probe of the issue is a test here: a hostile scene or flag ends with the stated exit code, one message naming
 the file or flag and the key, no traceback, no stray file, and (for schedulers) no connection attempted at all:
