@@ -569,3 +569,12 @@ def test_a_runners_stray_numerical_exception_is_exit_1(exc, capsys, tmp_path):
         assert code == 1 and "failing_s33 'f'" in err and type(exc).__name__ in err, err
     finally:
         registry.unregister("failing_s33")
+
+
+def test_a_late_error_names_the_flag_that_decided_it(capsys):
+    """The fuzz finding of this round: --set quadrature=1 makes stepped_rotor's quintic mass matrix singular,
+    found at the internal key 'M'; the message listed the first 8 values the scene sets and left the flag out.
+    The user's --set values now come first."""
+    scene = Path(__file__).resolve().parent.parent / "scenes" / "stepped_rotor.toml"
+    code, err = _run(["run", str(scene), "--set", "quadrature=1"], capsys)
+    assert code == 2 and "--set quadrature = 1" in err, err

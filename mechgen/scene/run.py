@@ -105,7 +105,8 @@ def placed(exc: InputError, scn) -> SceneError:
         info = lookup_model(scn.source) if names is not None else None
         if info is not None and info.length in scn.written:
             wanted.append(info.length)
-        shown = [f"{scn.written[n]} = {scn.params[n]!r}" for n in dict.fromkeys(wanted)][:8]
+        wanted = sorted(dict.fromkeys(wanted), key=lambda n: not scn.written[n].startswith("--set"))  # flags first:
+        shown = [f"{scn.written[n]} = {scn.params[n]!r}" for n in wanted][:8]  # the cap never drops the user's --set
         if scn.segments:
             shown.append("[[segments]]")
         if shown:
