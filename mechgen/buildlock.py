@@ -10,6 +10,10 @@ Nothing waits forever: a lock whose holder is gone (its pid not alive on this ho
 writing it) is broken; a waiter gives up after :data:`WAIT_SECONDS` and builds itself (the cache publishes by
 atomic rename, so two builders are still correct, only slower). A cache that cannot hold a lock builds without
 one. This module lives outside ``codegen/`` on purpose: those sources key every generated text.
+
+Two kinds of lock: ``request-<backend>-<key>`` (mechgen.pipeline.compile_request: a request's derivation,
+generated text and kernel library) and ``library-<stem>-<sha>`` (:func:`load_shared_once`: the runtime's loop
+libraries, hybrid_loop.c, radau_loop.c, field_flow.c, the variational and symplectic loops, the rod internals).
 """
 from __future__ import annotations
 
@@ -144,3 +148,15 @@ def _break(path: Path, stale: bytes) -> None:
             os.link(aside, path)
     with contextlib.suppress(OSError):
         os.unlink(aside)
+
+
+def load_shared_once(source: str, *, stem: str, **options):
+    """``mechgen.codegen.build.load_shared`` under the lock of this source (its sha256 and stem): concurrent first
+    runs compile a runtime loop library (hybrid_loop.c, radau_loop.c ...) once, the others load that build."""
+    import hashlib
+
+    from mechgen.codegen.build import load_shared
+
+    digest = hashlib.sha256(source.encode("utf-8")).hexdigest()[:32]
+    with held(f"library-{stem}-{digest}"):
+        return load_shared(source, stem=stem, **options)

@@ -115,7 +115,7 @@ SPECIALISE_MAX_STATES = 16
 def _library(n: int | None = None, m: int | None = None):
     """(the loaded loop library, None) or (None, why it is unavailable); built once per machine (the compile
     cache) and loaded once per process. With sizes (n, m): the loop built for exactly those (MGH_FIXED_N/M)."""
-    from mechgen.codegen.build import load_shared
+    from mechgen.buildlock import load_shared_once as load_shared  # compiled once across processes
 
     source, stem = SOURCE.read_text(encoding="utf-8"), STEM
     if n is not None:
