@@ -583,3 +583,18 @@ def test_a_late_error_names_the_flag_that_decided_it(capsys):
     scene = Path(__file__).resolve().parent.parent / "scenes" / "stepped_rotor.toml"
     code, err = _run(["run", str(scene), "--set", "quadrature=1"], capsys)
     assert code == 2 and "--set quadrature = 1" in err, err
+
+
+def test_a_kind_without_a_budget_of_its_own_stops_at_max_seconds(tmp_path, capsys):
+    """Beck's column at N = 20 000: stability's sparse eigen-solve (ARPACK, no budget of its own) takes tens of
+    seconds (N = 8 000: 9.8 s measured, N = 50 000: over 300 s); with max_seconds = 0.5 the backstop stops it after 0.55 s with exit 1 naming the key (at N = 10^6 the
+    probe's run went on past 10 minutes)."""
+    import time
+
+    text = (Path(__file__).resolve().parent.parent / "scenes" / "beck_column.toml").read_text()
+    text = text.split('[[analysis]]\nname = "load_sweep"')[0].replace("count = 3\n", "count = 3\nmax_seconds = 0.5\n")
+    (tmp_path / "beck.toml").write_text(text)
+    started = time.monotonic()
+    code, err = _run(["run", str(tmp_path / "beck.toml"), "--set", "N=20000"], capsys)
+    assert code == 1 and "stability 'at_P'" in err and "'max_seconds'" in err, err
+    assert time.monotonic() - started < 20
