@@ -587,7 +587,8 @@ def test_a_late_error_names_the_flag_that_decided_it(capsys):
 
 def test_a_kind_without_a_budget_of_its_own_stops_at_max_seconds(tmp_path, capsys):
     """Beck's column at N = 20 000: stability's sparse eigen-solve (ARPACK, no budget of its own) takes tens of
-    seconds (N = 8 000: 9.8 s measured, N = 50 000: over 300 s); with max_seconds = 0.5 the backstop stops it after 0.55 s with exit 1 naming the key (at N = 10^6 the
+    seconds (N = 8 000: 9.8 s measured, N = 50 000: over 300 s); with max_seconds = 0.5 the
+    backstop stops it after 0.55 s with exit 1 naming the key (at N = 10^6 the
     probe's run went on past 10 minutes)."""
     import time
 

@@ -8,7 +8,8 @@ that is refused), ``multiples`` (of the speed, default [1]),
 budget, default 600 s: the exact path refuses once its first speeds project past it; exit 1), and where the
 per-speed eigen-solves run, as for ``sweep``: ``executor`` (``serial``, ``processes`` or ``dask``; left out:
 processes when ``workers`` > 1, else serial), ``workers``, ``scheduler`` (Python calls only: a running scheduler's
-address; a scene cannot name one, ``mechgen run --scheduler`` does). On a parallel executor every speed is solved exactly (full size; the speeds are independent: their
+address; a scene cannot name one, ``mechgen run --scheduler`` does).
+On a parallel executor every speed is solved exactly (full size; the speeds are independent: their
 matrices are assembled here, the solves are distributed, in Dask chunks of at least ~0.5 s of work) and the
 modes are tracked here afterwards, so the result is the serial exact one; ``method = "reduced"`` (whose basis
 grows from speed to speed) is refused there, and ``auto`` means exact. Outputs: ``speeds``, ``frequencies`` and

@@ -11,7 +11,8 @@ lines starting with ``#`` are skipped. Every cell is a finite number, every row 
 column. The file is at most :data:`MAX_DATA_BYTES` bytes, lines of at most :data:`MAX_LINE_BYTES`, and holds at
 most the safety limit ``rows`` (mechgen.scene.bounds.LIMITS, default 10^6; ``[limits] rows = ...`` raises it)
 of rows, an inline table too (checked while reading: a file of 250 MB is refused after its first 10^6 rows),
-and at most 2 rows + 10 000 lines in all. A bad file, cell or column is a SceneError naming the key (``analysis[1].data``),
+and at most 2 rows + 10 000 lines in all.
+A bad file, cell or column is a SceneError naming the key (``analysis[1].data``),
 the file, its line and column and what was expected.
 """
 from __future__ import annotations
