@@ -8,7 +8,7 @@ The public names (DESIGN.md, "the user's three jobs"), importable from ``mechgen
   (``with_params(**values)`` gives a new one);
 * one function per analysis kind, each returning a ``Result``: ``modes``, ``stability``,
   ``steady``, ``continuation``, ``simulate``, ``sweep``, ``campbell``, ``fit``, ``impact``, ``restitution``,
-  ``periodic``, ``spectrum``, ``stability_boundary``, ``cross_section``, ``symplectic``, ``rod_statics``, ``rod_dynamics``,
+  ``periodic``, ``periodic_orbit``, ``spectrum``, ``stability_boundary``, ``cross_section``, ``symplectic``, ``rod_statics``, ``rod_dynamics``,
   ``response``; and ``analysis(kind, system, **options)`` for any registered kind by name;
 * ``run(scene)``: a scene file (or a dict of its contents), built on the same functions;
 * the errors: ``MechgenError`` and its kinds.
@@ -41,6 +41,7 @@ _EXPORTS = {
     "impact": "mechgen.analyses.public",
     "restitution": "mechgen.analyses.public",
     "periodic": "mechgen.analyses.public",
+    "periodic_orbit": "mechgen.analyses.public",
     "spectrum": "mechgen.analyses.public",
     "response": "mechgen.analyses.public",
     "stability_boundary": "mechgen.analyses.public",

@@ -58,7 +58,7 @@ def test_the_registry_lists_the_seven_kinds_each_with_a_function():
     # tests/test_fit.py; impact, restitution: tests/test_impacts.py)
     assert registry.kinds()[:len(KINDS)] == KINDS
     assert registry.kinds()[len(KINDS):] == ("response", "fit", "impact", "restitution", "stability_boundary", "spectrum",
-                                                    "periodic",
+                                                    "periodic", "periodic_orbit",
                                                     "cross_section", "symplectic", "rod_statics", "rod_dynamics")
     for kind in KINDS:
         record = registry.get(kind)

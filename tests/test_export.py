@@ -259,15 +259,16 @@ def test_casadi_export_integrates_the_laval_rotor_like_mechgen(tmp_path):
     ca = pytest.importorskip("casadi")
     from scipy.integrate import solve_ivp
 
-    folder = _export(tmp_path, "laval_rotor", "casadi", "--set", "c=0.4", "--set", "c_r=0.02", "--set", "c_i=0")
+    folder = _export(tmp_path, "laval_rotor", "casadi", "--set", "c=0.4", "--set", "c_r=0.02", "--set", "c_i=0",
+                     "--set", "k_t3=0")
     manifest = json.loads((folder / "laval_rotor.json").read_text())
     res = ca.Function.load(str(folder / manifest["kernels"]["residual"]["file"]))
     tan = ca.Function.load(str(folder / manifest["kernels"]["tangent"]["file"]))
     ins = {p["name"]: p for p in manifest["kernels"]["residual"]["inputs"]}
     assert ins["q"]["entries"] == ["x", "y", "theta_x", "theta_y"]
     assert ins["p"]["entries"] == manifest["free_params"] == ["m", "Ip", "Id", "k_t", "k_r", "Omega"]
-    assert manifest["fixed"] == {"c": 0.4, "c_r": 0.02, "c_i": 0.0}
-    model, system = _numpy_system("laval_rotor", {"c": 0.4, "c_r": 0.02, "c_i": 0.0})
+    assert manifest["fixed"] == {"c": 0.4, "c_r": 0.02, "c_i": 0.0, "k_t3": 0.0}
+    model, system = _numpy_system("laval_rotor", {"c": 0.4, "c_r": 0.02, "c_i": 0.0, "k_t3": 0.0})
     p_val = np.array([2.0, 0.03, 0.02, 4.0e4, 900.0, 120.0])
     system = _with(system, p_val)
 

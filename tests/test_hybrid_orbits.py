@@ -54,13 +54,13 @@ def oscillator(tmp_path_factory):
     return mechgen.compile(str(path))
 
 
-def hand_flow(x0, t_end: float) -> np.ndarray:
+def hand_flow(x0, t_end: float, *, c=C, f=F, w=W, d=D, e=E) -> np.ndarray:
     """The independent event-driven flow map: solve_ivp from impact to impact, the reset applied by hand."""
     def rhs(t, y):
-        return [y[1], F * math.cos(W * t) - C * y[1] - y[0]]
+        return [y[1], f * math.cos(w * t) - c * y[1] - y[0]]
 
     def hit(t, y):
-        return y[0] - D
+        return y[0] - d
 
     hit.terminal, hit.direction = True, 1
     t, y = 0.0, np.asarray(x0, float)
@@ -68,8 +68,8 @@ def hand_flow(x0, t_end: float) -> np.ndarray:
         sol = solve_ivp(rhs, (t, t_end), y, method="DOP853", rtol=1e-12, atol=1e-14, events=hit)
         t, y = sol.t[-1], sol.y[:, -1].copy()
         if sol.status == 1:
-            y[1] = -E * y[1]
-            y[0] = D - 1e-13  # just below the stop: the event is not found again at once
+            y[1] = -e * y[1]
+            y[0] = d - 1e-13  # just below the stop: the event is not found again at once
     return y
 
 
@@ -136,3 +136,139 @@ def test_shooting_that_cannot_converge_says_so(oscillator):
     with pytest.raises(ConvergenceError) as err:
         periodic_orbit(oscillator, np.array([-2.0, 0.0]), T, max_iter=1)
     assert "|x(T) - x0|" in str(err.value) and "guess" in str(err.value)
+
+
+# the period-doubling of the one-impact orbit: stop at the equilibrium (d = 0), e = 0.8, F = 1, c = 0.05; the
+# orbit's multiplier passes -1 between w = 2.6 and 2.7 (Shaw & Holmes 1983: the flip of the 1-impact orbit)
+PD = {"c": 0.05, "f": 1.0, "d": 0.0, "e": 0.8}
+
+
+def hand_multipliers(w: float, guess: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(x0, multipliers) of the 1-impact orbit at w, all by hand: fsolve on the hand flow's x(T) - x0 and the
+    eigenvalues of its central-difference Jacobian (step 1e-6)."""
+    from scipy.optimize import fsolve
+
+    T = 2 * math.pi / w
+    x0 = fsolve(lambda x: hand_flow(x, T, w=w, **PD) - x, guess, xtol=1e-12)
+    h = 1e-6
+    J = np.column_stack([(hand_flow(x0 + h * u, T, w=w, **PD) - hand_flow(x0 - h * u, T, w=w, **PD)) / (2 * h)
+                         for u in np.eye(2)])
+    return x0, np.linalg.eigvals(J)
+
+
+def test_period_doubling_of_the_impact_oscillator_and_its_doubled_orbit(tmp_path):
+    """The branch of 1-impact orbits in w from 2.5 to 2.8 meets a PD point; its w against an independent
+    computation in the test (the hand flow's orbit and multipliers, Brent on min mu + 1 = 0) to 1e-6 (the
+    multipliers by differences: ~1e-7), its multiplier -1 (to 1e-8); just past it the doubled orbit has period 2T,
+    is a fixed point of the hand flow over 2T (to 1e-8) and not over T."""
+    from scipy.optimize import brentq
+
+    from mechgen.runtime.integration.hybrid_orbit_branch import OrbitFamily, doubled_orbit
+    from mechgen.runtime.steady.continuation import continuation
+    from mechgen.runtime.steady.cycle_points import cycle_points
+
+    path = tmp_path / "flip.py"
+    path.write_text(MODEL.replace('"impact_orbit"', '"flip"'))
+    system = mechgen.compile(str(path), {"d": 0.0, "F": 1.0, "c": 0.05, "cor": 0.8, "w": 2.5})
+    family = OrbitFamily(system, "w", lambda w: 2 * math.pi / w)
+    run = mechgen.simulate(system, t_end=80 * 2 * math.pi / 2.5, samples=2, q0={"x": -0.5})
+    start = family.orbit(np.array([run["trajectory"]["x"][-1], run["trajectory"]["x_dot"][-1]]), 2.5)
+    eqs = family.equations()
+    branch = continuation(eqs, start.x0, 2.5, ds=0.02, ds_max=0.05, lam_max=2.8, max_points=40, progress=False)
+    (pd,) = cycle_points(eqs, np.hstack([branch.u, branch.lam[:, None]]), family.multipliers)
+    assert pd.type == "PD" and np.min(pd.data["multipliers"].real) == pytest.approx(-1.0, abs=1e-8)
+
+    guess = {"x": start.x0}
+
+    def flip(w):
+        guess["x"], mu = hand_multipliers(w, guess["x"])
+        return float(np.min(mu.real)) + 1.0
+
+    w_hand = brentq(flip, 2.6, 2.7, xtol=1e-10)
+    assert pd.x[-1] == pytest.approx(w_hand, abs=1e-6)
+
+    doubled = doubled_orbit(family, pd.x, 0.02)
+    w = pd.x[-1] + 0.02
+    assert doubled.period == pytest.approx(2 * 2 * math.pi / w, rel=1e-14)
+    assert np.max(np.abs(hand_flow(doubled.x0, doubled.period, w=w, **PD) - doubled.x0)) < 1e-8
+    assert np.max(np.abs(hand_flow(doubled.x0, doubled.period / 2, w=w, **PD) - doubled.x0)) > 1e-3
+
+
+def test_cycle_test_functions():
+    """psi_PD = prod (1 + mu) changes sign as a real multiplier passes -1; psi_NS = prod_{i<j} (mu_i mu_j - 1) as a
+    complex pair crosses the unit circle, and is_ns tells that from a real pair mu, 1/mu (both vanish there)."""
+    from mechgen.runtime.steady.cycle_points import is_ns, ns_value, pd_value, without_trivial
+
+    assert pd_value([-0.9, 0.3]) * pd_value([-1.1, 0.3]) < 0
+    inside, outside = 0.99 * np.exp(1j * np.array([0.7, -0.7])), 1.01 * np.exp(1j * np.array([0.7, -0.7]))
+    assert ns_value(np.append(inside, 0.2)) * ns_value(np.append(outside, 0.2)) < 0
+    assert is_ns(np.exp(1j * np.array([0.7, -0.7]))) and not is_ns(np.array([2.0, 0.5]))
+    assert list(without_trivial(np.array([0.3, 1.0 + 1e-9, -0.2]), True)) == [0.3, -0.2]
+
+
+def test_hybrid_orbit_outputs_and_branch_with_the_doubled_orbit(tmp_path):
+    """The analysis layer (mechgen.analyses.hybrid_orbit): the forced orbit's outputs (one impact per period, the
+    multipliers' product e^2 exp(-c T), no grazing), and the branch in w through the PD point (multiplier -1 to
+    1e-9) with the doubled orbit past it (period 2 T at its own w, two impacts, stable)."""
+    from mechgen.analyses.hybrid_orbit import run_hybrid_orbit
+    from mechgen.analyses.orbit_branch import run_orbit_branch
+    from mechgen.analyses.schema import ParamExpression
+
+    path = tmp_path / "flip.py"
+    path.write_text(MODEL.replace('"impact_orbit"', '"flip_kind"'))
+    system = mechgen.compile(str(path), {"d": 0.0, "F": 1.0, "c": 0.05, "cor": 0.8, "w": 2.5})
+    run = mechgen.simulate(system, t_end=80 * 2 * math.pi / 2.5, samples=2, q0={"x": -0.5})
+    guess = np.array([run["trajectory"]["x"][-1], run["trajectory"]["x_dot"][-1]])
+    options = {"frequency": ParamExpression(2.5, "w"), "rtol": 1e-9, "atol": 1e-12, "max_iterations": 50,
+               "samples": 201}
+    out = run_hybrid_orbit(system, options, guess)
+    T = 2 * math.pi / 2.5
+    assert out["period"] == pytest.approx(T, rel=1e-15) and len(out["events"]) == 1 and out["grazing"] == []
+    product = np.prod([complex(*mu) for mu in out["multipliers"]]).real
+    assert product == pytest.approx(0.8**2 * math.exp(-0.05 * T), rel=1e-9)
+    assert set(out["trajectory"]["mode_series"]) == {0}
+    branch = run_orbit_branch(system, {"parameter": "w", "stop": 2.8, "max_step": 0.05, "switch_branches": True,
+                                       "progress": False}, {"_orbit": out["_orbit"]})
+    (pd,) = [s for s in branch["special_points"] if s["type"] == "PD"]
+    assert min(mu[0] for mu in pd["multipliers"]) == pytest.approx(-1.0, abs=1e-9)
+    (doubled,) = branch["doubled"]
+    assert doubled["period"] == pytest.approx(2 * 2 * math.pi / doubled["w"], rel=1e-14)
+    assert doubled["events_per_period"] == 2 and doubled["stability"] == "stable"
+
+
+def test_impact_oscillator_scene_through_the_period_doubling():
+    """scenes/impact_oscillator_bifurcation.toml (the built-in impact_oscillator, the kinds periodic_orbit and
+    continuation): the PD point at the w the branch test above checks against the hand-written computation (to
+    1e-6), its multiplier -1 (to 1e-9), the two-impact orbit of period 2T past it."""
+    from pathlib import Path
+
+    scene = Path(__file__).resolve().parents[1] / "scenes" / "impact_oscillator_bifurcation.toml"
+    orbit, flip = (a["outputs"] for a in mechgen.run(str(scene))["analyses"])
+    assert len(orbit["events"]) == 1 and orbit["grazing"] == [] and orbit["stability"] == "stable"
+    (pd,) = [s for s in flip["special_points"] if s["type"] == "PD"]
+    assert pd["w"] == pytest.approx(2.6561773, abs=1e-6)
+    assert min(mu[0] for mu in pd["multipliers"]) == pytest.approx(-1.0, abs=1e-9)
+    (doubled,) = flip["doubled"]
+    assert doubled["events_per_period"] == 2 and doubled["period"] == pytest.approx(4 * math.pi / doubled["w"])
+
+
+@pytest.mark.parametrize("extra, key", [('method = "harmonic_balance"', "method"), ("segments = 2", "segments"),
+                                        (None, "frequency")])
+def test_hybrid_orbit_refuses_what_it_cannot_do(tmp_path, capsys, extra, key):
+    """A hybrid model's orbit by harmonic balance, multiple shooting, or without a forcing frequency: exit 2 naming
+    the key, no traceback."""
+    from pathlib import Path
+
+    from mechgen.cli import main
+
+    text = (Path(__file__).resolve().parents[1] / "scenes" / "impact_oscillator_bifurcation.toml").read_text()
+    text = text.split("[[analysis]]\nname = \"flip\"")[0]
+    if extra is None:
+        text = text.replace('frequency = "w"\n', "period = 2.5\n")
+    else:
+        text = text.replace('frequency = "w"\n', f'frequency = "w"\n{extra}\n')
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    assert main(["run", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert f".{key}" in err and "Traceback" not in err

@@ -198,7 +198,8 @@ def test_folds_are_special_points_and_nothing_else_is(tmp_path):
 def test_shipped_rotor_scene_reports_the_onset_speed():
     """scenes/rotor_internal_damping.toml (the built-in laval_rotor with c_i): H at Omega = sqrt(k_t/m)(1 + c/c_i)
     = 250 rad/s with the whirl frequency 200 rad/s (to 1e-8 relative: bisection to 1e-10 of a segment, then the
-    secant on Re of the critical pair); a linear model: no criticality is claimed."""
+    secant on Re of the critical pair); the hardening shaft (k_t3 > 0) makes it supercritical (l1 < 0: the bounded
+    whirl of scenes/rotor_whirl_limit_cycle.toml is born there)."""
     from pathlib import Path
 
     scene = Path(__file__).resolve().parents[1] / "scenes" / "rotor_internal_damping.toml"
@@ -206,7 +207,7 @@ def test_shipped_rotor_scene_reports_the_onset_speed():
     (h,) = out["special_points"]
     assert h["type"] == "H" and h["Omega"] == pytest.approx(250.0, rel=1e-8)
     assert h["frequency"] == pytest.approx(200.0, rel=1e-8)
-    assert h["criticality"] == "degenerate"
+    assert h["criticality"] == "supercritical" and h["lyapunov"] < 0
     curve = mechgen.run(str(scene))["analyses"][2]["outputs"]["curve"]
     c_i = np.array([p["c_i"] for p in curve])
     assert c_i[-1] == 320.0
@@ -279,3 +280,90 @@ def test_special_point_curve_refuses_a_branch_point_and_a_missing_index(tmp_path
     open(path, "w").write(text.replace('about = "cont"\nspecial_point = 1', 'about = "eq"\nspecial_point = 1'))
     assert main(["run", path]) == 2
     assert "special_point" in capsys.readouterr().err
+
+
+def test_rotor_whirl_limit_cycle_beyond_the_onset():
+    """scenes/rotor_whirl_limit_cycle.toml: at Omega = 300 rad/s the whirl is the circle r = R exp(i w t) with
+    w = c_i Omega / (c + c_i) = 240 rad/s and R^2 = (m w^2 - k_t) / k_t3 = 1e-4 m^2 (closed form: the damping
+    forces and the elastic and centripetal forces balance on the circle), to 1e-8 relative (shooting at Newton rtol
+    1e-9); the tilts stay at rest and the whirl is stable."""
+    from pathlib import Path
+
+    scene = Path(__file__).resolve().parents[1] / "scenes" / "rotor_whirl_limit_cycle.toml"
+    out = mechgen.run(str(scene))["analyses"][0]["outputs"]
+    assert out["frequency"] == pytest.approx(240.0, rel=1e-8)
+    assert out["amplitude"]["x"] == pytest.approx(0.01, rel=1e-8)
+    assert out["amplitude"]["y"] == pytest.approx(0.01, rel=1e-8)
+    assert out["amplitude"]["theta_x"] < 1e-12 and out["stability"] == "stable"
+
+
+def test_limit_cycles_born_at_a_hopf_point(tmp_path):
+    """The Rayleigh oscillator x'' + x = (mu + beta x^2) x' (beta = -1): continuing its Hopf point in mu itself
+    starts the branch of limit cycles from the normal form and follows it to mu = 0.5. Averaging gives the cycle
+    x = 2 sqrt(-mu/beta) cos t + O(mu) with the period 2 pi (1 + mu^2/16 + O(mu^4)): the amplitudes to
+    1e-2 mu^2 relative (the next averaging order, measured 5e-3 mu^2) and the periods to 2 pi mu^4 / 100
+    (measured 2 pi 1.1e-4 at mu = 0.5 = 2 pi 1.7e-3 mu^4); all stable (a supercritical point: l1 = -1/4)."""
+    model = RAYLEIGH.replace('Param("w0", 1.5)', 'Param("w0", 1.0)')
+    path = scene(tmp_path, model, "rayleigh", "x = 0.0", "mu", 0.5)
+    with open(path, "a") as f:
+        f.write('''[[analysis]]
+name = "cycles"
+kind = "continuation"
+about = "cont"
+special_point = 1
+parameter = "mu"
+stop = 0.5
+max_step = 0.05
+''')
+    out = mechgen.run(path)["analyses"][2]["outputs"]
+    assert out["hopf"]["lyapunov"] == pytest.approx(-0.25, rel=1e-6) and out["status"] == "lam_max"
+    for p in out["branch"]:
+        mu = p["mu"]
+        assert p["amplitude"]["x"] / (2 * mu**0.5) - 1 == pytest.approx(0.0, abs=1e-2 * mu**2 + 1e-7)
+        assert p["period"] == pytest.approx(2 * np.pi * (1 + mu**2 / 16), abs=2 * np.pi * mu**4 / 100 + 1e-8)
+        assert p["stability"] == "stable"
+
+
+def test_no_cycles_from_a_degenerate_hopf_point(tmp_path, capsys):
+    """The linear rotor's Hopf point (l1 = 0: no cycle is born) cannot start a branch of cycles: exit 2 at
+    special_point."""
+    from mechgen.cli import main
+
+    path = scene(tmp_path, ROTOR, "rotor", "x = 0.0, y = 0.0", "W", 40.0, "max_step = 2.0")
+    with open(path, "a") as f:
+        f.write('''[[analysis]]
+name = "cycles"
+kind = "continuation"
+about = "cont"
+special_point = 1
+parameter = "W"
+stop = 40.0
+''')
+    assert main(["run", path]) == 2
+    err = capsys.readouterr().err
+    assert "special_point" in err and "degenerate" in err and "Traceback" not in err
+
+
+def test_van_der_pol_limit_cycle_from_its_hopf_point():
+    """scenes/van_der_pol_from_hopf.toml: x'' - (mu - x^2) x' + x = 0 is van der Pol's equation for y = x / sqrt(mu),
+    so the cycle followed from the Hopf point at mu = 0 reaches at mu = 1 van der Pol's period 6.6632868593
+    (Andersen & Geer 1982; to 1e-8) and amplitude, the van der Pol cycle's max |y| at mu = 1, computed here by
+    scipy (the settled cycle's maximum located on the dense output; to 1e-8)."""
+    from scipy.integrate import solve_ivp
+    from scipy.optimize import minimize_scalar
+    from pathlib import Path
+
+    scene = Path(__file__).resolve().parents[1] / "scenes" / "van_der_pol_from_hopf.toml"
+    _, onset, cycles = (a["outputs"] for a in mechgen.run(str(scene))["analyses"])
+    (h,) = onset["special_points"]
+    assert h["type"] == "H" and h["mu"] == pytest.approx(0.0, abs=1e-9) and h["criticality"] == "supercritical"
+    last = cycles["branch"][-1]
+    assert last["mu"] == 1.0
+    assert last["period"] == pytest.approx(6.6632868593, abs=1e-8)
+    sol = solve_ivp(lambda t, y: [y[1], (1 - y[0] ** 2) * y[1] - y[0]], (0.0, 120.0), [2.0, 0.0], method="DOP853",
+                    rtol=1e-12, atol=1e-14, dense_output=True)
+    t = np.linspace(100.0, 100.0 + 6.7, 6701)
+    k = int(np.argmax(np.abs(sol.sol(t)[0])))
+    best = minimize_scalar(lambda s: -abs(sol.sol(s)[0]), bounds=(t[k - 1], t[k + 1]), method="bounded",
+                           options={"xatol": 1e-12})
+    assert last["amplitude"]["x"] == pytest.approx(-best.fun, abs=1e-8)

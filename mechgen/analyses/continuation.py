@@ -69,6 +69,7 @@ from mechgen.analyses import figures, schema, summary
 from mechgen.analyses.bvp_states import (bvp_summary, shape_declarations, shape_values, stability_about,
                                          stability_of_each)
 from mechgen.analyses.newton_branch import newton_branch
+from mechgen.analyses.orbit_branch import run_orbit_branch
 from mechgen.analyses.special_curves import run_curve
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import REQUIRED, Option
@@ -88,7 +89,7 @@ DIRECTIONS = ("increasing", "decreasing", "both")
 def _starts(ctx, key: str, value: object) -> str | list[str]:
     """One earlier steady analysis, or an array of them (one branch each); or one earlier continuation (the curve
     of one of its special points, with ``special_point``)."""
-    if isinstance(value, str) and ctx.earlier.get(value) == "continuation":
+    if isinstance(value, str) and ctx.earlier.get(value) in ("continuation", "periodic_orbit"):
         return value
     if not isinstance(value, list):
         return schema.about(ctx, key, value)
@@ -143,7 +144,8 @@ def _parameter(ctx, key: str, value: object) -> str:
 
 SCHEMA = {
     "about": Option(_starts, REQUIRED, doc="the earlier steady analysis the branch starts from, or a list of them "
-                    "(one branch each)"),
+                    "(one branch each); or an earlier periodic_orbit (a branch of orbits), or an earlier "
+                    "continuation (with special_point: the curve of one of its special points)"),
     "parameter": Option(_parameter, REQUIRED, doc="the numeric parameter the branch is followed in"),
     "stop": Option(schema.number, REQUIRED, doc="the parameter's value where the branch ends (its unit)"),
     "step": Option(schema.positive, 0.05, doc="the first pseudo-arclength step"),
@@ -204,7 +206,7 @@ def check(ctx, base: str, options: dict) -> None:
                    "a curve of special points needs both 'about' an earlier continuation and 'special_point'",
                    "special_point = <position in its special_points> with about = \"<continuation>\"" if curve
                    else "about = an earlier steady analysis (special_point goes with about = a continuation)")
-    if curve:
+    if curve or (isinstance(about, str) and ctx.earlier.get(about) == "periodic_orbit"):
         return
     if isinstance(options["about"], list) and "minimize" in options:
         raise fail(ctx.file, f"{base}.minimize", "minimize follows one branch; 'about' lists several starts",
@@ -401,6 +403,8 @@ def run_continuation(system, options: dict, context: dict) -> dict:
     budget = Budget("continuation", unit="points", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
     if "special_point" in options:
         return run_curve(system, options, context[about])
+    if isinstance(about, str) and "_orbit" in context[about]:
+        return run_orbit_branch(system, options, context[about])
     if newton_starts(starts, context):
         return _newton_continuation(system, starts, options, context, budget)
     if options.get("switch_branches"):
@@ -524,6 +528,48 @@ def _branch(plt, a: dict, path: Path) -> bool:
     return True
 
 
+def _orbit_branch(plt, a: dict, path: Path) -> bool:
+    """A branch of periodic orbits: each coordinate's amplitude against the parameter (stable solid, unstable
+    dashed), its cyclic folds, period doublings and torus points marked."""
+    out = a["outputs"]
+    points = out.get("branch") or []
+    if not points or not isinstance(points[0].get("amplitude"), dict):
+        return False
+    name = out["parameter"]
+    fig, ax = plt.subplots(figsize=(7, 5))
+    for coordinate in points[0]["amplitude"]:
+        lam = np.array([p[name] for p in points])
+        amp = np.array([p["amplitude"][coordinate] for p in points])
+        for style, label in (("-", "stable"), ("--", "unstable")):
+            mask = np.array([p["stability"] == label for p in points])
+            if not mask.any():
+                continue
+            mask[:-1] |= mask[1:]  # each run of points joined to its neighbours: no gap where stability changes
+            shown = np.where(mask, amp, np.nan)
+            ax.plot(lam, shown, style, lw=1.2, label=f"{coordinate}, {label}")
+        doubled = [d for d in out.get("doubled", []) if coordinate in d.get("amplitude", {})]
+        if doubled:
+            ax.plot([d[name] for d in doubled], [d["amplitude"][coordinate] for d in doubled], "o", mfc="none",
+                    color="tab:purple", label=f"{coordinate}, doubled orbit (period 2T)")
+        for special in out.get("special_points", []):
+            ax.plot(special[name], special["amplitude"][coordinate], _ORBIT_MARKS.get(special["type"], "o"), ms=7,
+                    mfc="none", color="k")
+            ax.annotate(special["type"], (special[name], special["amplitude"][coordinate]), fontsize=7,
+                        xytext=(5, 4), textcoords="offset points")
+    ax.set_xlabel(figures.labelled(a, name))
+    ax.set_ylabel("amplitude max |q| over the period")
+    ax.legend(fontsize=7, loc="best")
+    ax.set_title(f"{a['name']}: periodic orbits against {name} ({out.get('method', '')})", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return True
+
+
+#: markers of the special points of a branch of orbits
+_ORBIT_MARKS = {"LPC": "x", "PD": "s", "NS": "D"}
+
+
 def _curve(plt, a: dict, path: Path) -> bool:
     """A special point's curve: the first parameter against the second (LP: fold curve; H: Hopf curve, the
     frequency on a second axis)."""
@@ -608,7 +654,7 @@ def plot(plt, a: dict, path: Path) -> list[Path]:
     outputs such as the loop count written where they change, folds, stability changes and the ``at``
     crossings marked), the shapes of the ``at`` points (first field against the last), with ``eigenvalues``
     their real and imaginary parts along the branch, and the lowest frequencies against the parameter."""
-    written = [path] if _branch(plt, a, path) or _curve(plt, a, path) else []
+    written = [path] if _orbit_branch(plt, a, path) or _branch(plt, a, path) or _curve(plt, a, path) else []
     out = a["outputs"]
     name = out.get("parameter", "parameter")
     for key in [k[3:] for k in out if k.startswith("at_") and not k.endswith("_shapes")]:

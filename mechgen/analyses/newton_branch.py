@@ -84,13 +84,16 @@ def point(system, name: str, y: np.ndarray, p: float, options: dict) -> dict:
     return out
 
 
-def _steps(system, name: str, options: dict, here: float, budget: Budget) -> ContinuationOptions:
-    """The step control: towards ``stop`` (or the given ``direction``), bounded by it."""
+def arclength_steps(options: dict, here: float, budget: Budget, *,
+                    smallest_span: float = 1.0) -> ContinuationOptions:
+    """The step control of a continuation from the parameter value ``here``: towards ``stop`` (or the given
+    ``direction``), bounded by it; the first step ``step`` (default 0.05; at most ``max_step``) and the largest
+    ``max_step`` (default max(smallest_span, |stop - here| / 20))."""
     stop = float(options["stop"])
     rising = options.get("direction", "increasing" if stop >= here else "decreasing") == "increasing"
     bound = {"lam_max": stop} if stop >= here else {"lam_min": stop}
-    largest = options.get("max_step", max(1.0, abs(stop - here) / 20))
-    return ContinuationOptions(ds=options.get("step", 0.05), ds_max=largest,
+    largest = options.get("max_step", max(smallest_span, abs(stop - here) / 20))
+    return ContinuationOptions(ds=min(options.get("step", 0.05), largest), ds_max=largest,
                                direction=1 if rising else -1, max_points=options.get("max_points", 200), **bound,
                                budget=budget, progress=options.get("progress", True))
 
@@ -102,7 +105,7 @@ def newton_branch(system, start: dict, options: dict, budget: Budget) -> dict:
     here = float(own_value(system, name))
     eqs = equations(system, name)
     y0 = np.concatenate([np.asarray(start["_q"], float), np.asarray(start["_z"], float).ravel()])
-    branch = continuation(eqs, y0, here, _steps(system, name, options, here, budget))
+    branch = continuation(eqs, y0, here, arclength_steps(options, here, budget))
     points = [point(system, name, u, lam, options) for u, lam in zip(branch.u, branch.lam)]
     quiet = {**options, "stability": False}
     out = {"points": points, "status": branch.status,
@@ -110,7 +113,7 @@ def newton_branch(system, start: dict, options: dict, budget: Budget) -> dict:
     X = np.hstack([branch.u, branch.lam[:, None]])
     n = X.shape[1] - 1
     if options.get("special_points", True):
-        out.update(special(system, eqs, X, branch, options, _steps(system, name, options, here, budget)))
+        out.update(special(system, eqs, X, branch, options, arclength_steps(options, here, budget)))
     if options.get("stability", True):
 
         def verdict(x):

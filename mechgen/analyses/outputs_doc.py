@@ -186,11 +186,29 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("switched_branches", "list of {at, half, branch, status}", "the outputs'", "With "
            "``switch_branches = true``: the other branch through every BP, both ways (``half`` ``+`` or ``-``; "
            "``at``: the BP's position in ``special_points``, from 1; ``branch``: its points as in ``branch``)."),
+        _o("method", "string", "-", "About a ``periodic_orbit``: the orbit's method (``harmonic_balance`` or "
+           "``shooting``) the branch is continued by."),
+        _o("branch (orbits)", "list of {<parameter>, period, frequency, amplitude, start, multipliers, stability}",
+           "s, rad/s, coordinates'", "About a ``periodic_orbit``: one entry per orbit of the branch: the parameter, "
+           "the period T, 2 pi / T, ``amplitude`` ({coordinate: max \\|q\\| over the period}), ``start`` (the state "
+           "at t = 0: each coordinate and ``<coordinate>_dot``), the Floquet ``multipliers`` ([re, im] by "
+           "decreasing modulus) and ``stability``; its ``special_points`` are ``LPC`` (cyclic fold), ``PD`` (period "
+           "doubling: a multiplier through -1) and ``NS`` (a complex pair through the unit circle, with ``angle``)."),
+        _o("doubled", "list of {at, <parameter>, amplitude, period, start, multipliers, stability}", "the outputs'",
+           "About a forced ``periodic_orbit`` found by shooting (or a hybrid model's), with ``switch_branches = "
+           "true``: the period-2T orbit just past every PD point (``at``: the PD's position in ``special_points``, "
+           "from 1), at the parameter half-way to the next branch point on the side where the period-T orbit has a "
+           "multiplier below -1."),
         _o("curve", "list of {<first>, <second>, coordinates, ..., frequency}", "the outputs'", "With "
            "``special_point`` (``about`` an earlier continuation): the curve of its LP or H in two parameters, "
            "one entry per point with both parameters, ``coordinates``, the model's outputs and, on an H curve, "
-           "``frequency`` (omega of the pair +-i omega)."),
+           "``frequency`` (omega of the pair +-i omega); about a branch of orbits, the curve of its LPC, each "
+           "point with both parameters and the orbit's ``period``, ``amplitude``, ``start``, ``multipliers``."),
         _o("type", "string", "-", "With ``special_point``: ``LP`` or ``H``, the kind of point the curve follows."),
+        _o("hopf", "{<parameter>, frequency, lyapunov, growth_rate_slope, start_parameter}", "the parameter's, "
+           "rad/s", "With ``special_point`` an H point and ``parameter`` the earlier continuation's own: the Hopf "
+           "point the branch of limit cycles (``branch``, as about a ``periodic_orbit``) starts from, d Re(lambda)/dp "
+           "there and the parameter of the first cycle."),
         _o("parameters", "list of two strings", "-", "With ``special_point``: the earlier continuation's "
            "parameter and the second one."),
         _o("shape_outputs", "list of strings", "-", "The shape outputs reported at every point."),
@@ -322,6 +340,33 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("cycle_events", "list of {t, from, to, guard}", "s", "The events of that period."),
         _o("displacement_series", "(samples,)", "m", "With ``curve``: the loop's displacement."),
         _o("force_series", "(samples,)", "N", "With ``curve``: the loop's force."),
+    ),
+    "periodic_orbit": (
+        _o("period", "scalar", "s (or the model's time unit)", "T: 2 pi / ``frequency`` of a forced orbit; found "
+           "with an autonomous one."),
+        _o("frequency", "scalar", "rad/s", "omega = 2 pi / T: the forcing's, or the limit cycle's found."),
+        _o("t", "(samples,)", "s (or the model's time unit)", "One period, ``samples`` equally spaced times from 0 "
+           "to T."),
+        _o("trajectory", "{name: (samples,)}", MODEL_UNIT, "The orbit at ``t``, named as simulate's: each "
+           "coordinate, ``<coordinate>_dot`` and the model's outputs."),
+        _o("amplitude", "{coordinate: value}", MODEL_UNIT, "max \\|q\\| over the period (the largest of 4096 phases, "
+           "refined by the parabola through it and its neighbours)."),
+        _o("harmonics", "{coordinate: {mean, cos, sin, amplitude, phase}}", "the coordinate's; phase in rad",
+           "The Fourier coefficients of each coordinate, k = 1..H: q = mean + sum_k a_k cos(k omega t) + b_k "
+           "sin(k omega t) = mean + sum_k amplitude_k cos(k omega t + phase_k) (``cos`` a_k, ``sin`` b_k, "
+           "``amplitude`` sqrt(a_k^2 + b_k^2), ``phase`` atan2(-b_k, a_k))."),
+        _o("multipliers", "(2n, 2)", "-", "The Floquet multipliers (eigenvalues of the monodromy matrix) as [re, "
+           "im] pairs, by decreasing modulus (a conjugate pair: the positive imaginary part first)."),
+        _o("stability", "string", "-", "``stable`` (every multiplier \\|mu\\| <= 1 + 1e-6, an autonomous "
+           "orbit's trivial one set aside) or ``unstable``."),
+        _o("method", "string", "-", "``harmonic_balance``, ``shooting`` or ``collocation``: the method that ran."),
+        _o("residual", "scalar", "force units (harmonic balance), the state's (shooting), mixed (collocation: "
+           "q's rate and force units)", "\\|\\|R\\|\\|_inf at the solution."),
+        _o("iterations", "scalar (int)", "-", "Newton steps taken."),
+        _o("loop", "string", "-", "``c``: shooting's integrations ran in the compiled DOP853 loop (the monodromy "
+           "for Newton by central differences of it; a forced orbit's later segments, with ``segments`` > 1, in "
+           "scipy's); ``python``: in scipy's DOP853 (harmonic balance's and "
+           "collocation's multipliers, and ``loop = \"python\"``)."),
     ),
     "cross_section": (
         _o("K", "(6, 6)", "N, N m, N m^2", "The section's stiffness ordered [K_uu, K_uw; K_wu, K_ww]."),

@@ -20,7 +20,7 @@ from mechgen.analyses.schema import OptionContext, validate
 from mechgen.errors import InputError, did_you_mean
 
 __all__ = ["analysis", "campbell", "continuation", "fit", "impact", "modes", "restitution", "simulate", "stability",
-           "steady", "sweep", "cross_section", "symplectic", "rod_statics", "rod_dynamics", "periodic", "spectrum",
+           "steady", "sweep", "cross_section", "symplectic", "rod_statics", "rod_dynamics", "periodic", "periodic_orbit", "spectrum",
            "stability_boundary", "response", "option_lines"]
 
 
@@ -184,6 +184,17 @@ def periodic(system, *, name: str | None = None, **options) -> Result:
     ``equivalent_stiffness``, ``equivalent_damping`` and the hysteresis loop of the detected period.
     """
     return _run("periodic", system, options, name)
+
+
+def periodic_orbit(system, *, name: str | None = None, **options) -> Result:
+    """A periodic orbit of a smooth lumped model, forced (``frequency``) or autonomous (``period`` the guess), by
+    harmonic balance, shooting or collocation, with its Floquet multipliers and stability
+    (mechgen.analyses.periodic_orbit).
+
+    ``from`` is a Python keyword: start from an earlier simulate with ``periodic_orbit(system, **{"from": run})``
+    (``run`` the simulate's Result, kept with its trajectory).
+    """
+    return _run("periodic_orbit", system, options, name)
 
 
 def response(system, *, name: str | None = None, **options) -> Result:

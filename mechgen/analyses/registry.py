@@ -28,6 +28,7 @@ MODULES = (
     "mechgen.analyses.stability_boundary",
     "mechgen.analyses.spectrum",
     "mechgen.analyses.periodic",
+    "mechgen.analyses.periodic_orbit",
     "mechgen.analyses.cross_section",
     "mechgen.analyses.symplectic",
     "mechgen.analyses.rod_statics",

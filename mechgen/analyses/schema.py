@@ -145,6 +145,45 @@ def positive(ctx: OptionContext, key: str, value: object) -> float:
     return value
 
 
+class ParamExpression(float):
+    """A number given in a scene as an expression of parameters (``frequency = "2*w"``): its value, and the
+    expression's ``text``, so that an analysis that moves a parameter (a continuation) evaluates it again there."""
+
+    def __new__(cls, value: float, text: str) -> "ParamExpression":
+        obj = float.__new__(cls, value)
+        obj.text = text
+        return obj
+
+    def __reduce__(self):
+        return ParamExpression, (float(self), self.text)
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The parameter names the expression uses."""
+        from mechgen.scene.expr import parse_expression
+
+        return tuple(parse_expression(self.text).names)
+
+    def at(self, values: Mapping[str, float]) -> float:
+        """The expression's value with the parameters ``values``."""
+        from mechgen.scene.expr import parse_expression
+
+        return float(parse_expression(self.text).evaluate(values))
+
+    def moved(self, name: str, value: float, values: Mapping[str, float]) -> float:
+        """Its value with the parameter ``name`` at ``value`` (the others as when it was given, or ``values``
+        where a continuation keeps them free): itself when it does not use ``name``."""
+        if name not in self.names:
+            return float(self)
+        return self.at({**values, name: float(value)})
+
+
+def positive_expression(ctx: OptionContext, key: str, value: object) -> float:
+    """A number > 0; given as an expression of parameters, a :class:`ParamExpression` that keeps it."""
+    number_value = positive(ctx, key, value)
+    return ParamExpression(number_value, value) if isinstance(value, str) else number_value
+
+
 def int_at_least(ctx: OptionContext, key: str, value: object, low: int) -> int:
     """An integer >= ``low``."""
     if not isinstance(value, int) or isinstance(value, bool):

@@ -3,7 +3,8 @@ parameters.
 
 ``about`` names the earlier continuation (of a Newton steady state), ``special_point`` the point (its position in
 that continuation's ``special_points``, from 1: an LP or an H), ``parameter`` the second parameter b and ``stop``
-its end value; the first parameter a (the earlier continuation's) becomes an unknown. The curve is the branch of
+its end value (with ``parameter`` the earlier continuation's own and an H point: the branch of limit cycles born
+there, mechgen.analyses.hopf_cycles); the first parameter a (the earlier continuation's) becomes an unknown. The curve is the branch of
 the extended system of mechgen.runtime.steady.codim2 in b (pseudo-arclength, so a curve that turns in b is
 followed round), reported as ``curve``: one entry per point with both parameters, ``coordinates`` (lumped), the
 model's outputs and for an H curve ``frequency`` (omega of the pair +-i omega); with ``type`` (LP or H),
@@ -13,11 +14,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from mechgen.analyses.newton_branch import arclength_steps
 from mechgen.analyses.steady import equilibrium_functions
 from mechgen.errors import SceneError
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget
 from mechgen.runtime.steady import codim2
-from mechgen.runtime.steady.continuation import ContinuationOptions, continuation
+from mechgen.runtime.steady.continuation import continuation
 
 #: keys of a continuation that a curve of special points does not take
 CURVE_REFUSES = ("method", "stages", "bounds", "at", "minimize", "switch_branches", "eigenvalues")
@@ -76,12 +78,20 @@ def start_of(earlier: dict, index: int) -> tuple[str, np.ndarray, str]:
 def run_curve(system, options: dict, earlier: dict) -> dict:
     """The curve of a special point in two parameters (module doc)."""
     refuse_keys(options)
+    if "_orbit" in earlier:  # a branch of periodic orbits: the curve of its cyclic fold
+        from mechgen.analyses.orbit_curves import run_orbit_curve
+
+        return run_orbit_curve(system, options, earlier)
     if "_special_x" not in earlier:
         raise SceneError("the earlier continuation followed a boundary-value branch; special-point curves follow "
                          "Newton steady states' branches", key="about",
                          expected="a continuation about a Newton steady state")
     kind, x, first = start_of(earlier, int(options["special_point"]))
     second = options["parameter"]
+    if second == first and kind == "H":  # the limit cycles born at the Hopf point (mechgen.analyses.hopf_cycles)
+        from mechgen.analyses.hopf_cycles import run_hopf_cycles
+
+        return run_hopf_cycles(system, options, earlier, x, earlier["special_points"][int(options["special_point"]) - 1])
     if second == first:
         raise SceneError(f"parameter {second!r} is the earlier continuation's own", key="parameter",
                          expected=f"a second parameter, other than {first!r}")
@@ -92,13 +102,8 @@ def run_curve(system, options: dict, earlier: dict) -> dict:
         G, u0 = codim2.fold_system(model.residual, model.jacobian, y0, a0, b0)
     else:
         G, u0 = codim2.hopf_system(model.residual, model.state_jacobian, y0, a0, b0)
-    stop = float(options["stop"])
     budget = Budget("continuation", unit="points", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
-    steps = ContinuationOptions(ds=options.get("step", 0.05),
-                                ds_max=options.get("max_step", max(1.0, abs(stop - b0) / 20)),
-                                direction=1 if stop >= b0 else -1, max_points=options.get("max_points", 200),
-                                budget=budget, progress=options.get("progress", True),
-                                **({"lam_max": stop} if stop >= b0 else {"lam_min": stop}))
+    steps = arclength_steps(options, b0, budget)
     branch = continuation(codim2.equations(G, f"the {kind} curve in ({first}, {second})"), u0, b0, steps)
     curve = [point(system, first, second, u, b, kind) for u, b in zip(branch.u, branch.lam)]
     return {"type": kind, "parameters": [first, second], "curve": curve, "points": len(curve),

@@ -82,6 +82,10 @@ REGISTRY: dict[str, Suite] = {s.name: s for s in (
           "a forced Duffing oscillator's time response: the compiled loop against scipy's stepper on the same "
           "kernels and a hand-written solve_ivp; a 10^3-point sweep of simulate", ("simulate.json", "simulate.md"),
           peers=("scipy DOP853 stepped in Python", "hand-written solve_ivp")),
+    Suite("orbits", "mechgen.bench.orbits", "run_orbit_benchmarks",
+          "a Duffing frequency-response curve through its folds by harmonic balance and shooting against a "
+          "hand-written scipy shooting-plus-continuation baseline, at equal fold accuracy", ("orbits.json", "orbits.md"),
+          peers=("hand-written scipy shooting + continuation (benchmarks/)",)),
     Suite("sweep", "mechgen.bench.sweep", "run_sweep_benchmarks",
           "a 10^4-point Laval rotor stability sweep on the serial, local-process and Dask executors (2 workers): wall "
           "time, overhead per point, dask / processes", ("sweep.json", "sweep.md"),

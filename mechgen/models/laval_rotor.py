@@ -7,7 +7,7 @@ so its angular velocity in the tilted frame is
 omega = (theta_x' cos(theta_y), theta_y', Omega + theta_x' sin(theta_y)) and
 
     T = m/2 (x'^2 + y'^2) + Id/2 (omega_1^2 + omega_2^2) + Ip/2 omega_3^2
-    V = k_t/2 (x^2 + y^2) + k_r/2 (theta_x^2 + theta_y^2)
+    V = k_t/2 (x^2 + y^2) + k_t3/4 (x^2 + y^2)^2 + k_r/2 (theta_x^2 + theta_y^2)
     R = c/2 (x'^2 + y'^2) + c_r/2 (theta_x'^2 + theta_y'^2)   (non-rotating damping)
         + c_i/2 ((x' + Omega y)^2 + (y' - Omega x)^2)             (internal damping, in the rotating frame)
 
@@ -16,7 +16,9 @@ omega_f,b = (+-Ip Omega + sqrt(Ip^2 Omega^2 + 4 Id k_r)) / (2 Id), forward and
 backward, so omega_f - omega_b = Ip Omega / Id (the gyroscopic moment Ip Omega).
 Internal (rotating) damping c_i acts on the centre's velocity seen from the shaft, r' - Omega x r: it drives the
 forward whirl of the translations unstable above the onset speed Omega = sqrt(k_t/m) (1 + c/c_i) (Crandall;
-Genta, Dynamics of Rotating Systems, sec. 8.3), a Hopf point of the rest state in Omega.
+Genta, Dynamics of Rotating Systems, sec. 8.3), a Hopf point of the rest state in Omega. A hardening shaft
+(k_t3 > 0) bounds the whirl beyond it: the circular orbit r = R exp(i w t) with w = c_i Omega / (c + c_i) (the
+damping forces balance) and m w^2 = k_t + k_t3 R^2 (the elastic force balances the centripetal one).
 Whirl is judged at two stations, the centre's (x, y) and the tilts (theta_x, theta_y): the disk normal is
 n = (theta_y, -theta_x, 1), a rotation of (theta_x, theta_y) by -90 degrees, so a counter-clockwise tilt
 orbit is a counter-clockwise (forward) whirl of the normal.
@@ -39,6 +41,7 @@ model.params(
     Param("c", 0.0, "N s/m", "translational damping"),
     Param("c_r", 0.0, "N m s/rad", "tilt damping"),
     Param("c_i", 0.0, "N s/m", "internal (rotating) damping of the translations"),
+    Param("k_t3", 0.0, "N/m^3", "cubic (hardening) translational shaft stiffness"),
 )
 model.coordinates("x", "y", "theta_x", "theta_y")
 model.whirl_pair("x", "y")
@@ -53,7 +56,8 @@ def kinetic(q, v, p):
 
 @model.potential
 def potential(q, p):
-    return p.k_t / 2 * (q.x**2 + q.y**2) + p.k_r / 2 * (q.theta_x**2 + q.theta_y**2)
+    return (p.k_t / 2 * (q.x**2 + q.y**2) + p.k_t3 / 4 * (q.x**2 + q.y**2) ** 2
+            + p.k_r / 2 * (q.theta_x**2 + q.theta_y**2))
 
 
 @model.dissipation

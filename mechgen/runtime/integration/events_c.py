@@ -442,8 +442,9 @@ def _error(rc: int, system, state: CState, err_x: np.ndarray, where, options: Ru
         return KernelError(f"kernel {KINDS[state.err_kind]}__{state.err_guard} returned error code {state.err_rc}")
     if rc == E_RHS:
         why = diagnosis(system, seg, t, err_x.copy())
-        return KernelError(f"kernel residual/tangent of {model} gave NaN/Inf at t = {t}, x = {err_x[:6]} in mode "
-                           f"{system.modes[seg]}" + (f"; {why}" if why else ""))
+        mode = "" if getattr(system, "smooth", False) else f" in mode {system.modes[seg]}"
+        return KernelError(f"kernel residual/tangent of {model} gave NaN/Inf at t = {t}, x = {err_x[:6]}{mode}"
+                           + (f"; {why}" if why else ""))
     if rc == E_STATE:
         return KernelError(f"DOP853: state became NaN/Inf by {where(t, seg)}")
     if rc == E_RESET:

@@ -80,8 +80,7 @@ def flow_jacobian(system, x0, T: float, *, mode: int | None = None, rtol: float 
     doc)."""
     x0 = np.asarray(x0, float)
     mode = system.initial_mode if mode is None else int(mode)
-    run = integrate_hybrid(system, x0, T, mode=mode, options=RunOptions(rtol=rtol, atol=atol, t_eval=np.array([T]),
-                                                                        progress=False))
+    run = flow_run(system, x0, T, mode, rtol, atol)
     if run.terminated:
         raise ConvergenceError(f"the run from t = 0 ended at a terminal event at t = {run.t_final:.10g} before "
                                f"T = {T:.10g}: the flow map over the period is undefined there")
@@ -100,6 +99,19 @@ def flow_jacobian(system, x0, T: float, *, mode: int | None = None, rtol: float 
     phi = transition(system, current, t, T, x, rtol, atol) @ phi
     return FlowJacobian(np.asarray(run.x_final, float), phi, tuple(run.events), tuple(saltations), run.final_mode,
                         tuple(grazing))
+
+
+def flow_run(system, x0: np.ndarray, T: float, mode: int, rtol: float, atol: float):
+    """The event-driven run from x0 at t = 0 to T (DOP853: the compiled loop where it applies)."""
+    return integrate_hybrid(system, x0, T, mode=mode, options=RunOptions(method="DOP853", rtol=rtol, atol=atol,
+                                                                         t_eval=np.array([T]), progress=False))
+
+
+def flow_map(system, x0, T: float, *, mode: int | None = None, rtol: float = 1e-11, atol: float = 1e-13):
+    """(x(T), the mode it ends in) from x0 at t = 0 (no Jacobian)."""
+    mode = system.initial_mode if mode is None else int(mode)
+    run = flow_run(system, np.asarray(x0, float), T, mode, rtol, atol)
+    return np.asarray(run.x_final, float), run.final_mode
 
 
 def _grazes(system, mode: int, k: int, event) -> bool:

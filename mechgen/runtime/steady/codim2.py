@@ -19,8 +19,9 @@ mechgen.runtime.steady.continuation (pseudo-arclength through turns of b):
   after rotating q so that q_r . q_i = 0).
 
 G is evaluated exactly (the generated F, F_y and A); its Jacobian G_u and G_b are forward differences with
-step 1e-7 (1 + |u_k|): their error only slows Newton's convergence, it does not move a point, which solves G = 0
-to the corrector's tolerance.
+step 1e-7 (1 + |u_k|) (1e-5 for periodic orbits, whose R_u may itself come from differences of a flow): their
+error only slows Newton's convergence, it does not move a point, which solves G = 0 to the corrector's
+tolerance.
 """
 from __future__ import annotations
 
@@ -34,23 +35,33 @@ from mechgen.runtime.steady.continuation import ParametricEquations
 DIFF_STEP = 1e-7
 
 
-def jacobian_by_differences(G: Callable, u: np.ndarray, lam: float) -> tuple[np.ndarray, np.ndarray]:
-    """(G_u, G_lam) by forward differences (module doc)."""
+def jacobian_by_differences(G: Callable, u: np.ndarray, lam: float,
+                            step: float = DIFF_STEP) -> tuple[np.ndarray, np.ndarray]:
+    """(G_u, G_lam) by forward differences of relative step ``step`` (module doc)."""
     g0 = G(u, lam)
     cols = []
     for k in range(u.size):
-        h = DIFF_STEP * (1.0 + abs(u[k]))
+        h = step * (1.0 + abs(u[k]))
         du = u.copy()
         du[k] += h
         cols.append((G(du, lam) - g0) / h)
-    h = DIFF_STEP * (1.0 + abs(lam))
+    h = step * (1.0 + abs(lam))
     return np.column_stack(cols), (G(u, lam + h) - g0) / h
 
 
-def equations(G: Callable, name: str) -> ParametricEquations:
-    """G(u, lam) as the continuation's ParametricEquations, its Jacobian by differences."""
-    return ParametricEquations(G, lambda u, lam: jacobian_by_differences(G, u, lam)[0],
-                               lambda u, lam: jacobian_by_differences(G, u, lam)[1], name=name)
+def equations(G: Callable, name: str, step: float = DIFF_STEP) -> ParametricEquations:
+    """G(u, lam) as the continuation's ParametricEquations, its Jacobian by differences of relative step ``step``
+    (larger where G's own Jacobian inputs carry difference noise, as a shooting monodromy by differences does)."""
+    memo: dict = {}
+
+    def both(u, lam):
+        key = (np.asarray(u, float).tobytes(), float(lam))
+        if key not in memo:
+            memo.clear()
+            memo[key] = jacobian_by_differences(G, np.asarray(u, float), float(lam), step)
+        return memo[key]
+
+    return ParametricEquations(G, lambda u, lam: both(u, lam)[0], lambda u, lam: both(u, lam)[1], name=name)
 
 
 def fold_system(residual: Callable, jacobian: Callable, y0: np.ndarray, a0: float, b0: float):

@@ -25,8 +25,9 @@ and retried when the corrector fails or the tangent turns more than ``max_turn``
 sign change of the tangent's lam-component between two points; it is located by Brent's
 method on the arclength s of the segment, with t_lam(s) from a corrected point, so the
 fold's lam is accurate to the square of the location error. The branch ends at
-``max_points`` or where lam leaves [lam_min, lam_max] (the last point is then put exactly
-on the bound).
+``max_points``, where lam leaves [lam_min, lam_max] (the last point is then put exactly
+on the bound), or where it comes back to its start going the same way ('closed': an isola,
+a closed curve of orbits).
 
 :func:`continue_bvp` continues a BVP (:class:`mechgen.runtime.steady.bvp.BVP`) in one of its
 parameters through a collocation or multiple-shooting :class:`DiscreteBVP`;
@@ -78,7 +79,7 @@ class Fold:
 class Branch:
     """Accepted points ``u`` (m, n) and ``lam`` (m,), their arclength and unit tangents
     (m, n + 1), the folds, the callback's value per point (``data``), why it stopped
-    (``status``: 'max_points', 'lam_max', 'lam_min' or 'min_step') and a message, and
+    (``status``: 'max_points', 'lam_max', 'lam_min', 'min_step' or 'closed') and a message, and
     the system (to correct further points, e.g. for :func:`minimize_along_branch`)."""
 
     u: np.ndarray
@@ -428,6 +429,23 @@ def continuation(system, u0, lam0: float, options: ContinuationOptions | None = 
     return _run(system, x, t, callback, opts)
 
 
+def closes(w, xs: list, ts: list, step: float) -> bool:
+    """Whether the newest point has come back to the branch's start, going the same way (a closed branch, an
+    isola): the segment to it passes within half a step of the start, with the start's tangent direction, after
+    the branch has been at least 4 steps away from it."""
+    if len(xs) < 6:
+        return False
+    start, last, new = xs[0], xs[-2], xs[-1]
+    chord = new - last
+    length = _norm(w, chord)
+    if length == 0.0 or ts[-1] @ _row(w, ts[0]) <= 0:
+        return False
+    theta = float(np.clip((start - last) @ _row(w, chord) / length**2, 0.0, 1.0))
+    near = _norm(w, last + theta * chord - start) < 0.5 * step
+    went_away = max(_norm(w, x - start) for x in xs[1:-1]) > 4 * step
+    return bool(near and went_away)
+
+
 def _unit(w, t) -> np.ndarray:
     t = np.asarray(t, float)
     return t / _norm(w, t)
@@ -509,6 +527,11 @@ def _run(system, x, t, callback, opts: ContinuationOptions) -> Branch:
         ts.append(t_new)
         arc.append(arc[-1] + step)
         data.append(callback(x_new[:n].copy(), x_new[n]) if callback else None)
+        if closes(w, xs, ts, step):
+            status = "closed"
+            message = (f"the branch closed on itself after {len(xs) - 1} points (back at its start, lam = "
+                       f"{xs[0][n]:.10g}, going the same way: an isola)")
+            break
         if iters <= 3:
             step = min(step * grow, ds_max)
         elif iters >= max(4, max_corrector - 2):

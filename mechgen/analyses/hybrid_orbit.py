@@ -1,0 +1,149 @@
+"""``periodic_orbit`` of a hybrid model: event-aware shooting of a forced orbit, its monodromy through the events.
+
+A forced hybrid model (impacts, stick-slip: mechgen.symbolic.hybrid) has the orbit x(T) = x0 of the forcing's
+period T = 2 pi / ``frequency`` found by Newton on x(T; x0) - x0 with the Jacobian Phi - I, Phi the flow map's
+Jacobian through the events: the modes' state-transition matrices and the saltation matrices of the events,
+generated from the guards and resets (mechgen.runtime.integration.hybrid_monodromy). The orbit starts at t = 0 in
+the model's initial mode. Outputs as the smooth orbit's (mechgen.analyses.periodic_orbit): ``period``,
+``frequency``, ``t``, ``trajectory`` (with ``mode_series``, the mode index per sample), ``amplitude``,
+``harmonics``, ``multipliers`` (the eigenvalues of Phi), ``stability``, ``method`` (``shooting``), ``residual``,
+``iterations``; and ``events`` (those of one period: {t, guard, from, to}) and ``grazing`` (the events of the
+orbit that touch their guard tangentially, where the saltation matrix and the multipliers are not to be trusted).
+An autonomous hybrid orbit (unknown period) is not available yet (an input error at ``frequency``).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from mechgen.analyses import time_series
+from mechgen.errors import SceneError
+from mechgen.runtime.integration.events import integrate_hybrid
+from mechgen.runtime.integration.hybrid_monodromy import periodic_orbit
+from mechgen.runtime.integration.run_options import RunOptions
+from mechgen.runtime.periodic import floquet, fourier
+
+#: phases at which amplitudes and harmonics are taken
+FINE = 4096
+
+
+def orbit_states(system, x0: np.ndarray, T: float, times: np.ndarray, rtol: float, atol: float):
+    """(states (rows), mode per sample) of the orbit from x0 at ``times`` in [0, T] (the event-driven flow)."""
+    run = integrate_hybrid(system, x0, T, options=RunOptions(method="DOP853", rtol=rtol, atol=atol, t_eval=times,
+                                                             progress=False))
+    return np.asarray(run.x, float), np.asarray(run.mode, int)
+
+
+def run_hybrid_orbit(system, options: dict, guess: np.ndarray) -> dict:
+    """The forced orbit of a hybrid model from the starting state ``guess`` (module doc)."""
+    if options.get("frequency") is None:
+        raise SceneError("an autonomous periodic orbit of a hybrid model (unknown period) is not available yet",
+                         key="frequency", expected="the forcing's frequency (a forced hybrid model's orbit)")
+    if options.get("method", "shooting") != "shooting":
+        raise SceneError(f"method {options['method']!r} needs a smooth model; a hybrid model's orbit is found by "
+                         "shooting through its events", key="method", expected="shooting (or leave method out)")
+    omega = float(options["frequency"])
+    T = 2 * np.pi / omega
+    rtol, atol = float(options["rtol"]) * 1e-2, float(options["atol"]) * 1e-2
+    orbit = periodic_orbit(system, guess, T, tol=float(options["rtol"]), max_iter=int(options["max_iterations"]),
+                           rtol=rtol, atol=atol)
+    names = list(system.coordinates)
+    fine, _ = orbit_states(system, orbit.x0, T, T * np.arange(FINE) / FINE, rtol, atol)
+    t = np.linspace(0.0, T, int(options["samples"]))
+    X, modes = orbit_states(system, orbit.x0, T, t, rtol, atol)
+    series = time_series.sampled_outputs_by_mode(system.mode, t, X, modes)
+    history = time_series.time_history(system, t, X, series, None)
+    history["trajectory"]["mode_series"] = modes.tolist()
+    U = fourier.coefficients_of_samples(fine[:, :system.n], int(options.get("harmonics", 7)))
+    mu = orbit.multipliers
+    from mechgen.analyses.periodic_orbit import peak
+
+    return {"period": T, "frequency": omega, "t": history["t"], "trajectory": history["trajectory"],
+            "amplitude": {c: peak(fine[:, i]) for i, c in enumerate(names)},
+            "harmonics": fourier.harmonics_table(U, names), "multipliers": floquet.as_pairs(mu),
+            "stability": floquet.stability(mu, False), "method": "shooting", "residual": orbit.residual,
+            "iterations": orbit.iterations, "loop": "c" if getattr(system, "backend", None) == "c" else "python",
+            "events": [{"t": float(e.t), "guard": e.guard, "from": system.modes[e.source],
+                        "to": None if e.target is None else system.modes[e.target]} for e in orbit.events],
+            "grazing": [orbit.events[i].guard for i in orbit.grazing],
+            "_orbit": {"method": "shooting", "hybrid": True, "x0": orbit.x0, "mode": orbit.mode,
+                       "options": dict(options)}}
+
+
+def run_hybrid_branch(system, options: dict, orbit: dict) -> dict:
+    """``continuation`` about a hybrid model's ``periodic_orbit``: the branch of forced orbits in ``parameter``
+    (mechgen.runtime.integration.hybrid_orbit_branch), its cyclic folds (LPC), period doublings (PD) and torus
+    points (NS); with ``switch_branches``, the doubled orbit just past every PD (``doubled``: {at, <parameter>,
+    period, start, multipliers, stability})."""
+    from mechgen.analyses.newton_branch import arclength_steps
+    from mechgen.analyses.schema import ParamExpression
+    from mechgen.analyses.stability_boundary import own_value
+    from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget
+    from mechgen.runtime.integration.hybrid_orbit_branch import OrbitFamily
+    from mechgen.runtime.steady.continuation import continuation
+    from mechgen.runtime.steady.cycle_points import cycle_points
+
+    name, frequency = options["parameter"], orbit["options"]["frequency"]
+    rtol, atol = float(orbit["options"]["rtol"]) * 1e-2, float(orbit["options"]["atol"]) * 1e-2
+
+    def period(p: float) -> float:
+        w = frequency.moved(name, p, system.param_values()) if isinstance(frequency, ParamExpression) else frequency
+        return 2 * np.pi / float(w)
+
+    family = OrbitFamily(system, name, period, orbit["mode"], rtol=rtol, atol=atol)
+    here = float(own_value(system, name))
+    budget = Budget("continuation", unit="points", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
+    eqs = family.equations()
+    found = continuation(eqs, np.asarray(orbit["x0"], float), here, arclength_steps(options, here, budget,
+                                                                                    smallest_span=0.1))
+    X = np.hstack([found.u, found.lam[:, None]])
+    points = [hybrid_record(family, x) for x in X]
+    specials = [("LPC", np.append(f.u, f.lam), f.index) for f in found.folds]
+    if options.get("special_points", True):
+        specials += [(s.type, s.x, s.index) for s in cycle_points(eqs, X, family.multipliers)]
+    specials.sort(key=lambda s: s[2])
+    out = {"parameter": name, "method": "shooting", "branch": points, "points": len(points), "status": found.status,
+           "special_points": [{"type": kind, **hybrid_record(family, x)} for kind, x, _ in specials],
+           "shape_outputs": []}
+    out["folds"] = [s for s in out["special_points"] if s["type"] == "LPC"]
+    if options.get("switch_branches"):
+        out["doubled"] = [doubled_record(family, X, x, index, k + 1)
+                          for k, (kind, x, index) in enumerate(specials) if kind == "PD"]
+    return out
+
+
+def hybrid_record(family, x: np.ndarray) -> dict:
+    """One orbit of a hybrid branch: the parameter, period, frequency, amplitude, start, multipliers, stability and
+    the events per period."""
+    x0, p = x[:-1], float(x[-1])
+    T = family.period(p)
+    moved = family.system.with_params(**{family.name: p})
+    fine, _ = orbit_states(moved, x0, T, T * np.arange(1024) / 1024, family.rtol, family.atol)
+    mu = floquet.multipliers(family.flow(x0, p).phi)
+    names = list(family.system.coordinates)
+    from mechgen.analyses.periodic_orbit import peak
+
+    return {family.name: p, "period": T, "frequency": 2 * np.pi / T,
+            "amplitude": {c: peak(fine[:, i]) for i, c in enumerate(names)},
+            "start": dict(zip(names + [f"{c}_dot" for c in names], (float(v) for v in x0))),
+            "multipliers": floquet.as_pairs(mu), "stability": floquet.stability(mu, False),
+            "events_per_period": len(family.flow(x0, p).events)}
+
+
+def doubled_record(family, X: np.ndarray, x_pd: np.ndarray, index: int, at: int) -> dict:
+    """The doubled orbit past the PD point x_pd (between branch points index and index + 1): on the side whose
+    orbit has a multiplier below -1, half-way to that branch point."""
+    from mechgen.runtime.integration.hybrid_orbit_branch import doubled_orbit
+
+    side = max((X[index], X[index + 1]), key=lambda x: -float(np.min(family.multipliers(x).real)))
+    p = float(x_pd[-1]) + 0.5 * (float(side[-1]) - float(x_pd[-1]))
+    orbit = doubled_orbit(family, x_pd, p - float(x_pd[-1]))
+    names = list(family.system.coordinates)
+    fine, _ = orbit_states(family.system.with_params(**{family.name: p}), orbit.x0, orbit.period,
+                           orbit.period * np.arange(1024) / 1024, family.rtol, family.atol)
+    from mechgen.analyses.periodic_orbit import peak
+
+    return {"at": at, family.name: p, "amplitude": {c: peak(fine[:, i]) for i, c in enumerate(names)},
+            "period": orbit.period, "start": dict(zip(names + [f"{c}_dot" for c in names],
+                                                      (float(v) for v in orbit.x0))),
+            "multipliers": floquet.as_pairs(orbit.multipliers), "stability": floquet.stability(orbit.multipliers, False),
+            "events_per_period": len(orbit.events)}

@@ -1,0 +1,239 @@
+"""``continuation`` about a ``periodic_orbit``: the branch of periodic orbits in a parameter, with its cyclic folds,
+period doublings and torus points.
+
+The earlier orbit's method (harmonic balance or shooting) is continued in ``parameter`` up to ``stop`` by
+pseudo-arclength (mechgen.runtime.periodic.branch; mechgen.runtime.steady.continuation), so a frequency-response
+curve is followed round its folds: both stable branches and the unstable one between. A forced orbit whose
+``frequency`` is an expression of the continued parameter (``frequency = "w"``, continued in ``w``) has its period
+follow it; otherwise the forcing's frequency stays as it was.
+
+Outputs: ``branch`` (per point: the parameter, ``period``, ``frequency``, ``amplitude`` ({coordinate: max |q|
+over the period}), ``start`` (the state at t = 0: each coordinate and ``<coordinate>_dot``), ``multipliers`` ([re, im] by decreasing modulus) and ``stability``), ``points``, ``status``,
+``method``, ``folds`` and ``special_points``: ``LPC`` (a cyclic fold: the branch turns in the parameter),
+``PD`` (period doubling: a multiplier through -1) and ``NS`` (Neimark-Sacker: a complex pair through the unit
+circle, with ``angle``), each with the parameter, period, amplitude and multipliers there
+(mechgen.runtime.steady.cycle_points); with ``switch_branches`` (a forced orbit by shooting) ``doubled``, the
+period-2T orbit just past every PD point.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from mechgen.analyses.hybrid_orbit import run_hybrid_branch
+from mechgen.analyses.newton_branch import arclength_steps
+from mechgen.analyses.periodic_orbit import DEFAULT_HARMONICS, compiled_run, integrator_tolerances, peak
+from mechgen.analyses.schema import ParamExpression
+from mechgen.analyses.stability_boundary import own_value
+from mechgen.errors import SceneError
+from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget
+from mechgen.runtime.periodic import floquet, fourier
+from mechgen.runtime.periodic.branch import OrbitBranch, node_weights
+from mechgen.runtime.periodic.collocation import Collocation
+from mechgen.runtime.periodic.flow import differenced_flow, states_at, variational_flow
+from mechgen.runtime.periodic.harmonic_balance import HarmonicBalance
+from mechgen.runtime.periodic.shooting import Shooting
+from mechgen.runtime.steady.continuation import continuation
+from mechgen.runtime.steady.cycle_points import cycle_points
+
+#: keys of a continuation that an orbit branch does not take
+ORBIT_REFUSES = ("method", "stages", "bounds", "at", "minimize", "switch_branches", "special_point", "eigenvalues",
+                 "aliases")  # switch_branches: taken by a forced orbit found by shooting (and a hybrid model's)
+#: phases at which a branch point's amplitudes are taken
+PHASES = 4096
+
+
+class Orbits:
+    """The orbits of one earlier ``periodic_orbit`` moved along ``name``: problems, states and multipliers."""
+
+    def __init__(self, system, name: str, orbit: dict) -> None:
+        self.system, self.name = system, name
+        self.method, self.phase, self.options = orbit["method"], orbit["phase"], orbit["options"]
+        self.frequency = self.options.get("frequency")
+        self.autonomous = self.frequency is None
+        self.memo: dict = {}
+        #: the earlier collocation's mesh (its edges, adapted or uniform), kept along the branch
+        self.mesh = orbit["found"].get("problem") if self.method == "collocation" else None
+
+    def omega(self, p: float) -> float | None:
+        """The forcing's angular frequency at p (module doc)."""
+        if self.frequency is None:
+            return None
+        if isinstance(self.frequency, ParamExpression):
+            return self.frequency.moved(self.name, p, self.system.param_values())
+        return float(self.frequency)
+
+    def make(self, p: float):
+        """The method's problem at p (the earlier orbit's mesh, harmonics or segments)."""
+        moved = self.system.with_params(**{self.name: float(p)})
+        if self.method == "harmonic_balance":
+            H = int(self.options.get("harmonics", DEFAULT_HARMONICS))
+            return HarmonicBalance(moved, fourier.basis(H), self.omega(p), self.phase)
+        if self.method == "collocation":
+            return Collocation(moved, self.mesh.mesh, self.omega(p), self.phase, self.mesh.edges)
+        return Shooting(moved, self.omega(p), self.phase, *integrator_tolerances(self.options),
+                        compiled_run(moved, self.options), int(self.options.get("segments", 1)))
+
+    def start(self, problem, found: dict) -> np.ndarray:
+        """The unknowns u of the earlier orbit."""
+        if self.method == "harmonic_balance":
+            return problem.unknowns(found["U"], found["omega"])
+        if self.method == "collocation":
+            return np.asarray(found["u"], float)
+        T = 2 * np.pi / found["omega"]
+        S = getattr(problem, "segments", 1)
+        X = self.flow_states(problem, found["x0"], T * np.arange(S) / S) if S > 1 else found["x0"]
+        return problem.unknowns(X, T)
+
+    def flow_states(self, problem, x0: np.ndarray, times: np.ndarray) -> np.ndarray:
+        """The states from x0 at ``times`` (ascending, from 0) by the problem's flow."""
+        if problem.compiled is not None:
+            return problem.compiled(np.asarray(x0, float), np.asarray(times, float))
+        return states_at(problem.system, x0, 0.0, times, problem.rtol, problem.atol)
+
+    def states(self, problem, u: np.ndarray, times: np.ndarray) -> np.ndarray:
+        """The orbit's states at ``times`` in [0, T] (rows (q, v))."""
+        if self.method == "harmonic_balance":
+            U, w = problem.split(u)
+            return np.hstack([fourier.evaluate(U, w * times), w * fourier.evaluate(U, w * times, 1)])
+        if self.method == "collocation":
+            return problem.states_at(u, times)
+        x0, _ = problem.split(u)
+        if problem.compiled is not None:
+            return problem.compiled(x0, times)
+        return states_at(problem.system, x0, 0.0, times, problem.rtol, problem.atol)
+
+    def period(self, problem, u: np.ndarray) -> float:
+        """T of the orbit u (harmonic balance's unknowns hold the frequency, the others' the period)."""
+        if self.method == "harmonic_balance":
+            return float(2 * np.pi / problem.split(u)[1])
+        return float(problem.split(u)[1])
+
+    def multipliers(self, problem, u: np.ndarray, p: float) -> np.ndarray:
+        """The Floquet multipliers of the orbit u at p: the eigenvalues of its monodromy, by central differences of
+        the compiled flow where it runs (4n + 1 runs, about 1e-10 from the exact one:
+        mechgen.runtime.periodic.flow.differenced_flow), else from the variational equations; kept per orbit (a
+        branch point's are asked twice)."""
+        key = (float(p), np.asarray(u, float).tobytes())
+        if key not in self.memo:
+            if len(self.memo) > 1024:
+                self.memo.clear()
+            self.memo[key] = self.monodromy_eigenvalues(problem, u)
+        return self.memo[key]
+
+    def monodromy_eigenvalues(self, problem, u: np.ndarray) -> np.ndarray:
+        T = self.period(problem, u)
+        x0 = problem.split(u)[0] if self.method == "shooting" else self.states(problem, u, np.array([0.0]))[0]
+        run = compiled_run(problem.system, self.options)
+        if run is not None:
+            _, Phi = differenced_flow(run, x0, T)
+        else:
+            _, Phi = variational_flow(problem.system, x0, 0.0, T, *integrator_tolerances(self.options))
+        return floquet.multipliers(Phi)
+
+
+def record(orbits: Orbits, branch: OrbitBranch, u: np.ndarray, p: float) -> dict:
+    """One branch point's outputs (module doc)."""
+    problem = branch.problem(p)
+    T = orbits.period(problem, u)
+    X = orbits.states(problem, u, T * np.arange(PHASES) / PHASES)
+    mu = orbits.multipliers(problem, u, p)
+    names = list(orbits.system.coordinates)
+    start = dict(zip(names + [f"{c}_dot" for c in names], (float(v) for v in X[0])))
+    return {orbits.name: float(p), "period": T, "frequency": float(2 * np.pi / T),
+            "amplitude": {c: peak(X[:, i]) for i, c in enumerate(names)}, "start": start,
+            "multipliers": floquet.as_pairs(mu), "stability": floquet.stability(mu, orbits.autonomous)}
+
+
+def run_orbit_branch(system, options: dict, earlier: dict) -> dict:
+    """The branch of orbits through an earlier periodic_orbit (module doc; a hybrid model's:
+    mechgen.analyses.hybrid_orbit.run_hybrid_branch, which also takes ``switch_branches``)."""
+    hybrid = bool(earlier["_orbit"].get("hybrid"))
+    switchable = hybrid or (earlier["_orbit"]["method"] == "shooting"
+                            and earlier["_orbit"]["options"].get("frequency") is not None)
+    for key in ORBIT_REFUSES:
+        if options.get(key) and not (switchable and key == "switch_branches"):
+            raise SceneError(f"{key} does not apply to a branch of periodic orbits", key=key,
+                             expected=f"no {key} (a continuation about a steady state takes it)")
+    if hybrid:
+        return run_hybrid_branch(system, options, earlier["_orbit"])
+    name = options["parameter"]
+    orbits = Orbits(system, name, earlier["_orbit"])
+    here = float(own_value(system, name))
+    branch = OrbitBranch(orbits.make, name)
+    problem = branch.problem(here)
+    u0 = orbits.start(problem, earlier["_orbit"]["found"])
+    repeats = problem.nodes if orbits.method == "collocation" else getattr(problem, "segments", 1)
+    eqs = branch.equations(node_weights(u0.size, repeats, int(orbits.autonomous)) if repeats > 1 else None)
+    budget = Budget("continuation", unit="points", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
+    found = continuation(eqs, u0, here, arclength_steps(options, here, budget, smallest_span=0.1))
+    points = [record(orbits, branch, u, p) for u, p in zip(found.u, found.lam)]
+    X = np.hstack([found.u, found.lam[:, None]])
+
+    def multipliers(x):
+        return orbits.multipliers(branch.problem(x[-1]), x[:-1], x[-1])
+
+    specials = [("LPC", np.append(f.u, f.lam), f.index, {}) for f in found.folds]
+    if options.get("special_points", True):
+        specials += [(s.type, s.x, s.index, s.data) for s in cycle_points(eqs, X, multipliers,
+                                                                           trivial=orbits.autonomous)]
+    records, located = [], []
+    for kind, x, index, data in sorted(specials, key=lambda s: s[2]):
+        rec = {"type": kind, **record(orbits, branch, x[:-1], x[-1])}
+        if kind == "NS":
+            rec["angle"] = data["angle"]
+        records.append(rec)
+        located.append(np.asarray(x, float))
+    doubled = {}
+    if options.get("switch_branches"):
+        doubled["doubled"] = [doubled_record(orbits, branch, X, x, index, k + 1)
+                              for k, (kind, x, index, _) in enumerate(sorted(specials, key=lambda s: s[2]))
+                              if kind == "PD"]
+    return {"parameter": name, "method": orbits.method, "branch": points, "points": len(points),
+            "status": found.status, "folds": [r for r in records if r["type"] == "LPC"],
+            "special_points": records, "shape_outputs": [], **doubled,
+            # a curve of one of these points in two parameters starts here (mechgen.analyses.orbit_curves)
+            "_orbit": earlier["_orbit"], "_special_x": located}
+
+
+def doubled_record(orbits: Orbits, branch: OrbitBranch, X: np.ndarray, x_pd: np.ndarray, index: int,
+                   at: int) -> dict:
+    """The doubled orbit (period 2T) past the PD point x_pd of a forced orbit found by shooting: at the parameter
+    half-way to the neighbouring branch point whose orbit has a multiplier below -1, by shooting over 2T from the
+    period-T orbit there displaced along the eigenvector of the multiplier nearest -1 (both ways, 1e-3 to 1e-1 of
+    the state's size), the first start that converges to an orbit other than the period-T one."""
+    from mechgen.analyses.periodic_orbit import settings
+    from mechgen.errors import ConvergenceError
+    from mechgen.runtime.periodic.newton import newton
+
+    def most_negative(x):
+        return float(np.min(orbits.multipliers(branch.problem(x[-1]), x[:-1], x[-1]).real))
+
+    side = min((X[index], X[index + 1]), key=most_negative)
+    p = float(x_pd[-1]) + 0.5 * (float(side[-1]) - float(x_pd[-1]))
+    single = newton(branch.problem(p).residual_jacobian, np.asarray(x_pd[:-1], float),
+                    settings(orbits.options, "shooting")).u
+    values, vectors = np.linalg.eig(branch.residual_jacobian(single, p)[1] + np.eye(single.size))
+    v = np.real(vectors[:, int(np.argmin(np.abs(values + 1.0)))])
+    v = v / np.linalg.norm(v)
+    moved = orbits.system.with_params(**{orbits.name: p})
+    double = Shooting(moved, orbits.omega(p) / 2, orbits.phase, *integrator_tolerances(orbits.options),
+                      compiled_run(moved, orbits.options))
+    scale = 1.0 + float(np.max(np.abs(single)))
+    for size in (1e-3, 1e-2, 1e-1):
+        for sign in (1.0, -1.0):
+            try:
+                u = newton(double.residual_jacobian, single + sign * size * scale * v,
+                           settings(orbits.options, "shooting")).u
+            except ConvergenceError:
+                continue
+            if np.max(np.abs(u - single)) > 1e-6 * scale:
+                mu = floquet.multipliers(double.residual_jacobian(u)[1] + np.eye(u.size))
+                names = list(orbits.system.coordinates)
+                T2 = 2 * 2 * np.pi / orbits.omega(p)
+                X = orbits.flow_states(double, u, T2 * np.arange(PHASES) / PHASES)
+                return {"at": at, orbits.name: p, "period": T2,
+                        "amplitude": {c: peak(X[:, i]) for i, c in enumerate(names)},
+                        "start": dict(zip(names + [f"{c}_dot" for c in names], (float(c) for c in u))),
+                        "multipliers": floquet.as_pairs(mu), "stability": floquet.stability(mu, False)}
+    raise ConvergenceError(f"no doubled orbit found at {orbits.name} = {p:.10g} past the PD point (shooting over 2T "
+                           "returned the period-T orbit or did not converge); try a smaller max_step near it")
