@@ -8,11 +8,12 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import stat
 import sys
 import tempfile
 from pathlib import Path
 
-from mechgen.errors import InputError, MechgenError
+from mechgen.errors import InputError, MechgenError, file_kind
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -27,6 +28,9 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--backend", choices=None)
     run.add_argument("--json", dest="json_path")
     run.add_argument("--plot", dest="plot_dir")
+    run.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
+                     help="run the analyses with executor = \"dask\" on this running Dask scheduler (it is trusted "
+                          "to run code in this process; a scene file cannot name one)")
     regen = sub.add_parser("regen", help="rewrite mechgen/generated for the built-in models")
     regen.add_argument("--check", action="store_true", help="fail if mechgen/generated is stale")
     bench = sub.add_parser("bench", help="run the benchmarks")
@@ -59,15 +63,21 @@ def _existing_parent(path: Path) -> Path:
 def check_output(flag: str, path: str, *, folder: bool) -> None:
     """Refuse an output path that cannot be written, before anything is computed: ``--json FILE``
     must not be a folder, ``--plot DIR`` not a file, and the nearest existing ancestor of either
-    must be a writable folder (a file there, ``afile/x.json``, cannot be a folder)."""
+    must be a writable folder (a file there, ``afile/x.json``, cannot be a folder). An existing
+    ``--json`` target must be a regular file (or a link, which is replaced, never followed): a
+    device, FIFO or socket is refused, never replaced; a name longer than the file system allows is
+    refused at the flag."""
     target = Path(path)
     what = "a folder to write the plots into" if folder else "a path for the JSON file"
     if not path:
         raise InputError("the path is empty", key=flag, expected=what)
+    check_name_lengths(flag, path, what)
     if folder and target.exists() and not target.is_dir():
         raise InputError(f"{path} exists and is not a folder", key=flag, expected=what)
     if not folder and target.is_dir():
         raise InputError(f"{path} is a folder", key=flag, expected=what + " (a file name, such as results.json)")
+    if not folder:
+        check_replaceable(flag, target, what)
     if folder and target.is_dir():
         base = target
     else:
@@ -78,9 +88,41 @@ def check_output(flag: str, path: str, *, folder: bool) -> None:
         raise InputError(f"the folder {base} is not writable", key=flag, expected=what)
 
 
+def check_name_lengths(flag: str, path: str, what: str) -> None:
+    """Refuse a path with a name longer than NAME_MAX (255 bytes on Linux) or longer than PATH_MAX as a whole,
+    at the flag (an OSError "File name too long" otherwise, after the computation)."""
+    base = _existing_parent(Path(path))
+    try:
+        name_max, path_max = os.pathconf(base, "PC_NAME_MAX"), os.pathconf(base, "PC_PATH_MAX")
+    except (OSError, ValueError):
+        name_max, path_max = 255, 4096
+    if len(os.fsencode(os.path.abspath(path))) >= path_max:
+        raise InputError(f"the path is {len(path)} characters long, more than the file system allows", key=flag,
+                         expected=f"{what}, shorter than {path_max} bytes")
+    for part in Path(path).parts:
+        if len(os.fsencode(part)) > name_max:
+            raise InputError(f"the name {part[:40]}... is {len(part)} characters long", key=flag,
+                             expected=f"{what}, each name at most {name_max} bytes")
+
+
+def check_replaceable(flag: str, target: Path, what: str) -> None:
+    """Refuse an existing ``target`` that is not a regular file or a link (a device, FIFO, socket, folder):
+    writing by rename would replace the node itself (as root, /dev/null), writing into it is not a file."""
+    try:
+        mode = os.lstat(target).st_mode
+    except (FileNotFoundError, NotADirectoryError):  # a new name (a parent that is a file: refused below)
+        return
+    except OSError as exc:
+        raise InputError(f"cannot inspect {target} ({exc.strerror})", key=flag, expected=what) from None
+    if not (stat.S_ISREG(mode) or stat.S_ISLNK(mode)):
+        raise InputError(f"{target} exists and is {file_kind(mode)}, not a regular file", key=flag,
+                         expected=f"{what}: a new name or a regular file to replace")
+
+
 def _write_json(path: str, results: dict) -> None:
     """Write the results JSON through a temporary file in the same folder (never half a file, never
-    a temporary file left behind)."""
+    a temporary file left behind; an existing link is replaced, never followed; a target that became a device
+    or FIFO since the check is refused)."""
     target = Path(path)
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
@@ -91,6 +133,7 @@ def _write_json(path: str, results: dict) -> None:
     try:
         with os.fdopen(fd, "w") as fh:
             json.dump(results, fh, indent=2, default=float)
+        check_replaceable("--json", target, "a path for the JSON file")
         os.replace(tmp, target)
     except OSError as exc:
         raise InputError(f"cannot write {path} ({exc.strerror})", key="--json",
@@ -102,15 +145,17 @@ def _write_json(path: str, results: dict) -> None:
 
 def _cmd_run(args) -> int:
     from mechgen.scene.report import summary
-    from mechgen.scene.run import check_backend, run_scene
+    from mechgen.scene.run import check_backend, check_scheduler, run_scene
 
     check_backend(args.backend)
+    if args.scheduler is not None:
+        check_scheduler("--scheduler", args.scheduler)
     if args.json_path is not None:
         check_output("--json", args.json_path, folder=False)
     if args.plot_dir is not None:
         check_output("--plot", args.plot_dir, folder=True)
     try:
-        results = run_scene(args.scene, overrides=args.overrides, backend=args.backend)
+        results = run_scene(args.scene, overrides=args.overrides, backend=args.backend, scheduler=args.scheduler)
     except MechgenError as exc:  # the analyses before the failed one are printed and written, then the error
         partial = getattr(exc, "partial_results", None)
         if partial is not None:

@@ -18,6 +18,16 @@ def did_you_mean(name: object, names) -> str:
     return f" (did you mean {close[0]!r}?)" if close else ""
 
 
+def file_kind(mode: int) -> str:
+    """What an ``os.stat`` mode says a path is, for messages: "a folder", "a character device", "a FIFO"..."""
+    import stat
+
+    kinds = ((stat.S_ISREG, "a regular file"), (stat.S_ISDIR, "a folder"), (stat.S_ISLNK, "a symbolic link"),
+             (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+             (stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISSOCK, "a socket"))
+    return next((name for test, name in kinds if test(mode)), "not a regular file")
+
+
 class MechgenError(Exception):
     """Base class of every error mechgen raises on purpose."""
 

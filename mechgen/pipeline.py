@@ -7,6 +7,7 @@ the time of each stage and whether the artefact came from the cache.
 """
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
 import time
@@ -17,6 +18,7 @@ from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
+from mechgen import buildlock
 from mechgen.errors import CompilerUnavailable, InputError, MechgenError
 from mechgen.runtime.core.kernels import c_kernels, casadi_kernels, load_module, numpy_kernels
 from mechgen.runtime.core.system import System
@@ -603,13 +605,16 @@ def compile_request(request: CompileRequest, derive_with: Callable[[], tuple], *
     if request.backend not in BACKENDS:
         raise InputError(f"unknown backend {request.backend!r}", key="backend", expected=", ".join(BACKENDS))
     report = BuildReport(request.backend)
-    loaded = None
-    while loaded is None:
-        generated = generated_text(request.with_backend(report.backend), derive_with, report)
-        text, specs = generated["text"], generated["specs"]
-        clock = time.perf_counter()
-        loaded = _load(report.backend, text, specs, content_key(report.backend, text), report)
-        report.seconds["build"] = time.perf_counter() - clock
+    key = request.key()
+    # one derivation and build per request across processes (mechgen.buildlock): concurrent first runs wait
+    with buildlock.held(f"request-{request.backend}-{key}") if key else contextlib.nullcontext():
+        loaded = None
+        while loaded is None:
+            generated = generated_text(request.with_backend(report.backend), derive_with, report)
+            text, specs = generated["text"], generated["specs"]
+            clock = time.perf_counter()
+            loaded = _load(report.backend, text, specs, content_key(report.backend, text), report)
+            report.seconds["build"] = time.perf_counter() - clock
     report.kernels = {name: {"ops": s["ops"]} for name, s in specs.items()}
     meta = dict(next(iter(specs.values()))["meta"]) if specs else {}
     meta["source"] = request.source or request.model  # the canonical reference (mechgen.models.resolve)

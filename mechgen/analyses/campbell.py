@@ -7,8 +7,9 @@ that is refused), ``multiples`` (of the speed, default [1]),
 ``method`` (auto, exact, reduced), ``about`` and ``at`` (the operating point), ``max_seconds`` (the wall-time
 budget, default 600 s: the exact path refuses once its first speeds project past it; exit 1), and where the
 per-speed eigen-solves run, as for ``sweep``: ``executor`` (``serial``, ``processes`` or ``dask``; left out:
-processes when ``workers`` > 1, else serial), ``workers``, ``scheduler`` (with dask: a running scheduler's
-address). On a parallel executor every speed is solved exactly (full size; the speeds are independent: their
+processes when ``workers`` > 1, else serial), ``workers``, ``scheduler`` (Python calls only: a running scheduler's
+address; a scene cannot name one, ``mechgen run --scheduler`` does).
+On a parallel executor every speed is solved exactly (full size; the speeds are independent: their
 matrices are assembled here, the solves are distributed, in Dask chunks of at least ~0.5 s of work) and the
 modes are tracked here afterwards, so the result is the serial exact one; ``method = "reduced"`` (whose basis
 grows from speed to speed) is refused there, and ``auto`` means exact. Outputs: ``speeds``, ``frequencies`` and
@@ -23,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from mechgen.analyses import schema, summary
+from mechgen.analyses.context import scheduler_of
 from mechgen.analyses.operating_point import operating_point
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import ABSENT, REQUIRED, Option
@@ -72,8 +74,8 @@ SCHEMA = {"over": Option(_speeds, REQUIRED, "a table: parameter = [values] or {s
           **schema.executor_options()}
 
 
-def _executor(options: dict) -> SweepExecutor:
-    return SweepExecutor.of(options.get("executor"), options.get("workers", 0), options.get("scheduler"))
+def _executor(options: dict, context: dict | None = None) -> SweepExecutor:
+    return SweepExecutor.of(options.get("executor"), options.get("workers", 0), scheduler_of(options, context or {}))
 
 
 def check(ctx, base: str, options: dict) -> None:
@@ -154,7 +156,7 @@ def run_campbell(system, options: dict, context: dict) -> dict:
     matrices_at = assembled_at if poly is None else poly.combined({"M": ("M",), "C": ("D", "G"), "K": ("K",)})
     budget = Budget(f"campbell over {name}", unit="speeds",
                     seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
-    executor = _executor(options)
+    executor = _executor(options, context)
     res = campbell(matrices_at, speeds, count, CampbellOptions(sparse=sparse, method=options.get("method", "auto"),
                                                                 budget=budget, executor=executor),
                    x_index=stations[0], y_index=stations[1])

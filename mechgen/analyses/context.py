@@ -15,6 +15,15 @@ from typing import Any, Callable
 POINTS = "__points__"
 #: context key of the running analysis's name (progress bars)
 NAME = "__name__"
+#: context key of the Dask scheduler address the user gave (mechgen run --scheduler, mechgen.run(scheduler=)):
+#: the analyses with executor = "dask" connect to it; a scene itself cannot name one
+SCHEDULER = "__scheduler__"
+
+
+def scheduler_of(options: dict, context: dict) -> str | None:
+    """The Dask scheduler an analysis's points go to: its own ``scheduler`` (a Python call's argument), else the
+    one the user gave for the whole run, else None (Dask's scheduler-address setting, else a LocalCluster)."""
+    return options.get("scheduler", context.get(SCHEDULER))
 
 
 @dataclass(frozen=True)

@@ -2,22 +2,32 @@
 
 ``data`` is either a table of equal-length arrays (``{ d = [7.1, 12.7], R = [913, 787] }``) or a
 string: a CSV file path, relative to the scene file's folder (to the working directory for a
-scene given as a dict, or in Python). The file is UTF-8 text: a header row of column names
+scene given as a dict, or in Python). The file is read streamed, with bounded memory, and must be a regular file
+(a folder, FIFO, device or socket is refused as what it is, a FIFO never opened for blocking reads); messages
+name its line and column and show at most a 10-character escaped excerpt of the one offending cell, never a
+header line or a row (issue 33). The file is UTF-8 text: a header row of column names
 (identifiers, each once), then one row of numbers per line, comma-separated; blank lines and
 lines starting with ``#`` are skipped. Every cell is a finite number, every row has a cell per
-column. The file is at most :data:`MAX_DATA_BYTES` bytes and holds at most the safety limit
-``rows`` (mechgen.scene.bounds.LIMITS, default 10^6; ``[limits] rows = ...`` raises it) of rows, an
-inline table too. A bad file, cell or column is a SceneError naming the key (``analysis[1].data``),
+column. The file is at most :data:`MAX_DATA_BYTES` bytes, lines of at most :data:`MAX_LINE_BYTES`, and holds at
+most the safety limit ``rows`` (mechgen.scene.bounds.LIMITS, default 10^6; ``[limits] rows = ...`` raises it)
+of rows, an inline table too (checked while reading: a file of 250 MB is refused after its first 10^6 rows),
+and at most 2 rows + 10 000 lines in all.
+A bad file, cell or column is a SceneError naming the key (``analysis[1].data``),
 the file, its line and column and what was expected.
 """
 from __future__ import annotations
 
 import csv
+import math
+import os
+import stat
+from array import array
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from mechgen.errors import file_kind
 from mechgen.scene.bounds import LIMITS, number_text
 from mechgen.scene.expr import is_identifier
 from mechgen.scene.values import IDENTIFIER_RULE, fail, is_number, join, listing, show, type_name
@@ -26,6 +36,8 @@ from mechgen.scene.values import IDENTIFIER_RULE, fail, is_number, join, listing
 MAX_DATA_BYTES = 256 * 1024 * 1024
 #: the most columns a data set may have
 MAX_COLUMNS = 1000
+#: the longest line of a data file, bytes (1000 cells of 17 significant digits fit 25 times over)
+MAX_LINE_BYTES = 1024 * 1024
 TABLE = "a table of equal-length arrays of numbers (column = [values]) or a CSV file path"
 
 
@@ -104,22 +116,75 @@ def _path(ctx, text: str) -> Path:
     return base / path
 
 
-def _text(ctx, key: str, written: str, path: Path) -> str:
-    """The file's text, or a SceneError saying why not."""
-    expected = "a readable UTF-8 CSV file (path relative to the scene file's folder)"
+#: the longest excerpt of a cell a message shows (a data file's contents are never echoed beyond it)
+EXCERPT = 10
+EXPECTED_FILE = "a readable UTF-8 CSV file (path relative to the scene file's folder)"
+
+
+def excerpt(cell: str) -> str:
+    """A short, escaped excerpt of one cell for a message: its first :data:`EXCERPT` characters, repr-escaped,
+    ``…`` when cut (a file's header line or rows are never echoed whole)."""
+    text = cell.strip()
+    return repr(text[:EXCERPT]) + ("…" if len(text) > EXCERPT else "")
+
+
+def _opened(ctx, key: str, written: str, path: Path):
+    """The data file opened for reading in binary, or a SceneError: not found, or a folder, FIFO, device or
+    socket named as such (opened non-blocking and checked with fstat, so a FIFO never blocks), or too large."""
     try:
-        if not path.is_file():
-            raise fail(ctx.file, key, f"data file {show(written)} not found (looked for {path})", expected)
-        size = path.stat().st_size
-        if size > MAX_DATA_BYTES:
-            raise fail(ctx.file, key, f"data file {show(written)} is {size} bytes", f"at most {MAX_DATA_BYTES} bytes")
-        raw = path.read_bytes()
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
+    except FileNotFoundError:
+        raise fail(ctx.file, key, f"data file {show(written)} not found (looked for {path})", EXPECTED_FILE) from None
+    except IsADirectoryError:
+        raise fail(ctx.file, key, f"data file {show(written)} is a folder ({path})", EXPECTED_FILE) from None
     except OSError as exc:
-        raise fail(ctx.file, key, f"cannot read data file {show(written)} ({exc.strerror})", expected) from None
+        raise fail(ctx.file, key, f"cannot read data file {show(written)} ({exc.strerror})", EXPECTED_FILE) from None
+    mode, size = (st := os.fstat(fd)).st_mode, st.st_size
+    if not stat.S_ISREG(mode) or size > MAX_DATA_BYTES:
+        os.close(fd)
+        what = f"is {file_kind(mode)}" if not stat.S_ISREG(mode) else f"is {size} bytes"
+        raise fail(ctx.file, key, f"data file {show(written)} {what} ({path})",
+                   EXPECTED_FILE if not stat.S_ISREG(mode) else f"at most {MAX_DATA_BYTES} bytes")
+    os.set_blocking(fd, True)
+    return os.fdopen(fd, "rb")
+
+
+def _lines(ctx, key: str, written: str, fh):
+    """(line number, text) of the file's rows: blank and ``#`` lines skipped, decoded as UTF-8, streamed (bounded
+    memory); at most :data:`MAX_DATA_BYTES` bytes and :func:`line_limit` lines in all are read."""
+    read, top = 0, line_limit(ctx)
+    for number, raw in enumerate(iter(lambda: fh.readline(MAX_LINE_BYTES + 1), b""), 1):
+        read += len(raw)
+        if len(raw) > MAX_LINE_BYTES:
+            raise fail(ctx.file, key, f"line {number} of {written} is longer than {MAX_LINE_BYTES} bytes",
+                       f"rows of at most {MAX_COLUMNS} numbers, one row per line")
+        if read > MAX_DATA_BYTES or number > top:
+            what = f"more than {MAX_DATA_BYTES} bytes" if read > MAX_DATA_BYTES else f"more than {top} lines"
+            raise fail(ctx.file, key, f"data file {show(written)} has {what}",
+                       f"at most {MAX_DATA_BYTES} bytes and {top} lines (blank and comment lines included; "
+                       "raise [limits] rows = ...)")
+        try:
+            line = raw.decode("utf-8-sig" if number == 1 else "utf-8")
+        except UnicodeDecodeError as exc:
+            raise fail(ctx.file, key, f"line {number} of {written} is not UTF-8 text (byte {exc.start + 1} of the "
+                       "line)", EXPECTED_FILE) from None
+        if line.strip() and not line.lstrip().startswith("#"):
+            yield number, line.rstrip("\r\n")
+
+
+def line_limit(ctx) -> int:
+    """The most lines a data file may have in all: twice the row limit and 10 000 more (blank lines and comments
+    are skipped, but a file of nothing else must not run for minutes)."""
+    return 2 * row_limit(ctx) + 10_000
+
+
+def _cells(ctx, key: str, written: str, number: int, line: str) -> list[str]:
+    """The comma-separated cells of one line (a quoted cell cannot span lines)."""
     try:
-        return raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise fail(ctx.file, key, f"data file {show(written)} is not UTF-8 text (byte {exc.start})", expected) from None
+        return next(csv.reader((line,), strict=True))
+    except csv.Error as exc:
+        raise fail(ctx.file, key, f"line {number} of {written} is not CSV ({exc}; a quoted cell cannot span lines)",
+                   "comma-separated numbers, one row per line") from None
 
 
 def _header(ctx, key: str, written: str, cells: list[str], line: int) -> list[str]:
@@ -128,56 +193,62 @@ def _header(ctx, key: str, written: str, cells: list[str], line: int) -> list[st
         raise fail(ctx.file, key, f"data file {show(written)} has {len(names)} columns", f"at most {MAX_COLUMNS}")
     for j, name in enumerate(names, 1):
         if not is_identifier(name):
-            raise fail(ctx.file, key, f"line {line} of {written}: column {j} name {show(name)} is not an identifier",
-                       "a header row of column names: " + IDENTIFIER_RULE)
+            raise fail(ctx.file, key, f"line {line} of {written}, column {j}: the header cell {excerpt(name)} is not "
+                       "an identifier", "a header row of column names: " + IDENTIFIER_RULE)
         if name in names[: j - 1]:
-            raise fail(ctx.file, key, f"line {line} of {written}: column '{name}' is named twice",
+            raise fail(ctx.file, key, f"line {line} of {written}, column {j}: the name {excerpt(name)} comes twice",
                        "each column name once")
     return names
 
 
 def _read_csv(ctx, key: str, written: str) -> Data:
-    """The columns of a CSV file: header row, then numbers."""
-    text = _text(ctx, key, written, _path(ctx, written))
-    lines = [(i, line) for i, line in enumerate(text.splitlines(), 1) if line.strip() and not line.lstrip().startswith("#")]
-    if len(lines) < 2:
-        raise fail(ctx.file, key, f"data file {show(written)} has " + ("no header row" if not lines else "no data rows"),
+    """The columns of a CSV file: header row, then numbers; streamed (the row limit checked while reading)."""
+    with _opened(ctx, key, written, _path(ctx, written)) as fh:
+        rows = _lines(ctx, key, written, fh)
+        first = next(rows, None)
+        if first is None:
+            raise fail(ctx.file, key, f"data file {show(written)} has no header row",
+                       "a header row of column names, then rows of numbers")
+        names = _header(ctx, key, written, _cells(ctx, key, written, *first), first[0])
+        values, lines = _numbers(ctx, key, written, rows, names)
+    if not lines:
+        raise fail(ctx.file, key, f"data file {show(written)} has no data rows",
                    "a header row of column names, then rows of numbers")
-    if len(lines) - 1 > row_limit(ctx):
-        raise _too_many(ctx, key, f"data file {show(written)} has")
-    reader = csv.reader(line for _, line in lines)
-    try:
-        rows = list(reader)
-    except csv.Error as exc:
-        raise fail(ctx.file, key, f"line {lines[reader.line_num - 1][0]} of {written} is not CSV ({exc})",
-                   "comma-separated numbers") from None
-    if len(rows) != len(lines):
-        raise fail(ctx.file, key, f"data file {show(written)} has a quoted cell spanning lines",
-                   "one row per line")
-    names = _header(ctx, key, written, rows[0], lines[0][0])
-    values = np.empty((len(rows) - 1, len(names)))
-    for r, cells in enumerate(rows[1:]):
-        line = lines[r + 1][0]
+    table = np.array(values, dtype=float).reshape(len(lines), len(names))
+    return Data({n: table[:, j].copy() for j, n in enumerate(names)}, written, tuple(lines))
+
+
+def _numbers(ctx, key: str, written: str, rows, names: list[str]) -> tuple[array, list[int]]:
+    """The cells of the data rows as one flat array of doubles (row-major) and each row's line number; a row
+    past the scene's row limit is refused as soon as it is read."""
+    values, lines, top = array("d"), [], row_limit(ctx)
+    for number, line in rows:
+        if len(lines) == top:
+            raise _too_many(ctx, key, f"data file {show(written)} has")
+        cells = _cells(ctx, key, written, number, line)
         if len(cells) != len(names):
-            raise fail(ctx.file, key, f"line {line} of {written} has {len(cells)} cells, the header "
-                       f"{len(names)} ({listing(names)})", "a cell per column in every row")
+            raise fail(ctx.file, key, f"line {number} of {written} has {len(cells)} cells, the header {len(names)}",
+                       "a cell per column in every row")
         for j, cell in enumerate(cells):
             try:
-                number = float(cell)
+                value = float(cell)
             except ValueError:
-                number = None
-            if number is None or not np.isfinite(number):
-                raise fail(ctx.file, key, f"line {line} of {written}, column '{names[j]}': {show(cell.strip())} "
+                value = math.nan
+            if not math.isfinite(value):
+                raise fail(ctx.file, key, f"line {number} of {written}, column '{names[j]}': {excerpt(cell)} "
                            "is not a finite number", "numeric cells")
-            values[r, j] = number
-    return Data({n: values[:, j].copy() for j, n in enumerate(names)}, written, tuple(i for i, _ in lines[1:]))
+            values.append(value)
+        lines.append(number)
+    return values, lines
 
 
 def column(ctx, key: str, data: Data, name: str) -> np.ndarray:
     """The values of the column ``name`` (a key's value), or a SceneError listing the columns."""
     if name not in data.columns:
         where = f" of {data.source}" if data.source else ""
-        raise fail(ctx.file, key, f"no data column {show(name)}{where}", "one of the columns: " + listing(list(data.columns)))
+        names = [n if len(n) <= 40 else n[:40] + "…" for n in list(data.columns)[:8]]
+        more = f" and {len(data.columns) - 8} more" if len(data.columns) > 8 else ""
+        raise fail(ctx.file, key, f"no data column {show(name)}{where}", "one of the columns: " + listing(names) + more)
     return data.columns[name]
 
 

@@ -82,8 +82,23 @@ def register(kind: AnalysisKind) -> AnalysisKind:
     """Add a kind (called once, at the end of the kind's module)."""
     if kind.name in _KINDS and _KINDS[kind.name] is not kind:
         raise ValueError(f"analysis kind {kind.name!r} is registered twice")
+    kind = with_wall_time(kind)
     _KINDS[kind.name] = kind
     return kind
+
+
+def with_wall_time(kind: AnalysisKind) -> AnalysisKind:
+    """The kind with a ``max_seconds`` key if its schema has none: every kind's run is bounded in wall time
+    (mechgen.runtime.core.budget.wall_clock, issue 33), so every kind lets a scene raise the bound."""
+    if "max_seconds" in kind.schema:
+        return kind
+    from dataclasses import replace
+
+    from mechgen.analyses.schema import ABSENT, Option, positive
+
+    option = Option(positive, ABSENT, doc="the wall-time budget of the analysis (s, default 600): past it the run "
+                    "stops with exit 1 naming this key")
+    return replace(kind, schema={**kind.schema, "max_seconds": option})
 
 
 def unregister(name: str) -> None:

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from mechgen.analyses.context import public
+from mechgen.errors import ConvergenceError
 from mechgen.analyses.registry import get
 
 
@@ -133,18 +134,40 @@ def missing_key(key: object, present, where: str) -> str:
     return f"{key!r} is not an output of the {where}{hint}; its outputs: {', '.join(names) or '(none)'}"
 
 
+class NumericalFailure(ConvergenceError):
+    """A runner's stray numerical exception (overflow, NaN/Inf refused by a solver, a singular matrix that no
+    diagnosis caught), turned into exit 1 with the analysis named (issue 33: never a traceback); a scene run
+    names the parameters at the edge of the floating-point range when it has any
+    (mechgen.scene.run.edge_parameters)."""
+
+
+#: the stray numerical exceptions :func:`run_analysis` turns into a NumericalFailure (a ValueError only when it is
+#: about NaN/Inf, as scipy's finite checks raise)
+NUMERICAL = (np.linalg.LinAlgError, FloatingPointError, OverflowError, ZeroDivisionError, ValueError)
+
+
 def run_analysis(name: str, kind: str, system, options: dict, context: dict) -> Result:
     """Run a validated analysis through its kind's runner and time it (a spent work budget is named by the
     analysis: ``simulate 'swing': ...``)."""
-    from mechgen.runtime.core.budget import BudgetExceeded
+    from mechgen.runtime.core.budget import DEFAULT_SECONDS, BudgetExceeded, wall_clock
     from mechgen.runtime.core.threads import blas_threads_for
 
     clock = time.perf_counter()
     try:
-        with blas_threads_for(_unknowns(system)):
+        with blas_threads_for(_unknowns(system)), \
+                wall_clock(float(options.get("max_seconds", DEFAULT_SECONDS)), "wall time"):
             outputs = get(kind).run(system, options, context)
     except BudgetExceeded as exc:
         raise exc.named(f"{kind} '{name}'") from None
+    except (MemoryError, SystemError) as exc:  # an allocation no estimate foresaw (SuperLU's fill-in)
+        raise NumericalFailure(f"{kind} '{name}' ran out of memory ({type(exc).__name__}: {str(exc)[:200]}); a "
+                               "smaller size (N, elements, count) or a memory limit that allows it "
+                               "(MECHGEN_MEMORY_LIMIT)") from None
+    except NUMERICAL as exc:
+        if isinstance(exc, ValueError) and not any(w in str(exc).lower() for w in ("inf", "nan", "finite")):
+            raise
+        raise NumericalFailure(f"{kind} '{name}' failed numerically ({type(exc).__name__}: {exc}); the numbers "
+                               "left the floating-point range or a matrix was singular") from None
     shown = public(outputs)
     working = {k: v for k, v in outputs.items() if k not in shown}
     working.setdefault("units", parameter_units(system))

@@ -38,6 +38,7 @@ from mechgen.analyses.cross_section import STRAINS, checked_stiffness
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import Option
 from mechgen.errors import InputError
+from mechgen.runtime.core.memory import require
 from mechgen.runtime.rods.liegroup import orthonormality_error
 from mechgen.runtime.rods.statics import ENDS, UNCONSTRAINED, Rod, solve_statics, turning_angle
 from mechgen.scene.values import fail, show, type_name
@@ -53,7 +54,12 @@ def vector3(ctx, key: str, value: object) -> list[float]:
     return [schema.number(ctx, f"{key}[{i}]", v) for i, v in enumerate(value, 1)]
 
 
-MAX_ELEMENTS = 100_000   # the collocation's FD Jacobian holds 24 (N + 1) poses: ~300 MB at this size
+MAX_ELEMENTS = 100_000
+#: memory per element of a collocation solve (its sparse Jacobian, LU factors and the load path's states), bytes:
+#: measured 41 KB/element between 2 000 and 8 000 elements (peak RSS 171 MB -> 415 MB), with a margin; checked
+#: against the memory available before the solve starts (mechgen.runtime.core.memory, issue 33: 100 000 elements
+#: took 1.7 GiB within 15 s and ran on)
+ELEMENT_BYTES = 48_000
 MAX_STEPS = 10_000
 
 
@@ -186,6 +192,9 @@ def _point(rod: Rod, state, axis) -> dict:
 def run_rod_statics(system, options: dict, context: dict) -> dict:
     """Solve along the load path; the final state's tip pose and fields, and the branch."""
     rod = rod_of(system, options)
+    require(ELEMENT_BYTES * options["elements"], f"rod statics ({options['method']}) with {options['elements']} "
+            "elements", key="elements", expected="fewer elements (the midpoint collocation converges at order 2: "
+            "a few hundred elements resolve most rods)")
     path = solve_statics(rod, method=options["method"], elements=options["elements"], steps=options["steps"],
                          tol=options["tol"], min_step=options["min_step"], jacobian=options["jacobian"])
     final, axis = path.final, AXES[options["bending_axis"]]

@@ -78,6 +78,9 @@ class OptionContext:
     limits: Mapping[str, int] = field(default_factory=dict)
     #: parameter name -> (file, key) where the scene or a --set flag wrote its value (defaults left out)
     written: Mapping[str, tuple] = field(default_factory=dict)
+    #: the options come from the user's own Python call (mechgen.analyses.public), not from a scene: a scene is
+    #: data and may not choose what mechgen trusts (a Dask scheduler), a Python argument may
+    trusted: bool = False
 
 
 # --------------------------------------------------------------------------- the schema walk
@@ -386,12 +389,26 @@ def workers(ctx: OptionContext, key: str, value: object) -> int:
     return int_at_least(ctx, key, value, 0)
 
 
+#: what a scene that names a scheduler is told to do instead
+SCHEDULER_INSTEAD = ("no scheduler key in the scene: executor = \"dask\" alone runs the points on a LocalCluster "
+                     "mechgen starts on the loopback; a running scheduler is the user's choice, given on the command "
+                     "line (mechgen run SCENE --scheduler tcp://host:port), in Dask's scheduler-address setting "
+                     "(DASK_SCHEDULER_ADDRESS) or as the scheduler= argument in Python")
+
+
 def scheduler(ctx: OptionContext, key: str, value: object) -> str:
-    """A Dask scheduler's address: tcp://host:port (or tls://, inproc://)."""
-    if not isinstance(value, str) or "://" not in value or len(value) > 500 or not value.isprintable():
-        raise fail(ctx.file, key, f"value is {show(value)}",
-                   "a Dask scheduler address such as \"tcp://127.0.0.1:8786\"")
-    return value
+    """A Dask scheduler's address, tcp://host:port or tls://host:port, from a Python call only: a scene is data,
+    and connecting to a scheduler trusts it to run code in this process (its results are unpickled), so a scene
+    file (or a scene dict) that names one is refused (``mechgen run --scheduler`` instead)."""
+    from mechgen.runtime.core.sweep import SCHEDULER_FORM, scheduler_address
+
+    if not ctx.trusted:
+        raise fail(ctx.file, key, "a scene cannot name a Dask scheduler (connecting to one trusts it to run code "
+                   "in this process)", SCHEDULER_INSTEAD)
+    try:
+        return scheduler_address(value)
+    except ValueError as exc:
+        raise fail(ctx.file, key, f"value is {show(value)}: {exc}", SCHEDULER_FORM) from None
 
 
 def executor_options() -> dict[str, Option]:
@@ -405,8 +422,12 @@ def executor_options() -> dict[str, Option]:
                                "processes when workers > 1, else serial)"),
             "workers": Option(workers, 0, doc="how many local processes, or Dask LocalCluster workers, run the "
                               "points (0: two)"),
-            "scheduler": Option(scheduler, ABSENT, doc="with executor = \"dask\": the address of a running Dask "
-                                "scheduler (tcp://host:port) to use instead of a LocalCluster")}
+            "scheduler": Option(scheduler, ABSENT, doc="Python calls only (the scheduler= argument): with executor "
+                                "= \"dask\", the address of a running Dask scheduler (tcp://host:port or "
+                                "tls://host:port) to use instead of a LocalCluster. A scene file cannot name one "
+                                "(refused, exit 2): connecting trusts the scheduler to run code in this process, so "
+                                "it is the user's choice, mechgen run SCENE --scheduler tcp://host:port or Dask's "
+                                "scheduler-address setting (DASK_SCHEDULER_ADDRESS)")}
 
 
 def check_executor(ctx: OptionContext, base: str, options: dict) -> None:

@@ -153,9 +153,10 @@ SCHEMA = {
     "progress": Option(schema.boolean, ABSENT, doc="draw a progress bar with the remaining time on stderr "
                        "(default true, when stderr is a terminal and the run lasts over 2 s)"),
     "mode": Option(_mode, ABSENT, doc="a hybrid model's mode to start in (default its initial mode)"),
-    "max_events": Option(schema.count, ABSENT, doc="a hybrid run's most events before it ends (default 10^4)"),
+    "max_events": Option(schema.count, ABSENT, doc="a hybrid run's most events before it ends (default 10^4; at most "
+                         "max_steps, every event but one at a mode's start ending an accepted step)"),
     "zeno_events": Option(schema.count, ABSENT, doc="more than this many events within zeno_span is a Zeno or "
-                          "chattering approach (default 100)"),
+                          "chattering approach (default 100; at most max_events)"),
     "zeno_span": Option(schema.positive, ABSENT, doc="the time window of the Zeno test (s, or the model's time "
                         "unit; default 1e-9 t_end)"),
     "loop": Option(_loop, ABSENT, doc="the loop that steps the integrator: auto (compiled where it can run), "
@@ -184,6 +185,25 @@ def check(ctx, base: str, options: dict) -> None:
     if ctx.coordinates and options.get("initial_mode", 0) > len(ctx.coordinates):  # (a continuum's: at run time)
         raise fail(ctx.file, f"{base}.initial_mode", f"initial_mode {options['initial_mode']} exceeds the "
                    f"{len(ctx.coordinates)} coordinates", f"an integer from 1 to {len(ctx.coordinates)}")
+    check_event_bounds(ctx, base, options)
+
+
+def check_event_bounds(ctx, base: str, options: dict) -> None:
+    """max_events <= max_steps (every event but one at a mode's start ends an accepted step, so a larger count
+    can never be reached within the step budget) and zeno_events <= max_events (issue 33: a run with both at
+    10^9 ran on, its Zeno ring alone 8 GB); refused up front at the key."""
+    from mechgen.runtime.integration.run_options import EventRules
+
+    method = options.get("method", "auto")
+    steps = int(options.get("max_steps", DEFAULT_STEPS["leapfrog" if method in FIXED_STEP else "adaptive"]))
+    events = int(options.get("max_events", EventRules.max_events))
+    if "max_events" in options and events > steps:
+        raise fail(ctx.file, f"{base}.max_events", f"max_events = {events:,} exceeds the step budget max_steps = "
+                   f"{steps:,} (every event but one at a mode's start ends an accepted step)",
+                   "max_events <= max_steps (raise max_steps with it, the run's time is bounded by max_seconds)")
+    if "zeno_events" in options and int(options["zeno_events"]) > events:
+        raise fail(ctx.file, f"{base}.zeno_events", f"zeno_events = {int(options['zeno_events']):,} exceeds "
+                   f"max_events = {events:,}: the Zeno test could never end the run", "zeno_events <= max_events")
 
 
 def needs(options: dict, *, internal: bool) -> set[str]:

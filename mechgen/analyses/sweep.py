@@ -4,8 +4,9 @@ Scene keys: ``over`` (parameter = [values] or {start, stop, num}; several parame
 cartesian product, the first outermost; at most 10^6 points), ``analysis`` (a table with the inner
 ``kind``: modes, stability, steady or simulate, and its keys), ``executor`` (``serial``, ``processes``
 or ``dask``; left out: processes when ``workers`` > 1, else serial), ``workers`` (local processes, or
-the workers of the Dask LocalCluster started for the run; 0: two), ``scheduler`` (with dask: a running
-scheduler's address, ``tcp://host:port``, instead of a LocalCluster), ``on_error`` (``record``, the
+the workers of the Dask LocalCluster started for the run; 0: two), ``scheduler`` (Python calls only, with
+dask: a running scheduler's address, ``tcp://host:port``, instead of a LocalCluster; a scene cannot name one,
+``mechgen run --scheduler`` does), ``on_error`` (``record``, the
 default: a failed point gets its error in ``status`` and None outputs and the sweep goes on; ``raise``:
 the first failure stops the sweep), ``progress`` (a bar with the remaining time on stderr when it is a terminal and the sweep
 lasts over 2 s) and ``max_seconds`` (the wall-time budget, default 600: the time of the whole grid
@@ -22,7 +23,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from mechgen.analyses import figures, schema, summary
-from mechgen.analyses.context import NAME, POINTS, PointRunner, public
+from mechgen.analyses.context import NAME, POINTS, PointRunner, public, scheduler_of
 from mechgen.analyses.parameters import with_free_params
 from mechgen.analyses.registry import AnalysisKind, get, kinds, register
 from mechgen.analyses.schema import ABSENT, REQUIRED, AnalysisSpec, Option
@@ -124,7 +125,7 @@ def run_sweep(system, options: dict, context: dict) -> dict:
     points = context.get(POINTS) or PointRunner(_at_point, lambda kind, opts, point: (system, kind, opts, point))
     tasks = Tasks(points, inner.kind, dict(inner.options), options["grid"])
     budget = Budget(f"sweep of {inner.kind}", unit="points", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
-    executor = SweepExecutor.of(options.get("executor"), options.get("workers", 0), options.get("scheduler"))
+    executor = SweepExecutor.of(options.get("executor"), options.get("workers", 0), scheduler_of(options, context))
     run = sweep_points(points.evaluate, tasks, executor=executor, progress=options.get("progress", True),
                        desc=context.get(NAME, "sweep"), budget=budget, labels=options["grid"],
                        on_error=options.get("on_error", "record"))

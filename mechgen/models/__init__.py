@@ -17,8 +17,10 @@ declaration) become a :class:`~mechgen.errors.ModelError` naming the file and th
 """
 from __future__ import annotations
 
+import contextlib
 import importlib
 import importlib.util
+import io
 import os
 import re
 import sys
@@ -61,18 +63,19 @@ class ModelSource:
 
     def load(self):
         """Import the declaring module and return its Model (``Model.source`` set to :attr:`key`)."""
-        if self.module is not None:
-            module = _guarded(lambda: importlib.import_module(self.module), self.file, self.key)
-        else:
-            module = _import_file(self.file)
-        model = _model_of(module, self)
+        with _printed() as printed:  # held back until the module is known to hold a Model
+            if self.module is not None:
+                module = _guarded(lambda: importlib.import_module(self.module), self.file, self.key, printed)
+            else:
+                module = _import_file(self.file, printed)
+            model = _model_of(module, self, printed)
         if model.file is None and self.file is not None:
             model.file = str(self.file)
         model.source = self.key
         return model
 
 
-def _model_of(module, source: ModelSource):
+def _model_of(module, source: ModelSource, printed: "_Captured | None" = None):
     """The module's Model: its attribute ``source.attribute``, else its only module-level Model."""
     from mechgen.symbolic.model import Model
 
@@ -89,7 +92,7 @@ def _model_of(module, source: ModelSource):
         message = f"the module defines no Model called {source.attribute!r} (it has {', '.join(sorted(found))})"
     else:
         message = "the module defines no Model"
-    raise ModelError(message, file=where, key=source.attribute,
+    raise ModelError(message + (printed.note() if printed is not None else ""), file=where, key=source.attribute,
                      expected=f"a module-level `{source.attribute} = Model(...)` (mechgen.Model)")
 
 
@@ -103,33 +106,65 @@ def _line_in(tb, file: str | None) -> int | None:
     return line
 
 
-def _guarded(run, file: Path | None, key: str):
-    """``run()`` (an import), its errors turned into ModelErrors naming the model file and the line."""
+def _guarded(run, file: Path | None, key: str, printed: "_Captured | None" = None):
+    """``run()`` (an import), its errors turned into ModelErrors naming the model file and the line.
+
+    Whatever the module raises on import is caught, ``SystemExit`` included (never a silent exit 0 of
+    ``mechgen run``; only ``KeyboardInterrupt`` passes), and what it prints to stdout is held back
+    (:func:`_printed`), so that a module that is not a model leaves no output of its own on stdout."""
     where = str(file) if file is not None else key
+    with contextlib.nullcontext(printed) if printed is not None else _printed() as printed:
+        try:
+            return run()
+        except SyntaxError as exc:
+            at = f"line {exc.lineno}: " if exc.lineno else ""
+            source = Path(exc.filename) if exc.filename else file
+            raise ModelError(f"{at}syntax error: {exc.msg}", file=str(source or where),
+                             expected="a model file that is valid Python") from None
+        except ModelError as exc:
+            line = _line_in(exc.__traceback__, str(file) if file else None)
+            at = f"line {line}: " if line else ""
+            raise ModelError(at + exc.message, file=where, key=exc.key, expected=exc.expected) from None
+        except InputError:
+            raise
+        except (Exception, SystemExit) as exc:  # the user's module raised (or called sys.exit) while imported
+            line = _line_in(exc.__traceback__, str(file) if file else None)
+            at = f"line {line}: " if line else ""
+            what = f"SystemExit({exc.code!r})" if isinstance(exc, SystemExit) else f"{type(exc).__name__}: {exc}"
+            raise ModelError(f"{at}importing the model raised {what}{printed.note()}", file=where,
+                             expected="a model module that imports without errors (and does not exit)") from None
+
+
+class _Captured(io.StringIO):
+    """What a model module printed to stdout while it was imported."""
+
+    def note(self) -> str:
+        """`` (it printed N characters, not shown)``, or '' when it printed nothing."""
+        text = self.getvalue()
+        return f" (it printed {len(text)} characters, not shown)" if text else ""
+
+
+@contextlib.contextmanager
+def _printed():
+    """Hold back what an import prints to stdout (the results and summary own stdout); on success it goes to
+    stderr, so a model's own prints stay visible; on failure the message says how much was held back."""
+    captured = _Captured()
+    failed = False
     try:
-        return run()
-    except SyntaxError as exc:
-        at = f"line {exc.lineno}: " if exc.lineno else ""
-        source = Path(exc.filename) if exc.filename else file
-        raise ModelError(f"{at}syntax error: {exc.msg}", file=str(source or where),
-                         expected="a model file that is valid Python") from None
-    except ModelError as exc:
-        line = _line_in(exc.__traceback__, str(file) if file else None)
-        at = f"line {line}: " if line else ""
-        raise ModelError(at + exc.message, file=where, key=exc.key, expected=exc.expected) from None
-    except InputError:
+        with contextlib.redirect_stdout(captured):
+            yield captured
+    except BaseException:
+        failed = True
         raise
-    except Exception as exc:  # the user's module raised while it was imported
-        line = _line_in(exc.__traceback__, str(file) if file else None)
-        at = f"line {line}: " if line else ""
-        raise ModelError(f"{at}importing the model raised {type(exc).__name__}: {exc}", file=where,
-                         expected="a model module that imports without errors") from None
+    finally:
+        if not failed and captured.getvalue():
+            sys.stderr.write(captured.getvalue())
 
 
 _FILE_MODULES: dict[tuple[str, bytes], object] = {}
 
 
-def _import_file(path: Path):
+def _import_file(path: Path, printed: "_Captured | None" = None):
     """Import a model file as a module of its own (once per path and content)."""
     from mechgen.codegen.cache import content_key
 
@@ -141,7 +176,7 @@ def _import_file(path: Path):
         module = importlib.util.module_from_spec(spec)
         sys.modules[name] = module  # as an import would (dataclasses, pickling and inspect look it up)
         try:
-            _guarded(lambda: spec.loader.exec_module(module), path, str(path))
+            _guarded(lambda: spec.loader.exec_module(module), path, str(path), printed)
         except BaseException:
             sys.modules.pop(name, None)
             raise

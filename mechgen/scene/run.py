@@ -15,9 +15,9 @@ from pathlib import Path
 from typing import Mapping
 
 from mechgen import models
-from mechgen.analyses.context import NAME, POINTS, PointRunner, public
+from mechgen.analyses.context import NAME, POINTS, SCHEDULER, PointRunner, public
 from mechgen.analyses.registry import get
-from mechgen.analyses.result import run_analysis
+from mechgen.analyses.result import NumericalFailure, run_analysis
 from mechgen.errors import InputError, MechgenError, SceneError
 from mechgen.pipeline import compile_request, file_digest
 from mechgen.runtime.fields.mesh import Layout
@@ -69,12 +69,21 @@ def _point_task(scene: tuple, layout, kind: str, options: dict, point: dict) -> 
     return (*scene, kind, options, point, layout)
 
 
-def run_scene(scene, *, overrides=(), backend: str | None = None) -> dict:
-    """Run every analysis of a scene (a file, or a dict of its contents) and return the results dict."""
+def run_scene(scene, *, overrides=(), backend: str | None = None, scheduler: str | None = None) -> dict:
+    """Run every analysis of a scene (a file, or a dict of its contents) and return the results dict.
+
+    ``scheduler``: a running Dask scheduler's address (tcp://host:port) for the analyses with executor = "dask"
+    (the user's choice: ``mechgen run --scheduler``; a scene cannot name one)."""
+    if scheduler is not None:
+        check_scheduler("scheduler", scheduler)
     scn = load_scene(scene if isinstance(scene, Mapping) else str(scene), overrides=list(overrides),
                      lookup_model=lookup_model, model_names=models.known)
+    if scheduler is not None and not any(a.options.get("executor") == "dask" for a in scn.analyses):
+        raise InputError(f"a scheduler is given but no analysis of {scn.path} has executor = \"dask\"",
+                         key="scheduler", expected="executor = \"dask\" in the sweep or campbell analyses that "
+                         "should run on the scheduler, or no scheduler")
     try:
-        return _run_loaded(scn, backend)
+        return _run_loaded(scn, backend, scheduler)
     except InputError as exc:
         if exc.file is not None:
             raise
@@ -96,7 +105,8 @@ def placed(exc: InputError, scn) -> SceneError:
         info = lookup_model(scn.source) if names is not None else None
         if info is not None and info.length in scn.written:
             wanted.append(info.length)
-        shown = [f"{scn.written[n]} = {scn.params[n]!r}" for n in dict.fromkeys(wanted)][:8]
+        wanted = sorted(dict.fromkeys(wanted), key=lambda n: not scn.written[n].startswith("--set"))  # flags first:
+        shown = [f"{scn.written[n]} = {scn.params[n]!r}" for n in wanted][:8]  # the cap never drops the user's --set
         if scn.segments:
             shown.append("[[segments]]")
         if shown:
@@ -104,7 +114,7 @@ def placed(exc: InputError, scn) -> SceneError:
     return SceneError(exc.message.rstrip(".") + note, file=scn.path, key=exc.key, expected=exc.expected)
 
 
-def _run_loaded(scn, backend: str | None) -> dict:
+def _run_loaded(scn, backend: str | None, scheduler: str | None = None) -> dict:
     """Compile and run a loaded scene."""
     plan = plan_scene(scn, backend=backend)
     fixed = tuple(sorted((k, v) for k, v in scn.params.items()))
@@ -118,15 +128,39 @@ def _run_loaded(scn, backend: str | None) -> dict:
     results["build"]["seconds_total"] = time.perf_counter() - started
     scene_inputs = (plan.source.key, plan.main, fixed)
     context: dict = {POINTS: PointRunner(sweep_point, partial(_point_task, scene_inputs, layout))}
+    if scheduler is not None:
+        context[SCHEDULER] = scheduler
     for analysis in scn.analyses:
         context[NAME] = analysis.name
         try:
             result = run_analysis(analysis.name, analysis.kind, system, dict(analysis.options), context)
+        except NumericalFailure as exc:
+            raise with_partial(edge_parameters(exc, scn), results, analysis, scn) from None
         except MechgenError as exc:
             raise with_partial(exc, results, analysis, scn) from None
         context[analysis.name] = result.state
         results["analyses"].append(result.to_json())
     return results
+
+
+#: a parameter beyond this magnitude (or nonzero below its inverse) is at the edge of the floating-point range:
+#: its square, or its product with another such value, leaves it
+EDGE = 1e150
+
+
+def edge_parameters(exc: MechgenError, scn) -> MechgenError:
+    """A numerical failure of a scene whose parameters hold values at the edge of the floating-point range
+    (|x| > EDGE or 0 < |x| < 1/EDGE) is that value's fault: a SceneError (exit 2) at the key that wrote it
+    (``params.k_r``, ``--set k_r``); otherwise the failure itself."""
+    edge = [n for n, v in scn.params.items() if isinstance(v, (int, float)) and not isinstance(v, bool)
+            and (abs(v) > EDGE or 0 < abs(v) < 1 / EDGE)]
+    if not edge:
+        return exc
+    name = edge[0]
+    return SceneError(f"{name} = {scn.params[name]!r} is at the edge of the floating-point range and the "
+                      f"computation overflowed: {exc}", file=scn.path, key=scn.written.get(name, f"params.{name}"),
+                      expected=f"a value of magnitude between {1 / EDGE:.0e} and {EDGE:.0e} (or 0); change the "
+                               "model's units if the physics needs more")
 
 
 def with_partial(exc: MechgenError, results: dict, analysis, scn) -> MechgenError:
@@ -141,6 +175,17 @@ def with_partial(exc: MechgenError, results: dict, analysis, scn) -> MechgenErro
                                 "error": f"{type(exc).__name__}: {message}"})
     exc.partial_results = results
     return exc
+
+
+def check_scheduler(key: str, address: str) -> str:
+    """Validate a Dask scheduler address the user gave (``--scheduler``, ``scheduler=``) before anything connects."""
+    from mechgen.runtime.core.sweep import SCHEDULER_FORM, scheduler_address
+
+    try:
+        return scheduler_address(address)
+    except ValueError as exc:
+        raise InputError(f"{address[:80]!r} is not a scheduler address: {exc}", key=key,
+                         expected=SCHEDULER_FORM) from None
 
 
 def check_backend(name: str | None) -> None:

@@ -22,7 +22,10 @@ quick runs, pipes and tests print nothing.
 """
 from __future__ import annotations
 
+import contextlib
+import signal
 import sys
+import threading
 import time
 from typing import Callable
 
@@ -208,3 +211,40 @@ def _is_terminal(stream) -> bool:
         return bool(stream.isatty())
     except (AttributeError, ValueError):
         return False
+
+
+#: the backstop fires this long after an analysis's own wall-time budget (its loops' checks come first)
+BACKSTOP_GRACE = 1.10
+
+
+@contextlib.contextmanager
+def wall_clock(seconds: float | None, what: str):
+    """The wall-time budget of a whole analysis, for every kind (issue 33): a real-time timer (SIGALRM) that
+    raises BudgetExceeded (key ``max_seconds``) in the main thread once ``seconds`` x BACKSTOP_GRACE have passed,
+    a backstop behind the loops' own budgets for the work that has none (an eigen-solve, a rod's Newton steps).
+    Python code is interrupted between bytecodes; a long call into compiled code ends first. Off outside the
+    main thread, where no timer can be set, and for ``seconds`` None; under a caller's timer that fires first it
+    sets none, and a later one is restored with what is left of it."""
+    if seconds is None or threading.current_thread() is not threading.main_thread() or not hasattr(signal, "setitimer"):
+        yield
+        return
+    limit = seconds * BACKSTOP_GRACE
+    pending = signal.getitimer(signal.ITIMER_REAL)[0]
+    if 0 < pending <= limit:  # a caller's own timer (a test harness, an outer analysis) fires first: leave it
+        yield
+        return
+
+    def expired(signum, frame):
+        raise BudgetExceeded(f"{what}: stopped after {limit:.1f} s of wall time ({SECONDS_KEY} = {seconds:g})",
+                             key=SECONDS_KEY)
+
+    started = time.monotonic()
+    previous_handler = signal.signal(signal.SIGALRM, expired)
+    previous_left, _ = signal.setitimer(signal.ITIMER_REAL, limit)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous_handler)
+        if previous_left > 0:  # an outer timer: what is left of it
+            signal.setitimer(signal.ITIMER_REAL, max(previous_left - (time.monotonic() - started), 1e-3))

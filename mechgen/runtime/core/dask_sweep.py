@@ -1,8 +1,11 @@
 """A sweep's points on a ``dask.distributed`` cluster, in chunks, with lost workers' points run again.
 
-- **Cluster**: a running scheduler (``SweepExecutor.scheduler = "tcp://host:port"``), or a
-  ``LocalCluster`` on the loopback started for this sweep and closed after it (``workers`` worker
-  processes, default 2, one thread each, no dashboard).
+- **Cluster**: a running scheduler the user named (``SweepExecutor.scheduler = "tcp://host:port"``, from
+  ``mechgen run --scheduler`` or a Python argument, never from a scene), else the one in Dask's own
+  ``scheduler-address`` setting (``DASK_SCHEDULER_ADDRESS``), else a ``LocalCluster`` on the loopback started
+  for this sweep and closed after it (``workers`` worker processes, default 2, one thread each, no dashboard).
+  Every address is checked (:func:`mechgen.runtime.core.sweep.scheduler_address`) before anything connects.
+  A scheduler and its workers run code in this process (results are unpickled): only the user names one.
 - **Chunks**: the first two points run here (the first also puts the compiled kernels in the compile
   cache, where the workers find them: a task carries the compile request, never a shared library, and
   warms this process: imports, kernels loaded) and the second one's time t1 sizes the chunks:
@@ -75,6 +78,7 @@ def run_on_dask(func, points, executor, store, done, label, inner: str, record: 
     total = len(points)
     if total == 0:
         return [], 0
+    address = executor.scheduler if executor.scheduler is not None else configured_scheduler()
     # the first point warms this process (imports, kernels loaded from the cache): the second one's time is the
     # time of a point (a first point of 30 ms beside 0.3 ms ones would cut 10^4 points into 600 tasks)
     here = min(total, WARM_POINTS)
@@ -87,12 +91,12 @@ def run_on_dask(func, points, executor, store, done, label, inner: str, record: 
         return [], here
     cluster = None
     try:
-        if executor.scheduler is None:
+        if address is None:
             cluster = LocalCluster(n_workers=executor.workers or 2, threads_per_worker=1, processes=True,
                                    host="127.0.0.1", dashboard_address=None, silence_logs=40)
             client = Client(cluster)
         else:
-            client = _connect(Client, executor.scheduler)
+            client = _connect(Client, address)
         try:
             client.wait_for_workers(1, timeout=CONNECT_SECONDS)
             workers = len(client.scheduler_info()["workers"]) or 1
@@ -105,11 +109,28 @@ def run_on_dask(func, points, executor, store, done, label, inner: str, record: 
             cluster.close()
 
 
+def configured_scheduler() -> str | None:
+    """The scheduler in Dask's own configuration (``scheduler-address``, set by DASK_SCHEDULER_ADDRESS or a
+    Dask config file: the user's environment), checked; None when it names none."""
+    import dask
+
+    from mechgen.runtime.core.sweep import SCHEDULER_FORM, scheduler_address
+
+    value = dask.config.get("scheduler-address", None)
+    if value is None or value == "":
+        return None
+    try:
+        return scheduler_address(value)
+    except ValueError as exc:
+        raise InputError(f"Dask's scheduler-address setting {str(value)[:80]!r} is not a scheduler address: {exc}",
+                         key="DASK_SCHEDULER_ADDRESS", expected=SCHEDULER_FORM + ", or unset") from None
+
+
 def _connect(client_class, address: str):
     try:
         return client_class(address, timeout=CONNECT_SECONDS)
-    except (OSError, TimeoutError) as exc:
-        raise InputError(f"no Dask scheduler answers at {address!r}: {exc}", key="scheduler",
+    except (OSError, TimeoutError, ValueError, TypeError) as exc:  # refused, timed out, no TLS configuration
+        raise InputError(f"no Dask scheduler answers at {address!r}: {type(exc).__name__}: {exc}", key="scheduler",
                          expected="the address of a running scheduler, tcp://host:port, or no scheduler "
                                   "(a LocalCluster is started for the sweep)") from exc
 

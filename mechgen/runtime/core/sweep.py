@@ -20,7 +20,10 @@ same numbers (tests/test_sweep_executors.py).
 """
 from __future__ import annotations
 
+import ipaddress
+import re
 from dataclasses import dataclass, field
+from urllib.parse import urlsplit
 
 from mechgen.errors import InputError, MechgenError
 from mechgen.runtime.core.budget import Budget, BudgetExceeded, Progress
@@ -30,6 +33,46 @@ EXECUTORS = ("serial", "processes", "dask")
 ON_ERROR = ("record", "raise")
 #: a point's status when its function returned
 OK = "ok"
+#: the schemes of a running Dask scheduler's address mechgen connects to (inproc:// lives in one process only)
+SCHEDULER_SCHEMES = ("tcp", "tls")
+#: what a scheduler address looks like, for messages
+SCHEDULER_FORM = "a Dask scheduler address tcp://host:port or tls://host:port (port 1-65535)"
+_HOST_LABEL = re.compile(r"[A-Za-z0-9](?:[A-Za-z0-9-]{0,61}[A-Za-z0-9])?\Z")
+
+
+def scheduler_address(text: object) -> str:
+    """``text`` if it is the address of a running Dask scheduler, scheme://host:port with a scheme of
+    :data:`SCHEDULER_SCHEMES`, a host name or IP address and a port 1-65535, nothing else (no path, user,
+    query); else ValueError saying what is wrong. Checked before anything connects (issue 33)."""
+    if not isinstance(text, str) or not text or len(text) > 300 or not text.isprintable() or " " in text:
+        raise ValueError("it is not a short address without spaces")
+    scheme, sep, _ = text.partition("://")
+    if not sep or scheme not in SCHEDULER_SCHEMES:
+        raise ValueError(f"its scheme {scheme[:20]!r} is not " + " or ".join(SCHEDULER_SCHEMES) if sep
+                         else "it has no scheme://")
+    parts = urlsplit(text)
+    if parts.path or parts.query or parts.fragment or "@" in parts.netloc:
+        raise ValueError("it has more than scheme://host:port (a path, a query or a user)")
+    try:
+        port = parts.port
+    except ValueError:
+        port = 0
+    if port is None or not 1 <= port <= 65535:
+        raise ValueError("it has no port 1-65535")
+    if not _valid_host(parts.hostname or ""):
+        raise ValueError("its host is not a host name or an IP address")
+    return text
+
+
+def _valid_host(host: str) -> bool:
+    """An IP address, or a DNS name of labels (letters, digits, inner hyphens) of at most 253 characters."""
+    try:
+        ipaddress.ip_address(host)
+        return True
+    except ValueError:
+        pass
+    labels = host.rstrip(".").split(".")
+    return 0 < len(host) <= 253 and all(_HOST_LABEL.match(label) for label in labels)
 
 
 class SweepError(MechgenError):
@@ -52,6 +95,12 @@ class SweepExecutor:
     def __post_init__(self) -> None:
         if self.kind not in EXECUTORS:
             raise InputError(f"unknown executor {self.kind!r}", key="executor", expected=" | ".join(EXECUTORS))
+        if self.scheduler is not None:
+            try:
+                scheduler_address(self.scheduler)
+            except ValueError as exc:
+                raise InputError(f"{str(self.scheduler)[:80]!r} is not a scheduler address: {exc}", key="scheduler",
+                                 expected=SCHEDULER_FORM) from None
 
     @classmethod
     def of(cls, kind: str | None, workers: int = 0, scheduler: str | None = None) -> "SweepExecutor":

@@ -61,7 +61,7 @@ class CFlow(ctypes.Structure):
 @lru_cache(maxsize=1)
 def _library():
     """(the loaded flow library, None) or (None, why it is unavailable); built once per process."""
-    from mechgen.codegen.build import load_shared
+    from mechgen.buildlock import load_shared_once as load_shared  # compiled once across processes
 
     try:
         lib = load_shared(SOURCE.read_text(encoding="utf-8"), stem=STEM, symbols=("mgf_rhs", "mgf_layout"))

@@ -50,6 +50,10 @@ closed form):
   when that motion is its direction (an impact starting at contact, t = 0: the event is logged at
   t = 0), and not when it moves away. When g = 0 and g_t = 0 its sign is unknown: the first step's
   first 2^-12 is sampled for the first point where g is nonzero, and it fires only on a later crossing.
+* **Unnoticed crossings.** A one-directional guard whose sign is unknown at the start of a mode (g = g_t = 0)
+  and is first seen past zero the way of its direction (a ball at rest on the floor, or left there by a Zeno
+  sequence whose resets no longer lift it) has been crossed without an event that can be located: the run ends
+  with ConvergenceError (exit 1) naming the guard, the mode and the time, never goes on past the guard.
 * **Zeno / chattering.** More than ``zeno_events`` events within ``zeno_span`` (default 1e-9
   t_end), or more than ``max_events`` in all, end the run with BudgetExceeded (exit 1) naming the
   time, the mode and the key; never a hang (each step's checks are bounded, and so is Brent).
@@ -310,7 +314,7 @@ def integrate_hybrid(system, x0, t_end: float, *, mode: int | None = None, optio
         with Progress(run.t_end, desc=options.desc, unit="t", enabled=options.progress) as bar:
             while True:
                 seg = run.segment(mode)
-                g0, d0 = seg.values(t, x)
+                g0, d0 = _start_values(seg, t, x, method, run.where)
                 sign, at_once = start_signs(g0, d0, seg.directions, time_tolerance(t, run.t_end))
                 if at_once:  # the guards are in priority order: terminal first, then declared order
                     target, x = run.fire(seg, at_once[0], t, x)
@@ -453,6 +457,19 @@ class _Hooks:
     where: Callable
 
 
+def _start_values(seg, t: float, x: np.ndarray, method: str, where) -> tuple:
+    """The guards' (g, g_t) where a mode starts; a singular mass there (a zero mass in that mode) is a
+    ConvergenceError with its diagnosis, as inside a step, never a bare LinAlgError."""
+    from numpy.linalg import LinAlgError
+
+    try:
+        return seg.values(t, x)
+    except (LinAlgError, ZeroDivisionError) as exc:
+        why = diagnosis(seg.system, seg.index, t, np.array(x))
+        raise ConvergenceError(f"{method} failed near {where(t, seg.index)} ({exc})" + (f"; {why}" if why else "")) \
+            from None
+
+
 def _integrate_segment(seg, state: tuple, start, sign, options: RunOptions, stats: dict, hooks: _Hooks):
     """Integrate one mode from ``state`` = (t, x) until a guard fires (-> (guard, t*, x*)) or t_end (-> None).
     ``start``: the guards' (g, g_t) at (t, x); ``sign``: their tracked signs there."""
@@ -483,7 +500,12 @@ def _integrate_segment(seg, state: tuple, start, sign, options: RunOptions, stat
             dense = solver.dense_output()
             stats["dense"] = dense
             g_new, d_new = seg.values(t_new, y_new, dxdt=_end_rate(solver, seg, t_new, y_new))
-            found = _scan(seg, dense, sign, (t_old, g_old, d_old), (t_new, g_new, d_new), t_start)
+            try:
+                found = _scan(seg, dense, sign, (t_old, g_old, d_old), (t_new, g_new, d_new), t_start)
+            except LeftSurface as left:
+                info = seg.guards[left.k]
+                raise unnoticed(info.name, info.direction, seg.system.modes[seg.index], left.ta, left.tb,
+                                where(left.tb, seg.index)) from None
             if found is not None:
                 k, t_root, t_lo, t_hi = found
                 t_star, x_star = _locate(seg, dense, k, (t_root, t_lo, t_hi), (t_old, y_old), options)
@@ -528,8 +550,32 @@ def _scan(seg, dense, sign, a, b, t_start):
         if crossed.any():
             return _first(seg, dense, sign, crossed, ta, tb)
         nonzero = np.sign(gb) != 0
+        left = np.flatnonzero((sign == 0) & nonzero & (directions != 0) & (np.sign(gb) == directions))
+        if left.size:
+            raise LeftSurface(int(left[0]), ta, tb)
         sign[...] = np.where(nonzero, np.sign(gb), sign)
     return None
+
+
+class LeftSurface(Exception):
+    """A one-directional guard of unknown sign (g = g_t = 0 where its mode started) first seen past zero in its
+    own direction: the state crossed it without an event (module doc, "Unnoticed crossings")."""
+
+    def __init__(self, k: int, ta: float, tb: float) -> None:
+        super().__init__(k, ta, tb)
+        self.k, self.ta, self.tb = k, ta, tb
+
+
+def unnoticed(guard: str, direction: int, mode: str, ta: float, tb: float, where: str) -> ConvergenceError:
+    """The error of :class:`LeftSurface`: names the guard, the mode and the time (exit 1)."""
+    way = "falling" if direction < 0 else "rising"
+    return ConvergenceError(
+        f"guard {guard} of mode {mode} ({way}) was crossed without an event between t = {ta:.17g} and "
+        f"{tb:.17g} ({where}): the mode started on the guard's surface with zero rate (g = dg/dt = 0: a contact at "
+        "rest, or the accumulation point of a Zeno sequence of events) and the state left it past zero the way "
+        "of the guard, so no crossing can be located; the run is stopped rather than go on past the guard. "
+        "Start the mode off the surface, model the contact as a mode of its own, or keep zeno_events low enough "
+        f"(default 100) that the Zeno approach is caught first ({ZENO_HINT})")
 
 
 def _first(seg, dense, sign, crossed, ta: float, tb: float):
@@ -587,6 +633,6 @@ def _locate(seg, dense, k: int, bracket: tuple, start: tuple, options: RunOption
     return t_d, x_d
 
 
-__all__ = ["DIP_DEPTH", "EPS", "Event", "EventRules", "HybridTrajectory", "LOOPS", "MAX_DEPTH", "RunOptions",
-           "ZENO_HINT", "ZenoApproach", "diagnosis", "integrate_hybrid", "split_point", "start_signs",
-           "time_tolerance"]
+__all__ = ["DIP_DEPTH", "EPS", "Event", "EventRules", "HybridTrajectory", "LOOPS", "LeftSurface", "MAX_DEPTH",
+           "RunOptions", "ZENO_HINT", "ZenoApproach", "diagnosis", "integrate_hybrid", "split_point", "start_signs",
+           "time_tolerance", "unnoticed"]

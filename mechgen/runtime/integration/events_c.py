@@ -32,7 +32,8 @@ import numpy as np
 
 from mechgen.errors import BuildError, CompilerUnavailable, ConvergenceError, KernelError
 from mechgen.runtime.core.budget import BudgetExceeded, Progress
-from mechgen.runtime.integration.events import ZENO_HINT, Event, HybridTrajectory, ZenoApproach, diagnosis
+from mechgen.runtime.integration.events import (ZENO_HINT, Event, HybridTrajectory, ZenoApproach, diagnosis,
+                                                 unnoticed)
 from mechgen.runtime.integration.run_options import RunOptions
 from mechgen.runtime.core.pattern import extent
 
@@ -53,7 +54,7 @@ KINDS = ("residual", "tangent", "rates", "guards", "reset")
 
 DONE, TERMINATED, PAUSED, FULL_SAMPLES, FULL_EVENTS, SLICED = 0, 1, 2, 3, 4, 5
 (E_KERNEL, E_RHS, E_STATE, E_RESET, E_SINGULAR, E_SMALL, E_EVENTS, E_ZENO, E_BUDGET, E_GUARD, E_MEMORY,
- E_INPUT) = range(-1, -13, -1)
+ E_INPUT, E_LEFT) = range(-1, -14, -1)
 
 c_long, c_double, c_void_p = ctypes.c_long, ctypes.c_double, ctypes.c_void_p
 #: numpy's dtype of a C long (the integer tables and buffers)
@@ -114,7 +115,7 @@ SPECIALISE_MAX_STATES = 16
 def _library(n: int | None = None, m: int | None = None):
     """(the loaded loop library, None) or (None, why it is unavailable); built once per machine (the compile
     cache) and loaded once per process. With sizes (n, m): the loop built for exactly those (MGH_FIXED_N/M)."""
-    from mechgen.codegen.build import load_shared
+    from mechgen.buildlock import load_shared_once as load_shared  # compiled once across processes
 
     source, stem = SOURCE.read_text(encoding="utf-8"), STEM
     if n is not None:
@@ -467,6 +468,9 @@ def _error(rc: int, system, state: CState, err_x: np.ndarray, where, options: Ru
                             f"{rules.zeno_events} within zeno_span = {zeno_span:.3g}): a Zeno or chattering approach "
                             f"(guard {system.guards(seg)[state.err_guard].name} of mode {system.modes[seg]}); "
                             f"{ZENO_HINT}", key="zeno_events", reached=where(t, seg))
+    if rc == E_LEFT:
+        guard = system.guards(seg)[state.err_guard]
+        return unnoticed(guard.name, guard.direction, system.modes[seg], float(state.err_span), t, where(t, seg))
     if rc == E_BUDGET:
         return BudgetExceeded("DOP853 steps: stopped by the step budget", key="max_steps", reached=where(t, seg))
     if rc == E_MEMORY:

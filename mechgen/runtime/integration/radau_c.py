@@ -78,7 +78,7 @@ LAYOUT = (CKernel, CProblem, CState)
 def library():
     """(the loaded Radau loop library, None) or (None, why it is unavailable); built once per machine (the compile
     cache), loaded once per process, its structs checked against their Python mirrors."""
-    from mechgen.codegen.build import load_shared
+    from mechgen.buildlock import load_shared_once as load_shared  # compiled once across processes
 
     try:
         lib = load_shared(SOURCE.read_text(encoding="utf-8"), stem=STEM, ldflags=("-lm",),

@@ -77,7 +77,7 @@ SOURCE = Path(__file__).resolve().parent.parent.parent / "codegen" / "templates"
 @lru_cache(maxsize=1)
 def element_library():
     """The loaded rod-element library, or None (no compiler: the numpy path runs; one log line)."""
-    from mechgen.codegen.build import load_shared
+    from mechgen.buildlock import load_shared_once as load_shared  # compiled once across processes
     from mechgen.errors import BuildError, CompilerUnavailable
 
     try:

@@ -55,7 +55,9 @@ enum {
     MGH_E_BUDGET = -9,     /* more than budget_left steps */
     MGH_E_GUARD = -10,     /* a guard value or rate is NaN/Inf */
     MGH_E_MEMORY = -11,
-    MGH_E_INPUT = -12
+    MGH_E_INPUT = -12,
+    MGH_E_LEFT = -13       /* a one-directional guard of unknown sign first seen past zero its own way: crossed
+                              without an event (err_guard, err_span .. err_t: the interval) */
 };
 
 /* which kernel failed (err_kind) */
@@ -1075,6 +1077,14 @@ static int scan(mgh_ctx *c, long mode, double *sign, double t0, double t1, long 
             *t_hi = t_his[best];
             *t_root = c->roots[best];
             return 1;
+        }
+        for (k = 0; k < ng; ++k) {  /* events.py "Unnoticed crossings" */
+            if (sign[k] == 0 && md->direction[k] != 0 && sgn(c->cb[k]) == (double)md->direction[k]) {
+                c->S->err_guard = k;
+                c->S->err_span = ta;
+                c->S->err_t = tb;
+                return MGH_E_LEFT;
+            }
         }
         for (k = 0; k < ng; ++k)
             if (sgn(c->cb[k]) != 0)

@@ -1,0 +1,601 @@
+"""A scene is data (issue 33): it cannot make mechgen connect anywhere or run code, the outputs write only
+what the user named, as regular files, data files are streamed and never echoed, no event-driven run is silently
+wrong, every run is bounded, and concurrent first runs build once.
+
+Each probe of the issue is a test here: a hostile scene or flag ends with the stated exit code, one message naming
+the file or flag and the key, no traceback, no stray file, and (for schedulers) no connection attempted at all:
+``socket.socket.connect`` is replaced by a recorder, so a test proves that nothing was dialled, not that nothing
+answered. The one test that connects starts its own Dask scheduler on the loopback and closes it.
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import re
+import socket
+import stat
+from pathlib import Path
+
+import pytest
+
+import mechgen
+from mechgen.cli import main
+from mechgen.errors import InputError, SceneError
+
+SWEEP = ('model = "laval_rotor"\n[[analysis]]\nname = "g"\nkind = "sweep"\nover = {{ Omega = [0.0, 1.0, 2.0] }}\n'
+         'analysis = {{ kind = "stability" }}\nprogress = false\n{extra}\n')
+#: addresses a scene named in the probe: a hostile scheduler, a port probe, and the ones that ended in tracebacks
+HOSTILE_SCHEDULERS = ["tcp://127.0.0.1:8786", "tcp://203.0.113.7:8786", "inproc://x", "tls://127.0.0.1:8786",
+                      "tcp://127.0.0.1", "file:///etc/passwd"]
+
+
+@pytest.fixture
+def dialled(monkeypatch) -> list:
+    """Every address a socket of this process tries to connect to (none is let through)."""
+    calls: list = []
+
+    def refuse(self, address):
+        calls.append(address)
+        raise ConnectionRefusedError("test: no connection may be attempted")
+
+    monkeypatch.setattr(socket.socket, "connect", refuse)
+    monkeypatch.setattr(socket.socket, "connect_ex", refuse)
+    return calls
+
+
+def _run(argv, capsys) -> tuple[int, str]:
+    code = main(argv)
+    err = capsys.readouterr().err
+    assert "Traceback" not in err, err
+    return code, err
+
+
+# ----------------------------------------------------------------------------- item 1: schedulers
+
+
+@pytest.mark.parametrize("address", HOSTILE_SCHEDULERS)
+def test_a_scene_cannot_name_a_scheduler(tmp_path, capsys, dialled, address):
+    """executor = "dask" with a scheduler in the file is refused at load, exit 2 at the key, nothing dialled."""
+    scene = tmp_path / "hostile.toml"
+    scene.write_text(SWEEP.format(extra=f'executor = "dask"\nscheduler = "{address}"'))
+    code, err = _run(["run", str(scene), "--backend", "numpy"], capsys)
+    assert code == 2
+    assert "hostile.toml" in err and "analysis[1].scheduler" in err and "--scheduler" in err, err
+    assert dialled == []
+
+
+def test_a_scene_dict_cannot_name_a_scheduler(dialled):
+    """A scene given to mechgen.run as a dict is a scene too: the scheduler= argument is the Python way."""
+    scene = {"model": "laval_rotor", "analysis": [
+        {"name": "g", "kind": "sweep", "executor": "dask", "scheduler": "tcp://127.0.0.1:8786",
+         "over": {"Omega": [0.0, 1.0]}, "analysis": {"kind": "stability"}}]}
+    with pytest.raises(SceneError) as info:
+        mechgen.run(scene)
+    assert info.value.key == "analysis[1].scheduler" and "scheduler=" in str(info.value)
+    assert dialled == []
+
+
+@pytest.mark.parametrize("address", ["inproc://x", "tls://127.0.0.1", "tcp://127.0.0.1", "file:///etc/passwd",
+                                     "tcp://127.0.0.1:99999", "tcp://user@127.0.0.1:8786", "tcp://a b:1",
+                                     "tcp://127.0.0.1:8786/path", "localhost:8786", "x" * 400])
+def test_the_scheduler_flag_is_checked_before_anything_connects(tmp_path, capsys, dialled, address):
+    scene = tmp_path / "ok.toml"
+    scene.write_text(SWEEP.format(extra='executor = "dask"'))
+    code, err = _run(["run", str(scene), "--backend", "numpy", "--scheduler", address], capsys)
+    assert code == 2 and "--scheduler" in err and "tcp://host:port" in err, err
+    assert len(err) < 600  # a 400-character value is not echoed whole
+    assert dialled == []
+
+
+def test_a_scheduler_flag_for_a_scene_without_dask_is_refused(tmp_path, capsys, dialled):
+    scene = tmp_path / "serial.toml"
+    scene.write_text(SWEEP.format(extra=""))
+    code, err = _run(["run", str(scene), "--backend", "numpy", "--scheduler", "tcp://127.0.0.1:8786"], capsys)
+    assert code == 2 and "scheduler" in err and 'executor = "dask"' in err, err
+    assert dialled == []
+
+
+def test_python_scheduler_argument_is_checked(dialled):
+    """The scheduler= argument of the Python functions is the user's choice, and still checked before use."""
+    from mechgen.runtime.core.sweep import SweepExecutor
+
+    system = mechgen.compile("laval_rotor", free=["Omega"], backend="numpy")
+    with pytest.raises(InputError) as info:
+        mechgen.sweep(system, "stability", {"Omega": [0.0, 1.0]}, executor="dask", scheduler="inproc://x")
+    assert "scheduler" in info.value.key and "tcp://" in info.value.expected
+    with pytest.raises(InputError) as info:
+        SweepExecutor("dask", scheduler="file:///etc/passwd")
+    assert info.value.key == "scheduler"
+    assert dialled == []
+
+
+def test_dask_configuration_address_is_checked(dialled):
+    """Dask's own scheduler-address setting (DASK_SCHEDULER_ADDRESS) is the environment's choice: honoured,
+    and checked before the first point runs."""
+    dask = pytest.importorskip("dask")
+    pytest.importorskip("distributed")
+    from mechgen.runtime.core.sweep import SweepExecutor, sweep_points
+
+    ran = []
+    with dask.config.set({"scheduler-address": "inproc://x"}):
+        with pytest.raises(InputError) as info:
+            sweep_points(ran.append, [1.0, 2.0, 3.0], executor=SweepExecutor("dask"), progress=False)
+    assert info.value.key == "DASK_SCHEDULER_ADDRESS" and ran == []
+    assert dialled == []
+
+
+def test_the_scheduler_flag_runs_on_the_users_scheduler(tmp_path, capsys):
+    """--scheduler at a running scheduler (started here, loopback) gives the serial numbers bit for bit."""
+    distributed = pytest.importorskip("distributed")
+    scene = tmp_path / "grid.toml"
+    scene.write_text(SWEEP.format(extra='executor = "dask"').replace("[0.0, 1.0, 2.0]", "[0.0, 500.0, 1000.0, 1500.0]"))
+    serial = mechgen.run({**_toml(scene), "analysis": [{**_toml(scene)["analysis"][0], "executor": "serial"}]})
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                  dashboard_address=None, silence_logs=40) as cluster:
+        out = tmp_path / "out.json"
+        code, err = _run(["run", str(scene), "--scheduler", cluster.scheduler_address, "--json", str(out)], capsys)
+    assert code == 0, err
+    import json
+
+    got = json.loads(out.read_text())["analyses"][0]["outputs"]
+    assert got["executor"] == "dask"
+    assert got["frequencies"] == serial["analyses"][0]["outputs"]["frequencies"]
+
+
+def _toml(path: Path) -> dict:
+    import tomllib
+
+    return tomllib.loads(path.read_text())
+
+
+# ----------------------------------------------------------------------------- item 2: output targets
+
+SMALL = ('model = "spring_pendulum"\n[[analysis]]\nname = "eq"\nkind = "steady"\nguess = { r = 1.0 }\n'
+         '[[analysis]]\nname = "small"\nkind = "modes"\nabout = "eq"\n')
+
+
+@pytest.fixture
+def small(tmp_path) -> Path:
+    scene = tmp_path / "sp.toml"
+    scene.write_text(SMALL)
+    return scene
+
+
+def _nodes(folder: Path) -> dict[str, Path]:
+    """A FIFO, a socket and (as root) a character device equal to /dev/null, all made here: never the
+    system's own nodes."""
+    folder.mkdir(exist_ok=True)
+    made = {"FIFO": folder / "fifo.json"}
+    os.mkfifo(made["FIFO"])
+    sock = socket.socket(socket.AF_UNIX)
+    made["socket"] = folder / "sock.json"
+    sock.bind(str(made["socket"]))
+    sock.close()
+    if os.geteuid() == 0:
+        made["character device"] = folder / "null.json"
+        os.mknod(made["character device"], stat.S_IFCHR | 0o666, os.makedev(1, 3))
+    return made
+
+
+def _mode(path: Path) -> int:
+    return stat.S_IFMT(os.lstat(path).st_mode)
+
+
+def test_json_never_replaces_a_device_fifo_or_socket(tmp_path, small, capsys):
+    """--json onto a node that is not a regular file is refused before anything runs, and the node stays."""
+    for what, node in _nodes(tmp_path / "nodes").items():
+        before = _mode(node)
+        code, err = _run(["run", str(small), "--json", str(node)], capsys)
+        assert code == 2 and "--json" in err and what in err, (what, err)
+        assert _mode(node) == before, what
+    assert not [p for p in (tmp_path / "nodes").iterdir() if p.name.startswith(".tmp")]
+
+
+def test_json_replaces_a_link_and_leaves_its_target(tmp_path, small, capsys):
+    victim = tmp_path / "victim.txt"
+    victim.write_text("keep me")
+    link = tmp_path / "out.json"
+    link.symlink_to(victim)
+    code, err = _run(["run", str(small), "--json", str(link)], capsys)
+    assert code == 0, err
+    assert victim.read_text() == "keep me" and not link.is_symlink() and '"analyses"' in link.read_text()
+
+
+def test_plot_never_follows_a_link_planted_in_the_folder(tmp_path, small, capsys):
+    """A link at a figure's name inside --plot DIR is replaced by the figure; its target is untouched."""
+    pytest.importorskip("matplotlib")
+    victim = tmp_path / "victim.txt"
+    victim.write_text("keep me")
+    plots = tmp_path / "plots"
+    plots.mkdir()
+    planted = plots / "sp_small_shapes.png"
+    planted.symlink_to(victim)
+    code, err = _run(["run", str(small), "--plot", str(plots)], capsys)
+    assert code == 0, err
+    assert victim.read_text() == "keep me"
+    assert not planted.is_symlink() and planted.read_bytes()[:4] == b"\x89PNG"
+    assert sorted(p.name for p in plots.iterdir()) == ["sp_small.png", "sp_small_shapes.png"]  # no stray file
+
+
+def test_plot_refuses_a_node_at_a_figure_name(tmp_path, small, capsys):
+    """A FIFO (or a folder) holding a figure's name is refused at --plot, not opened (a FIFO would block)."""
+    pytest.importorskip("matplotlib")
+    plots = tmp_path / "plots"
+    plots.mkdir()
+    os.mkfifo(plots / "sp_small.png")
+    (plots / "sp_small_shapes.png").mkdir()
+    code, err = _run(["run", str(small), "--plot", str(plots)], capsys)
+    assert code == 2 and "--plot" in err and ("FIFO" in err or "is a folder" in err), err
+    assert stat.S_ISFIFO(os.lstat(plots / "sp_small.png").st_mode)
+    assert sorted(p.name for p in plots.iterdir()) == ["sp_small.png", "sp_small_shapes.png"]
+
+
+@pytest.mark.parametrize("flag", ["--json", "--plot"])
+def test_an_overlong_name_is_refused_at_the_flag(tmp_path, small, capsys, flag):
+    for path in (tmp_path / ("x" * 300), tmp_path / ("y" * 300) / "out.json", Path("/" + "z/" * 2100)):
+        code, err = _run(["run", str(small), flag, str(path)], capsys)
+        assert code == 2 and flag in err and "long" in err, err
+        assert len(err) < 800  # the name is not echoed whole
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["sp.toml"]
+
+
+# ----------------------------------------------------------------------------- item 4: data files
+
+FIT = """model = "spring_pendulum"
+[[analysis]]
+name = "f"
+kind = "fit"
+parameters = ["K", "k"]
+start = { K = 500.0, k = 50.0 }
+data = "DATA"
+observed = "R"
+expression = "K + k * (d0 / d)"
+constants = { d0 = 25.4 }
+"""
+SECRET = "root:x:0:0:root:/root:/bin/bash"
+
+
+def _fit(tmp_path, data: str, capsys) -> tuple[int, str]:
+    scene = tmp_path / "scenes" / "fit.toml"
+    scene.parent.mkdir(exist_ok=True)
+    scene.write_text(FIT.replace("DATA", data))
+    return _run(["run", str(scene)], capsys)
+
+
+def _ctx(tmp_path, rows: int = 10):
+    from types import SimpleNamespace
+
+    return SimpleNamespace(file=str(tmp_path / "s.toml"), limits={"rows": rows})
+
+
+@pytest.mark.parametrize("where", ["absolute", "relative"])
+def test_a_data_file_is_never_echoed(tmp_path, capsys, where):
+    """A file that is not CSV data (a passwd-like file of the test's own, by an absolute or a ../ path): the
+    message names the line and column and shows at most a 10-character excerpt of the one cell."""
+    secret = tmp_path / "passwd"
+    secret.write_text(SECRET + "\ndaemon:x:1:1:daemon:/usr/sbin:/usr/sbin/nologin\n")
+    code, err = _fit(tmp_path, str(secret) if where == "absolute" else "../passwd", capsys)
+    assert code == 2 and "analysis[1].data" in err and "line 1" in err and "column 1" in err, err
+    assert SECRET not in err and "root:x:0:0:r" not in err and "daemon" not in err, err
+
+
+def test_cells_and_headers_are_excerpted(tmp_path, capsys):
+    data = tmp_path / "scenes" / "d.csv"
+    data.parent.mkdir()
+    for text, words in [("d,R\n1,2\n3,topsecretvalue123\n", "'topsecretv'…"),
+                        ("d,R,password_is_hunter2\n1,2,3\n4,5\n", "has 2 cells, the header 3"),
+                        ("d,R\n1,2\n" + "x" * 2_000_000, "longer than")]:
+        data.write_text(text)
+        code, err = _fit(tmp_path, "d.csv", capsys)
+        assert code == 2 and words in err and "line 3" in err, err
+        assert "topsecretvalue" not in err and "hunter2" not in err and "xxxxxxxxxxx" not in err, err
+
+
+def test_the_row_limit_is_checked_while_reading(tmp_path):
+    """A 4 MB file of 10^6 rows against a limit of 10 rows: refused after reading a few lines, with a peak
+    of well under the file's size (the whole file split into a list took 11 GiB for 250 MB)."""
+    import tracemalloc
+
+    from mechgen.analyses import fit_data
+
+    big = tmp_path / "big.csv"
+    big.write_bytes(b"d,R\n" + b"1,2\n" * 1_000_000)
+    blank = tmp_path / "blank.csv"
+    blank.write_bytes(b"d,R\n" + b"\n" * 4_000_000)
+    for path, words in [(big, "more than 10 rows"), (blank, "more than 10020 lines")]:
+        tracemalloc.start()
+        with pytest.raises(SceneError) as info:
+            fit_data.load(_ctx(tmp_path), "analysis[1].data", str(path))
+        peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+        assert words in str(info.value)
+        assert peak < 1_000_000, peak  # bytes; the file is 4 MB
+
+
+def test_folders_fifos_and_devices_are_named_as_what_they_are(tmp_path):
+    from mechgen.analyses import fit_data
+
+    (tmp_path / "folder.csv").mkdir()
+    os.mkfifo(tmp_path / "fifo.csv")
+    cases = {"folder.csv": "is a folder", "fifo.csv": "is a FIFO", "missing.csv": "not found"}
+    if os.geteuid() == 0:  # a node of the test's own, equal to /dev/zero (endless zero bytes)
+        os.mknod(tmp_path / "zero.csv", stat.S_IFCHR | 0o444, os.makedev(1, 5))
+        cases["zero.csv"] = "is a character device"
+    for name, words in cases.items():
+        with pytest.raises(SceneError) as info:  # a FIFO without a writer must not block
+            fit_data.load(_ctx(tmp_path), "analysis[1].data", str(tmp_path / name))
+        assert words in str(info.value) and info.value.key == "analysis[1].data", (name, str(info.value))
+
+
+# ----------------------------------------------------------------------------- item 6: model references
+
+OSC = '''from mechgen import Model, Param
+print("model says hello")
+model = Model("osc_s33", doc="x'' = -k/m x")
+model.params(Param("m", 1.0, "kg"), Param("k", 4.0, "N/m"))
+model.coordinates("x")
+model.kinetic(lambda q, v, p: p.m * v.x**2 / 2)
+model.potential(lambda q, p: p.k * q.x**2 / 2)
+'''
+
+
+def _model_scene(tmp_path, ref: str) -> Path:
+    scene = tmp_path / "m.toml"
+    scene.write_text(f'model = "{ref}"\n[[analysis]]\nname = "m"\nkind = "modes"\n')
+    return scene
+
+
+@pytest.mark.parametrize("code_line", ["raise SystemExit(0)", "import sys; sys.exit()", "raise SystemExit('bye')"])
+def test_a_model_that_exits_on_import_is_exit_2(tmp_path, capsys, code_line):
+    (tmp_path / "quits.py").write_text(f'print("SECRET-PRINT")\n{code_line}\n')
+    code = main(["run", str(_model_scene(tmp_path, "quits.py"))])
+    out = capsys.readouterr()
+    assert code == 2 and "quits.py" in out.err and "SystemExit" in out.err and "Traceback" not in out.err, out.err
+    assert "SECRET-PRINT" not in out.out + out.err
+
+
+def test_a_module_without_a_model_prints_nothing(tmp_path, capsys, monkeypatch):
+    """package.module:attribute of a module that is not a model (as `this:model` printed the Zen of Python)."""
+    (tmp_path / "chatty_s33.py").write_text('print("SECRET-PRINT")\nvalue = 1\n')
+    monkeypatch.syspath_prepend(str(tmp_path))
+    code = main(["run", str(_model_scene(tmp_path, "chatty_s33:model"))])
+    out = capsys.readouterr()
+    assert code == 2 and "defines no Model" in out.err and "SECRET-PRINT" not in out.out + out.err, out
+
+
+def test_a_models_own_prints_go_to_stderr(tmp_path, capsys):
+    (tmp_path / "osc_s33.py").write_text(OSC)
+    code = main(["run", str(_model_scene(tmp_path, "osc_s33.py")), "--backend", "numpy"])
+    out = capsys.readouterr()
+    assert code == 0, out.err
+    assert "model says hello" in out.err and "model says hello" not in out.out
+
+
+# ----------------------------------------------------------------------------- item 3: unnoticed crossings
+
+BALL = str(Path(__file__).resolve().parent / "models" / "bouncing_ball.py")
+G = 9.81  # the test model's default g (m/s^2)
+
+
+def _drop(y0: float, cor: float, loop: str, **extra) -> dict:
+    return mechgen.run({"model": BALL, "params": {"cor": cor}, "analysis": [
+        {"name": "drop", "kind": "simulate", "method": "DOP853", "t_end": 10.0, "q0": {"y": y0}, "loop": loop,
+         "progress": False, **extra}]})
+
+
+@pytest.mark.parametrize("loop", ["python", "c"])
+def test_a_ball_at_rest_on_the_floor_never_falls_through_silently(loop):
+    """y = 0, y' = 0: the floor guard (falling) has g = g_t = 0; the ball leaves it downwards at once."""
+    with pytest.raises(mechgen.ConvergenceError) as info:
+        _drop(0.0, 0.5, loop)
+    assert "guard floor of mode flight" in str(info.value) and "t = 0 and" in str(info.value)
+
+
+@pytest.mark.parametrize("loop", ["python", "c"])
+def test_a_zeno_accumulation_with_a_huge_zeno_limit_is_stopped_at_the_accumulation_time(loop):
+    """The probe's case: zeno_events so large that the Zeno test never fires. The impacts accumulate at
+    T = t1 (1 + e) / (1 - e), t1 = sqrt(2 h / g) (the model's docstring); there the resets no longer lift the
+    ball and it left the floor downwards (3 596 J of kinetic energy at t = 10 s, exit 0, before the fix). Now the
+    run ends there with exit 1 naming the guard and the time; the time agrees with T to 1e-6 relative (the last
+    located impacts are within the integrator's tolerance of the closed form's geometric sequence)."""
+    import re
+
+    h, e = 1.0, 0.5
+    T = math.sqrt(2 * h / G) * (1 + e) / (1 - e)
+    with pytest.raises(mechgen.ConvergenceError) as info:
+        _drop(h, e, loop, zeno_events=100_000, max_events=100_000)
+    text = str(info.value)
+    assert "guard floor of mode flight" in text, text
+    t_hi = float(re.search(r"between t = \S+ and (\S+) \(", text).group(1))
+    assert abs(t_hi - T) < 1e-6 * T, (t_hi, T)
+
+
+def test_event_limits_beyond_the_budget_are_refused_up_front(tmp_path, capsys):
+    (tmp_path / "ball.py").write_text(Path(BALL).read_text())
+    scene = tmp_path / "ball.toml"
+    base = 'model = "ball.py"\n[[analysis]]\nname = "d"\nkind = "simulate"\nt_end = 10.0\nq0 = { y = 1.0 }\n'
+    for extra, key in [("zeno_events = 1_000_000_000\nmax_events = 1_000_000_000\n", "analysis[1].max_events"),
+                       ("zeno_events = 20_000\n", "analysis[1].zeno_events")]:
+        scene.write_text(base + extra)
+        code, err = _run(["run", str(scene)], capsys)
+        assert code == 2 and key in err and "ball.toml" in err, err
+
+
+# ----------------------------------------------------------------------------- item 7: one build per key
+
+def _first_run(args: tuple) -> int:
+    """In a worker process: compile a model of the test's own into an empty cache; its compiler runs."""
+    root, model_file = args
+    os.environ["MECHGEN_CACHE"] = root
+    import mechgen as mg
+    from mechgen.codegen.build import STATS
+
+    system = mg.compile(model_file, backend="c")
+    assert system.n == 1
+    from mechgen.runtime.integration.events_c import loop_library
+
+    loop_library()  # a runtime loop library (hybrid_loop.c), built through mechgen.buildlock.load_shared_once
+    return STATS["compile"]
+
+
+def test_concurrent_first_runs_derive_and_compile_once(tmp_path):
+    """Four processes compile one model, and load the C event loop, into one empty cache at once: the build
+    locks let one derive and compile each; the others wait, then load its cache entries."""
+    import multiprocessing
+
+    from mechgen.codegen.build import find_compiler
+
+    if find_compiler() is None:
+        pytest.skip("no C compiler")
+    (tmp_path / "osc_s33.py").write_text(OSC)
+    args = (str(tmp_path / "cache"), str(tmp_path / "osc_s33.py"))
+    with multiprocessing.get_context("spawn").Pool(4) as pool:
+        runs = pool.map(_first_run, [args] * 4)
+    # one compile each: the kernels and the kernel caller (under the request's lock), the loop library (under its
+    # own); without the locks every process compiled all three: [3, 3, 3, 3]
+    assert sum(runs) == 3, runs
+    assert not list((tmp_path / "cache" / "locks").iterdir())
+
+
+def test_a_lock_left_by_a_killed_process_is_broken(tmp_path, monkeypatch):
+    """A lock naming a process that no longer exists (a child started and reaped here) is broken at once; a
+    lock of a live process (this one) is waited on (here the wait is cut to 0.2 s); an empty lock whose writer
+    died before writing it is broken after EMPTY_SECONDS."""
+    import subprocess
+    import time
+
+    from mechgen import buildlock
+
+    monkeypatch.setenv("MECHGEN_CACHE", str(tmp_path / "cache"))
+    dead = subprocess.Popen(["true"])
+    dead.wait()
+    path = buildlock.lock_path("k1")
+    path.write_text(json.dumps({"pid": dead.pid, "host": socket.gethostname(), "time": time.time()}))
+    started = time.monotonic()
+    with buildlock.held("k1") as mine:
+        assert mine and json.loads(path.read_text())["pid"] == os.getpid()
+    assert time.monotonic() - started < 1 and not path.exists()
+    live = buildlock.lock_path("k2")
+    live.write_text(json.dumps({"pid": os.getpid(), "host": socket.gethostname(), "time": time.time()}))
+    started = time.monotonic()
+    assert buildlock.acquire("k2", wait=0.2) is None and live.exists()
+    assert 0.2 <= time.monotonic() - started < 2
+    empty = buildlock.lock_path("k3")
+    empty.write_text("")
+    os.utime(empty, (time.time() - 2 * buildlock.EMPTY_SECONDS,) * 2)
+    lock = buildlock.acquire("k3", wait=0.2)
+    assert lock == empty and json.loads(empty.read_text())["pid"] == os.getpid()
+    buildlock.release(lock)
+    assert sorted(p.name for p in path.parent.iterdir()) == ["k2"]  # nothing stray
+
+
+# ----------------------------------------------------------------------------- item 5: edge values, singular modes
+
+def test_a_parameter_at_the_edge_of_the_float_range_is_named(capsys):
+    """k_r = DBL_MAX: the stiffness matrix overflows; exit 2 at the flag that set it, not a ValueError traceback."""
+    scene = Path(__file__).resolve().parent.parent / "scenes" / "laval_rotor.toml"
+    code, err = _run(["run", str(scene), "--backend", "numpy", "--set", "k_r=1.7976931348623157e308"], capsys)
+    assert code == 2 and "'--set k_r'" in err and "edge of the floating-point range" in err, err
+
+
+@pytest.mark.parametrize("loop", ["python", "c"])
+def test_a_zero_mass_in_a_hybrid_mode_is_diagnosed(tmp_path, loop):
+    """m = 0 in the ball's only mode (its bound positive=True removed): M = 0 is singular where the mode starts;
+    a ConvergenceError naming the coordinate, in both loops (the Python loop raised a bare LinAlgError)."""
+    (tmp_path / "ball0.py").write_text(Path(BALL).read_text().replace(', positive=True), Param("g"',
+                                                                      '), Param("g"', 1))
+    with pytest.raises(mechgen.ConvergenceError) as info:
+        mechgen.run({"model": str(tmp_path / "ball0.py"), "params": {"m": 0.0}, "analysis": [
+            {"name": "d", "kind": "simulate", "method": "DOP853", "t_end": 1.0, "q0": {"y": 1.0}, "loop": loop}]})
+    assert "no inertia along coordinate 'y'" in str(info.value), str(info.value)
+
+
+def test_every_kind_has_a_wall_time_budget():
+    """max_seconds is a key of every kind, and a kind whose runner has no budget of its own (here a test kind
+    that computes for 30 s) is stopped by the backstop at max_seconds x 1.1, exit 1 naming the key."""
+    import time
+
+    from mechgen.analyses import registry, summary
+    from mechgen.analyses.public import analysis
+    from mechgen.runtime.core.budget import BudgetExceeded
+
+    assert all("max_seconds" in registry.get(k).schema for k in registry.kinds())
+
+    def endless(system, options, context):
+        stop = time.monotonic() + 30
+        while time.monotonic() < stop:
+            sum(range(1000))
+        return {}
+
+    registry.register(registry.AnalysisKind("endless_s33", {}, endless, lambda o, *, internal: set(), summary.lines))
+    try:
+        system = mechgen.compile("spring_pendulum", backend="numpy")
+        started = time.monotonic()
+        with pytest.raises(BudgetExceeded) as info:
+            analysis("endless_s33", system, max_seconds=0.3)
+        assert info.value.key == "max_seconds" and "endless_s33" in str(info.value)
+        assert 0.3 < time.monotonic() - started < 3
+    finally:
+        registry.unregister("endless_s33")
+
+
+@pytest.mark.parametrize("scene, per_element", [("rod_tip_load.toml", 48_000), ("rod_dynamics.toml", 32_000)])
+def test_a_huge_rod_is_refused_before_it_starts(tmp_path, capsys, monkeypatch, scene, per_element):
+    """elements = 100 000 under a 2 GiB memory limit: the estimate (the measured bytes per element times the
+    elements) is refused at the key up front, in seconds (it took 1.7 GiB within 15 s and ran on)."""
+    import time
+
+    text = (Path(__file__).resolve().parent.parent / "scenes" / scene).read_text()
+    text = re.sub(r"elements = \d+", "elements = 100000", text)
+    (tmp_path / scene).write_text(text)
+    monkeypatch.setenv("MECHGEN_MEMORY_LIMIT", "2GiB")
+    started = time.monotonic()
+    code, err = _run(["run", str(tmp_path / scene)], capsys)
+    assert code == 2 and "'elements'" in err and f"{100_000 * per_element / 2**30:.3g} GiB" in err, err
+    assert time.monotonic() - started < 30
+
+
+@pytest.mark.parametrize("exc", [MemoryError(), SystemError("SuperLU: out of memory"),
+                                 ValueError("array must not contain infs or NaNs"), ZeroDivisionError("x")])
+def test_a_runners_stray_numerical_exception_is_exit_1(exc, capsys, tmp_path):
+    """What a runner raises from numpy/scipy (as SuperLU did under an address-space limit) is a ConvergenceError
+    naming the analysis: exit 1, one message, no traceback."""
+    from mechgen.analyses import registry, summary
+
+    def failing(system, options, context):
+        raise exc
+
+    registry.register(registry.AnalysisKind("failing_s33", {}, failing, lambda o, *, internal: set(), summary.lines))
+    try:
+        scene = tmp_path / "f.toml"
+        scene.write_text('model = "spring_pendulum"\n[[analysis]]\nname = "f"\nkind = "failing_s33"\n')
+        code, err = _run(["run", str(scene), "--backend", "numpy"], capsys)
+        assert code == 1 and "failing_s33 'f'" in err and type(exc).__name__ in err, err
+    finally:
+        registry.unregister("failing_s33")
+
+
+def test_a_late_error_names_the_flag_that_decided_it(capsys):
+    """The fuzz finding of this round: --set quadrature=1 makes stepped_rotor's quintic mass matrix singular,
+    found at the internal key 'M'; the message listed the first 8 values the scene sets and left the flag out.
+    The user's --set values now come first."""
+    scene = Path(__file__).resolve().parent.parent / "scenes" / "stepped_rotor.toml"
+    code, err = _run(["run", str(scene), "--set", "quadrature=1"], capsys)
+    assert code == 2 and "--set quadrature = 1" in err, err
+
+
+def test_a_kind_without_a_budget_of_its_own_stops_at_max_seconds(tmp_path, capsys):
+    """Beck's column at N = 20 000: stability's sparse eigen-solve (ARPACK, no budget of its own) takes tens of
+    seconds (N = 8 000: 9.8 s measured, N = 50 000: over 300 s); with max_seconds = 0.5 the
+    backstop stops it after 0.55 s with exit 1 naming the key (at N = 10^6 the
+    probe's run went on past 10 minutes)."""
+    import time
+
+    text = (Path(__file__).resolve().parent.parent / "scenes" / "beck_column.toml").read_text()
+    text = text.split('[[analysis]]\nname = "load_sweep"')[0].replace("count = 3\n", "count = 3\nmax_seconds = 0.5\n")
+    (tmp_path / "beck.toml").write_text(text)
+    started = time.monotonic()
+    code, err = _run(["run", str(tmp_path / "beck.toml"), "--set", "N=20000"], capsys)
+    assert code == 1 and "stability 'at_P'" in err and "'max_seconds'" in err, err
+    assert time.monotonic() - started < 20
