@@ -9,7 +9,7 @@ default parameters as in ``scenes/laval_rotor.toml``, C kernels from the compile
   scene with ``executor = "dask"`` does (its cold start - spawning two interpreters that import mechgen -
   is part of its wall time);
 * ``dask (running cluster)``: the same sweep sent to an already running, warmed 2-worker LocalCluster
-  (``scheduler = "tcp://..."``): the steady per-point cost of Dask without the cluster's start.
+  (``mechgen.run(..., scheduler="tcp://...")``, the user's choice, never the scene's): the steady per-point cost of Dask without the cluster's start.
 
 Measured, per executor (best of ``repeats`` rounds, the executors interleaved in each round; BLAS on one
 thread everywhere, :func:`mechgen.bench.common.blas_threads`): the sweep's wall time W (the analysis's
@@ -51,12 +51,11 @@ TARGET = 1.5
 SERIAL, PROCESSES, DASK, DASK_RUNNING = "serial", "processes", "dask", "dask (running cluster)"
 
 
-def laval_sweep_scene(executor: str, points: int, scheduler: str | None = None) -> dict:
-    """The benchmark's scene: the Laval rotor's stability at ``points`` speeds from 0 to OMEGA_MAX on ``executor``."""
+def laval_sweep_scene(executor: str, points: int) -> dict:
+    """The benchmark's scene: the Laval rotor's stability at ``points`` speeds from 0 to OMEGA_MAX on ``executor``
+    (a running scheduler is not the scene's to name: :func:`run_once` passes it as the user would)."""
     sweep = {"name": "grid", "kind": "sweep", "executor": executor, "workers": WORKERS, "progress": False,
              "over": {"Omega": {"start": 0.0, "stop": OMEGA_MAX, "num": points}}, "analysis": {"kind": "stability"}}
-    if scheduler is not None:
-        sweep["scheduler"] = scheduler
     return {"model": "laval_rotor", "backend": "c", "analysis": [sweep]}
 
 
@@ -64,7 +63,8 @@ def run_once(executor: str, points: int, scheduler: str | None = None) -> dict:
     """One sweep: {"wall_s" (the analysis's seconds), "tasks", "grid", "frequencies", "status"}."""
     import mechgen
 
-    analysis = mechgen.run(laval_sweep_scene(executor, points, scheduler))["analyses"][0]
+    analysis = mechgen.run(laval_sweep_scene(executor, points),
+                           **({"scheduler": scheduler} if scheduler is not None else {}))["analyses"][0]
     out = analysis["outputs"]
     return {"wall_s": float(analysis["seconds"]), "tasks": int(out["tasks"]), "grid": out["grid"],
             "frequencies": out["frequencies"], "status": out["status"]}

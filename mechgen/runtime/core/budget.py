@@ -213,14 +213,18 @@ def _is_terminal(stream) -> bool:
         return False
 
 
-#: the backstop fires this long after an analysis's own wall-time budget (its loops' checks come first)
+#: the backstop fires this long after an analysis's own wall-time budget (its loops' checks come first):
+#: max_seconds x BACKSTOP_GRACE + BACKSTOP_MARGIN s, so that a loop's own check, with its informative message
+#: (the steps done, where it stopped), runs first even for a tiny budget
 BACKSTOP_GRACE = 1.10
+BACKSTOP_MARGIN = 2.0
 
 
 @contextlib.contextmanager
 def wall_clock(seconds: float | None, what: str):
     """The wall-time budget of a whole analysis, for every kind (issue 33): a real-time timer (SIGALRM) that
-    raises BudgetExceeded (key ``max_seconds``) in the main thread once ``seconds`` x BACKSTOP_GRACE have passed,
+    raises BudgetExceeded (key ``max_seconds``) in the main thread once ``seconds`` x BACKSTOP_GRACE +
+BACKSTOP_MARGIN have passed,
     a backstop behind the loops' own budgets for the work that has none (an eigen-solve, a rod's Newton steps).
     Python code is interrupted between bytecodes; a long call into compiled code ends first. Off outside the
     main thread, where no timer can be set, and for ``seconds`` None; under a caller's timer that fires first it
@@ -228,7 +232,7 @@ def wall_clock(seconds: float | None, what: str):
     if seconds is None or threading.current_thread() is not threading.main_thread() or not hasattr(signal, "setitimer"):
         yield
         return
-    limit = seconds * BACKSTOP_GRACE
+    limit = seconds * BACKSTOP_GRACE + BACKSTOP_MARGIN
     pending = signal.getitimer(signal.ITIMER_REAL)[0]
     if 0 < pending <= limit:  # a caller's own timer (a test harness, an outer analysis) fires first: leave it
         yield
