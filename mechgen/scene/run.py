@@ -97,9 +97,14 @@ INTERNAL_KEYS = {"discretisation": ("N", "discretisation", "quadrature", "constr
 def placed(exc: InputError, scn) -> SceneError:
     """A bad-input error found after loading (compiling, discretising, factorising M), which names no
     file, placed in the scene: its file, and for an internal key (``discretisation``, ``M``) the keys
-    the scene wrote that decide it (``params.N = 0``), so that the user sees what to change."""
-    note = ""
-    if exc.key in INTERNAL_KEYS:
+    the scene wrote that decide it (``params.N = 0``), so that the user sees what to change; a parameter the user
+    set on the command line is named by its flag (``--set quadrature``)."""
+    note, key = "", exc.key
+    name = exc.key[len("params."):] if isinstance(exc.key, str) and exc.key.startswith("params.") else None
+    if name is not None and str(scn.written.get(name, "")).startswith("--set"):  # the user's flag decided it
+        key = scn.written[name]
+        note = f" (decided by what the scene sets: {scn.written[name]} = {scn.params[name]!r})"
+    elif exc.key in INTERNAL_KEYS:
         names = INTERNAL_KEYS[exc.key]
         wanted = [n for n in scn.written if names is None or n in names]
         info = lookup_model(scn.source) if names is not None else None
@@ -111,7 +116,7 @@ def placed(exc: InputError, scn) -> SceneError:
             shown.append("[[segments]]")
         if shown:
             note = f" (decided by what the scene sets: {', '.join(shown)})"
-    return SceneError(exc.message.rstrip(".") + note, file=scn.path, key=exc.key, expected=exc.expected)
+    return SceneError(exc.message.rstrip(".") + note, file=scn.path, key=key, expected=exc.expected)
 
 
 def _run_loaded(scn, backend: str | None, scheduler: str | None = None) -> dict:
