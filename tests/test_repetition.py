@@ -25,9 +25,11 @@ def _derive_and_lower(n):
 
 
 def test_ir_is_independent_of_chain_length():
+    """The IR is the same for 8 and 100 000 sites, and so is the work of making it (the least of 3 runs each:
+    a single run's wall time can absorb a descheduling under the parallel suite, which the least does not)."""
     _derive_and_lower(8)  # warm sympy caches
-    small, t_small = _derive_and_lower(8)
-    large, t_large = _derive_and_lower(100_000)
+    small, t_small = min((_derive_and_lower(8) for _ in range(3)), key=lambda r: r[1])
+    large, t_large = min((_derive_and_lower(100_000) for _ in range(3)), key=lambda r: r[1])
     assert [ir.signature() for ir in small] == [ir.signature() for ir in large]
     assert [ir.op_count() for ir in small] == [ir.op_count() for ir in large]
     assert t_large < 2 * t_small + 0.05
