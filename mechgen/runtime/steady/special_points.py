@@ -201,7 +201,12 @@ def bp_value(eqs, row: np.ndarray, reference: np.ndarray) -> Callable:
         return np.linalg.slogdet(np.vstack([augmented(eqs, x), row.reshape(1, -1)]))
 
     _, ref = det(reference)
-    return lambda x: float(det(x)[0] * np.exp(det(x)[1] - ref))
+
+    def value(x):
+        sign, logdet = det(x)  # one factorisation per evaluation
+        return float(sign * np.exp(logdet - ref))
+
+    return value
 
 
 def branch_points(eqs, X: np.ndarray) -> list[SpecialPoint]:
