@@ -88,7 +88,8 @@ def run_orbit_benchmarks(out: Path, quick: bool = False) -> dict:
     ours = _fastest_as_accurate(seconds, errors, sides, errors[peer])
     ratios = [{"peer": "hand-written scipy shooting + continuation (benchmarks/)", "ours_s": seconds[ours],
                "peer_s": seconds[peer], "condition": f"same curve (w 0.5 to 2.5, both folds); ours: {ours} (fold error "
-               f"{errors[ours]:.1e}), peer: {peer} (fold error {errors[peer]:.1e})"}]
+               f"{errors[ours]:.1e}), peer: {peer} (fold error {errors[peer]:.1e}); mechgen also gives every "
+               "orbit's multipliers, stability and amplitude, the baseline the branch and its folds only"}]
     suite_report(out, "orbits", points, reference="mechgen shooting at Newton rtol 1e-12 (folds' multiplier 1)",
                  error="max |w_fold - w_fold,ref| (rad/s)", time="seconds per curve (median of interleaved rounds)",
                  title="Duffing frequency-response curve", ratios=ratios)
