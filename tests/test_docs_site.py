@@ -58,6 +58,7 @@ def build_site(work: Path) -> Path:
     source = work / "docs"
     shutil.copytree(DOCS, source, ignore=shutil.ignore_patterns("_build", "auto_examples", "kinds",
                                                                "sg_execution_times.rst"))
+    shutil.copy(ROOT / "CHANGELOG.md", work / "CHANGELOG.md")  # docs/changelog.md includes ../CHANGELOG.md
     out = work / "html"
     run = subprocess.run([sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-b", "html", str(source),
                           str(out)], capture_output=True, text=True, timeout=600, cwd=work)
