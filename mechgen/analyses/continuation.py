@@ -69,7 +69,7 @@ from mechgen.analyses import figures, schema, summary
 from mechgen.analyses.bvp_states import (bvp_summary, shape_declarations, shape_values, stability_about,
                                          stability_of_each)
 from mechgen.analyses.newton_branch import newton_branch
-from mechgen.analyses.orbit_branch import run_orbit_branch
+from mechgen.analyses.orbit_branch import FAMILY_PARAMETER, run_orbit_branch
 from mechgen.analyses.special_curves import run_curve
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import REQUIRED, Option
@@ -133,7 +133,14 @@ def _bounds(ctx, key: str, value: object) -> dict[str, tuple[float, float]]:
     return out
 
 
+class FamilyParameter(str):
+    """``parameter = "amplitude"`` on a model without a parameter of that name: the level of a conservative
+    family's free orbits (mechgen.analyses.backbone), not a model parameter (nothing is freed in the kernels)."""
+
+
 def _parameter(ctx, key: str, value: object) -> str:
+    if value == FAMILY_PARAMETER and value not in ctx.model.params:
+        return FamilyParameter(value)
     info = param_info(ctx.file, key, ctx.model, value)
     if is_choice(info) or info.integer:
         raise fail(ctx.file, key, f"parameter {show(value)} is not a real number", "a numeric model parameter")
@@ -146,7 +153,10 @@ SCHEMA = {
     "about": Option(_starts, REQUIRED, doc="the earlier steady analysis the branch starts from, or a list of them "
                     "(one branch each); or an earlier periodic_orbit (a branch of orbits), or an earlier "
                     "continuation (with special_point: the curve of one of its special points)"),
-    "parameter": Option(_parameter, REQUIRED, doc="the numeric parameter the branch is followed in"),
+    "parameter": Option(_parameter, REQUIRED, doc="the numeric parameter the branch is followed in; about the "
+                        "free orbit of a conservative model (a periodic_orbit without frequency), \"amplitude\" "
+                        "follows its family, the backbone curve, in the level q_p(0) (a model parameter of that name "
+                        "wins)"),
     "stop": Option(schema.number, REQUIRED, doc="the parameter's value where the branch ends (its unit)"),
     "step": Option(schema.positive, 0.05, doc="the first pseudo-arclength step"),
     "max_step": Option(schema.positive, doc="the largest pseudo-arclength step"),
@@ -206,7 +216,13 @@ def check(ctx, base: str, options: dict) -> None:
                    "a curve of special points needs both 'about' an earlier continuation and 'special_point'",
                    "special_point = <position in its special_points> with about = \"<continuation>\"" if curve
                    else "about = an earlier steady analysis (special_point goes with about = a continuation)")
-    if curve or (isinstance(about, str) and ctx.earlier.get(about) == "periodic_orbit"):
+    orbit = isinstance(about, str) and ctx.earlier.get(about) == "periodic_orbit"
+    if isinstance(options["parameter"], FamilyParameter) and not orbit:
+        raise fail(ctx.file, f"{base}.parameter", f"parameter '{FAMILY_PARAMETER}' (model {ctx.model.name} has no "
+                   "parameter of that name) continues the family of a conservative model's free orbits, and 'about' "
+                   "is not a periodic_orbit", "about = a periodic_orbit without frequency on a conservative model, "
+                   "or one of the model's parameters: " + listing(list(ctx.model.params)))
+    if curve or orbit:
         return
     if isinstance(options["about"], list) and "minimize" in options:
         raise fail(ctx.file, f"{base}.minimize", "minimize follows one branch; 'about' lists several starts",
@@ -220,8 +236,8 @@ def check(ctx, base: str, options: dict) -> None:
 
 
 def frees(options: dict) -> list[str]:
-    """The continuation parameter: free in the kernels."""
-    return [options["parameter"]]
+    """The continuation parameter: free in the kernels (a conservative family's level is none)."""
+    return [] if isinstance(options["parameter"], FamilyParameter) else [options["parameter"]]
 
 
 def needs(options: dict, *, internal: bool) -> set[str]:

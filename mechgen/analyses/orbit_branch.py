@@ -38,6 +38,8 @@ from mechgen.runtime.steady.cycle_points import cycle_points
 #: keys of a continuation that an orbit branch does not take
 ORBIT_REFUSES = ("method", "stages", "bounds", "at", "minimize", "switch_branches", "special_point", "eigenvalues",
                  "aliases")  # switch_branches: taken by a forced orbit found by shooting (and a hybrid model's)
+#: ``parameter`` of a continuation along a conservative family (mechgen.analyses.backbone): the level q_p(0)
+FAMILY_PARAMETER = "amplitude"
 #: phases at which a branch point's amplitudes are taken
 PHASES = 4096
 
@@ -147,6 +149,20 @@ def record(orbits: Orbits, branch: OrbitBranch, u: np.ndarray, p: float) -> dict
 def run_orbit_branch(system, options: dict, earlier: dict) -> dict:
     """The branch of orbits through an earlier periodic_orbit (module doc; a hybrid model's:
     mechgen.analyses.hybrid_orbit.run_hybrid_branch, which also takes ``switch_branches``)."""
+    if earlier["_orbit"].get("conservative"):  # a free orbit's family (mechgen.analyses.backbone)
+        for key in ORBIT_REFUSES:
+            if options.get(key):
+                raise SceneError(f"{key} does not apply to the family of a conservative model's free orbits",
+                                 key=key, expected=f"no {key}")
+        from mechgen.analyses.backbone import run_backbone
+
+        return run_backbone(system, options, earlier["_orbit"])
+    if options["parameter"] == FAMILY_PARAMETER and FAMILY_PARAMETER not in system.param_values():
+        raise SceneError(f"parameter '{FAMILY_PARAMETER}' continues the family of a conservative model's free "
+                         "orbits, and the earlier periodic_orbit is not one (it is forced, or its model dissipates "
+                         "or is forced)", key="parameter",
+                         expected="a model parameter, or about = a periodic_orbit without frequency on a "
+                         "conservative model")
     hybrid = bool(earlier["_orbit"].get("hybrid"))
     switchable = hybrid or (earlier["_orbit"]["method"] == "shooting"
                             and earlier["_orbit"]["options"].get("frequency") is not None)
