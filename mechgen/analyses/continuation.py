@@ -582,6 +582,38 @@ def _orbit_branch(plt, a: dict, path: Path) -> bool:
     return True
 
 
+def _backbone(plt, a: dict, path: Path) -> bool:
+    """A conservative family's backbone: each coordinate's amplitude against the orbit's frequency (stable solid,
+    unstable dashed), its special points marked (mechgen.analyses.backbone)."""
+    out = a["outputs"]
+    table = out.get("backbone")
+    if not table or not out.get("branch"):
+        return False
+    points = out["branch"]
+    w = np.array(table["frequency"])
+    fig, ax = plt.subplots(figsize=(7, 5))
+    for coordinate, values in table["amplitude"].items():
+        amp = np.array(values)
+        for style, label in (("-", "stable"), ("--", "unstable")):
+            mask = np.array([p["stability"] == label for p in points])
+            if mask.any():
+                mask[:-1] |= mask[1:]
+                ax.plot(w, np.where(mask, amp, np.nan), style, lw=1.2, label=f"{coordinate}, {label}")
+        for special in out.get("special_points", []):
+            ax.plot(special["frequency"], special["amplitude"][coordinate], _ORBIT_MARKS.get(special["type"], "o"),
+                    ms=7, mfc="none", color="k")
+            ax.annotate(special["type"], (special["frequency"], special["amplitude"][coordinate]), fontsize=7,
+                        xytext=(5, 4), textcoords="offset points")
+    ax.set_xlabel("frequency of the free orbit, 2 pi / T (rad per unit time)")
+    ax.set_ylabel("amplitude max |q| over the period")
+    ax.legend(fontsize=7, loc="best")
+    ax.set_title(f"{a['name']}: backbone curve, the free orbits' family ({out.get('method', '')})", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return True
+
+
 #: markers of the special points of a branch of orbits
 _ORBIT_MARKS = {"LPC": "x", "PD": "s", "NS": "D"}
 
@@ -670,7 +702,8 @@ def plot(plt, a: dict, path: Path) -> list[Path]:
     outputs such as the loop count written where they change, folds, stability changes and the ``at``
     crossings marked), the shapes of the ``at`` points (first field against the last), with ``eigenvalues``
     their real and imaginary parts along the branch, and the lowest frequencies against the parameter."""
-    written = [path] if _orbit_branch(plt, a, path) or _branch(plt, a, path) or _curve(plt, a, path) else []
+    written = [path] if (_backbone(plt, a, path) or _orbit_branch(plt, a, path) or _branch(plt, a, path)
+                         or _curve(plt, a, path)) else []
     out = a["outputs"]
     name = out.get("parameter", "parameter")
     for key in [k[3:] for k in out if k.startswith("at_") and not k.endswith("_shapes")]:
