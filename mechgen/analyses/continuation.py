@@ -54,6 +54,26 @@ det [[F_y, F_p], [chord]], with the other branch's ``direction``) and, with ``st
 coefficient ``lyapunov`` and ``criticality``). ``switch_branches = true`` follows the other branch from every BP,
 both ways (``switched_branches``).
 
+Branches of periodic orbits (mechgen.analyses.orbit_branch): with ``about`` an earlier ``periodic_orbit`` the
+orbit is continued by its own method (harmonic balance, collocation or shooting) through its folds, reporting per
+point ``period``, ``frequency``, ``amplitude``, ``start``, ``multipliers`` and ``stability``, and the special points
+``LPC`` (cyclic fold), ``PD`` (period doubling) and ``NS`` (torus); ``switch_branches = true`` (a forced orbit) adds
+``doubled``, the period-2T orbit past every PD point, by the same method. A forced orbit's first guess may be the
+linear forced response (periodic_orbit's ``start = "linear"``).
+
+Backbone curves (mechgen.analyses.backbone): with ``about`` the free orbit of a conservative model (a
+``periodic_orbit`` without ``frequency`` on a model without damping or forcing) and ``parameter = "amplitude"`` (a
+model parameter of that name wins), the continuation follows the family of free orbits in the displacement
+q_p(0) of the orbit's coordinate p at t = 0 (an extremum there; the amplitude of a symmetric orbit), from the
+earlier orbit's to ``stop``, with the frequency an unknown. The family is regularised by the unfolding parameter
+eps of Munoz-Almaraz et al. (Physica D 181, 2003): an unknown added to the equations (harmonic balance and
+collocation: a viscous term eps v in the residual; shooting: eps grad E(x0) on the return map) whose energy balance
+forces eps = 0 on any orbit, reported per point as ``unfolding`` (zero to the corrector's tolerance: the check that
+the family is conservative). Each point also reports the orbit's ``energy``; ``backbone`` gathers frequency,
+period, amplitude, energy and unfolding as columns, and the plot draws the amplitude against the frequency. With a
+model parameter instead, the orbit of the earlier level is followed as that parameter moves. Special points: LPC
+and PD (NS is not sought: a conservative orbit's multipliers come in pairs mu, 1/mu).
+
 Curves of special points (mechgen.analyses.special_curves): with ``about`` an earlier continuation and
 ``special_point`` the position of one of its LP or H points, the continuation follows that point in two
 parameters (the earlier one and ``parameter``, up to ``stop``): output ``curve``, ``type``, ``parameters``.

@@ -1,7 +1,7 @@
 """``continuation`` about a ``periodic_orbit``: the branch of periodic orbits in a parameter, with its cyclic folds,
 period doublings and torus points.
 
-The earlier orbit's method (harmonic balance or shooting) is continued in ``parameter`` up to ``stop`` by
+The earlier orbit's method (harmonic balance, collocation or shooting) is continued in ``parameter`` up to ``stop`` by
 pseudo-arclength (mechgen.runtime.periodic.branch; mechgen.runtime.steady.continuation), so a frequency-response
 curve is followed round its folds: both stable branches and the unstable one between. A forced orbit whose
 ``frequency`` is an expression of the continued parameter (``frequency = "w"``, continued in ``w``) has its period
@@ -12,8 +12,14 @@ over the period}), ``start`` (the state at t = 0: each coordinate and ``<coordin
 ``method``, ``folds`` and ``special_points``: ``LPC`` (a cyclic fold: the branch turns in the parameter),
 ``PD`` (period doubling: a multiplier through -1) and ``NS`` (Neimark-Sacker: a complex pair through the unit
 circle, with ``angle``), each with the parameter, period, amplitude and multipliers there
-(mechgen.runtime.steady.cycle_points); with ``switch_branches`` (a forced orbit by shooting) ``doubled``, the
-period-2T orbit just past every PD point.
+(mechgen.runtime.steady.cycle_points); with ``switch_branches`` (a forced orbit) ``doubled``, the period-2T orbit
+just past every PD point, by the orbit's own method: shooting over 2T from the period-T orbit displaced along the
+eigenvector of the multiplier -1; harmonic balance with 2H harmonics of omega / 2 (the period-T orbit's harmonics are
+the even ones) and collocation on the mesh repeated over [0, 2T], each from the period-T orbit plus the perturbation
+Phi(t) v over [0, 2T] (v that eigenvector: Phi(t + T) v = -Phi(t) v, odd harmonics of omega / 2).
+
+About the free orbit of a conservative model (a ``periodic_orbit`` without frequency on a model that keeps its
+energy) the continuation follows its family: mechgen.analyses.backbone (``parameter = "amplitude"``: the backbone).
 """
 from __future__ import annotations
 

@@ -13,6 +13,27 @@ starts): forced, its last whole period [m T, (m + 1) T]; autonomous, from the se
 the coordinate that varies most over the run's second half, their distance the period's guess (unless ``period`` is
 given).
 
+*Free orbits of a conservative model* (no ``frequency``, and a model that keeps its energy: its residual passes the
+power balance v . r = dE/dt of its ``energy`` output at a few states about the guess, so no damping and no forcing;
+mechgen.analyses.free_orbit): such orbits are not isolated but form a one-parameter family (the backbone curve), so
+the orbit found is the member whose coordinate p (the largest \|q0\|) has the guess's displacement at t = 0,
+q_p(0) = q0_p, where the phase condition puts an extremum of q_p; its frequency is an unknown. The family is
+regularised by the unfolding parameter eps of Munoz-Almaraz, Freire, Galan, Doedel & Vanderbauwhede (Physica D 181,
+2003), an unknown beside the orbit that vanishes on it: harmonic balance and collocation solve
+r(q, v, a, t) + eps v = 0 (the energy balance over a period, eps int \|v\|^2 dt = 0, forces eps = 0), shooting
+x(T) - x(0) + eps grad E(x(0)) = 0 (the flow keeps E) (mechgen.runtime.periodic.conservative). The outputs add
+``unfolding`` (eps, zero to Newton's tolerance) and ``energy`` (E = T + V of the orbit); ``stability`` sets aside the
+two multipliers nearest 1 (along the orbit and along the family). ``continuation`` with ``parameter = "amplitude"``
+follows the family (mechgen.analyses.backbone).
+
+*The linear start* (``start = "linear"``, a forced orbit without q0 / v0 / from): the first guess is the linear
+forced response at the forcing's frequency, X_k = (K - (k omega)^2 M + i k omega C)^-1 F_k for each harmonic k of
+the forcing f(t) = -r(0, 0, 0, t), the model linearised at q = 0 (mechgen.analyses.linear_start): a guess within a
+few Newton steps of the orbit far from resonance, where the nonlinear forces are small beside the linear ones (at
+resonance the linear amplitude F / (c omega) may be far above the nonlinear one: there a continuation from a
+frequency away from it serves better). Where K - (k omega)^2 M + i k omega C is singular (an undamped resonance) the
+linear response does not exist and the start is refused (exit 2 at ``start``).
+
 Methods (``method``; left out: ``harmonic_balance`` when ``harmonics`` is given, ``collocation`` when ``mesh`` is,
 ``shooting`` otherwise; the output ``method`` says which ran):
 

@@ -2,7 +2,8 @@
 
 The multipliers mu are the eigenvalues of the monodromy matrix Phi(T) (mechgen.runtime.periodic.flow): a small
 perturbation grows by mu per period along its eigenvector. An autonomous orbit always has the trivial multiplier
-mu = 1 (a shift along the orbit); the one nearest 1 is set aside before judging. The orbit is ``stable`` when
+mu = 1 (a shift along the orbit); the one nearest 1 is set aside before judging (a free orbit of a conservative family
+has two, along the orbit and along the family: ``trivial = 2``). The orbit is ``stable`` when
 every other |mu| <= 1 + NEUTRAL (a neutral multiplier, |mu| = 1 of a conservative system, counts as stable: the
 multipliers themselves say more), else ``unstable``. By Liouville's formula det Phi(T) = exp(int_0^T trace J dt),
 the product of all multipliers (exp(-c T / m) for a linear dashpot c on a mass m).
