@@ -1,6 +1,6 @@
 """
 The backbone curve of the Duffing oscillator: free orbits continued in their amplitude
-=====================================================================================
+======================================================================================
 
 Without damping and forcing the Duffing oscillator (the built-in model ``duffing`` with :math:`c = F = 0`)
 
@@ -82,8 +82,9 @@ fig, ax = plt.subplots(figsize=(7, 5))
 ax.plot(np.where(stable, w_frc, np.nan), A_frc, "b-", lw=1.2, label="forced response (c = 0.1, F = 0.3), stable")
 ax.plot(np.where(~stable, w_frc, np.nan), A_frc, "b--", lw=1.2, label="forced response, unstable")
 ax.plot(table["frequency"], A, "k-", lw=2.0, label="backbone, mechgen (harmonic balance)")
-ax.plot(outputs["backbone_shooting"]["backbone"]["frequency"], outputs["backbone_shooting"]["backbone"]["amplitude"]["x"],
-        "o", mfc="none", color="tab:orange", ms=4, label="backbone, mechgen (shooting)")
+shot = outputs["backbone_shooting"]["backbone"]
+ax.plot(shot["frequency"], shot["amplitude"]["x"], "o", mfc="none", color="tab:orange", ms=4,
+        label="backbone, mechgen (shooting)")
 grid = np.linspace(0.0, A.max(), 200)
 ax.plot(np.sqrt((k + 0.75 * k3 * grid**2) / m), grid, "k:", lw=1.0, label="first-order harmonic balance")
 exact_w = 2 * np.pi * np.sqrt((k + k3 * grid**2) / m) / (4 * ellipk(k3 * grid**2 / (2 * (k + k3 * grid**2))))

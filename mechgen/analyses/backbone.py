@@ -9,9 +9,10 @@ on the unfolded equations: the backbone curve, frequency against amplitude. With
 orbit of the earlier level as the parameter moves. Each branch point reports, beside a branch of orbits' outputs
 (mechgen.analyses.orbit_branch: ``period``, ``frequency``, ``amplitude``, ``start``, ``multipliers``,
 ``stability``), the orbit's ``energy`` (E = T + V, the model's ``energy`` output) and ``unfolding`` (eps, zero to
-the corrector's tolerance on each orbit of the family). ``stability`` sets aside the two multipliers nearest 1 (along
-the orbit and along the family). ``backbone`` gathers the branch as columns: ``frequency``, ``period``,
-``amplitude`` ({coordinate: max \\|q\\|}), ``energy``, ``unfolding``. Special points: ``LPC`` (the level turns) and
+the corrector's tolerance on each orbit of the family); a point's level is its ``start[<coordinate p>]`` (the
+point's key ``amplitude`` keeps its meaning, {coordinate: max |q|}). ``stability`` sets aside the two multipliers
+nearest 1 (along the orbit and along the family). ``backbone`` gathers the branch as columns: ``frequency``, ``period``,
+``amplitude`` ({coordinate: max |q|}), ``energy``, ``unfolding``. Special points: ``LPC`` (the level turns) and
 ``PD``; NS is not sought (the multipliers of a conservative orbit come in pairs mu, 1/mu, so its test function
 vanishes identically).
 """

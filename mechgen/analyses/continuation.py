@@ -65,7 +65,8 @@ Backbone curves (mechgen.analyses.backbone): with ``about`` the free orbit of a 
 ``periodic_orbit`` without ``frequency`` on a model without damping or forcing) and ``parameter = "amplitude"`` (a
 model parameter of that name wins), the continuation follows the family of free orbits in the displacement
 q_p(0) of the orbit's coordinate p at t = 0 (an extremum there; the amplitude of a symmetric orbit), from the
-earlier orbit's to ``stop``, with the frequency an unknown. The family is regularised by the unfolding parameter
+earlier orbit's to ``stop``, with the frequency an unknown (each point's level is its ``start[<coordinate p>]``;
+its ``amplitude`` keeps its meaning, max |q| per coordinate). The family is regularised by the unfolding parameter
 eps of Munoz-Almaraz et al. (Physica D 181, 2003): an unknown added to the equations (harmonic balance and
 collocation: a viscous term eps v in the residual; shooting: eps grad E(x0) on the return map) whose energy balance
 forces eps = 0 on any orbit, reported per point as ``unfolding`` (zero to the corrector's tolerance: the check that

@@ -4,7 +4,7 @@ energy, solved as one member of its family (mechgen.runtime.periodic.conservativ
 A model is taken as conservative when its residual passes the power balance v . r(q, v, a, t) = dE/dt (E its
 ``energy`` output, T + V) at a few states about the guess, to POWER_TOLERANCE relative
 (mechgen.runtime.periodic.conservative.power_gap): no dissipation, no forcing, no non-conservative force. Such an
-orbit is not isolated: periodic_orbit finds the member whose coordinate p (the one with the largest \\|q0\\|) has the
+orbit is not isolated: periodic_orbit finds the member whose coordinate p (the one with the largest |q0|) has the
 guess's displacement at t = 0, q_p(0) = q0_p (an extremum of q_p there), with the frequency an unknown and the
 unfolding eps (Munoz-Almaraz et al. 2003) solved beside it, zero on the orbit; ``unfolding`` reports it and
 ``energy`` the orbit's E. ``continuation`` about it follows the family (mechgen.analyses.backbone).

@@ -16,11 +16,11 @@ given).
 *Free orbits of a conservative model* (no ``frequency``, and a model that keeps its energy: its residual passes the
 power balance v . r = dE/dt of its ``energy`` output at a few states about the guess, so no damping and no forcing;
 mechgen.analyses.free_orbit): such orbits are not isolated but form a one-parameter family (the backbone curve), so
-the orbit found is the member whose coordinate p (the largest \|q0\|) has the guess's displacement at t = 0,
+the orbit found is the member whose coordinate p (the largest |q0|) has the guess's displacement at t = 0,
 q_p(0) = q0_p, where the phase condition puts an extremum of q_p; its frequency is an unknown. The family is
 regularised by the unfolding parameter eps of Munoz-Almaraz, Freire, Galan, Doedel & Vanderbauwhede (Physica D 181,
 2003), an unknown beside the orbit that vanishes on it: harmonic balance and collocation solve
-r(q, v, a, t) + eps v = 0 (the energy balance over a period, eps int \|v\|^2 dt = 0, forces eps = 0), shooting
+r(q, v, a, t) + eps v = 0 (the energy balance over a period, eps int |v|^2 dt = 0, forces eps = 0), shooting
 x(T) - x(0) + eps grad E(x(0)) = 0 (the flow keeps E) (mechgen.runtime.periodic.conservative). The outputs add
 ``unfolding`` (eps, zero to Newton's tolerance) and ``energy`` (E = T + V of the orbit); ``stability`` sets aside the
 two multipliers nearest 1 (along the orbit and along the family). ``continuation`` with ``parameter = "amplitude"``
@@ -568,6 +568,11 @@ def run_periodic_orbit(system, options: dict, context: dict) -> dict:
             raise SceneError("periodic_orbit: an autonomous orbit from a zero starting guess would find the "
                              "equilibrium", key="q0", expected="a starting guess on or near the orbit (q0, v0)")
     free = omega is None and is_conservative(system, start.x0)
+    if free and not np.any(start.x0[:system.n]):
+        raise SceneError("periodic_orbit: the free orbit of a conservative model is the member through the guess's "
+                         "displacement q_p(0) = q0_p, and q0 is zero", key="q0",
+                         expected="q0 = the displacement at an extremum of the orbit (its amplitude), e.g. "
+                         "q0 = { x = 0.5 }")
     if free:  # a member of a conservative family (mechgen.analyses.free_orbit)
         found = solve_free(system, options, start, method, free_defaults(system, options, method),
                            settings(options, method))
