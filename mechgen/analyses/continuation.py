@@ -200,12 +200,15 @@ SCHEMA = {
     "eigenvalues": Option(schema.boolean, False, doc="report every branch point's eigenvalues too"),
     "special_points": Option(schema.boolean, True, doc="locate and report the branch's special points: folds (LP), "
                              "and on a Newton steady state's branch branch points (BP) and, with stability, Hopf "
-                             "points (H, with the first Lyapunov coefficient)"),
+                             "points (H, with the first Lyapunov coefficient); on a branch of periodic orbits cyclic "
+                             "folds (LPC), period doublings (PD) and torus points (NS; not on a conservative family)"),
     "special_point": Option(schema.count, doc="with about an earlier continuation: the position (from 1) of the "
                             "fold (LP) or Hopf point (H) in its special_points whose curve in two parameters is "
                             "followed (parameter: the second one)"),
     "switch_branches": Option(schema.boolean, False, doc="also follow the other branch through every branch point "
-                              "(BP), both ways (output switched_branches; a Newton steady state's branch)"),
+                              "(BP), both ways (output switched_branches; a Newton steady state's branch); about a "
+                              "forced periodic_orbit, the doubled orbit (period 2T) past every period doubling (PD) "
+                              "by the orbit's own method (output doubled)"),
     "max_seconds": Option(schema.positive, doc="the wall-time budget of the whole analysis (s, default 600), "
                          "checked before every continuation step"),
     "progress": Option(schema.boolean, doc="draw a bar of the branch points on stderr (default true, when it is "
