@@ -17,7 +17,9 @@ from mechgen.errors import InputError, MechgenError, file_kind
 
 
 def _parser() -> argparse.ArgumentParser:
-    ap = argparse.ArgumentParser(prog="mechgen", description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(prog="mechgen", description=__doc__.splitlines()[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--version", action="version", version=_version_line())
     sub = ap.add_subparsers(dest="command", required=True)
     sub.add_parser("models", help="list the built-in models and those installed packages register")
     show = sub.add_parser("show", help="print a model's derived equations and matrices")
@@ -46,6 +48,14 @@ def _parser() -> argparse.ArgumentParser:
                         help="fold a parameter value into the code (others stay inputs)")
     export.add_argument("--kernels", default=None, metavar="K1,K2", help="kernels to export (default: all)")
     return ap
+
+
+def _version_line() -> str:
+    """``mechgen 0.1.0 (python 3.11.7, numpy ..., scipy ..., sympy ..., casadi ...)``."""
+    from mechgen.version import versions
+
+    found = versions()
+    return f"mechgen {found.pop('mechgen')} (" + ", ".join(f"{k} {v}" for k, v in found.items()) + ")"
 
 
 class _Parser(argparse.ArgumentParser):
@@ -207,9 +217,21 @@ def _cmd_show(args) -> int:
     return 0
 
 
-def _cmd_regen(args) -> int:
-    from mechgen.regen import regen
+def _need_checkout(command: str, folders: list[Path]) -> None:
+    """Refuse a command that reads the repository's own folders (scenes/, benchmarks/) where the package was
+    installed from a wheel, which ships the package only."""
+    missing = [f"{folder.name}/" for folder in folders if not folder.is_dir()]
+    if missing:
+        raise InputError(f"mechgen {command} reads {', '.join(missing)} of a source checkout, and this mechgen "
+                         f"({Path(__file__).resolve().parent}) was installed without them",
+                         key=command, expected="mechgen installed from a clone of the repository "
+                                               "(pip install -e . in the clone)")
 
+
+def _cmd_regen(args) -> int:
+    from mechgen.regen import SCENES, regen
+
+    _need_checkout("regen", [SCENES])
     stale = regen(check=args.check)
     if args.check and stale:
         print("mechgen/generated is stale: " + ", ".join(stale) + " (run `mechgen regen`)", file=sys.stderr)
@@ -225,6 +247,9 @@ def _cmd_bench(args) -> int:
     if args.list_suites:
         print("\n".join(suite_lines()))
         return 0
+    from mechgen.bench.common import ROOT
+
+    _need_checkout("bench", [ROOT / "scenes", ROOT / "benchmarks"])
     run_benchmarks(args.models, out=Path(args.out), quick=args.quick)
     return 0
 

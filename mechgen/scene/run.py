@@ -24,6 +24,7 @@ from mechgen.runtime.fields.mesh import Layout
 from mechgen.scene.info import lookup_model, model_info
 from mechgen.scene.load import load_scene
 from mechgen.scene.plan import derive_with, plan_scene, point_request, request_for
+from mechgen.version import versions
 
 
 @lru_cache(maxsize=8)
@@ -129,7 +130,7 @@ def _run_loaded(scn, backend: str | None, scheduler: str | None = None) -> dict:
     system = laid_out(system, layout)
     results = {"scene": Path(scn.path).name, "title": scn.title, "model": scn.model, "backend": report.backend,
                "params": dict(scn.params), "units": model_info(scn.source).units() if scn.source else {},
-               "build": report.to_json(), "analyses": []}
+               "build": report.to_json(), "versions": versions(), "analyses": []}
     results["build"]["seconds_total"] = time.perf_counter() - started
     scene_inputs = (plan.source.key, plan.main, fixed)
     context: dict = {POINTS: PointRunner(sweep_point, partial(_point_task, scene_inputs, layout))}
