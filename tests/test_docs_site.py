@@ -406,7 +406,7 @@ def test_decorators_page_examples_declare_models_that_derive():
 CHEAP_SCENES = ("balloon_stability", "beam_modes", "beck_column", "curved_beam_stiffness", "fpu_chain",
                 "fpu_recurrence", "friction_beam", "impact_models", "laval_rotor", "moving_string", "penetration_limestone",
                 "rate_state_slider", "rod_dynamics", "rod_tip_load", "rotating_string", "spring_pendulum",
-                "stepped_rotor", "stick_slip_element", "timoshenko_modes", "jeffcott_unbalance")
+                "stepped_rotor", "stick_slip_element", "timoshenko_modes", "jeffcott_unbalance", "duffing_backbone")
 
 PLACEHOLDER = re.compile(r"<([a-z ]+)>")
 

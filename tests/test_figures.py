@@ -19,7 +19,7 @@ SCENES = ("beam_modes", "beck_column", "fpu_chain", "fpu_recurrence", "friction_
           "impact_models", "laval_rotor", "moving_string", "penetration_limestone", "rod_dynamics", "rod_end_torque",
           "rod_tip_load", "rotating_beam", "rotating_string", "spring_pendulum", "stick_slip_element",
           "timoshenko_modes", "balloon_stability", "rotor_internal_damping", "jeffcott_unbalance",
-          "van_der_pol_limit_cycle", "duffing_frequency_response", "duffing_softening",
+          "van_der_pol_limit_cycle", "duffing_frequency_response", "duffing_softening", "duffing_backbone",
           "rotor_whirl_limit_cycle", "impact_oscillator_bifurcation", "van_der_pol_from_hopf")
 #: the shipped scenes that take 7 to 25 s each (the rest of the shipped scenes with figures)
 SLOW_SCENES = ("balloon_branches", "balloon_frequencies", "rate_state_stick_slip", "ross_example_rotor",

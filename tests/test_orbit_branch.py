@@ -378,3 +378,63 @@ switch_branches = true
     x0 = np.array([first["start"]["x"], first["start"]["x_dot"]])
     assert np.max(np.abs(flow(x0, 2 * T) - x0)) < 1e-8
     assert np.max(np.abs(flow(x0, T) - x0)) > 1e-4
+
+
+WELL = """model = "duffing"
+backend = "c"
+[params]
+c = 0.3
+k = -1.0
+k3 = 1.0
+F = 0.05
+w = 1.2
+[[analysis]]
+name = "settle"
+kind = "simulate"
+t_end = 104.71975511965977
+q0 = { x = 1.0 }
+series = true
+samples = 2001
+[[analysis]]
+name = "orbit"
+kind = "periodic_orbit"
+method = "METHOD"
+EXTRA
+frequency = "w"
+from = "settle"
+[[analysis]]
+name = "branch"
+kind = "continuation"
+about = "orbit"
+parameter = "F"
+stop = 0.5
+max_step = 0.02
+switch_branches = true
+"""
+
+
+@pytest.mark.parametrize("method, extra", [("harmonic_balance", "harmonics = 15"), ("collocation", "mesh = 40")])
+def test_doubled_orbit_by_harmonic_balance_and_collocation(tmp_path, method, extra):
+    """switch_branches on the double-well Duffing branch (the orbit in one well, from a simulate that settled there)
+    by harmonic balance (the doubled orbit: 30 harmonics of w/2) and collocation (80 intervals over 2T): the PD point
+    agrees with shooting's F = 0.2655817860716 (measured there; to 1e-9: the methods' errors, measured 5e-12), the
+    doubled orbit's period is 2T, and its start is the 2T-periodic orbit of a hand-written shooting (scipy DOP853 at
+    1e-12, fsolve over 2T) at its F to 1e-9 (measured 1e-12 for both), and not T-periodic."""
+    scene = tmp_path / f"well_{method}.toml"
+    scene.write_text(WELL.replace("METHOD", method).replace("EXTRA", extra))
+    out = mechgen.run(str(scene))["analyses"][-1]["outputs"]
+    pd = [s for s in out["special_points"] if s["type"] == "PD"]
+    assert pd and pd[0]["F"] == pytest.approx(0.2655817860716, abs=1e-9)
+    first = out["doubled"][0]
+    F_d, T = first["F"], 2 * math.pi / 1.2
+    assert first["period"] == pytest.approx(2 * T, rel=1e-14) and first["at"] == 1
+
+    def flow(x, span):
+        def rhs(t, y):
+            return [y[1], F_d * math.cos(1.2 * t) - 0.3 * y[1] + y[0] - y[0] ** 3]
+        return solve_ivp(rhs, (0.0, span), x, method="DOP853", rtol=1e-12, atol=1e-14).y[:, -1]
+
+    x0 = np.array([first["start"]["x"], first["start"]["x_dot"]])
+    reference = fsolve(lambda x: flow(x, 2 * T) - x, x0, xtol=1e-13)
+    assert np.max(np.abs(reference - x0)) < 1e-9
+    assert np.max(np.abs(flow(x0, T) - x0)) > 1e-3

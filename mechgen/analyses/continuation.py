@@ -54,6 +54,27 @@ det [[F_y, F_p], [chord]], with the other branch's ``direction``) and, with ``st
 coefficient ``lyapunov`` and ``criticality``). ``switch_branches = true`` follows the other branch from every BP,
 both ways (``switched_branches``).
 
+Branches of periodic orbits (mechgen.analyses.orbit_branch): with ``about`` an earlier ``periodic_orbit`` the
+orbit is continued by its own method (harmonic balance, collocation or shooting) through its folds, reporting per
+point ``period``, ``frequency``, ``amplitude``, ``start``, ``multipliers`` and ``stability``, and the special points
+``LPC`` (cyclic fold), ``PD`` (period doubling) and ``NS`` (torus); ``switch_branches = true`` (a forced orbit) adds
+``doubled``, the period-2T orbit past every PD point, by the same method. A forced orbit's first guess may be the
+linear forced response (periodic_orbit's ``start = "linear"``).
+
+Backbone curves (mechgen.analyses.backbone): with ``about`` the free orbit of a conservative model (a
+``periodic_orbit`` without ``frequency`` on a model without damping or forcing) and ``parameter = "amplitude"`` (a
+model parameter of that name wins), the continuation follows the family of free orbits in the displacement
+q_p(0) of the orbit's coordinate p at t = 0 (an extremum there; the amplitude of a symmetric orbit), from the
+earlier orbit's to ``stop``, with the frequency an unknown (each point's level is its ``start[<coordinate p>]``;
+its ``amplitude`` keeps its meaning, max |q| per coordinate). The family is regularised by the unfolding parameter
+eps of Munoz-Almaraz et al. (Physica D 181, 2003): an unknown added to the equations (harmonic balance and
+collocation: a viscous term eps v in the residual; shooting: eps grad E(x0) on the return map) whose energy balance
+forces eps = 0 on any orbit, reported per point as ``unfolding`` (zero to the corrector's tolerance: the check that
+the family is conservative). Each point also reports the orbit's ``energy``; ``backbone`` gathers frequency,
+period, amplitude, energy and unfolding as columns, and the plot draws the amplitude against the frequency. With a
+model parameter instead, the orbit of the earlier level is followed as that parameter moves. Special points: LPC
+and PD (NS is not sought: a conservative orbit's multipliers come in pairs mu, 1/mu).
+
 Curves of special points (mechgen.analyses.special_curves): with ``about`` an earlier continuation and
 ``special_point`` the position of one of its LP or H points, the continuation follows that point in two
 parameters (the earlier one and ``parameter``, up to ``stop``): output ``curve``, ``type``, ``parameters``.
@@ -69,7 +90,7 @@ from mechgen.analyses import figures, schema, summary
 from mechgen.analyses.bvp_states import (bvp_summary, shape_declarations, shape_values, stability_about,
                                          stability_of_each)
 from mechgen.analyses.newton_branch import newton_branch
-from mechgen.analyses.orbit_branch import run_orbit_branch
+from mechgen.analyses.orbit_branch import FAMILY_PARAMETER, run_orbit_branch
 from mechgen.analyses.special_curves import run_curve
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import REQUIRED, Option
@@ -133,7 +154,14 @@ def _bounds(ctx, key: str, value: object) -> dict[str, tuple[float, float]]:
     return out
 
 
+class FamilyParameter(str):
+    """``parameter = "amplitude"`` on a model without a parameter of that name: the level of a conservative
+    family's free orbits (mechgen.analyses.backbone), not a model parameter (nothing is freed in the kernels)."""
+
+
 def _parameter(ctx, key: str, value: object) -> str:
+    if value == FAMILY_PARAMETER and value not in ctx.model.params:
+        return FamilyParameter(value)
     info = param_info(ctx.file, key, ctx.model, value)
     if is_choice(info) or info.integer:
         raise fail(ctx.file, key, f"parameter {show(value)} is not a real number", "a numeric model parameter")
@@ -146,7 +174,10 @@ SCHEMA = {
     "about": Option(_starts, REQUIRED, doc="the earlier steady analysis the branch starts from, or a list of them "
                     "(one branch each); or an earlier periodic_orbit (a branch of orbits), or an earlier "
                     "continuation (with special_point: the curve of one of its special points)"),
-    "parameter": Option(_parameter, REQUIRED, doc="the numeric parameter the branch is followed in"),
+    "parameter": Option(_parameter, REQUIRED, doc="the numeric parameter the branch is followed in; about the "
+                        "free orbit of a conservative model (a periodic_orbit without frequency), \"amplitude\" "
+                        "follows its family, the backbone curve, in the level q_p(0) (a model parameter of that name "
+                        "wins)"),
     "stop": Option(schema.number, REQUIRED, doc="the parameter's value where the branch ends (its unit)"),
     "step": Option(schema.positive, 0.05, doc="the first pseudo-arclength step"),
     "max_step": Option(schema.positive, doc="the largest pseudo-arclength step"),
@@ -169,12 +200,15 @@ SCHEMA = {
     "eigenvalues": Option(schema.boolean, False, doc="report every branch point's eigenvalues too"),
     "special_points": Option(schema.boolean, True, doc="locate and report the branch's special points: folds (LP), "
                              "and on a Newton steady state's branch branch points (BP) and, with stability, Hopf "
-                             "points (H, with the first Lyapunov coefficient)"),
+                             "points (H, with the first Lyapunov coefficient); on a branch of periodic orbits cyclic "
+                             "folds (LPC), period doublings (PD) and torus points (NS; not on a conservative family)"),
     "special_point": Option(schema.count, doc="with about an earlier continuation: the position (from 1) of the "
                             "fold (LP) or Hopf point (H) in its special_points whose curve in two parameters is "
                             "followed (parameter: the second one)"),
     "switch_branches": Option(schema.boolean, False, doc="also follow the other branch through every branch point "
-                              "(BP), both ways (output switched_branches; a Newton steady state's branch)"),
+                              "(BP), both ways (output switched_branches; a Newton steady state's branch); about a "
+                              "forced periodic_orbit, the doubled orbit (period 2T) past every period doubling (PD) "
+                              "by the orbit's own method (output doubled)"),
     "max_seconds": Option(schema.positive, doc="the wall-time budget of the whole analysis (s, default 600), "
                          "checked before every continuation step"),
     "progress": Option(schema.boolean, doc="draw a bar of the branch points on stderr (default true, when it is "
@@ -206,7 +240,13 @@ def check(ctx, base: str, options: dict) -> None:
                    "a curve of special points needs both 'about' an earlier continuation and 'special_point'",
                    "special_point = <position in its special_points> with about = \"<continuation>\"" if curve
                    else "about = an earlier steady analysis (special_point goes with about = a continuation)")
-    if curve or (isinstance(about, str) and ctx.earlier.get(about) == "periodic_orbit"):
+    orbit = isinstance(about, str) and ctx.earlier.get(about) == "periodic_orbit"
+    if isinstance(options["parameter"], FamilyParameter) and not orbit:
+        raise fail(ctx.file, f"{base}.parameter", f"parameter '{FAMILY_PARAMETER}' (model {ctx.model.name} has no "
+                   "parameter of that name) continues the family of a conservative model's free orbits, and 'about' "
+                   "is not a periodic_orbit", "about = a periodic_orbit without frequency on a conservative model, "
+                   "or one of the model's parameters: " + listing(list(ctx.model.params)))
+    if curve or orbit:
         return
     if isinstance(options["about"], list) and "minimize" in options:
         raise fail(ctx.file, f"{base}.minimize", "minimize follows one branch; 'about' lists several starts",
@@ -220,8 +260,8 @@ def check(ctx, base: str, options: dict) -> None:
 
 
 def frees(options: dict) -> list[str]:
-    """The continuation parameter: free in the kernels."""
-    return [options["parameter"]]
+    """The continuation parameter: free in the kernels (a conservative family's level is none)."""
+    return [] if isinstance(options["parameter"], FamilyParameter) else [options["parameter"]]
 
 
 def needs(options: dict, *, internal: bool) -> set[str]:
@@ -566,6 +606,38 @@ def _orbit_branch(plt, a: dict, path: Path) -> bool:
     return True
 
 
+def _backbone(plt, a: dict, path: Path) -> bool:
+    """A conservative family's backbone: each coordinate's amplitude against the orbit's frequency (stable solid,
+    unstable dashed), its special points marked (mechgen.analyses.backbone)."""
+    out = a["outputs"]
+    table = out.get("backbone")
+    if not table or not out.get("branch"):
+        return False
+    points = out["branch"]
+    w = np.array(table["frequency"])
+    fig, ax = plt.subplots(figsize=(7, 5))
+    for coordinate, values in table["amplitude"].items():
+        amp = np.array(values)
+        for style, label in (("-", "stable"), ("--", "unstable")):
+            mask = np.array([p["stability"] == label for p in points])
+            if mask.any():
+                mask[:-1] |= mask[1:]
+                ax.plot(w, np.where(mask, amp, np.nan), style, lw=1.2, label=f"{coordinate}, {label}")
+        for special in out.get("special_points", []):
+            ax.plot(special["frequency"], special["amplitude"][coordinate], _ORBIT_MARKS.get(special["type"], "o"),
+                    ms=7, mfc="none", color="k")
+            ax.annotate(special["type"], (special["frequency"], special["amplitude"][coordinate]), fontsize=7,
+                        xytext=(5, 4), textcoords="offset points")
+    ax.set_xlabel("frequency of the free orbit, 2 pi / T (rad per unit time)")
+    ax.set_ylabel("amplitude max |q| over the period")
+    ax.legend(fontsize=7, loc="best")
+    ax.set_title(f"{a['name']}: backbone curve, the free orbits' family ({out.get('method', '')})", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return True
+
+
 #: markers of the special points of a branch of orbits
 _ORBIT_MARKS = {"LPC": "x", "PD": "s", "NS": "D"}
 
@@ -654,7 +726,8 @@ def plot(plt, a: dict, path: Path) -> list[Path]:
     outputs such as the loop count written where they change, folds, stability changes and the ``at``
     crossings marked), the shapes of the ``at`` points (first field against the last), with ``eigenvalues``
     their real and imaginary parts along the branch, and the lowest frequencies against the parameter."""
-    written = [path] if _orbit_branch(plt, a, path) or _branch(plt, a, path) or _curve(plt, a, path) else []
+    written = [path] if (_backbone(plt, a, path) or _orbit_branch(plt, a, path) or _branch(plt, a, path)
+                         or _curve(plt, a, path)) else []
     out = a["outputs"]
     name = out.get("parameter", "parameter")
     for key in [k[3:] for k in out if k.startswith("at_") and not k.endswith("_shapes")]:

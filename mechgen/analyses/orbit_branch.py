@@ -1,7 +1,7 @@
 """``continuation`` about a ``periodic_orbit``: the branch of periodic orbits in a parameter, with its cyclic folds,
 period doublings and torus points.
 
-The earlier orbit's method (harmonic balance or shooting) is continued in ``parameter`` up to ``stop`` by
+The earlier orbit's method (harmonic balance, collocation or shooting) is continued in ``parameter`` up to ``stop`` by
 pseudo-arclength (mechgen.runtime.periodic.branch; mechgen.runtime.steady.continuation), so a frequency-response
 curve is followed round its folds: both stable branches and the unstable one between. A forced orbit whose
 ``frequency`` is an expression of the continued parameter (``frequency = "w"``, continued in ``w``) has its period
@@ -12,8 +12,14 @@ over the period}), ``start`` (the state at t = 0: each coordinate and ``<coordin
 ``method``, ``folds`` and ``special_points``: ``LPC`` (a cyclic fold: the branch turns in the parameter),
 ``PD`` (period doubling: a multiplier through -1) and ``NS`` (Neimark-Sacker: a complex pair through the unit
 circle, with ``angle``), each with the parameter, period, amplitude and multipliers there
-(mechgen.runtime.steady.cycle_points); with ``switch_branches`` (a forced orbit by shooting) ``doubled``, the
-period-2T orbit just past every PD point.
+(mechgen.runtime.steady.cycle_points); with ``switch_branches`` (a forced orbit) ``doubled``, the period-2T orbit
+just past every PD point, by the orbit's own method: shooting over 2T from the period-T orbit displaced along the
+eigenvector of the multiplier -1; harmonic balance with 2H harmonics of omega / 2 (the period-T orbit's harmonics are
+the even ones) and collocation on the mesh repeated over [0, 2T], each from the period-T orbit plus the perturbation
+Phi(t) v over [0, 2T] (v that eigenvector: Phi(t + T) v = -Phi(t) v, odd harmonics of omega / 2).
+
+About the free orbit of a conservative model (a ``periodic_orbit`` without frequency on a model that keeps its
+energy) the continuation follows its family: mechgen.analyses.backbone (``parameter = "amplitude"``: the backbone).
 """
 from __future__ import annotations
 
@@ -37,7 +43,9 @@ from mechgen.runtime.steady.cycle_points import cycle_points
 
 #: keys of a continuation that an orbit branch does not take
 ORBIT_REFUSES = ("method", "stages", "bounds", "at", "minimize", "switch_branches", "special_point", "eigenvalues",
-                 "aliases")  # switch_branches: taken by a forced orbit found by shooting (and a hybrid model's)
+                 "aliases")  # switch_branches: taken by a forced orbit (and a hybrid model's)
+#: ``parameter`` of a continuation along a conservative family (mechgen.analyses.backbone): the level q_p(0)
+FAMILY_PARAMETER = "amplitude"
 #: phases at which a branch point's amplitudes are taken
 PHASES = 4096
 
@@ -147,9 +155,22 @@ def record(orbits: Orbits, branch: OrbitBranch, u: np.ndarray, p: float) -> dict
 def run_orbit_branch(system, options: dict, earlier: dict) -> dict:
     """The branch of orbits through an earlier periodic_orbit (module doc; a hybrid model's:
     mechgen.analyses.hybrid_orbit.run_hybrid_branch, which also takes ``switch_branches``)."""
+    if earlier["_orbit"].get("conservative"):  # a free orbit's family (mechgen.analyses.backbone)
+        for key in ORBIT_REFUSES:
+            if options.get(key):
+                raise SceneError(f"{key} does not apply to the family of a conservative model's free orbits",
+                                 key=key, expected=f"no {key}")
+        from mechgen.analyses.backbone import run_backbone
+
+        return run_backbone(system, options, earlier["_orbit"])
+    if options["parameter"] == FAMILY_PARAMETER and FAMILY_PARAMETER not in system.param_values():
+        raise SceneError(f"parameter '{FAMILY_PARAMETER}' continues the family of a conservative model's free "
+                         "orbits, and the earlier periodic_orbit is not one (it is forced, or its model dissipates "
+                         "or is forced)", key="parameter",
+                         expected="a model parameter, or about = a periodic_orbit without frequency on a "
+                         "conservative model")
     hybrid = bool(earlier["_orbit"].get("hybrid"))
-    switchable = hybrid or (earlier["_orbit"]["method"] == "shooting"
-                            and earlier["_orbit"]["options"].get("frequency") is not None)
+    switchable = hybrid or earlier["_orbit"]["options"].get("frequency") is not None  # a forced orbit
     for key in ORBIT_REFUSES:
         if options.get(key) and not (switchable and key == "switch_branches"):
             raise SceneError(f"{key} does not apply to a branch of periodic orbits", key=key,
@@ -197,12 +218,12 @@ def run_orbit_branch(system, options: dict, earlier: dict) -> dict:
 
 def doubled_record(orbits: Orbits, branch: OrbitBranch, X: np.ndarray, x_pd: np.ndarray, index: int,
                    at: int) -> dict:
-    """The doubled orbit (period 2T) past the PD point x_pd of a forced orbit found by shooting: at the parameter
-    half-way to the neighbouring branch point whose orbit has a multiplier below -1, by shooting over 2T from the
-    period-T orbit there displaced along the eigenvector of the multiplier nearest -1 (both ways, 1e-3 to 1e-1 of
-    the state's size), the first start that converges to an orbit other than the period-T one."""
+    """The doubled orbit (period 2T) past the PD point x_pd of a forced orbit: at the parameter half-way to the
+    neighbouring branch point whose orbit has a multiplier below -1, from the period-T orbit there displaced along
+    the eigenvector of the multiplier nearest -1 (both ways, 1e-3 to 1e-1 of the state's size), the first start
+    that converges to an orbit other than the period-T one: by shooting over 2T (:func:`shooting_doubled`), or by
+    the earlier orbit's harmonic balance or collocation over 2T (:func:`spectral_doubled`)."""
     from mechgen.analyses.periodic_orbit import settings
-    from mechgen.errors import ConvergenceError
     from mechgen.runtime.periodic.newton import newton
 
     def most_negative(x):
@@ -211,7 +232,19 @@ def doubled_record(orbits: Orbits, branch: OrbitBranch, X: np.ndarray, x_pd: np.
     side = min((X[index], X[index + 1]), key=most_negative)
     p = float(x_pd[-1]) + 0.5 * (float(side[-1]) - float(x_pd[-1]))
     single = newton(branch.problem(p).residual_jacobian, np.asarray(x_pd[:-1], float),
-                    settings(orbits.options, "shooting")).u
+                    settings(orbits.options, orbits.method)).u
+    if orbits.method == "shooting":
+        return shooting_doubled(orbits, branch, p, single, at)
+    return spectral_doubled(orbits, branch.problem(p), p, single, at)
+
+
+def shooting_doubled(orbits: Orbits, branch: OrbitBranch, p: float, single: np.ndarray, at: int) -> dict:
+    """Shooting over 2T from the period-T orbit ``single`` at p displaced along the PD eigenvector (the eigenvector
+    of Phi = dR/du + I for the multiplier nearest -1)."""
+    from mechgen.analyses.periodic_orbit import settings
+    from mechgen.errors import ConvergenceError
+    from mechgen.runtime.periodic.newton import newton
+
     values, vectors = np.linalg.eig(branch.residual_jacobian(single, p)[1] + np.eye(single.size))
     v = np.real(vectors[:, int(np.argmin(np.abs(values + 1.0)))])
     v = v / np.linalg.norm(v)
@@ -228,12 +261,107 @@ def doubled_record(orbits: Orbits, branch: OrbitBranch, X: np.ndarray, x_pd: np.
                 continue
             if np.max(np.abs(u - single)) > 1e-6 * scale:
                 mu = floquet.multipliers(double.residual_jacobian(u)[1] + np.eye(u.size))
-                names = list(orbits.system.coordinates)
                 T2 = 2 * 2 * np.pi / orbits.omega(p)
                 X = orbits.flow_states(double, u, T2 * np.arange(PHASES) / PHASES)
-                return {"at": at, orbits.name: p, "period": T2,
-                        "amplitude": {c: peak(X[:, i]) for i, c in enumerate(names)},
-                        "start": dict(zip(names + [f"{c}_dot" for c in names], (float(c) for c in u))),
-                        "multipliers": floquet.as_pairs(mu), "stability": floquet.stability(mu, False)}
-    raise ConvergenceError(f"no doubled orbit found at {orbits.name} = {p:.10g} past the PD point (shooting over 2T "
-                           "returned the period-T orbit or did not converge); try a smaller max_step near it")
+                return doubled_outputs(orbits, p, T2, X, mu, at)
+    raise no_doubled(orbits, p, "shooting")
+
+
+def no_doubled(orbits: Orbits, p: float, method: str):
+    """The failure to find the doubled orbit."""
+    from mechgen.errors import ConvergenceError
+
+    return ConvergenceError(f"no doubled orbit found at {orbits.name} = {p:.10g} past the PD point ({method} over 2T "
+                            "returned the period-T orbit or did not converge); try a smaller max_step near it")
+
+
+def doubled_outputs(orbits: Orbits, p: float, T2: float, X: np.ndarray, mu: np.ndarray, at: int) -> dict:
+    """The record of a doubled orbit: its states X at PHASES phases of [0, 2T], its multipliers mu."""
+    names = list(orbits.system.coordinates)
+    return {"at": at, orbits.name: p, "period": T2, "amplitude": {c: peak(X[:, i]) for i, c in enumerate(names)},
+            "start": dict(zip(names + [f"{c}_dot" for c in names], (float(c) for c in X[0]))),
+            "multipliers": floquet.as_pairs(mu), "stability": floquet.stability(mu, False)}
+
+
+def flow_of(orbits: Orbits, system, x0: np.ndarray, times: np.ndarray) -> np.ndarray:
+    """The states from x0 at ``times`` (ascending, from 0) by the compiled loop where it runs, else scipy's."""
+    run = compiled_run(system, orbits.options)
+    if run is not None:
+        return run(np.asarray(x0, float), np.asarray(times, float))
+    return states_at(system, x0, 0.0, times, *integrator_tolerances(orbits.options))
+
+
+def monodromy(orbits: Orbits, system, x0: np.ndarray, span: float) -> np.ndarray:
+    """Phi(span) from x0: central differences of the compiled flow where it runs, else the variational equations."""
+    run = compiled_run(system, orbits.options)
+    if run is not None:
+        return differenced_flow(run, x0, span)[1]
+    return variational_flow(system, x0, 0.0, span, *integrator_tolerances(orbits.options))[1]
+
+
+def pd_perturbation(orbits: Orbits, system, x0: np.ndarray, T: float, times: np.ndarray) -> np.ndarray:
+    """dx(t) = Phi(t) v at ``times`` in [0, 2T], v the unit eigenvector of Phi(T) for the multiplier nearest -1 (so
+    dx(t + T) = -dx(t): odd harmonics of omega / 2), by central differences of the flow (step 1e-6 (1 + |x0|))."""
+    values, vectors = np.linalg.eig(monodromy(orbits, system, x0, T))
+    v = np.real(vectors[:, int(np.argmin(np.abs(values + 1.0)))])
+    v = v / np.linalg.norm(v)
+    h = 1e-6 * (1.0 + float(np.max(np.abs(x0))))
+    return (flow_of(orbits, system, x0 + h * v, times) - flow_of(orbits, system, x0 - h * v, times)) / (2 * h)
+
+
+def doubled_problem(orbits: Orbits, problem, p: float):
+    """The earlier method's problem over 2T at p: harmonic balance at omega / 2 with 2H harmonics (the period-T
+    orbit's harmonics are the even ones), collocation on the mesh repeated over [0, 2T]."""
+    omega = orbits.omega(p) / 2
+    if orbits.method == "harmonic_balance":
+        return HarmonicBalance(problem.system, fourier.basis(2 * problem.basis.harmonics), omega, orbits.phase)
+    edges = problem.edge_array
+    twice = np.concatenate([edges / 2, 0.5 + edges[1:] / 2])
+    return Collocation(problem.system, 2 * problem.mesh, omega, orbits.phase, tuple(twice))
+
+
+def doubled_unknowns(double, curve) -> np.ndarray:
+    """The doubled problem's unknowns from ``curve``: times in [0, 2T] -> states (rows)."""
+    T2 = 2 * np.pi / double.omega
+    if isinstance(double, HarmonicBalance):
+        N = double.basis.theta.size
+        n = double.system.n
+        return fourier.coefficients_of_samples(curve(T2 * np.arange(N) / N)[:, :n], double.basis.harmonics).ravel()
+    edges = double.edge_array
+    from mechgen.runtime.periodic.collocation import DEGREE
+
+    tau = (edges[:-1, None] + (np.arange(DEGREE) / DEGREE)[None, :] * np.diff(edges)[:, None]).ravel()
+    return double.unknowns(curve(tau * T2), T2)
+
+
+def spectral_doubled(orbits: Orbits, problem, p: float, single: np.ndarray, at: int) -> dict:
+    """Harmonic balance or collocation over 2T (:func:`doubled_problem`) from the period-T orbit ``single`` at p plus
+    s dx(t) (:func:`pd_perturbation`), s = +-(1e-3 .. 1e-1) (1 + max |x|); accepted when x(t + T) differs from x(t)
+    by more than 1e-6 of that scale."""
+    from mechgen.analyses.periodic_orbit import settings
+    from mechgen.errors import ConvergenceError
+    from mechgen.runtime.periodic.newton import newton
+
+    T = orbits.period(problem, single)
+    grid = 2 * T * np.arange(2 * PHASES) / (2 * PHASES)
+    base = orbits.states(problem, single, grid[:PHASES])
+    x0 = base[0]
+    shift = pd_perturbation(orbits, problem.system, x0, T, grid)
+    shift = shift / float(np.max(np.abs(shift)))
+    double = doubled_problem(orbits, problem, p)
+    scale = 1.0 + float(np.max(np.abs(base)))
+    for size in (1e-3, 1e-2, 1e-1):
+        for sign in (1.0, -1.0):
+            def curve(times, k=sign * size * scale):
+                index = np.rint(np.asarray(times) / (2 * T) * 2 * PHASES).astype(int) % (2 * PHASES)
+                return np.vstack([base, base])[index] + k * shift[index]
+            try:
+                u = newton(double.residual_jacobian, doubled_unknowns(double, curve),
+                           settings(orbits.options, orbits.method)).u
+            except ConvergenceError:
+                continue
+            X = orbits.states(double, u, grid)
+            if np.max(np.abs(X[:PHASES] - X[PHASES:])) > 1e-6 * scale:
+                mu = floquet.multipliers(monodromy(orbits, problem.system, X[0], 2 * T))
+                return doubled_outputs(orbits, p, 2 * T, X, mu, at)
+    raise no_doubled(orbits, p, orbits.method)

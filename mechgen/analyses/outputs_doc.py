@@ -186,8 +186,8 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("switched_branches", "list of {at, half, branch, status}", "the outputs'", "With "
            "``switch_branches = true``: the other branch through every BP, both ways (``half`` ``+`` or ``-``; "
            "``at``: the BP's position in ``special_points``, from 1; ``branch``: its points as in ``branch``)."),
-        _o("method", "string", "-", "About a ``periodic_orbit``: the orbit's method (``harmonic_balance`` or "
-           "``shooting``) the branch is continued by."),
+        _o("method", "string", "-", "About a ``periodic_orbit``: the orbit's method (``harmonic_balance``, "
+           "``collocation`` or ``shooting``) the branch is continued by."),
         _o("branch (orbits)", "list of {<parameter>, period, frequency, amplitude, start, multipliers, stability}",
            "s, rad/s, coordinates'", "About a ``periodic_orbit``: one entry per orbit of the branch: the parameter, "
            "the period T, 2 pi / T, ``amplitude`` ({coordinate: max \\|q\\| over the period}), ``start`` (the state "
@@ -195,10 +195,18 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
            "decreasing modulus) and ``stability``; its ``special_points`` are ``LPC`` (cyclic fold), ``PD`` (period "
            "doubling: a multiplier through -1) and ``NS`` (a complex pair through the unit circle, with ``angle``)."),
         _o("doubled", "list of {at, <parameter>, amplitude, period, start, multipliers, stability}", "the outputs'",
-           "About a forced ``periodic_orbit`` found by shooting (or a hybrid model's), with ``switch_branches = "
-           "true``: the period-2T orbit just past every PD point (``at``: the PD's position in ``special_points``, "
-           "from 1), at the parameter half-way to the next branch point on the side where the period-T orbit has a "
-           "multiplier below -1."),
+           "About a forced ``periodic_orbit`` (by harmonic balance, collocation or shooting; or a hybrid model's), "
+           "with ``switch_branches = true``: the period-2T orbit just past every PD point (``at``: the PD's position "
+           "in ``special_points``, from 1), at the parameter half-way to the next branch point on the side where the "
+           "period-T orbit has a multiplier below -1, by the orbit's own method over 2T (harmonic balance: 2H "
+           "harmonics of omega / 2; collocation: the mesh repeated)."),
+        _o("backbone", "{frequency, period, amplitude: {coordinate: (points,)}, energy, unfolding}",
+           "rad/s, s, the coordinates', J, force per velocity", "About the free orbit of a conservative model (a "
+           "``periodic_orbit`` without ``frequency``): the family's branch as columns, one entry per point: the "
+           "orbit's frequency 2 pi / T, period, ``amplitude`` (max \\|q\\| per coordinate), ``energy`` (T + V, the "
+           "model's ``energy`` output) and ``unfolding`` (the Munoz-Almaraz parameter eps, zero to the corrector's "
+           "tolerance); the points of ``branch`` carry ``energy`` and ``unfolding`` too. With ``parameter = "
+           "\"amplitude\"`` the backbone curve (frequency against amplitude)."),
         _o("curve", "list of {<first>, <second>, coordinates, ..., frequency}", "the outputs'", "With "
            "``special_point`` (``about`` an earlier continuation): the curve of its LP or H in two parameters, "
            "one entry per point with both parameters, ``coordinates``, the model's outputs and, on an H curve, "
@@ -358,11 +366,16 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("multipliers", "(2n, 2)", "-", "The Floquet multipliers (eigenvalues of the monodromy matrix) as [re, "
            "im] pairs, by decreasing modulus (a conjugate pair: the positive imaginary part first)."),
         _o("stability", "string", "-", "``stable`` (every multiplier \\|mu\\| <= 1 + 1e-6, an autonomous "
-           "orbit's trivial one set aside) or ``unstable``."),
+           "orbit's trivial one set aside, a conservative model's free orbit's two nearest 1) or ``unstable``."),
         _o("method", "string", "-", "``harmonic_balance``, ``shooting`` or ``collocation``: the method that ran."),
         _o("residual", "scalar", "force units (harmonic balance), the state's (shooting), mixed (collocation: "
            "q's rate and force units)", "\\|\\|R\\|\\|_inf at the solution."),
         _o("iterations", "scalar (int)", "-", "Newton steps taken."),
+        _o("unfolding", "scalar", "force per velocity (shooting: the state's per J)", "The free orbit of a "
+           "conservative model (no ``frequency``, a model that keeps its energy): the unfolding parameter eps of "
+           "Munoz-Almaraz et al. (2003) solved beside the orbit, zero to Newton's tolerance on it."),
+        _o("energy", "scalar", "J (the model's energy unit)", "The free orbit of a conservative model: its energy "
+           "T + V (the model's ``energy`` output), constant along it."),
         _o("loop", "string", "-", "``c``: shooting's integrations ran in the compiled DOP853 loop (the monodromy "
            "for Newton by central differences of it; a forced orbit's later segments, with ``segments`` > 1, in "
            "scipy's); ``python``: in scipy's DOP853 (harmonic balance's and "

@@ -13,6 +13,27 @@ starts): forced, its last whole period [m T, (m + 1) T]; autonomous, from the se
 the coordinate that varies most over the run's second half, their distance the period's guess (unless ``period`` is
 given).
 
+*Free orbits of a conservative model* (no ``frequency``, and a model that keeps its energy: its residual passes the
+power balance v . r = dE/dt of its ``energy`` output at a few states about the guess, so no damping and no forcing;
+mechgen.analyses.free_orbit): such orbits are not isolated but form a one-parameter family (the backbone curve), so
+the orbit found is the member whose coordinate p (the largest |q0|) has the guess's displacement at t = 0,
+q_p(0) = q0_p, where the phase condition puts an extremum of q_p; its frequency is an unknown. The family is
+regularised by the unfolding parameter eps of Munoz-Almaraz, Freire, Galan, Doedel & Vanderbauwhede (Physica D 181,
+2003), an unknown beside the orbit that vanishes on it: harmonic balance and collocation solve
+r(q, v, a, t) + eps v = 0 (the energy balance over a period, eps int |v|^2 dt = 0, forces eps = 0), shooting
+x(T) - x(0) + eps grad E(x(0)) = 0 (the flow keeps E) (mechgen.runtime.periodic.conservative). The outputs add
+``unfolding`` (eps, zero to Newton's tolerance) and ``energy`` (E = T + V of the orbit); ``stability`` sets aside the
+two multipliers nearest 1 (along the orbit and along the family). ``continuation`` with ``parameter = "amplitude"``
+follows the family (mechgen.analyses.backbone).
+
+*The linear start* (``start = "linear"``, a forced orbit without q0 / v0 / from): the first guess is the linear
+forced response at the forcing's frequency, X_k = (K - (k omega)^2 M + i k omega C)^-1 F_k for each harmonic k of
+the forcing f(t) = -r(0, 0, 0, t), the model linearised at q = 0 (mechgen.analyses.linear_start): a guess within a
+few Newton steps of the orbit far from resonance, where the nonlinear forces are small beside the linear ones (at
+resonance the linear amplitude F / (c omega) may be far above the nonlinear one: there a continuation from a
+frequency away from it serves better). Where K - (k omega)^2 M + i k omega C is singular (an undamped resonance) the
+linear response does not exist and the start is refused (exit 2 at ``start``).
+
 Methods (``method``; left out: ``harmonic_balance`` when ``harmonics`` is given, ``collocation`` when ``mesh`` is,
 ``shooting`` otherwise; the output ``method`` says which ran):
 
@@ -80,6 +101,8 @@ from typing import Callable
 import numpy as np
 
 from mechgen.analyses import schema, summary, time_series
+from mechgen.analyses.free_orbit import is_conservative, orbit_energy, solve_free
+from mechgen.analyses.linear_start import linear_coefficients
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import ABSENT, Option
 from mechgen.errors import ConvergenceError, SceneError
@@ -95,6 +118,7 @@ from mechgen.scene.values import fail, listing, show
 METHODS = ("harmonic_balance", "shooting", "collocation")
 LOOPS = ("auto", "python", "c")
 FLOQUET = ("monodromy", "hill")
+STARTS = ("guess", "linear")
 #: the harmonics of harmonic balance, and those reported by shooting, when ``harmonics`` is left out
 DEFAULT_HARMONICS = 7
 #: collocation's intervals when ``mesh`` is left out
@@ -204,6 +228,10 @@ SCHEMA = {
     "loop": Option(schema.one_of("loop", LOOPS), "auto", doc="shooting's integrations: auto (the compiled DOP853 "
                    "loop where it can run: the C backend), python (scipy's DOP853 and the variational equations "
                    "throughout) or c (compiled, else an input error)"),
+    "start": Option(schema.one_of("start", STARTS), "guess", doc="the forced orbit's first guess: guess (q0 / v0, "
+                    "or from) or linear (the linear forced response at the frequency, (K - omega^2 M + i omega C)^-1 "
+                    "F per harmonic of the forcing, the model linearised at q = 0: mechgen.analyses.linear_start; "
+                    "refused where K - omega^2 M + i omega C is singular)"),
     "samples": Option(schema.count_within("samples"), 201, doc="how many equally spaced times from 0 to T the "
                       "reported orbit (t, trajectory) has"),
 }
@@ -237,9 +265,25 @@ def check(ctx, base: str, options: dict) -> None:
     if "from" in options and ({"q0", "v0"} & {k for k, v in options.items() if v}):
         raise fail(ctx.file, f"{base}.from", "a starting guess both from a simulate and from q0 / v0",
                    "from, or q0 / v0")
+    if options.get("start") == "linear":
+        check_linear_start(ctx, base, options)
     if "frequency" not in options and "period" not in options and "from" not in options:
         raise fail(ctx.file, f"{base}.period", "an autonomous orbit (no frequency) needs a starting guess of its "
                    "period", "period = a number > 0 (or frequency = the forcing's, for a forced orbit)")
+
+
+def check_linear_start(ctx, base: str, options: dict) -> None:
+    """start = "linear": a forced orbit of a model without internal variables, and no other guess."""
+    if "frequency" not in options:
+        raise fail(ctx.file, f"{base}.start", "start = \"linear\" is the linear forced response, and the orbit has "
+                   "no frequency (autonomous)", "frequency = the forcing's, or start = \"guess\"")
+    given = [k for k in ("q0", "v0", "z0", "from") if options.get(k)]
+    if given:
+        raise fail(ctx.file, f"{base}.start", f"start = \"linear\" and a guess ({', '.join(given)}) are both given",
+                   f"start = \"linear\" or {given[0]}, not both")
+    if getattr(ctx.model, "internals", False):
+        raise fail(ctx.file, f"{base}.start", f"model {ctx.model.name} has internal variables, which the linear "
+                   "response of the coordinates does not give", "start = \"guess\" (q0, v0, z0)")
 
 
 def check_hybrid(ctx, base: str, options: dict) -> None:
@@ -255,8 +299,8 @@ def check_hybrid(ctx, base: str, options: dict) -> None:
     if "frequency" not in options:
         raise fail(ctx.file, f"{base}.frequency", f"an autonomous periodic orbit of a hybrid model ({model.name}) is "
                    "not available yet", "the forcing's frequency (a forced hybrid model's orbit)")
-    if options.get("floquet") == "hill" or "from" in options:
-        key = "floquet" if options.get("floquet") == "hill" else "from"
+    if options.get("floquet") == "hill" or "from" in options or options.get("start") == "linear":
+        key = "floquet" if options.get("floquet") == "hill" else "from" if "from" in options else "start"
         raise fail(ctx.file, f"{base}.{key}", f"{key} does not apply to a hybrid model's orbit",
                    f"no {key} (q0 / v0 as the starting guess)")
 
@@ -325,6 +369,18 @@ def guess(system, options: dict, omega) -> Guess:
     w, n = 2 * np.pi / period, system.n
     phase = int(np.argmax(np.abs(q0))) if n else int(np.argmax(np.abs(x0)))
     return Guess(x0, period, phase, lambda times: first_harmonic_states(x0, w, times, n))
+
+
+def linear_guess(system, options: dict, omega: float) -> Guess:
+    """The linear forced response at omega (mechgen.analyses.linear_start) as the guess: its series over one period
+    (harmonics: ``harmonics`` or 7)."""
+    U = linear_coefficients(system, float(omega), int(options.get("harmonics", DEFAULT_HARMONICS)))
+
+    def curve(times):
+        theta = omega * np.asarray(times, float)
+        return np.hstack([fourier.evaluate(U, theta), omega * fourier.evaluate(U, theta, 1)])
+
+    return Guess(curve(np.zeros(1))[0], 2 * np.pi / omega, 0, curve)
 
 
 def internal_start(system, table: dict | None = None) -> np.ndarray:
@@ -504,22 +560,44 @@ def run_periodic_orbit(system, options: dict, context: dict) -> dict:
         return run_hybrid_orbit(system, options, guess(system, options, options.get("frequency")).x0)
     method = chosen_method(options)
     omega = options.get("frequency")
-    start = guess_from_simulate(system, options, context, omega) if "from" in options else guess(system, options, omega)
+    start = guess_from_simulate(system, options, context, omega) if "from" in options else \
+        linear_guess(system, options, omega) if options.get("start") == "linear" else guess(system, options, omega)
     if omega is None:
         refuse_time_dependent(system, start.x0)
         if not np.any(start.x0):
             raise SceneError("periodic_orbit: an autonomous orbit from a zero starting guess would find the "
                              "equilibrium", key="q0", expected="a starting guess on or near the orbit (q0, v0)")
-    solve = {"harmonic_balance": solve_harmonic_balance, "collocation": solve_collocation}.get(method, solve_shooting)
-    found = solve(system, options, start, omega)
-    out = report(system, options, found, method, autonomous=omega is None)
+    free = omega is None and is_conservative(system, start.x0)
+    if free and not np.any(start.x0[:system.n]):
+        raise SceneError("periodic_orbit: the free orbit of a conservative model is the member through the guess's "
+                         "displacement q_p(0) = q0_p, and q0 is zero", key="q0",
+                         expected="q0 = the displacement at an extremum of the orbit (its amplitude), e.g. "
+                         "q0 = { x = 0.5 }")
+    if free:  # a member of a conservative family (mechgen.analyses.free_orbit)
+        found = solve_free(system, options, start, method, free_defaults(system, options, method),
+                           settings(options, method))
+    else:
+        solve = {"harmonic_balance": solve_harmonic_balance, "collocation": solve_collocation}.get(method,
+                                                                                                  solve_shooting)
+        found = solve(system, options, start, omega)
+    out = report(system, options, found, method, autonomous=omega is None, conservative=free)
+    if free:
+        out.update(unfolding=found["unfolding"], energy=orbit_energy(system, found["x0"]))
     # what a continuation of the orbit starts from (mechgen.analyses.orbit_branch)
-    out["_orbit"] = {"method": method, "phase": start.phase, "found": found, "options": dict(options)}
+    out["_orbit"] = {"method": method, "phase": start.phase, "found": found, "options": dict(options),
+                     "conservative": free}
     return out
 
 
-def report(system, options: dict, found: dict, method: str, *, autonomous: bool) -> dict:
-    """The outputs (module doc) of a converged orbit."""
+def free_defaults(system, options: dict, method: str) -> dict:
+    """The defaults the free orbit's problems take (mechgen.analyses.free_orbit.base_problem)."""
+    return {"harmonics": DEFAULT_HARMONICS, "mesh": DEFAULT_MESH, "tolerances": integrator_tolerances(options),
+            "run": compiled_run(system, options) if method == "shooting" else None}
+
+
+def report(system, options: dict, found: dict, method: str, *, autonomous: bool, conservative: bool = False) -> dict:
+    """The outputs (module doc) of a converged orbit (``conservative``: a free orbit of a conservative family, whose
+    two multipliers nearest 1 are trivial)."""
     w = found["omega"]
     T = 2 * np.pi / w
     n = system.n
@@ -545,7 +623,7 @@ def report(system, options: dict, found: dict, method: str, *, autonomous: bool)
     return {"period": float(T), "frequency": float(w), "t": trajectory["t"], "trajectory": trajectory["trajectory"],
             "amplitude": {c: peak(fine[:, i]) for i, c in enumerate(names)},
             "harmonics": fourier.harmonics_table(U, names), "multipliers": floquet.as_pairs(mu),
-            "stability": floquet.stability(mu, autonomous), "method": method, "residual": float(found["residual"]),
+            "stability": floquet.stability(mu, autonomous, trivial=2 if conservative else None), "method": method, "residual": float(found["residual"]),
             "iterations": int(found["iterations"]), "loop": "c" if found.get("run") is not None else "python"}
 
 

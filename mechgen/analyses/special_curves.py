@@ -78,6 +78,10 @@ def start_of(earlier: dict, index: int) -> tuple[str, np.ndarray, str]:
 def run_curve(system, options: dict, earlier: dict) -> dict:
     """The curve of a special point in two parameters (module doc)."""
     refuse_keys(options)
+    if earlier.get("_backbone"):
+        raise SceneError("the earlier continuation followed a conservative family (a backbone); curves of its "
+                         "special points are not available", key="about",
+                         expected="a continuation about a steady state or a forced or autonomous periodic orbit")
     if "_orbit" in earlier:  # a branch of periodic orbits: the curve of its cyclic fold
         from mechgen.analyses.orbit_curves import run_orbit_curve
 

@@ -18,6 +18,9 @@ The interface a continuation builds on, one problem object per method, each hold
   R through ``system.with_params`` (a new system per value; the kernels are those of the compiled model).
 * :func:`~mechgen.runtime.periodic.newton.newton` solves R(u) = 0 from a guess; a pseudo-arclength step appends
   one row to the same (R, dR/du).
+* :class:`~mechgen.runtime.periodic.conservative.Unfolded` wraps an autonomous problem of a conservative model:
+  its free orbits form a family, made isolated by a prescribed level q_p(0) and the unfolding parameter eps of
+  Munoz-Almaraz et al. (2003), an unknown that vanishes on the orbit.
 * :mod:`~mechgen.runtime.periodic.floquet` turns a monodromy matrix
   (:func:`~mechgen.runtime.periodic.flow.variational_flow`) into multipliers and stability.
 """

@@ -2,7 +2,8 @@
 
 The multipliers mu are the eigenvalues of the monodromy matrix Phi(T) (mechgen.runtime.periodic.flow): a small
 perturbation grows by mu per period along its eigenvector. An autonomous orbit always has the trivial multiplier
-mu = 1 (a shift along the orbit); the one nearest 1 is set aside before judging. The orbit is ``stable`` when
+mu = 1 (a shift along the orbit); the one nearest 1 is set aside before judging (a free orbit of a conservative family
+has two, along the orbit and along the family: ``trivial = 2``). The orbit is ``stable`` when
 every other |mu| <= 1 + NEUTRAL (a neutral multiplier, |mu| = 1 of a conservative system, counts as stable: the
 multipliers themselves say more), else ``unstable``. By Liouville's formula det Phi(T) = exp(int_0^T trace J dt),
 the product of all multipliers (exp(-c T / m) for a linear dashpot c on a mass m).
@@ -27,16 +28,19 @@ def multipliers(monodromy: np.ndarray) -> np.ndarray:
     return ordered(np.linalg.eigvals(np.asarray(monodromy, float)))
 
 
-def nontrivial(mu: np.ndarray, autonomous: bool) -> np.ndarray:
-    """The multipliers without the trivial one (the nearest 1) of an autonomous orbit."""
-    if not autonomous or mu.size == 0:
-        return mu
-    return np.delete(mu, int(np.argmin(np.abs(mu - 1.0))))
+def nontrivial(mu: np.ndarray, autonomous: bool, trivial: int | None = None) -> np.ndarray:
+    """The multipliers without the trivial ones: the one nearest 1 of an autonomous orbit, or the ``trivial`` nearest
+    1 (2 for a free orbit of a conservative family: along the orbit and along the family)."""
+    count = int(autonomous) if trivial is None else int(trivial)
+    mu = np.asarray(mu)
+    for _ in range(min(count, mu.size)):
+        mu = np.delete(mu, int(np.argmin(np.abs(mu - 1.0))))
+    return mu
 
 
-def stability(mu: np.ndarray, autonomous: bool) -> str:
-    """``stable`` or ``unstable`` (module doc)."""
-    rest = nontrivial(mu, autonomous)
+def stability(mu: np.ndarray, autonomous: bool, trivial: int | None = None) -> str:
+    """``stable`` or ``unstable`` (module doc; ``trivial``: :func:`nontrivial`)."""
+    rest = nontrivial(mu, autonomous, trivial)
     return "stable" if float(np.max(np.abs(rest), initial=0.0)) <= 1.0 + NEUTRAL else "unstable"
 
 

@@ -55,14 +55,14 @@ def is_ns(multipliers: np.ndarray) -> bool:
 
 
 def cycle_points(eqs, X: np.ndarray, multipliers: Callable[[np.ndarray], np.ndarray], *,
-                 trivial: bool = False) -> list[SpecialPoint]:
+                 trivial: bool = False, kinds: tuple = ("PD", "NS")) -> list[SpecialPoint]:
     """PD and NS points between consecutive rows of X (branch points (x0, p)); ``multipliers(x)``: the Floquet
     multipliers of the orbit at the branch point x. A PD point carries the eigenvector of -1 (``direction``, the
     doubled orbit leaves along it); an NS point the pair's angle (``angle``, rad: the torus's rotation number
-    times 2 pi)."""
+    times 2 pi). ``kinds``: the points sought (a conservative orbit's NS test function vanishes identically)."""
     mus = [without_trivial(multipliers(x), trivial) for x in X]
     found = []
-    for kind, value in (("PD", pd_value), ("NS", ns_value)):
+    for kind, value in [(k, v) for k, v in (("PD", pd_value), ("NS", ns_value)) if k in kinds]:
         values = [value(mu) for mu in mus]
         for i in range(len(X) - 1):
             if values[i] * values[i + 1] >= 0:
