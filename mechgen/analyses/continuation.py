@@ -351,9 +351,9 @@ def _one_branch(system, start: dict, options: dict, label: str | None, budget: B
     stab = stability_of_each(system, bvp, results) if stability else [{}] * len(results)
     spent("their stability")
     points = []
-    for lam, res, summary, st in zip(branch.lam, results, summaries, stab):
+    for lam, res, values, st in zip(branch.lam, results, summaries, stab):
         point = {**tag, name: float(lam), **{bvp.params[i]: float(res.p[i]) for i in bvp.problem.unknown},
-                 **summary}
+                 **values}
         if stability:
             point["verdict"], point["frequencies"] = st["verdict"], st["frequencies"]
             if options.get("eigenvalues"):

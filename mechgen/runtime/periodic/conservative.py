@@ -88,7 +88,7 @@ class Unfolded:
         """Collocation's states at ``times`` (u less eps)."""
         return self.problem.states_at(np.asarray(u)[:-1], times)
 
-    def level_row(self, size: int) -> tuple[int, np.ndarray]:
+    def level_row(self, size: int) -> np.ndarray:
         """The gradient of q_p(0) over the method's unknowns (``size`` of them): q_p(0) is linear in them."""
         row = np.zeros(size)
         p, b = self.problem.phase, self.problem
