@@ -86,6 +86,7 @@ from mechgen.errors import ConvergenceError, SceneError
 from mechgen.runtime.core.memory import dense_bytes, require
 from mechgen.runtime.periodic import floquet, fourier
 from mechgen.runtime.periodic.collocation import Collocation
+from mechgen.runtime.periodic.cycle_guess import closed_cycle
 from mechgen.runtime.periodic.flow import compiled_flow, states_at, variational_flow
 from mechgen.runtime.periodic.harmonic_balance import HarmonicBalance, hill_multipliers
 from mechgen.runtime.periodic.newton import NewtonSettings, newton
@@ -218,10 +219,10 @@ def check(ctx, base: str, options: dict) -> None:
         return
     why = ("is a continuum" if getattr(model, "continuum", False) else "is a chain" if getattr(model, "chain", None)
            else None)
-    if getattr(model, "internals", False) and chosen_method(options) != "shooting":
+    if getattr(model, "internals", False) and chosen_method(options) == "harmonic_balance":
         raise fail(ctx.file, f"{base}.method", f"model {model.name} has internal variables, which "
-                   f"{chosen_method(options)} does not carry (its residual is the coordinates')",
-                   "method = \"shooting\" (the flow carries the internal variables)")
+                   "harmonic_balance does not carry (its residual is the coordinates')",
+                   "method = \"collocation\" or \"shooting\" (both carry the internal variables)")
     if why:
         raise fail(ctx.file, f"{base}.method", f"model {model.name} {why}: periodic_orbit's methods need a smooth "
                    "lumped model", "a smooth lumped model (a hybrid model's periodic response: kind periodic)")
@@ -389,6 +390,14 @@ def guess_from_simulate(system, options: dict, context: dict, omega) -> Guess:
     return Guess(spline(start), period, p, lambda times: spline(start + np.asarray(times)))
 
 
+def closed_guess(system, start: Guess) -> Guess:
+    """An autonomous collocation of a model with internal variables starts from one period re-integrated from the
+    guess's state at t = 0, cut at its slowest point and closed by a Poincare section there
+    (mechgen.runtime.periodic.cycle_guess): a stiff cycle's fast phase lies between a simulate's samples."""
+    x0, period, curve = closed_cycle(system, start.x0, start.period)
+    return Guess(x0, period, start.phase, curve)
+
+
 def settings(options: dict, method: str) -> NewtonSettings:
     """Newton's tolerances and its failure's advice."""
     advice = ("a better starting guess (q0, v0" + (", period" if "frequency" not in options else "") + ")"
@@ -426,14 +435,20 @@ def solve_harmonic_balance(system, options: dict, start: Guess, omega) -> dict:
 
 
 def solve_collocation(system, options: dict, start: Guess, omega) -> dict:
-    """Collocation from the guess (its curve at the nodes): {problem, u, x0, omega, residual, iterations}."""
-    problem = Collocation(system, int(options.get("mesh", DEFAULT_MESH)), omega, start.phase)
-    size = problem.nodes * 2 * system.n + 1
-    require(dense_bytes(size, size), f"collocation's dense {size} x {size} Jacobian", key="mesh")
-    X = start.curve(start.period * np.arange(problem.nodes) / problem.nodes)
-    if problem.autonomous:
-        X[0, system.n + start.phase] = 0.0
-    sol = newton(problem.residual_jacobian, problem.unknowns(X, start.period), settings(options, "collocation"))
+    """Collocation from the guess (its curve at the nodes; with internal variables on the mesh adapted to the guess):
+    {problem, u, x0, omega, residual, iterations}."""
+    mesh = int(options.get("mesh", DEFAULT_MESH))
+    if system.m:
+        problem, u = first_order_start(system, mesh, start, omega)
+    else:
+        problem = Collocation(system, mesh, omega, start.phase)
+        size = problem.nodes * 2 * system.n + 1
+        require(dense_bytes(size, size), f"collocation's dense {size} x {size} Jacobian", key="mesh")
+        X = start.curve(start.period * np.arange(problem.nodes) / problem.nodes)
+        if problem.autonomous:
+            X[0, system.n + start.phase] = 0.0
+        u = problem.unknowns(X, start.period)
+    sol = newton(problem.residual_jacobian, u, settings(options, "collocation"))
     for _ in range(int(options.get("adapt", 0))):
         problem, u = problem.adapted(sol.u)
         sol = newton(problem.residual_jacobian, u, settings(options, "collocation"))
@@ -443,6 +458,22 @@ def solve_collocation(system, options: dict, start: Guess, omega) -> dict:
                                "starting guess (period, q0, v0, or from a simulate)")
     return {"problem": problem, "u": sol.u, "x0": X[0].copy(), "omega": 2 * np.pi / T, "residual": sol.residual,
             "iterations": sol.iterations}
+
+
+#: a model with internal variables: the guess is first laid on GUESS_REFINEMENT x ``mesh`` uniform intervals, whose
+#: monitor places the ``mesh`` intervals of the first solve
+GUESS_REFINEMENT = 4
+
+
+def first_order_start(system, mesh: int, start: Guess, omega) -> tuple[Collocation, np.ndarray]:
+    """(problem, u) of a model with internal variables: the first-order collocation (sparse Jacobian; autonomous:
+    the integral phase condition against the guess) on ``mesh`` intervals that equidistribute the guess's monitor
+    (AUTO's, as ``adapt``: a stiff cycle's fast phase gets its intervals before the first solve)."""
+    fine = Collocation(system, GUESS_REFINEMENT * mesh, omega, start.phase)
+    X = np.asarray(start.curve(start.period * fine.node_tau()), float)
+    if fine.autonomous:
+        fine = Collocation(system, fine.mesh, omega, start.phase, None, X)
+    return fine.adapted(fine.unknowns(X, start.period), mesh)
 
 
 def compiled_run(system, options: dict):
@@ -510,6 +541,8 @@ def run_periodic_orbit(system, options: dict, context: dict) -> dict:
         if not np.any(start.x0):
             raise SceneError("periodic_orbit: an autonomous orbit from a zero starting guess would find the "
                              "equilibrium", key="q0", expected="a starting guess on or near the orbit (q0, v0)")
+    if method == "collocation" and system.m and omega is None:
+        start = closed_guess(system, start)
     solve = {"harmonic_balance": solve_harmonic_balance, "collocation": solve_collocation}.get(method, solve_shooting)
     found = solve(system, options, start, omega)
     out = report(system, options, found, method, autonomous=omega is None)
@@ -535,6 +568,8 @@ def report(system, options: dict, found: dict, method: str, *, autonomous: bool)
         fine, int(options.get("harmonics", DEFAULT_HARMONICS)))
     if options.get("floquet") == "hill":
         mu = hill_multipliers(found["problem"], found["u"])
+    elif method == "collocation":  # the discretisation's own monodromy (mechgen.runtime.periodic.collocation)
+        mu = floquet.multipliers(found["problem"].monodromy(found["u"]))
     else:
         _, Phi = variational_flow(system, found["x0"], 0.0, T, *integrator_tolerances(options))
         mu = floquet.multipliers(Phi)
