@@ -17,6 +17,8 @@ period-2T orbit just past every PD point.
 """
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from mechgen.analyses.hybrid_orbit import run_hybrid_branch
@@ -24,11 +26,11 @@ from mechgen.analyses.newton_branch import arclength_steps
 from mechgen.analyses.periodic_orbit import DEFAULT_HARMONICS, compiled_run, integrator_tolerances, peak
 from mechgen.analyses.schema import ParamExpression
 from mechgen.analyses.stability_boundary import own_value
+from mechgen.analyses.time_series import state_names
 from mechgen.errors import SceneError
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget
 from mechgen.runtime.periodic import floquet, fourier
 from mechgen.runtime.periodic.branch import OrbitBranch, node_weights
-from mechgen.runtime.periodic.collocation import Collocation
 from mechgen.runtime.periodic.flow import differenced_flow, states_at, variational_flow
 from mechgen.runtime.periodic.harmonic_balance import HarmonicBalance
 from mechgen.runtime.periodic.shooting import Shooting
@@ -68,8 +70,8 @@ class Orbits:
         if self.method == "harmonic_balance":
             H = int(self.options.get("harmonics", DEFAULT_HARMONICS))
             return HarmonicBalance(moved, fourier.basis(H), self.omega(p), self.phase)
-        if self.method == "collocation":
-            return Collocation(moved, self.mesh.mesh, self.omega(p), self.phase, self.mesh.edges)
+        if self.method == "collocation":  # the earlier mesh and phase condition (its reference orbit)
+            return replace(self.mesh, system=moved, omega=self.omega(p))
         return Shooting(moved, self.omega(p), self.phase, *integrator_tolerances(self.options),
                         compiled_run(moved, self.options), int(self.options.get("segments", 1)))
 
@@ -121,6 +123,9 @@ class Orbits:
         return self.memo[key]
 
     def monodromy_eigenvalues(self, problem, u: np.ndarray) -> np.ndarray:
+        """The multipliers: collocation's from its own monodromy (no integration), the others' from the flow."""
+        if self.method == "collocation":
+            return floquet.multipliers(problem.monodromy(u))
         T = self.period(problem, u)
         x0 = problem.split(u)[0] if self.method == "shooting" else self.states(problem, u, np.array([0.0]))[0]
         run = compiled_run(problem.system, self.options)
@@ -137,10 +142,13 @@ def record(orbits: Orbits, branch: OrbitBranch, u: np.ndarray, p: float) -> dict
     T = orbits.period(problem, u)
     X = orbits.states(problem, u, T * np.arange(PHASES) / PHASES)
     mu = orbits.multipliers(problem, u, p)
-    names = list(orbits.system.coordinates)
-    start = dict(zip(names + [f"{c}_dot" for c in names], (float(v) for v in X[0])))
+    system = orbits.system
+    names = list(system.coordinates)
+    internals = state_names(system)[2 * system.n:]
+    start = dict(zip(names + [f"{c}_dot" for c in names] + internals, (float(v) for v in X[0])))
+    columns = list(range(system.n)) + list(range(2 * system.n, 2 * system.n + system.m))
     return {orbits.name: float(p), "period": T, "frequency": float(2 * np.pi / T),
-            "amplitude": {c: peak(X[:, i]) for i, c in enumerate(names)}, "start": start,
+            "amplitude": {c: peak(X[:, i]) for c, i in zip(names + internals, columns)}, "start": start,
             "multipliers": floquet.as_pairs(mu), "stability": floquet.stability(mu, orbits.autonomous)}
 
 
@@ -163,7 +171,8 @@ def run_orbit_branch(system, options: dict, earlier: dict) -> dict:
     problem = branch.problem(here)
     u0 = orbits.start(problem, earlier["_orbit"]["found"])
     repeats = problem.nodes if orbits.method == "collocation" else getattr(problem, "segments", 1)
-    eqs = branch.equations(node_weights(u0.size, repeats, int(orbits.autonomous)) if repeats > 1 else None)
+    scale = max(1.0, abs(here))
+    eqs = branch.equations(node_weights(u0.size, repeats, int(orbits.autonomous), scale) if repeats > 1 else None)
     budget = Budget("continuation", unit="points", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
     found = continuation(eqs, u0, here, arclength_steps(options, here, budget, smallest_span=0.1))
     points = [record(orbits, branch, u, p) for u, p in zip(found.u, found.lam)]

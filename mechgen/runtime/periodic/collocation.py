@@ -26,7 +26,9 @@ Gauss point the first-order rows
 
 g the generated ``rates`` kernel (its Jacobian from ``rates_tangent``: d/dz_node (l'(zeta)/h) I - T g_z l(zeta),
 d/dq_node -T g_q l(zeta), d/dv_node -T g_v l(zeta), d/dT -g), and r takes z too (r_z from the tangent). Its
-Jacobian is sparse (scipy CSR, built in one vectorised pass: a stiff orbit needs hundreds of intervals). Its
+Jacobian is sparse (scipy CSR, built in one vectorised pass: a stiff orbit needs hundreds of intervals), and each of
+its point's rows is weighted by the interval's width h_i (h_i dx/dtau - h_i T f: the state's change over the
+interval, so that the small intervals of a fast phase do not dominate ||R|| and R's round-off is the state's). Its
 autonomous phase condition is AUTO's integral one against a ``reference`` orbit x_ref (the starting guess, then the
 previous solution on each adapted mesh),
 
@@ -181,7 +183,10 @@ class Collocation:
             parts += [at["dq"] - T * at["v"], r]
         if m:
             parts.append(at["dz"] - T * np.asarray(self.kernel("rates", at, T)["g"], float).reshape(-1, m))
-        E = np.hstack(parts).ravel()
+        E = np.hstack(parts)
+        if self.first_order:  # weighted by the interval's width (module doc)
+            E = E * np.repeat(self.widths, DEGREE)[:, None]
+        E = E.ravel()
         return np.append(E, self.phase_row() @ X.ravel()) if self.autonomous else E
 
     def phase_row(self) -> np.ndarray:
@@ -261,7 +266,8 @@ class Collocation:
 
     def sparse_jacobian(self, u: np.ndarray):
         """dR/du as scipy CSR, in one vectorised pass: the block of point (i, k) and local node j is
-        A l_j(zeta_k) + B l_j'(zeta_k) / h_i, the period's column c, the phase condition's row."""
+        h_i (A l_j(zeta_k) + B l_j'(zeta_k) / h_i) (the rows weighted by h_i), the period's column h_i c, the phase
+        condition's row."""
         X, T = self.split(u)
         at = self.points(X, T)
         A, B, c = self.point_blocks(X, T, at)
@@ -269,8 +275,8 @@ class Collocation:
         m, d, P = DEGREE, self.state_size, at["tau"].size
         h = np.repeat(self.widths, m)  # per point
         k = np.tile(np.arange(m), self.mesh)
-        blocks = (A[:, None] * L[k][:, :, None, None]
-                  + B[:, None] * (D[k] / h[:, None])[:, :, None, None])  # P x (m + 1) x d x d
+        blocks = (A[:, None] * (L[k] * h[:, None])[:, :, None, None]
+                  + B[:, None] * D[k][:, :, None, None])  # P x (m + 1) x d x d, the rows weighted by h_i
         nodes = np.repeat(self.node_index(), m, axis=0)  # P x (m + 1)
         rows = np.broadcast_to((np.arange(P)[:, None, None, None] * d + np.arange(d)[None, None, :, None]),
                                blocks.shape)
@@ -280,7 +286,7 @@ class Collocation:
         if self.autonomous:
             phase = self.phase_row()
             nz = np.flatnonzero(phase)
-            data += [c.ravel(), phase[nz]]
+            data += [(c * h[:, None]).ravel(), phase[nz]]
             I += [np.arange(P * d), np.full(nz.size, P * d)]
             J += [np.full(P * d, size), nz]
         shape = (P * d + self.autonomous, size + self.autonomous)
