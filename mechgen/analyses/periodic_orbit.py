@@ -539,8 +539,10 @@ def run_periodic_orbit(system, options: dict, context: dict) -> dict:
     if omega is None:
         refuse_time_dependent(system, start.x0)
         if not np.any(start.x0):
+            key = "q0" if system.n else "z0"
             raise SceneError("periodic_orbit: an autonomous orbit from a zero starting guess would find the "
-                             "equilibrium", key="q0", expected="a starting guess on or near the orbit (q0, v0)")
+                             "equilibrium", key=key, expected="a starting guess on or near the orbit ("
+                             + ("q0, v0" if system.n else "z0") + ", or from a simulate)")
     if method == "collocation" and system.m and omega is None:
         start = closed_guess(system, start)
     solve = {"harmonic_balance": solve_harmonic_balance, "collocation": solve_collocation}.get(method, solve_shooting)
