@@ -128,22 +128,40 @@ def aitken_period(periods: np.ndarray) -> float:
     return float(periods[k + 1] - d[k] ** 2 / (d[k] - d[k - 1]))
 
 
+def k_critical() -> float:
+    """k_c = sigma (b - a) / D_c (1 + m V2^2 / (sigma a D_c)) (Rice & Ruina 1983; tests/test_rate_state_inertial.py)."""
+    p = SLIDER
+    return p["sigma"] * (p["b"] - p["a"]) / p["D_c"] * (1 + p["m"] * p["V2"] ** 2 / (p["sigma"] * p["a"] * p["D_c"]))
+
+
 @pytest.mark.slow
 def test_the_scene_finds_the_cycle_from_its_simulate_and_follows_it_in_k():
     """scenes/rate_state_stick_slip.toml: "cycle" starts from the last cycle of the simulate "cycles" (601 samples
     over 300 s: the slip falls between samples, so the guess is re-integrated over one period from its state) and
-    finds the aging-law period of the hand-written Radau run (1e-9 relative, as above); "cycle_in_k" starts on it and
-    follows it to k = 5e9 < k_c, every cycle stable, the period falling with k (the spring reloads faster)."""
+    finds the aging-law period of the hand-written Radau run (1e-9 relative, as above). "cycle_in_k" follows it in
+    k: stable, its period falling, up to one cyclic fold (LPC) just above k_c (a subcritical Hopf point: measured
+    k = 5.0746e9 = 1.0049 k_c), then unstable, shrinking onto steady sliding, where the branch ends (status
+    ``equilibrium``) at the Hopf point of the linear theory: k_c (1e-4 relative, measured 1.4e-5) with the neutral
+    period 2 pi / ((V2 / D_c) sqrt((b - a) / a)) (1e-3 relative, measured 2.8e-4: the last orbit keeps 2 % of the
+    first's size, whose period differs by O(size^2))."""
     scene = Path(__file__).resolve().parents[1] / "scenes" / "rate_state_stick_slip.toml"
     analyses = {a["name"]: a["outputs"] for a in mechgen.run(str(scene))["analyses"]}
     cycle, branch = analyses["cycle"], analyses["cycle_in_k"]
     T_ref = aitken_period(reference_periods("aging"))
     assert abs(cycle["period"] - T_ref) < 1e-9 * T_ref and cycle["stability"] == "stable"
     points = branch["branch"]
-    assert branch["status"] == "lam_max" and points[-1]["k"] == pytest.approx(5e9)
     assert points[0]["period"] == pytest.approx(cycle["period"], rel=1e-9)
-    assert all(p["stability"] == "stable" for p in points)
+    assert [s["type"] for s in branch["special_points"]] == ["LPC"]
+    fold = branch["special_points"][0]["k"]
+    assert k_critical() < fold < 1.01 * k_critical()
+    before = [p for p in points if p["period"] > branch["special_points"][0]["period"]]
+    after = points[len(before) + 1:]
+    assert all(p["stability"] == "stable" for p in before) and all(p["stability"] == "unstable" for p in after)
     assert np.all(np.diff([p["period"] for p in points]) < 0)
+    assert branch["status"] == "equilibrium"
+    omega = SLIDER["V2"] / SLIDER["D_c"] * math.sqrt((SLIDER["b"] - SLIDER["a"]) / SLIDER["a"])
+    assert points[-1]["k"] == pytest.approx(k_critical(), rel=1e-4)
+    assert points[-1]["period"] == pytest.approx(2 * math.pi / omega, rel=1e-3)
 
 
 def test_stick_slip_mesh_convergence_and_trivial_multiplier(aging):

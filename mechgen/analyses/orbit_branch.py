@@ -1,14 +1,22 @@
 """``continuation`` about a ``periodic_orbit``: the branch of periodic orbits in a parameter, with its cyclic folds,
 period doublings and torus points.
 
-The earlier orbit's method (harmonic balance or shooting) is continued in ``parameter`` up to ``stop`` by
+The earlier orbit's method (harmonic balance, shooting or collocation, with its mesh and, for a model with internal
+variables, its integral phase condition's reference orbit) is continued in ``parameter`` up to ``stop`` by
 pseudo-arclength (mechgen.runtime.periodic.branch; mechgen.runtime.steady.continuation), so a frequency-response
-curve is followed round its folds: both stable branches and the unstable one between. A forced orbit whose
+curve is followed round its folds: both stable branches and the unstable one between. Collocation and multiple
+shooting weigh a node's state by 1 / nodes in the arclength and, for a parameter of size |p0| > 1, the unknowns by
+p0^2: the arclength measures the parameter's relative change against the orbit's (a fold at k ~ 5e9 Pa/m is then
+within the step control's reach; ``step`` and ``max_step`` are in those units, p0 times the orbit's change where the
+branch turns). An autonomous orbit's branch ends where its orbits shrink to an equilibrium (status
+``equilibrium``: a Hopf point, the orbits' size, the largest range of a state component over the period relative to
+the first orbit's, at a local minimum below 0.1), at its smallest orbit, rather than return through it. A forced orbit whose
 ``frequency`` is an expression of the continued parameter (``frequency = "w"``, continued in ``w``) has its period
 follow it; otherwise the forcing's frequency stays as it was.
 
 Outputs: ``branch`` (per point: the parameter, ``period``, ``frequency``, ``amplitude`` ({coordinate: max |q|
-over the period}), ``start`` (the state at t = 0: each coordinate and ``<coordinate>_dot``), ``multipliers`` ([re, im] by decreasing modulus) and ``stability``), ``points``, ``status``,
+over the period}, then each internal variable's), ``start`` (the state at t = 0: each coordinate and
+``<coordinate>_dot``, then each internal variable), ``multipliers`` ([re, im] by decreasing modulus) and ``stability``), ``points``, ``status``,
 ``method``, ``folds`` and ``special_points``: ``LPC`` (a cyclic fold: the branch turns in the parameter),
 ``PD`` (period doubling: a multiplier through -1) and ``NS`` (Neimark-Sacker: a complex pair through the unit
 circle, with ``angle``), each with the parameter, period, amplitude and multipliers there
@@ -136,6 +144,39 @@ class Orbits:
         return floquet.multipliers(Phi)
 
 
+#: an autonomous orbit's branch ends at a local minimum of its orbits' size below COLLAPSE times the first orbit's
+COLLAPSE = 0.1
+#: phases at which an orbit's size is measured
+SIZE_PHASES = 256
+
+
+class Collapse:
+    """``until`` of an autonomous orbit's branch (mechgen.runtime.steady.continuation): the orbits' size, the largest
+    range over the period of a state component relative to the first orbit's, at each accepted point; the branch
+    ends at the smallest orbit when the size, below COLLAPSE, starts to grow again (the orbits shrank to an
+    equilibrium, a Hopf point, and the branch would return through it along the same orbits)."""
+
+    def __init__(self, orbits: Orbits, branch: OrbitBranch, u0: np.ndarray, p0: float) -> None:
+        self.orbits, self.branch = orbits, branch
+        self.first = self.ranges(u0, p0) + 1e-300
+        self.sizes, self.last = [1.0], float(p0)
+
+    def ranges(self, u: np.ndarray, p: float) -> np.ndarray:
+        problem = self.branch.problem(p)
+        T = self.orbits.period(problem, u)
+        return np.ptp(self.orbits.states(problem, u, T * np.arange(SIZE_PHASES) / SIZE_PHASES), axis=0)
+
+    def __call__(self, u: np.ndarray, p: float):
+        size = float(np.max(self.ranges(u, p) / self.first))
+        if len(self.sizes) > 1 and self.sizes[-1] < min(COLLAPSE, self.sizes[-2], size):
+            return ("equilibrium", f"the orbits shrank to an equilibrium near {self.orbits.name} = {self.last:.10g} "
+                    f"(a Hopf point): the branch ends at its smallest orbit, {self.sizes[-1]:.3g} of the first "
+                    "orbit's size")
+        self.sizes.append(size)
+        self.last = float(p)
+        return None
+
+
 def record(orbits: Orbits, branch: OrbitBranch, u: np.ndarray, p: float) -> dict:
     """One branch point's outputs (module doc)."""
     problem = branch.problem(p)
@@ -174,7 +215,8 @@ def run_orbit_branch(system, options: dict, earlier: dict) -> dict:
     scale = max(1.0, abs(here))
     eqs = branch.equations(node_weights(u0.size, repeats, int(orbits.autonomous), scale) if repeats > 1 else None)
     budget = Budget("continuation", unit="points", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
-    found = continuation(eqs, u0, here, arclength_steps(options, here, budget, smallest_span=0.1))
+    until = Collapse(orbits, branch, u0, here) if orbits.autonomous else None
+    found = continuation(eqs, u0, here, arclength_steps(options, here, budget, smallest_span=0.1), until=until)
     points = [record(orbits, branch, u, p) for u, p in zip(found.u, found.lam)]
     X = np.hstack([found.u, found.lam[:, None]])
 

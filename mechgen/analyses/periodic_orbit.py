@@ -39,12 +39,27 @@ Methods (``method``; left out: ``harmonic_balance`` when ``harmonics`` is given,
   and the phase condition v_p(0) = 0, as shooting's. Its error falls as mesh^-8 at the mesh points (the order 2m
   of Gauss collocation). With ``adapt`` = k > 0 the mesh is adapted k times after the uniform solve: its intervals
   moved so that each holds an equal share of the monitor |x^(5)|^(1/5) (AUTO's rule: small intervals where the orbit
-  turns fast), the orbit interpolated onto them and solved again.
+  turns fast), the orbit interpolated onto them and solved again. A model with internal variables z (with or
+  without coordinates) is collocated in its first-order form: beside the rows above, dz/dtau = T g(q, v, z, t) with
+  g the generated ``rates`` kernel (its Jacobian from ``rates_tangent``), each point's rows weighted by its
+  interval's width, the Jacobian sparse (SuperLU); autonomous, the phase condition is AUTO's integral one,
+  int_0^1 x(tau) . x_ref'(tau) dtau = 0 against the starting guess x_ref (then the previous solution at each
+  adaptation). Its guess is one period re-integrated (scipy's Radau, the exact Jacobian) from the guess's state at
+  t = 0 (``z0`` / ``q0`` / ``v0``, or the ``from`` simulate's state at its second-to-last maximum), cut at its slowest
+  point and closed by a Poincare section there (mechgen.runtime.periodic.cycle_guess: a stiff cycle's fast phase,
+  such as a stick-slip cycle's slip, falls between a simulate's samples, and the maxima's distance guesses the
+  period to a sample's width), and the first mesh already equidistributes the guess's monitor (from 4 x ``mesh``
+  uniform intervals). A stiff cycle wants ``mesh`` of 50 to 100 and ``adapt`` = 2 (the stick-slip cycle of
+  scenes/rate_state_stick_slip.toml: period error 5e-8 at 50 intervals, 1.5e-10 at 100); on a mesh too coarse for it
+  Newton may converge to a spurious orbit, which the trivial multiplier shows (far from 1: 2.4 at 25 intervals).
 
 Newton stops after a step ||du||_inf <= ``atol`` + ``rtol`` ||u||_inf (u the unknowns), and raises a
 ConvergenceError after ``max_iterations`` steps, naming the residual. Stability comes from the monodromy matrix
-Phi(T) of the converged orbit, always from the variational equations (for harmonic balance and collocation:
-integrated over one period from the orbit's state at t = 0): the Floquet multipliers are its eigenvalues. With
+Phi(T) of the converged orbit: the Floquet multipliers are its eigenvalues. For shooting and harmonic balance Phi(T)
+comes from the variational equations (for harmonic balance integrated over one period from the orbit's state at
+t = 0); for collocation from the collocation equations themselves (AUTO's way: each interval's linearised equations
+condensed to its end state's dependence on its start state, their product Phi(T), of the method's order and with no
+integration, so that a stiff cycle's multipliers cost nothing more). With
 ``floquet = "hill"`` (harmonic balance only) they come from Hill's method instead
 (mechgen.runtime.periodic.harmonic_balance.hill_exponents: the quadratic eigenproblem of the linearisation on the
 harmonics, the 2n exponents whose eigenvectors weigh most on the low harmonics kept; no integration). The orbit is
@@ -62,15 +77,15 @@ shooting and collocation H = ``harmonics`` or 7, projected from 4096 samples of 
 force units for harmonic balance, the state's for shooting, both for collocation), ``iterations`` and ``loop``
 (``c``: shooting's integrations ran in the compiled loop; ``python``: in scipy's).
 
-Smooth lumped models without internal variables, and forced hybrid models: a hybrid model's orbit (impacts,
+Smooth lumped models, with or without internal variables, and forced hybrid models: a hybrid model's orbit (impacts,
 stick-slip) is found by single shooting through its events, the monodromy built from the modes'
 state-transition matrices and the saltation matrices of the events (generated from the guards and resets;
 mechgen.analyses.hybrid_orbit), with ``events`` (one period's) and ``grazing`` besides the outputs above; harmonic
 balance, collocation, multiple shooting and an autonomous hybrid orbit are refused for it (exit 2 at the key). A
-model with internal variables z is solved by shooting, whose flow carries them (``z0`` their guess; the phase
-condition of a model of internal variables only is dz_p/dt = 0 at t = 0; ``amplitude`` and ``harmonics`` list them
-after the coordinates); harmonic balance and collocation, whose residual holds the coordinates only, are refused
-for it. A continuum or a chain is refused (key ``method``).
+model with internal variables z is solved by collocation (above) or shooting, whose flow carries them (``z0`` their
+guess; shooting's phase condition of a model of internal variables only is dz_p/dt = 0 at t = 0; ``amplitude`` and
+``harmonics`` list them after the coordinates); harmonic balance, whose residual holds the coordinates only, is
+refused for it (exit 2 at ``method``). A continuum or a chain is refused (key ``method``).
 """
 from __future__ import annotations
 
@@ -186,12 +201,14 @@ SCHEMA = {
     "q0": Option(schema.coordinate_table, {}, doc="the starting guess of the coordinates at t = 0, a table "
                  "coordinate = value (left out: zero, or the model's declared initial state)"),
     "z0": Option(internal_table, {}, doc="the starting guess of the internal variables at t = 0, a table "
-                 "name = value (left out: the model's declared initial values, else zero)"),
+                 "name = value (left out: the model's declared initial values, else zero); for collocation the "
+                 "state one period is re-integrated from"),
     "v0": Option(schema.coordinate_table, {}, doc="the starting guess of the velocities at t = 0, a table "
                  "coordinate = value"),
     "from": Option(earlier_simulate, ABSENT, doc="an earlier simulate analysis (with its trajectory) whose "
                    "motion near its end is the starting guess instead of q0 / v0 (and, for an autonomous orbit, the "
-                   "period between its last two maxima the period's)"),
+                   "period between its last two maxima the period's; an autonomous collocation of a model with internal "
+                   "variables re-integrates one period from its state at the second-to-last maximum)"),
     "segments": Option(schema.count, 1, doc="shooting's number of segments S of the period (1: single shooting; more: "
                        "multiple shooting, for unstable or stiff orbits)"),
     "rtol": Option(schema.positive, 1e-9, doc="Newton's relative tolerance on the unknowns (shooting integrates "
