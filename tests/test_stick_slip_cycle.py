@@ -68,7 +68,8 @@ def slider_rhs(law: str):
             dpsi = p["V_ref"] / p["D_c"] * (math.exp(-psi) - math.exp(phi))
         else:
             dpsi = -p["V_ref"] / p["D_c"] * math.exp(phi) * (phi + psi)
-        return [p["sigma"] * (f - p["a"] * phi - p["b"] * psi) / (p["m"] * V), dpsi, p["k"] * (p["V2"] - V) / p["sigma"]]
+        return [p["sigma"] * (f - p["a"] * phi - p["b"] * psi) / (p["m"] * V), dpsi,
+                p["k"] * (p["V2"] - V) / p["sigma"]]
 
     return rhs
 

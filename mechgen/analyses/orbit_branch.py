@@ -8,19 +8,19 @@ curve is followed round its folds: both stable branches and the unstable one bet
 shooting weigh a node's state by 1 / nodes in the arclength and, for a parameter of size |p0| > 1, the unknowns by
 p0^2: the arclength measures the parameter's relative change against the orbit's (a fold at k ~ 5e9 Pa/m is then
 within the step control's reach; ``step`` and ``max_step`` are in those units, p0 times the orbit's change where the
-branch turns). An autonomous orbit's branch ends where its orbits shrink to an equilibrium (status
-``equilibrium``: a Hopf point, the orbits' size, the largest range of a state component over the period relative to
-the first orbit's, at a local minimum below 0.1), at its smallest orbit, rather than return through it. A forced orbit whose
+branch turns). An autonomous orbit's branch ends where its orbits shrink to an equilibrium (status ``equilibrium``:
+a Hopf point, the orbits' size, the largest range of a state component over the period relative to the first
+orbit's, at a local minimum below 0.1), at its smallest orbit, rather than return through it. A forced orbit whose
 ``frequency`` is an expression of the continued parameter (``frequency = "w"``, continued in ``w``) has its period
 follow it; otherwise the forcing's frequency stays as it was.
 
-Outputs: ``branch`` (per point: the parameter, ``period``, ``frequency``, ``amplitude`` ({coordinate: max |q|
-over the period}, then each internal variable's), ``start`` (the state at t = 0: each coordinate and
-``<coordinate>_dot``, then each internal variable), ``multipliers`` ([re, im] by decreasing modulus) and ``stability``), ``points``, ``status``,
-``method``, ``folds`` and ``special_points``: ``LPC`` (a cyclic fold: the branch turns in the parameter),
-``PD`` (period doubling: a multiplier through -1) and ``NS`` (Neimark-Sacker: a complex pair through the unit
-circle, with ``angle``), each with the parameter, period, amplitude and multipliers there
-(mechgen.runtime.steady.cycle_points); with ``switch_branches`` (a forced orbit by shooting) ``doubled``, the
+Outputs: ``branch`` (per point: the parameter, ``period``, ``frequency``, ``amplitude`` ({coordinate: max |q| over
+the period}, then each internal variable's), ``start`` (the state at t = 0: each coordinate and
+``<coordinate>_dot``, then each internal variable), ``multipliers`` ([re, im] by decreasing modulus) and
+``stability``), ``points``, ``status``, ``method``, ``folds`` and ``special_points``: ``LPC`` (a cyclic fold: the
+branch turns in the parameter), ``PD`` (period doubling: a multiplier through -1) and ``NS`` (Neimark-Sacker: a
+complex pair through the unit circle, with ``angle``), each with the parameter, period, amplitude and multipliers
+there (mechgen.runtime.steady.cycle_points); with ``switch_branches`` (a forced orbit by shooting) ``doubled``, the
 period-2T orbit just past every PD point.
 """
 from __future__ import annotations

@@ -207,8 +207,8 @@ SCHEMA = {
                  "coordinate = value"),
     "from": Option(earlier_simulate, ABSENT, doc="an earlier simulate analysis (with its trajectory) whose "
                    "motion near its end is the starting guess instead of q0 / v0 (and, for an autonomous orbit, the "
-                   "period between its last two maxima the period's; an autonomous collocation of a model with internal "
-                   "variables re-integrates one period from its state at the second-to-last maximum)"),
+                   "period between its last two maxima the period's; an autonomous collocation of a model with "
+                   "internal variables re-integrates one period from its state at the second-to-last maximum)"),
     "segments": Option(schema.count, 1, doc="shooting's number of segments S of the period (1: single shooting; more: "
                        "multiple shooting, for unstable or stiff orbits)"),
     "rtol": Option(schema.positive, 1e-9, doc="Newton's relative tolerance on the unknowns (shooting integrates "

@@ -1,7 +1,7 @@
-"""Newton's method for a periodic orbit's unknowns u: R(u) = 0 with the exact dR/du, one dense solve a step.
+"""Newton's method for a periodic orbit's unknowns u: R(u) = 0 with the exact dR/du, one solve a step.
 
-Each step solves J du = -R (LU, SuperLU for a sparse J; least squares when J is singular to working precision), shortens it to at most
-``trust`` (1 + ||u||_inf), and takes the largest
+Each step solves J du = -R (LU, SuperLU for a sparse J; least squares when J is singular to working precision),
+shortens it to at most ``trust`` (1 + ||u||_inf), and takes the largest
 alpha in 1, 1/2, ... 1/256 that does not increase ||R||_inf (when none does, the longest trial that
 could be evaluated). It stops after the step that was small,
 ||du||_inf <= atol + rtol ||u||_inf (Newton's convergence is quadratic, so the residual after it is far below
