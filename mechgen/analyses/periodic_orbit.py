@@ -50,7 +50,7 @@ Methods (``method``; left out: ``harmonic_balance`` when ``harmonics`` is given,
   such as a stick-slip cycle's slip, falls between a simulate's samples, and the maxima's distance guesses the
   period to a sample's width), and the first mesh already equidistributes the guess's monitor (from 4 x ``mesh``
   uniform intervals). A stiff cycle wants ``mesh`` of 50 to 100 and ``adapt`` = 2 (the stick-slip cycle of
-  scenes/rate_state_stick_slip.toml: period error 5e-8 at 50 intervals, 1.5e-10 at 100); on a mesh too coarse for it
+  scenes/rate_state_stick_slip.toml: period error 4e-8 at 50 intervals, 1.5e-10 at 100); on a mesh too coarse for it
   Newton may converge to a spurious orbit, which the trivial multiplier shows (far from 1: 2.4 at 25 intervals).
 
 Newton stops after a step ||du||_inf <= ``atol`` + ``rtol`` ||u||_inf (u the unknowns), and raises a
