@@ -101,6 +101,8 @@ fig.tight_layout()
 # ms): a scene is a dict too.
 SCENES = Path(mechgen.__file__).resolve().parents[1] / "scenes"
 scene = tomllib.loads((SCENES / "rate_state_stick_slip.toml").read_text())
+# the scene's cycle by collocation and its branch in k have their own page (plot_stick_slip_cycle.py)
+scene["analysis"] = [a for a in scene["analysis"] if a["kind"] not in ("periodic_orbit", "continuation")]
 for analysis in scene["analysis"]:
     if analysis["name"] == "cycles":
         analysis["samples"] = 60001

@@ -1,27 +1,37 @@
 """``continuation`` about a ``periodic_orbit``: the branch of periodic orbits in a parameter, with its cyclic folds,
 period doublings and torus points.
 
-The earlier orbit's method (harmonic balance, collocation or shooting) is continued in ``parameter`` up to ``stop`` by
+The earlier orbit's method (harmonic balance, shooting or collocation, with its mesh and, for a model with internal
+variables, its integral phase condition's reference orbit) is continued in ``parameter`` up to ``stop`` by
 pseudo-arclength (mechgen.runtime.periodic.branch; mechgen.runtime.steady.continuation), so a frequency-response
-curve is followed round its folds: both stable branches and the unstable one between. A forced orbit whose
+curve is followed round its folds: both stable branches and the unstable one between. Collocation and multiple
+shooting weigh a node's state by 1 / nodes in the arclength and, for a parameter of size |p0| > 1, the unknowns by
+p0^2: the arclength measures the parameter's relative change against the orbit's (a fold at k ~ 5e9 Pa/m is then
+within the step control's reach; ``step`` and ``max_step`` are in those units, p0 times the orbit's change where the
+branch turns). An autonomous orbit's branch ends where its orbits shrink to an equilibrium (status ``equilibrium``:
+a Hopf point, the orbits' size, the largest range of a state component over the period relative to the first
+orbit's, at a local minimum below 0.1), at its smallest orbit, rather than return through it. A forced orbit whose
 ``frequency`` is an expression of the continued parameter (``frequency = "w"``, continued in ``w``) has its period
 follow it; otherwise the forcing's frequency stays as it was.
 
-Outputs: ``branch`` (per point: the parameter, ``period``, ``frequency``, ``amplitude`` ({coordinate: max |q|
-over the period}), ``start`` (the state at t = 0: each coordinate and ``<coordinate>_dot``), ``multipliers`` ([re, im] by decreasing modulus) and ``stability``), ``points``, ``status``,
-``method``, ``folds`` and ``special_points``: ``LPC`` (a cyclic fold: the branch turns in the parameter),
-``PD`` (period doubling: a multiplier through -1) and ``NS`` (Neimark-Sacker: a complex pair through the unit
-circle, with ``angle``), each with the parameter, period, amplitude and multipliers there
-(mechgen.runtime.steady.cycle_points); with ``switch_branches`` (a forced orbit) ``doubled``, the period-2T orbit
-just past every PD point, by the orbit's own method: shooting over 2T from the period-T orbit displaced along the
-eigenvector of the multiplier -1; harmonic balance with 2H harmonics of omega / 2 (the period-T orbit's harmonics are
-the even ones) and collocation on the mesh repeated over [0, 2T], each from the period-T orbit plus the perturbation
-Phi(t) v over [0, 2T] (v that eigenvector: Phi(t + T) v = -Phi(t) v, odd harmonics of omega / 2).
+Outputs: ``branch`` (per point: the parameter, ``period``, ``frequency``, ``amplitude`` ({coordinate: max |q| over
+the period}, then each internal variable's), ``start`` (the state at t = 0: each coordinate and
+``<coordinate>_dot``, then each internal variable), ``multipliers`` ([re, im] by decreasing modulus) and
+``stability``), ``points``, ``status``, ``method``, ``folds`` and ``special_points``: ``LPC`` (a cyclic fold: the
+branch turns in the parameter), ``PD`` (period doubling: a multiplier through -1) and ``NS`` (Neimark-Sacker: a
+complex pair through the unit circle, with ``angle``), each with the parameter, period, amplitude and multipliers
+there (mechgen.runtime.steady.cycle_points); with ``switch_branches`` (a forced orbit) ``doubled``, the period-2T
+orbit just past every PD point, by the orbit's own method: shooting over 2T from the period-T orbit displaced along
+the eigenvector of the multiplier -1; harmonic balance with 2H harmonics of omega / 2 (the period-T orbit's
+harmonics are the even ones) and collocation on the mesh repeated over [0, 2T], each from the period-T orbit plus
+the perturbation Phi(t) v over [0, 2T] (v that eigenvector: Phi(t + T) v = -Phi(t) v, odd harmonics of omega / 2).
 
 About the free orbit of a conservative model (a ``periodic_orbit`` without frequency on a model that keeps its
 energy) the continuation follows its family: mechgen.analyses.backbone (``parameter = "amplitude"``: the backbone).
 """
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 
@@ -30,6 +40,7 @@ from mechgen.analyses.newton_branch import arclength_steps
 from mechgen.analyses.periodic_orbit import DEFAULT_HARMONICS, compiled_run, integrator_tolerances, peak
 from mechgen.analyses.schema import ParamExpression
 from mechgen.analyses.stability_boundary import own_value
+from mechgen.analyses.time_series import state_names
 from mechgen.errors import SceneError
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget
 from mechgen.runtime.periodic import floquet, fourier
@@ -76,8 +87,8 @@ class Orbits:
         if self.method == "harmonic_balance":
             H = int(self.options.get("harmonics", DEFAULT_HARMONICS))
             return HarmonicBalance(moved, fourier.basis(H), self.omega(p), self.phase)
-        if self.method == "collocation":
-            return Collocation(moved, self.mesh.mesh, self.omega(p), self.phase, self.mesh.edges)
+        if self.method == "collocation":  # the earlier mesh and phase condition (its reference orbit)
+            return replace(self.mesh, system=moved, omega=self.omega(p))
         return Shooting(moved, self.omega(p), self.phase, *integrator_tolerances(self.options),
                         compiled_run(moved, self.options), int(self.options.get("segments", 1)))
 
@@ -129,6 +140,9 @@ class Orbits:
         return self.memo[key]
 
     def monodromy_eigenvalues(self, problem, u: np.ndarray) -> np.ndarray:
+        """The multipliers: collocation's from its own monodromy (no integration), the others' from the flow."""
+        if self.method == "collocation":
+            return floquet.multipliers(problem.monodromy(u))
         T = self.period(problem, u)
         x0 = problem.split(u)[0] if self.method == "shooting" else self.states(problem, u, np.array([0.0]))[0]
         run = compiled_run(problem.system, self.options)
@@ -139,16 +153,52 @@ class Orbits:
         return floquet.multipliers(Phi)
 
 
+#: an autonomous orbit's branch ends at a local minimum of its orbits' size below COLLAPSE times the first orbit's
+COLLAPSE = 0.1
+#: phases at which an orbit's size is measured
+SIZE_PHASES = 256
+
+
+class Collapse:
+    """``until`` of an autonomous orbit's branch (mechgen.runtime.steady.continuation): the orbits' size, the largest
+    range over the period of a state component relative to the first orbit's, at each accepted point; the branch
+    ends at the smallest orbit when the size, below COLLAPSE, starts to grow again (the orbits shrank to an
+    equilibrium, a Hopf point, and the branch would return through it along the same orbits)."""
+
+    def __init__(self, orbits: Orbits, branch: OrbitBranch, u0: np.ndarray, p0: float) -> None:
+        self.orbits, self.branch = orbits, branch
+        self.first = self.ranges(u0, p0) + 1e-300
+        self.sizes, self.last = [1.0], float(p0)
+
+    def ranges(self, u: np.ndarray, p: float) -> np.ndarray:
+        problem = self.branch.problem(p)
+        T = self.orbits.period(problem, u)
+        return np.ptp(self.orbits.states(problem, u, T * np.arange(SIZE_PHASES) / SIZE_PHASES), axis=0)
+
+    def __call__(self, u: np.ndarray, p: float):
+        size = float(np.max(self.ranges(u, p) / self.first))
+        if len(self.sizes) > 1 and self.sizes[-1] < min(COLLAPSE, self.sizes[-2], size):
+            return ("equilibrium", f"the orbits shrank to an equilibrium near {self.orbits.name} = {self.last:.10g} "
+                    f"(a Hopf point): the branch ends at its smallest orbit, {self.sizes[-1]:.3g} of the first "
+                    "orbit's size")
+        self.sizes.append(size)
+        self.last = float(p)
+        return None
+
+
 def record(orbits: Orbits, branch: OrbitBranch, u: np.ndarray, p: float) -> dict:
     """One branch point's outputs (module doc)."""
     problem = branch.problem(p)
     T = orbits.period(problem, u)
     X = orbits.states(problem, u, T * np.arange(PHASES) / PHASES)
     mu = orbits.multipliers(problem, u, p)
-    names = list(orbits.system.coordinates)
-    start = dict(zip(names + [f"{c}_dot" for c in names], (float(v) for v in X[0])))
+    system = orbits.system
+    names = list(system.coordinates)
+    internals = state_names(system)[2 * system.n:]
+    start = dict(zip(names + [f"{c}_dot" for c in names] + internals, (float(v) for v in X[0])))
+    columns = list(range(system.n)) + list(range(2 * system.n, 2 * system.n + system.m))
     return {orbits.name: float(p), "period": T, "frequency": float(2 * np.pi / T),
-            "amplitude": {c: peak(X[:, i]) for i, c in enumerate(names)}, "start": start,
+            "amplitude": {c: peak(X[:, i]) for c, i in zip(names + internals, columns)}, "start": start,
             "multipliers": floquet.as_pairs(mu), "stability": floquet.stability(mu, orbits.autonomous)}
 
 
@@ -184,9 +234,11 @@ def run_orbit_branch(system, options: dict, earlier: dict) -> dict:
     problem = branch.problem(here)
     u0 = orbits.start(problem, earlier["_orbit"]["found"])
     repeats = problem.nodes if orbits.method == "collocation" else getattr(problem, "segments", 1)
-    eqs = branch.equations(node_weights(u0.size, repeats, int(orbits.autonomous)) if repeats > 1 else None)
+    scale = max(1.0, abs(here))
+    eqs = branch.equations(node_weights(u0.size, repeats, int(orbits.autonomous), scale) if repeats > 1 else None)
     budget = Budget("continuation", unit="points", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
-    found = continuation(eqs, u0, here, arclength_steps(options, here, budget, smallest_span=0.1))
+    until = Collapse(orbits, branch, u0, here) if orbits.autonomous else None
+    found = continuation(eqs, u0, here, arclength_steps(options, here, budget, smallest_span=0.1), until=until)
     points = [record(orbits, branch, u, p) for u, p in zip(found.u, found.lam)]
     X = np.hstack([found.u, found.lam[:, None]])
 

@@ -11,6 +11,7 @@ the second parameter b by pseudo-arclength (so the curve is followed round a cus
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sps
 
 from mechgen.analyses.newton_branch import arclength_steps
 from mechgen.analyses.orbit_branch import Orbits, record
@@ -47,7 +48,9 @@ class TwoParameterOrbits:
         return residual_only(self.at(b)[1].problem(a), np.asarray(u, float))
 
     def jacobian(self, u, a, b) -> np.ndarray:
-        return self.at(b)[1].residual_jacobian(np.asarray(u, float), a)[1]
+        """dR/du, dense (a collocation of a model with internal variables gives it sparse)."""
+        J = self.at(b)[1].residual_jacobian(np.asarray(u, float), a)[1]
+        return J.toarray() if sps.issparse(J) else J
 
 
 def run_orbit_curve(system, options: dict, earlier: dict) -> dict:

@@ -171,7 +171,8 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
            "``start`` (with several starts)."),
         _o("points", "scalar (int)", "-", "How many branch points."),
         _o("status", "string, or {start: string}", "-", "Why the branch ended (``lam_max``, ``bounds``, "
-           "``max_points`` ...; per start with several)."),
+           "``max_points`` ...; per start with several; about an autonomous ``periodic_orbit``, ``equilibrium``: "
+           "the orbits shrank onto an equilibrium, a Hopf point, and the branch ends at its smallest orbit)."),
         _o("folds", "list of branch points", "the outputs'", "The turning points in the parameter."),
         _o("stability_changes", "list of {..., from, to}", "the outputs'", "With ``stability``: where the "
            "verdict changes between consecutive points, located by bisection along the branch."),
@@ -190,8 +191,9 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
            "``collocation`` or ``shooting``) the branch is continued by."),
         _o("branch (orbits)", "list of {<parameter>, period, frequency, amplitude, start, multipliers, stability}",
            "s, rad/s, coordinates'", "About a ``periodic_orbit``: one entry per orbit of the branch: the parameter, "
-           "the period T, 2 pi / T, ``amplitude`` ({coordinate: max \\|q\\| over the period}), ``start`` (the state "
-           "at t = 0: each coordinate and ``<coordinate>_dot``), the Floquet ``multipliers`` ([re, im] by "
+           "the period T, 2 pi / T, ``amplitude`` ({coordinate: max \\|q\\| over the period}, then each internal "
+           "variable's), ``start`` (the state at t = 0: each coordinate and ``<coordinate>_dot``, then each internal "
+           "variable), the Floquet ``multipliers`` ([re, im] by "
            "decreasing modulus) and ``stability``; its ``special_points`` are ``LPC`` (cyclic fold), ``PD`` (period "
            "doubling: a multiplier through -1) and ``NS`` (a complex pair through the unit circle, with ``angle``)."),
         _o("doubled", "list of {at, <parameter>, amplitude, period, start, multipliers, stability}", "the outputs'",
@@ -356,20 +358,22 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("t", "(samples,)", "s (or the model's time unit)", "One period, ``samples`` equally spaced times from 0 "
            "to T."),
         _o("trajectory", "{name: (samples,)}", MODEL_UNIT, "The orbit at ``t``, named as simulate's: each "
-           "coordinate, ``<coordinate>_dot`` and the model's outputs."),
+           "coordinate, ``<coordinate>_dot``, each internal variable and the model's outputs."),
         _o("amplitude", "{coordinate: value}", MODEL_UNIT, "max \\|q\\| over the period (the largest of 4096 phases, "
-           "refined by the parabola through it and its neighbours)."),
+           "refined by the parabola through it and its neighbours), then each internal variable's."),
         _o("harmonics", "{coordinate: {mean, cos, sin, amplitude, phase}}", "the coordinate's; phase in rad",
            "The Fourier coefficients of each coordinate, k = 1..H: q = mean + sum_k a_k cos(k omega t) + b_k "
            "sin(k omega t) = mean + sum_k amplitude_k cos(k omega t + phase_k) (``cos`` a_k, ``sin`` b_k, "
            "``amplitude`` sqrt(a_k^2 + b_k^2), ``phase`` atan2(-b_k, a_k))."),
-        _o("multipliers", "(2n, 2)", "-", "The Floquet multipliers (eigenvalues of the monodromy matrix) as [re, "
-           "im] pairs, by decreasing modulus (a conjugate pair: the positive imaginary part first)."),
+        _o("multipliers", "(2n + m, 2)", "-", "The Floquet multipliers (eigenvalues of the monodromy matrix; "
+           "collocation's from its own equations) as [re, im] pairs, by decreasing modulus (a conjugate pair: the "
+           "positive imaginary part first)."),
         _o("stability", "string", "-", "``stable`` (every multiplier \\|mu\\| <= 1 + 1e-6, an autonomous "
            "orbit's trivial one set aside, a conservative model's free orbit's two nearest 1) or ``unstable``."),
         _o("method", "string", "-", "``harmonic_balance``, ``shooting`` or ``collocation``: the method that ran."),
         _o("residual", "scalar", "force units (harmonic balance), the state's (shooting), mixed (collocation: "
-           "q's rate and force units)", "\\|\\|R\\|\\|_inf at the solution."),
+           "q's rate and force units; with internal variables each row times its interval's width)",
+           "\\|\\|R\\|\\|_inf at the solution."),
         _o("iterations", "scalar (int)", "-", "Newton steps taken."),
         _o("unfolding", "scalar", "force per velocity (shooting: the state's per J)", "The free orbit of a "
            "conservative model (no ``frequency``, a model that keeps its energy): the unfolding parameter eps of "
@@ -378,8 +382,8 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
            "T + V (the model's ``energy`` output), constant along it."),
         _o("loop", "string", "-", "``c``: shooting's integrations ran in the compiled DOP853 loop (the monodromy "
            "for Newton by central differences of it; a forced orbit's later segments, with ``segments`` > 1, in "
-           "scipy's); ``python``: in scipy's DOP853 (harmonic balance's and "
-           "collocation's multipliers, and ``loop = \"python\"``)."),
+           "scipy's); ``python``: in scipy's DOP853 (harmonic balance's multipliers, and ``loop = \"python\"``), or "
+           "no integration (collocation)."),
     ),
     "cross_section": (
         _o("K", "(6, 6)", "N, N m, N m^2", "The section's stiffness ordered [K_uu, K_uw; K_wu, K_ww]."),

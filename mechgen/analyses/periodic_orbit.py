@@ -60,12 +60,27 @@ Methods (``method``; left out: ``harmonic_balance`` when ``harmonics`` is given,
   and the phase condition v_p(0) = 0, as shooting's. Its error falls as mesh^-8 at the mesh points (the order 2m
   of Gauss collocation). With ``adapt`` = k > 0 the mesh is adapted k times after the uniform solve: its intervals
   moved so that each holds an equal share of the monitor |x^(5)|^(1/5) (AUTO's rule: small intervals where the orbit
-  turns fast), the orbit interpolated onto them and solved again.
+  turns fast), the orbit interpolated onto them and solved again. A model with internal variables z (with or
+  without coordinates) is collocated in its first-order form: beside the rows above, dz/dtau = T g(q, v, z, t) with
+  g the generated ``rates`` kernel (its Jacobian from ``rates_tangent``), each point's rows weighted by its
+  interval's width, the Jacobian sparse (SuperLU); autonomous, the phase condition is AUTO's integral one,
+  int_0^1 x(tau) . x_ref'(tau) dtau = 0 against the starting guess x_ref (then the previous solution at each
+  adaptation). Its guess is one period re-integrated (scipy's Radau, the exact Jacobian) from the guess's state at
+  t = 0 (``z0`` / ``q0`` / ``v0``, or the ``from`` simulate's state at its second-to-last maximum), cut at its slowest
+  point and closed by a Poincare section there (mechgen.runtime.periodic.cycle_guess: a stiff cycle's fast phase,
+  such as a stick-slip cycle's slip, falls between a simulate's samples, and the maxima's distance guesses the
+  period to a sample's width), and the first mesh already equidistributes the guess's monitor (from 4 x ``mesh``
+  uniform intervals). A stiff cycle wants ``mesh`` of 50 to 100 and ``adapt`` = 2 (the stick-slip cycle of
+  scenes/rate_state_stick_slip.toml: period error 4e-8 at 50 intervals, 1.5e-10 at 100); on a mesh too coarse for it
+  Newton may converge to a spurious orbit, which the trivial multiplier shows (far from 1: 2.4 at 25 intervals).
 
 Newton stops after a step ||du||_inf <= ``atol`` + ``rtol`` ||u||_inf (u the unknowns), and raises a
 ConvergenceError after ``max_iterations`` steps, naming the residual. Stability comes from the monodromy matrix
-Phi(T) of the converged orbit, always from the variational equations (for harmonic balance and collocation:
-integrated over one period from the orbit's state at t = 0): the Floquet multipliers are its eigenvalues. With
+Phi(T) of the converged orbit: the Floquet multipliers are its eigenvalues. For shooting and harmonic balance Phi(T)
+comes from the variational equations (for harmonic balance integrated over one period from the orbit's state at
+t = 0); for collocation from the collocation equations themselves (AUTO's way: each interval's linearised equations
+condensed to its end state's dependence on its start state, their product Phi(T), of the method's order and with no
+integration, so that a stiff cycle's multipliers cost nothing more). With
 ``floquet = "hill"`` (harmonic balance only) they come from Hill's method instead
 (mechgen.runtime.periodic.harmonic_balance.hill_exponents: the quadratic eigenproblem of the linearisation on the
 harmonics, the 2n exponents whose eigenvectors weigh most on the low harmonics kept; no integration). The orbit is
@@ -83,15 +98,15 @@ shooting and collocation H = ``harmonics`` or 7, projected from 4096 samples of 
 force units for harmonic balance, the state's for shooting, both for collocation), ``iterations`` and ``loop``
 (``c``: shooting's integrations ran in the compiled loop; ``python``: in scipy's).
 
-Smooth lumped models without internal variables, and forced hybrid models: a hybrid model's orbit (impacts,
+Smooth lumped models, with or without internal variables, and forced hybrid models: a hybrid model's orbit (impacts,
 stick-slip) is found by single shooting through its events, the monodromy built from the modes'
 state-transition matrices and the saltation matrices of the events (generated from the guards and resets;
 mechgen.analyses.hybrid_orbit), with ``events`` (one period's) and ``grazing`` besides the outputs above; harmonic
 balance, collocation, multiple shooting and an autonomous hybrid orbit are refused for it (exit 2 at the key). A
-model with internal variables z is solved by shooting, whose flow carries them (``z0`` their guess; the phase
-condition of a model of internal variables only is dz_p/dt = 0 at t = 0; ``amplitude`` and ``harmonics`` list them
-after the coordinates); harmonic balance and collocation, whose residual holds the coordinates only, are refused
-for it. A continuum or a chain is refused (key ``method``).
+model with internal variables z is solved by collocation (above) or shooting, whose flow carries them (``z0`` their
+guess; shooting's phase condition of a model of internal variables only is dz_p/dt = 0 at t = 0; ``amplitude`` and
+``harmonics`` list them after the coordinates); harmonic balance, whose residual holds the coordinates only, is
+refused for it (exit 2 at ``method``). A continuum or a chain is refused (key ``method``).
 """
 from __future__ import annotations
 
@@ -109,6 +124,7 @@ from mechgen.errors import ConvergenceError, SceneError
 from mechgen.runtime.core.memory import dense_bytes, require
 from mechgen.runtime.periodic import floquet, fourier
 from mechgen.runtime.periodic.collocation import Collocation
+from mechgen.runtime.periodic.cycle_guess import closed_cycle
 from mechgen.runtime.periodic.flow import compiled_flow, states_at, variational_flow
 from mechgen.runtime.periodic.harmonic_balance import HarmonicBalance, hill_multipliers
 from mechgen.runtime.periodic.newton import NewtonSettings, newton
@@ -209,12 +225,14 @@ SCHEMA = {
     "q0": Option(schema.coordinate_table, {}, doc="the starting guess of the coordinates at t = 0, a table "
                  "coordinate = value (left out: zero, or the model's declared initial state)"),
     "z0": Option(internal_table, {}, doc="the starting guess of the internal variables at t = 0, a table "
-                 "name = value (left out: the model's declared initial values, else zero)"),
+                 "name = value (left out: the model's declared initial values, else zero); for collocation the "
+                 "state one period is re-integrated from"),
     "v0": Option(schema.coordinate_table, {}, doc="the starting guess of the velocities at t = 0, a table "
                  "coordinate = value"),
     "from": Option(earlier_simulate, ABSENT, doc="an earlier simulate analysis (with its trajectory) whose "
                    "motion near its end is the starting guess instead of q0 / v0 (and, for an autonomous orbit, the "
-                   "period between its last two maxima the period's)"),
+                   "period between its last two maxima the period's; an autonomous collocation of a model with "
+                   "internal variables re-integrates one period from its state at the second-to-last maximum)"),
     "segments": Option(schema.count, 1, doc="shooting's number of segments S of the period (1: single shooting; more: "
                        "multiple shooting, for unstable or stiff orbits)"),
     "rtol": Option(schema.positive, 1e-9, doc="Newton's relative tolerance on the unknowns (shooting integrates "
@@ -246,10 +264,10 @@ def check(ctx, base: str, options: dict) -> None:
         return
     why = ("is a continuum" if getattr(model, "continuum", False) else "is a chain" if getattr(model, "chain", None)
            else None)
-    if getattr(model, "internals", False) and chosen_method(options) != "shooting":
+    if getattr(model, "internals", False) and chosen_method(options) == "harmonic_balance":
         raise fail(ctx.file, f"{base}.method", f"model {model.name} has internal variables, which "
-                   f"{chosen_method(options)} does not carry (its residual is the coordinates')",
-                   "method = \"shooting\" (the flow carries the internal variables)")
+                   "harmonic_balance does not carry (its residual is the coordinates')",
+                   "method = \"collocation\" or \"shooting\" (both carry the internal variables)")
     if why:
         raise fail(ctx.file, f"{base}.method", f"model {model.name} {why}: periodic_orbit's methods need a smooth "
                    "lumped model", "a smooth lumped model (a hybrid model's periodic response: kind periodic)")
@@ -445,6 +463,14 @@ def guess_from_simulate(system, options: dict, context: dict, omega) -> Guess:
     return Guess(spline(start), period, p, lambda times: spline(start + np.asarray(times)))
 
 
+def closed_guess(system, start: Guess) -> Guess:
+    """An autonomous collocation of a model with internal variables starts from one period re-integrated from the
+    guess's state at t = 0, cut at its slowest point and closed by a Poincare section there
+    (mechgen.runtime.periodic.cycle_guess): a stiff cycle's fast phase lies between a simulate's samples."""
+    x0, period, curve = closed_cycle(system, start.x0, start.period)
+    return Guess(x0, period, start.phase, curve)
+
+
 def settings(options: dict, method: str) -> NewtonSettings:
     """Newton's tolerances and its failure's advice."""
     advice = ("a better starting guess (q0, v0" + (", period" if "frequency" not in options else "") + ")"
@@ -482,14 +508,20 @@ def solve_harmonic_balance(system, options: dict, start: Guess, omega) -> dict:
 
 
 def solve_collocation(system, options: dict, start: Guess, omega) -> dict:
-    """Collocation from the guess (its curve at the nodes): {problem, u, x0, omega, residual, iterations}."""
-    problem = Collocation(system, int(options.get("mesh", DEFAULT_MESH)), omega, start.phase)
-    size = problem.nodes * 2 * system.n + 1
-    require(dense_bytes(size, size), f"collocation's dense {size} x {size} Jacobian", key="mesh")
-    X = start.curve(start.period * np.arange(problem.nodes) / problem.nodes)
-    if problem.autonomous:
-        X[0, system.n + start.phase] = 0.0
-    sol = newton(problem.residual_jacobian, problem.unknowns(X, start.period), settings(options, "collocation"))
+    """Collocation from the guess (its curve at the nodes; with internal variables on the mesh adapted to the guess):
+    {problem, u, x0, omega, residual, iterations}."""
+    mesh = int(options.get("mesh", DEFAULT_MESH))
+    if system.m:
+        problem, u = first_order_start(system, mesh, start, omega)
+    else:
+        problem = Collocation(system, mesh, omega, start.phase)
+        size = problem.nodes * 2 * system.n + 1
+        require(dense_bytes(size, size), f"collocation's dense {size} x {size} Jacobian", key="mesh")
+        X = start.curve(start.period * np.arange(problem.nodes) / problem.nodes)
+        if problem.autonomous:
+            X[0, system.n + start.phase] = 0.0
+        u = problem.unknowns(X, start.period)
+    sol = newton(problem.residual_jacobian, u, settings(options, "collocation"))
     for _ in range(int(options.get("adapt", 0))):
         problem, u = problem.adapted(sol.u)
         sol = newton(problem.residual_jacobian, u, settings(options, "collocation"))
@@ -499,6 +531,22 @@ def solve_collocation(system, options: dict, start: Guess, omega) -> dict:
                                "starting guess (period, q0, v0, or from a simulate)")
     return {"problem": problem, "u": sol.u, "x0": X[0].copy(), "omega": 2 * np.pi / T, "residual": sol.residual,
             "iterations": sol.iterations}
+
+
+#: a model with internal variables: the guess is first laid on GUESS_REFINEMENT x ``mesh`` uniform intervals, whose
+#: monitor places the ``mesh`` intervals of the first solve
+GUESS_REFINEMENT = 4
+
+
+def first_order_start(system, mesh: int, start: Guess, omega) -> tuple[Collocation, np.ndarray]:
+    """(problem, u) of a model with internal variables: the first-order collocation (sparse Jacobian; autonomous:
+    the integral phase condition against the guess) on ``mesh`` intervals that equidistribute the guess's monitor
+    (AUTO's, as ``adapt``: a stiff cycle's fast phase gets its intervals before the first solve)."""
+    fine = Collocation(system, GUESS_REFINEMENT * mesh, omega, start.phase)
+    X = np.asarray(start.curve(start.period * fine.node_tau()), float)
+    if fine.autonomous:
+        fine = Collocation(system, fine.mesh, omega, start.phase, None, X)
+    return fine.adapted(fine.unknowns(X, start.period), mesh)
 
 
 def compiled_run(system, options: dict):
@@ -565,8 +613,12 @@ def run_periodic_orbit(system, options: dict, context: dict) -> dict:
     if omega is None:
         refuse_time_dependent(system, start.x0)
         if not np.any(start.x0):
+            key = "q0" if system.n else "z0"
             raise SceneError("periodic_orbit: an autonomous orbit from a zero starting guess would find the "
-                             "equilibrium", key="q0", expected="a starting guess on or near the orbit (q0, v0)")
+                             "equilibrium", key=key, expected="a starting guess on or near the orbit ("
+                             + ("q0, v0" if system.n else "z0") + ", or from a simulate)")
+    if method == "collocation" and system.m and omega is None:
+        start = closed_guess(system, start)
     free = omega is None and is_conservative(system, start.x0)
     if free and not np.any(start.x0[:system.n]):
         raise SceneError("periodic_orbit: the free orbit of a conservative model is the member through the guess's "
@@ -613,6 +665,8 @@ def report(system, options: dict, found: dict, method: str, *, autonomous: bool,
         fine, int(options.get("harmonics", DEFAULT_HARMONICS)))
     if options.get("floquet") == "hill":
         mu = hill_multipliers(found["problem"], found["u"])
+    elif method == "collocation":  # the discretisation's own monodromy (mechgen.runtime.periodic.collocation)
+        mu = floquet.multipliers(found["problem"].monodromy(found["u"]))
     else:
         _, Phi = variational_flow(system, found["x0"], 0.0, T, *integrator_tolerances(options))
         mu = floquet.multipliers(Phi)
@@ -641,20 +695,27 @@ def peak(values: np.ndarray) -> float:
 
 
 def plot(plt, a: dict, path) -> list:
-    """The orbit: each coordinate against t over one period, and the phase portrait of each (up to 4)."""
+    """The orbit: each coordinate against t over one period, and the phase portrait of each (up to 4); a model of
+    internal variables only: each internal variable against t, and the second against the first."""
     out = a["outputs"]
     traj = out["trajectory"]
     names = [c for c in traj if f"{c}_dot" in traj][:4]
+    pairs = [(c, f"{c}_dot") for c in names]
+    internals = [] if names else list(out["amplitude"])[:4]
+    if len(internals) > 1:
+        pairs = [(internals[0], internals[1])]
     fig, axes = plt.subplots(1, 2, figsize=(9, 3.6))
-    for c in names:
+    for c in names or internals:
         axes[0].plot(out["t"], traj[c], label=c)
-        axes[1].plot(traj[c], traj[f"{c}_dot"], label=c)
+    for x, y in pairs:
+        axes[1].plot(traj[x], traj[y], label=x if names else None)
     axes[0].set_xlabel("t (s, or the model's time unit)")
-    axes[0].set_ylabel("coordinates")
-    axes[1].set_xlabel("q")
-    axes[1].set_ylabel("dq/dt")
-    for ax in axes if len(names) > 1 else ():
-        ax.legend(fontsize="small")
+    axes[0].set_ylabel("coordinates" if names else "internal variables")
+    axes[1].set_xlabel("q" if names else pairs[0][0] if pairs else "")
+    axes[1].set_ylabel("dq/dt" if names else pairs[0][1] if pairs else "")
+    for ax in axes if len(names or internals) > 1 else ():
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize="small")
     fig.suptitle(f"{a['name']}: T = {out['period']:.6g}, {out['stability']} ({out['method']})")
     fig.tight_layout()
     fig.savefig(path, dpi=120)

@@ -22,5 +22,12 @@ The interface a continuation builds on, one problem object per method, each hold
   its free orbits form a family, made isolated by a prescribed level q_p(0) and the unfolding parameter eps of
   Munoz-Almaraz et al. (2003), an unknown that vanishes on the orbit.
 * :mod:`~mechgen.runtime.periodic.floquet` turns a monodromy matrix
-  (:func:`~mechgen.runtime.periodic.flow.variational_flow`) into multipliers and stability.
+  (:func:`~mechgen.runtime.periodic.flow.variational_flow`, or a collocation's own
+  :meth:`~mechgen.runtime.periodic.collocation.Collocation.monodromy`) into multipliers and stability.
+* :func:`~mechgen.runtime.periodic.cycle_guess.closed_cycle` closes the starting guess of a stiff autonomous cycle
+  (one period re-integrated from a state near it).
+
+A model with internal variables z has the state x = (q, v, z) at every node and in every start state; collocation
+then returns a sparse (CSR) dR/du, which :func:`~mechgen.runtime.periodic.newton.newton` and the continuation solve
+by SuperLU.
 """

@@ -93,9 +93,12 @@ class WeightedEquations:
         self.arclength_weights = weights
 
 
-def node_weights(size: int, repeats: int, trailing: int) -> np.ndarray:
+def node_weights(size: int, repeats: int, trailing: int, scale: float = 1.0) -> np.ndarray:
     """Weights of unknowns made of ``repeats`` equal blocks (node or segment states) followed by ``trailing``
-    scalars (a period) and the parameter: 1 / repeats on the blocks, 1 on the rest."""
-    w = np.ones(size + 1)
-    w[:size - trailing] = 1.0 / repeats
+    scalars (a period) and the parameter: scale^2 / repeats on the blocks, scale^2 on the rest, 1 on the parameter.
+    ``scale`` = max(1, |p0|) of a parameter of size |p0| (a stiffness of 5e9 Pa/m) makes the arclength measure its
+    relative change against the unknowns' (a fold's turn then spans steps the step control can take)."""
+    w = np.full(size + 1, float(scale) ** 2)
+    w[:size - trailing] /= repeats
+    w[-1] = 1.0
     return w

@@ -88,6 +88,10 @@ class Unfolded:
         """Collocation's states at ``times`` (u less eps)."""
         return self.problem.states_at(np.asarray(u)[:-1], times)
 
+    def monodromy(self, u: np.ndarray) -> np.ndarray:
+        """Collocation's monodromy of the orbit (u less eps: eps = 0 on the family's orbits)."""
+        return self.problem.monodromy(np.asarray(u)[:-1])
+
     def level_row(self, size: int) -> np.ndarray:
         """The gradient of q_p(0) over the method's unknowns (``size`` of them): q_p(0) is linear in them."""
         row = np.zeros(size)

@@ -1,7 +1,7 @@
-"""Newton's method for a periodic orbit's unknowns u: R(u) = 0 with the exact dR/du, one dense solve a step.
+"""Newton's method for a periodic orbit's unknowns u: R(u) = 0 with the exact dR/du, one solve a step.
 
-Each step solves J du = -R (LU; least squares when J is singular to working precision), shortens it to at most
-``trust`` (1 + ||u||_inf), and takes the largest
+Each step solves J du = -R (LU, SuperLU for a sparse J; least squares when J is singular to working precision),
+shortens it to at most ``trust`` (1 + ||u||_inf), and takes the largest
 alpha in 1, 1/2, ... 1/256 that does not increase ||R||_inf (when none does, the longest trial that
 could be evaluated). It stops after the step that was small,
 ||du||_inf <= atol + rtol ||u||_inf (Newton's convergence is quadratic, so the residual after it is far below
@@ -15,8 +15,10 @@ from typing import Callable
 
 import numpy as np
 import scipy.linalg as sla
+import scipy.sparse as sps
+import scipy.sparse.linalg as spla
 
-from mechgen.errors import ConvergenceError
+from mechgen.errors import ConvergenceError, KernelError
 
 
 @dataclass(frozen=True)
@@ -43,8 +45,17 @@ class NewtonSettings:
     advice: str = "a better starting guess (q0, v0)"
 
 
-def step(J: np.ndarray, R: np.ndarray) -> np.ndarray:
-    """du = -J^-1 R (least squares when J is singular)."""
+def step(J, R: np.ndarray) -> np.ndarray:
+    """du = -J^-1 R (least squares when J is singular); J dense, or sparse (SuperLU)."""
+    if sps.issparse(J):
+        try:
+            with np.errstate(all="ignore"):
+                du = spla.splu(J.tocsc()).solve(-R)
+            if np.all(np.isfinite(du)):
+                return du
+        except RuntimeError:  # exactly singular
+            pass
+        J = J.toarray()
     try:
         with np.errstate(all="ignore"):
             du = sla.solve(J, -R, check_finite=True)
@@ -69,7 +80,7 @@ def line_search(system_of: Callable, u: np.ndarray, du: np.ndarray, before: floa
         trial = u + alpha * du
         try:
             R, J = system_of(trial)
-        except (ConvergenceError, FloatingPointError):
+        except (ConvergenceError, FloatingPointError, KernelError):  # a trial the flow or the kernels cannot take
             continue
         if not np.all(np.isfinite(R)):
             continue
@@ -89,7 +100,7 @@ def newton(system_of: Callable[[np.ndarray], tuple], u0: np.ndarray, settings: N
     R, J = system_of(u)
     history = [norm(R)]
     for it in range(1, settings.max_iterations + 1):
-        if not (np.all(np.isfinite(R)) and np.all(np.isfinite(J))):
+        if not (np.all(np.isfinite(R)) and np.all(np.isfinite(J.data if sps.issparse(J) else J))):
             break
         du = step(J, R)
         limit = settings.trust * (1.0 + norm(u))

@@ -79,7 +79,8 @@ class Fold:
 class Branch:
     """Accepted points ``u`` (m, n) and ``lam`` (m,), their arclength and unit tangents
     (m, n + 1), the folds, the callback's value per point (``data``), why it stopped
-    (``status``: 'max_points', 'lam_max', 'lam_min', 'min_step' or 'closed') and a message, and
+    (``status``: 'max_points', 'lam_max', 'lam_min', 'min_step', 'closed' or the one ``until`` gave) and a
+    message, and
     the system (to correct further points, e.g. for :func:`minimize_along_branch`)."""
 
     u: np.ndarray
@@ -381,7 +382,8 @@ def _check_system(system, u, lam):
 
 
 def continuation(system, u0, lam0: float, options: ContinuationOptions | None = None, *,
-                 callback: Callable | None = None, start_tangent: np.ndarray | None = None, **overrides) -> Branch:
+                 callback: Callable | None = None, start_tangent: np.ndarray | None = None,
+                 until: Callable | None = None, **overrides) -> Branch:
     """Continue F(u, lam) = 0 from (u0, lam0) in the direction of increasing lam
     (``direction=+1``) or decreasing lam (-1).
 
@@ -391,7 +393,9 @@ def continuation(system, u0, lam0: float, options: ContinuationOptions | None = 
     single options (``continuation(F, u0, lam0, ds=0.1, lam_max=2.0)``). ``callback(u, lam)`` is
     called at every accepted point and its values are kept in ``Branch.data``. ``start_tangent``: a start
     already on the branch (a branch point, mechgen.runtime.steady.special_points) and the direction of the first
-    step, used as given (no correction at fixed lam, no orientation by ``direction``).
+    step, used as given (no correction at fixed lam, no orientation by ``direction``). ``until(u, lam)``, called
+    at each corrected point before it is accepted, may end the branch there: it returns None, or (status, message),
+    and the point is not kept (a branch of orbits that shrink to an equilibrium ends at its smallest orbit).
     """
     opts = ContinuationOptions.of(options, **overrides)
     opts.check()
@@ -406,7 +410,7 @@ def continuation(system, u0, lam0: float, options: ContinuationOptions | None = 
     e_lam = np.zeros(n + 1)
     e_lam[-1] = 1.0
     if start_tangent is not None:
-        return _run(system, np.append(u, lam0), _unit(w, start_tangent), callback, opts)
+        return _run(system, np.append(u, lam0), _unit(w, start_tangent), callback, opts, until)
     got = _correct(system, np.append(u, lam0), e_lam, lam0, tol=tol, max_iter=4 * max_corrector)
     if got is None:
         F = _eval(system, u, lam0, jac=False)[0]
@@ -426,7 +430,7 @@ def continuation(system, u0, lam0: float, options: ContinuationOptions | None = 
                                "branch point)")
     if t[-1] * opts.direction < 0:
         t = -t
-    return _run(system, x, t, callback, opts)
+    return _run(system, x, t, callback, opts, until)
 
 
 def closes(w, xs: list, ts: list, step: float) -> bool:
@@ -451,7 +455,7 @@ def _unit(w, t) -> np.ndarray:
     return t / _norm(w, t)
 
 
-def _run(system, x, t, callback, opts: ContinuationOptions) -> Branch:
+def _run(system, x, t, callback, opts: ContinuationOptions, until: Callable | None = None) -> Branch:
     """The steps of :func:`continuation` from the point x on the branch with the unit tangent t."""
     ds, ds_min, ds_max, max_points = opts.ds, opts.ds_min, opts.ds_max, opts.max_points
     lam_min, lam_max, tol, max_corrector, grow = opts.lam_min, opts.lam_max, opts.tol, opts.max_corrector, opts.grow
@@ -494,6 +498,10 @@ def _run(system, x, t, callback, opts: ContinuationOptions) -> Branch:
                            "or the branch turns too sharply: a singular point, or tol below the residual's noise)")
                 break
             continue
+        ended = until(x_new[:n].copy(), float(x_new[n])) if until is not None else None
+        if ended is not None:
+            status, message = ended
+            break
         # a fold between x_i and x_new?
         if locate_folds and t_i[n] * t_new[n] < 0:
             fold = _locate_fold(system, x_i, t_i, step, tol=tol, max_corrector=max_corrector, w=w)
