@@ -27,8 +27,13 @@ def test_fpu_recurrence_scene(tmp_path, capsys):
     assert code == 0, err
     out = json.loads(target.read_text())["analyses"][0]["outputs"]
     for key in ("recurrence_periods", "recurrence_fraction", "energy_error", "steps_per_second",
-                "bandwidth_fraction", "mode_energies_series", "t"):
+                "bandwidth_fraction", "bandwidth_share", "bytes_per_step", "mode_energies_series", "t"):
         assert key in out
+    # a step of symplectic_loop.c streams 8 N bytes per array read or written: per force call f zeroed, q in, f in
+    # and out (4 arrays), per kick v, f in, v out (3), per drift q, v in, q out (3); the scene's ABA864 (Blanes,
+    # Casas & Murua 2013) has 8 drifts and 7 kicks, each kick after its own force call (unit masses):
+    # 8 N (7 x 4 + 7 x 3 + 8 x 3) = 584 N bytes at N = 31
+    assert out["bytes_per_step"] == 584 * 31
     assert abs(out["recurrence_periods"] - 146.394) < 1e-3 and abs(out["recurrence_fraction"] - 0.98159) < 1e-4
     assert out["energy_error"] < 1e-8 and out["loop"] == "c"
     assert list(tmp_path.glob("*.png"))
@@ -59,5 +64,7 @@ def test_fpu_large_scene(tmp_path, capsys):
     assert code == 0, err
     out = json.loads(target.read_text())["analyses"][0]["outputs"]
     assert out["loop"] == "c" and out["energy_error"] < 1e-10 and out["steps"] == 2000
-    assert out["steps_per_second"] > 0 and 0 < out["bandwidth_fraction"]
-    print(f"N = 10^6: {out['steps_per_second']:.0f} steps/s, bandwidth fraction {out['bandwidth_fraction']:.2f}")
+    assert out["steps_per_second"] > 0 and 0 < out["bandwidth_fraction"] and 0 < out["bandwidth_share"]
+    assert out["bytes_per_step"] == 80 * 10**6
+    print(f"N = 10^6: {out['steps_per_second']:.0f} steps/s, share of the all-core bandwidth "
+          f"{out['bandwidth_share']:.2f} (deprecated fraction {out['bandwidth_fraction']:.2f})")

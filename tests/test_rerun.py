@@ -31,7 +31,7 @@ def assert_same(a, b, where: str = "outputs") -> None:
 
 
 #: outputs that are wall-time measurements (the symplectic kind's speed), not computed numbers
-MEASURED = ("steps_per_second", "bandwidth_fraction")
+MEASURED = ("steps_per_second", "bandwidth_fraction", "bandwidth_share")
 
 
 #: scenes rerun at a smaller size: parameters, and analysis keys by analysis name (the full size runs in its own

@@ -392,7 +392,12 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
     "symplectic": (
         _o("energy_error", "scalar", "-", "max \\|E(t) - E(0)\\| / \\|E(0)\\| over the outputs."),
         _o("steps_per_second", "scalar", "1/s", "The loop's steps over its wall time (transforms excluded)."),
-        _o("bandwidth_fraction", "scalar", "-", "The memory-bandwidth bound of a step over its measured time."),
+        _o("bandwidth_fraction", "scalar", "-", "Deprecated (use ``bandwidth_share``): the bandwidth bound of a "
+           "step over its measured time, counting 64 N bytes per leapfrog step against a one-thread copy."),
+        _o("bytes_per_step", "scalar", "B", "What the C loop's step streams: 80 N for the leapfrog (88 N with "
+           "masses), 8 N per array read or written."),
+        _o("bandwidth_share", "scalar", "-", "bytes_per_step x steps_per_second over the all-core copy "
+           "bandwidth: the share of the machine's memory bandwidth the loop reaches."),
         _o("loop", "string", "-", "``c`` or ``numpy``."),
         _o("steps", "scalar (int)", "-", "Steps taken."),
         _o("integrator", "string", "-", "The splitting that ran (leapfrog, yoshida4, yoshida6, aba864)."),

@@ -16,16 +16,20 @@ chunks the modal energies E_k = (P_k^2 + omega_k^2 Q_k^2)/2 come from a sine tra
 mechgen.runtime.linear.chain_modes; O(N log N) per output).
 
 Outputs: ``energy_error`` (max |E(t) - E(0)| / |E(0)| over the outputs), ``steps_per_second`` (the loop's
-steps over its wall time, transforms excluded), ``bandwidth_fraction`` (the memory-bandwidth bound of a
-step over its measured time: bytes a step moves, 8 N per array read or written: per force call q in,
-f out, per kick v, f in and v out, per drift q, v in and q out, divided by the bandwidth of a numpy copy
-of an N-array, 16 N bytes over its best time of 5), ``loop`` (c or numpy), ``steps``; fixed ends also
+steps over its wall time, transforms excluded), ``bytes_per_step`` (what the C loop's step streams, 8 N per array
+read or written: per force call f zeroed, q in, f in and out (the kernel accumulates), per kick v, f (and the
+inverse masses) in and v out, per drift q, v in and q out: 80 N for the leapfrog, 88 N with masses),
+``bandwidth_share`` (bytes_per_step times steps_per_second over the bandwidth of a numpy copy of an N-array
+split over every core at once, 16 N bytes over its best time of 5: the share of the machine's memory
+bandwidth the one-thread loop reaches), ``bandwidth_fraction`` (deprecated, kept for scripts that read it:
+the same with 64 N bytes per leapfrog step and a one-thread copy), ``loop`` (c or numpy), ``steps``; fixed ends also
 ``recurrence_periods`` and ``recurrence_fraction`` (the first return of the energy to mode 1, in periods
 T_1, and the share of the harmonic energy back in it; null when none within t_end), ``t`` and
 ``mode_energies_series`` (rows of E_1..E_modes).
 """
 from __future__ import annotations
 
+import os
 import time
 from pathlib import Path
 
@@ -85,9 +89,43 @@ def copy_bandwidth(n: int, repeats: int = 5) -> float:
 
 
 def bytes_per_step(n: int, split) -> float:
-    """Bytes one step moves (module doc): 16 n per force call, 24 n per kick and per drift."""
-    kicks = sum(1 for b in split.b if b != 0.0) - (1 if split.b[0] != 0.0 and split.b[-1] != 0.0 else 0)
+    """Bytes one step moves as ``bandwidth_fraction`` counts them (kept for it): 16 n per force call, 24 n per kick
+    and per drift (leapfrog: 64 n)."""
+    kicks = _kicks(split)
     return 8.0 * n * (2 * split.forces_per_step + 3 * kicks + 3 * len(split.a))
+
+
+def _kicks(split) -> int:
+    """Kicks per step (a last kick merged with the next step's first)."""
+    return sum(1 for b in split.b if b != 0.0) - (1 if split.b[0] != 0.0 and split.b[-1] != 0.0 else 0)
+
+
+def loop_bytes_per_step(n: int, split, scaled: bool = False) -> float:
+    """Bytes the C loop's step really moves (codegen/templates/c99/symplectic_loop.c), 8 n per array streamed:
+    per force call f zeroed (8 n), q read (8 n) and f read and written by the accumulating kernel (16 n): 32 n; per
+    kick v and f read, v written: 24 n (32 n with the inverse masses read, ``scaled``); per drift q and v read, q
+    written: 24 n. Leapfrog: 80 n (88 n scaled)."""
+    kick = 4 if scaled else 3
+    return 8.0 * n * (4 * split.forces_per_step + kick * _kicks(split) + 3 * len(split.a))
+
+
+def all_core_copy_bandwidth(n: int, repeats: int = 5, threads: int | None = None) -> float:
+    """Bytes per second of a numpy copy of n doubles split over ``threads`` (default: every core) copying their
+    parts at once (np.copyto releases the GIL; 16 n bytes over the best of ``repeats``): the memory system's bound
+    with all cores, which a one-thread copy understates."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    count = max(1, int(threads or os.cpu_count() or 1))
+    src, dst = np.ones(n), np.empty(n)
+    edges = np.linspace(0, n, count + 1).astype(int)
+    parts = [(dst[a:b], src[a:b]) for a, b in zip(edges[:-1], edges[1:])]
+    best = np.inf
+    with ThreadPoolExecutor(count) as pool:
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            list(pool.map(lambda part: np.copyto(*part), parts))
+            best = min(best, time.perf_counter() - t0)
+    return 16.0 * n / max(best, 1e-9)
 
 
 def _start(system, options: dict) -> tuple[np.ndarray, np.ndarray, float]:
@@ -148,6 +186,9 @@ def run_symplectic(system, options: dict, context: dict) -> dict:
     rate = steps / max(spent, 1e-12)
     out = {"energy_error": float(np.max(np.abs(e - e[0])) / max(abs(e[0]), 1e-300)), "steps_per_second": rate,
            "bandwidth_fraction": bytes_per_step(system.n, split) / copy_bandwidth(system.n) * rate,
+           "bytes_per_step": loop_bytes_per_step(system.n, split, scaled=not unit),
+           "bandwidth_share": loop_bytes_per_step(system.n, split, scaled=not unit) * rate
+           / all_core_copy_bandwidth(system.n),
            "loop": used, "steps": steps, "integrator": split.name}
     if fixed:
         E = np.asarray(full)

@@ -15,12 +15,13 @@ at N = 4096 (quick: 100 at N = 64), computed by
   of a bigger chain takes longer than the rest of the benchmark).
 
 Memory bandwidth (measured in the same run): the batched force moves 16 N B bytes per call (u read, F
-written: 8 bytes per double); its achieved fraction of the bound is (16 N B / t) / bw_copy(N B), bw_copy(n)
-the bandwidth of a numpy copy of n doubles (16 n bytes over its best time of 5,
-:func:`mechgen.analyses.symplectic.copy_bandwidth`). The leapfrog step of the C time loop
-(mechgen.runtime.core.symplectic_c, ``scenes/fpu_large.toml``: N = 10^6 FPU-beta, 2000 steps; quick: 10^5,
-100 steps) reports its own ``bandwidth_fraction`` the same way (bytes a step moves,
-:func:`mechgen.analyses.symplectic.bytes_per_step`). Target (issue 16): within 2x of the bound, a
+written: 8 bytes per double); its achieved fraction of the bound is (16 N B / t) / bw_all(N B), bw_all(n)
+the bandwidth of a numpy copy of n doubles split over every core at once (16 n bytes over its best time of 5,
+:func:`mechgen.analyses.symplectic.all_core_copy_bandwidth`: the machine's bound, which a one-thread copy
+understates). The leapfrog step of the C time loop (mechgen.runtime.core.symplectic_c,
+``scenes/fpu_large.toml``: N = 10^6 FPU-beta, 2000 steps; quick: 10^5, 100 steps) reports its
+``bandwidth_share`` the same way, with the bytes its step really streams (80 N:
+:func:`mechgen.analyses.symplectic.loop_bytes_per_step`). Target (issue 16): within 2x of the bound, a
 fraction >= 0.5.
 
 Also: the Python-level overhead of a prepared call of a small kernel, derivation +
@@ -249,11 +250,11 @@ def kernel_rows(sizes, batch_n: int, batch: int, lambdify_max: int, casadi_max: 
 
 def batch_bandwidth(rows: list, batch_n: int, batch: int) -> dict:
     """The batched force's achieved share of the memory-bandwidth bound, per method timed on it (generated C,
-    hand C, numba, numpy): (16 N B bytes / its seconds) / bw_copy(N B) (module docstring), bw_copy measured now."""
-    from mechgen.analyses.symplectic import copy_bandwidth
+    hand C, numba, numpy): (16 N B bytes / its seconds) / bw_all(N B) (module docstring), bw_all measured now."""
+    from mechgen.analyses.symplectic import all_core_copy_bandwidth
 
     moved = 16.0 * batch_n * batch
-    bw = copy_bandwidth(batch_n * batch)
+    bw = all_core_copy_bandwidth(batch_n * batch)
     shares = {r["method"]: moved / r["seconds"] / bw for r in rows
               if (r["quantity"], r["N"], r["batch"]) == ("force", batch_n, batch) and r["method"] in
               ("generated C", "hand C -O3", "numba", "numpy")}
@@ -273,7 +274,8 @@ def leapfrog_bandwidth(n: int, t_end: float) -> dict:
     analysis["stride"] = min(int(analysis.get("stride", 500)), int(round(t_end / analysis["dt"])))
     out = mechgen.run(scene)["analyses"][0]["outputs"]
     return {"N": int(n), "steps": out["steps"], "loop": out["loop"], "steps_per_second": out["steps_per_second"],
-            "energy_error": out["energy_error"], "fraction": out["bandwidth_fraction"], "target": BANDWIDTH_TARGET}
+            "energy_error": out["energy_error"], "fraction": out["bandwidth_share"],
+            "bytes_per_step": out["bytes_per_step"], "target": BANDWIDTH_TARGET}
 
 
 def ratio_table(rows: list) -> list[dict]:
@@ -378,11 +380,12 @@ def bandwidth_markdown(batched: dict, leapfrog: dict, numba_note: str | None) ->
     """The bandwidth lines (and why numba is missing, if it is)."""
     shares = ", ".join(f"{m} {f:.2f}" for m, f in batched["fraction"].items())
     lines = ["", f"batched force, {batched['states']:,} states at N = {batched['N']:,} "
-             f"({batched['bytes_per_call'] / 1e6:.0f} MB moved per call; numpy copy of the same size "
+             f"({batched['bytes_per_call'] / 1e6:.0f} MB moved per call; numpy copy of the same size on every core "
              f"{batched['copy_bandwidth_GBps']:.2f} GB/s): share of the bandwidth bound {shares} "
              f"(target >= {BANDWIDTH_TARGET:g})",
              f"leapfrog step, C time loop ({leapfrog['loop']}), N = {leapfrog['N']:,}, {leapfrog['steps']:,} steps: "
-             f"{leapfrog['steps_per_second']:.1f} steps/s, share of the bandwidth bound {leapfrog['fraction']:.2f} "
+             f"{leapfrog['steps_per_second']:.1f} steps/s, {leapfrog['bytes_per_step'] / leapfrog['N']:.0f} N bytes "
+             f"per step, share of the all-core bandwidth bound {leapfrog['fraction']:.2f} "
              f"(target >= {BANDWIDTH_TARGET:g}), energy error {leapfrog['energy_error']:.1e}"]
     if numba_note:
         lines.append(f"numba: not timed - {numba_note}")
