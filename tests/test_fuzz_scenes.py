@@ -189,6 +189,10 @@ EXPLICIT = {
                              None),
     "ross_part_kind_list": (lambda: _edit("ross_example_rotor", [(("parts", 0, "kind"), ["disk"])], limit=60.0),
                             (2,), "kind", None),
+    # issue 33, the fuzz corpus of 500 (tests/fuzzing.py --examples 500 --seed 1 --limit 10): a disk's bore above
+    # its outer diameter makes M singular; the message named only the internal key 'M' and the params, not the part
+    "ross_disk_inner_999999": (lambda: _edit("ross_example_rotor", [(("parts", 0, "inner"), 999999)], limit=60.0),
+                               (2,), "parts", None),
     "laval_set_m_310_digits": (lambda: _edit("laval_rotor", args=["--set", "m=" + "1" * 310]), (2,), "m",
                                None),
     "laval_json_is_a_directory": (lambda: _edit("laval_rotor", args=["--json", "outdir"]), (2,), "--json",
