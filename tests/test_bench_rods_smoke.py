@@ -10,7 +10,7 @@ import json
 import pytest
 
 from mechgen.bench import REGISTRY
-from mechgen.bench.rods import MATTIASSON_10, base_section, elastica
+from mechgen.bench.rods import MATTIASSON_10, REST_TOL, base_section, elastica
 
 
 def test_elliptic_reference_reproduces_mattiasson():
@@ -44,7 +44,7 @@ def test_quick_run_writes_the_reports(tmp_path):
         assert res["pyelastica"].startswith("skipped") and ratios["ratios"] == []
     else:
         peer = [r for r in st["rows"] if r["side"] == "PyElastica static limit"]
-        assert peer and not any(r["blew_up"] for r in peer) and all(r["max_speed_end"] < 1e-9 for r in peer)
+        assert peer and not any(r["blew_up"] for r in peer) and all(r["max_speed_end"] < REST_TOL for r in peer)
         assert ratios["ratios"] and all(r["ratio"] > 0 for r in ratios["ratios"])
     dyn, stiff = res["dynamic"], res["stiff"]
     assert not isinstance(dyn, str) and not isinstance(stiff, str)
@@ -94,3 +94,24 @@ def test_quick_run_writes_the_reports(tmp_path):
         assert any(r["peer"] == "PyElastica (stiff, matched accuracy)" for r in ratios["ratios"])
         assert "Matched accuracy" in (tmp_path / "rods.md").read_text().split("## Stiff rod")[1]
 
+
+
+def test_every_ratio_is_timed_again_interleaved():
+    """The like-for-like rule: a ratio's two runs are timed again as the median of the same number of rounds in
+    which they alternate, each side's first call untimed; checked on fake sides whose times are known."""
+    from mechgen.bench.rods import interleaved_medians, retimed
+
+    calls, peer_seconds = [], iter([7.0, 1.0, 2.0, 3.0])  # the first, untimed call "takes" 7 s
+
+    def ours():
+        calls.append("ours")
+
+    def theirs():
+        calls.append("theirs")
+        return next(peer_seconds)
+
+    _, peer = interleaved_medians(ours, theirs, 3)
+    assert calls == ["ours", "theirs"] * 4 and peer == 2.0
+    entry = retimed({"x": 1}, lambda: None, lambda: 0.5, 3)
+    assert entry["x"] == 1 and entry["pyelastica_s"] == 0.5 and entry["ratio"] == 0.5 / entry["mechgen_s"]
+    assert "interleaved" in entry["statistic"]

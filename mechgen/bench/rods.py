@@ -68,8 +68,10 @@ difference (the FD error), in ``rods.json`` ("jacobians") and ``rods.md``.
 
 Timing: one BLAS thread for both (common.blas_threads); PyElastica's numba functions compiled by an untimed
 warm-up run first (its seconds reported); a PyElastica time is its stepping loop, a mechgen time the whole
-public call (``mechgen.rod_statics`` / ``mechgen.rod_dynamics``: set-up and solve) on a compiled system,
-the best of 3 runs after a warm-up (one run in quick mode); a PyElastica time is one run. Writes
+public call (``mechgen.rod_statics`` / ``mechgen.rod_dynamics``: set-up and solve) on a compiled system. The
+ladders (the work-precision points): mechgen the median of 3 runs after an untimed one, PyElastica one run each
+(its runs are the long ones). Every ratio: the two runs it compares timed again, the median of 3 rounds in which
+the two alternate, after an untimed call of each (:func:`interleaved_medians`; one round in quick mode). Writes
 ``rods_work_precision.{csv,png}`` (the static work-precision), ``rods_ratios.json`` (every ratio, = PyElastica
 seconds / mechgen seconds at the condition stated), ``rods_dynamic_work_precision.{csv,png}`` (the dynamic,
 gravity and stiff points, each with its reference), ``rods.json`` and ``rods.md``; ``quick``: tiny ladders
@@ -84,7 +86,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mechgen.bench.common import (best_time, blas_threads, environment, loglog_plot, suite_report, write_csv,
+from mechgen.bench.common import (blas_threads, environment, loglog_plot, suite_report, write_csv,
                                   write_json, write_text)
 
 #: the PyElastica release the suite was written and measured against (pyproject's bench extra)
@@ -95,8 +97,10 @@ ALPHA_C_PIN = 27.0 / 28.0
 MATTIASSON_10 = (0.55500, -0.81061)
 #: the static load P L^2/EI
 STATIC_LOAD = 10.0
-#: PyElastica's static limit: run (damped) until max |v| < REST_TOL (m/s), at most REST_T_MAX (s)
-REST_TOL = 1e-9
+#: PyElastica's static limit: run (damped) until max |v| < REST_TOL (m/s), at most REST_T_MAX (s). 1e-6 m/s, not
+#: 1e-9: the tip then differs from the 1e-9 one by at most 1.1e-7 L (measured at n_elem 10, 40, 160), against
+#: PyElastica's own static errors of 5.5e-2 .. 3.2e-3 L there, and the run stops 1.3-1.6 s (of 4.3 s) earlier
+REST_TOL = 1e-6
 REST_T_MAX = 60.0
 #: PyElastica's damping for the static limit (1/s; about twice the loaded rod's first frequency)
 REST_DAMPING = 10.0
@@ -307,13 +311,38 @@ def _system(params: dict):
     return mechgen.compile("cosserat_rod", params={k: v for k, v in params.items() if k in known}, backend="c")
 
 
-def _timed_best(fn, repeats: int):
-    out = {}
+def _timed_median(fn, repeats: int):
+    """(median seconds of ``repeats`` timed calls of ``fn`` after one untimed call, its result)."""
+    result = fn()
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        result = fn()
+        times.append(time.perf_counter() - start)
+    return float(np.median(times)), result
 
-    def call():
-        out["res"] = fn()
 
-    return best_time(call, min_time=0.0, repeats=repeats), out["res"]
+def interleaved_medians(ours, theirs, repeats: int) -> tuple[float, float]:
+    """(median seconds of ``ours``, median of ``theirs``'s own seconds) over ``repeats`` rounds after one untimed
+    call of each, the two alternating in every round: ``ours`` is timed here (mechgen's whole public call),
+    ``theirs`` returns its seconds (PyElastica's stepping loop, its set-up left out)."""
+    ours()
+    theirs()
+    mine, peer = [], []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        ours()
+        mine.append(time.perf_counter() - start)
+        peer.append(float(theirs()))
+    return float(np.median(mine)), float(np.median(peer))
+
+
+def retimed(entry: dict, ours, theirs, repeats: int) -> dict:
+    """``entry`` (a comparison with mechgen_s, pyelastica_s) with both sides timed again by
+    :func:`interleaved_medians` and its ratio from those times."""
+    mine, peer = interleaved_medians(ours, theirs, repeats)
+    return {**entry, "mechgen_s": mine, "pyelastica_s": peer, "ratio": peer / mine,
+            "statistic": f"median of {repeats} interleaved rounds, each side's first call untimed"}
 
 
 def _tip_error(tip, ref, L: float) -> float:
@@ -352,7 +381,7 @@ def static_study(quick: bool, repeats: int, have_elastica: bool) -> dict:
                "shooting": (5, 10) if quick else (5, 10, 20, 40, 80, 160)}
     for method, ns in ladders.items():
         for n in ns:
-            seconds, tip = _timed_best(lambda: statics(method, n), repeats)
+            seconds, tip = _timed_median(lambda: statics(method, n), repeats)
             rows.append({"side": f"mechgen {method}", "n": n, "seconds": seconds,
                          "error": _tip_error(tip, ref, sec.L), "tip": list(tip)})
     pyel = []
@@ -365,8 +394,17 @@ def static_study(quick: bool, repeats: int, have_elastica: bool) -> dict:
                          "error": _tip_error(run["tip_position"], ref, sec.L), "tip": list(run["tip_position"]),
                          "dt": dt, "steps": run["steps"], "t_rest": run["steps"] * dt,
                          "max_speed_end": run["max_speed"], "blew_up": run["blew_up"]})
+    headline = None
+    ours = [r for r in rows if r["side"] == "mechgen collocation" and pyel and r["error"] <= pyel[-1]["error"]]
+    if ours:  # the like-for-like ratio: both chosen runs timed again, interleaved
+        finest = pyel[-1]
+        headline = retimed({"mechgen_n": ours[0]["n"], "pyelastica_n": finest["n"]},
+                           lambda: statics("collocation", ours[0]["n"]),
+                           lambda: pyelastica_cantilever(sec, finest["n"], tip_force=force, dt=finest["dt"],
+                                                         t_end=REST_T_MAX, damping=REST_DAMPING,
+                                                         rest_tol=REST_TOL)["wall_s"], repeats)
     return {"section": sec.__dict__, "params": sec.params(), "tip_force": force, "reference_steps": ref_steps,
-            "reference_tip": list(ref), "validation": validation, "rows": rows + pyel,
+            "reference_tip": list(ref), "validation": validation, "rows": rows + pyel, "headline": headline,
             "orders": {side: _orders([r for r in rows + pyel if r["side"] == side])
                        for side in dict.fromkeys(r["side"] for r in rows + pyel)}}
 
@@ -444,7 +482,7 @@ def dynamic_study(quick: bool, repeats: int, have_elastica: bool, case: str = "t
     rows, runs_at_n = [], {}
     for m in ours_n:
         for dt in dts:
-            seconds, run = _timed_best(lambda: _mechgen_dynamic(system, m, dt, t_end, force), repeats)
+            seconds, run = _timed_median(lambda: _mechgen_dynamic(system, m, dt, t_end, force), repeats)
             steps = int(round(t_end / dt))
             rows.append({"side": f"mechgen N={m}", "n": m, "dt": dt, "seconds": seconds, "steps": steps,
                          "seconds_per_step": seconds / steps,
@@ -457,6 +495,13 @@ def dynamic_study(quick: bool, repeats: int, have_elastica: bool, case: str = "t
            "reference": {"elements": ref_n, "dt": ref_dt, "max_tip_deflection": scale,
                          "self_convergence_half_elements": _traj_error(half["t"], half["tip_trajectory"], t_ref,
                                                                        tip_ref, scale)}}
+    def pair(mine: dict, peer: dict) -> tuple:
+        """(mechgen's run, PyElastica's run) of two chosen rows, to be timed again."""
+        return (lambda: _mechgen_dynamic(system, mine["n"], mine["dt"], t_end, force),
+                lambda: pyelastica_cantilever(sec, peer["n"], tip_force=force, dt=peer["dt"], t_end=t_end,
+                                              save_every=max(1, int(round(dts[-1] / peer["dt"]))), check_every=20,
+                                              gravity=gravity)["wall_s"])
+
     if have_elastica:
         peers, searches, same_run = [], {}, None
         for m in peer_n:
@@ -488,18 +533,17 @@ def dynamic_study(quick: bool, repeats: int, have_elastica: bool, case: str = "t
                                                                  run["t"], run["tip_trajectory"], scale)
             theirs = next(p for p in peers if p["n"] == n)
             best = _fastest([r for r in rows if r["n"] == n], theirs["error"])
-            out["same_resolution"] = None if best is None else {
-                "elements": n, "mechgen_dt": best["dt"], "mechgen_error": best["error"], "mechgen_s": best["seconds"],
-                "pyelastica_dt": theirs["dt"], "pyelastica_error": theirs["error"], "pyelastica_s": theirs["seconds"],
-                "ratio": theirs["seconds"] / best["seconds"], "dt_ratio": best["dt"] / theirs["dt"]}
+            out["same_resolution"] = None if best is None else retimed({
+                "elements": n, "mechgen_dt": best["dt"], "mechgen_error": best["error"],
+                "pyelastica_dt": theirs["dt"], "pyelastica_error": theirs["error"],
+                "dt_ratio": best["dt"] / theirs["dt"]}, *pair(best, theirs), repeats)
         target = peers[-1]["error"]
         ours, theirs = _fastest(rows, target), _fastest(peers, target)
-        out["matched"] = None if ours is None or theirs is None else {
+        out["matched"] = None if ours is None or theirs is None else retimed({
             "target_error": target, "mechgen_n": ours["n"], "mechgen_dt": ours["dt"], "mechgen_error": ours["error"],
-            "mechgen_s": ours["seconds"], "pyelastica_n": theirs["n"], "pyelastica_dt": theirs["dt"],
-            "pyelastica_error": theirs["error"], "pyelastica_s": theirs["seconds"],
-            "ratio": theirs["seconds"] / ours["seconds"], "dt_ratio": ours["dt"] / theirs["dt"],
-            "mechgen_is_coarsest": ours["n"] == min(ours_n) and ours["dt"] == max(dts)}
+            "pyelastica_n": theirs["n"], "pyelastica_dt": theirs["dt"], "pyelastica_error": theirs["error"],
+            "dt_ratio": ours["dt"] / theirs["dt"],
+            "mechgen_is_coarsest": ours["n"] == min(ours_n) and ours["dt"] == max(dts)}, *pair(ours, theirs), repeats)
     out["rows"] = rows
     return out
 
@@ -547,7 +591,7 @@ def stiff_study(quick: bool, repeats: int, have_elastica: bool) -> dict:
     rows, grid = [], []
     for m in ours_n:
         for dt in dts:
-            seconds, run = _timed_best(lambda: _mechgen_dynamic(system, m, dt, t_end, force), repeats)
+            seconds, run = _timed_median(lambda: _mechgen_dynamic(system, m, dt, t_end, force), repeats)
             steps = int(round(t_end / dt))
             grid.append({"side": f"mechgen N={m}", "n": m, "dt": dt, "dt_over_pyelastica_limit": dt / sec.stable_dt(m),
                          "seconds": seconds, "steps": steps, "seconds_per_step": seconds / steps,
@@ -561,6 +605,16 @@ def stiff_study(quick: bool, repeats: int, have_elastica: bool) -> dict:
     out["reference"] = {"elements": n, "dt": dts[-1] / 4, "max_tip_deflection": scale,
                         "note": "the same N (time error only)"}
     out["grid"] = grid
+    c_dt = dts[-1]
+
+    def pair(mine: dict, peer: dict, save_dt: float = c_dt) -> tuple:
+        """(mechgen's run, PyElastica's run) of two chosen rows, to be timed again (PyElastica at its dt to
+        t_end: a stable run)."""
+        return (lambda: _mechgen_dynamic(system, mine["n"], mine["dt"], t_end, force),
+                lambda: pyelastica_cantilever(sec, peer["n"], tip_force=force, dt=peer["dt"], t_end=t_end,
+                                              save_every=max(1, int(round(save_dt / peer["dt"]))),
+                                              check_every=20)["wall_s"])
+
     if have_elastica:
         peer, stable_at_n = [], None
         wave = out["wave_limit_dt"]
@@ -580,10 +634,9 @@ def stiff_study(quick: bool, repeats: int, have_elastica: bool) -> dict:
         out["pyelastica"] = peer
         ours = _fastest(rows, STIFF_ACCURACY)
         if ours is not None and not peer[0]["blew_up"]:
-            out["times"] = {"mechgen_dt": ours["dt"], "mechgen_s": ours["seconds"], "mechgen_error": ours["error"],
-                            "pyelastica_dt": peer[0]["dt"], "pyelastica_s": peer[0]["seconds"],
-                            "pyelastica_error": peer[0]["error"], "ratio": peer[0]["seconds"] / ours["seconds"],
-                            "dt_ratio": ours["dt"] / peer[0]["dt"]}
+            out["times"] = retimed({"mechgen_dt": ours["dt"], "mechgen_error": ours["error"],
+                                    "pyelastica_dt": peer[0]["dt"], "pyelastica_error": peer[0]["error"],
+                                    "dt_ratio": ours["dt"] / peer[0]["dt"]}, *pair(ours, peer[0]), repeats)
         # PyElastica's N ladder at 0.5 x its limit (the run at N = elements above is reused), one run each
         ladder = []
         for m in peer_n:
@@ -602,16 +655,17 @@ def stiff_study(quick: bool, repeats: int, have_elastica: bool) -> dict:
         if fine:
             target = fine[-1]["error"]
             mine, theirs = _fastest(grid, target), _fastest(fine, target)
-            out["matched"] = None if mine is None or theirs is None else {
+            out["matched"] = None if mine is None or theirs is None else retimed({
                 "target_error": target, "mechgen_n": mine["n"], "mechgen_dt": mine["dt"],
-                "mechgen_error": mine["error"], "mechgen_s": mine["seconds"], "pyelastica_n": theirs["n"],
-                "pyelastica_dt": theirs["dt"], "pyelastica_error": theirs["error"], "pyelastica_s": theirs["seconds"],
-                "ratio": theirs["seconds"] / mine["seconds"], "dt_ratio": mine["dt"] / theirs["dt"],
+                "mechgen_error": mine["error"], "pyelastica_n": theirs["n"],
+                "pyelastica_dt": theirs["dt"], "pyelastica_error": theirs["error"],
+                "dt_ratio": mine["dt"] / theirs["dt"],
                 "mechgen_dt_over_pyelastica_limit": mine["dt_over_pyelastica_limit"],
                 "mechgen_is_coarsest": mine["n"] == min(ours_n) and mine["dt"] == max(dts),
                 "mechgen_at_coarsest_n": mine["n"] == min(ours_n),
                 "mechgen_coarsest_meets_target": any(r["n"] == min(ours_n) and r["dt"] == max(dts)
-                                                     and r["error"] <= target for r in grid)}
+                                                     and r["error"] <= target for r in grid)},
+                *pair(mine, theirs, c_dt), repeats)
     out["rows"] = rows
     return out
 
@@ -635,8 +689,8 @@ def jacobian_study(quick: bool, repeats: int) -> dict:
 
     def timed(kind: str, n: int, ad_fn, fd_fn, dense):
         ad_fn(), fd_fn()                                      # builds, compiles, caches
-        t_ad, a = _timed_best(ad_fn, repeats)
-        t_fd, f = _timed_best(fd_fn, repeats)
+        t_ad, a = _timed_median(ad_fn, repeats)
+        t_fd, f = _timed_median(fd_fn, repeats)
         a, f = dense(a), dense(f)
         rows.append({"piece": kind, "n": n, "ad_s": t_ad, "fd_s": t_fd, "ratio": t_fd / t_ad,
                      "fd_minus_ad": float(np.max(np.abs(f - a)) / np.max(np.abs(a)))})
@@ -789,7 +843,10 @@ def write_reports(out: Path, results: dict) -> None:
         ours = [r for r in st_rows if r["side"] == "mechgen collocation" and r["error"] <= finest["error"]]
         if ours:
             coarsest = ours[0] is next(r for r in st_rows if r["side"] == "mechgen collocation")
-            ratios.append({"peer": "PyElastica (static limit)", "ours_s": ours[0]["seconds"], "peer_s": finest["seconds"],
+            head = results["static"].get("headline") or {"mechgen_s": ours[0]["seconds"],
+                                                         "pyelastica_s": finest["seconds"]}
+            ratios.append({"peer": "PyElastica (static limit)", "ours_s": head["mechgen_s"],
+                           "peer_s": head["pyelastica_s"],
                            "condition": f"static tip error <= {finest['error']:.2e} L: PyElastica n_elem "
                                         f"{finest['n']} (damped run to rest: it has no static solver), mechgen "
                                         f"collocation {ours[0]['n']} elements (error {ours[0]['error']:.2e})"

@@ -25,6 +25,7 @@ from __future__ import annotations
 import ctypes
 import logging
 import math
+import threading
 from functools import lru_cache
 from pathlib import Path
 
@@ -326,6 +327,61 @@ class _Buffers:
         setattr(self.problem, cap, 2 * keep)
 
 
+def _problem(system, tables: _Tables, params: np.ndarray, options: RunOptions, t_end: float) -> CProblem:
+    """The loop's problem (read-only to the loop) for ``system`` with ``params`` kept alive by the caller."""
+    rules = options.rules
+    return CProblem(n=system.n, m=system.m, nmodes=len(system.modes), nresets=tables.n_resets,
+                    max_guards=tables.max_guards, modes=ctypes.addressof(tables.modes),
+                    resets=ctypes.addressof(tables.resets), p=params.ctypes.data if params.size else None,
+                    rtol=float(options.rtol), atol=float(options.atol), t_end=float(t_end),
+                    max_events=int(rules.max_events), zeno_events=int(rules.zeno_events),
+                    zeno_span=1e-9 * float(t_end), stop_mode=-1, pause=0, budget_left=-1, slice=SLICE,
+                    carried=int(getattr(system, "carried", 0)))
+
+
+class RepeatedRuns:
+    """Many short runs of one system without guards (a smooth model's loop view) at fixed tolerances, for the
+    shooting of periodic orbits (thousands of one-period runs along a branch): the loop's problem and buffers are
+    set up once per sample count and thread, and each run resets what the loop reads (the start, t_end, t_eval,
+    the step budget) and starts from a fresh state, so runs do not depend on one another. The loop only reads the
+    problem and writes the state and the buffers. :meth:`__call__` returns the states at ``times``, or None where
+    the run did not end cleanly within one slice of steps (a budget, a kernel error, buffers to grow): the caller
+    then runs :func:`integrate_hybrid_c`, which says exactly what happened."""
+
+    def __init__(self, system, rtol: float, atol: float, max_steps: int) -> None:
+        if getattr(system, "guards", None) is None or any(system.guards(k) for k in range(len(system.modes))):
+            raise ValueError("RepeatedRuns serves systems without guards")
+        self.system, self.max_steps = system, int(max_steps)
+        self.options = RunOptions(method="DOP853", rtol=float(rtol), atol=float(atol), loop="c")
+        self.local = threading.local()
+
+    def _prepared(self, samples: int) -> tuple:
+        table = self.local.__dict__.setdefault("prepared", {})
+        if samples not in table:
+            system = self.system
+            params = np.ascontiguousarray(system.params, dtype=float)
+            problem = _problem(system, _tables(system), params, self.options, 1.0)
+            scratch = CState(phase=-1, mode=0, t=0.0)
+            buffers = _Buffers(problem, scratch, 2 * system.n + system.m, max(1, _tables(system).max_guards),
+                               2, samples, FIRST_ROWS[1])
+            addresses = {name: getattr(scratch, name) for name in _Buffers.STATE}
+            table[samples] = (problem, buffers.arrays, addresses, params)
+        return table[samples]
+
+    def __call__(self, x0: np.ndarray, times: np.ndarray) -> np.ndarray | None:
+        times = np.ascontiguousarray(times, dtype=float).reshape(-1)
+        problem, arrays, addresses, _ = self._prepared(times.size)
+        t_end = float(times[-1])
+        problem.t_end, problem.zeno_span, problem.budget_left = t_end, 1e-9 * t_end, self.max_steps
+        problem.n_eval, problem.t_eval = times.size, times.ctypes.data
+        state = CState(phase=-1, mode=0, t=0.0, **addresses)
+        arrays["x"][...] = np.asarray(x0, float).reshape(-1)
+        rc = loop_library(self.system.n, self.system.m).mgh_run(ctypes.byref(problem), ctypes.byref(state))
+        if rc != DONE or state.n_samples != times.size:
+            return None
+        return arrays["s_x"][:times.size].copy()
+
+
 def integrate_hybrid_c(system, x0, t_end: float, *, mode: int | None = None, options: RunOptions | None = None,
                        **changes) -> HybridTrajectory:
     """:func:`mechgen.runtime.integration.events.integrate_hybrid` with ``method="DOP853"``, run by the C loop (module
@@ -333,7 +389,7 @@ def integrate_hybrid_c(system, x0, t_end: float, *, mode: int | None = None, opt
     (``extra["loop"] = "c"``; ``nfev`` counts every evaluation of dx/dt, ``guard_evaluations`` every one of the
     guards). CompilerUnavailable when the loop cannot run ``system`` (:func:`c_loop_problem` says why)."""
     options = RunOptions.of(options, **changes)
-    rtol, atol, budget, rules, stop_after = options.rtol, options.atol, options.budget, options.rules, options.stop_after
+    budget, rules, stop_after = options.budget, options.rules, options.stop_after
     why = c_loop_problem(system, "DOP853")
     if why is not None:
         raise CompilerUnavailable(why)
@@ -354,12 +410,8 @@ def integrate_hybrid_c(system, x0, t_end: float, *, mode: int | None = None, opt
     params = np.ascontiguousarray(system.params, dtype=float)
     ng = max(1, tables.max_guards)
 
-    problem = CProblem(n=n, m=m, nmodes=len(names), nresets=tables.n_resets, max_guards=tables.max_guards,
-                       modes=ctypes.addressof(tables.modes), resets=ctypes.addressof(tables.resets),
-                       p=params.ctypes.data if params.size else None, rtol=float(rtol), atol=float(atol),
-                       t_end=t_end, max_events=int(rules.max_events), zeno_events=int(rules.zeno_events),
-                       zeno_span=float(zeno_span), stop_mode=-1, pause=int(stop_after is not None),
-                       budget_left=-1, slice=SLICE, carried=int(getattr(system, "carried", 0)))
+    problem = _problem(system, tables, params, options, t_end)
+    problem.zeno_span, problem.pause = float(zeno_span), int(stop_after is not None)
     flow = getattr(system, "flow", None)  # (fn, data) addresses of a provider of dx/dt (a continuum)
     if flow is not None:
         problem.flow, problem.flow_data = flow

@@ -15,6 +15,7 @@ called from Python, and the Jacobian needs the matrices anyway.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -44,9 +45,14 @@ class FourierBasis:
 
 
 def basis(harmonics: int, samples: int | None = None) -> FourierBasis:
-    """The :class:`FourierBasis` of ``harmonics`` H at ``samples`` N phases (default :func:`sample_count`)."""
+    """The :class:`FourierBasis` of ``harmonics`` H at ``samples`` N phases (default :func:`sample_count`); one
+    per (H, N), shared (its arrays are read-only): a continuation builds a problem at every parameter it tries."""
     H = int(harmonics)
-    N = sample_count(H) if samples is None else int(samples)
+    return _shared_basis(H, sample_count(H) if samples is None else int(samples))
+
+
+@lru_cache(maxsize=64)
+def _shared_basis(H: int, N: int) -> FourierBasis:
     if N <= 2 * H:
         raise ValueError(f"{N} samples cannot resolve {H} harmonics (need more than {2 * H})")
     theta = 2 * np.pi * np.arange(N) / N
@@ -57,7 +63,10 @@ def basis(harmonics: int, samples: int | None = None) -> FourierBasis:
     slopes = np.hstack([zeros, -s * k, c * k])
     curvatures = np.hstack([zeros, -c * k**2, -s * k**2])
     weights = np.concatenate([[1.0 / N], np.full(2 * H, 2.0 / N)])
-    return FourierBasis(H, theta, values, slopes, curvatures, weights[:, None] * values.T)
+    arrays = (theta, values, slopes, curvatures, weights[:, None] * values.T)
+    for array in arrays:
+        array.flags.writeable = False
+    return FourierBasis(H, *arrays)
 
 
 def coefficients_of_samples(samples: np.ndarray, harmonics: int) -> np.ndarray:
