@@ -189,6 +189,14 @@ EXPLICIT = {
                              None),
     "ross_part_kind_list": (lambda: _edit("ross_example_rotor", [(("parts", 0, "kind"), ["disk"])], limit=60.0),
                             (2,), "kind", None),
+    # issue 33, the fuzz corpus of 500 (tests/fuzzing.py --examples 500 --seed 1 --limit 10): a disk's bore above
+    # its outer diameter makes M singular; the message named only the internal key 'M' and the params, not the part
+    "ross_disk_inner_999999": (lambda: _edit("ross_example_rotor", [(("parts", 0, "inner"), 999999)], limit=60.0),
+                               (2,), "parts", None),
+    # the same corpus re-run: 216 mode shapes of a 216-element beam at 3 sweep points tabulated the basis row by row
+    # for every mode (12.7 s on a loaded machine, past the 10 s case limit); the rows are now tabulated once
+    "beam_216_shapes": (lambda: _edit("beam_modes", [(P + ("N",), 216), (("analysis", 1, "analysis", "count"), 216)],
+                                      limit=30.0), (0,), None, None),
     "laval_set_m_310_digits": (lambda: _edit("laval_rotor", args=["--set", "m=" + "1" * 310]), (2,), "m",
                                None),
     "laval_json_is_a_directory": (lambda: _edit("laval_rotor", args=["--json", "outdir"]), (2,), "--json",

@@ -511,6 +511,55 @@ def test_a_zero_mass_in_a_hybrid_mode_is_diagnosed(tmp_path, loop):
     assert "no inertia along coordinate 'y'" in str(info.value), str(info.value)
 
 
+TWO_MODE = '''"""A ball in flight (mass m) landing into mode 'glued', whose added kinetic energy extra/2 y'^2 makes the mass
+m + extra: zero for extra = -m, a singular M in that mode only."""
+from mechgen import Model, Param
+
+model = Model("test_two_mode_mass", doc=__doc__)
+model.params(Param("m", 1.0, "kg", positive=True), Param("g", 9.81, "m/s^2", positive=True), Param("extra", 0.0, "kg"))
+model.coordinates("y")
+flight = model.mode("flight")
+glued = model.mode("glued")
+
+
+@model.kinetic
+def kinetic(v, p):
+    return p.m / 2 * v.y**2
+
+
+@model.potential
+def potential(q, p):
+    return p.m * p.g * q.y
+
+
+@glued.kinetic
+def glued_kinetic(v, p):
+    return p.extra / 2 * v.y**2
+
+
+@flight.guard(to="glued", direction="falling")
+def floor(q):
+    return q.y
+'''
+
+
+@pytest.mark.parametrize("loop", ["python", "c"])
+def test_a_zero_mass_in_one_mode_only_names_that_mode(tmp_path, capsys, loop):
+    """M = 0 only in the mode entered at the first landing (t1 = sqrt(2 h / g) = 0.1428 s from h = 0.1 m): exit 1
+    naming that mode, the coordinate and M = dr/da (the tangent kernel), in both loops (the compiled loop named the
+    mode it left, flight, and explained nothing)."""
+    (tmp_path / "two_mode.py").write_text(TWO_MODE)
+    scene = tmp_path / "glued.toml"
+    scene.write_text('model = "two_mode.py"\n[params]\nextra = -1.0\n[[analysis]]\nname = "d"\nkind = "simulate"\n'
+                     f'method = "DOP853"\nt_end = 1.0\nq0 = {{ y = 0.1 }}\nloop = "{loop}"\n')
+    code, err = _run(["run", str(scene)], capsys)
+    message = err.strip().splitlines()[-1]
+    assert code == 1 and message.startswith("mechgen: ConvergenceError:"), err
+    assert "in mode glued" in message and "M = dr/da is zero" in message and "coordinate 'y'" in message, message
+    t1 = math.sqrt(2 * 0.1 / 9.81)
+    assert f"t = {t1:.6g}" in message, message  # the landing time, closed form
+
+
 def test_every_kind_has_a_wall_time_budget():
     """max_seconds is a key of every kind, and a kind whose runner has no budget of its own (here a test kind
     that computes for 30 s) is stopped by the backstop at max_seconds x 1.1 + 2 s, exit 1 naming the key."""
@@ -538,6 +587,71 @@ def test_every_kind_has_a_wall_time_budget():
         assert 2.3 < time.monotonic() - started < 5  # 0.3 x 1.1 + 2 s (BACKSTOP_GRACE, BACKSTOP_MARGIN)
     finally:
         registry.unregister("endless_s33")
+
+
+SCENES_DIR = Path(__file__).resolve().parent.parent / "scenes"
+
+
+@pytest.mark.parametrize("scene, analysis, limit, unknowns", [
+    ("beck_column.toml", "at_P", "1GiB", 4 * 100_000),     # hermite: 2 unknowns per node, refined at 2N
+    ("beam_modes.toml", "modes", "0.9GiB", 4 * 100_000)])  # quintic: 4 unknowns per element, no refinement
+def test_a_huge_sparse_eigenproblem_is_refused_before_it_starts(tmp_path, capsys, monkeypatch, scene, analysis,
+                                                                limit, unknowns):
+    """N = 10^5 with count (the sparse shift-invert path): SPARSE_BYTES_PER_UNKNOWN x the unknowns of the largest
+    solve is refused at the flag that set N, before anything is assembled (the discretisation's own estimate
+    passes under this limit); at N = 10^6 Beck's column ran 10 minutes past 3.4 GiB."""
+    import time
+
+    from mechgen.runtime.linear.stability import SPARSE_BYTES_PER_UNKNOWN
+
+    text = (SCENES_DIR / scene).read_text().split("\n[[analysis]]\nname = ")
+    (tmp_path / scene).write_text(text[0] + "".join("\n[[analysis]]\nname = " + t for t in text[1:]
+                                                     if t.startswith(f'"{analysis}"')))
+    monkeypatch.setenv("MECHGEN_MEMORY_LIMIT", limit)
+    started = time.monotonic()
+    code, err = _run(["run", str(tmp_path / scene), "--set", "N=100000"], capsys)
+    message = err.strip().splitlines()[-1]
+    assert code == 2 and "at key '--set N'" in message and f"of {unknowns} unknowns" in message, message
+    assert f"{SPARSE_BYTES_PER_UNKNOWN * unknowns / 2**30:.3g} GiB" in message, message
+    assert time.monotonic() - started < 30
+
+
+def test_a_hybrid_event_store_past_the_memory_is_refused(tmp_path, capsys, monkeypatch):
+    """max_events = max_steps = 10^9 (the step bound allows it): 10^9 x (EVENT_BYTES + 3 x 8 x 2) bytes of stored
+    events are refused at the key up front under a 1 GiB limit; the default 10^4 runs."""
+    from mechgen.analyses.simulate_hybrid import EVENT_BYTES
+
+    scene = tmp_path / "ball.toml"
+    body = (f'model = "{BALL}"\n[[analysis]]\nname = "d"\nkind = "simulate"\nmethod = "DOP853"\nt_end = 1.0\n'
+            'q0 = {{ y = 1.0 }}\n{extra}')
+    monkeypatch.setenv("MECHGEN_MEMORY_LIMIT", "1GiB")
+    scene.write_text(body.format(extra="max_events = 1000000000\nmax_steps = 1000000000\n"))
+    code, err = _run(["run", str(scene)], capsys)
+    assert code == 2 and "at key 'max_events'" in err, err
+    assert f"{10**9 * (EVENT_BYTES + 48) / 2**30:.3g} GiB" in err, err
+    scene.write_text(body.format(extra=""))
+    assert _run(["run", str(scene)], capsys)[0] == 0
+
+
+@pytest.mark.parametrize("extra, key", [("max_events = 1000000000", "analysis[1].max_events"),
+                                        ("zeno_events = 20000", "analysis[1].zeno_events"),
+                                        ("max_events = 1000000000\nmax_steps = 1000000000", "max_events")])
+def test_periodic_event_limits_are_bounded_up_front(tmp_path, capsys, extra, key):
+    """The hybrid periodic kind refuses max_events above its step budget (default 10^5 steps) and zeno_events above
+    max_events at load, as simulate does, and an event store past the memory before it runs."""
+    scene = tmp_path / "loop.toml"
+    scene.write_text((SCENES_DIR / "stick_slip_element.toml").read_text() + extra + "\n")
+    code, err = _run(["run", str(scene)], capsys)
+    assert code == 2 and f"at key '{key}'" in err, err
+
+
+def test_periodic_keeps_running_with_few_events(tmp_path, capsys):
+    """max_events = 50 alone is not refused for the default zeno_events (100): only a zeno_events the scene wrote
+    is compared with max_events (the loop has a handful of events a period)."""
+    scene = tmp_path / "loop.toml"
+    scene.write_text((SCENES_DIR / "stick_slip_element.toml").read_text() + "max_events = 50\n")
+    code, err = _run(["run", str(scene)], capsys)
+    assert code == 0 or "max_events" in err, err
 
 
 @pytest.mark.parametrize("scene, per_element", [("rod_tip_load.toml", 48_000), ("rod_dynamics.toml", 32_000)])

@@ -186,3 +186,62 @@ def test_an_unreachable_scheduler_is_named(monkeypatch):
                      progress=False)
     assert info.value.key == "scheduler" and "tcp://127.0.0.1:1" in str(info.value)
     assert time.monotonic() - started < 30
+
+
+def _endless_kind(name: str):
+    """A sweepable test kind that computes for 20 s in Python, with no budget of its own (only the backstop)."""
+    from mechgen.analyses import registry, summary
+
+    def endless(system, options, context):
+        stop = time.monotonic() + 20
+        while time.monotonic() < stop:
+            sum(range(1000))
+        return {"done": 1.0}
+
+    registry.register(registry.AnalysisKind(name, {}, endless, lambda o, *, internal: set(), summary.lines,
+                                            sweepable=True))
+
+
+@pytest.mark.parametrize("executor", ["serial", "processes"])
+def test_a_slow_point_stops_at_its_own_budget_naming_the_point(executor):
+    """Issue 33: the inner analysis's max_seconds is enforced where the point runs, in a worker process too (the
+    backstop, SIGALRM at max_seconds x 1.1 + 2 s, is set by the point's own run in the worker's main thread): a
+    BudgetExceeded naming the point and the key analysis.max_seconds, after ~2.2 s, not the point's 20 s."""
+    from mechgen.analyses import registry
+    from mechgen.runtime.core.budget import BudgetExceeded
+
+    _endless_kind("endless_w33")
+    scene = {"model": "laval_rotor", "analysis": [
+        {"name": "grid", "kind": "sweep", "executor": executor, "workers": 2, "progress": False,
+         "over": {"Omega": [10.0, 20.0]}, "analysis": {"kind": "endless_w33", "max_seconds": 0.2}}]}
+    started = time.monotonic()
+    try:
+        with pytest.raises(BudgetExceeded) as info:
+            mechgen.run(scene)
+    finally:
+        registry.unregister("endless_w33")
+    text = str(info.value)
+    assert info.value.key == "analysis.max_seconds" and "sweep point {'Omega': 10.0}" in text, text
+    assert time.monotonic() - started < 12  # 0.2 x 1.1 + 2 s per point, the workers' start; not 20 s
+
+
+@pytest.mark.parametrize("executor", ["serial", "processes"])
+def test_the_sweeps_budget_ends_its_worker_processes(executor):
+    """The sweep's own max_seconds (the parent's backstop: its points have 600 s each) stops the sweep, named as the
+    sweep's key (not the point's), and terminates the workers still computing (the pool's shutdown waited for their
+    20 s points)."""
+    from mechgen.analyses import registry
+    from mechgen.runtime.core.budget import BudgetExceeded
+
+    _endless_kind("endless_p33")
+    scene = {"model": "laval_rotor", "analysis": [
+        {"name": "grid", "kind": "sweep", "executor": executor, "workers": 2, "progress": False,
+         "max_seconds": 0.3, "over": {"Omega": [10.0, 20.0]}, "analysis": {"kind": "endless_p33"}}]}
+    started = time.monotonic()
+    try:
+        with pytest.raises(BudgetExceeded) as info:
+            mechgen.run(scene)
+    finally:
+        registry.unregister("endless_p33")
+    assert info.value.key == "max_seconds" and "sweep 'grid'" in str(info.value), str(info.value)
+    assert time.monotonic() - started < 10  # 0.3 x 1.1 + 2 s and the workers' end; not the points' 20 s

@@ -41,3 +41,16 @@ class PointRunner:
 def public(outputs: dict) -> dict:
     """The outputs without working entries (names starting with ``_``)."""
     return {k: v for k, v in outputs.items() if not k.startswith("_")}
+
+
+def run_at_point(kind: str, system, options: dict) -> dict:
+    """The public outputs of analysis ``kind`` on ``system`` (already set to the point's parameters) under the inner
+    analysis's own wall-time budget: ``max_seconds`` of ``options`` (default 600 s) enforced by the SIGALRM backstop
+    (mechgen.runtime.core.budget.wall_clock) also where the point runs in a worker process, whose main thread runs
+    it. A point past its budget raises BudgetExceeded (key ``max_seconds``), which the sweep names with the point and
+    the key under ``analysis`` (mechgen.runtime.core.sweep.inner_budget)."""
+    from mechgen.analyses.registry import get
+    from mechgen.runtime.core.budget import DEFAULT_SECONDS, wall_clock
+
+    with wall_clock(float(options.get("max_seconds", DEFAULT_SECONDS)), f"{kind} at a sweep point"):
+        return public(get(kind).run(system, options, {}))

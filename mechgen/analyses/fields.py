@@ -12,8 +12,10 @@ def field_shapes(system, columns: np.ndarray, name: str, samples: int = 101) -> 
     """
     s = np.linspace(0.0, system.disc.length, samples)
     curves: dict = {f: [] for f in system.disc.fields}
-    for col in columns.T:
-        values = system.field_values(col, s)
+    columns = np.asarray(columns)
+    every = system.field_values(columns, s) if columns.shape[1] else {}  # the rows tabulated once for all columns
+    for j in range(columns.shape[1]):
+        values = {f: v[:, j] for f, v in every.items()}
         if name == "shapes":
             stacked = np.concatenate(list(values.values()))
             peak = stacked[np.argmax(np.abs(stacked))]

@@ -14,9 +14,8 @@ import re
 
 import numpy as np
 
-from mechgen.analyses.context import POINTS, PointRunner, public
+from mechgen.analyses.context import POINTS, PointRunner, run_at_point
 from mechgen.analyses.parameters import with_free_params
-from mechgen.analyses.registry import get
 from mechgen.errors import InputError, SceneError
 from mechgen.scene.expr_arrays import evaluate_rows
 from mechgen.scene.values import listing, show
@@ -54,7 +53,7 @@ def _shown(names, theta) -> str:
 def _at_point(task: tuple) -> dict:
     """The inner analysis on a copy of the system with the point's parameter values (the Python API's path)."""
     system, kind, options, point = task
-    return public(get(kind).run(with_free_params(system, point, key="parameters"), options, {}))
+    return run_at_point(kind, with_free_params(system, point, key="parameters"), options)
 
 
 class AnalysisModel:

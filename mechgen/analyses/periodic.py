@@ -58,9 +58,10 @@ SCHEMA = {
     "rtol": Option(schema.positive, 1e-12, doc="the integrator's relative tolerance"),
     "atol": Option(schema.positive, 1e-14, doc="the integrator's absolute tolerance (the state's units)"),
     "curve": Option(schema.boolean, False, doc="also report the loop: displacement_series and force_series"),
-    "max_events": Option(schema.count, 10_000, doc="the most events of the whole run"),
-    "zeno_events": Option(schema.count, 100, doc="more than this many events within 1e-9 times the run's end time "
-                          "is a Zeno approach"),
+    "max_events": Option(schema.count, ABSENT, doc="the most events of the whole run (default 10^4; at most max_steps, "
+                         "and its stored events must fit in memory)"),
+    "zeno_events": Option(schema.count, ABSENT, doc="more than this many events within 1e-9 times the run's end time "
+                          "is a Zeno approach (default 100; at most max_events)"),
     "max_steps": Option(schema.count, ABSENT, doc="the work budget in integrator steps"),
     "max_seconds": Option(schema.positive, ABSENT, doc="the wall-time budget (s, default 600)"),
     "loop": Option(schema.one_of("loop", LOOPS), "auto", doc="the event loop: auto (compiled for DOP853 on the "
@@ -74,10 +75,13 @@ def needs(options: dict, *, internal: bool) -> set[str]:
 
 
 def check(ctx, base: str, options: dict) -> None:
-    """The model has modes."""
+    """The model has modes; max_events <= max_steps and zeno_events <= max_events (as simulate: a larger count
+    can never be reached within the step budget, refused at load at the key)."""
     from mechgen.analyses.impact import hybrid_only
+    from mechgen.analyses.simulate import check_event_bounds
 
     hybrid_only(ctx, base, options)
+    check_event_bounds(ctx, base, options)
 
 
 def loop_outputs(system, traj, names: tuple[str, str]) -> np.ndarray:
@@ -99,8 +103,9 @@ def steady_period(system, x0, mode, period: float, options: dict, run: dict) -> 
     """(k, error, trajectory): the first period [(k-1)T, kT] whose end state and loop point repeat its start
     (module doc)."""
     from mechgen.analyses.simulate import budget_of
-    from mechgen.analyses.simulate_hybrid import rules_of
+    from mechgen.analyses.simulate_hybrid import require_event_memory, rules_of
 
+    require_event_memory(options, np.asarray(x0).size)
     limit = int(options.get("max_periods", 64))
     tol, floor = float(options.get("tolerance", 1e-9)), float(options.get("atol_periodic", 1e-12))
     count = min(2, limit)

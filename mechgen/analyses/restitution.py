@@ -17,10 +17,10 @@ result, divided by it, is the time per impact).
 from __future__ import annotations
 
 from mechgen.analyses import figures, schema, summary
-from mechgen.analyses.context import NAME, POINTS, PointRunner, public
+from mechgen.analyses.context import NAME, POINTS, PointRunner, run_at_point
 from mechgen.analyses.impact import SCHEMA as IMPACT, hybrid_only, needs
 from mechgen.analyses.parameters import with_free_params
-from mechgen.analyses.registry import AnalysisKind, get, register
+from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import Option
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget
 from mechgen.runtime.core.sweep import sweep
@@ -74,7 +74,7 @@ def frees(options: dict) -> list[str]:
 
 def _at_point(task: tuple) -> dict:
     system, kind, options, point = task
-    return public(get(kind).run(with_free_params(system, point, key="grid"), options, {}))
+    return run_at_point(kind, with_free_params(system, point, key="grid"), options)
 
 
 def curve_points(values: list, count) -> set:

@@ -49,6 +49,21 @@ def rules_of(options: dict) -> EventRules:
                       int(options.get("zeno_events", base.zeno_events)), options.get("zeno_span"))
 
 
+#: memory of one stored event beyond its two states (the Event record, its JSON log entry, the Zeno ring's time),
+#: bytes: a bouncing ball (2 states) peaked at 116 MB with 10^4 events and 145 MB with 10^5 in the compiled loop
+#: (330 B per event), 98 MB and 167 MB in the Python loop (770 B per event, its Event objects); with a margin
+EVENT_BYTES = 1_000
+
+
+def require_event_memory(options: dict, states: int) -> None:
+    """Refuse up front (exit 2 at ``max_events``) a hybrid run whose event store could outgrow the memory limit:
+    max_events x (EVENT_BYTES + 3 x 8 x states) bytes (the states before and after each event, and one copy in the
+    outputs), mechgen.runtime.core.memory.require."""
+    events = int(options.get("max_events", EventRules.max_events))
+    require(events * (EVENT_BYTES + 3 * 8 * int(states)), f"{events:,} stored events (a state of {int(states)} entries each)",
+            key="max_events", expected="a smaller max_events")
+
+
 def event_log(system, events) -> list[dict]:
     """The events as JSON records ``{t, from, to, guard}`` (mode names; ``to`` None when the run ended)."""
     names = system.modes
@@ -68,6 +83,7 @@ def run_hybrid(system, options: dict, context: dict) -> dict:
     x0 = np.concatenate([q0, v0, np.zeros(system.m) if start is None else start[2 * system.n:]])
     n_out = int(options.get("samples", 201))
     require(dense_bytes(n_out, 3 * x0.size + 6), f"{n_out} output samples", key="samples")
+    require_event_memory(options, x0.size)
     carry = energy_balance.hybrid_accounted(system)
     runner = BalancedHybrid(system) if carry else system
     x_run = np.concatenate([x0, np.zeros(energy_balance.EXTRA)]) if carry else x0

@@ -27,9 +27,9 @@ from mechgen.analyses import figures, schema, summary
 from mechgen.analyses.operating_point import equilibrium_point, linear_about
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import LINEAR_OPTIONS, Option
-from mechgen.runtime.core.memory import require_dense
+from mechgen.runtime.core.memory import require, require_dense
 from mechgen.runtime.linear.stability import stability as solve_stability
-from mechgen.runtime.linear.stability import stability_first_order, stability_sparse
+from mechgen.runtime.linear.stability import SPARSE_BYTES_PER_UNKNOWN, stability_first_order, stability_sparse
 
 #: above this many unknowns, a stability analysis with a ``count`` of sparse matrices uses shift-invert
 SPARSE_STABILITY_N = 400
@@ -59,6 +59,21 @@ def _stability_of(system, q, options: dict, context: dict):
     require_dense(system.n, 40, "the dense stability eigenproblem", expected="a count with finite elements (sparse)")
     dense = {k: (v.toarray() if hasattr(v, "toarray") else v) for k, v in mats.items()}
     return solve_stability(dense["M"], dense["D"] + dense["G"], dense["K"], tolerance=tol)
+
+
+def require_sparse_stability(system, options: dict) -> None:
+    """Refuse up front (exit 2 at params.N) a continuum's sparse stability solve whose memory, SPARSE_BYTES_PER_UNKNOWN
+    x the unknowns of its largest solve (2n when refined at 2N), exceeds the limit (mechgen.runtime.core.memory)."""
+    if not (options.get("count") and getattr(system, "is_field", False)):
+        return
+    n = int(system.n)
+    if n <= SPARSE_STABILITY_N:
+        return
+    refined = hasattr(system, "refined") and options.get("refine", True) and not options.get("about")
+    largest = 2 * n if refined else n
+    require(SPARSE_BYTES_PER_UNKNOWN * largest, f"the sparse stability solve of {largest} unknowns"
+            + (f" (refined at 2N from {n})" if refined else ""), key="params.N",
+            expected="a smaller N" + (", or refine = false" if refined else ""))
 
 
 def refinement_verdict(verdicts: list[str], structures: list[tuple[int, int]]) -> str:
@@ -102,6 +117,7 @@ def run_stability(system, options: dict, context: dict) -> dict:
     discretised twice as finely: ``unconverged`` when the verdict or the sign structure
     changes (``refinement`` reports both, and the growth rates).
     """
+    require_sparse_stability(system, options)
     q, found = equilibrium_point(system, options, context)
     res = _stability_of(system, q, options, context)
     eig, freqs = _trimmed(res, options.get("count"))

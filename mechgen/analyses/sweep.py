@@ -23,7 +23,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from mechgen.analyses import figures, schema, summary
-from mechgen.analyses.context import NAME, POINTS, PointRunner, public, scheduler_of
+from mechgen.analyses.context import NAME, POINTS, PointRunner, run_at_point, scheduler_of
 from mechgen.analyses.parameters import with_free_params
 from mechgen.analyses.registry import AnalysisKind, get, kinds, register
 from mechgen.analyses.schema import ABSENT, REQUIRED, AnalysisSpec, Option
@@ -80,7 +80,7 @@ def needs(options: dict, *, internal: bool) -> set[str]:
 def _at_point(task: tuple) -> dict:
     """The inner analysis at one point on a copy of the system with the point's parameter values."""
     system, kind, options, point = task
-    return public(get(kind).run(with_free_params(system, point, key="grid"), options, {}))
+    return run_at_point(kind, with_free_params(system, point, key="grid"), options)
 
 
 def collect(grid: list[dict], results: list, status: list | None = None, retried: list | None = None) -> dict:

@@ -15,8 +15,7 @@ from pathlib import Path
 from typing import Mapping
 
 from mechgen import models
-from mechgen.analyses.context import NAME, POINTS, SCHEDULER, PointRunner, public
-from mechgen.analyses.registry import get
+from mechgen.analyses.context import NAME, POINTS, SCHEDULER, PointRunner, run_at_point
 from mechgen.analyses.result import NumericalFailure, run_analysis
 from mechgen.errors import InputError, MechgenError, SceneError
 from mechgen.pipeline import compile_request, file_digest
@@ -62,7 +61,7 @@ def sweep_point(task: tuple) -> dict:
     system, _ = system_of(source_key, point_request(request, info, point) or request)
     system = laid_out(system, layout).with_param_vector(
         [float(point.get(n, dict(values).get(n, info.param(n).default))) for n in system.metadata.params])
-    return public(get(kind).run(system, options, {}))
+    return run_at_point(kind, system, options)
 
 
 def _point_task(scene: tuple, layout, kind: str, options: dict, point: dict) -> tuple:
@@ -115,9 +114,18 @@ def placed(exc: InputError, scn) -> SceneError:
         shown = [f"{scn.written[n]} = {scn.params[n]!r}" for n in wanted][:8]  # the cap never drops the user's --set
         if scn.segments:
             shown.append("[[segments]]")
+        if exc.key == "M":  # a part's values are lumped inertia: one of them can make M singular (issue 33 fuzz)
+            shown += part_values(scn.parts)
         if shown:
             note = f" (decided by what the scene sets: {', '.join(shown)})"
     return SceneError(exc.message.rstrip(".") + note, file=scn.path, key=key, expected=exc.expected)
+
+
+def part_values(parts) -> list[str]:
+    """``'parts[i]' (kind at s): name = value, ...`` of each [[parts]] table (at most 8), for messages."""
+    shown = [f"'parts[{i}]' ({p.kind} at {p.at:g}): " + ", ".join(f"{k} = {v!r}" for k, v in p.values.items())
+             for i, p in enumerate(parts[:8], 1)]
+    return shown + ([f"{len(parts) - 8} more [[parts]]"] if len(parts) > 8 else [])
 
 
 def _run_loaded(scn, backend: str | None, scheduler: str | None = None) -> dict:

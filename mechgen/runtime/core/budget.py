@@ -52,6 +52,8 @@ class BudgetExceeded(MechgenError):
 
     def __init__(self, message: str, *, key: str | None = None, reached: str = "", analysis: str = "") -> None:
         self.message, self.key, self.reached, self.analysis = message, key, reached, analysis
+        #: the nesting level of the wall_clock backstop that raised it (0: the outermost); None: a loop's own budget
+        self.level: int | None = None
         super().__init__(self.paragraph())
 
     def paragraph(self) -> str:
@@ -220,6 +222,16 @@ BACKSTOP_GRACE = 1.10
 BACKSTOP_MARGIN = 2.0
 
 
+#: the levels of the wall_clock timers set now, outermost first (one process's main thread)
+_CLOCKS: list[int] = []
+
+
+def clock_depth() -> int:
+    """How many wall_clock timers are set now: a BudgetExceeded whose ``level`` is below the depth read before a
+    call came from a timer set outside that call (a sweep's own budget, not its point's)."""
+    return len(_CLOCKS)
+
+
 @contextlib.contextmanager
 def wall_clock(seconds: float | None, what: str):
     """The wall-time budget of a whole analysis, for every kind (issue 33): a real-time timer (SIGALRM) that
@@ -238,16 +250,22 @@ BACKSTOP_MARGIN have passed,
         yield
         return
 
+    level = len(_CLOCKS)
+
     def expired(signum, frame):
-        raise BudgetExceeded(f"{what}: stopped after {limit:.1f} s of wall time ({SECONDS_KEY} = {seconds:g})",
+        exc = BudgetExceeded(f"{what}: stopped after {limit:.1f} s of wall time ({SECONDS_KEY} = {seconds:g})",
                              key=SECONDS_KEY)
+        exc.level = level
+        raise exc
 
     started = time.monotonic()
     previous_handler = signal.signal(signal.SIGALRM, expired)
     previous_left, _ = signal.setitimer(signal.ITIMER_REAL, limit)
+    _CLOCKS.append(level)
     try:
         yield
     finally:
+        _CLOCKS.pop()
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, previous_handler)
         if previous_left > 0:  # an outer timer: what is left of it

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 from urllib.parse import urlsplit
 
 from mechgen.errors import InputError, MechgenError
-from mechgen.runtime.core.budget import Budget, BudgetExceeded, Progress
+from mechgen.runtime.core.budget import Budget, BudgetExceeded, Progress, clock_depth
 from mechgen.runtime.core.threads import single_thread_worker
 
 EXECUTORS = ("serial", "processes", "dask")
@@ -204,28 +204,44 @@ def _run_processes(func, points, workers: int, store, done, label, inner: str, r
         futures = [pool.submit(inherited_point, i, inner, record) if forks
                    else pool.submit(guarded, func, points[i], inner, None, record) for i in range(len(points))]
         for i, fut in enumerate(futures):
-            try:
-                outcome = fut.result()
-            except BudgetExceeded as exc:
-                raise inner_budget(exc, label(i), inner) from exc
-            except SweepError as exc:  # raised in the worker, which knew the task, not its label
-                raise SweepError(f"sweep point {describe(label(i))} failed: {exc}") from exc
-            store(i, outcome)
+            failure = fut.exception()  # waits for point i; the sweep's own budget (a timer here) interrupts the wait
+            if isinstance(failure, BudgetExceeded):  # the point's budget, spent in the worker
+                raise inner_budget(failure, label(i), inner) from failure
+            if isinstance(failure, SweepError):  # raised in the worker, which knew the task, not its label
+                raise SweepError(f"sweep point {describe(label(i))} failed: {failure}") from failure
+            store(i, fut.result())
             done(1)
+    except BaseException:  # a failure, a spent budget (the parent's backstop included), Ctrl-C: end the workers now
+        stop_workers(pool)
+        raise
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
         _INHERITED.pop("tasks", None)
+
+
+def stop_workers(pool) -> None:
+    """Terminate (SIGTERM) the worker processes of a ProcessPoolExecutor, so that its shutdown does not wait for the
+    points they are still running (a sweep stopped by its budget would otherwise run on until they end). The pool
+    keeps its processes in its ``_processes`` mapping (CPython 3.9-3.13; 3.14 has ``terminate_workers``)."""
+    terminate = getattr(pool, "terminate_workers", None)
+    if terminate is not None:
+        terminate()
+        return
+    for process in list((getattr(pool, "_processes", None) or {}).values()):
+        if process.is_alive():
+            process.terminate()
 
 
 def guarded(func, point, inner: str, label, record: bool = True) -> tuple:
     """("ok", func(point)), or with ``record`` ("failed: <message>", None) for a failed computation. A
     user's mistake (InputError) and a spent budget (named with the point when ``label`` is given) are
     raised; without ``record`` so is every failure (a MechgenError as it is, another named with the point)."""
+    depth = clock_depth()
     try:
         return OK, func(point)
     except BudgetExceeded as exc:
-        if label is None:
-            raise
+        if label is None or (exc.level is not None and exc.level < depth):
+            raise  # in a worker the driver names the point; a timer set outside the point is the sweep's own
         raise inner_budget(exc, label, inner) from exc
     except InputError:
         raise

@@ -294,6 +294,13 @@ def stability_first_order(A, E, *, tolerance: float | None = None) -> StabilityR
     return _judged(s, A, B, tolerance, 0.0, None)
 
 
+#: memory per unknown of the sparse stability solve (A, B of size 2n, the SuperLU factors of A - sigma B and of
+#: K + mu M, ARPACK's Krylov basis), bytes: peak RSS of Beck's column (scenes/beck_column.toml, stability with
+#: count = 3, refined at 2N) 199 MB at N = 10^4 and 1220 MB at N = 10^5, i.e. 1021 MB for the 360 000 unknowns added
+#: at 2N (hermite: 2 per node): 2.8 kB per unknown, with a margin (issue 33: N = 10^6 ran 10 min past 3.4 GiB)
+SPARSE_BYTES_PER_UNKNOWN = 4_000
+
+
 def low_shift(M, K, scale: float, steps: int = 8) -> float:
     """The shift sigma = -1e-3 omega_low of the sparse stability solve, omega_low^2 the Rayleigh quotient
     |x^T K x| / |x^T M x| after ``steps`` inverse iterations (K + mu M) x_{j+1} = M x_j, mu = (1e-6 scale)^2.

@@ -376,6 +376,7 @@ static int rhs_unchecked(mgh_ctx *c, long mode, double t, const double *x, doubl
     if (n == 1) {  /* a scalar M: no elimination */
         if (M_out[md->tangent.pick[0]][0] == 0.0) {
             fail_at(c, t, x);
+            c->S->err_mode = mode;  /* the mode whose M it is (a mode entered at an event: not the one left) */
             return MGH_E_SINGULAR;
         }
         c->b[0] /= M_out[md->tangent.pick[0]][0];
@@ -384,6 +385,7 @@ static int rhs_unchecked(mgh_ctx *c, long mode, double t, const double *x, doubl
     memcpy(c->M, M_out[md->tangent.pick[0]], (size_t)(n * n) * sizeof(double));
     if (solve(n, c->M, c->b)) {
         fail_at(c, t, x);
+        c->S->err_mode = mode;
         return MGH_E_SINGULAR;
     }
 solved:
