@@ -9,7 +9,16 @@ the model's initial mode. Outputs as the smooth orbit's (mechgen.analyses.period
 ``harmonics``, ``multipliers`` (the eigenvalues of Phi), ``stability``, ``method`` (``shooting``), ``residual``,
 ``iterations``; and ``events`` (those of one period: {t, guard, from, to}) and ``grazing`` (the events of the
 orbit that touch their guard tangentially, where the saltation matrix and the multipliers are not to be trusted).
-An autonomous hybrid orbit (unknown period) is not available yet (an input error at ``frequency``).
+*Autonomous* (no ``frequency``: an orbit of unknown period, such as a stick-slip cycle on a moving belt): the phase
+is fixed by a Poincare section at an event, the guard named by ``section`` (left out: the guard of the first event
+of the run from the guess); the orbit starts just after that event, in the mode it leads to, and ends just after its
+next one (mechgen.runtime.integration.hybrid_autonomous: Newton on the return map, its Jacobian from the saltation
+matrices and the return time's gradient). The guess is ``q0`` / ``v0`` run ``passes`` = 3 times through the section
+(from the model's initial mode; ``period`` the guess of the period, which bounds each run at 3 periods); its state
+after the third event starts Newton. Outputs as above, with ``section`` (the guard) and ``start_mode``; ``t`` runs
+from the section's event (t = 0) over one period. ``multipliers`` hold the trivial 1 (along the orbit; set aside by
+``stability``), and a stick phase, which forgets the velocity it started with, gives multipliers 0 (the monodromy
+is rank-deficient: a 1-degree-of-freedom stick-slip cycle has multipliers 1 and 0 and is stable).
 """
 from __future__ import annotations
 
@@ -26,30 +35,63 @@ from mechgen.runtime.periodic import floquet, fourier
 FINE = 4096
 
 
-def orbit_states(system, x0: np.ndarray, T: float, times: np.ndarray, rtol: float, atol: float):
-    """(states (rows), mode per sample) of the orbit from x0 at ``times`` in [0, T] (the event-driven flow)."""
-    run = integrate_hybrid(system, x0, T, options=RunOptions(method="DOP853", rtol=rtol, atol=atol, t_eval=times,
-                                                             progress=False))
+def orbit_states(system, x0: np.ndarray, T: float, times: np.ndarray, rtol: float, atol: float,
+                 mode: int | None = None):
+    """(states (rows), mode per sample) of the orbit from x0 in ``mode`` (default the initial one) at ``times`` in
+    [0, T] (the event-driven flow)."""
+    run = integrate_hybrid(system, x0, T, mode=mode, options=RunOptions(method="DOP853", rtol=rtol, atol=atol,
+                                                                        t_eval=times, progress=False))
     return np.asarray(run.x, float), np.asarray(run.mode, int)
 
 
 def run_hybrid_orbit(system, options: dict, guess: np.ndarray) -> dict:
     """The forced orbit of a hybrid model from the starting state ``guess`` (module doc)."""
-    if options.get("frequency") is None:
-        raise SceneError("an autonomous periodic orbit of a hybrid model (unknown period) is not available yet",
-                         key="frequency", expected="the forcing's frequency (a forced hybrid model's orbit)")
     if options.get("method", "shooting") != "shooting":
         raise SceneError(f"method {options['method']!r} needs a smooth model; a hybrid model's orbit is found by "
                          "shooting through its events", key="method", expected="shooting (or leave method out)")
+    rtol, atol = float(options["rtol"]) * 1e-2, float(options["atol"]) * 1e-2
+    if options.get("frequency") is None:
+        return run_autonomous(system, options, guess, rtol, atol)
     omega = float(options["frequency"])
     T = 2 * np.pi / omega
-    rtol, atol = float(options["rtol"]) * 1e-2, float(options["atol"]) * 1e-2
     orbit = periodic_orbit(system, guess, T, tol=float(options["rtol"]), max_iter=int(options["max_iterations"]),
                            rtol=rtol, atol=atol)
+    out = orbit_outputs(system, options, orbit, rtol, atol, autonomous=False)
+    out["frequency"] = omega
+    out["_orbit"] = {"method": "shooting", "hybrid": True, "x0": orbit.x0, "mode": orbit.mode,
+                     "options": dict(options)}
+    return out
+
+
+def run_autonomous(system, options: dict, guess: np.ndarray, rtol: float, atol: float) -> dict:
+    """The autonomous orbit of a hybrid model through the section's event (module doc)."""
+    from mechgen.runtime.integration.hybrid_autonomous import autonomous_orbit, settle_on_section
+
+    section = options.get("section")
+    if section is not None and not any(g.name == section for m in range(len(system.modes))
+                                       for g in system.guards(m)):
+        names = sorted({g.name for m in range(len(system.modes)) for g in system.guards(m)})
+        raise SceneError(f"periodic_orbit: model {system.metadata.model} has no guard {section!r}", key="section",
+                         expected="one of its guards: " + ", ".join(names))
+    x0, mode, section = settle_on_section(system, guess, system.initial_mode, section, float(options["period"]),
+                                          rtol=rtol, atol=atol)
+    orbit = autonomous_orbit(system, x0, mode, section, float(options["period"]), tol=float(options["rtol"]),
+                             max_iter=int(options["max_iterations"]), rtol=rtol, atol=atol)
+    out = orbit_outputs(system, options, orbit, rtol, atol, autonomous=True)
+    out.update(section=section, start_mode=system.modes[orbit.mode])
+    out["_orbit"] = {"method": "shooting", "hybrid": True, "autonomous": True, "x0": orbit.x0, "mode": orbit.mode,
+                     "section": section, "period": orbit.period, "options": dict(options)}
+    return out
+
+
+def orbit_outputs(system, options: dict, orbit, rtol: float, atol: float, *, autonomous: bool) -> dict:
+    """The outputs (module doc) of a converged orbit (a HybridOrbit or an AutonomousOrbit) of period orbit.period,
+    sampled from its start x0 in orbit.mode."""
+    T = float(orbit.period)
     names = list(system.coordinates)
-    fine, _ = orbit_states(system, orbit.x0, T, T * np.arange(FINE) / FINE, rtol, atol)
+    fine, _ = orbit_states(system, orbit.x0, T, T * np.arange(FINE) / FINE, rtol, atol, orbit.mode)
     t = np.linspace(0.0, T, int(options["samples"]))
-    X, modes = orbit_states(system, orbit.x0, T, t, rtol, atol)
+    X, modes = orbit_states(system, orbit.x0, T, t, rtol, atol, orbit.mode)
     series = time_series.sampled_outputs_by_mode(system.mode, t, X, modes)
     history = time_series.time_history(system, t, X, series, None)
     history["trajectory"]["mode_series"] = modes.tolist()
@@ -57,16 +99,14 @@ def run_hybrid_orbit(system, options: dict, guess: np.ndarray) -> dict:
     mu = orbit.multipliers
     from mechgen.analyses.periodic_orbit import peak
 
-    return {"period": T, "frequency": omega, "t": history["t"], "trajectory": history["trajectory"],
+    return {"period": T, "frequency": 2 * np.pi / T, "t": history["t"], "trajectory": history["trajectory"],
             "amplitude": {c: peak(fine[:, i]) for i, c in enumerate(names)},
             "harmonics": fourier.harmonics_table(U, names), "multipliers": floquet.as_pairs(mu),
-            "stability": floquet.stability(mu, False), "method": "shooting", "residual": orbit.residual,
+            "stability": floquet.stability(mu, autonomous), "method": "shooting", "residual": orbit.residual,
             "iterations": orbit.iterations, "loop": "c" if getattr(system, "backend", None) == "c" else "python",
             "events": [{"t": float(e.t), "guard": e.guard, "from": system.modes[e.source],
                         "to": None if e.target is None else system.modes[e.target]} for e in orbit.events],
-            "grazing": [orbit.events[i].guard for i in orbit.grazing],
-            "_orbit": {"method": "shooting", "hybrid": True, "x0": orbit.x0, "mode": orbit.mode,
-                       "options": dict(options)}}
+            "grazing": [orbit.events[i].guard for i in orbit.grazing]}
 
 
 def run_hybrid_branch(system, options: dict, orbit: dict) -> dict:

@@ -102,7 +102,13 @@ Smooth lumped models, with or without internal variables, and forced hybrid mode
 stick-slip) is found by single shooting through its events, the monodromy built from the modes'
 state-transition matrices and the saltation matrices of the events (generated from the guards and resets;
 mechgen.analyses.hybrid_orbit), with ``events`` (one period's) and ``grazing`` besides the outputs above; harmonic
-balance, collocation, multiple shooting and an autonomous hybrid orbit are refused for it (exit 2 at the key). A
+balance, collocation and multiple shooting are refused for it (exit 2 at the key). An autonomous hybrid orbit (no
+``frequency``; ``period`` its guess) has its phase fixed by a Poincare section at an event, the guard ``section``
+(left out: the first event's guard of the run from the guess): the orbit starts just after that event and Newton
+solves the return map to it, whose Jacobian holds the saltation matrices and the return time's gradient
+(mechgen.runtime.integration.hybrid_autonomous); ``t`` starts at the event, and the outputs add ``section`` and
+``start_mode``. Its ``multipliers`` hold the trivial 1, and a stick phase (a velocity held at the belt's) makes the
+monodromy rank-deficient: multipliers 0, one per held state component (scenes/belt_stick_slip.toml: 1 and 0). A
 model with internal variables z is solved by collocation (above) or shooting, whose flow carries them (``z0`` their
 guess; shooting's phase condition of a model of internal variables only is dz_p/dt = 0 at t = 0; ``amplitude`` and
 ``harmonics`` list them after the coordinates); harmonic balance, whose residual holds the coordinates only, is
@@ -214,6 +220,9 @@ SCHEMA = {
                         "autonomous orbit, its period found)"),
     "period": Option(schema.positive, ABSENT, doc="the starting guess of an autonomous orbit's period (s, or the "
                      "model's time unit; required without frequency)"),
+    "section": Option(schema.name, ABSENT, doc="an autonomous hybrid orbit's Poincare section: the name of the guard "
+                      "whose event starts and ends the period (left out: the guard of the first event of the run "
+                      "from the guess); a smooth model's orbit takes none"),
     "harmonics": Option(harmonics_count, ABSENT, doc="harmonic balance's number of harmonics H "
                         "(default 7); with shooting, how many harmonics are reported"),
     "mesh": Option(mesh_count, ABSENT, doc="collocation's number of mesh intervals (default 40), each with a "
@@ -262,6 +271,9 @@ def check(ctx, base: str, options: dict) -> None:
     if getattr(model, "modes", ()):
         check_hybrid(ctx, base, options)
         return
+    if "section" in options:
+        raise fail(ctx.file, f"{base}.section", f"model {model.name} has no modes: section is an autonomous hybrid "
+                   "orbit's Poincare section (a guard)", "no section (a smooth orbit's phase is fixed by v_p(0) = 0)")
     why = ("is a continuum" if getattr(model, "continuum", False) else "is a chain" if getattr(model, "chain", None)
            else None)
     if getattr(model, "internals", False) and chosen_method(options) == "harmonic_balance":
@@ -314,9 +326,13 @@ def check_hybrid(ctx, base: str, options: dict) -> None:
     if int(options.get("segments", 1)) != 1:
         raise fail(ctx.file, f"{base}.segments", "a hybrid model's orbit is found by single shooting",
                    "segments = 1 (or no segments)")
-    if "frequency" not in options:
-        raise fail(ctx.file, f"{base}.frequency", f"an autonomous periodic orbit of a hybrid model ({model.name}) is "
-                   "not available yet", "the forcing's frequency (a forced hybrid model's orbit)")
+    if "frequency" not in options and "period" not in options:
+        raise fail(ctx.file, f"{base}.period", f"an autonomous orbit of a hybrid model ({model.name}) needs a "
+                   "guess of its period", "period = a number > 0 (or frequency = the forcing's, for a forced orbit)")
+    if "frequency" in options and ("period" in options or "section" in options):
+        key = "period" if "period" in options else "section"
+        raise fail(ctx.file, f"{base}.{key}", f"a forced orbit's period is 2 pi / frequency and starts at t = 0; "
+                   f"{key} belongs to an autonomous one", f"{key} or frequency, not both")
     if options.get("floquet") == "hill" or "from" in options or options.get("start") == "linear":
         key = "floquet" if options.get("floquet") == "hill" else "from" if "from" in options else "start"
         raise fail(ctx.file, f"{base}.{key}", f"{key} does not apply to a hybrid model's orbit",

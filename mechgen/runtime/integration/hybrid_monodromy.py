@@ -90,7 +90,7 @@ def flow_jacobian(system, x0, T: float, *, mode: int | None = None, rtol: float 
         phi = transition(system, current, t, event.t, x, rtol, atol) @ phi
         k = guard_index(system, current, event.guard)
         S = system.saltation(current, k, event.t, event.x_before)
-        if _grazes(system, current, k, event):
+        if grazes(system, current, k, event):
             grazing.append(i)
         saltations.append(S)
         phi = S @ phi
@@ -114,7 +114,7 @@ def flow_map(system, x0, T: float, *, mode: int | None = None, rtol: float = 1e-
     return np.asarray(run.x_final, float), run.final_mode
 
 
-def _grazes(system, mode: int, k: int, event) -> bool:
+def grazes(system, mode: int, k: int, event) -> bool:
     """Whether the event's |dg/dt| is below GRAZING |g_x| |f-| (module doc)."""
     n = system.n
     x = np.asarray(event.x_before, float)
