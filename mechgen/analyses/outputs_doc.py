@@ -384,6 +384,15 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
            "for Newton by central differences of it; a forced orbit's later segments, with ``segments`` > 1, in "
            "scipy's); ``python``: in scipy's DOP853 (harmonic balance's multipliers, and ``loop = \"python\"``), or "
            "no integration (collocation)."),
+        _o("events", "list of {t, guard, from, to}", "s", "A hybrid model's orbit: the events of one period (its "
+           "time from the orbit's start, the guard, the modes left and entered)."),
+        _o("grazing", "list of strings", "-", "A hybrid model's orbit: the guards of the events that touch their "
+           "surface tangentially (\|dg/dt\| < 1e-3 \|g_x\| \|f\|), where the saltation matrix and the "
+           "multipliers are not to be trusted."),
+        _o("section", "string", "-", "An autonomous hybrid orbit: the guard whose event is its Poincare section "
+           "(the orbit starts, t = 0, just after that event and ends just after the next)."),
+        _o("start_mode", "string", "-", "An autonomous hybrid orbit: the mode the orbit starts in (the one the "
+           "section's event leads to)."),
     ),
     "cross_section": (
         _o("K", "(6, 6)", "N, N m, N m^2", "The section's stiffness ordered [K_uu, K_uw; K_wu, K_ww]."),
