@@ -387,7 +387,7 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("events", "list of {t, guard, from, to}", "s", "A hybrid model's orbit: the events of one period (its "
            "time from the orbit's start, the guard, the modes left and entered)."),
         _o("grazing", "list of strings", "-", "A hybrid model's orbit: the guards of the events that touch their "
-           "surface tangentially (\|dg/dt\| < 1e-3 \|g_x\| \|f\|), where the saltation matrix and the "
+           "surface tangentially (\\|dg/dt\\| < 1e-3 \\|g_x\\| \\|f\\|), where the saltation matrix and the "
            "multipliers are not to be trusted."),
         _o("section", "string", "-", "An autonomous hybrid orbit: the guard whose event is its Poincare section "
            "(the orbit starts, t = 0, just after that event and ends just after the next)."),

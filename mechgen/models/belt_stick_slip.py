@@ -19,6 +19,11 @@ a static coefficient mu_s above the kinetic one mu_k (a jump at v_rel = 0). Mode
 * ``slip_back``: v_rel < 0, F = -mu(v_rel) N; back to ``stick`` when v_rel rises through 0 (guard
   ``catch_back``, reset x' = v_belt).
 
+With ``stribeck`` = 1 the slip starts tangentially (x'' = 0 at the breakaway, v_rel growing as t^2), so the catch
+guard would start on its surface with a rate of round-off size and its sign would decide between slip and an
+at-once return to stick (a Zeno chatter); the breakaway resets scale x' by 1 -+ 64 ulps, so that v_rel starts
+strictly inside the slip mode (the stick-slip contact's rule, mechgen/models/stick_slip_contact.py).
+
 The run starts in ``stick`` at x = 0, x' = v_belt. With mu_s > mu_k the motion settles on a stick-slip limit cycle:
 stick from x = (2 mu_k - mu_s) N / k to x = mu_s N / k, then a slip arc about x = mu_k N / k back to it (in closed
 form for Coulomb friction: tests/test_hybrid_autonomous.py). The stick phase forgets the state it started from, so
@@ -73,12 +78,16 @@ slip.forces(lambda v, p: {"x": friction(p, p.v_belt - v.x)})
 slip_back.forces(lambda v, p: {"x": -friction(p, v.x - p.v_belt)})
 
 
-@stick.guard(to="slip", direction="rising")
+#: the stick -> slip resets scale x' by (1 -+ NUDGE): v_rel starts a few ulps inside the slip mode (module doc)
+NUDGE = 64 * 2.220446049250313e-16
+
+
+@stick.guard(to="slip", direction="rising", reset=lambda v: {"x_dot": v.x * (1 - NUDGE)})
 def breakaway(q, p):
     return p.k * q.x - p.mu_s * p.N
 
 
-@stick.guard(to="slip_back", direction="falling")
+@stick.guard(to="slip_back", direction="falling", reset=lambda v: {"x_dot": v.x * (1 + NUDGE)})
 def breakaway_back(q, p):
     return p.k * q.x + p.mu_s * p.N
 
