@@ -172,3 +172,22 @@ def test_section_refused_for_forced_and_smooth(tmp_path):
     with pytest.raises(InputError) as err:
         mechgen.run(str(scene))
     assert "section" in str(err.value)
+
+
+def test_branch_in_belt_speed_closed_form(tmp_path):
+    """continuation about the autonomous orbit: the Coulomb cycle's period along v_belt against the closed form."""
+    scene = tmp_path / "belt.toml"
+    scene.write_text('model = "belt_stick_slip"\nbackend = "c"\n[params]\n'
+                     + "".join(f"{k} = {v}\n" for k, v in P.items())
+                     + '[[analysis]]\nname = "cycle"\nkind = "periodic_orbit"\nperiod = 5.0\n'
+                     '[[analysis]]\nname = "speed"\nkind = "continuation"\nabout = "cycle"\nparameter = "v_belt"\n'
+                     'stop = 0.8\nmax_step = 0.1\n')
+    out = mechgen.run(str(scene))["analyses"][1]["outputs"]
+    assert out["status"] == "lam_max" and out["points"] >= 5
+    for point in out["branch"]:
+        T, peak, _ = coulomb_cycle(**{**P, "v_belt": point["v_belt"]})
+        # each point a converged shooting orbit (Newton's corrector at 1e-9, DOP853 at 1e-11)
+        assert point["period"] == pytest.approx(T, rel=1e-8, abs=0)
+        assert point["amplitude"]["x"] == pytest.approx(peak, rel=1e-6)  # 1024 phases: parabola error O(h^3)
+        assert point["multipliers"][1] == pytest.approx([0.0, 0.0], abs=1e-9)
+    assert out["special_points"] == []

@@ -122,6 +122,8 @@ def run_hybrid_branch(system, options: dict, orbit: dict) -> dict:
     from mechgen.runtime.steady.continuation import continuation
     from mechgen.runtime.steady.cycle_points import cycle_points
 
+    if orbit.get("autonomous"):
+        return run_section_branch(system, options, orbit)
     name, frequency = options["parameter"], orbit["options"]["frequency"]
     rtol, atol = float(orbit["options"]["rtol"]) * 1e-2, float(orbit["options"]["atol"]) * 1e-2
 
@@ -149,6 +151,60 @@ def run_hybrid_branch(system, options: dict, orbit: dict) -> dict:
         out["doubled"] = [doubled_record(family, X, x, index, k + 1)
                           for k, (kind, x, index) in enumerate(specials) if kind == "PD"]
     return out
+
+
+def run_section_branch(system, options: dict, orbit: dict) -> dict:
+    """``continuation`` about an autonomous hybrid orbit: the branch of orbits through the section's event in
+    ``parameter`` (mechgen.runtime.integration.hybrid_autonomous.SectionFamily), its cyclic folds (LPC) and its PD
+    and NS points from the return map's multipliers. ``switch_branches`` is not available for it (the doubled
+    orbit of an autonomous hybrid orbit is not sought): the key is refused."""
+    from mechgen.analyses.newton_branch import arclength_steps
+    from mechgen.analyses.stability_boundary import own_value
+    from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget
+    from mechgen.runtime.integration.hybrid_autonomous import SectionFamily
+    from mechgen.runtime.steady.continuation import continuation
+    from mechgen.runtime.steady.cycle_points import cycle_points
+
+    if options.get("switch_branches"):
+        raise SceneError("switch_branches: the doubled orbit of an autonomous hybrid orbit is not available",
+                         key="switch_branches", expected="no switch_branches (or a forced orbit)")
+    name = options["parameter"]
+    rtol, atol = float(orbit["options"]["rtol"]) * 1e-2, float(orbit["options"]["atol"]) * 1e-2
+    family = SectionFamily(system, name, orbit["mode"], orbit["section"], orbit["period"], rtol=rtol, atol=atol)
+    here = float(own_value(system, name))
+    budget = Budget("continuation", unit="points", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
+    eqs = family.equations()
+    found = continuation(eqs, np.asarray(orbit["x0"], float), here, arclength_steps(options, here, budget,
+                                                                                    smallest_span=0.1))
+    X = np.hstack([found.u, found.lam[:, None]])
+    specials = [("LPC", np.append(f.u, f.lam), f.index) for f in found.folds]
+    if options.get("special_points", True):
+        specials += [(s.type, s.x, s.index) for s in cycle_points(eqs, X, family.multipliers)]
+    specials.sort(key=lambda s: s[2])
+    out = {"parameter": name, "method": "shooting", "branch": [section_record(family, x) for x in X],
+           "points": len(X), "status": found.status, "shape_outputs": [],
+           "special_points": [{"type": kind, **section_record(family, x)} for kind, x, _ in specials]}
+    out["folds"] = [s for s in out["special_points"] if s["type"] == "LPC"]
+    return out
+
+
+def section_record(family, x: np.ndarray) -> dict:
+    """One autonomous orbit of a branch: the parameter, period, frequency, amplitude, start (just after the
+    section's event), multipliers (the monodromy's), stability and the events per period."""
+    x0, p = x[:-1], float(x[-1])
+    rm = family.map(x0, p)
+    T = rm.period
+    fine, _ = orbit_states(family.moved(p), x0, T, T * np.arange(1024) / 1024, family.rtol, family.atol,
+                           family.mode)
+    mu = floquet.multipliers(rm.monodromy)
+    names = list(family.system.coordinates)
+    from mechgen.analyses.periodic_orbit import peak
+
+    return {family.name: p, "period": T, "frequency": 2 * np.pi / T,
+            "amplitude": {c: peak(fine[:, i]) for i, c in enumerate(names)},
+            "start": dict(zip(names + [f"{c}_dot" for c in names], (float(v) for v in x0))),
+            "multipliers": floquet.as_pairs(mu), "stability": floquet.stability(mu, True),
+            "events_per_period": len(rm.events)}
 
 
 def hybrid_record(family, x: np.ndarray) -> dict:

@@ -153,3 +153,53 @@ def settle_on_section(system, x0, mode: int, section: str | None, period: float,
                                f"{horizon:.6g}; its events: {sorted({e.guard for e in events})}")
     last = hits[min(passes, len(hits)) - 1]
     return np.asarray(last.x_after, float), int(last.target), section
+
+
+#: the central-difference step of R_p, relative to 1 + |p| (as mechgen.runtime.integration.hybrid_orbit_branch's)
+PARAM_STEP = 1e-6
+
+
+class SectionFamily:
+    """Autonomous orbits of ``system`` in its parameter ``name``, each through the event of ``section`` (starting in
+    ``mode``): R(x0, p) = P(x0; p) - x0, R_x0 = P_x - I (module doc), R_p by central differences; the return time
+    found with each orbit (each run looks 3 times the last return time ahead)."""
+
+    def __init__(self, system, name: str, mode: int, section: str, period: float, *, rtol: float = 1e-11,
+                 atol: float = 1e-13) -> None:
+        self.system, self.name, self.mode, self.section = system, name, int(mode), section
+        self.last_period, self.rtol, self.atol = float(period), rtol, atol
+        self.memo: dict = {}
+
+    def moved(self, p: float):
+        """The system at p."""
+        return self.system.with_params(**{self.name: float(p)})
+
+    def map(self, x0, p: float) -> ReturnMap:
+        """P(x0; p), its Jacobian and the monodromy (the last few kept)."""
+        key = (tuple(np.asarray(x0, float)), float(p))
+        if key not in self.memo:
+            if len(self.memo) > 32:
+                self.memo.clear()
+            self.memo[key] = return_map(self.moved(p), x0, self.mode, self.section, 3.0 * self.last_period,
+                                        rtol=self.rtol, atol=self.atol)
+            self.last_period = self.memo[key].period
+        return self.memo[key]
+
+    def equations(self):
+        """R, R_x0 and R_p for mechgen.runtime.steady.continuation."""
+        from mechgen.runtime.steady.continuation import ParametricEquations
+
+        def R(x0, p):
+            return self.map(x0, p).x - np.asarray(x0, float)
+
+        def R_p(x0, p):
+            h = PARAM_STEP * (1.0 + abs(p))
+            return (R(x0, p + h) - R(x0, p - h)) / (2 * h)
+
+        return ParametricEquations(R, lambda x0, p: self.map(x0, p).jacobian - np.eye(np.size(x0)), R_p,
+                                   name=f"the autonomous orbits in {self.name}")
+
+    def multipliers(self, x: np.ndarray) -> np.ndarray:
+        """The multipliers of the return map at the branch point x = (x0, p): the monodromy's, with 0 in place of
+        the trivial 1 (so that the PD and NS test functions see the others only)."""
+        return np.linalg.eigvals(self.map(x[:-1], x[-1]).jacobian)
