@@ -67,6 +67,7 @@ def run_autonomous(system, options: dict, guess: np.ndarray, rtol: float, atol: 
     """The autonomous orbit of a hybrid model through the section's event (module doc)."""
     from mechgen.runtime.integration.hybrid_autonomous import autonomous_orbit, settle_on_section
 
+    refuse_forced(system, guess)
     section = options.get("section")
     if section is not None and not any(g.name == section for m in range(len(system.modes))
                                        for g in system.guards(m)):
@@ -82,6 +83,18 @@ def run_autonomous(system, options: dict, guess: np.ndarray, rtol: float, atol: 
     out["_orbit"] = {"method": "shooting", "hybrid": True, "autonomous": True, "x0": orbit.x0, "mode": orbit.mode,
                      "section": section, "period": orbit.period, "options": dict(options)}
     return out
+
+
+def refuse_forced(system, x: np.ndarray) -> None:
+    """An autonomous orbit needs equations and guards without t: each mode's dx/dt and guards compared at t = 0 and
+    t = 1.2345 at the guess x (a SceneError at ``frequency`` when they differ)."""
+    for k in range(len(system.modes)):
+        f0, f1 = system.mode(k).rhs(0.0, x), system.mode(k).rhs(1.2345, x)
+        g0, g1 = system.guard_values(k, 0.0, x)[0], system.guard_values(k, 1.2345, x)[0]
+        if not (np.allclose(f0, f1, rtol=1e-12, atol=1e-14) and np.allclose(g0, g1, rtol=1e-12, atol=1e-14)):
+            raise SceneError(f"periodic_orbit: model {system.metadata.model}'s equations or guards depend on t (in "
+                             f"mode {system.modes[k]}: a forcing) and no frequency is given", key="frequency",
+                             expected="the forcing's angular frequency (rad/s), a number or a parameter expression")
 
 
 def orbit_outputs(system, options: dict, orbit, rtol: float, atol: float, *, autonomous: bool) -> dict:
