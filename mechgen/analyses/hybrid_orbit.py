@@ -4,7 +4,8 @@ A forced hybrid model (impacts, stick-slip: mechgen.symbolic.hybrid) has the orb
 period T = 2 pi / ``frequency`` found by Newton on x(T; x0) - x0 with the Jacobian Phi - I, Phi the flow map's
 Jacobian through the events: the modes' state-transition matrices and the saltation matrices of the events,
 generated from the guards and resets (mechgen.runtime.integration.hybrid_monodromy). The orbit starts at t = 0 in
-the model's initial mode. Outputs as the smooth orbit's (mechgen.analyses.periodic_orbit): ``period``,
+the model's initial mode; an event at the period's boundary (a stick-slip reversal at the drive's extremum) is taken
+at T (mechgen.runtime.integration.hybrid_monodromy.closing_run). Outputs as the smooth orbit's (mechgen.analyses.periodic_orbit): ``period``,
 ``frequency``, ``t``, ``trajectory`` (with ``mode_series``, the mode index per sample), ``amplitude``,
 ``harmonics``, ``multipliers`` (the eigenvalues of Phi), ``stability``, ``method`` (``shooting``), ``residual``,
 ``iterations``; and ``events`` (those of one period: {t, guard, from, to}) and ``grazing`` (the events of the

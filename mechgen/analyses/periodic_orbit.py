@@ -102,7 +102,11 @@ Smooth lumped models, with or without internal variables, and forced hybrid mode
 stick-slip) is found by single shooting through its events, the monodromy built from the modes'
 state-transition matrices and the saltation matrices of the events (generated from the guards and resets;
 mechgen.analyses.hybrid_orbit), with ``events`` (one period's) and ``grazing`` besides the outputs above; harmonic
-balance, collocation and multiple shooting are refused for it (exit 2 at the key). An autonomous hybrid orbit (no
+balance, collocation and multiple shooting are refused for it (exit 2 at the key). A forced hybrid orbit starts at
+t = 0 in the model's initial mode; an event at the period's boundary is accepted (the stick-slip contact under
+u = U cos(omega t) reverses at t = 0 = T, so its run ends a round-off short of the slip -> stick event): a run that
+ends in another mode is continued 1e-8 T past T and the events there are taken at T, their saltation matrices in the
+monodromy. An autonomous hybrid orbit (no
 ``frequency``; ``period`` its guess) has its phase fixed by a Poincare section at an event, the guard ``section``
 (left out: the first event's guard of the run from the guess): the orbit starts just after that event and Newton
 solves the return map to it, whose Jacobian holds the saltation matrices and the return time's gradient
