@@ -14,7 +14,7 @@ orbit that touch their guard tangentially, where the saltation matrix and the mu
 is fixed by a Poincare section at an event, the guard named by ``section`` (left out: the guard of the first event
 of the run from the guess); the orbit starts just after that event, in the mode it leads to, and ends just after its
 next one (mechgen.runtime.integration.hybrid_autonomous: Newton on the return map, its Jacobian from the saltation
-matrices and the return time's gradient). The guess is ``q0`` / ``v0`` run ``passes`` = 3 times through the section
+matrices and the return time's gradient). The guess ``q0`` / ``v0`` is run 3 times through the section
 (from the model's initial mode; ``period`` the guess of the period, which bounds each run at 3 periods); its state
 after the third event starts Newton. Outputs as above, with ``section`` (the guard) and ``start_mode``; ``t`` runs
 from the section's event (t = 0) over one period. ``multipliers`` hold the trivial 1 (along the orbit; set aside by
@@ -101,15 +101,18 @@ def refuse_forced(system, x: np.ndarray) -> None:
 def orbit_outputs(system, options: dict, orbit, rtol: float, atol: float, *, autonomous: bool) -> dict:
     """The outputs (module doc) of a converged orbit (a HybridOrbit or an AutonomousOrbit) of period orbit.period,
     sampled from its start x0 in orbit.mode."""
-    T = float(orbit.period)
-    names = list(system.coordinates)
+    T, n = float(orbit.period), system.n
+    # the coordinates, then the internal variables (as a smooth orbit's: mechgen.analyses.periodic_orbit.report)
+    columns = list(range(n)) + list(range(2 * n, 2 * n + system.m))
+    names = list(system.coordinates) + time_series.state_names(system)[2 * n:]
     fine, _ = orbit_states(system, orbit.x0, T, T * np.arange(FINE) / FINE, rtol, atol, orbit.mode)
+    fine = fine[:, columns]
     t = np.linspace(0.0, T, int(options["samples"]))
     X, modes = orbit_states(system, orbit.x0, T, t, rtol, atol, orbit.mode)
     series = time_series.sampled_outputs_by_mode(system.mode, t, X, modes)
     history = time_series.time_history(system, t, X, series, None)
     history["trajectory"]["mode_series"] = modes.tolist()
-    U = fourier.coefficients_of_samples(fine[:, :system.n], int(options.get("harmonics", 7)))
+    U = fourier.coefficients_of_samples(fine, int(options.get("harmonics", 7)))
     mu = orbit.multipliers
     from mechgen.analyses.periodic_orbit import peak
 

@@ -716,7 +716,8 @@ def peak(values: np.ndarray) -> float:
 
 def plot(plt, a: dict, path) -> list:
     """The orbit: each coordinate against t over one period, and the phase portrait of each (up to 4); a model of
-    internal variables only: each internal variable against t, and the second against the first."""
+    internal variables only: each internal variable against t, and the second against the first (one panel when it
+    has one)."""
     out = a["outputs"]
     traj = out["trajectory"]
     names = [c for c in traj if f"{c}_dot" in traj][:4]
@@ -724,15 +725,17 @@ def plot(plt, a: dict, path) -> list:
     internals = [] if names else list(out["amplitude"])[:4]
     if len(internals) > 1:
         pairs = [(internals[0], internals[1])]
-    fig, axes = plt.subplots(1, 2, figsize=(9, 3.6))
+    fig, axes = plt.subplots(1, 2 if pairs else 1, figsize=(9 if pairs else 5.5, 3.6), squeeze=False)
+    axes = axes[0]
     for c in names or internals:
         axes[0].plot(out["t"], traj[c], label=c)
     for x, y in pairs:
         axes[1].plot(traj[x], traj[y], label=x if names else None)
     axes[0].set_xlabel("t (s, or the model's time unit)")
-    axes[0].set_ylabel("coordinates" if names else "internal variables")
-    axes[1].set_xlabel("q" if names else pairs[0][0] if pairs else "")
-    axes[1].set_ylabel("dq/dt" if names else pairs[0][1] if pairs else "")
+    axes[0].set_ylabel("coordinates" if names else "internal variables" if len(internals) != 1 else internals[0])
+    if pairs:  # a single internal variable has no phase portrait
+        axes[1].set_xlabel("q" if names else pairs[0][0])
+        axes[1].set_ylabel("dq/dt" if names else pairs[0][1])
     for ax in axes if len(names or internals) > 1 else ():
         if ax.get_legend_handles_labels()[0]:
             ax.legend(fontsize="small")
