@@ -191,3 +191,13 @@ def test_branch_in_belt_speed_closed_form(tmp_path):
         assert point["amplitude"]["x"] == pytest.approx(peak, rel=1e-6)  # 1024 phases: parabola error O(h^3)
         assert point["multipliers"][1] == pytest.approx([0.0, 0.0], abs=1e-9)
     assert out["special_points"] == []
+
+
+def test_switch_branches_refused_for_an_autonomous_hybrid_orbit(tmp_path):
+    scene = tmp_path / "belt.toml"
+    scene.write_text('model = "belt_stick_slip"\nbackend = "c"\n[[analysis]]\nname = "cycle"\nkind = "periodic_orbit"\n'
+                     'period = 6.0\n[[analysis]]\nname = "speed"\nkind = "continuation"\nabout = "cycle"\n'
+                     'parameter = "v_belt"\nstop = 0.6\nswitch_branches = true\n')
+    with pytest.raises(InputError) as err:
+        mechgen.run(str(scene))
+    assert "switch_branches" in str(err.value)

@@ -173,8 +173,8 @@ def run_hybrid_branch(system, options: dict, orbit: dict) -> dict:
 def run_section_branch(system, options: dict, orbit: dict) -> dict:
     """``continuation`` about an autonomous hybrid orbit: the branch of orbits through the section's event in
     ``parameter`` (mechgen.runtime.integration.hybrid_autonomous.SectionFamily), its cyclic folds (LPC) and its PD
-    and NS points from the return map's multipliers. ``switch_branches`` is not available for it (the doubled
-    orbit of an autonomous hybrid orbit is not sought): the key is refused."""
+    and NS points from the return map's multipliers. The doubled orbit past a PD point is not sought
+    (mechgen.analyses.orbit_branch refuses ``switch_branches`` about an autonomous orbit)."""
     from mechgen.analyses.newton_branch import arclength_steps
     from mechgen.analyses.stability_boundary import own_value
     from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget
@@ -182,9 +182,6 @@ def run_section_branch(system, options: dict, orbit: dict) -> dict:
     from mechgen.runtime.steady.continuation import continuation
     from mechgen.runtime.steady.cycle_points import cycle_points
 
-    if options.get("switch_branches"):
-        raise SceneError("switch_branches: the doubled orbit of an autonomous hybrid orbit is not available",
-                         key="switch_branches", expected="no switch_branches (or a forced orbit)")
     name = options["parameter"]
     rtol, atol = float(orbit["options"]["rtol"]) * 1e-2, float(orbit["options"]["atol"]) * 1e-2
     family = SectionFamily(system, name, orbit["mode"], orbit["section"], orbit["period"], rtol=rtol, atol=atol)
