@@ -1,13 +1,14 @@
-"""``periodic_orbit`` of a hybrid model: event-aware shooting of a forced orbit, its monodromy through the events.
+"""``periodic_orbit`` of a hybrid model: event-aware shooting of a forced or autonomous orbit, its monodromy through
+the events.
 
 A forced hybrid model (impacts, stick-slip: mechgen.symbolic.hybrid) has the orbit x(T) = x0 of the forcing's
 period T = 2 pi / ``frequency`` found by Newton on x(T; x0) - x0 with the Jacobian Phi - I, Phi the flow map's
 Jacobian through the events: the modes' state-transition matrices and the saltation matrices of the events,
 generated from the guards and resets (mechgen.runtime.integration.hybrid_monodromy). The orbit starts at t = 0 in
 the model's initial mode; an event at the period's boundary (a stick-slip reversal at the drive's extremum) is taken
-at T (mechgen.runtime.integration.hybrid_monodromy.closing_run). Outputs as the smooth orbit's (mechgen.analyses.periodic_orbit): ``period``,
-``frequency``, ``t``, ``trajectory`` (with ``mode_series``, the mode index per sample), ``amplitude``,
-``harmonics``, ``multipliers`` (the eigenvalues of Phi), ``stability``, ``method`` (``shooting``), ``residual``,
+at T (mechgen.runtime.integration.hybrid_monodromy.closing_run). Outputs as the smooth orbit's
+(mechgen.analyses.periodic_orbit): ``period``, ``frequency``, ``t``, ``trajectory`` (with ``mode_series``, the mode
+index per sample), ``amplitude`` and ``harmonics`` (the coordinates, then the internal variables), ``multipliers`` (the eigenvalues of Phi), ``stability``, ``method`` (``shooting``), ``residual``,
 ``iterations``; and ``events`` (those of one period: {t, guard, from, to}) and ``grazing`` (the events of the
 orbit that touch their guard tangentially, where the saltation matrix and the multipliers are not to be trusted).
 *Autonomous* (no ``frequency``: an orbit of unknown period, such as a stick-slip cycle on a moving belt): the phase
