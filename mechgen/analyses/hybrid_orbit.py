@@ -9,8 +9,9 @@ the model's initial mode; an event at the period's boundary (a stick-slip revers
 at T (mechgen.runtime.integration.hybrid_monodromy.closing_run). Outputs as the smooth orbit's
 (mechgen.analyses.periodic_orbit): ``period``, ``frequency``, ``t``, ``trajectory`` (with ``mode_series``, the mode
 index per sample), ``amplitude`` and ``harmonics`` (the coordinates, then the internal variables), ``multipliers``
-(the eigenvalues of Phi), ``stability``, ``method`` (``shooting``), ``residual``, ``iterations``; and ``events`` (those of one period: {t, guard, from, to}) and ``grazing`` (the events of the
-orbit that touch their guard tangentially, where the saltation matrix and the multipliers are not to be trusted).
+(the eigenvalues of Phi), ``stability``, ``method`` (``shooting``), ``residual``, ``iterations``; and ``events``
+(those of one period: {t, guard, from, to}) and ``grazing`` (the events of the orbit that touch their guard
+tangentially, where the saltation matrix and the multipliers are not to be trusted).
 
 *Autonomous* (no ``frequency``: an orbit of unknown period, such as a stick-slip cycle on a moving belt): the phase
 is fixed by a Poincare section at an event, the guard named by ``section`` (left out: the guard of the first event
