@@ -201,3 +201,15 @@ def test_switch_branches_refused_for_an_autonomous_hybrid_orbit(tmp_path):
     with pytest.raises(InputError) as err:
         mechgen.run(str(scene))
     assert "switch_branches" in str(err.value)
+
+
+def test_equal_coefficients_graze(belt):
+    """mu_s = mu_k: the slip arc is the circle x = x_k + (v_b / w) sin(w t), back at x' = v_b tangentially after
+    2 pi / w; the catch is reported as grazing (its saltation matrix and the multipliers are not to be trusted)."""
+    system = belt.with_params(mu_k=P["mu_s"])
+    out = mechgen.periodic_orbit(system, period=5.0, section="breakaway")
+    w = math.sqrt(P["k"] / P["m"])
+    assert out["grazing"] == ["catch"]
+    # a tangential zero, v_rel ~ (t - T)^2, is located to about sqrt(round-off) ~ 1e-8 in time (measured 5e-13)
+    assert out["period"] == pytest.approx(2 * math.pi / w, rel=1e-7)
+    assert out["amplitude"]["x"] == pytest.approx(P["mu_s"] * P["N"] / P["k"] + P["v_belt"] / w, rel=1e-6)
