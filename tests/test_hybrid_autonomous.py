@@ -143,6 +143,8 @@ def test_jenkins_orbit_energy_and_reversal():
     f = np.array(out["trajectory"]["friction_force"])
     t = np.array(out["t"])
     assert f[0] == pytest.approx(mu * N, rel=1e-9)
+    # the flat slip phase meets the stick phase in a kink: the amplitude is not a parabola's overshoot across it
+    assert out["amplitude"]["f"] == pytest.approx(mu * N, rel=1e-9)
     slip = math.acos(1 - 2 * delta / U) / omega
     assert out["events"][0]["t"] == pytest.approx(slip, rel=1e-9)
     assert [e["guard"] for e in out["events"]][-1] == "stop_forward"
@@ -213,3 +215,19 @@ def test_equal_coefficients_graze(belt):
     # a tangential zero, v_rel ~ (t - T)^2, is located to about sqrt(round-off) ~ 1e-8 in time (measured 5e-13)
     assert out["period"] == pytest.approx(2 * math.pi / w, rel=1e-7)
     assert out["amplitude"]["x"] == pytest.approx(P["mu_s"] * P["N"] / P["k"] + P["v_belt"] / w, rel=1e-6)
+
+
+def test_jenkins_orbit_branch_in_the_normal_load(tmp_path):
+    """continuation of the forced stick-slip orbit (a boundary event at every point) in N: the reversal force
+    f(0) = mu N and the largest |f| = mu N along the branch, while k_u U > mu N (slip every half period)."""
+    scene = tmp_path / "jenkins.toml"
+    scene.write_text('model = "stick_slip_contact"\nbackend = "c"\n[[analysis]]\nname = "orbit"\n'
+                     'kind = "periodic_orbit"\nfrequency = "omega"\n[[analysis]]\nname = "load"\n'
+                     'kind = "continuation"\nabout = "orbit"\nparameter = "N"\nstop = 2.5\nmax_step = 0.3\n')
+    out = mechgen.run(str(scene))["analyses"][1]["outputs"]
+    assert out["status"] == "lam_max" and out["points"] >= 4
+    for point in out["branch"]:
+        # Newton's corrector at rtol 1e-9 on f(0); the peak of 1024 phases on the flat slip part is exact
+        assert point["start"]["f"] == pytest.approx(0.3 * point["N"], rel=1e-8)
+        assert point["amplitude"]["f"] == pytest.approx(0.3 * point["N"], rel=1e-8)
+        assert point["events_per_period"] == 4

@@ -89,6 +89,35 @@ def run_autonomous(system, options: dict, guess: np.ndarray, rtol: float, atol: 
     return out
 
 
+def amplitudes(system, states: np.ndarray, period: float, events) -> dict:
+    """{name: max |value|} over one period (the coordinates, then the internal variables), from the states (rows) at
+    the equally spaced phases period * k / rows and the states on both sides of the ``events``: the largest sample
+    refined by the parabola through it and its neighbours (mechgen.analyses.periodic_orbit.peak) unless an event
+    falls between those neighbours (a kink, where the parabola would overshoot: a flat slip phase meets a stick
+    phase), then the larger of that sample and the event states."""
+    n, names = system.n, time_series.state_names(system)
+    columns = list(range(n)) + list(range(2 * n, 2 * n + system.m))
+    times = np.array([e.t for e in events], float)
+    sides = np.array([s for e in events for s in (e.x_before, e.x_after)], float).reshape(-1, states.shape[1])
+    return {names[j]: kinked_peak(states[:, j], period, times, sides[:, j]) for j in columns}
+
+
+def kinked_peak(values: np.ndarray, period: float, event_times: np.ndarray, event_values: np.ndarray) -> float:
+    """max |value| of a piecewise-smooth periodic signal sampled at period * k / values.size (amplitudes' doc)."""
+    from mechgen.analyses.periodic_orbit import peak
+
+    y = np.abs(np.asarray(values, float))
+    k, h = int(np.argmax(y)), period / y.size
+    gap = np.abs(np.mod(event_times - k * h + period / 2, period) - period / 2)
+    best = peak(values) if not np.any(gap < h) else float(y[k])
+    return float(max(best, np.max(np.abs(event_values), initial=0.0)))
+
+
+def start_state(system, x0: np.ndarray) -> dict:
+    """{state name: value} of the orbit's start: the coordinates, their velocities, the internal variables."""
+    return dict(zip(time_series.state_names(system), (float(v) for v in x0)))
+
+
 def refuse_forced(system, x: np.ndarray) -> None:
     """An autonomous orbit needs equations and guards without t: each mode's dx/dt and guards compared at t = 0 and
     t = 1.2345 at the guess x (a SceneError at ``frequency`` when they differ)."""
@@ -109,6 +138,7 @@ def orbit_outputs(system, options: dict, orbit, rtol: float, atol: float, *, aut
     columns = list(range(n)) + list(range(2 * n, 2 * n + system.m))
     names = list(system.coordinates) + time_series.state_names(system)[2 * n:]
     fine, _ = orbit_states(system, orbit.x0, T, T * np.arange(FINE) / FINE, rtol, atol, orbit.mode)
+    amplitude = amplitudes(system, fine, T, orbit.events)
     fine = fine[:, columns]
     t = np.linspace(0.0, T, int(options["samples"]))
     X, modes = orbit_states(system, orbit.x0, T, t, rtol, atol, orbit.mode)
@@ -117,10 +147,8 @@ def orbit_outputs(system, options: dict, orbit, rtol: float, atol: float, *, aut
     history["trajectory"]["mode_series"] = modes.tolist()
     U = fourier.coefficients_of_samples(fine, int(options.get("harmonics", 7)))
     mu = orbit.multipliers
-    from mechgen.analyses.periodic_orbit import peak
-
     return {"period": T, "frequency": 2 * np.pi / T, "t": history["t"], "trajectory": history["trajectory"],
-            "amplitude": {c: peak(fine[:, i]) for i, c in enumerate(names)},
+            "amplitude": amplitude,
             "harmonics": fourier.harmonics_table(U, names), "multipliers": floquet.as_pairs(mu),
             "stability": floquet.stability(mu, autonomous), "method": "shooting", "residual": orbit.residual,
             "iterations": orbit.iterations, "loop": "c" if getattr(system, "backend", None) == "c" else "python",
@@ -214,12 +242,9 @@ def section_record(family, x: np.ndarray) -> dict:
     fine, _ = orbit_states(family.moved(p), x0, T, T * np.arange(1024) / 1024, family.rtol, family.atol,
                            family.mode)
     mu = floquet.multipliers(rm.monodromy)
-    names = list(family.system.coordinates)
-    from mechgen.analyses.periodic_orbit import peak
-
     return {family.name: p, "period": T, "frequency": 2 * np.pi / T,
-            "amplitude": {c: peak(fine[:, i]) for i, c in enumerate(names)},
-            "start": dict(zip(names + [f"{c}_dot" for c in names], (float(v) for v in x0))),
+            "amplitude": amplitudes(family.system, fine, T, rm.events),
+            "start": start_state(family.system, x0),
             "multipliers": floquet.as_pairs(mu), "stability": floquet.stability(mu, True),
             "events_per_period": len(rm.events)}
 
@@ -232,12 +257,9 @@ def hybrid_record(family, x: np.ndarray) -> dict:
     moved = family.system.with_params(**{family.name: p})
     fine, _ = orbit_states(moved, x0, T, T * np.arange(1024) / 1024, family.rtol, family.atol)
     mu = floquet.multipliers(family.flow(x0, p).phi)
-    names = list(family.system.coordinates)
-    from mechgen.analyses.periodic_orbit import peak
-
     return {family.name: p, "period": T, "frequency": 2 * np.pi / T,
-            "amplitude": {c: peak(fine[:, i]) for i, c in enumerate(names)},
-            "start": dict(zip(names + [f"{c}_dot" for c in names], (float(v) for v in x0))),
+            "amplitude": amplitudes(family.system, fine, T, family.flow(x0, p).events),
+            "start": start_state(family.system, x0),
             "multipliers": floquet.as_pairs(mu), "stability": floquet.stability(mu, False),
             "events_per_period": len(family.flow(x0, p).events)}
 
@@ -250,13 +272,10 @@ def doubled_record(family, X: np.ndarray, x_pd: np.ndarray, index: int, at: int)
     side = max((X[index], X[index + 1]), key=lambda x: -float(np.min(family.multipliers(x).real)))
     p = float(x_pd[-1]) + 0.5 * (float(side[-1]) - float(x_pd[-1]))
     orbit = doubled_orbit(family, x_pd, p - float(x_pd[-1]))
-    names = list(family.system.coordinates)
     fine, _ = orbit_states(family.system.with_params(**{family.name: p}), orbit.x0, orbit.period,
                            orbit.period * np.arange(1024) / 1024, family.rtol, family.atol)
-    from mechgen.analyses.periodic_orbit import peak
-
-    return {"at": at, family.name: p, "amplitude": {c: peak(fine[:, i]) for i, c in enumerate(names)},
-            "period": orbit.period, "start": dict(zip(names + [f"{c}_dot" for c in names],
-                                                      (float(v) for v in orbit.x0))),
-            "multipliers": floquet.as_pairs(orbit.multipliers), "stability": floquet.stability(orbit.multipliers, False),
+    mu = orbit.multipliers
+    return {"at": at, family.name: p, "amplitude": amplitudes(family.system, fine, orbit.period, orbit.events),
+            "period": orbit.period, "start": start_state(family.system, orbit.x0),
+            "multipliers": floquet.as_pairs(mu), "stability": floquet.stability(mu, False),
             "events_per_period": len(orbit.events)}

@@ -360,7 +360,8 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("trajectory", "{name: (samples,)}", MODEL_UNIT, "The orbit at ``t``, named as simulate's: each "
            "coordinate, ``<coordinate>_dot``, each internal variable and the model's outputs."),
         _o("amplitude", "{coordinate: value}", MODEL_UNIT, "max \\|q\\| over the period (the largest of 4096 phases, "
-           "refined by the parabola through it and its neighbours), then each internal variable's."),
+           "refined by the parabola through it and its neighbours; a hybrid orbit's not across an event, whose "
+           "states count too), then each internal variable's."),
         _o("harmonics", "{coordinate: {mean, cos, sin, amplitude, phase}}", "the coordinate's; phase in rad",
            "The Fourier coefficients of each coordinate, k = 1..H: q = mean + sum_k a_k cos(k omega t) + b_k "
            "sin(k omega t) = mean + sum_k amplitude_k cos(k omega t + phase_k) (``cos`` a_k, ``sin`` b_k, "
