@@ -232,3 +232,10 @@ def test_jenkins_orbit_branch_in_the_normal_load(tmp_path):
         assert point["start"]["f"] == pytest.approx(0.3 * point["N"], rel=1e-8)
         assert point["amplitude"]["f"] == pytest.approx(0.3 * point["N"], rel=1e-8)
         assert point["events_per_period"] == 4
+
+
+def test_a_short_period_guess_is_corrected_by_the_settling_run(belt):
+    """period = 1 (the cycle's is 3.9): the settling run's return time replaces the guess, so that the return map,
+    bounded at 3 periods, runs past the real return."""
+    out = mechgen.periodic_orbit(belt, period=1.0, section="breakaway")
+    assert out["period"] == pytest.approx(coulomb_cycle(**P)[0], rel=1e-8, abs=0)  # as the closed-form test

@@ -18,8 +18,9 @@ is fixed by a Poincare section at an event, the guard named by ``section`` (left
 of the run from the guess); the orbit starts just after that event, in the mode it leads to, and ends just after its
 next one (mechgen.runtime.integration.hybrid_autonomous: Newton on the return map, its Jacobian from the saltation
 matrices and the return time's gradient). The guess ``q0`` / ``v0`` is run 3 times through the section
-(from the model's initial mode; ``period`` the guess of the period, which bounds each run at 3 periods); its state
-after the third event starts Newton. Outputs as above, with ``section`` (the guard) and ``start_mode``; ``t`` runs
+(from the model's initial mode; ``period`` the guess of the period, which bounds that run at 9 periods); its state
+after the third event starts Newton, and the time between its last two events there is the period's guess from
+then on (each run bounded at 3 of them). Outputs as above, with ``section`` (the guard) and ``start_mode``; ``t`` runs
 from the section's event (t = 0) over one period. ``multipliers`` hold the trivial 1 (along the orbit; set aside by
 ``stability``), and a stick phase, which forgets the velocity it started with, gives multipliers 0 (the monodromy
 is rank-deficient: a 1-degree-of-freedom stick-slip cycle has multipliers 1 and 0 and is stable).
@@ -78,9 +79,9 @@ def run_autonomous(system, options: dict, guess: np.ndarray, rtol: float, atol: 
         names = sorted({g.name for m in range(len(system.modes)) for g in system.guards(m)})
         raise SceneError(f"periodic_orbit: model {system.metadata.model} has no guard {section!r}", key="section",
                          expected="one of its guards: " + ", ".join(names))
-    x0, mode, section = settle_on_section(system, guess, system.initial_mode, section, float(options["period"]),
-                                          rtol=rtol, atol=atol)
-    orbit = autonomous_orbit(system, x0, mode, section, float(options["period"]), tol=float(options["rtol"]),
+    x0, mode, section, period = settle_on_section(system, guess, system.initial_mode, section,
+                                                  float(options["period"]), rtol=rtol, atol=atol)
+    orbit = autonomous_orbit(system, x0, mode, section, period, tol=float(options["rtol"]),
                              max_iter=int(options["max_iterations"]), rtol=rtol, atol=atol)
     out = orbit_outputs(system, options, orbit, rtol, atol, autonomous=True)
     out.update(section=section, start_mode=system.modes[orbit.mode])

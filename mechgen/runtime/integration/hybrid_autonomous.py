@@ -136,8 +136,9 @@ def autonomous_orbit(system, x0, mode: int, section: str, period: float, *, tol:
 
 def settle_on_section(system, x0, mode: int, section: str | None, period: float, *, rtol: float = 1e-11,
                       atol: float = 1e-13, passes: int = 3):
-    """(state, mode, section) just after the last of ``passes`` events of ``section`` (None: the guard of the
-    first event of the run) from the guess x0 in ``mode``: a start on the section near an attracting orbit."""
+    """(state, mode, section, period) just after the last of ``passes`` events of ``section`` (None: the guard of
+    the first event of the run) from the guess x0 in ``mode``: a start on the section near an attracting orbit, and
+    the time between its last two events there (the guess ``period`` when there is one event only)."""
     horizon = 3.0 * float(period) * passes
     run = integrate_hybrid(system, np.asarray(x0, float), horizon, mode=mode,
                            options=RunOptions(method="DOP853", rtol=rtol, atol=atol, t_eval=np.array([horizon]),
@@ -151,8 +152,9 @@ def settle_on_section(system, x0, mode: int, section: str | None, period: float,
     if not hits:
         raise ConvergenceError(f"the run from the guess meets no event of guard {section!r} within t = "
                                f"{horizon:.6g}; its events: {sorted({e.guard for e in events})}")
-    last = hits[min(passes, len(hits)) - 1]
-    return np.asarray(last.x_after, float), int(last.target), section
+    used = hits[:passes]
+    between = used[-1].t - used[-2].t if len(used) > 1 else float(period)
+    return np.asarray(used[-1].x_after, float), int(used[-1].target), section, float(between)
 
 
 #: the central-difference step of R_p, relative to 1 + |p| (as mechgen.runtime.integration.hybrid_orbit_branch's)
