@@ -26,6 +26,11 @@ the eigenvector of the multiplier -1; harmonic balance with 2H harmonics of omeg
 harmonics are the even ones) and collocation on the mesh repeated over [0, 2T], each from the period-T orbit plus
 the perturbation Phi(t) v over [0, 2T] (v that eigenvector: Phi(t + T) v = -Phi(t) v, odd harmonics of omega / 2).
 
+About an autonomous hybrid orbit (a ``periodic_orbit`` without frequency on a hybrid model, its phase fixed by its
+``section``) the branch is that of the return map's fixed points (mechgen.analyses.hybrid_orbit.run_section_branch:
+``start`` the state just after the section's event, PD and NS from the return map's multipliers); without
+``switch_branches``.
+
 About the free orbit of a conservative model (a ``periodic_orbit`` without frequency on a model that keeps its
 energy) the continuation follows its family: mechgen.analyses.backbone (``parameter = "amplitude"``: the backbone).
 """
@@ -220,7 +225,7 @@ def run_orbit_branch(system, options: dict, earlier: dict) -> dict:
                          expected="a model parameter, or about = a periodic_orbit without frequency on a "
                          "conservative model")
     hybrid = bool(earlier["_orbit"].get("hybrid"))
-    switchable = hybrid or earlier["_orbit"]["options"].get("frequency") is not None  # a forced orbit
+    switchable = earlier["_orbit"]["options"].get("frequency") is not None  # a forced orbit (smooth or hybrid)
     for key in ORBIT_REFUSES:
         if options.get(key) and not (switchable and key == "switch_branches"):
             raise SceneError(f"{key} does not apply to a branch of periodic orbits", key=key,

@@ -360,7 +360,8 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("trajectory", "{name: (samples,)}", MODEL_UNIT, "The orbit at ``t``, named as simulate's: each "
            "coordinate, ``<coordinate>_dot``, each internal variable and the model's outputs."),
         _o("amplitude", "{coordinate: value}", MODEL_UNIT, "max \\|q\\| over the period (the largest of 4096 phases, "
-           "refined by the parabola through it and its neighbours), then each internal variable's."),
+           "refined by the parabola through it and its neighbours; a hybrid orbit's not across an event, whose "
+           "states count too), then each internal variable's."),
         _o("harmonics", "{coordinate: {mean, cos, sin, amplitude, phase}}", "the coordinate's; phase in rad",
            "The Fourier coefficients of each coordinate, k = 1..H: q = mean + sum_k a_k cos(k omega t) + b_k "
            "sin(k omega t) = mean + sum_k amplitude_k cos(k omega t + phase_k) (``cos`` a_k, ``sin`` b_k, "
@@ -384,6 +385,15 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
            "for Newton by central differences of it; a forced orbit's later segments, with ``segments`` > 1, in "
            "scipy's); ``python``: in scipy's DOP853 (harmonic balance's multipliers, and ``loop = \"python\"``), or "
            "no integration (collocation)."),
+        _o("events", "list of {t, guard, from, to}", "s", "A hybrid model's orbit: the events of one period (its "
+           "time from the orbit's start, the guard, the modes left and entered)."),
+        _o("grazing", "list of strings", "-", "A hybrid model's orbit: the guards of the events that touch their "
+           "surface tangentially (\\|dg/dt\\| < 1e-3 \\|g_x\\| \\|f\\|), where the saltation matrix and the "
+           "multipliers are not to be trusted."),
+        _o("section", "string", "-", "An autonomous hybrid orbit: the guard whose event is its Poincare section "
+           "(the orbit starts, t = 0, just after that event and ends just after the next)."),
+        _o("start_mode", "string", "-", "An autonomous hybrid orbit: the mode the orbit starts in (the one the "
+           "section's event leads to)."),
     ),
     "cross_section": (
         _o("K", "(6, 6)", "N, N m, N m^2", "The section's stiffness ordered [K_uu, K_uw; K_wu, K_ww]."),

@@ -102,7 +102,17 @@ Smooth lumped models, with or without internal variables, and forced hybrid mode
 stick-slip) is found by single shooting through its events, the monodromy built from the modes'
 state-transition matrices and the saltation matrices of the events (generated from the guards and resets;
 mechgen.analyses.hybrid_orbit), with ``events`` (one period's) and ``grazing`` besides the outputs above; harmonic
-balance, collocation, multiple shooting and an autonomous hybrid orbit are refused for it (exit 2 at the key). A
+balance, collocation and multiple shooting are refused for it (exit 2 at the key). A forced hybrid orbit starts at
+t = 0 in the model's initial mode; an event at the period's boundary is accepted (the stick-slip contact under
+u = U cos(omega t) reverses at t = 0 = T, so its run ends a round-off short of the slip -> stick event): a run that
+ends in another mode is continued 1e-8 T past T and the events there are taken at T, their saltation matrices in the
+monodromy. An autonomous hybrid orbit (no
+``frequency``; ``period`` its guess) has its phase fixed by a Poincare section at an event, the guard ``section``
+(left out: the first event's guard of the run from the guess): the orbit starts just after that event and Newton
+solves the return map to it, whose Jacobian holds the saltation matrices and the return time's gradient
+(mechgen.runtime.integration.hybrid_autonomous); ``t`` starts at the event, and the outputs add ``section`` and
+``start_mode``. Its ``multipliers`` hold the trivial 1, and a stick phase (a velocity held at the belt's) makes the
+monodromy rank-deficient: multipliers 0, one per held state component (scenes/belt_stick_slip.toml: 1 and 0). A
 model with internal variables z is solved by collocation (above) or shooting, whose flow carries them (``z0`` their
 guess; shooting's phase condition of a model of internal variables only is dz_p/dt = 0 at t = 0; ``amplitude`` and
 ``harmonics`` list them after the coordinates); harmonic balance, whose residual holds the coordinates only, is
@@ -214,6 +224,9 @@ SCHEMA = {
                         "autonomous orbit, its period found)"),
     "period": Option(schema.positive, ABSENT, doc="the starting guess of an autonomous orbit's period (s, or the "
                      "model's time unit; required without frequency)"),
+    "section": Option(schema.name, ABSENT, doc="an autonomous hybrid orbit's Poincare section: the name of the guard "
+                      "whose event starts and ends the period (left out: the guard of the first event of the run "
+                      "from the guess); a smooth model's orbit takes none"),
     "harmonics": Option(harmonics_count, ABSENT, doc="harmonic balance's number of harmonics H "
                         "(default 7); with shooting, how many harmonics are reported"),
     "mesh": Option(mesh_count, ABSENT, doc="collocation's number of mesh intervals (default 40), each with a "
@@ -262,6 +275,9 @@ def check(ctx, base: str, options: dict) -> None:
     if getattr(model, "modes", ()):
         check_hybrid(ctx, base, options)
         return
+    if "section" in options:
+        raise fail(ctx.file, f"{base}.section", f"model {model.name} has no modes: section is an autonomous hybrid "
+                   "orbit's Poincare section (a guard)", "no section (a smooth orbit's phase is fixed by v_p(0) = 0)")
     why = ("is a continuum" if getattr(model, "continuum", False) else "is a chain" if getattr(model, "chain", None)
            else None)
     if getattr(model, "internals", False) and chosen_method(options) == "harmonic_balance":
@@ -314,9 +330,13 @@ def check_hybrid(ctx, base: str, options: dict) -> None:
     if int(options.get("segments", 1)) != 1:
         raise fail(ctx.file, f"{base}.segments", "a hybrid model's orbit is found by single shooting",
                    "segments = 1 (or no segments)")
-    if "frequency" not in options:
-        raise fail(ctx.file, f"{base}.frequency", f"an autonomous periodic orbit of a hybrid model ({model.name}) is "
-                   "not available yet", "the forcing's frequency (a forced hybrid model's orbit)")
+    if "frequency" not in options and "period" not in options:
+        raise fail(ctx.file, f"{base}.period", f"an autonomous orbit of a hybrid model ({model.name}) needs a "
+                   "guess of its period", "period = a number > 0 (or frequency = the forcing's, for a forced orbit)")
+    if "frequency" in options and ("period" in options or "section" in options):
+        key = "period" if "period" in options else "section"
+        raise fail(ctx.file, f"{base}.{key}", f"a forced orbit's period is 2 pi / frequency and starts at t = 0; "
+                   f"{key} belongs to an autonomous one", f"{key} or frequency, not both")
     if options.get("floquet") == "hill" or "from" in options or options.get("start") == "linear":
         key = "floquet" if options.get("floquet") == "hill" else "from" if "from" in options else "start"
         raise fail(ctx.file, f"{base}.{key}", f"{key} does not apply to a hybrid model's orbit",
@@ -696,7 +716,8 @@ def peak(values: np.ndarray) -> float:
 
 def plot(plt, a: dict, path) -> list:
     """The orbit: each coordinate against t over one period, and the phase portrait of each (up to 4); a model of
-    internal variables only: each internal variable against t, and the second against the first."""
+    internal variables only: each internal variable against t, and the second against the first (one panel when it
+    has one)."""
     out = a["outputs"]
     traj = out["trajectory"]
     names = [c for c in traj if f"{c}_dot" in traj][:4]
@@ -704,15 +725,17 @@ def plot(plt, a: dict, path) -> list:
     internals = [] if names else list(out["amplitude"])[:4]
     if len(internals) > 1:
         pairs = [(internals[0], internals[1])]
-    fig, axes = plt.subplots(1, 2, figsize=(9, 3.6))
+    fig, axes = plt.subplots(1, 2 if pairs else 1, figsize=(9 if pairs else 5.5, 3.6), squeeze=False)
+    axes = axes[0]
     for c in names or internals:
         axes[0].plot(out["t"], traj[c], label=c)
     for x, y in pairs:
         axes[1].plot(traj[x], traj[y], label=x if names else None)
     axes[0].set_xlabel("t (s, or the model's time unit)")
-    axes[0].set_ylabel("coordinates" if names else "internal variables")
-    axes[1].set_xlabel("q" if names else pairs[0][0] if pairs else "")
-    axes[1].set_ylabel("dq/dt" if names else pairs[0][1] if pairs else "")
+    axes[0].set_ylabel("coordinates" if names else "internal variables" if len(internals) != 1 else internals[0])
+    if pairs:  # a single internal variable has no phase portrait
+        axes[1].set_xlabel("q" if names else pairs[0][0])
+        axes[1].set_ylabel("dq/dt" if names else pairs[0][1])
     for ax in axes if len(names or internals) > 1 else ():
         if ax.get_legend_handles_labels()[0]:
             ax.legend(fontsize="small")

@@ -18,7 +18,9 @@ reported (``grazing``) instead of silently trusted.
 
 :func:`periodic_orbit` finds x0 with x(T) = x0 for a drive of period T (a forced model: the period is the
 drive's) by Newton on r(x0) = x(T; x0) - x0 with r' = Phi - I; the orbit's Floquet multipliers are the
-eigenvalues of Phi there.
+eigenvalues of Phi there. An event at the period's boundary (a stick-slip contact under u = U cos(omega t) reverses
+at t = 0 = T) is accepted: a run that ends in another mode than it started in is continued BOUNDARY = 1e-8 of the
+period past T, and the events there are taken at T, their saltation matrices in Phi (:func:`closing_run`).
 """
 from __future__ import annotations
 
@@ -30,6 +32,9 @@ from mechgen.errors import ConvergenceError
 from mechgen.runtime.integration.events import integrate_hybrid
 from mechgen.runtime.integration.run_options import RunOptions
 
+#: a forced orbit whose run ends in another mode than it started in is closed by the events within this fraction
+#: of the period past its end (an event at the period's boundary: a stick-slip reversal at the drive's extremum)
+BOUNDARY = 1e-8
 #: an event is grazing when |dg/dt| < GRAZING |g_x| |f-| (relative to the guard's and the flow's size)
 GRAZING = 1e-3
 
@@ -75,12 +80,13 @@ def transition(system, mode: int, t0: float, t1: float, x0: np.ndarray, rtol: fl
 
 
 def flow_jacobian(system, x0, T: float, *, mode: int | None = None, rtol: float = 1e-11,
-                  atol: float = 1e-13) -> FlowJacobian:
+                  atol: float = 1e-13, close: bool = False) -> FlowJacobian:
     """x(T) from x0 at t = 0 in ``mode`` (default the initial one) and its Jacobian through the events (module
-    doc)."""
+    doc); ``close``: a run ending in another mode is closed by the events at the period's boundary
+    (:func:`closing_run`)."""
     x0 = np.asarray(x0, float)
     mode = system.initial_mode if mode is None else int(mode)
-    run = flow_run(system, x0, T, mode, rtol, atol)
+    run = closing_run(system, x0, T, mode, rtol, atol) if close else flow_run(system, x0, T, mode, rtol, atol)
     if run.terminated:
         raise ConvergenceError(f"the run from t = 0 ended at a terminal event at t = {run.t_final:.10g} before "
                                f"T = {T:.10g}: the flow map over the period is undefined there")
@@ -90,14 +96,15 @@ def flow_jacobian(system, x0, T: float, *, mode: int | None = None, rtol: float 
         phi = transition(system, current, t, event.t, x, rtol, atol) @ phi
         k = guard_index(system, current, event.guard)
         S = system.saltation(current, k, event.t, event.x_before)
-        if _grazes(system, current, k, event):
+        if grazes(system, current, k, event):
             grazing.append(i)
         saltations.append(S)
         phi = S @ phi
         t, x = event.t, np.asarray(event.x_after, float)
         current = event.target if event.target is not None else current
     phi = transition(system, current, t, T, x, rtol, atol) @ phi
-    return FlowJacobian(np.asarray(run.x_final, float), phi, tuple(run.events), tuple(saltations), run.final_mode,
+    x_end = x if run.events and run.events[-1].t > T else np.asarray(run.x_final, float)
+    return FlowJacobian(x_end, phi, tuple(run.events), tuple(saltations), run.final_mode,
                         tuple(grazing))
 
 
@@ -107,14 +114,30 @@ def flow_run(system, x0: np.ndarray, T: float, mode: int, rtol: float, atol: flo
                                                                          t_eval=np.array([T]), progress=False))
 
 
-def flow_map(system, x0, T: float, *, mode: int | None = None, rtol: float = 1e-11, atol: float = 1e-13):
-    """(x(T), the mode it ends in) from x0 at t = 0 (no Jacobian)."""
+def closing_run(system, x0: np.ndarray, T: float, mode: int, rtol: float, atol: float):
+    """The run from x0 in ``mode`` over T; when it ends in another mode, the run over T (1 + BOUNDARY) if that one
+    ends in ``mode``: the events within BOUNDARY T past T are taken to be at the period's boundary (the state after
+    the last of them stands for x(T), off by |dx/dt| (t_event - T) at most; a stick-slip reversal at the drive's
+    extremum falls within round-off of T)."""
+    run = flow_run(system, x0, T, mode, rtol, atol)
+    if run.final_mode == mode:
+        return run
+    longer = flow_run(system, x0, T * (1.0 + BOUNDARY), mode, rtol, atol)
+    return longer if longer.final_mode == mode else run
+
+
+def flow_map(system, x0, T: float, *, mode: int | None = None, rtol: float = 1e-11, atol: float = 1e-13,
+             close: bool = False):
+    """(x(T), the mode it ends in) from x0 at t = 0 (no Jacobian; ``close`` as :func:`flow_jacobian`'s)."""
     mode = system.initial_mode if mode is None else int(mode)
-    run = flow_run(system, np.asarray(x0, float), T, mode, rtol, atol)
+    x0 = np.asarray(x0, float)
+    run = closing_run(system, x0, T, mode, rtol, atol) if close else flow_run(system, x0, T, mode, rtol, atol)
+    if run.events and run.events[-1].t > T:
+        return np.asarray(run.events[-1].x_after, float), run.final_mode
     return np.asarray(run.x_final, float), run.final_mode
 
 
-def _grazes(system, mode: int, k: int, event) -> bool:
+def grazes(system, mode: int, k: int, event) -> bool:
     """Whether the event's |dg/dt| is below GRAZING |g_x| |f-| (module doc)."""
     n = system.n
     x = np.asarray(event.x_before, float)
@@ -150,7 +173,7 @@ def periodic_orbit(system, x0, T: float, *, mode: int | None = None, tol: float 
     mode = system.initial_mode if mode is None else int(mode)
     scale = 1.0 + np.linalg.norm(x)
     for it in range(1, max_iter + 1):
-        fj = flow_jacobian(system, x, T, mode=mode, rtol=rtol, atol=atol)
+        fj = flow_jacobian(system, x, T, mode=mode, rtol=rtol, atol=atol, close=True)
         r = fj.x - x
         if fj.mode != mode:
             raise ConvergenceError(f"the orbit guess ends its period in mode {system.modes[fj.mode]}, not "

@@ -45,7 +45,7 @@ class OrbitFamily:
                 self.memo.clear()
             moved = self.system.with_params(**{self.name: float(p)})
             self.memo[key] = flow_jacobian(moved, np.asarray(x0, float), periods * self.period(float(p)),
-                                           mode=self.mode, rtol=self.rtol, atol=self.atol)
+                                           mode=self.mode, rtol=self.rtol, atol=self.atol, close=True)
         return self.memo[key]
 
     def residual(self, x0, p) -> np.ndarray:
@@ -54,7 +54,8 @@ class OrbitFamily:
         if key in self.memo:
             return self.memo[key].x - np.asarray(x0, float)
         moved = self.system.with_params(**{self.name: float(p)})
-        x, _ = flow_map(moved, x0, self.period(float(p)), mode=self.mode, rtol=self.rtol, atol=self.atol)
+        x, _ = flow_map(moved, x0, self.period(float(p)), mode=self.mode, rtol=self.rtol, atol=self.atol,
+                        close=True)
         return x - np.asarray(x0, float)
 
     def equations(self) -> ParametricEquations:

@@ -236,6 +236,110 @@ int mg_tangent__3(const double *const *in, double *const *out, const long *sizes
     return 0;
 }
 
+/* flow__0: r at a = 0 and M = dr/da (dx/dt = (v, -M^-1 r))
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  z: length 1 per state
+ *   in[3]  t: length 1 per state
+ *   in[4]  p: length 0
+ *   out[0] r: length 0 per state shape (0, 1)
+ *   out[1] M: length 0 per state shape (0, 0)
+ */
+int mg_flow__0(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    (void)in;
+    const long len_out0 = 0;
+    const long len_out1 = 0;
+    for (long b = 0; b < nbatch; ++b) {
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        double *const out1 = out[1] + b * len_out1;
+        for (long i = 0; i < len_out1; ++i) out1[i] = 0.0;
+        {
+        }
+    }
+    return 0;
+}
+
+/* flow__1: r at a = 0 and M = dr/da (dx/dt = (v, -M^-1 r))
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  z: length 1 per state
+ *   in[3]  t: length 1 per state
+ *   in[4]  p: length 0
+ *   out[0] r: length 0 per state shape (0, 1)
+ *   out[1] M: length 0 per state shape (0, 0)
+ */
+int mg_flow__1(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    (void)in;
+    const long len_out0 = 0;
+    const long len_out1 = 0;
+    for (long b = 0; b < nbatch; ++b) {
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        double *const out1 = out[1] + b * len_out1;
+        for (long i = 0; i < len_out1; ++i) out1[i] = 0.0;
+        {
+        }
+    }
+    return 0;
+}
+
+/* flow__2: r at a = 0 and M = dr/da (dx/dt = (v, -M^-1 r))
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  z: length 1 per state
+ *   in[3]  t: length 1 per state
+ *   in[4]  p: length 0
+ *   out[0] r: length 0 per state shape (0, 1)
+ *   out[1] M: length 0 per state shape (0, 0)
+ */
+int mg_flow__2(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    (void)in;
+    const long len_out0 = 0;
+    const long len_out1 = 0;
+    for (long b = 0; b < nbatch; ++b) {
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        double *const out1 = out[1] + b * len_out1;
+        for (long i = 0; i < len_out1; ++i) out1[i] = 0.0;
+        {
+        }
+    }
+    return 0;
+}
+
+/* flow__3: r at a = 0 and M = dr/da (dx/dt = (v, -M^-1 r))
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  z: length 1 per state
+ *   in[3]  t: length 1 per state
+ *   in[4]  p: length 0
+ *   out[0] r: length 0 per state shape (0, 1)
+ *   out[1] M: length 0 per state shape (0, 0)
+ */
+int mg_flow__3(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    (void)in;
+    const long len_out0 = 0;
+    const long len_out1 = 0;
+    for (long b = 0; b < nbatch; ++b) {
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        double *const out1 = out[1] + b * len_out1;
+        for (long i = 0; i < len_out1; ++i) out1[i] = 0.0;
+        {
+        }
+    }
+    return 0;
+}
+
 /* rates__0: internal rates dz/dt
  *   in[0]  q: length 0 per state
  *   in[1]  v: length 0 per state
@@ -680,6 +784,258 @@ int mg_outputs__3(const double *const *in, double *const *out, const long *sizes
             const double t0 = cos(g1);
             out1[0] = t0;
             out4[0] = -g0 + t0;
+        }
+    }
+    return 0;
+}
+
+/* guard_jacobian__0: dg/dx of the guards leaving mode 0
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  z: length 1 per state
+ *   in[3]  t: length 1 per state
+ *   in[4]  p: length 0
+ *   out[0] g_x: length 3 per state shape (3, 1)
+ */
+int mg_guard_jacobian__0(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    (void)in;
+    const long len_out0 = 3;
+    for (long b = 0; b < nbatch; ++b) {
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        {
+            out0[0] = 1.0;
+            out0[1] = 1.0;
+        }
+    }
+    return 0;
+}
+
+/* guard_jacobian__1: dg/dx of the guards leaving mode 1
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  z: length 1 per state
+ *   in[3]  t: length 1 per state
+ *   in[4]  p: length 0
+ *   out[0] g_x: length 2 per state shape (2, 1)
+ */
+int mg_guard_jacobian__1(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    (void)in;
+    const long len_out0 = 2;
+    for (long b = 0; b < nbatch; ++b) {
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        {
+        }
+    }
+    return 0;
+}
+
+/* guard_jacobian__2: dg/dx of the guards leaving mode 2
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  z: length 1 per state
+ *   in[3]  t: length 1 per state
+ *   in[4]  p: length 0
+ *   out[0] g_x: length 2 per state shape (2, 1)
+ */
+int mg_guard_jacobian__2(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    (void)in;
+    const long len_out0 = 2;
+    for (long b = 0; b < nbatch; ++b) {
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        {
+        }
+    }
+    return 0;
+}
+
+/* guard_jacobian__3: dg/dx of the guards leaving mode 3
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  z: length 1 per state
+ *   in[3]  t: length 1 per state
+ *   in[4]  p: length 0
+ *   out[0] g_x: length 1 per state shape (1, 1)
+ */
+int mg_guard_jacobian__3(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    (void)in;
+    const long len_out0 = 1;
+    for (long b = 0; b < nbatch; ++b) {
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        {
+        }
+    }
+    return 0;
+}
+
+/* reset_jacobian__0: dx+/dx and dx+/dt of reset 0
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  z: length 1 per state
+ *   in[3]  t: length 1 per state
+ *   in[4]  p: length 0
+ *   out[0] R_x: length 1 per state shape (1, 1)
+ *   out[1] R_t: length 1 per state shape (1, 1)
+ */
+int mg_reset_jacobian__0(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    (void)in;
+    const long len_out0 = 1;
+    const long len_out1 = 1;
+    for (long b = 0; b < nbatch; ++b) {
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        double *const out1 = out[1] + b * len_out1;
+        for (long i = 0; i < len_out1; ++i) out1[i] = 0.0;
+        {
+        }
+    }
+    return 0;
+}
+
+/* reset_jacobian__1: dx+/dx and dx+/dt of reset 1
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  z: length 1 per state
+ *   in[3]  t: length 1 per state
+ *   in[4]  p: length 0
+ *   out[0] R_x: length 1 per state shape (1, 1)
+ *   out[1] R_t: length 1 per state shape (1, 1)
+ */
+int mg_reset_jacobian__1(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    const long len_in2 = 1;
+    const long len_out0 = 1;
+    const long len_out1 = 1;
+    for (long b = 0; b < nbatch; ++b) {
+        const double *const in2 = in[2] + b * len_in2;
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        double *const out1 = out[1] + b * len_out1;
+        for (long i = 0; i < len_out1; ++i) out1[i] = 0.0;
+        {
+            const double g0 = in2[0];
+            out0[0] = 1.0 - 1.4210854715202004e-14*(((g0) > 0) - ((g0) < 0));
+        }
+    }
+    return 0;
+}
+
+/* reset_jacobian__2: dx+/dx and dx+/dt of reset 2
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  z: length 1 per state
+ *   in[3]  t: length 1 per state
+ *   in[4]  p: length 0
+ *   out[0] R_x: length 1 per state shape (1, 1)
+ *   out[1] R_t: length 1 per state shape (1, 1)
+ */
+int mg_reset_jacobian__2(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    (void)in;
+    const long len_out0 = 1;
+    const long len_out1 = 1;
+    for (long b = 0; b < nbatch; ++b) {
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        double *const out1 = out[1] + b * len_out1;
+        for (long i = 0; i < len_out1; ++i) out1[i] = 0.0;
+        {
+        }
+    }
+    return 0;
+}
+
+/* reset_jacobian__3: dx+/dx and dx+/dt of reset 3
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  z: length 1 per state
+ *   in[3]  t: length 1 per state
+ *   in[4]  p: length 0
+ *   out[0] R_x: length 1 per state shape (1, 1)
+ *   out[1] R_t: length 1 per state shape (1, 1)
+ */
+int mg_reset_jacobian__3(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    const long len_in2 = 1;
+    const long len_out0 = 1;
+    const long len_out1 = 1;
+    for (long b = 0; b < nbatch; ++b) {
+        const double *const in2 = in[2] + b * len_in2;
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        double *const out1 = out[1] + b * len_out1;
+        for (long i = 0; i < len_out1; ++i) out1[i] = 0.0;
+        {
+            const double g0 = in2[0];
+            out0[0] = 1.4210854715202004e-14*(((g0) > 0) - ((g0) < 0)) + 1.0;
+        }
+    }
+    return 0;
+}
+
+/* reset_jacobian__4: dx+/dx and dx+/dt of reset 4
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  z: length 1 per state
+ *   in[3]  t: length 1 per state
+ *   in[4]  p: length 0
+ *   out[0] R_x: length 1 per state shape (1, 1)
+ *   out[1] R_t: length 1 per state shape (1, 1)
+ */
+int mg_reset_jacobian__4(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    (void)in;
+    const long len_out0 = 1;
+    const long len_out1 = 1;
+    for (long b = 0; b < nbatch; ++b) {
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        double *const out1 = out[1] + b * len_out1;
+        for (long i = 0; i < len_out1; ++i) out1[i] = 0.0;
+        {
+        }
+    }
+    return 0;
+}
+
+/* reset_jacobian__5: dx+/dx and dx+/dt of reset 5
+ *   in[0]  q: length 0 per state
+ *   in[1]  v: length 0 per state
+ *   in[2]  z: length 1 per state
+ *   in[3]  t: length 1 per state
+ *   in[4]  p: length 0
+ *   out[0] R_x: length 1 per state shape (1, 1)
+ *   out[1] R_t: length 1 per state shape (1, 1)
+ */
+int mg_reset_jacobian__5(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    (void)in;
+    const long len_out0 = 1;
+    const long len_out1 = 1;
+    for (long b = 0; b < nbatch; ++b) {
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        double *const out1 = out[1] + b * len_out1;
+        for (long i = 0; i < len_out1; ++i) out1[i] = 0.0;
+        {
         }
     }
     return 0;
