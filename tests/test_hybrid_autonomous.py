@@ -24,6 +24,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import mechgen
+from mechgen.cli import main
 from mechgen.errors import InputError
 from mechgen.runtime.integration.hybrid_autonomous import return_map
 
@@ -239,3 +240,21 @@ def test_a_short_period_guess_is_corrected_by_the_settling_run(belt):
     bounded at 3 periods, runs past the real return."""
     out = mechgen.periodic_orbit(belt, period=1.0, section="breakaway")
     assert out["period"] == pytest.approx(coulomb_cycle(**P)[0], rel=1e-8, abs=0)  # as the closed-form test
+
+
+def test_a_parameter_named_amplitude_keeps_the_orbit_amplitude(tmp_path):
+    """Continued in the contact's forcing ``amplitude`` U (a model parameter whose name is also a branch output):
+    each point carries U under ``amplitude`` and the orbit's max |f| under ``orbit_amplitude``, which stays
+    mu N = 0.3 (the slider saturates while k_u U > mu N) as U grows; the figure draws it."""
+    scene = tmp_path / "jenkins.toml"
+    scene.write_text('model = "stick_slip_contact"\nbackend = "c"\n[[analysis]]\nname = "orbit"\n'
+                     'kind = "periodic_orbit"\nfrequency = "omega"\n[[analysis]]\nname = "in_U"\n'
+                     'kind = "continuation"\nabout = "orbit"\nparameter = "amplitude"\nstop = 2.0\n'
+                     'max_step = 0.3\n')
+    out = mechgen.run(str(scene))["analyses"][1]["outputs"]
+    us = [point["amplitude"] for point in out["branch"]]
+    assert us[0] == pytest.approx(1.0) and us[-1] == pytest.approx(2.0) and us == sorted(us)
+    for point in out["branch"]:
+        assert point["orbit_amplitude"]["f"] == pytest.approx(0.3, rel=1e-8)
+    assert main(["run", str(scene), "--plot", str(tmp_path / "figures")]) == 0
+    assert (tmp_path / "figures" / "jenkins_in_U.png").stat().st_size > 0

@@ -573,13 +573,14 @@ def _orbit_branch(plt, a: dict, path: Path) -> bool:
     dashed), its cyclic folds, period doublings and torus points marked."""
     out = a["outputs"]
     points = out.get("branch") or []
-    if not points or not isinstance(points[0].get("amplitude"), dict):
+    key = "orbit_amplitude" if points and "orbit_amplitude" in points[0] else "amplitude"  # a parameter "amplitude"
+    if not points or not isinstance(points[0].get(key), dict):
         return False
     name = out["parameter"]
     fig, ax = plt.subplots(figsize=(7, 5))
-    for coordinate in points[0]["amplitude"]:
+    for coordinate in points[0][key]:
         lam = np.array([p[name] for p in points])
-        amp = np.array([p["amplitude"][coordinate] for p in points])
+        amp = np.array([p[key][coordinate] for p in points])
         for style, label in (("-", "stable"), ("--", "unstable")):
             mask = np.array([p["stability"] == label for p in points])
             if not mask.any():
@@ -587,14 +588,14 @@ def _orbit_branch(plt, a: dict, path: Path) -> bool:
             mask[:-1] |= mask[1:]  # each run of points joined to its neighbours: no gap where stability changes
             shown = np.where(mask, amp, np.nan)
             ax.plot(lam, shown, style, lw=1.2, label=f"{coordinate}, {label}")
-        doubled = [d for d in out.get("doubled", []) if coordinate in d.get("amplitude", {})]
+        doubled = [d for d in out.get("doubled", []) if coordinate in d.get(key, {})]
         if doubled:
-            ax.plot([d[name] for d in doubled], [d["amplitude"][coordinate] for d in doubled], "o", mfc="none",
+            ax.plot([d[name] for d in doubled], [d[key][coordinate] for d in doubled], "o", mfc="none",
                     color="tab:purple", label=f"{coordinate}, doubled orbit (period 2T)")
         for special in out.get("special_points", []):
-            ax.plot(special[name], special["amplitude"][coordinate], _ORBIT_MARKS.get(special["type"], "o"), ms=7,
+            ax.plot(special[name], special[key][coordinate], _ORBIT_MARKS.get(special["type"], "o"), ms=7,
                     mfc="none", color="k")
-            ax.annotate(special["type"], (special[name], special["amplitude"][coordinate]), fontsize=7,
+            ax.annotate(special["type"], (special[name], special[key][coordinate]), fontsize=7,
                         xytext=(5, 4), textcoords="offset points")
     ax.set_xlabel(figures.labelled(a, name))
     ax.set_ylabel("amplitude max |q| over the period")

@@ -30,6 +30,7 @@ from __future__ import annotations
 import numpy as np
 
 from mechgen.analyses import time_series
+from mechgen.analyses.branch_points import branch_point
 from mechgen.errors import SceneError
 from mechgen.runtime.integration.events import integrate_hybrid
 from mechgen.runtime.integration.hybrid_monodromy import periodic_orbit
@@ -243,11 +244,10 @@ def section_record(family, x: np.ndarray) -> dict:
     fine, _ = orbit_states(family.moved(p), x0, T, T * np.arange(1024) / 1024, family.rtol, family.atol,
                            family.mode)
     mu = floquet.multipliers(rm.monodromy)
-    return {family.name: p, "period": T, "frequency": 2 * np.pi / T,
-            "amplitude": amplitudes(family.system, fine, T, rm.events),
-            "start": start_state(family.system, x0),
-            "multipliers": floquet.as_pairs(mu), "stability": floquet.stability(mu, True),
-            "events_per_period": len(rm.events)}
+    return branch_point(family.name, p, {
+        "period": T, "frequency": 2 * np.pi / T, "amplitude": amplitudes(family.system, fine, T, rm.events),
+        "start": start_state(family.system, x0), "multipliers": floquet.as_pairs(mu),
+        "stability": floquet.stability(mu, True), "events_per_period": len(rm.events)})
 
 
 def hybrid_record(family, x: np.ndarray) -> dict:
@@ -258,11 +258,10 @@ def hybrid_record(family, x: np.ndarray) -> dict:
     moved = family.system.with_params(**{family.name: p})
     fine, _ = orbit_states(moved, x0, T, T * np.arange(1024) / 1024, family.rtol, family.atol)
     mu = floquet.multipliers(family.flow(x0, p).phi)
-    return {family.name: p, "period": T, "frequency": 2 * np.pi / T,
-            "amplitude": amplitudes(family.system, fine, T, family.flow(x0, p).events),
-            "start": start_state(family.system, x0),
-            "multipliers": floquet.as_pairs(mu), "stability": floquet.stability(mu, False),
-            "events_per_period": len(family.flow(x0, p).events)}
+    return branch_point(family.name, p, {
+        "period": T, "frequency": 2 * np.pi / T, "amplitude": amplitudes(family.system, fine, T, family.flow(x0, p).events),
+        "start": start_state(family.system, x0), "multipliers": floquet.as_pairs(mu),
+        "stability": floquet.stability(mu, False), "events_per_period": len(family.flow(x0, p).events)})
 
 
 def doubled_record(family, X: np.ndarray, x_pd: np.ndarray, index: int, at: int) -> dict:
@@ -276,7 +275,7 @@ def doubled_record(family, X: np.ndarray, x_pd: np.ndarray, index: int, at: int)
     fine, _ = orbit_states(family.system.with_params(**{family.name: p}), orbit.x0, orbit.period,
                            orbit.period * np.arange(1024) / 1024, family.rtol, family.atol)
     mu = orbit.multipliers
-    return {"at": at, family.name: p, "amplitude": amplitudes(family.system, fine, orbit.period, orbit.events),
-            "period": orbit.period, "start": start_state(family.system, orbit.x0),
-            "multipliers": floquet.as_pairs(mu), "stability": floquet.stability(mu, False),
-            "events_per_period": len(orbit.events)}
+    return branch_point(family.name, p, {
+        "at": at, "amplitude": amplitudes(family.system, fine, orbit.period, orbit.events), "period": orbit.period,
+        "start": start_state(family.system, orbit.x0), "multipliers": floquet.as_pairs(mu),
+        "stability": floquet.stability(mu, False), "events_per_period": len(orbit.events)})

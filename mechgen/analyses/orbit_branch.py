@@ -25,6 +25,8 @@ orbit just past every PD point, by the orbit's own method: shooting over 2T from
 the eigenvector of the multiplier -1; harmonic balance with 2H harmonics of omega / 2 (the period-T orbit's
 harmonics are the even ones) and collocation on the mesh repeated over [0, 2T], each from the period-T orbit plus
 the perturbation Phi(t) v over [0, 2T] (v that eigenvector: Phi(t + T) v = -Phi(t) v, odd harmonics of omega / 2).
+A continued parameter whose name is also an output's (the stick-slip contact's forcing ``amplitude``) keeps its
+name; the output is then ``orbit_<name>`` (mechgen.analyses.branch_points).
 
 About an autonomous hybrid orbit (a ``periodic_orbit`` without frequency on a hybrid model, its phase fixed by its
 ``section``) the branch is that of the return map's fixed points (mechgen.analyses.hybrid_orbit.run_section_branch:
@@ -40,6 +42,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from mechgen.analyses.branch_points import branch_point
 from mechgen.analyses.hybrid_orbit import run_hybrid_branch
 from mechgen.analyses.newton_branch import arclength_steps
 from mechgen.analyses.periodic_orbit import DEFAULT_HARMONICS, compiled_run, integrator_tolerances, peak
@@ -202,9 +205,10 @@ def record(orbits: Orbits, branch: OrbitBranch, u: np.ndarray, p: float) -> dict
     internals = state_names(system)[2 * system.n:]
     start = dict(zip(names + [f"{c}_dot" for c in names] + internals, (float(v) for v in X[0])))
     columns = list(range(system.n)) + list(range(2 * system.n, 2 * system.n + system.m))
-    return {orbits.name: float(p), "period": T, "frequency": float(2 * np.pi / T),
-            "amplitude": {c: peak(X[:, i]) for c, i in zip(names + internals, columns)}, "start": start,
-            "multipliers": floquet.as_pairs(mu), "stability": floquet.stability(mu, orbits.autonomous)}
+    return branch_point(orbits.name, p, {
+        "period": T, "frequency": float(2 * np.pi / T),
+        "amplitude": {c: peak(X[:, i]) for c, i in zip(names + internals, columns)}, "start": start,
+        "multipliers": floquet.as_pairs(mu), "stability": floquet.stability(mu, orbits.autonomous)})
 
 
 def run_orbit_branch(system, options: dict, earlier: dict) -> dict:
@@ -335,9 +339,10 @@ def no_doubled(orbits: Orbits, p: float, method: str):
 def doubled_outputs(orbits: Orbits, p: float, T2: float, X: np.ndarray, mu: np.ndarray, at: int) -> dict:
     """The record of a doubled orbit: its states X at PHASES phases of [0, 2T], its multipliers mu."""
     names = list(orbits.system.coordinates)
-    return {"at": at, orbits.name: p, "period": T2, "amplitude": {c: peak(X[:, i]) for i, c in enumerate(names)},
-            "start": dict(zip(names + [f"{c}_dot" for c in names], (float(c) for c in X[0]))),
-            "multipliers": floquet.as_pairs(mu), "stability": floquet.stability(mu, False)}
+    return branch_point(orbits.name, p, {
+        "at": at, "period": T2, "amplitude": {c: peak(X[:, i]) for i, c in enumerate(names)},
+        "start": dict(zip(names + [f"{c}_dot" for c in names], (float(c) for c in X[0]))),
+        "multipliers": floquet.as_pairs(mu), "stability": floquet.stability(mu, False)})
 
 
 def flow_of(orbits: Orbits, system, x0: np.ndarray, times: np.ndarray) -> np.ndarray:
