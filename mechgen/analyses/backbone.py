@@ -9,8 +9,8 @@ on the unfolded equations: the backbone curve, frequency against amplitude. With
 orbit of the earlier level as the parameter moves. Each branch point reports, beside a branch of orbits' outputs
 (mechgen.analyses.orbit_branch: ``period``, ``frequency``, ``amplitude``, ``start``, ``multipliers``,
 ``stability``), the orbit's ``energy`` (E = T + V, the model's ``energy`` output) and ``unfolding`` (eps, zero to
-the corrector's tolerance on each orbit of the family); a point's level is its ``start[<coordinate p>]`` (the
-point's key ``amplitude`` keeps its meaning, {coordinate: max |q|}). ``stability`` sets aside the two multipliers
+the corrector's tolerance on each orbit of the family); along the family a point's level, q_p(0), is its
+``level`` (also its ``start[<coordinate p>]``; the key ``amplitude`` keeps its meaning, {coordinate: max |q|}). ``stability`` sets aside the two multipliers
 nearest 1 (along the orbit and along the family). ``backbone`` gathers the branch as columns: ``frequency``, ``period``,
 ``amplitude`` ({coordinate: max |q|}), ``energy``, ``unfolding``. Special points: ``LPC`` (the level turns) and
 ``PD``; NS is not sought (the multipliers of a conservative orbit come in pairs mu, 1/mu, so its test function
@@ -76,6 +76,9 @@ def family_record(orbits: FamilyOrbits, branch: OrbitBranch, u: np.ndarray, p: f
     """One branch point (module doc): a branch of orbits' record with ``energy``, ``unfolding`` and the stability
     of a conservative orbit."""
     out = record(orbits, branch, u, p)
+    if orbits.family:  # the family's own level, q_p(0): ``level``; ``amplitude`` stays the orbit's max |q|
+        out["level"] = out.pop(orbits.name)
+        out["amplitude"] = out.pop(f"orbit_{orbits.name}")
     mu = orbits.multipliers(branch.problem(p), u, p)
     problem = branch.problem(p)
     x0 = problem.split(u)[0] if orbits.method == "shooting" else orbits.states(problem, u, np.array([0.0]))[0]
