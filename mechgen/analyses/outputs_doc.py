@@ -208,7 +208,9 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
            "orbit's frequency 2 pi / T, period, ``amplitude`` (max \\|q\\| per coordinate), ``energy`` (T + V, the "
            "model's ``energy`` output) and ``unfolding`` (the Munoz-Almaraz parameter eps, zero to the corrector's "
            "tolerance); the points of ``branch`` carry ``energy`` and ``unfolding`` too. With ``parameter = "
-           "\"amplitude\"`` the backbone curve (frequency against amplitude)."),
+           "\"amplitude\"`` the backbone curve (frequency against amplitude), each point's ``level`` its "
+           "q_p(0). A continued model parameter whose name is an output's keeps its name; that output is then "
+           "``orbit_<name>``."),
         _o("curve", "list of {<first>, <second>, coordinates, ..., frequency}", "the outputs'", "With "
            "``special_point`` (``about`` an earlier continuation): the curve of its LP or H in two parameters, "
            "one entry per point with both parameters, ``coordinates``, the model's outputs and, on an H curve, "
