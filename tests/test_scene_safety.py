@@ -633,6 +633,14 @@ def test_a_hybrid_event_store_past_the_memory_is_refused(tmp_path, capsys, monke
     assert _run(["run", str(scene)], capsys)[0] == 0
 
 
+def periodic_scene() -> str:
+    """scenes/stick_slip_element.toml up to and including its hybrid ``periodic`` analysis (its first), so that keys
+    appended to the text land in that analysis's table."""
+    head, periodic = (SCENES_DIR / "stick_slip_element.toml").read_text().split("[[analysis]]")[:2]
+    assert 'kind = "periodic"' in periodic
+    return head + "[[analysis]]" + periodic.rstrip() + "\n"
+
+
 @pytest.mark.parametrize("extra, key", [("max_events = 1000000000", "analysis[1].max_events"),
                                         ("zeno_events = 20000", "analysis[1].zeno_events"),
                                         ("max_events = 1000000000\nmax_steps = 1000000000", "max_events")])
@@ -640,7 +648,7 @@ def test_periodic_event_limits_are_bounded_up_front(tmp_path, capsys, extra, key
     """The hybrid periodic kind refuses max_events above its step budget (default 10^5 steps) and zeno_events above
     max_events at load, as simulate does, and an event store past the memory before it runs."""
     scene = tmp_path / "loop.toml"
-    scene.write_text((SCENES_DIR / "stick_slip_element.toml").read_text() + extra + "\n")
+    scene.write_text(periodic_scene() + extra + "\n")
     code, err = _run(["run", str(scene)], capsys)
     assert code == 2 and f"at key '{key}'" in err, err
 
@@ -649,7 +657,7 @@ def test_periodic_keeps_running_with_few_events(tmp_path, capsys):
     """max_events = 50 alone is not refused for the default zeno_events (100): only a zeno_events the scene wrote
     is compared with max_events (the loop has a handful of events a period)."""
     scene = tmp_path / "loop.toml"
-    scene.write_text((SCENES_DIR / "stick_slip_element.toml").read_text() + "max_events = 50\n")
+    scene.write_text(periodic_scene() + "max_events = 50\n")
     code, err = _run(["run", str(scene)], capsys)
     assert code == 0 or "max_events" in err, err
 
