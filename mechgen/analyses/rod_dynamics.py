@@ -33,6 +33,7 @@ Newton iteration fails even when split 12 times is a ConvergenceError naming the
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -42,9 +43,11 @@ from mechgen.analyses.rod_statics import AXES, MAX_ELEMENTS, bounded, rod_of, ve
 from mechgen.analyses.schema import Option
 from mechgen.errors import InputError
 from mechgen.runtime.core.memory import require
-from mechgen.runtime.rods.dynamics import ENDS, Discrete, RodBody, check_inertia, reference_state, simulate
-from mechgen.runtime.rods.liegroup import orthonormality_error
+from mechgen.runtime.rods.ends import ENDS
 from mechgen.scene.values import fail
+
+if TYPE_CHECKING:
+    from mechgen.runtime.rods.dynamics import RodBody
 
 #: memory per element of a step (the Newton system's sparse Jacobian and factors, the saved shapes), bytes:
 #: measured 25 KB/element between 1 000 and 4 000 elements (peak RSS 110 MB -> 183 MB), with a margin
@@ -128,6 +131,8 @@ def needs(options: dict, *, internal: bool) -> set[str]:
 
 def body_of(system, options: dict) -> RodBody:
     """The runtime RodBody: the statics Rod (stiffness, loads, ends) with the rod kernel's M and the damping."""
+    from mechgen.runtime.rods.dynamics import RodBody, check_inertia  # loaded with a rod scene only
+
     opts = dict(options)
     opts.setdefault("base", "clamped")
     opts.setdefault("tip", "free")
@@ -144,6 +149,8 @@ def body_of(system, options: dict) -> RodBody:
 
 def initial_state(body: RodBody, elements: int, v0, w0):
     """The reference configuration moving rigidly: v(s) = v0 + w0 x r(s), body rates R^T w0."""
+    from mechgen.runtime.rods.dynamics import reference_state
+
     st = reference_state(body, elements)
     v0, w0 = np.asarray(v0, dtype=float), np.asarray(w0, dtype=float)
     st.v = v0[None, :] + np.cross(w0[None, :], st.x)
@@ -153,6 +160,9 @@ def initial_state(body: RodBody, elements: int, v0, w0):
 
 def run_rod_dynamics(system, options: dict, context: dict) -> dict:
     """March the midpoint step; the saved tip path and energies and the final fields."""
+    from mechgen.runtime.rods.dynamics import Discrete, simulate
+    from mechgen.runtime.rods.liegroup import orthonormality_error
+
     body = body_of(system, options)
     n = options["elements"]
     require(ELEMENT_BYTES * n, f"rod dynamics with {n} elements", key="elements",

@@ -30,6 +30,7 @@ does not converge is a ConvergenceError naming the last load factor reached (exi
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -39,9 +40,11 @@ from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import Option
 from mechgen.errors import InputError
 from mechgen.runtime.core.memory import require
-from mechgen.runtime.rods.liegroup import orthonormality_error
-from mechgen.runtime.rods.statics import ENDS, UNCONSTRAINED, Rod, solve_statics, turning_angle
+from mechgen.runtime.rods.ends import ENDS, UNCONSTRAINED
 from mechgen.scene.values import fail, show, type_name
+
+if TYPE_CHECKING:
+    from mechgen.runtime.rods.statics import Rod
 
 AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
 
@@ -122,6 +125,8 @@ def needs(options: dict, *, internal: bool) -> set[str]:
 
 def rod_of(system, options: dict) -> Rod:
     """The runtime Rod from the system's ``rod`` kernel and the analysis's ends and tip loads."""
+    from mechgen.runtime.rods.statics import Rod  # the rod solvers (and scipy.sparse) load with a rod scene
+
     if "rod" not in system.kernels:
         raise InputError(f"model {system.metadata.model} declares no rod (the rod_statics analysis needs one)",
                          key="kind", expected="a model with Model.rod(...), or another analysis kind")
@@ -182,6 +187,8 @@ def _check_spd(system, K: np.ndarray) -> None:
 
 
 def _point(rod: Rod, state, axis) -> dict:
+    from mechgen.runtime.rods.statics import turning_angle
+
     return {"load": float(state.lam), "tip_force": [float(state.lam * x) for x in rod.tip_force],
             "tip_torque": [float(state.lam * x) for x in rod.tip_torque],
             "tip_position": [float(x) + 0.0 for x in state.H[-1, :3, 3]],
@@ -191,6 +198,9 @@ def _point(rod: Rod, state, axis) -> dict:
 
 def run_rod_statics(system, options: dict, context: dict) -> dict:
     """Solve along the load path; the final state's tip pose and fields, and the branch."""
+    from mechgen.runtime.rods.liegroup import orthonormality_error
+    from mechgen.runtime.rods.statics import solve_statics, turning_angle
+
     rod = rod_of(system, options)
     require(ELEMENT_BYTES * options["elements"], f"rod statics ({options['method']}) with {options['elements']} "
             "elements", key="elements", expected="fewer elements (the midpoint collocation converges at order 2: "

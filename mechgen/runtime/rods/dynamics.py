@@ -61,8 +61,8 @@ from scipy.linalg import lapack
 from mechgen.errors import ConvergenceError
 from mechgen.runtime.rods.liegroup import cross3, exp_so3, hat3, jac_left_so3, jac_left_so3_inv, log_so3
 from mechgen.runtime.rods.statics import Rod
+from mechgen.runtime.rods.ends import ENDS
 
-ENDS = ("clamped", "pinned", "free")
 #: band half-width of the node-major Jacobian: a node's 6 equations reach the 6 unknowns of each neighbour
 BAND = 11
 log = logging.getLogger("mechgen")

@@ -50,10 +50,9 @@ import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
 from mechgen.errors import ConvergenceError
+from mechgen.runtime.rods.ends import ENDS, UNCONSTRAINED
 from mechgen.runtime.rods.liegroup import coad6, exp_se3, inverse, jac_right_se3, log_se3, log_so3, vee3
 
-ENDS = ("clamped", "pinned", "free")
-UNCONSTRAINED = {("free", "free"), ("pinned", "free"), ("free", "pinned")}
 
 
 @dataclass(frozen=True)
