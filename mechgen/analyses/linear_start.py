@@ -10,19 +10,19 @@ F_k = a_k - i b_k (mechgen.runtime.periodic.fourier). The guess is the linear re
 
 the receptance at the starting frequency (for one harmonic forcing F cos(omega t): (K - omega^2 M + i omega C)^-1 F).
 Harmonics whose forcing is zero (below 1e-12 of the largest) are left out; where a forced harmonic's dynamic
-stiffness is singular (an undamped resonance, condition number above 1e12) the linear response does not exist and
-the start is refused (SceneError at ``start``), as is a singular K under a mean force.
+stiffness is singular (an undamped resonance: mechgen.runtime.linear.harmonic.harmonic_solve's pivot test) the
+linear response does not exist and the start is refused (SceneError at ``start``), as is a singular K under a
+mean force.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from mechgen.errors import SceneError
+from mechgen.errors import ConvergenceError, SceneError
+from mechgen.runtime.linear.harmonic import harmonic_solve
 from mechgen.runtime.periodic import fourier
 from mechgen.runtime.periodic.harmonic_balance import HarmonicBalance
 
-#: a dynamic stiffness with a larger condition number counts as singular
-SINGULAR = 1e12
 #: forcing harmonics below this share of the largest are left out
 NEGLIGIBLE = 1e-12
 
@@ -48,11 +48,13 @@ def singular(what: str, omega: float, k: int) -> SceneError:
                       "resonance (or damping in the model)")
 
 
-def solve_dense(Z: np.ndarray, rhs: np.ndarray, what: str, omega: float, k: int) -> np.ndarray:
-    """Z^-1 rhs, refused (:func:`singular`) when cond(Z) > SINGULAR."""
-    if not np.isfinite(np.linalg.cond(Z)) or np.linalg.cond(Z) > SINGULAR:
-        raise singular(what, omega, k)
-    return np.linalg.solve(Z, rhs)
+def solve_dense(M, C, K, w: float, rhs: np.ndarray, what: str, omega: float, k: int) -> np.ndarray:
+    """(K - w^2 M + i w C)^-1 rhs by the forced response's own solve (mechgen.runtime.linear.harmonic), refused
+    (:func:`singular`) where it finds the dynamic stiffness singular."""
+    try:
+        return harmonic_solve(M, C, K, w, np.asarray(rhs, complex))
+    except ConvergenceError:
+        raise singular(what, omega, k) from None
 
 
 def linear_coefficients(system, omega: float, harmonics: int) -> np.ndarray:
@@ -62,13 +64,12 @@ def linear_coefficients(system, omega: float, harmonics: int) -> np.ndarray:
     U = np.zeros_like(F)
     largest = float(np.max(np.abs(F), initial=0.0))
     if np.max(np.abs(F[0]), initial=0.0) > NEGLIGIBLE * largest:
-        U[0] = solve_dense(K, F[0], "K", omega, 0)
+        U[0] = solve_dense(M, C, K, 0.0, F[0], "K", omega, 0).real
     for k in range(1, H + 1):
         Fk = F[k] - 1j * F[H + k]
         if np.max(np.abs(Fk), initial=0.0) <= NEGLIGIBLE * largest:
             continue
         w = k * omega
-        X = solve_dense(K - w**2 * M + 1j * w * C, Fk.astype(complex), f"K - ({k} omega)^2 M + i {k} omega C",
-                        omega, k)
+        X = solve_dense(M, C, K, w, Fk, f"K - ({k} omega)^2 M + i {k} omega C", omega, k)
         U[k], U[H + k] = X.real, -X.imag
     return U
