@@ -50,6 +50,9 @@ def test_a_scene_json_records_the_versions_that_produced_it(tmp_path, capsys):
     recorded = json.loads(target.read_text())["versions"]
     assert recorded == versions()
     assert set(recorded) == {"mechgen", "python", "numpy", "scipy", "sympy", "casadi"}
+    # against the installed distributions' metadata, read independently of mechgen.version
+    assert all(recorded[name] == metadata.version(name) for name in ("numpy", "scipy", "sympy", "casadi"))
+    assert recorded["python"] == sys.version.split()[0] and recorded["mechgen"] == metadata.version("mechgen")
 
 
 @pytest.mark.parametrize("argv", [["bench", "--quick", "simulate"], ["regen", "--check"]])
