@@ -92,11 +92,11 @@ def lower_lumped(eqs: LumpedEquations, name: str, *, cse: bool = True) -> Kernel
     if name == "residual":
         return _matrix_kernel(eqs, name, "Lagrange residual r = M a - f", {"r": r}, accel=True, cse=cse)
     if name == "tangent":
-        mats = {f"r_{w}": eqs.jacobian(r, w) for w in ("q", "v", "a", "z")}
+        mats = {f"r_{w}": eqs.residual_jacobian(w) for w in ("q", "v", "a", "z")}
         return _matrix_kernel(eqs, name, "Jacobians of the residual", mats, accel=True, cse=cse)
     if name == "flow":
-        at_rest = {ai: 0 for ai in eqs.a}
-        mats = {"r": r.subs(at_rest), "M": eqs.jacobian(r, "a").subs(at_rest)}
+        M, h = eqs.split()
+        mats = {"r": h, "M": M}
         return _matrix_kernel(eqs, name, "r at a = 0 and M = dr/da (dx/dt = (v, -M^-1 r))", mats, accel=False, cse=cse)
     if name == "linear":
         return _matrix_kernel(eqs, name, "M, D, G, K of the linearisation (a = 0)", eqs.linear_matrices(),
