@@ -228,9 +228,29 @@ def _energy(model: Model, scope, what: str, env) -> sp.Expr:
     return total
 
 
-def derive_lumped(model: Model, spec: Specialization, mode: str | None = None) -> LumpedEquations:
-    """Derive the residual, internal rates and outputs of a lumped model (of one mode of a hybrid model:
-    the model-wide terms plus the mode's, mechgen.symbolic.hybrid)."""
+@dataclass(frozen=True)
+class Declared:
+    """What a lumped model declares, evaluated on the state symbols: the energies T, V, Rayleigh's R, the
+    generalized forces Q, the internal rates, the outputs (energies included) and the parameter namespace."""
+
+    names: tuple[str, ...]
+    q: tuple
+    v: tuple
+    a: tuple
+    z: tuple
+    free: tuple
+    p_ns: Namespace
+    T: sp.Expr
+    V: sp.Expr
+    R: sp.Expr
+    Q: list
+    rates: list
+    outputs: dict
+
+
+def declared_lumped(model: Model, spec: Specialization, mode: str | None = None) -> Declared:
+    """The declared pieces of a lumped model (of one mode of a hybrid model: the model-wide terms plus the
+    mode's, mechgen.symbolic.hybrid), before any derivative is taken."""
     if model.is_lattice:
         raise ModelError(f"model {model.name} is a lattice; use derive_lattice", file=model.file)
     scope = model.mode_scopes[mode] if mode is not None else None
@@ -243,9 +263,6 @@ def derive_lumped(model: Model, spec: Specialization, mode: str | None = None) -
     Q = _forces(model, names, env)
     if scope is not None and scope.forces_fn is not None:
         Q = [a_ + b_ for a_, b_ in zip(Q, _forces(model, names, env, scope.forces_fn))]
-    M, h = lagrange_parts(T, V, R, q, v)
-    bias = sp.Matrix([hi - Qi for hi, Qi in zip(h, Q)]) if names else sp.zeros(0, 1)
-    res = list(M * sp.Matrix(a) + bias) if names else []
     laws = scope.rates if scope is not None else {}
     rates = [_scalar(call_declared(laws.get(i.name, i.rate), **env), f"rate of {i.name}", model)
              for i in model.internals]
@@ -253,15 +270,28 @@ def derive_lumped(model: Model, spec: Specialization, mode: str | None = None) -
     outputs = {o.name: _scalar(call_declared(own.get(o.name, o.fn), **env), f"output {o.name}", model)
                for o in model.outputs}
     outputs.update(kinetic_energy=T, potential_energy=V, energy=T + V)
-    power, excess = energy_powers(T, V, R, Q, v=v, q=q)
+    return Declared(tuple(names), q, v, a, z, free, p_ns, T, V, R, Q, rates, outputs)
+
+
+def derive_lumped(model: Model, spec: Specialization, mode: str | None = None, *,
+                  declared: Declared | None = None) -> LumpedEquations:
+    """Derive the residual, internal rates and outputs of a lumped model (of one mode of a hybrid model:
+    the model-wide terms plus the mode's, mechgen.symbolic.hybrid); ``declared``: its declared pieces when
+    already evaluated (:func:`declared_lumped`)."""
+    d = declared if declared is not None else declared_lumped(model, spec, mode)
+    names, q, v, a = d.names, d.q, d.v, d.a
+    M, h = lagrange_parts(d.T, d.V, d.R, q, v)
+    bias = sp.Matrix([hi - Qi for hi, Qi in zip(h, d.Q)]) if names else sp.zeros(0, 1)
+    res = list(M * sp.Matrix(a) + bias) if names else []
+    power, excess = energy_powers(d.T, d.V, d.R, d.Q, v=v, q=q)
     return LumpedEquations(
-        model=model.name, coordinates=names, q=q, v=v, a=a, z=z, params=free,
-        param_names=tuple(s.name for s in free), internal_names=tuple(i.name for i in model.internals),
-        kinetic=T, potential=V, residual=sp.Matrix(res) if res else sp.zeros(0, 1),
-        rates=sp.Matrix(rates) if rates else sp.zeros(0, 1), outputs=outputs,
-        initial=initial_column(model, p_ns, names, tuple(i.name for i in model.internals)),
-        section=(section := _section(model, p_ns)),
-        rod=derive_rod(model, p_ns, section, free), power=power, excess=excess, mass=M, bias=bias,
+        model=model.name, coordinates=names, q=q, v=v, a=a, z=d.z, params=d.free,
+        param_names=tuple(s.name for s in d.free), internal_names=tuple(i.name for i in model.internals),
+        kinetic=d.T, potential=d.V, residual=sp.Matrix(res) if res else sp.zeros(0, 1),
+        rates=sp.Matrix(d.rates) if d.rates else sp.zeros(0, 1), outputs=d.outputs,
+        initial=initial_column(model, d.p_ns, names, tuple(i.name for i in model.internals)),
+        section=(section := _section(model, d.p_ns)),
+        rod=derive_rod(model, d.p_ns, section, d.free), power=power, excess=excess, mass=M, bias=bias,
     )
 
 
