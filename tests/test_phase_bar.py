@@ -27,15 +27,26 @@ from mechgen.cli import main
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def _boundary(params: dict, strain_range, **options):
-    system = mechgen.compile("phase_bar", params, backend="c")
-    return mechgen.analysis("phase_boundary", system, strain_range=strain_range, **options)
+@pytest.fixture(scope="module")
+def trilinear():
+    """The trilinear law with every numeric parameter free (one compilation; with_params for the variants)."""
+    return mechgen.compile("phase_bar", {"law": "trilinear"}, backend="c")
 
 
-@pytest.mark.parametrize("beta, c", [(3.0, 2.2), (2.0, 1.0)])
-def test_cubic_maxwell_stress_is_the_stress_at_the_inflection(beta, c):
-    mu = 2.5
-    r = _boundary({"law": "cubic", "mu": mu, "beta": beta, "c": c}, [-1.0, 3.0])
+def _scene_outputs(name: str) -> tuple[dict, dict]:
+    run = mechgen.run(str(ROOT / "scenes" / name))
+    return run["params"], {a["name"]: a["outputs"] for a in run["analyses"]}
+
+
+@pytest.fixture(scope="module")
+def cubic_scene():
+    return _scene_outputs("phase_bar_cubic.toml")
+
+
+def test_cubic_maxwell_stress_is_the_stress_at_the_inflection(cubic_scene):
+    p, out = cubic_scene
+    mu, beta, c = p["mu"], p["beta"], p["c"]
+    r = out["maxwell"]
     gi = beta / (3 * c)
     sigma_m = mu * (beta / (3 * c) - 2 * beta**3 / (27 * c**2))
     u = np.sqrt((beta**2 - 3 * c) / (3 * c**2))
@@ -43,6 +54,17 @@ def test_cubic_maxwell_stress_is_the_stress_at_the_inflection(beta, c):
     # Brent's method to 1e-15 of the stress scale on a kernel evaluated in double precision
     assert abs(r["maxwell_stress"] - sigma_m) <= 1e-11 * mu
     np.testing.assert_allclose(r["phase_strains"], [gi - u, gi + u], rtol=0, atol=1e-9)  # sigma' ~ 1: same digits
+    # the spinodal: sigma' = mu (1 - 2 beta gamma + 3 c gamma^2) = 0
+    roots = np.sort(np.roots([3 * c, -2 * beta, 1.0]))
+    np.testing.assert_allclose(r["spinodal_strains"], roots, rtol=0, atol=1e-12)
+
+
+def test_cubic_kinetic_run_satisfies_the_dissipation_identity(cubic_scene):
+    p, out = cubic_scene
+    k = out["kinetics"]
+    assert [e["guard"] for e in k["events"]] == ["nucleation", "arrival", "turn", "reversion", "retreat"]
+    assert abs(k["dissipation_residual"]) <= 1e-10 * abs(k["work"])  # integrals carried at rtol 1e-10
+    assert k["dissipated"] > 0 and min(np.array(k["driving_traction"]) * np.gradient(k["s"], k["t"])) >= -1e-12
 
 
 def _trilinear(g, gM, gm, gT):
@@ -54,9 +76,9 @@ def _trilinear(g, gM, gm, gT):
     return g - gT
 
 
-def test_trilinear_maxwell_stress_against_an_independent_equal_area_solve():
+def test_trilinear_maxwell_stress_against_an_independent_equal_area_solve(trilinear):
     gM, gm, gT = 0.02, 0.07, 0.06
-    r = _boundary({"law": "trilinear", "gamma_M": gM, "gamma_m": gm, "gamma_T": gT}, [-0.01, 0.12])
+    r = mechgen.phase_boundary(trilinear.with_params(gamma_M=gM, gamma_m=gm, gamma_T=gT), strain_range=[-0.01, 0.12])
 
     def area(sigma):  # int_{g1}^{g2} (sigma(g) - sigma) dg with g1 = sigma, g2 = sigma + gT (mu = 1)
         return quad(lambda g: _trilinear(g, gM, gm, gT) - sigma, sigma, sigma + gT, points=[gM, gm],
@@ -68,10 +90,10 @@ def test_trilinear_maxwell_stress_against_an_independent_equal_area_solve():
     np.testing.assert_allclose(r["spinodal_strains"], [gM, gm], rtol=0, atol=1e-12)  # the kinks, by Brent
 
 
-def test_two_phase_equilibria_fractions_and_driving_traction():
+def test_two_phase_equilibria_fractions_and_driving_traction(trilinear):
     gM, gm, gT, L = 0.02, 0.06, 0.05, 2.0
-    r = _boundary({"law": "trilinear", "gamma_M": gM, "gamma_m": gm, "gamma_T": gT, "L": L}, [-0.01, 0.1],
-                  elongation=[0.08, 0.01], equilibrium_samples=9)
+    r = mechgen.phase_boundary(trilinear.with_params(gamma_M=gM, gamma_m=gm, gamma_T=gT, L=L), strain_range=[-0.01, 0.1],
+                               elongation=[0.08, 0.01], equilibrium_samples=9)
     sigma_m = r["maxwell_stress"]
     w0 = gM**2 / 2 + gM * (gm - gM) + ((gm - gT) - gM) / (gm - gM) * (gm - gM)**2 / 2 - (gm - gT)**2 / 2
     assert abs(sigma_m - w0 / gT) <= 1e-13  # sigma_M = w0/gamma_T (the model's docstring)
@@ -86,11 +108,20 @@ def test_two_phase_equilibria_fractions_and_driving_traction():
     np.testing.assert_allclose(fam["phase_fraction"], (0.08 / L - np.array(fam["stress"])) / gT, rtol=0, atol=1e-12)
 
 
-def test_a_convex_energy_has_no_phase_boundary_and_says_so():
-    r = _boundary({"law": "cubic", "beta": 1.0, "c": 1.0}, [-1.0, 2.0], elongation=[0.5])
+def test_a_convex_energy_has_no_phase_boundary_and_says_so(trilinear):
+    # gamma_m - gamma_T = 0.03 > gamma_M: the "falling" branch rises, W is convex (slopes mu, 0.25 mu, mu)
+    r = mechgen.phase_boundary(trilinear.with_params(gamma_T=0.03), strain_range=[-0.01, 0.1], elongation=[0.04])
     assert r["phase_boundary"] is False and r["maxwell_stress"] is None
     assert r["phase_strains"] == [] and r["equilibria"] == []
     assert "convex" in r["note"] and "no phase boundary" in r["note"]
+
+
+def test_a_convex_cubic_law_says_no_phase_boundary_and_its_kinetic_run_is_refused(capsys):
+    # beta^2 = 1 < 3 c = 6.6: sigma increasing, W convex
+    assert main(["run", str(ROOT / "scenes" / "phase_bar_cubic.toml"), "--set", "beta=1.0"]) == 2
+    captured = capsys.readouterr()
+    assert "convex there, so no phase boundary" in captured.out
+    assert "phase_bar_cubic.toml" in captured.err and "'params'" in captured.err and "beta^2 > 3 c" in captured.err
 
 
 def _scene(tmp_path, *edits) -> Path:
@@ -106,7 +137,6 @@ def _scene(tmp_path, *edits) -> Path:
 @pytest.mark.parametrize("edit, words", [
     (('law = "trilinear"', 'law = "quartic"'), ["law", "cubic", "trilinear"]),
     (("strain_range = [-0.01, 0.1]", "strain_range = [0.0, 0.05]"), ["strain_range", "wider"]),
-    (("gamma_m = 0.06", "gamma_m = 0.01"), ["params", "gamma_M < gamma_m"]),
     (("strain_range = [-0.01, 0.1]", "strain_range = [0.1, -0.01]"), ["strain_range", "increasing"]),
 ])
 def test_bad_input_is_refused_naming_file_and_key(tmp_path, capsys, edit, words):
@@ -116,3 +146,99 @@ def test_bad_input_is_refused_naming_file_and_key(tmp_path, capsys, edit, words)
     assert "bar.toml" in err or words[0] == "params"
     for word in words:
         assert word in err, err
+
+
+# --------------------------------------------------------------------------- kinetics (item 8)
+#
+# Trilinear law, both phases of modulus mu, phase 2 on 0 < x < s: the stress is affine in s and delta,
+# sigma = mu (delta - gamma_T s)/L (from s (sigma/mu + gamma_T) + (L - s) sigma/mu = delta), and
+# f = gamma_T (sigma - sigma_M), so linear kinetics ds/dt = f/eta is the linear ODE
+#     ds/dt + k s = (gamma_T/eta) (mu delta(t)/L - sigma_M),   k = mu gamma_T^2/(L eta).
+# For a ramp delta = delta_0 + r (t - t_0) the right side is a + b (t - t_0) with a = (gamma_T/eta)(mu delta_0/L -
+# sigma_M), b = gamma_T mu r/(L eta); its solution from s(t_0) = s_0 is
+#     s(t) = p(t) + (s_0 - p(t_0)) exp(-k (t - t_0)),   p(t) = (a - b/k)/k + (b/k) (t - t_0).
+# Nucleation at sigma_nucleation on the way up: t_n = L sigma_nucleation/(mu r), s = 0; reversion at
+# sigma_reversion on the way down (all phase 2: sigma = mu (delta/L - gamma_T)): delta_r = L (sigma_reversion/mu +
+# gamma_T), t_r = 2 t_turn - delta_r/r, s = L.
+
+def _scene_run():
+    run = mechgen.run(str(ROOT / "scenes" / "phase_bar.toml"))
+    return run["params"], {a["name"]: a["outputs"] for a in run["analyses"]}["kinetics"]
+
+
+def _segment(p, t0, s0, delta0, r):
+    """s(t) on a ramp from (t0, s0, delta0) at rate r (the closed form above)."""
+    mu, gT, L, eta, sigma_m = p["mu"], p["gamma_T"], p["L"], p["eta"], p["_sigma_m"]
+    k = mu * gT**2 / (L * eta)
+    a, b = gT / eta * (mu * delta0 / L - sigma_m), gT * mu * r / (L * eta)
+    return lambda t: (a - b / k) / k + b / k * (t - t0) + (s0 - (a - b / k) / k) * np.exp(-k * (t - t0))
+
+
+@pytest.fixture(scope="module")
+def kinetics():
+    p, k = _scene_run()
+    gM, gm, gT = p["gamma_M"], p["gamma_m"], p["gamma_T"]
+    p["_sigma_m"] = p["mu"] * (gM**2 / 2 + gM * (gm - gM) + ((gm - gT) - gM) * (gm - gM) / 2 - (gm - gT)**2 / 2) / gT
+    return p, k
+
+
+def test_boundary_position_and_event_times_against_the_closed_form(kinetics):
+    p, k = kinetics
+    mu, L, r, T = p["mu"], p["L"], p["rate"], p["t_turn"]
+    t_n = L * p["sigma_nucleation"] / (mu * r)
+    up = _segment(p, t_n, 0.0, r * t_n, r)
+    t_a = brentq(lambda t: up(t) - L, t_n + 1e-9, T)
+    delta_r = L * (p["sigma_reversion"] / mu + p["gamma_T"])
+    t_r = 2 * T - delta_r / r
+    down = _segment(p, t_r, L, delta_r, -r)
+    t_b = brentq(lambda t: down(t), t_r + 1e-9, 2 * T)
+    # events located to the integrator's accuracy (rtol 1e-10, atol 1e-12: measured 2e-12 s on times ~ 10 s)
+    for key, ref in (("nucleation_time", t_n), ("arrival_time", t_a), ("reversion_time", t_r), ("retreat_time", t_b)):
+        assert abs(k[key] - ref) <= 1e-9, (key, k[key], ref)
+    t, s = np.array(k["t"]), np.array(k["s"])
+    reference = np.where(t < t_n, 0.0, np.where(t < t_a, up(t), np.where(t < t_r, L, np.where(t < t_b, down(t), 0.0))))
+    near = np.min(np.abs(t[:, None] - np.array([t_n, t_a, t_r, t_b])[None, :]), axis=1) < 1e-6  # a sample on an event
+    assert np.count_nonzero(~near) > 300
+    assert np.max(np.abs(s - reference)[~near]) <= 1e-9 * L  # rtol 1e-10, atol 1e-12 over 20 s (measured 2e-11)
+
+
+def test_dissipation_identity_and_the_closed_form_dissipation(kinetics):
+    p, k = kinetics
+    scale = abs(k["work"])
+    assert abs(k["dissipation_residual"]) <= 1e-10 * scale  # integrated with the state at rtol 1e-10
+    assert abs(k["stored_energy_change"]) <= 1e-12 * scale  # back to delta = 0, all phase 1, E = 0
+    # int f V dt = int gamma_T^2 (sigma - sigma_M)^2/eta dt with sigma = mu (delta - gamma_T s)/L, s in closed form
+    mu, gT, L, eta, r, T = p["mu"], p["gamma_T"], p["L"], p["eta"], p["rate"], p["t_turn"]
+    t_n, t_a, t_r, t_b = (k[key] for key in ("nucleation_time", "arrival_time", "reversion_time", "retreat_time"))
+    up, down = _segment(p, t_n, 0.0, r * t_n, r), _segment(p, t_r, L, r * (2 * T - t_r), -r)
+
+    def rate(t, seg, delta):
+        sigma = mu * (delta(t) - gT * seg(t)) / L
+        return gT**2 * (sigma - p["_sigma_m"])**2 / eta
+
+    total = quad(rate, t_n, t_a, args=(up, lambda t: r * t), epsabs=0, epsrel=1e-12, limit=200)[0] + \
+        quad(rate, t_r, t_b, args=(down, lambda t: r * (2 * T - t)), epsabs=0, epsrel=1e-12, limit=200)[0]
+    assert abs(k["dissipated"] - total) <= 1e-8 * total  # the integrator's rtol 1e-10 and quad's 1e-12, with margin
+    # the loop: on the plateaus sigma -> sigma_M + eta r/gamma_T^2 (loading) and sigma_M - eta r/gamma_T^2
+    t, stress = np.array(k["t"]), np.array(k["stress"])
+    plateau = p["_sigma_m"] + eta * r / gT**2
+    assert abs(stress[np.argmin(np.abs(t - (t_a - 0.5)))] - plateau) <= 1e-8
+
+
+def test_trilinear_law_with_gamma_m_below_gamma_M_is_refused(trilinear):
+    with pytest.raises(mechgen.InputError, match="gamma_M < gamma_m") as info:
+        mechgen.phase_boundary(trilinear.with_params(gamma_m=0.01), strain_range=[-0.01, 0.1])
+    assert info.value.key == "params"
+
+
+@pytest.mark.parametrize("values, key", [
+    ({"sigma_nucleation": 0.025}, "params.sigma_nucleation"),  # above the peak 0.02: never nucleates
+    ({"sigma_reversion": 0.016}, "params.sigma_reversion"),  # above sigma_M = 0.015: phase 1 would shrink
+    ({"eta": 0.1}, "params.eta"),  # the boundary too slow: phase 1 strained onto the falling branch
+    ({"gamma_T": 0.03}, "params"),  # a convex law
+])
+def test_kinetics_bad_input_is_refused_at_the_key(trilinear, values, key):
+    system = trilinear.with_params(eta=5e-4, sigma_nucleation=0.018, sigma_reversion=0.012, rate=0.01, t_turn=10.0)
+    with pytest.raises(mechgen.InputError) as info:
+        mechgen.phase_kinetics(system.with_params(**values), t_end=20.0, strain_range=[-0.01, 0.1])
+    assert info.value.key == key, str(info.value)

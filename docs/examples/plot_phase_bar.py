@@ -31,8 +31,8 @@ Reference: R. Abeyaratne and J. K. Knowles, "On the driving traction acting on a
 discontinuity in a continuum", J. Mech. Phys. Solids 38 (1990) 345-360; *Evolution of Phase Transitions*,
 Cambridge University Press (2006), ch. 2-3.
 
-mechgen runs the ``phase_boundary`` analysis on the built-in model ``phase_bar`` (the shipped scene
-``scenes/phase_bar.toml`` for the trilinear law, :func:`mechgen.phase_boundary` for the cubic one).
+mechgen runs the ``phase_boundary`` analysis on the built-in model ``phase_bar``: the shipped scenes
+``scenes/phase_bar_cubic.toml`` (cubic law) and ``scenes/phase_bar.toml`` (trilinear law).
 """
 from pathlib import Path
 
@@ -45,9 +45,9 @@ SCENES = Path(mechgen.__file__).resolve().parents[1] / "scenes"
 
 # %%
 # The cubic law: the Maxwell stress against the closed form.
-mu, beta, c = 1.0, 3.0, 2.2
-cubic = mechgen.phase_boundary(mechgen.compile("phase_bar", {"law": "cubic", "mu": mu, "beta": beta, "c": c}),
-                               strain_range=[-0.2, 1.2])
+cubic_run = mechgen.run(str(SCENES / "phase_bar_cubic.toml"))
+mu, beta, c = (cubic_run["params"][k] for k in ("mu", "beta", "c"))
+cubic = {a["name"]: a["outputs"] for a in cubic_run["analyses"]}["maxwell"]
 gi = beta / (3 * c)
 closed = mu * (beta / (3 * c) - 2 * beta**3 / (27 * c**2))
 u = np.sqrt((beta**2 - 3 * c) / (3 * c**2))

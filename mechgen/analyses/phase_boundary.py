@@ -6,7 +6,7 @@ sigma(gamma), ``energy_density`` W(gamma) (Pa) and, optionally, ``modulus`` sigm
 again (a non-convex W: phase 1, an unstable branch, phase 2), mechgen.runtime.steady.phases finds the peak and the
 valley, the Maxwell stress sigma_M where the driving traction f = [[W]] - sigma [[gamma]] of the two phase strains
 vanishes (equal areas: int_{gamma_1}^{gamma_2} sigma dgamma = sigma_M (gamma_2 - gamma_1), Abeyaratne & Knowles),
-and, for each mean strain delta/L of ``elongation`` (m; L the model's parameter ``L``), the equilibria with one
+and, for each mean strain delta/L of ``elongation`` (m; L the model's output ``bar_length``, else 1), the equilibria with one
 phase boundary: the Maxwell one (phase-2 fraction, boundary position s with phase 2 on 0 < x < s, f = 0) and the
 family at every stress between valley and peak (``equilibrium_samples`` of them), each with its interface's
 driving traction (nonzero but at sigma_M: a boundary at rest there is not at rest under kinetics).
@@ -36,7 +36,7 @@ from mechgen.scene.values import fail
 LAW_OUTPUTS = ("stress", "energy_density")
 
 
-def _range(ctx, key: str, value: object) -> list[float]:
+def strain_range(ctx, key: str, value: object) -> list[float]:
     """Two increasing strains [low, high]."""
     if not isinstance(value, list) or len(value) != 2:
         raise fail(ctx.file, key, f"value is {value!r}", "two strains [low, high]")
@@ -53,7 +53,7 @@ def _elongations(ctx, key: str, value: object) -> list[float]:
 
 
 SCHEMA = {
-    "strain_range": Option(_range, REQUIRED, "two strains [low, high]", doc="the strains [low, high] the law is "
+    "strain_range": Option(strain_range, REQUIRED, "two strains [low, high]", doc="the strains [low, high] the law is "
                            "sampled on: phase 1's and phase 2's stresses between peak and valley must lie in it"),
     "samples": Option(schema.count_within("samples"), 2001, doc="how many strains of strain_range sample the "
                       "law (finds its peak and valley, then refined)"),
@@ -99,6 +99,11 @@ class KernelLaw:
         X = np.zeros((g.size, 2 * self.system.n + self.system.m))
         X[:, self.column] = g
         return np.asarray(self.system.evaluate_series("outputs", np.zeros(g.size), X)[name], float).reshape(g.size)
+
+    def constant(self, name: str, default: float) -> float:
+        """An output that does not depend on the state (a parameter the model reports: ``bar_length``), else
+        ``default``."""
+        return float(self._out(name, 0.0)[0]) if name in output_names(self.system) else default
 
     def stress(self, g):
         return self._out("stress", g)
@@ -152,7 +157,7 @@ def run_phase_boundary(system, options: dict, context: dict) -> dict:
                          f"ends, not beyond the valley {sp_.sigma_b:.6g} and the peak {sp_.sigma_a:.6g}", key="strain_range",
                          expected="a wider range: both phases at every stress between valley and peak")
     m = phases.maxwell(law.stress, law.energy, sp_, low, high)
-    length = system.param_values().get("L", 1.0)
+    length = law.constant("bar_length", 1.0)
     out.update({"phase_boundary": True, "maxwell_stress": m.stress, "phase_strains": [m.gamma_1, m.gamma_2],
                 "spinodal_strains": [sp_.gamma_a, sp_.gamma_b], "peak_stress": sp_.sigma_a,
                 "valley_stress": sp_.sigma_b})

@@ -34,6 +34,7 @@ MODULES = (
     "mechgen.analyses.rod_statics",
     "mechgen.analyses.rod_dynamics",
     "mechgen.analyses.phase_boundary",
+    "mechgen.analyses.phase_kinetics",
 )
 
 

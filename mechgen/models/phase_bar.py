@@ -32,13 +32,16 @@ Modes: ``phase_1`` (s = 0, gamma = delta/L; to ``two_phase`` when sigma rises th
 boundary nucleates at x = 0), ``two_phase`` (to ``phase_2`` when s reaches L: arrival at the end, gamma reset
 to the phase-2 strain; back to ``phase_1`` when s falls to 0), ``phase_2`` (s = L, gamma the phase-2 strain =
 delta/L; to ``two_phase`` when sigma falls through ``sigma_reversion``: phase 1 nucleates at x = L, gamma reset
-to the phase-1 strain at that stress). Internal variables: ``s``, ``gamma`` (the strain of the phase-1
-part; of the whole bar in ``phase_2``), ``work`` = int sigma ddelta/dt dt and ``dissipated`` = int f V dt (J/m^2,
+to the phase-1 strain at that stress). Each mode also has the event ``turn`` at t = t_turn (back to itself, no
+reset but ``leg`` = 1, the internal variable that gives d delta/dt = rate (1 - 2 leg)), so that no integration step
+straddles the kink of delta(t). Internal variables: ``s``, ``gamma`` (the strain of the phase-1
+part; of the whole bar in ``phase_2``), ``leg`` (0 up, 1 after the turn), ``work`` = int sigma ddelta/dt dt and ``dissipated`` = int f V dt (J/m^2,
 per unit cross-section): work - dissipated = the stored energy E - E(0) (the dissipation check).
 Outputs: ``stress`` sigma(gamma), ``energy_density`` W(gamma), ``modulus`` sigma'(gamma) (these three read the
 law at the state's gamma: the ``phase_boundary`` analysis evaluates them at chosen strains), ``elongation``
 delta, ``driving_traction`` f (0 without a boundary), ``velocity`` V, ``stored_energy`` E = s W(gamma_2) +
-(L - s) W(gamma) (J/m^2), ``phase_fraction`` s/L.
+(L - s) W(gamma) (J/m^2), ``phase_fraction`` s/L; ``bar_length``, ``nucleation_stress``, ``reversion_stress``
+(the parameters L, sigma_nucleation, sigma_reversion, read by the analyses whether folded or free).
 """
 import sympy as sp
 
@@ -80,8 +83,11 @@ def law_energy(g, p):
         return p.mu * (g**2 / 2 - p.beta * g**3 / 3 + p.c * g**4 / 4)
     slope = p.mu * ((p.gamma_m - p.gamma_T) - p.gamma_M) / (p.gamma_m - p.gamma_M)
     at_peak = p.mu * p.gamma_M**2 / 2
-    middle = at_peak + p.mu * p.gamma_M * (g - p.gamma_M) + slope * (g - p.gamma_M)**2 / 2
-    at_valley = middle.subs(g, p.gamma_m)
+
+    def middle_at(x):
+        return at_peak + p.mu * p.gamma_M * (x - p.gamma_M) + slope * (x - p.gamma_M)**2 / 2
+
+    middle, at_valley = middle_at(g), middle_at(p.gamma_m)
     phase_2 = at_valley + p.mu * ((g - p.gamma_T)**2 - (p.gamma_m - p.gamma_T)**2) / 2
     return sp.Piecewise((p.mu * g**2 / 2, g <= p.gamma_M), (middle, g < p.gamma_m), (phase_2, True))
 
@@ -114,9 +120,9 @@ def elongation(p, t):
     return p.rate * (p.t_turn - sp.Abs(t - p.t_turn))
 
 
-def elongation_rate(p, t):
-    """d delta/dt (m/s): rate before t_turn, -rate after."""
-    return -p.rate * sp.sign(t - p.t_turn)
+def elongation_rate(z, p):
+    """d delta/dt (m/s): rate on the way up (leg = 0), -rate after the turn (leg = 1)."""
+    return p.rate * (1 - 2 * z.leg)
 
 
 def driving_traction(z, p):
@@ -136,7 +142,7 @@ def strain_rate(z, p, t):
     g2 = phase_2_strain(z.gamma, p)
     dg2 = sp.diff(phase_2_strain(g, p), g).subs(g, z.gamma)
     V = kinetic_rate(driving_traction(z, p), p)
-    return (elongation_rate(p, t) - V * (g2 - z.gamma)) / (z.s * dg2 + p.L - z.s)
+    return (elongation_rate(z, p) - V * (g2 - z.gamma)) / (z.s * dg2 + p.L - z.s)
 
 
 phase_1 = model.mode("phase_1", initial=True)
@@ -145,13 +151,15 @@ phase_2 = model.mode("phase_2")
 
 for _scope in (phase_1, phase_2):
     _scope.internal("s", lambda: 0, doc="phase-boundary position (m); phase 2 on 0 < x < s")
-    _scope.internal("gamma", lambda p, t: elongation_rate(p, t) / p.L, doc="strain of the phase-1 part")
-    _scope.internal("work", lambda z, p, t: law_stress(z.gamma, p) * elongation_rate(p, t),
+    _scope.internal("gamma", lambda z, p: elongation_rate(z, p) / p.L, doc="strain of the phase-1 part")
+    _scope.internal("work", lambda z, p, t: law_stress(z.gamma, p) * elongation_rate(z, p),
                     doc="work done on the bar per unit area (J/m^2)")
     _scope.internal("dissipated", lambda: 0, doc="int f V dt (J/m^2)")
+for _scope in (phase_1, two_phase, phase_2):
+    _scope.internal("leg", lambda: 0, doc="0 while the ramp goes up, 1 after the turn")
 two_phase.internal("s", lambda z, p: kinetic_rate(driving_traction(z, p), p))
 two_phase.internal("gamma", strain_rate)
-two_phase.internal("work", lambda z, p, t: law_stress(z.gamma, p) * elongation_rate(p, t))
+two_phase.internal("work", lambda z, p, t: law_stress(z.gamma, p) * elongation_rate(z, p))
 two_phase.internal("dissipated", lambda z, p: driving_traction(z, p) * kinetic_rate(driving_traction(z, p), p))
 
 
@@ -175,6 +183,16 @@ def reversion(z, p):
     return p.sigma_reversion - law_stress(z.gamma, p)
 
 
+def turn(z, p, t):
+    """(1 - 2 leg)(t - t_turn) - leg t_turn (s): rises through 0 at t_turn on the way up (leg = 0); after the
+    turn (leg = 1) it is -t < 0, so it never fires again."""
+    return (1 - 2 * z.leg) * (t - p.t_turn) - z.leg * p.t_turn
+
+
+for _scope in (phase_1, two_phase, phase_2):
+    _scope.guard(to=_scope.name, direction="rising", reset=lambda: {"leg": 1})(turn)
+
+
 model.output("stress", lambda z, p: law_stress(z.gamma, p), unit="Pa", doc="sigma(gamma), the bar's stress")
 model.output("energy_density", lambda z, p: law_energy(z.gamma, p), unit="Pa", doc="W(gamma)")
 model.output("modulus", lambda z, p: law_modulus(z.gamma, p), unit="Pa", doc="d sigma/d gamma at gamma")
@@ -184,6 +202,9 @@ model.output("velocity", lambda z, p: kinetic_rate(driving_traction(z, p), p), u
 model.output("stored_energy", lambda z, p: z.s * law_energy(phase_2_strain(z.gamma, p), p)
              + (p.L - z.s) * law_energy(z.gamma, p), unit="J/m^2", doc="E = int_0^L W dx per unit area")
 model.output("phase_fraction", lambda z, p: z.s / p.L, doc="s/L, the phase-2 fraction")
+model.output("bar_length", lambda p: p.L, unit="m", doc="L (the analyses read it here, folded or free)")
+model.output("nucleation_stress", lambda p: p.sigma_nucleation, unit="Pa", doc="sigma_nucleation")
+model.output("reversion_stress", lambda p: p.sigma_reversion, unit="Pa", doc="sigma_reversion")
 for _scope in (phase_1, phase_2):
     _scope.output("driving_traction", lambda: 0)
     _scope.output("velocity", lambda: 0)
