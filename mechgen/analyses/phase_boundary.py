@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mechgen.analyses import schema, summary
+from mechgen.analyses import phase_figures, schema, summary
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import REQUIRED, Option
 from mechgen.errors import InputError
@@ -190,4 +190,4 @@ def lines(outputs: dict) -> list[str]:
     return rows
 
 
-register(AnalysisKind("phase_boundary", SCHEMA, run_phase_boundary, needs, lines))
+register(AnalysisKind("phase_boundary", SCHEMA, run_phase_boundary, needs, lines, plot=phase_figures.law_figure))

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mechgen.analyses import schema, summary
+from mechgen.analyses import phase_figures, schema, summary
 from mechgen.analyses.phase_boundary import KernelLaw, checked_law, strain_range
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import REQUIRED, Option
@@ -120,4 +120,4 @@ def lines(outputs: dict) -> list[str]:
     return summary.output_lines(outputs, skip=SERIES + ("t", "events"))
 
 
-register(AnalysisKind("phase_kinetics", SCHEMA, run_phase_kinetics, needs, lines))
+register(AnalysisKind("phase_kinetics", SCHEMA, run_phase_kinetics, needs, lines, plot=phase_figures.kinetics_figure))
