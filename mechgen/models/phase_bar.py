@@ -20,7 +20,8 @@ Across a phase boundary at x = s(t) with phase 2 on 0 < x < s (strain gamma_2) a
     f = [[W]] - sigma [[gamma]] = W(gamma) - W(gamma_2) - sigma (gamma - gamma_2)      (Pa)
 
 ([[g]] = g(s+) - g(s-)); the dissipation rate per unit area is f ds/dt >= 0 and f = 0 is Maxwell's rule of
-equal areas. Kinetics: ds/dt = V = phi(f) = f/eta (:func:`kinetic_rate`, the law a user edits). The end
+equal areas. Kinetics (``kinetics``, :func:`kinetic_rate`): ds/dt = V = phi(f) = f/eta (``linear``, the default) or
+V0 sign(f) |f/f0|^exponent (``power``). The end
 x = L moves by the elongation delta(t) = rate (t_turn - |t - t_turn|) (m): a ramp up to t_turn and back to 0 at
 2 t_turn, quasi-static (no inertia): s gamma_2 + (L - s) gamma = delta with sigma(gamma_2) = sigma(gamma), the
 phase-2 strain gamma_2 = :func:`phase_2_strain` (gamma) in closed form (cubic: the other roots of
@@ -47,8 +48,10 @@ import sympy as sp
 
 from mechgen.symbolic.model import Model
 from mechgen.symbolic.params import Param
+from mechgen.symbolic.powers import signed_power
 
 LAWS = ("cubic", "trilinear")
+KINETICS = ("linear", "power")
 
 model = Model("phase_bar", doc=__doc__)
 model.params(
@@ -61,7 +64,11 @@ model.params(
     Param("gamma_T", 0.05, "", "trilinear law: transformation strain (phase 2: sigma = mu (gamma - gamma_T))",
           positive=True),
     Param("L", 1.0, "m", "bar length", positive=True),
-    Param("eta", 1.0, "Pa s/m", "kinetic viscosity: V = f/eta", positive=True),
+    Param("kinetics", "linear", "", "kinetic law V = phi(f)", choices=KINETICS),
+    Param("eta", 1.0, "Pa s/m", "linear kinetics: viscosity, V = f/eta", positive=True),
+    Param("V0", 1.0, "m/s", "power kinetics: the speed at f = f0", positive=True),
+    Param("f0", 1.0, "Pa", "power kinetics: the reference driving traction", positive=True),
+    Param("exponent", 3.0, "", "power kinetics: V = V0 sign(f) |f/f0|^exponent", positive=True),
     Param("rate", 0.01, "m/s", "elongation rate of the ramp", positive=True),
     Param("t_turn", 10.0, "s", "time the ramp turns back", positive=True),
     Param("sigma_nucleation", 0.05, "Pa", "stress at which phase 2 nucleates at x = 0"),
@@ -132,7 +139,9 @@ def driving_traction(z, p):
 
 
 def kinetic_rate(f, p):
-    """V = phi(f) (m/s): the kinetic law, linear f/eta (edit here for another law)."""
+    """V = phi(f) (m/s), ``kinetics``: linear f/eta, or power V0 sign(f) |f/f0|^exponent (both odd, so f V >= 0)."""
+    if p.kinetics == "power":
+        return p.V0 * signed_power(f / p.f0, p.exponent)
     return f / p.eta
 
 
