@@ -35,9 +35,9 @@ to the phase-2 strain; back to ``phase_1`` when s falls to 0), ``phase_2`` (s = 
 delta/L; to ``two_phase`` when sigma falls through ``sigma_reversion``: phase 1 nucleates at x = L, gamma reset
 to the phase-1 strain at that stress). Each mode also has the event ``turn`` at t = t_turn (back to itself, no
 reset but ``leg`` = 1, the internal variable that gives d delta/dt = rate (1 - 2 leg)), so that no integration step
-straddles the kink of delta(t). Internal variables: ``s``, ``gamma`` (the strain of the phase-1
-part; of the whole bar in ``phase_2``), ``leg`` (0 up, 1 after the turn), ``work`` = int sigma ddelta/dt dt and ``dissipated`` = int f V dt (J/m^2,
-per unit cross-section): work - dissipated = the stored energy E - E(0) (the dissipation check).
+straddles the kink of delta(t). Internal variables: ``s``, ``gamma`` (the strain of the phase-1 part; of the
+whole bar in ``phase_2``), ``leg`` (0 up, 1 after the turn), ``work`` = int sigma ddelta/dt dt and ``dissipated`` =
+int f V dt (J/m^2, per unit cross-section): work - dissipated = the stored energy E - E(0) (the dissipation check).
 Outputs: ``stress`` sigma(gamma), ``energy_density`` W(gamma), ``modulus`` sigma'(gamma) (these three read the
 law at the state's gamma: the ``phase_boundary`` analysis evaluates them at chosen strains), ``elongation``
 delta, ``driving_traction`` f (0 without a boundary), ``velocity`` V, ``stored_energy`` E = s W(gamma_2) +
