@@ -269,3 +269,24 @@ def test_kinetics_bad_input_is_refused_at_the_key(trilinear, values, key):
     with pytest.raises(mechgen.InputError) as info:
         mechgen.phase_kinetics(system.with_params(**values), t_end=20.0, strain_range=[-0.01, 0.1])
     assert info.value.key == key, str(info.value)
+
+
+def test_runtime_phases_on_a_hand_written_double_well():
+    """mechgen.runtime.steady.phases on numpy functions alone (no kernels): W = g^4/4 - g^2/2 + a g, sigma = g^3 - g
+    + a; a shifts the stress only, so sigma_M = a, the phase strains are -1 and 1 and the spinodal -+1/sqrt(3)."""
+    from mechgen.runtime.steady import phases
+
+    a = 0.3
+    stress = lambda g: np.asarray(g) ** 3 - np.asarray(g) + a  # noqa: E731
+    energy = lambda g: np.asarray(g) ** 4 / 4 - np.asarray(g) ** 2 / 2 + a * np.asarray(g)  # noqa: E731
+    modulus = lambda g: 3 * np.asarray(g) ** 2 - 1  # noqa: E731
+    grid = np.linspace(-2.0, 2.0, 401)
+    sp_ = phases.spinodal(stress, modulus, grid)
+    np.testing.assert_allclose([sp_.gamma_a, sp_.gamma_b], [-1 / np.sqrt(3), 1 / np.sqrt(3)], rtol=0, atol=1e-14)
+    m = phases.maxwell(stress, energy, sp_, -2.0, 2.0)
+    assert abs(m.stress - a) <= 1e-14 and abs(m.gamma_1 + 1) <= 1e-13 and abs(m.gamma_2 - 1) <= 1e-13
+    eq = phases.equilibria(stress, energy, sp_, -2.0, 2.0, 0.0, 5)
+    g1 = [np.sort(np.roots([1, 0, -1, a - s]).real)[0] for s in eq["stress"]]
+    g2 = [np.sort(np.roots([1, 0, -1, a - s]).real)[2] for s in eq["stress"]]
+    np.testing.assert_allclose(eq["phase_fraction"], [-x / (y - x) for x, y in zip(g1, g2)], rtol=0, atol=1e-12)
+    assert phases.spinodal(lambda g: np.asarray(g) ** 3 + np.asarray(g), None, grid) is None  # convex: none

@@ -11,6 +11,11 @@ falls to ``sigma_reversion``) -> ``phase_1`` (``retreat``: s reaches 0), and the
 model's (``phase_bar``: f/eta). The run is ``simulate``'s hybrid path (mechgen.analyses.simulate_hybrid: events
 located on the dense output, the compiled DOP853 loop), from t = 0 to ``t_end``.
 
+Nucleation is a critical stress. A critical driving traction f_c is the same criterion: between valley and peak the
+driving traction of the two phase strains at equal stress increases with the stress (df/dsigma = gamma_2 - gamma_1
+> 0), so f_c names one stress sigma_c (``phase_boundary``'s ``family`` tabulates f(sigma); trilinear:
+sigma_c = sigma_M + f_c/gamma_T).
+
 Before it runs, the law is sampled on ``strain_range`` (mechgen.runtime.steady.phases): a law without two phases
 there (a convex W) is bad input at ``params`` (no boundary can nucleate), and so are nucleation stresses outside
 (sigma_M, peak) and reversion stresses outside (valley, sigma_M) (the boundary would never nucleate, or would move
