@@ -95,7 +95,19 @@ def kernel_context(ir: KernelIR) -> dict:
         body += loop_block(ir, i, names.inp, names.out, names.out_len) if block.loop else _straight(block, names)
     return {"name": code_identifier(ir.name), "doc": c_comment(ir.doc).replace("\n", " "),
             "port_doc": [line for doc in _port_doc(ir) for line in c_comment_lines(doc, "")],
-            "prologue": _prologue(ir), "body": body}
+            "prologue": _prologue(ir), "body": body, "quick_build": quick_build(ir)}
+
+
+#: straight-line statements (assignments and writes) above which GCC compiles a kernel at -O0
+QUICK_BUILD_STATEMENTS = 4000
+
+
+def quick_build(ir: KernelIR) -> bool:
+    """Whether GCC builds the kernel without optimisation: a straight-line block of tens of thousands of
+    single-assignment temporaries (an AD-derived Jacobian of a large model, mechgen.codegen.lower_ad) costs GCC's
+    optimiser seconds to minutes (an n = 16 pendulum's kernels: 15 s at -O3, 1.3 s at -O0), far more than the
+    kernel's calls save; small and looping kernels keep -O3. Clang ignores the request (it has no such pragma)."""
+    return sum(len(b.assignments) + len(b.writes) for b in ir.blocks if not b.loop) > QUICK_BUILD_STATEMENTS
 
 
 def emit_c(irs: list[KernelIR], *, model: str, title: str) -> str:
