@@ -9,7 +9,7 @@ The public names (DESIGN.md, "the user's three jobs"), importable from ``mechgen
 * one function per analysis kind, each returning a ``Result``: ``modes``, ``stability``,
   ``steady``, ``continuation``, ``simulate``, ``sweep``, ``campbell``, ``fit``, ``impact``, ``restitution``,
   ``periodic``, ``periodic_orbit``, ``spectrum``, ``stability_boundary``, ``cross_section``, ``symplectic``, ``rod_statics``, ``rod_dynamics``,
-  ``response``; and ``analysis(kind, system, **options)`` for any registered kind by name;
+  ``response``, ``phase_boundary``, ``phase_kinetics``; and ``analysis(kind, system, **options)`` for any registered kind by name;
 * ``run(scene)``: a scene file (or a dict of its contents), built on the same functions;
 * the errors: ``MechgenError`` and its kinds.
 
@@ -49,6 +49,8 @@ _EXPORTS = {
     "symplectic": "mechgen.analyses.public",
     "rod_statics": "mechgen.analyses.public",
     "rod_dynamics": "mechgen.analyses.public",
+    "phase_boundary": "mechgen.analyses.public",
+    "phase_kinetics": "mechgen.analyses.public",
     "analysis": "mechgen.analyses.public",
     "MechgenError": "mechgen.errors",
     "InputError": "mechgen.errors",
