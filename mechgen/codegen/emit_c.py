@@ -115,3 +115,16 @@ def quick_build(ir: KernelIR) -> str:
     statements = sum(len(b.assignments) + len(b.writes) for b in ir.blocks if not b.loop)
     low, none = QUICK_BUILD_STATEMENTS
     return "O0" if statements > none else "O1" if statements > low else ""
+
+
+def emit_c(irs: list[KernelIR], *, model: str, title: str) -> str:
+    """The C99 source of all kernels of one model specialisation.
+
+    The model name, ``title`` (the specialisation's key, choice values included) and kernel and
+    port docs reach the source only through :func:`~mechgen.codegen.escape.c_comment`.
+    """
+    return render("c99/kernels.c.j2", version=__version__, model=c_comment(model).replace("\n", " "),
+                  title="\n * ".join(c_comment_lines(title, "")), kernels=[kernel_context(ir) for ir in irs])
+
+
+__all__ = ["emit_c", "kernel_context", "Port"]
