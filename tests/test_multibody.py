@@ -158,3 +158,20 @@ def test_chain_sums_share_their_prefixes():
         T = ca.Function("T", [eqs.inputs["q"], eqs.inputs["v"], eqs.inputs["p"]], [eqs.pieces["T"]])
         counts.append(T.n_instructions())
     assert counts[1] <= 2.1 * counts[0]
+
+
+def test_mass_solve_cholesky_with_lu_where_not_positive_definite():
+    """mass_solve equals LU's solution for an SPD matrix (to round-off), solves an indefinite one by LU, and a
+    singular one raises as numpy's solve does."""
+    from mechgen.runtime.core.system import mass_solve
+
+    rng = np.random.default_rng(3)
+    A = rng.normal(size=(6, 6))
+    b = rng.normal(size=6)
+    spd = A @ A.T + 6 * np.eye(6)
+    assert np.allclose(mass_solve(spd, b), np.linalg.solve(spd, b), rtol=1e-13, atol=1e-15)
+    indefinite = np.diag([1.0, -2.0, 3.0, 1.0, 1.0, 1.0])
+    assert np.allclose(mass_solve(indefinite, b), b / np.diag(indefinite), rtol=1e-15)
+    with pytest.raises(np.linalg.LinAlgError):
+        mass_solve(np.zeros((6, 6)), b)
+    assert mass_solve(np.zeros((0, 0)), np.zeros(0)).shape == (0,)
