@@ -15,10 +15,6 @@ import casadi as ca
 import sympy as sp
 
 
-#: sums of more terms are not built on a previous sum (each step of such a chain nests one Python call)
-_MAX_CHAIN = 400
-
-
 class NotConvertible(ValueError):
     """An expression holds a function the CasADi path does not convert (the reason is the message)."""
 
@@ -35,13 +31,12 @@ class SXForm:
         self.memo: dict = dict(symbols)
         #: the SX of every sum converted so far, by the set of its terms (:meth:`_sum`)
         self.sums: dict[frozenset, ca.SX] = {}
-        #: the sums of the expression being converted, by the set of their terms
-        self.present: dict[frozenset, sp.Add] = {}
 
     def __call__(self, expr) -> ca.SX:
         """The SX of ``expr`` (a sympy expression in the symbols given at construction)."""
         expr = sp.sympify(expr)
-        self.present = {frozenset(n.args): n for n in _sums(expr, self.memo)}
+        for node in _sums_by_size(expr, self.memo):  # every smaller sum first: a sum's prefix is converted before it
+            self._convert(node)
         return self._convert(expr)
 
     def _convert(self, expr) -> ca.SX:
@@ -87,28 +82,34 @@ class SXForm:
         terms = frozenset(node.args)
         if len(terms) > 2:
             for a in node.args:
-                rest = terms - {a}
-                if rest not in self.sums and rest in self.present and len(rest) < _MAX_CHAIN:
-                    self._convert(self.present[rest])  # a chain of sums: depth up to its length
-                if rest in self.sums:
-                    self.sums[terms] = self.sums[rest] + self.memo[a]
+                rest = self.sums.get(terms - {a})
+                if rest is not None:
+                    self.sums[terms] = rest + self.memo[a]
                     return self.sums[terms]
         self.sums[terms] = _fold([self.memo[a] for a in node.args], lambda x, y: x + y)
         return self.sums[terms]
 
 
-def _sums(expr, done: dict) -> list:
-    """The sums inside ``expr`` not converted yet."""
-    seen, order, stack = set(), [], [expr]
-    while stack:
-        node = stack.pop()
-        if node in seen or node in done:
+def _sums_by_size(expr, done: dict) -> list:
+    """The sums inside ``expr`` not converted yet, in increasing size of their trees (ties in the order of a
+    depth-first walk over the distinct nodes: deterministic, sympy's argument order being canonical). A sum of all
+    the terms of another but one is the larger, and so is any sum holding another, so converting in this order
+    finds every prefix already converted."""
+    size: dict = {}
+    order: list = []
+    stack = [(expr, False)]
+    while stack:  # post-order over distinct nodes, without recursion
+        node, ready = stack.pop()
+        if node in size or node in done:
             continue
-        seen.add(node)
-        if node.is_Add:
-            order.append(node)
-        stack.extend(node.args)
-    return order
+        if ready:
+            size[node] = 1 + sum(size.get(a, 1) for a in node.args)
+            if node.is_Add:
+                order.append(node)
+            continue
+        stack.append((node, True))
+        stack.extend((a, False) for a in node.args if a not in size and a not in done)
+    return sorted(order, key=lambda n: size[n])
 
 
 def _fold(args: list, op) -> ca.SX:
