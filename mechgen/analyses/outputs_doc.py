@@ -460,6 +460,20 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("dt", "scalar", "s", "The time step."),
         _o("elements", "scalar (int)", "-", "Elements."),
     ),
+    "orr_sommerfeld": (
+        _o("least_stable_c", "(2,)", "U_c", "[Re c, Im c] of the resolved eigenvalue with the largest Im c (at N_check)."),
+        _o("growth_rate", "scalar", "U_c / h", "alpha Im c of the least stable mode."),
+        _o("verdict", "string", "-", "``unstable`` where Im c > 0, else ``stable``."),
+        _o("eigenvalues", "(count, 2)", "U_c", "The resolved wave speeds [Re c, Im c], least stable first."),
+        _o("resolved", "scalar (int)", "-", "Eigenvalues that agree between N and N_check within tol."),
+        _o("rejected", "scalar (int)", "-", "Eigenvalues at N that do not reappear at N_check (not reported)."),
+        _o("resolution", "(2,)", "-", "[N, N_check], the two numbers of collocation intervals."),
+        _o("least_stable_change", "scalar", "U_c", "\\|c(N) - c(N_check)\\| of the least stable eigenvalue."),
+        _o("critical_Re", "scalar", "-", "The smallest Re of the neutral curve (Im c = 0, d Im c / d alpha = 0), at N."),
+        _o("critical_alpha", "scalar", "1/h", "The wavenumber at critical_Re."),
+        _o("critical_c", "(2,)", "U_c", "[Re c, Im c] at the critical point (Im c zero to the Newton tolerance)."),
+        _o("critical_Re_change", "scalar", "-", "\\|Re_c(N) - Re_c(N_check)\\|."),
+    ),
 }
 
 

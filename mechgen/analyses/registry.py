@@ -33,6 +33,7 @@ MODULES = (
     "mechgen.analyses.symplectic",
     "mechgen.analyses.rod_statics",
     "mechgen.analyses.rod_dynamics",
+    "mechgen.analyses.orr_sommerfeld",
 )
 
 
