@@ -85,3 +85,12 @@ def test_same_resolutions_refused(tmp_path):
     scene.write_text(SCENE.read_text().replace("N = 64", "N = 64\nN_check = 64"))
     with pytest.raises(SceneError, match="N_check"):
         run_scene(str(scene))
+
+
+def test_scene_values_reach_the_analysis(tmp_path):
+    """The scene's Re is the one solved (alpha, Re kept free in the kernels): Re = 5000 < Re_c is stable at
+    alpha = 1 (Orszag 1971: the neutral curve's minimum is Re_c = 5772.22)."""
+    scene = tmp_path / "os.toml"
+    scene.write_text(SCENE.read_text().replace("Re = 1.0e4", "Re = 5.0e3").replace("count = 8", "critical = false"))
+    out = run_scene(str(scene))["analyses"][0]["outputs"]
+    assert out["verdict"] == "stable" and out["least_stable_c"][1] < 0 and "critical_Re" not in out

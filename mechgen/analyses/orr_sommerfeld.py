@@ -74,6 +74,11 @@ SCHEMA = {
 }
 
 
+def frees(options: dict) -> list[str]:
+    """The parameters the analysis reads, kept free so that the system carries the scene's values."""
+    return list(PARAMS)
+
+
 def needs(options: dict, *, internal: bool) -> set[str]:
     """Only the (empty) outputs kernel, which every model has, so that a compile request names a kernel: the
     model supplies alpha and Re, the base flow is the analysis's."""
@@ -123,5 +128,5 @@ def run_orr_sommerfeld(system, options: dict, context: dict) -> dict:
     return out
 
 
-register(AnalysisKind("orr_sommerfeld", SCHEMA, run_orr_sommerfeld, needs, summary.lines, check=check,
+register(AnalysisKind("orr_sommerfeld", SCHEMA, run_orr_sommerfeld, needs, summary.lines, check=check, frees=frees,
                       sweepable=True))

@@ -474,6 +474,20 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("critical_c", "(2,)", "U_c", "[Re c, Im c] at the critical point (Im c zero to the Newton tolerance)."),
         _o("critical_Re_change", "scalar", "-", "\\|Re_c(N) - Re_c(N_check)\\|."),
     ),
+    "shear_curve": (
+        _o("shear_rate", "(samples,)", "1/lambda", "The sampled shear rates, 0 to rate_max."),
+        _o("stress", "(samples,)", "eta_p/lambda", "T(g) = epsilon g + g / (1 + xi (2 - xi) g^2) at those rates."),
+        _o("monotone", "bool", "-", "Whether T(g) is monotone (epsilon >= 1/8, or xi = 0 or 2)."),
+        _o("shear_rate_max", "scalar", "1/lambda", "The rate of T's local maximum (absent when monotone)."),
+        _o("stress_max", "scalar", "eta_p/lambda", "T's local maximum (absent when monotone)."),
+        _o("shear_rate_min", "scalar", "1/lambda", "The rate of T's local minimum (absent when monotone)."),
+        _o("stress_min", "scalar", "eta_p/lambda", "T's local minimum (absent when monotone)."),
+        _o("note", "string", "-", "Present when monotone: no extrema, no fold, no spurt."),
+        _o("hopf", "string", "-", "``none``: no equilibrium of the stress-controlled local law has an imaginary pair."),
+        _o("pair_trace_max", "scalar", "1/lambda", "The largest sum of the eigenvalue pair other than -1 over the "
+           "sampled curve, -2 - 1/(epsilon (1 + k g^2)) < 0."),
+        _o("off_manifold_eigenvalue", "scalar", "1/lambda", "-1: the rate of xi tau_xx + (2 - xi) tau_yy."),
+    ),
 }
 
 

@@ -34,6 +34,7 @@ MODULES = (
     "mechgen.analyses.rod_statics",
     "mechgen.analyses.rod_dynamics",
     "mechgen.analyses.orr_sommerfeld",
+    "mechgen.analyses.shear_curve",
 )
 
 
