@@ -488,6 +488,21 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
            "sampled curve, -2 - 1/(epsilon (1 + k g^2)) < 0."),
         _o("off_manifold_eigenvalue", "scalar", "1/lambda", "-1: the rate of xi tau_xx + (2 - xi) tau_yy."),
     ),
+    "channel_flow": (
+        _o("monotone", "bool", "-", "Whether the shear curve is monotone (no spurt)."),
+        _o("note", "string", "-", "Present when monotone: one steady solution at every G."),
+        _o("spurt_gradient", "scalar", "eta_p/lambda", "G at which the wall stress reaches T_max (absent when monotone)."),
+        _o("G", "(samples,)", "eta_p/lambda", "Pressure gradients along the classical branch, 0 to spurt_gradient."),
+        _o("flow_rate", "(samples,)", "h^2/lambda", "Flux per unit width through the channel on the classical branch."),
+        _o("G_above", "(samples,)", "eta_p/lambda", "Pressure gradients from spurt_gradient to G_max."),
+        _o("flow_rate_top", "(samples,)", "h^2/lambda", "Flux of the top-jumping solution (jump where G y = T_max)."),
+        _o("flow_rate_bottom", "(samples,)", "h^2/lambda", "Flux of the bottom-jumping solution (jump where G y = T_min)."),
+        _o("jump_position_top", "(samples,)", "h", "y of the top-jumping solution's jump, T_max / G."),
+        _o("jump_position_bottom", "(samples,)", "h", "y of the bottom-jumping solution's jump, T_min / G."),
+        _o("flow_rate_at_G", "scalar", "h^2/lambda", "Classical flux at the model's G (G <= spurt_gradient)."),
+        _o("flow_rate_top_at_G", "scalar", "h^2/lambda", "Top-jumping flux at the model's G (above the threshold)."),
+        _o("flow_rate_bottom_at_G", "scalar", "h^2/lambda", "Bottom-jumping flux at the model's G (above the threshold)."),
+    ),
 }
 
 

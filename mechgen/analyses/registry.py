@@ -35,6 +35,7 @@ MODULES = (
     "mechgen.analyses.rod_dynamics",
     "mechgen.analyses.orr_sommerfeld",
     "mechgen.analyses.shear_curve",
+    "mechgen.analyses.channel_flow",
 )
 
 

@@ -88,3 +88,74 @@ def classical_rate(stress: float, epsilon: float, xi: float) -> float:
     if stress >= T_max:
         return g_max
     return brentq(lambda g: total_stress(g, epsilon, xi) - stress, 0.0, g_max, xtol=1e-14, rtol=1e-14)
+
+
+def stress_square_integral(rate: float, epsilon: float, xi: float) -> float:
+    """I(g) = int_0^g T(s)^2 ds in closed form (k = xi (2 - xi) > 0):
+    eps^2 g^3/3 + 2 eps (g/k - atan(sqrt(k) g)/k^(3/2)) + (atan(sqrt(k) g)/sqrt(k) - g/(1 + k g^2))/(2 k);
+    for k = 0, (1 + eps)^2 g^3 / 3."""
+    k = slip_factor(xi)
+    if k <= 0.0:
+        return (1.0 + epsilon) ** 2 * rate**3 / 3.0
+    r = math.sqrt(k)
+    x = r * rate
+    return (epsilon**2 * rate**3 / 3.0 + 2.0 * epsilon * atan_remainder(x) / k**1.5
+            + atan_pair(x) / (2.0 * k * r))
+
+
+#: below this x the atan differences are summed as series (their closed forms cancel: relative error eps / x^2)
+SERIES_BELOW = 1e-2
+
+
+def atan_remainder(x: float) -> float:
+    """x - atan(x) (= x^3/3 - x^5/5 + x^7/7 - x^9/9 + ... for small x)."""
+    if x < SERIES_BELOW:
+        return x**3 * (1.0 / 3.0 - x**2 * (1.0 / 5.0 - x**2 * (1.0 / 7.0 - x**2 / 9.0)))
+    return x - math.atan(x)
+
+
+def atan_pair(x: float) -> float:
+    """atan(x) - x / (1 + x^2) (= 2x^3/3 - 4x^5/5 + 6x^7/7 - 8x^9/9 + ... for small x)."""
+    if x < SERIES_BELOW:
+        return x**3 * (2.0 / 3.0 - x**2 * (4.0 / 5.0 - x**2 * (6.0 / 7.0 - x**2 * 8.0 / 9.0)))
+    return math.atan(x) - x / (1.0 + x**2)
+
+
+def branch_flux(g1: float, g2: float, epsilon: float, xi: float) -> float:
+    """int T g dT along a monotone piece of the curve from rate g1 to g2 (by parts in g:
+    [g T^2/2] - int T^2/2 dg), the contribution of that piece to G^2 Q / 2."""
+    T1, T2 = float(total_stress(g1, epsilon, xi)), float(total_stress(g2, epsilon, xi))
+    return 0.5 * (g2 * T2**2 - g1 * T1**2) - 0.5 * (stress_square_integral(g2, epsilon, xi)
+                                                     - stress_square_integral(g1, epsilon, xi))
+
+
+def high_rate(stress: float, epsilon: float, xi: float) -> float:
+    """The root g >= g_min of T(g) = stress on the high-rate branch (stress >= T_min), by Brent's method."""
+    (_, _), (g_min, T_min) = extrema(epsilon, xi)
+    if stress <= T_min:
+        return g_min
+    high = 2.0 * g_min
+    while total_stress(high, epsilon, xi) < stress:
+        high *= 2.0
+    return brentq(lambda g: total_stress(g, epsilon, xi) - stress, g_min, high, xtol=1e-14, rtol=1e-14)
+
+
+def flow_rate(G: float, epsilon: float, xi: float, jump: str | None = None) -> tuple[float, float]:
+    """(Q, y_jump): the flux per unit width through the channel -1 < y < 1 at pressure gradient G (wall stress
+    G), Q = 2 int_0^1 y g(G y) dy = (2/G^2) int_0^G T g(T) dT, and the position of the jump in shear rate
+    (1 where there is none). ``jump`` None: the classical branch (G <= T_max); "top": the rate jumps to the
+    high branch where G y = T_max; "bottom": where G y = T_min (G >= T_max resp. T_min)."""
+    if G <= 0.0:
+        return 0.0, 1.0
+    if jump is None:
+        return 2.0 * branch_flux(0.0, classical_rate(G, epsilon, xi), epsilon, xi) / G**2, 1.0
+    top = extrema(epsilon, xi)
+    if top is None:
+        raise ValueError("a jumping solution needs a non-monotone curve (epsilon < 1/8, 0 < xi < 2)")
+    T_jump = top[0][1] if jump == "top" else top[1][1]
+    if G < T_jump:
+        raise ValueError(f"no {jump}-jumping solution below G = {T_jump!r}")
+    g_low = top[0][0] if jump == "top" else classical_rate(T_jump, epsilon, xi)
+    g_high = high_rate(T_jump, epsilon, xi)
+    flux = branch_flux(0.0, g_low, epsilon, xi) + branch_flux(g_high, high_rate(G, epsilon, xi), epsilon, xi)
+    return 2.0 * flux / G**2, T_jump / G

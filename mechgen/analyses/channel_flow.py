@@ -1,0 +1,114 @@
+"""``channel_flow``: steady pressure-driven channel flow of a Johnson-Segalman fluid, from its local law.
+
+The model supplies ``epsilon``, ``xi`` and the pressure gradient ``G`` (built-in ``js_channel``; walls at
+y = -1, 1, stress in eta_p / lambda). In a steady state the total shear stress is G |y|, so the shear rate at
+each y is a root g(G y) of T(g) = epsilon g + g / (1 + xi (2 - xi) g^2) (mechgen.runtime.fluids.johnson_segalman).
+The classical (low-rate) solution exists up to the wall stress G = T_max, the curve's local maximum:
+``spurt_gradient`` (exact, before any discretisation). The flux per unit width through the channel,
+
+    Q(G) = 2 int_0^1 y g(G y) dy = (2 / G^2) int_0^G T g(T) dT,
+
+is summed in closed form (integration by parts in g: int T g dT = [g T^2/2] - int T^2/2 dg, with
+int T^2 dg elementary). Outputs: ``spurt_gradient``; the classical flow curve ``G`` (``samples`` values from 0
+to spurt_gradient) and ``flow_rate``; above the threshold (``G_above``, ``samples`` values from spurt_gradient to
+``G_max``, default 1.5 x spurt_gradient) the two jumping solutions: ``flow_rate_top`` (the rate jumps to the high
+branch where G y = T_max) and ``flow_rate_bottom`` (where G y = T_min), with ``jump_position_top`` and
+``jump_position_bottom`` (y of the jump); at the model's G, ``flow_rate_at_G`` (classical, when G <=
+spurt_gradient) or ``flow_rate_top_at_G`` and ``flow_rate_bottom_at_G``. For a monotone curve (epsilon >= 1/8)
+there is no spurt: ``monotone`` true, a ``note``, the classical curve up to ``G_max`` (default 2) and no
+threshold or jumping outputs.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from mechgen.analyses import summary
+from mechgen.analyses.parameters import parameter_dict
+from mechgen.analyses.registry import AnalysisKind, register
+from mechgen.analyses.schema import Option, count_within, positive
+from mechgen.errors import InputError
+from mechgen.runtime.fluids.johnson_segalman import extrema, flow_rate
+from mechgen.scene.values import fail
+
+PARAMS = ("epsilon", "xi", "G")
+SAMPLED = ("G", "flow_rate", "G_above", "flow_rate_top", "flow_rate_bottom", "jump_position_top",
+           "jump_position_bottom")
+
+
+def check(ctx, base: str, options: dict) -> None:
+    """The model has parameters epsilon, xi and G."""
+    missing = [p for p in PARAMS if p not in ctx.model.params]
+    if missing:
+        raise fail(ctx.file, f"{base}.kind", f"model {ctx.model.name} has no parameter {', '.join(missing)}",
+                   "a model with parameters epsilon, xi and G (the built-in js_channel)")
+
+
+SCHEMA = {
+    "samples": Option(count_within("samples"), 101, doc="Pressure gradients sampled on each part of the flow curve."),
+    "G_max": Option(positive, doc="Largest sampled pressure gradient (default 1.5 x spurt_gradient, or 2 if none)."),
+}
+
+
+def frees(options: dict) -> list[str]:
+    """The parameters the analysis reads, kept free so that the system carries the scene's values."""
+    return list(PARAMS)
+
+
+def needs(options: dict, *, internal: bool) -> set[str]:
+    """Only the outputs kernel (closed forms in the parameters)."""
+    return {"outputs"}
+
+
+def jumping(G_values: np.ndarray, epsilon: float, xi: float) -> dict:
+    """The top- and bottom-jumping flow rates and jump positions at each G (all above the threshold)."""
+    out = {"G_above": G_values.tolist()}
+    for jump in ("top", "bottom"):
+        pairs = [flow_rate(float(G), epsilon, xi, jump) for G in G_values]
+        out[f"flow_rate_{jump}"] = [q for q, _ in pairs]
+        out[f"jump_position_{jump}"] = [y for _, y in pairs]
+    return out
+
+
+def at_gradient(G: float, spurt: float | None, epsilon: float, xi: float) -> dict:
+    """The flow rates at the model's own G."""
+    if spurt is None or G <= spurt:
+        return {"flow_rate_at_G": flow_rate(G, epsilon, xi)[0]}
+    return {"flow_rate_top_at_G": flow_rate(G, epsilon, xi, "top")[0],
+            "flow_rate_bottom_at_G": flow_rate(G, epsilon, xi, "bottom")[0]}
+
+
+def run_channel_flow(system, options: dict, context: dict) -> dict:
+    """The spurt threshold, the flow curve and the jumping solutions."""
+    values = parameter_dict(system, system.params)
+    epsilon, xi, G = values["epsilon"], values["xi"], values["G"]
+    if not (epsilon > 0.0 and 0.0 <= xi <= 2.0 and G >= 0.0):
+        raise InputError(f"channel_flow needs epsilon > 0, 0 <= xi <= 2, G >= 0; got epsilon = {epsilon:g}, "
+                         f"xi = {xi:g}, G = {G:g}", key="params", expected="epsilon > 0, 0 <= xi <= 2 and G >= 0")
+    top = extrema(epsilon, xi)
+    spurt = top[0][1] if top else None
+    n = options["samples"]
+    if spurt is None:
+        grid = np.linspace(0.0, options.get("G_max") or 2.0, n)
+        out = {"monotone": True, "note": f"epsilon = {epsilon:g}, xi = {xi:g}: the shear curve is monotone, "
+               "no spurt: one steady solution at every G"}
+    else:
+        G_max = options.get("G_max") or 1.5 * spurt
+        if G_max <= spurt:
+            raise InputError(f"channel_flow: G_max = {G_max:g} is not above the spurt gradient {spurt:.6g}",
+                             key="G_max", expected="a G_max above spurt_gradient")
+        grid = np.linspace(0.0, spurt, n)
+        out = {"monotone": False, "spurt_gradient": spurt}
+    out.update({"G": grid.tolist(), "flow_rate": [flow_rate(float(g), epsilon, xi)[0] for g in grid]})
+    if spurt is not None:
+        out.update(jumping(np.linspace(spurt, G_max, n), epsilon, xi))
+    out.update(at_gradient(G, spurt, epsilon, xi))
+    return out
+
+
+def lines(outputs: dict) -> list[str]:
+    """Every output but the sampled curves."""
+    return summary.output_lines(outputs, skip=SAMPLED)
+
+
+register(AnalysisKind("channel_flow", SCHEMA, run_channel_flow, needs, lines, check=check, frees=frees,
+                      sweepable=True))

@@ -1,0 +1,86 @@
+"""Johnson-Segalman channel flow from the local law (issue 28 item 3; seed 002, Khayat & Ashrafi).
+
+References: the spurt threshold is the maximum of T(g) = epsilon g + g / (1 + xi (2 - xi) g^2) (found here by
+scipy's bounded minimiser); the flow rate Q(G) = 2 int_0^1 y g(G y) dy by scipy's quad, g by scipy's brentq on a
+hand-written T (mechgen sums it in closed form after an integration by parts); the Newtonian limit xi = 0,
+Q = 2 G / (3 (1 + epsilon)).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.integrate import quad
+from scipy.optimize import brentq, minimize_scalar
+
+from mechgen.runtime.fluids import johnson_segalman as js
+from mechgen.scene.run import run_scene
+
+SCENE = Path(__file__).resolve().parents[1] / "scenes" / "js_channel.toml"
+EPS, XI = 0.06, 0.2
+K = XI * (2 - XI)
+
+
+def T(g, eps=EPS):
+    return eps * g + g / (1 + K * g**2)
+
+
+def rate(stress, low, high):
+    """The root of T(g) = stress in [low, high] (a bracket holding one branch)."""
+    return 0.0 if stress <= 0 else brentq(lambda g: T(g) - stress, low, high, xtol=1e-15, rtol=1e-15)
+
+
+def reference_Q(G, jump_stress=None):
+    """2 int_0^1 y g(G y) dy by quad; above jump_stress the rate is on the high branch."""
+    g3 = np.sqrt(3 / K)
+    g_min = minimize_scalar(T, bounds=(g3, 100 * g3), method="bounded", options={"xatol": 1e-13}).x
+    g_max = minimize_scalar(lambda g: -T(g), bounds=(0, g3), method="bounded", options={"xatol": 1e-13}).x
+    low = lambda y: y * rate(G * y, 0.0, g_max)  # noqa: E731
+    if jump_stress is None:
+        return 2 * quad(low, 0, 1, epsabs=0, epsrel=1e-13)[0]
+    high = lambda y: y * rate(G * y, g_min, 1e3)  # noqa: E731
+    yj = jump_stress / G
+    return 2 * (quad(low, 0, yj, epsabs=0, epsrel=1e-13)[0] + quad(high, yj, 1, epsabs=0, epsrel=1e-13)[0])
+
+
+def test_spurt_threshold_is_the_curve_maximum():
+    top = minimize_scalar(lambda g: -T(g), bounds=(0, np.sqrt(3 / K)), method="bounded", options={"xatol": 1e-12})
+    (g_max, T_max), _ = js.extrema(EPS, XI)
+    assert abs(T_max + top.fun) < 1e-13  # the maximum's value is flat in g: round-off only
+    assert js.classical_rate(T_max, EPS, XI) == g_max
+    with pytest.raises(ValueError, match="above the classical branch"):
+        js.classical_rate(T_max * (1 + 1e-9), EPS, XI)
+
+
+@pytest.mark.parametrize("G", [1e-3, 0.1, 0.5, 0.9, 0.94])
+def test_classical_flow_rate_against_quad(G):
+    # quad of a brentq root: both to ~1e-13 relative; the closed form's cancellations stay below 1e-11
+    assert abs(js.flow_rate(G, EPS, XI)[0] / reference_Q(G) - 1) < 1e-10
+
+
+@pytest.mark.parametrize("G", [1.0, 1.3])
+def test_jumping_flow_rates_against_quad(G):
+    (_, T_max), (_, T_min) = js.extrema(EPS, XI)
+    for jump, stress in (("top", T_max), ("bottom", T_min)):
+        Q, y_jump = js.flow_rate(G, EPS, XI, jump)
+        assert abs(y_jump - stress / G) < 1e-15
+        assert abs(Q / reference_Q(G, stress) - 1) < 1e-10
+
+
+def test_newtonian_limit():
+    """xi = 0 (Oldroyd-B in shear): T = (1 + epsilon) g, Q = 2 G / (3 (1 + epsilon)), no spurt."""
+    assert abs(js.flow_rate(0.7, EPS, 0.0)[0] - 2 * 0.7 / (3 * (1 + EPS))) < 1e-15
+    assert js.extrema(EPS, 0.0) is None
+
+
+def test_scene_outputs(tmp_path):
+    out = run_scene(str(SCENE))["analyses"][0]["outputs"]
+    (_, T_max), _ = js.extrema(EPS, XI)
+    assert out["spurt_gradient"] == T_max and out["G"][-1] == T_max
+    assert abs(out["flow_rate_at_G"] / reference_Q(0.5) - 1) < 1e-10
+    assert np.all(np.diff(out["flow_rate"]) > 0) and np.all(np.array(out["flow_rate_bottom"]) > out["flow_rate_top"])
+    scene = tmp_path / "mono.toml"
+    scene.write_text(SCENE.read_text().replace("epsilon = 0.06", "epsilon = 0.2"))
+    mono = run_scene(str(scene))["analyses"][0]["outputs"]
+    assert mono["monotone"] is True and "spurt_gradient" not in mono and "flow_rate_at_G" in mono
