@@ -21,6 +21,19 @@ threshold** :math:`G_s = T_{max}`, exact before any discretisation. Its flux per
 is summed in closed form (``channel_flow``). Above :math:`G_s` the rate must jump to the high branch: at
 :math:`G y = T_{max}` (top-jumping) or :math:`G y = T_{min}` (bottom-jumping). Reference: scipy's ``quad`` of the
 defining integral with the rate found by ``brentq``; :math:`\\epsilon = 0.06`, :math:`\\xi = 0.2` as in the paper.
+
+**Spectrum.** ``channel_spectrum`` linearises the classical state at G = 0.5, Re = 1 (Chebyshev collocation at
+two resolutions, the local blocks from the model's generated stress laws):
+
+.. math::
+
+    Re\\,\\lambda u = \\epsilon u'' + \\tau_{xy}', \\qquad \\lambda \\sigma = J_\\sigma(y)\\,\\sigma + J_g(y)\\, u' .
+
+The local stress-controlled eigenvalues :math:`\\lambda_{loc}(T = G y)` (the eigenvalues of
+:math:`J_\\sigma - J_g e_{xy}^T/\\epsilon`) form the essential spectrum, drawn as a band and reported apart
+from the point eigenvalues. Reference for the point eigenvalues: for :math:`\\xi = 0` the closed form
+:math:`Re\\,\\lambda^2 + (Re + \\epsilon\\kappa^2)\\lambda + \\kappa^2(1 + \\epsilon) = 0`,
+:math:`\\kappa = n\\pi/2` (drawn here), and an independent finite-difference discretisation (tests/test_js_channel_spectrum.py).
 """
 from pathlib import Path
 
@@ -33,7 +46,8 @@ import mechgen
 
 here = Path(__file__).resolve().parent if "__file__" in globals() else Path.cwd()
 scene = next(p / "scenes" / "js_channel.toml" for p in (here, *here.parents) if (p / "scenes").is_dir())
-out = mechgen.run(str(scene))["analyses"][0]["outputs"]
+results = {a["name"]: a["outputs"] for a in mechgen.run(str(scene))["analyses"]}
+out, spectrum = results["flow_curve"], results["spectrum"]
 
 eps, xi = 0.06, 0.2
 k = xi * (2 - xi)
@@ -64,4 +78,30 @@ ax.text(out["spurt_gradient"], 0.2, " spurt", color="0.4")
 ax.set(xlabel="pressure gradient G (eta_p / lambda per half-width)", ylabel="flow rate Q",
        title="Johnson-Segalman channel, epsilon = 0.06, xi = 0.2")
 ax.legend()
+plt.show()
+
+# %%
+# The spectrum at G = 0.5, Re = 1: point eigenvalues and the essential band; the same analysis at xi = 0 against the
+# Oldroyd-B closed form.
+point = np.array([complex(*v) for v in spectrum["eigenvalues"]])
+print("rightmost point eigenvalues:", ", ".join(f"{v.real:.6f}{v.imag:+.6f}i" for v in point[:5]))
+print("essential spectrum, centre:", [complex(*v) for v in spectrum["essential_spectrum"][0]])
+print("essential spectrum, wall:  ", [complex(*v) for v in spectrum["essential_spectrum"][1]])
+oldroyd = next(a["outputs"] for a in mechgen.run(str(scene), overrides=["xi=0"])["analyses"] if a["name"] == "spectrum")
+found = np.array([complex(*v) for v in oldroyd["eigenvalues"]])
+roots = [r for n in range(1, 5) for r in np.roots([1.0, 1.0 + eps * (n * np.pi / 2) ** 2, (n * np.pi / 2) ** 2 * (1 + eps)])]
+err = max(np.min(np.abs(found - r)) for r in roots)
+print(f"xi = 0: point eigenvalues vs Re l^2 + (Re + eps k^2) l + k^2 (1 + eps) = 0, n = 1..4: largest error {err:.1e}")
+assert err < 1e-8
+
+fig, ax = plt.subplots(figsize=(6.4, 4.4))
+ax.plot(point.real, point.imag, "o", mfc="none", color="C0", label="point eigenvalues, xi = 0.2")
+ax.plot(found.real, found.imag, "x", color="C1", label="point eigenvalues, xi = 0")
+ax.plot(np.real(roots), np.imag(roots), "+", color="k", ms=12, label="closed form, xi = 0")
+for end in spectrum["essential_spectrum"]:
+    ax.plot([v[0] for v in end], [v[1] for v in end], "s", color="0.5", mfc="none", ms=8)
+ax.plot([], [], "s", color="0.5", mfc="none", label="essential band ends, xi = 0.2 (centre, wall)")
+ax.set(xlim=(-3, 0.2), ylim=(-6, 6), xlabel="Re lambda", ylabel="Im lambda",
+       title=f"linearised channel, G = 0.5, Re = 1 (band's right end {spectrum['essential_rightmost']:.3f})")
+ax.legend(loc="upper left", fontsize=8)
 plt.show()

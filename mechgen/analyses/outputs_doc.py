@@ -503,6 +503,20 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("flow_rate_top_at_G", "scalar", "h^2/lambda", "Top-jumping flux at the model's G (above the threshold)."),
         _o("flow_rate_bottom_at_G", "scalar", "h^2/lambda", "Bottom-jumping flux at the model's G (above the threshold)."),
     ),
+    "channel_spectrum": (
+        _o("eigenvalues", "(count, 2)", "1/lambda", "The resolved point spectrum [Re, Im], rightmost first (band copies "
+           "left out)."),
+        _o("rightmost", "(2,)", "1/lambda", "The first of them (absent when there is none)."),
+        _o("verdict", "string", "-", "``unstable`` where a point or band eigenvalue has Re > 0, else ``stable``."),
+        _o("essential_spectrum", "(2, 3, 2)", "1/lambda", "The band's ends: the local stress-controlled eigenvalues "
+           "at the centre y = 0 and at the wall y = 1."),
+        _o("essential_rightmost", "scalar", "1/lambda", "The largest Re lambda_loc(T = G y) over 0 <= y <= 1."),
+        _o("band_eigenvalues", "scalar (int)", "-", "Resolved eigenvalues lying on the band (not point eigenvalues)."),
+        _o("rejected", "scalar (int)", "-", "Eigenvalues at N that do not reappear at N_check."),
+        _o("resolution", "(2,)", "-", "[N, N_check]."),
+        _o("base_residual", "scalar", "eta_p/lambda^2", "The generated rates at the base state (zero: the model is "
+           "the law of the closed-form base state)."),
+    ),
 }
 
 

@@ -36,6 +36,7 @@ MODULES = (
     "mechgen.analyses.orr_sommerfeld",
     "mechgen.analyses.shear_curve",
     "mechgen.analyses.channel_flow",
+    "mechgen.analyses.channel_spectrum",
 )
 
 

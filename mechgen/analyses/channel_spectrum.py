@@ -1,0 +1,153 @@
+"""``channel_spectrum``: eigenvalues of a Johnson-Segalman channel flow linearised about its classical steady state.
+
+The model (built-in ``js_channel``) supplies ``epsilon``, ``xi``, ``Re``, ``G`` and declares the local stress laws at
+an imposed shear rate ``shear_rate`` (internal variables tau_xx, tau_yy, tau_xy). The base state is the classical
+one, shear rate g_b(y) = -sign(y) g(G |y|) with g the low-rate root of the local shear curve
+(mechgen.runtime.fluids.johnson_segalman; G <= the spurt gradient, else refused) and the steady stresses; the
+generated kernels' residual there is checked to vanish (the model is the law the base state is for). At each
+Chebyshev point the rates kernel's Jacobian J_sigma and its derivative in the shear rate J_g (f is affine in g:
+a central difference is exact to round-off) are the local blocks of the linearised channel
+(mechgen.runtime.spectral.channel):
+
+    Re lambda u = epsilon u'' + (tau_xy)',   lambda sigma = J_sigma(y) sigma + J_g(y) u',   u = 0 at y = +-1,
+
+solved at ``N`` and ``N_check`` intervals (default round(1.5 N)); an eigenvalue is kept when it reappears at the
+other resolution within ``tol`` * max(1, |lambda|). The local stress-controlled eigenvalues lambda_loc(T = G y)
+form the essential spectrum: sampled over 0 <= y <= 1 at ``band_samples`` points, kept eigenvalues on that band
+are reported apart (``band_eigenvalues``), not as point eigenvalues.
+
+Outputs: ``eigenvalues`` (the resolved point spectrum, rightmost first, at most ``count``, each [Re, Im]),
+``rightmost`` ([Re, Im] of the first, absent when none), ``verdict`` (stable / unstable by the rightmost point and
+band eigenvalues), ``essential_spectrum`` (the band's ends: the local eigenvalues at the centre y = 0 and at the
+wall y = 1, each a list of [Re, Im]), ``essential_rightmost`` (the largest Re lambda_loc over y),
+``band_eigenvalues`` and ``rejected`` (how many), ``resolution`` [N, N_check], ``base_residual``.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from mechgen.analyses import summary
+from mechgen.analyses.orr_sommerfeld import intervals, pair
+from mechgen.analyses.parameters import parameter_dict
+from mechgen.analyses.registry import AnalysisKind, register
+from mechgen.analyses.schema import Option, count, count_within, positive
+from mechgen.errors import InputError, KernelError
+from mechgen.runtime.fluids.johnson_segalman import classical_rate, extrema, polymer_stresses
+from mechgen.runtime.spectral.channel import LocalBlocks, eigenvalues, local_eigenvalues, off_band
+from mechgen.runtime.spectral.chebyshev import points, resolved
+from mechgen.scene.values import fail
+
+PARAMS = ("epsilon", "xi", "Re", "G", "shear_rate")
+STRESSES = ("txx", "tyy", "txy")
+#: a base state's rates residual above this (relative to the stresses' size) means the model is another law
+BASE_TOL = 1e-10
+
+
+def check(ctx, base: str, options: dict) -> None:
+    """The model has the parameters and stresses of js_channel; N_check differs from N."""
+    missing = [p for p in PARAMS if p not in ctx.model.params]
+    if missing:
+        raise fail(ctx.file, f"{base}.kind", f"model {ctx.model.name} has no parameter {', '.join(missing)}",
+                   "a model with parameters epsilon, xi, Re, G, shear_rate (the built-in js_channel)")
+    options.setdefault("N_check", int(round(1.5 * options["N"])))
+    if options["N_check"] == options["N"]:
+        raise fail(ctx.file, f"{base}.N_check", "N_check equals N", "a second resolution, e.g. round(1.5 N)")
+
+
+SCHEMA = {
+    "N": Option(intervals, 48, doc="Chebyshev collocation intervals across the channel."),
+    "N_check": Option(intervals, doc="The second resolution the eigenvalues must reappear at (default round(1.5 N))."),
+    "tol": Option(positive, 1e-6, doc="Agreement of an eigenvalue between the resolutions, times max(1, |lambda|)."),
+    "count": Option(count, 8, doc="How many point eigenvalues to report, rightmost first."),
+    "band_samples": Option(count_within("samples"), 201, doc="Points 0 <= y <= 1 at which the band is sampled."),
+}
+
+
+def frees(options: dict) -> list[str]:
+    """The parameters read, and the local shear rate the analysis sets point by point."""
+    return list(PARAMS)
+
+
+def needs(options: dict, *, internal: bool) -> set[str]:
+    """The rates and their Jacobian (the local law), and the residual/tangent the system's flow needs."""
+    return {"residual", "tangent", "rates", "rates_tangent"}
+
+
+def base_rates(y: np.ndarray, G: float, epsilon: float, xi: float) -> np.ndarray:
+    """g_b(y) = -sign(y) g(G |y|) on the classical branch."""
+    return np.array([-np.sign(v) * classical_rate(G * abs(v), epsilon, xi) for v in y])
+
+
+def local_blocks(system, rates: np.ndarray, xi: float) -> tuple[LocalBlocks, float]:
+    """J_sigma and J_g at each point from the generated kernels, and the largest base residual |f(sigma_b; g_b)|."""
+    shear = list(system.metadata.internal).index("txy")
+    order = [list(system.metadata.internal).index(s) for s in STRESSES]
+    Js, Jg, worst = [], [], 0.0
+    for g in rates:
+        sigma = np.empty(3)
+        sigma[order] = np.array(polymer_stresses(g, xi), dtype=float)
+        here = system.with_params(shear_rate=float(g))
+        worst = max(worst, float(np.max(np.abs(here.rhs(0.0, sigma)))) / max(1.0, float(np.max(np.abs(sigma)))))
+        Js.append(here.jacobian(0.0, sigma))
+        plus, minus = system.with_params(shear_rate=float(g) + 1.0), system.with_params(shear_rate=float(g) - 1.0)
+        Jg.append((plus.rhs(0.0, sigma) - minus.rhs(0.0, sigma)) / 2.0)
+    return LocalBlocks(np.array(Js), np.array(Jg), shear), worst
+
+
+def base_values(system) -> tuple[float, float, float, float]:
+    """(epsilon, xi, Re, G), refused beyond the classical branch."""
+    v = parameter_dict(system, system.params)
+    epsilon, xi, Re, G = v["epsilon"], v["xi"], v["Re"], v["G"]
+    if not (epsilon > 0 and 0 <= xi <= 2 and Re >= 0 and G >= 0):
+        raise InputError("channel_spectrum needs epsilon > 0, 0 <= xi <= 2, Re >= 0 and G >= 0", key="params",
+                         expected="epsilon > 0, 0 <= xi <= 2, Re >= 0 and G >= 0")
+    top = extrema(epsilon, xi)
+    if top is not None and G > top[0][1]:
+        raise InputError(f"channel_spectrum linearises the classical steady state, which exists for G <= "
+                         f"{top[0][1]:.10g} (the spurt gradient); G = {G:g}", key="params.G",
+                         expected="G at or below the spurt gradient")
+    return epsilon, xi, Re, G
+
+
+def band(system, epsilon: float, xi: float, G: float, samples: int) -> tuple[np.ndarray, np.ndarray]:
+    """(y, lambda_loc(y)) for 0 <= y <= 1."""
+    y = np.linspace(0.0, 1.0, samples)
+    blocks, _ = local_blocks(system, base_rates(-y, G, epsilon, xi), xi)
+    return y, local_eigenvalues(blocks, epsilon)
+
+
+def spectra(system, options: dict, values) -> tuple[np.ndarray, np.ndarray, float]:
+    """The eigenvalues at N and N_check and the worst base residual."""
+    epsilon, xi, Re, G = values
+    out, worst = [], 0.0
+    for N in (options["N"], options["N_check"]):
+        blocks, res = local_blocks(system, base_rates(points(N), G, epsilon, xi), xi)
+        worst = max(worst, res)
+        out.append(eigenvalues(N, epsilon, Re, blocks))
+    return out[0], out[1], worst
+
+
+def run_channel_spectrum(system, options: dict, context: dict) -> dict:
+    """Point spectrum, essential band, verdict."""
+    values = base_values(system)
+    epsilon, xi, Re, G = values
+    coarse, fine, worst = spectra(system, options, values)
+    if worst > BASE_TOL:
+        raise KernelError(f"channel_spectrum: the model's rates do not vanish at the Johnson-Segalman base state "
+                          f"(residual {worst:.3g}): the model is not the law the base state is for")
+    kept, rejected = resolved(coarse, fine, options["tol"])
+    y, loc = band(system, epsilon, xi, G, options["band_samples"])
+    point, on_band = off_band(kept, loc, 1e-3)
+    point = point[np.argsort(-point.real, kind="stable")]
+    top = max([v.real for v in point] + [float(np.max(loc.real))])
+    out = {"eigenvalues": [pair(v) for v in point[:options["count"]]], "verdict": "unstable" if top > 0 else "stable",
+           "essential_spectrum": [[pair(v) for v in loc[0]], [pair(v) for v in loc[-1]]],
+           "essential_rightmost": float(np.max(loc.real)), "band_eigenvalues": int(on_band.size),
+           "rejected": int(rejected.size), "resolution": [options["N"], options["N_check"]], "base_residual": worst}
+    if point.size:
+        out["rightmost"] = pair(point[0])
+    return out
+
+
+register(AnalysisKind("channel_spectrum", SCHEMA, run_channel_spectrum, needs, summary.lines, check=check,
+                      frees=frees, sweepable=True))
