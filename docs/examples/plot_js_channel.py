@@ -18,7 +18,9 @@ threshold** :math:`G_s = T_{max}`, exact before any discretisation. Its flux per
     Q(G) = 2\\int_0^1 y\\, g(G y)\\, dy = \\frac{2}{G^2}\\int_0^G T\\, g(T)\\, dT
          = \\frac{2}{G^2}\\Big[\\frac{g T^2}{2} - \\frac12\\int_0^g T^2\\, dg'\\Big]_{g_w}
 
-is summed in closed form (``channel_flow``). Above :math:`G_s` the rate must jump to the high branch: at
+is summed in closed form (``channel_flow``). With ``discrete = true`` the collocated steady channel (the model's
+generated stress laws at every Chebyshev point) is continued in G past its first fold, which converges to
+:math:`G_s` under refinement. Above :math:`G_s` the rate must jump to the high branch: at
 :math:`G y = T_{max}` (top-jumping) or :math:`G y = T_{min}` (bottom-jumping). Reference: scipy's ``quad`` of the
 defining integral with the rate found by ``brentq``; :math:`\\epsilon = 0.06`, :math:`\\xi = 0.2` as in the paper.
 
@@ -44,8 +46,7 @@ from scipy.optimize import brentq
 
 import mechgen
 
-here = Path(__file__).resolve().parent if "__file__" in globals() else Path.cwd()
-scene = next(p / "scenes" / "js_channel.toml" for p in (here, *here.parents) if (p / "scenes").is_dir())
+scene = Path(mechgen.__file__).resolve().parents[1] / "scenes" / "js_channel.toml"
 results = {a["name"]: a["outputs"] for a in mechgen.run(str(scene))["analyses"]}
 out, spectrum = results["flow_curve"], results["spectrum"]
 
@@ -67,12 +68,17 @@ check = [(g, q, reference(g)) for g, q in zip(G[1::20], Q[1::20])]
 err = max(abs(q / r - 1) for _, q, r in check)
 print(f"flow rate vs quad at {len(check)} gradients: largest relative error {err:.1e}")
 assert err < 1e-10
+fold17, fold25 = out["spurt_gradient_discrete"]
+print(f"collocated steady branch's first fold: N = 17: {fold17:.6f}, N = 25: {fold25:.6f} "
+      f"(errors {fold17 - out['spurt_gradient']:.1e}, {fold25 - out['spurt_gradient']:.1e}: O(N^-2))")
 
 fig, ax = plt.subplots(figsize=(6.4, 4.4))
 ax.plot(G, Q, "k-", label="classical branch")
 ax.plot(out["G_above"], out["flow_rate_top"], "C0-", label="top-jumping")
 ax.plot(out["G_above"], out["flow_rate_bottom"], "C1--", label="bottom-jumping")
 ax.plot([c[0] for c in check], [c[2] for c in check], "r+", ms=9, label="quad (reference)")
+ax.plot(out["discrete_G"], out["discrete_flow_rate"], "o", mfc="none", ms=5, color="C2",
+        label="collocated steady branch, N = 25")
 ax.axvline(out["spurt_gradient"], color="0.5", lw=0.8, ls=":")
 ax.text(out["spurt_gradient"], 0.2, " spurt", color="0.4")
 ax.set(xlabel="pressure gradient G (eta_p / lambda per half-width)", ylabel="flow rate Q",

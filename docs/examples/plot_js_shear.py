@@ -33,8 +33,7 @@ import numpy as np
 
 import mechgen
 
-here = Path(__file__).resolve().parent if "__file__" in globals() else Path.cwd()
-scene = next(p / "scenes" / "js_shear.toml" for p in (here, *here.parents) if (p / "scenes").is_dir())
+scene = Path(mechgen.__file__).resolve().parents[1] / "scenes" / "js_shear.toml"
 out = {a["name"]: a["outputs"] for a in mechgen.run(str(scene))["analyses"]}
 curve, branch = out["curve"], out["s_curve"]
 

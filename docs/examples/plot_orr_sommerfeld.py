@@ -30,8 +30,7 @@ import mechgen
 from mechgen.runtime.spectral.chebyshev import resolved
 from mechgen.runtime.spectral.orr_sommerfeld import operators, wave_speeds
 
-here = Path(__file__).resolve().parent if "__file__" in globals() else Path.cwd()
-scene = next(p / "scenes" / "orr_sommerfeld.toml" for p in (here, *here.parents) if (p / "scenes").is_dir())
+scene = Path(mechgen.__file__).resolve().parents[1] / "scenes" / "orr_sommerfeld.toml"
 out = mechgen.run(str(scene))["analyses"][0]["outputs"]
 
 c = complex(*out["least_stable_c"])

@@ -25,9 +25,13 @@ import numpy as np
 from mechgen.analyses import summary
 from mechgen.analyses.parameters import parameter_dict
 from mechgen.analyses.registry import AnalysisKind, register
-from mechgen.analyses.schema import Option, count_within, positive
-from mechgen.errors import InputError
+from mechgen.analyses.channel_spectrum import STRESSES, kernel_law
+from mechgen.analyses.orr_sommerfeld import intervals
+from mechgen.analyses.schema import Option, boolean, count_within, positive
+from mechgen.errors import ConvergenceError, InputError
 from mechgen.runtime.fluids.johnson_segalman import extrema, flow_rate
+from mechgen.runtime.spectral.channel import SteadyChannel, steady_branch
+from mechgen.runtime.spectral.chebyshev import points
 from mechgen.scene.values import fail
 
 PARAMS = ("epsilon", "xi", "G")
@@ -36,27 +40,63 @@ SAMPLED = ("G", "flow_rate", "G_above", "flow_rate_top", "flow_rate_bottom", "ju
 
 
 def check(ctx, base: str, options: dict) -> None:
-    """The model has parameters epsilon, xi and G."""
-    missing = [p for p in PARAMS if p not in ctx.model.params]
+    """The model has parameters epsilon, xi and G (and shear_rate for the discrete branch); N_check differs from N."""
+    wanted = PARAMS + (("shear_rate",) if options["discrete"] else ())
+    missing = [p for p in wanted if p not in ctx.model.params]
     if missing:
         raise fail(ctx.file, f"{base}.kind", f"model {ctx.model.name} has no parameter {', '.join(missing)}",
                    "a model with parameters epsilon, xi and G (the built-in js_channel)")
+    options.setdefault("N_check", int(round(1.5 * options["N"])))
+    if options["N_check"] == options["N"]:
+        raise fail(ctx.file, f"{base}.N_check", "N_check equals N", "a second resolution, e.g. round(1.5 N)")
 
 
 SCHEMA = {
     "samples": Option(count_within("samples"), 101, doc="Pressure gradients sampled on each part of the flow curve."),
+    "discrete": Option(boolean, False, doc="Also continue the collocated steady channel in G past its first fold, "
+                       "at N and N_check (the model's generated stress laws)."),
+    "N": Option(intervals, 17, doc="Chebyshev intervals of the discrete steady branch (odd: the fold converges to the "
+                "spurt gradient as N^-2; even: it equals it, the collocated total stress being exactly G y by symmetry)."),
+    "N_check": Option(intervals, doc="Its second resolution (default round(1.5 N))."),
     "G_max": Option(positive, doc="Largest sampled pressure gradient (default 1.5 x spurt_gradient, or 2 if none)."),
 }
 
 
 def frees(options: dict) -> list[str]:
-    """The parameters the analysis reads, kept free so that the system carries the scene's values."""
-    return list(PARAMS)
+    """The parameters the analysis reads (and the local shear rate for the discrete branch), kept free."""
+    return list(PARAMS) + (["shear_rate"] if options.get("discrete") else [])
 
 
 def needs(options: dict, *, internal: bool) -> set[str]:
-    """Only the outputs kernel (closed forms in the parameters)."""
-    return {"outputs"}
+    """The outputs kernel (closed forms in the parameters); the local law's rates for the discrete branch."""
+    return {"residual", "tangent", "rates", "rates_tangent"} if options.get("discrete") else {"outputs"}
+
+
+def discrete_branch(system, N: int, epsilon: float, spurt: float):
+    """The collocated steady branch at N from G = spurt / 20 (a Newtonian guess, corrected) past its first fold."""
+    channel = SteadyChannel(N, epsilon, kernel_law(system), 3, STRESSES.index("txy"))
+    y, G0 = points(N), 0.05 * spurt
+    u = G0 * (1.0 - y**2) / (2.0 * (1.0 + epsilon))
+    g = -G0 * y / (1.0 + epsilon)
+    sigma = np.zeros((N + 1, 3))
+    sigma[:, STRESSES.index("txy")] = g
+    return steady_branch(channel, channel.pack(u[1:N], sigma), G0, 1.5 * spurt)
+
+
+def discrete_outputs(system, options: dict, epsilon: float, xi: float, spurt: float) -> dict:
+    """The first fold at N and N_check, the N_check branch's flow rate against the closed form below the fold."""
+    coarse = discrete_branch(system, options["N"], epsilon, spurt)
+    fine = discrete_branch(system, options["N_check"], epsilon, spurt)
+    if not coarse.folds or not fine.folds:
+        raise ConvergenceError(f"channel_flow: the discrete steady branch found no fold ({fine.status})")
+    below = fine.G <= fine.folds[0]
+    stop = int(np.argmin(below)) if not below.all() else below.size  # the points before the first fold
+    G, Q = fine.G[:stop], fine.flow_rate[:stop]
+    error = max(abs(q - flow_rate(float(g), epsilon, xi)[0]) for g, q in zip(G, Q) if g <= spurt)
+    folds = [coarse.folds[0], fine.folds[0]]
+    return {"spurt_gradient_discrete": folds, "spurt_gradient_discrete_error": [abs(f - spurt) for f in folds],
+            "discrete_folds": list(fine.folds), "discrete_G": G.tolist(), "discrete_flow_rate": Q.tolist(),
+            "discrete_flow_rate_error": float(error)}
 
 
 def jumping(G_values: np.ndarray, epsilon: float, xi: float) -> dict:
@@ -101,6 +141,8 @@ def run_channel_flow(system, options: dict, context: dict) -> dict:
     out.update({"G": grid.tolist(), "flow_rate": [flow_rate(float(g), epsilon, xi)[0] for g in grid]})
     if spurt is not None:
         out.update(jumping(np.linspace(spurt, G_max, n), epsilon, xi))
+        if options["discrete"]:
+            out.update(discrete_outputs(system, options, epsilon, xi, spurt))
     out.update(at_gradient(G, spurt, epsilon, xi))
     return out
 

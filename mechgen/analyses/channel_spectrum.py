@@ -5,8 +5,8 @@ an imposed shear rate ``shear_rate`` (internal variables tau_xx, tau_yy, tau_xy)
 one, shear rate g_b(y) = -sign(y) g(G |y|) with g the low-rate root of the local shear curve
 (mechgen.runtime.fluids.johnson_segalman; G <= the spurt gradient, else refused) and the steady stresses; the
 generated kernels' residual there is checked to vanish (the model is the law the base state is for). At each
-Chebyshev point the rates kernel's Jacobian J_sigma and its derivative in the shear rate J_g (f is affine in g:
-a central difference is exact to round-off) are the local blocks of the linearised channel
+Chebyshev point the rates kernel's Jacobian J_sigma and its derivative in the shear rate J_g (the law is affine in
+g, checked: both from the kernels at shear_rate = 0 and 1) are the local blocks of the linearised channel
 (mechgen.runtime.spectral.channel):
 
     Re lambda u = epsilon u'' + (tau_xy)',   lambda sigma = J_sigma(y) sigma + J_g(y) u',   u = 0 at y = +-1,
@@ -33,7 +33,7 @@ from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import Option, count, count_within, positive
 from mechgen.errors import InputError, KernelError
 from mechgen.runtime.fluids.johnson_segalman import classical_rate, extrema, polymer_stresses
-from mechgen.runtime.spectral.channel import LocalBlocks, eigenvalues, local_eigenvalues, off_band
+from mechgen.runtime.spectral.channel import LocalBlocks, eigenvalues, local_eigenvalues, off_band, rightmost_first
 from mechgen.runtime.spectral.chebyshev import points, resolved
 from mechgen.scene.values import fail
 
@@ -78,20 +78,40 @@ def base_rates(y: np.ndarray, G: float, epsilon: float, xi: float) -> np.ndarray
     return np.array([-np.sign(v) * classical_rate(G * abs(v), epsilon, xi) for v in y])
 
 
-def local_blocks(system, rates: np.ndarray, xi: float) -> tuple[LocalBlocks, float]:
-    """J_sigma and J_g at each point from the generated kernels, and the largest base residual |f(sigma_b; g_b)|."""
-    shear = list(system.metadata.internal).index("txy")
-    order = [list(system.metadata.internal).index(s) for s in STRESSES]
-    Js, Jg, worst = [], [], 0.0
-    for g in rates:
-        sigma = np.empty(3)
-        sigma[order] = np.array(polymer_stresses(g, xi), dtype=float)
-        here = system.with_params(shear_rate=float(g))
-        worst = max(worst, float(np.max(np.abs(here.rhs(0.0, sigma)))) / max(1.0, float(np.max(np.abs(sigma)))))
-        Js.append(here.jacobian(0.0, sigma))
-        plus, minus = system.with_params(shear_rate=float(g) + 1.0), system.with_params(shear_rate=float(g) - 1.0)
-        Jg.append((plus.rhs(0.0, sigma) - minus.rhs(0.0, sigma)) / 2.0)
-    return LocalBlocks(np.array(Js), np.array(Jg), shear), worst
+def kernel_law(system):
+    """The model's local law at P points, (g, sigma (P, 3)) -> (f, J_sigma, J_g), from its generated rates and their
+    Jacobian at shear_rate = 0 and 1: the law is affine in g (f = f0 + g (f1 - f0)), checked at g = 2.5 on a sample
+    state (else an InputError: the analysis assumes it)."""
+    order = [list(system.metadata.internal).index(name) for name in STRESSES]
+    at = {g: system.with_params(shear_rate=g) for g in (0.0, 1.0, 2.5)}
+    probe = np.array([0.3, -0.2, 0.7])
+    affine = at[0.0].rhs(0.0, probe) + 2.5 * (at[1.0].rhs(0.0, probe) - at[0.0].rhs(0.0, probe))
+    if not np.allclose(at[2.5].rhs(0.0, probe), affine, rtol=1e-12, atol=1e-12):
+        raise InputError(f"channel_spectrum: the stress laws of model {system.metadata.model} are not affine in "
+                         "shear_rate", key="model", expected="a local law linear in the shear rate (js_channel)")
+
+    def law(g: np.ndarray, sigma: np.ndarray):
+        f, J_sigma, J_g = [], [], []
+        for gj, sj in zip(g, sigma):
+            z = np.empty(3)
+            z[order] = sj
+            f0, f1 = at[0.0].rhs(0.0, z), at[1.0].rhs(0.0, z)
+            J0, J1 = at[0.0].jacobian(0.0, z), at[1.0].jacobian(0.0, z)
+            f.append((f0 + gj * (f1 - f0))[order])
+            J_sigma.append((J0 + gj * (J1 - J0))[np.ix_(order, order)])
+            J_g.append((f1 - f0)[order])
+        return np.array(f), np.array(J_sigma), np.array(J_g)
+
+    return law
+
+
+def local_blocks(law, rates: np.ndarray, xi: float) -> tuple[LocalBlocks, float]:
+    """J_sigma and J_g at each point at the closed-form base stresses, and the largest base residual
+    |f(sigma_b; g_b)| relative to max(1, |sigma_b|)."""
+    sigma = np.array(polymer_stresses(rates, xi), dtype=float).T
+    f, J_sigma, J_g = law(rates, sigma)
+    worst = float(np.max(np.abs(f) / np.maximum(1.0, np.max(np.abs(sigma), axis=1))[:, None]))
+    return LocalBlocks(J_sigma, J_g, STRESSES.index("txy")), worst
 
 
 def base_values(system) -> tuple[float, float, float, float]:
@@ -112,16 +132,16 @@ def base_values(system) -> tuple[float, float, float, float]:
 def band(system, epsilon: float, xi: float, G: float, samples: int) -> tuple[np.ndarray, np.ndarray]:
     """(y, lambda_loc(y)) for 0 <= y <= 1."""
     y = np.linspace(0.0, 1.0, samples)
-    blocks, _ = local_blocks(system, base_rates(-y, G, epsilon, xi), xi)
+    blocks, _ = local_blocks(kernel_law(system), base_rates(-y, G, epsilon, xi), xi)
     return y, local_eigenvalues(blocks, epsilon)
 
 
 def spectra(system, options: dict, values) -> tuple[np.ndarray, np.ndarray, float]:
     """The eigenvalues at N and N_check and the worst base residual."""
     epsilon, xi, Re, G = values
-    out, worst = [], 0.0
+    out, worst, law = [], 0.0, kernel_law(system)
     for N in (options["N"], options["N_check"]):
-        blocks, res = local_blocks(system, base_rates(points(N), G, epsilon, xi), xi)
+        blocks, res = local_blocks(law, base_rates(points(N), G, epsilon, xi), xi)
         worst = max(worst, res)
         out.append(eigenvalues(N, epsilon, Re, blocks))
     return out[0], out[1], worst
@@ -138,7 +158,7 @@ def run_channel_spectrum(system, options: dict, context: dict) -> dict:
     kept, rejected = resolved(coarse, fine, options["tol"])
     y, loc = band(system, epsilon, xi, G, options["band_samples"])
     point, on_band = off_band(kept, loc, 1e-3)
-    point = point[np.argsort(-point.real, kind="stable")]
+    point = rightmost_first(point)
     top = max([v.real for v in point] + [float(np.max(loc.real))])
     out = {"eigenvalues": [pair(v) for v in point[:options["count"]]], "verdict": "unstable" if top > 0 else "stable",
            "essential_spectrum": [[pair(v) for v in loc[0]], [pair(v) for v in loc[-1]]],

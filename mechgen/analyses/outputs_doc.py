@@ -502,6 +502,14 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("flow_rate_at_G", "scalar", "h^2/lambda", "Classical flux at the model's G (G <= spurt_gradient)."),
         _o("flow_rate_top_at_G", "scalar", "h^2/lambda", "Top-jumping flux at the model's G (above the threshold)."),
         _o("flow_rate_bottom_at_G", "scalar", "h^2/lambda", "Bottom-jumping flux at the model's G (above the threshold)."),
+        _o("spurt_gradient_discrete", "(2,)", "eta_p/lambda", "With ``discrete``: the collocated steady branch's first "
+           "fold at N and N_check."),
+        _o("spurt_gradient_discrete_error", "(2,)", "eta_p/lambda", "\\|fold - spurt_gradient\\| at N and N_check."),
+        _o("discrete_folds", "(folds,)", "eta_p/lambda", "All folds the N_check branch passed (the first, then as it turns)."),
+        _o("discrete_G", "(points,)", "eta_p/lambda", "G along the N_check branch up to its first fold."),
+        _o("discrete_flow_rate", "(points,)", "h^2/lambda", "Its flux, Clenshaw-Curtis quadrature of u."),
+        _o("discrete_flow_rate_error", "scalar", "h^2/lambda", "The largest \\|Q_discrete - Q\\| at those G up to "
+           "spurt_gradient."),
     ),
     "channel_spectrum": (
         _o("eigenvalues", "(count, 2)", "1/lambda", "The resolved point spectrum [Re, Im], rightmost first (band copies "

@@ -16,11 +16,13 @@ viscous term slaves u' to -sigma_s/epsilon); its discretised copies lie on that 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 import scipy.linalg as sl
 
-from mechgen.runtime.spectral.chebyshev import differentiation
+from mechgen.runtime.spectral.chebyshev import clenshaw_curtis, differentiation
+from mechgen.runtime.steady.continuation import continuation
 
 
 @dataclass(frozen=True)
@@ -59,8 +61,13 @@ def eigenvalues(N: int, epsilon: float, Re: float, blocks: LocalBlocks) -> np.nd
     """The finite eigenvalues lambda, rightmost first."""
     L, M = operator(N, epsilon, Re, blocks)
     lam = sl.eigvals(L, M) if Re > 0 else sl.eigvals(L, M, overwrite_a=True)
-    lam = lam[np.isfinite(lam)]
-    return lam[np.argsort(-lam.real, kind="stable")]
+    return rightmost_first(lam[np.isfinite(lam)])
+
+
+def rightmost_first(values: np.ndarray) -> np.ndarray:
+    """Sorted by real part descending (rounded to 10 decimals, so that a conjugate pair's round-off does not order
+    it), then imaginary part descending (a pair's positive member first)."""
+    return values[np.lexsort((-values.imag, -np.round(values.real, 10)))]
 
 
 def local_eigenvalues(blocks: LocalBlocks, epsilon: float) -> np.ndarray:
@@ -79,3 +86,83 @@ def off_band(values: np.ndarray, band: np.ndarray, tol: float) -> tuple[np.ndarr
     band = band.ravel()
     far = np.array([np.min(np.abs(band - v)) > tol * max(1.0, abs(v)) for v in values], dtype=bool)
     return values[far], values[~far]
+
+
+#: a local stress law at P points: (g (P,), sigma (P, m)) -> (f (P, m), J_sigma (P, m, m), J_g (P, m))
+LocalLaw = Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]]
+
+
+@dataclass(frozen=True)
+class SteadyChannel:
+    """Steady channel flow at pressure gradient G (the continuation parameter), collocated as in ``operator``:
+
+        epsilon u'' + (sigma_s)' + G = 0 at the interior points,   f(sigma; g = u') = 0 at every point,
+
+    unknowns x = [u interior (N - 1); sigma_1 .. sigma_m at the N + 1 points]. F_x is the operator L of the
+    linearisation (its local blocks from ``law`` at the current state), F_G = [1 (momentum rows); 0]."""
+
+    N: int
+    epsilon: float
+    law: LocalLaw
+    m: int
+    shear: int
+    name: str = "steady channel"
+
+    def state(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(g at every point, sigma (N + 1, m)) of x."""
+        D, _ = differentiation(self.N)
+        u, n_p = x[:self.N - 1], self.N + 1
+        sigma = x[self.N - 1:].reshape(self.m, n_p).T
+        return D[:, 1:self.N] @ u, sigma
+
+    def F(self, x: np.ndarray, G: float) -> np.ndarray:
+        """The residual (see the class doc)."""
+        D, _ = differentiation(self.N)
+        g, sigma = self.state(x)
+        u = x[:self.N - 1]
+        f = self.law(g, sigma)[0]
+        momentum = self.epsilon * (D @ D)[1:self.N, 1:self.N] @ u + D[1:self.N, :] @ sigma[:, self.shear] + G
+        return np.concatenate([momentum, f.T.ravel()])
+
+    def F_u(self, x: np.ndarray, G: float) -> np.ndarray:
+        """dF/dx: the linearised operator at x."""
+        g, sigma = self.state(x)
+        _, J_sigma, J_g = self.law(g, sigma)
+        return operator(self.N, self.epsilon, 1.0, LocalBlocks(J_sigma, J_g, self.shear))[0]
+
+    def F_lam(self, x: np.ndarray, G: float) -> np.ndarray:
+        """dF/dG."""
+        out = np.zeros(x.size)
+        out[:self.N - 1] = 1.0
+        return out
+
+    def pack(self, u_interior: np.ndarray, sigma: np.ndarray) -> np.ndarray:
+        """x from u at the interior points and sigma (N + 1, m)."""
+        return np.concatenate([u_interior, sigma.T.ravel()])
+
+
+@dataclass(frozen=True)
+class SteadyBranch:
+    """The collocated steady branch in G from its start to just past its first fold: G and the flux
+    Q = int u dy (Clenshaw-Curtis) per point, the folds' G (all those passed) and why it stopped."""
+
+    G: np.ndarray
+    flow_rate: np.ndarray
+    folds: tuple
+    status: str
+
+
+def steady_branch(channel: SteadyChannel, x0: np.ndarray, G0: float, G_max: float, *,
+                  max_points: int = 400) -> SteadyBranch:
+    """Pseudo-arclength continuation (mechgen.runtime.steady.continuation) of the steady channel in G from (x0, G0)
+    until G has come back by 2 % of G_max after its largest value (past the first fold), or G_max."""
+    top = [G0]
+
+    def until(x, G):
+        top[0] = max(top[0], G)
+        return ("fold passed", "past the first fold") if G < top[0] - 0.02 * G_max else None
+
+    branch = continuation(channel, x0, G0, lam_max=G_max, max_points=max_points, ds=0.1, ds_max=1.0, until=until)
+    w = clenshaw_curtis(channel.N)[1:channel.N]
+    return SteadyBranch(branch.lam.copy(), branch.u[:, :channel.N - 1] @ w, tuple(f.lam for f in branch.folds),
+                        branch.status)

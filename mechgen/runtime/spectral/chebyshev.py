@@ -70,3 +70,23 @@ def resolved(coarse: np.ndarray, fine: np.ndarray, tol: float) -> tuple[np.ndarr
         else:
             rejected.append(lam)
     return np.asarray(kept, dtype=complex), np.asarray(rejected, dtype=complex)
+
+
+def clenshaw_curtis(N: int) -> np.ndarray:
+    """Weights w_j with sum_j w_j v(y_j) = int_{-1}^{1} v dy exactly for polynomials of degree <= N (Trefethen's
+    clencurt): w_j = (c_j / N) (1 - sum_k b_k cos(2 k theta_j) / (4 k^2 - 1)), theta_j = pi j / N."""
+    theta = np.pi * np.arange(N + 1) / N
+    w = np.zeros(N + 1)
+    v = np.ones(N - 1)
+    inner = theta[1:N]
+    if N % 2 == 0:
+        w[0] = w[N] = 1.0 / (N**2 - 1)
+        for k in range(1, N // 2):
+            v -= 2.0 * np.cos(2 * k * inner) / (4 * k**2 - 1)
+        v -= np.cos(N * inner) / (N**2 - 1)
+    else:
+        w[0] = w[N] = 1.0 / N**2
+        for k in range(1, (N - 1) // 2 + 1):
+            v -= 2.0 * np.cos(2 * k * inner) / (4 * k**2 - 1)
+    w[1:N] = 2.0 * v / N
+    return w

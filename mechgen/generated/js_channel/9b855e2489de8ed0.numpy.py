@@ -6,81 +6,7 @@ batched ports shaped (nbatch, length), outputs zeroed by the caller.
 """
 import numpy as np
 
-SPEC = {'outputs': {'doc': 'named outputs',
-             'inputs': [{'batched': True,
-                         'extent': {'const': 0, 'terms': []},
-                         'integer': False,
-                         'name': 'q',
-                         'shape': None,
-                         'sparse': False,
-                         'symmetric': False},
-                        {'batched': True,
-                         'extent': {'const': 0, 'terms': []},
-                         'integer': False,
-                         'name': 'v',
-                         'shape': None,
-                         'sparse': False,
-                         'symmetric': False},
-                        {'batched': True,
-                         'extent': {'const': 3, 'terms': []},
-                         'integer': False,
-                         'name': 'z',
-                         'shape': None,
-                         'sparse': False,
-                         'symmetric': False},
-                        {'batched': True,
-                         'extent': {'const': 1, 'terms': []},
-                         'integer': False,
-                         'name': 't',
-                         'shape': None,
-                         'sparse': False,
-                         'symmetric': False},
-                        {'batched': False,
-                         'extent': {'const': 5, 'terms': []},
-                         'integer': False,
-                         'name': 'p',
-                         'shape': None,
-                         'sparse': False,
-                         'symmetric': False}],
-             'meta': {'coordinates': [],
-                      'internal': ['txx', 'tyy', 'txy'],
-                      'kind': 'lumped',
-                      'model': 'js_channel',
-                      'params': ['epsilon', 'xi', 'Re', 'G', 'shear_rate']},
-             'name': 'outputs',
-             'ops': 1,
-             'outputs': [{'batched': True,
-                          'extent': {'const': 1, 'terms': []},
-                          'integer': False,
-                          'name': 'normal_stress_difference',
-                          'shape': [1, 1],
-                          'sparse': False,
-                          'symmetric': False},
-                         {'batched': True,
-                          'extent': {'const': 1, 'terms': []},
-                          'integer': False,
-                          'name': 'kinetic_energy',
-                          'shape': [1, 1],
-                          'sparse': False,
-                          'symmetric': False},
-                         {'batched': True,
-                          'extent': {'const': 1, 'terms': []},
-                          'integer': False,
-                          'name': 'potential_energy',
-                          'shape': [1, 1],
-                          'sparse': False,
-                          'symmetric': False},
-                         {'batched': True,
-                          'extent': {'const': 1, 'terms': []},
-                          'integer': False,
-                          'name': 'energy',
-                          'shape': [1, 1],
-                          'sparse': False,
-                          'symmetric': False}],
-             'signature': 'b05f652b3b797b6bcd8ee8141300ab3558d31c53e74d7f10b0e77ff430a083c5',
-             'sizes': [],
-             'slots': []},
- 'rates': {'doc': 'internal rates dz/dt',
+SPEC = {'rates': {'doc': 'internal rates dz/dt',
            'inputs': [{'batched': True,
                        'extent': {'const': 0, 'terms': []},
                        'integer': False,
@@ -415,20 +341,3 @@ def mg_rates_tangent(ins, outs, sizes):
     out2[:, 6] = -(1.0/2.0)*t0
     out2[:, 7] = g1*(1.0 - (1.0/2.0)*g0)
     out2[:, 8] = -1.0
-
-
-def mg_outputs(ins, outs, sizes):
-    """named outputs"""
-    in0 = ins[0]
-    in1 = ins[1]
-    in2 = ins[2]
-    in3 = ins[3]
-    in4 = ins[4]
-    out0 = outs[0]
-    out1 = outs[1]
-    out2 = outs[2]
-    out3 = outs[3]
-    nb = outs[0].shape[0]
-    g0 = in2[:, 0]
-    g1 = in2[:, 1]
-    out0[:, 0] = g0 - g1
