@@ -36,7 +36,7 @@ from mechgen.scene.values import fail
 
 PARAMS = ("epsilon", "xi", "G")
 SAMPLED = ("G", "flow_rate", "G_above", "flow_rate_top", "flow_rate_bottom", "jump_position_top",
-           "jump_position_bottom")
+           "jump_position_bottom", "discrete_G", "discrete_flow_rate")
 
 
 def check(ctx, base: str, options: dict) -> None:
@@ -152,5 +152,26 @@ def lines(outputs: dict) -> list[str]:
     return summary.output_lines(outputs, skip=SAMPLED)
 
 
-register(AnalysisKind("channel_flow", SCHEMA, run_channel_flow, needs, lines, check=check, frees=frees,
+def plot(plt, entry: dict, path) -> list:
+    """The flow curve: classical branch, top- and bottom-jumping solutions, the discrete branch, the threshold."""
+    out = entry["outputs"]
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    ax.plot(out["G"], out["flow_rate"], "k-", label="classical branch")
+    if "G_above" in out:
+        ax.plot(out["G_above"], out["flow_rate_top"], "-", color="tab:blue", label="top-jumping")
+        ax.plot(out["G_above"], out["flow_rate_bottom"], "--", color="tab:orange", label="bottom-jumping")
+        ax.axvline(out["spurt_gradient"], color="0.5", lw=0.8, ls=":", label="spurt gradient")
+    if "discrete_G" in out:
+        ax.plot(out["discrete_G"], out["discrete_flow_rate"], "o", mfc="none", ms=4, color="tab:green",
+                label="collocated steady branch")
+    ax.set(xlabel="pressure gradient G (eta_p/lambda per half-width)", ylabel="flow rate Q",
+           title=f"{entry['name']}: flow curve")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return [path]
+
+
+register(AnalysisKind("channel_flow", SCHEMA, run_channel_flow, needs, lines, check=check, frees=frees, plot=plot,
                       sweepable=True))

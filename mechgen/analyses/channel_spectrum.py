@@ -20,7 +20,8 @@ Outputs: ``eigenvalues`` (the resolved point spectrum, rightmost first, at most 
 ``rightmost`` ([Re, Im] of the first, absent when none), ``verdict`` (stable / unstable by the rightmost point and
 band eigenvalues), ``essential_spectrum`` (the band's ends: the local eigenvalues at the centre y = 0 and at the
 wall y = 1, each a list of [Re, Im]), ``essential_rightmost`` (the largest Re lambda_loc over y),
-``band_eigenvalues`` and ``rejected`` (how many), ``resolution`` [N, N_check], ``base_residual``.
+``band_eigenvalues`` and ``rejected`` (how many), ``resolution`` [N, N_check], ``base_residual``, and the band's
+samples ``band_y`` (0 to 1) and ``band`` (per y, the local eigenvalues [Re, Im], rightmost first).
 """
 from __future__ import annotations
 
@@ -163,11 +164,35 @@ def run_channel_spectrum(system, options: dict, context: dict) -> dict:
     out = {"eigenvalues": [pair(v) for v in point[:options["count"]]], "verdict": "unstable" if top > 0 else "stable",
            "essential_spectrum": [[pair(v) for v in loc[0]], [pair(v) for v in loc[-1]]],
            "essential_rightmost": float(np.max(loc.real)), "band_eigenvalues": int(on_band.size),
-           "rejected": int(rejected.size), "resolution": [options["N"], options["N_check"]], "base_residual": worst}
+           "rejected": int(rejected.size), "resolution": [options["N"], options["N_check"]], "base_residual": worst,
+           "band_y": y.tolist(), "band": [[pair(v) for v in row] for row in loc]}
     if point.size:
         out["rightmost"] = pair(point[0])
     return out
 
 
-register(AnalysisKind("channel_spectrum", SCHEMA, run_channel_spectrum, needs, summary.lines, check=check,
-                      frees=frees, sweepable=True))
+def lines(outputs: dict) -> list[str]:
+    """Every output but the band's samples."""
+    return summary.output_lines(outputs, skip=("band_y", "band"))
+
+
+def plot(plt, entry: dict, path) -> list:
+    """Point eigenvalues and the essential band in the complex plane."""
+    out = entry["outputs"]
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    band = np.asarray(out["band"], dtype=float)
+    ax.plot(band[:, :, 0].ravel(), band[:, :, 1].ravel(), ".", ms=2, color="0.6", label="essential band (local)")
+    if out["eigenvalues"]:
+        pts = np.asarray(out["eigenvalues"], dtype=float)
+        ax.plot(pts[:, 0], pts[:, 1], "o", mfc="none", color="tab:blue", label="point eigenvalues (resolved)")
+    ax.axvline(0.0, color="k", lw=0.5)
+    ax.set(xlabel="Re lambda (1/lambda)", ylabel="Im lambda (1/lambda)", title=f"{entry['name']}: channel spectrum")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return [path]
+
+
+register(AnalysisKind("channel_spectrum", SCHEMA, run_channel_spectrum, needs, lines, check=check,
+                      frees=frees, plot=plot, sweepable=True))

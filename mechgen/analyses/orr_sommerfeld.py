@@ -128,5 +128,21 @@ def run_orr_sommerfeld(system, options: dict, context: dict) -> dict:
     return out
 
 
+def plot(plt, entry: dict, path) -> list:
+    """The resolved wave speeds in the complex c plane, the least stable one marked."""
+    out = entry["outputs"]
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    c = np.asarray(out["eigenvalues"], dtype=float)
+    ax.plot(c[:, 0], c[:, 1], "o", mfc="none", label=f"resolved (N = {out['resolution'][0]}, {out['resolution'][1]})")
+    ax.plot(*out["least_stable_c"], "r+", ms=12, label="least stable")
+    ax.axhline(0.0, color="k", lw=0.5)
+    ax.set(xlabel="Re c", ylabel="Im c", title=f"{entry['name']}: Orr-Sommerfeld spectrum ({out['verdict']})")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return [path]
+
+
 register(AnalysisKind("orr_sommerfeld", SCHEMA, run_orr_sommerfeld, needs, summary.lines, check=check, frees=frees,
-                      sweepable=True))
+                      plot=plot, sweepable=True))

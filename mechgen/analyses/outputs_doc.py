@@ -524,6 +524,8 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("resolution", "(2,)", "-", "[N, N_check]."),
         _o("base_residual", "scalar", "eta_p/lambda^2", "The generated rates at the base state (zero: the model is "
            "the law of the closed-form base state)."),
+        _o("band_y", "(band_samples,)", "h", "The positions 0 <= y <= 1 where the band is sampled."),
+        _o("band", "(band_samples, 3, 2)", "1/lambda", "The local stress-controlled eigenvalues at band_y, rightmost first."),
     ),
 }
 

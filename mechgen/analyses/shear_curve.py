@@ -89,5 +89,22 @@ def lines(outputs: dict) -> list[str]:
     return summary.output_lines(outputs, skip=SAMPLED)
 
 
-register(AnalysisKind("shear_curve", SCHEMA, run_shear_curve, needs, lines, check=check, frees=frees,
+def plot(plt, entry: dict, path) -> list:
+    """T(g) with its extrema marked."""
+    out = entry["outputs"]
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    ax.plot(out["shear_rate"], out["stress"], lw=1.2, label="T(shear rate)")
+    if not out["monotone"]:
+        ax.plot([out["shear_rate_max"], out["shear_rate_min"]], [out["stress_max"], out["stress_min"]], "o",
+                mfc="none", color="tab:red", label="extrema (closed form)")
+    ax.set(xlabel="shear rate (1/lambda)", ylabel="total shear stress (eta_p/lambda)",
+           title=f"{entry['name']}: steady shear curve" + (" (monotone)" if out["monotone"] else ""))
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return [path]
+
+
+register(AnalysisKind("shear_curve", SCHEMA, run_shear_curve, needs, lines, check=check, frees=frees, plot=plot,
                       sweepable=True))
