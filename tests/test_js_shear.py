@@ -97,3 +97,18 @@ def test_fold_eigenvalue_zero_and_no_hopf(scene):
         assert abs(lam[k] + 1) < 1e-10
         pair = np.delete(lam, k)
         assert abs(pair.sum().real - js.pair_trace(g, 0.06, 0.2)) < 1e-9 and pair.sum().real < -2
+
+
+def test_reduced_two_stress_model_is_the_invariant_plane():
+    """js_local_reduced (the seed's N, S form) has js_local's eigenvalues without the constant -1, at equilibria
+    of the S-curve on all three branches (g below, between and above the extrema)."""
+    full = mechgen.compile("js_local", params={"epsilon": 0.06, "xi": 0.2}, free=["T"])
+    reduced = mechgen.compile("js_local_reduced", params={"epsilon": 0.06, "xi": 0.2}, free=["T"])
+    for g in (0.5, 3.0, 9.0):
+        txx, tyy, txy = js.polymer_stresses(g, 0.2)
+        T = float(js.total_stress(g, 0.06, 0.2))
+        lam3 = np.linalg.eigvals(full.with_params(T=T).jacobian(0.0, np.array([txx, tyy, txy])))
+        lam2 = np.linalg.eigvals(reduced.with_params(T=T).jacobian(0.0, np.array([txx - tyy, txy])))
+        k = int(np.argmin(np.abs(lam3 + 1)))
+        rest = np.sort_complex(np.delete(lam3, k))
+        assert abs(lam3[k] + 1) < 1e-12 and np.allclose(rest, np.sort_complex(lam2), rtol=0, atol=1e-12)
