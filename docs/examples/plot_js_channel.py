@@ -21,7 +21,10 @@ threshold** :math:`G_s = T_{max}`, exact before any discretisation. Its flux per
 is summed in closed form (``channel_flow``). With ``discrete = true`` the collocated steady channel (the model's
 generated stress laws at every Chebyshev point) is continued in G past its first fold, which converges to
 :math:`G_s` under refinement. Above :math:`G_s` the rate must jump to the high branch: at
-:math:`G y = T_{max}` (top-jumping) or :math:`G y = T_{min}` (bottom-jumping). Reference: scipy's ``quad`` of the
+:math:`G y = T_{max}` (top-jumping) or :math:`G y = T_{min}` (bottom-jumping). A quasi-static ramp up and down
+without inertia (each y on its own S-curve, jumping up at :math:`T_{max}`, down at :math:`T_{min}`) loads along
+the top-jumping curve and unloads with the interface latched at :math:`T_{max}/G_{max}`, then bottom-jumping:
+the hysteresis loop (checked against a slow ramp of the local dynamics in tests/test_js_channel.py). Reference: scipy's ``quad`` of the
 defining integral with the rate found by ``brentq``; :math:`\\epsilon = 0.06`, :math:`\\xi = 0.2` as in the paper.
 
 **Spectrum.** ``channel_spectrum`` linearises the classical state at G = 0.5, Re = 1 (Chebyshev collocation at
@@ -76,6 +79,7 @@ fig, ax = plt.subplots(figsize=(6.4, 4.4))
 ax.plot(G, Q, "k-", label="classical branch")
 ax.plot(out["G_above"], out["flow_rate_top"], "C0-", label="top-jumping")
 ax.plot(out["G_above"], out["flow_rate_bottom"], "C1--", label="bottom-jumping")
+ax.plot(out["G_down"], out["flow_rate_down"], "C3:", label="quasi-static unloading (loop)")
 ax.plot([c[0] for c in check], [c[2] for c in check], "r+", ms=9, label="quad (reference)")
 ax.plot(out["discrete_G"], out["discrete_flow_rate"], "o", mfc="none", ms=5, color="C2",
         label="collocated steady branch, N = 25")

@@ -13,7 +13,10 @@ int T^2 dg elementary). Outputs: ``spurt_gradient``; the classical flow curve ``
 to spurt_gradient) and ``flow_rate``; above the threshold (``G_above``, ``samples`` values from spurt_gradient to
 ``G_max``, default 1.5 x spurt_gradient) the two jumping solutions: ``flow_rate_top`` (the rate jumps to the high
 branch where G y = T_max) and ``flow_rate_bottom`` (where G y = T_min), with ``jump_position_top`` and
-``jump_position_bottom`` (y of the jump); at the model's G, ``flow_rate_at_G`` (classical, when G <=
+``jump_position_bottom`` (y of the jump); the quasi-static hysteresis loop of a ramp 0 -> G_max -> 0 without
+inertia (each y following its local S-curve, jumping up at T_max and down at T_min): ``G_up``, ``flow_rate_up``
+(classical, then top-jumping), ``G_down``, ``flow_rate_down`` and ``jump_position_down`` (the interface latched at
+T_max / G_max, then bottom-jumping at T_min / G, none below G = T_min); at the model's G, ``flow_rate_at_G`` (classical, when G <=
 spurt_gradient) or ``flow_rate_top_at_G`` and ``flow_rate_bottom_at_G``. For a monotone curve (epsilon >= 1/8)
 there is no spurt: ``monotone`` true, a ``note``, the classical curve up to ``G_max`` (default 2) and no
 threshold or jumping outputs.
@@ -29,14 +32,15 @@ from mechgen.analyses.channel_spectrum import STRESSES, kernel_law
 from mechgen.analyses.orr_sommerfeld import intervals
 from mechgen.analyses.schema import Option, boolean, count_within, positive
 from mechgen.errors import ConvergenceError, InputError
-from mechgen.runtime.fluids.johnson_segalman import extrema, flow_rate
+from mechgen.runtime.fluids.johnson_segalman import extrema, flow_rate, hysteresis_loop
 from mechgen.runtime.spectral.channel import SteadyChannel, steady_branch
 from mechgen.runtime.spectral.chebyshev import points
 from mechgen.scene.values import fail
 
 PARAMS = ("epsilon", "xi", "G")
 SAMPLED = ("G", "flow_rate", "G_above", "flow_rate_top", "flow_rate_bottom", "jump_position_top",
-           "jump_position_bottom", "discrete_G", "discrete_flow_rate")
+           "jump_position_bottom", "discrete_G", "discrete_flow_rate", "G_up", "flow_rate_up", "G_down",
+           "flow_rate_down", "jump_position_down")
 
 
 def check(ctx, base: str, options: dict) -> None:
@@ -141,6 +145,9 @@ def run_channel_flow(system, options: dict, context: dict) -> dict:
     out.update({"G": grid.tolist(), "flow_rate": [flow_rate(float(g), epsilon, xi)[0] for g in grid]})
     if spurt is not None:
         out.update(jumping(np.linspace(spurt, G_max, n), epsilon, xi))
+        loop = hysteresis_loop(G_max, epsilon, xi, n)
+        out.update({"G_up": loop["G_up"], "flow_rate_up": loop["flow_rate_up"], "G_down": loop["G_down"],
+                    "flow_rate_down": loop["flow_rate_down"], "jump_position_down": loop["jump_down"]})
         if options["discrete"]:
             out.update(discrete_outputs(system, options, epsilon, xi, spurt))
     out.update(at_gradient(G, spurt, epsilon, xi))
@@ -161,6 +168,8 @@ def plot(plt, entry: dict, path) -> list:
         ax.plot(out["G_above"], out["flow_rate_top"], "-", color="tab:blue", label="top-jumping")
         ax.plot(out["G_above"], out["flow_rate_bottom"], "--", color="tab:orange", label="bottom-jumping")
         ax.axvline(out["spurt_gradient"], color="0.5", lw=0.8, ls=":", label="spurt gradient")
+    if "G_down" in out:
+        ax.plot(out["G_down"], out["flow_rate_down"], ":", color="tab:red", label="quasi-static unloading")
     if "discrete_G" in out:
         ax.plot(out["discrete_G"], out["discrete_flow_rate"], "o", mfc="none", ms=4, color="tab:green",
                 label="collocated steady branch")

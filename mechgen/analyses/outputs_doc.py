@@ -502,6 +502,11 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("flow_rate_at_G", "scalar", "h^2/lambda", "Classical flux at the model's G (G <= spurt_gradient)."),
         _o("flow_rate_top_at_G", "scalar", "h^2/lambda", "Top-jumping flux at the model's G (above the threshold)."),
         _o("flow_rate_bottom_at_G", "scalar", "h^2/lambda", "Bottom-jumping flux at the model's G (above the threshold)."),
+        _o("G_up", "(samples,)", "eta_p/lambda", "The loading half of the quasi-static ramp, 0 to G_max."),
+        _o("flow_rate_up", "(samples,)", "h^2/lambda", "Its flux: classical, then top-jumping above spurt_gradient."),
+        _o("G_down", "(samples,)", "eta_p/lambda", "The unloading half, G_max to 0."),
+        _o("flow_rate_down", "(samples,)", "h^2/lambda", "Its flux: interface latched, then bottom-jumping, then classical."),
+        _o("jump_position_down", "(samples,)", "h", "The interface on unloading (1: none)."),
         _o("spurt_gradient_discrete", "(2,)", "eta_p/lambda", "With ``discrete``: the collocated steady branch's first "
            "fold at N and N_check."),
         _o("spurt_gradient_discrete_error", "(2,)", "eta_p/lambda", "\\|fold - spurt_gradient\\| at N and N_check."),

@@ -159,3 +159,39 @@ def flow_rate(G: float, epsilon: float, xi: float, jump: str | None = None) -> t
     g_high = high_rate(T_jump, epsilon, xi)
     flux = branch_flux(0.0, g_low, epsilon, xi) + branch_flux(g_high, high_rate(G, epsilon, xi), epsilon, xi)
     return 2.0 * flux / G**2, T_jump / G
+
+
+def latched_flow_rate(G: float, y_jump: float, epsilon: float, xi: float) -> float:
+    """The flux with the low branch for |y| < y_jump and the high branch beyond (needs T_min <= G y_jump <= T_max)."""
+    T_jump = G * y_jump
+    flux = (branch_flux(0.0, classical_rate(T_jump, epsilon, xi), epsilon, xi)
+            + branch_flux(high_rate(T_jump, epsilon, xi), high_rate(G, epsilon, xi), epsilon, xi))
+    return 2.0 * flux / G**2
+
+
+def hysteresis_loop(G_max: float, epsilon: float, xi: float, samples: int) -> dict:
+    """The quasi-static loop of a ramp 0 -> G_max -> 0 without inertia (each y follows its local S-curve, jumping up
+    at T_max and down at T_min): loading, the classical branch up to T_max then top-jumping (interface T_max / G);
+    unloading, the interface latched at y_l = T_max / G_max while G y_l >= T_min, then bottom-jumping (T_min / G)
+    until G = T_min, then classical. Returns G_up, flow_rate_up, G_down, flow_rate_down, jump_down (the interface,
+    1 where none)."""
+    (_, T_max), (_, T_min) = extrema(epsilon, xi)
+    if G_max <= T_max:
+        raise ValueError(f"a hysteresis loop needs G_max above the spurt gradient {T_max!r}")
+    up = np.linspace(0.0, G_max, samples)
+    q_up = [float(flow_rate(G, epsilon, xi, None if G <= T_max else "top")[0]) for G in up]
+    down = up[::-1]
+    y_latched = T_max / G_max
+    q_down, jump = [], []
+    for G in down:
+        if G * y_latched >= T_min:
+            q_down.append(float(latched_flow_rate(G, y_latched, epsilon, xi)))
+            jump.append(float(y_latched))
+        elif G >= T_min:
+            q_down.append(float(flow_rate(G, epsilon, xi, "bottom")[0]))
+            jump.append(float(T_min / G))
+        else:
+            q_down.append(float(flow_rate(G, epsilon, xi)[0]))
+            jump.append(1.0)
+    return {"G_up": up.tolist(), "flow_rate_up": q_up, "G_down": down.tolist(), "flow_rate_down": q_down,
+            "jump_down": jump}
