@@ -24,7 +24,6 @@ found by Newton with the eigenvalue's derivatives from its left and right eigenv
 from pathlib import Path
 
 import matplotlib.pyplot as plt
-import numpy as np
 
 import mechgen
 from mechgen.runtime.spectral.chebyshev import resolved

@@ -25,7 +25,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.integrate import quad
 from scipy.optimize import brentq
 
 #: epsilon at and above which T(g) is monotone (no extrema, no spurt)
