@@ -100,3 +100,23 @@ def test_against_finite_differences(tmp_path):
 def test_above_spurt_refused(tmp_path):
     with pytest.raises(InputError, match="spurt gradient"):
         run(tmp_path, G=1.0)
+
+
+def test_stress_diffusion_closed_form(tmp_path):
+    """xi = 0 with a stress diffusion D tau'' (tau' = 0 at the walls): tau_xy = b phi_n' still fits the Neumann
+    condition, so Re lambda^2 + (Re (1 + D kappa^2) + eps kappa^2) lambda + eps kappa^2 (1 + D kappa^2) + kappa^2 = 0,
+    n = 1..4; the normal stresses' Neumann modes give -1 - D (m pi / 2)^2. Every resolved eigenvalue is a point
+    eigenvalue (the band is no longer essential)."""
+    eps, Re, D = 0.06, 1.0, 0.01
+    text = SCENE.read_text().replace("xi = 0.2", "xi = 0.0")
+    scene = tmp_path / "diffusive.toml"
+    scene.write_text(text + "stress_diffusion = 0.01\ncount = 60\n")
+    out = {a["name"]: a["outputs"] for a in run_scene(str(scene))["analyses"]}["spectrum"]
+    found = np.array([complex(*v) for v in out["eigenvalues"]])
+    for n in range(1, 5):
+        k2 = (n * np.pi / 2) ** 2
+        for root in np.roots([Re, Re * (1 + D * k2) + eps * k2, eps * k2 * (1 + D * k2) + k2]):
+            assert np.min(np.abs(found - root)) < 1e-8  # spectral convergence, as without diffusion
+    for m in range(0, 5):
+        assert np.min(np.abs(found - (-1 - D * (m * np.pi / 2) ** 2))) < 1e-8
+    assert out["band_eigenvalues"] == 0

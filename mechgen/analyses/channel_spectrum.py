@@ -21,7 +21,10 @@ Outputs: ``eigenvalues`` (the resolved point spectrum, rightmost first, at most 
 band eigenvalues), ``essential_spectrum`` (the band's ends: the local eigenvalues at the centre y = 0 and at the
 wall y = 1, each a list of [Re, Im]), ``essential_rightmost`` (the largest Re lambda_loc over y),
 ``band_eigenvalues`` and ``rejected`` (how many), ``resolution`` [N, N_check], ``base_residual``, and the band's
-samples ``band_y`` (0 to 1) and ``band`` (per y, the local eigenvalues [Re, Im], rightmost first).
+samples ``band_y`` (0 to 1) and ``band`` (per y, the local eigenvalues [Re, Im], rightmost first). With
+``stress_diffusion`` D > 0 (D tau'' in each stress law, tau' = 0 at the walls) the band is no longer an essential
+spectrum (diffusion sends the high wavenumbers to -infinity): every resolved eigenvalue is then reported as a point
+eigenvalue, and the band's outputs describe the local law only.
 """
 from __future__ import annotations
 
@@ -31,7 +34,7 @@ from mechgen.analyses import summary
 from mechgen.analyses.orr_sommerfeld import intervals, pair
 from mechgen.analyses.parameters import parameter_dict
 from mechgen.analyses.registry import AnalysisKind, register
-from mechgen.analyses.schema import Option, count, count_within, positive
+from mechgen.analyses.schema import Option, count, count_within, number, positive
 from mechgen.errors import InputError, KernelError
 from mechgen.runtime.fluids.johnson_segalman import classical_rate, extrema, polymer_stresses
 from mechgen.runtime.spectral.channel import LocalBlocks, eigenvalues, local_eigenvalues, off_band, rightmost_first
@@ -42,6 +45,14 @@ PARAMS = ("epsilon", "xi", "Re", "G", "shear_rate")
 STRESSES = ("txx", "tyy", "txy")
 #: a base state's rates residual above this (relative to the stresses' size) means the model is another law
 BASE_TOL = 1e-10
+
+
+def non_negative(ctx, key: str, value: object) -> float:
+    """A number >= 0."""
+    x = number(ctx, key, value)
+    if x < 0:
+        raise fail(ctx.file, key, f"value {x!r} is negative", "a number >= 0")
+    return x
 
 
 def check(ctx, base: str, options: dict) -> None:
@@ -61,6 +72,8 @@ SCHEMA = {
     "tol": Option(positive, 1e-6, doc="Agreement of an eigenvalue between the resolutions, times max(1, |lambda|)."),
     "count": Option(count, 8, doc="How many point eigenvalues to report, rightmost first."),
     "band_samples": Option(count_within("samples"), 201, doc="Points 0 <= y <= 1 at which the band is sampled."),
+    "stress_diffusion": Option(non_negative, 0.0, doc="D of a stress diffusion D tau'' added to each stress law, with "
+                               "tau' = 0 at the walls (lambda h^2 units; 0: none, the band is then essential)."),
 }
 
 
@@ -144,7 +157,7 @@ def spectra(system, options: dict, values) -> tuple[np.ndarray, np.ndarray, floa
     for N in (options["N"], options["N_check"]):
         blocks, res = local_blocks(law, base_rates(points(N), G, epsilon, xi), xi)
         worst = max(worst, res)
-        out.append(eigenvalues(N, epsilon, Re, blocks))
+        out.append(eigenvalues(N, epsilon, Re, blocks, options["stress_diffusion"]))
     return out[0], out[1], worst
 
 
@@ -158,7 +171,8 @@ def run_channel_spectrum(system, options: dict, context: dict) -> dict:
                           f"(residual {worst:.3g}): the model is not the law the base state is for")
     kept, rejected = resolved(coarse, fine, options["tol"])
     y, loc = band(system, epsilon, xi, G, options["band_samples"])
-    point, on_band = off_band(kept, loc, 1e-3)
+    # with stress diffusion the band is no longer essential: every resolved eigenvalue is a point eigenvalue
+    point, on_band = off_band(kept, loc, 1e-3) if options["stress_diffusion"] == 0.0 else (kept, kept[:0])
     point = rightmost_first(point)
     top = max([v.real for v in point] + [float(np.max(loc.real))])
     out = {"eigenvalues": [pair(v) for v in point[:options["count"]]], "verdict": "unstable" if top > 0 else "stable",

@@ -35,8 +35,10 @@ class LocalBlocks:
     shear: int
 
 
-def operator(N: int, epsilon: float, Re: float, blocks: LocalBlocks) -> tuple[np.ndarray, np.ndarray]:
-    """(L, M) of size (N - 1) + m (N + 1), ordered [u interior; sigma_1 at all points; ...; sigma_m]."""
+def operator(N: int, epsilon: float, Re: float, blocks: LocalBlocks,
+             diffusion: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """(L, M) of size (N - 1) + m (N + 1), ordered [u interior; sigma_1 at all points; ...; sigma_m]. With stress
+    diffusion D > 0 each stress law gains D sigma'' and the walls' rows become sigma' = 0 (algebraic: M's row 0)."""
     D, _ = differentiation(N)
     m = blocks.J_g.shape[1]
     n_u, n_p = N - 1, N + 1
@@ -46,21 +48,27 @@ def operator(N: int, epsilon: float, Re: float, blocks: LocalBlocks) -> tuple[np
     s0 = n_u + blocks.shear * n_p
     L[:n_u, s0:s0 + n_p] = D[1:N, :]
     Du = D[:, 1:N]  # u' at every point from the interior values (u = 0 at the walls)
+    M = np.eye(size)
+    M[:n_u, :n_u] *= Re
     for a in range(m):
         rows = slice(n_u + a * n_p, n_u + (a + 1) * n_p)
         L[rows, :n_u] = blocks.J_g[:, a][:, None] * Du
         for b in range(m):
             cols = slice(n_u + b * n_p, n_u + (b + 1) * n_p)
             L[rows, cols] = np.diag(blocks.J_sigma[:, a, b])
-    M = np.eye(size)
-    M[:n_u, :n_u] *= Re
+        if diffusion > 0.0:
+            L[rows, rows] += diffusion * (D @ D)
+            for wall in (n_u + a * n_p, n_u + (a + 1) * n_p - 1):  # sigma' = 0 in place of the wall's law
+                L[wall, :] = 0.0
+                L[wall, rows] = D[0 if wall == n_u + a * n_p else N, :]
+                M[wall, wall] = 0.0
     return L, M
 
 
-def eigenvalues(N: int, epsilon: float, Re: float, blocks: LocalBlocks) -> np.ndarray:
+def eigenvalues(N: int, epsilon: float, Re: float, blocks: LocalBlocks, diffusion: float = 0.0) -> np.ndarray:
     """The finite eigenvalues lambda, rightmost first."""
-    L, M = operator(N, epsilon, Re, blocks)
-    lam = sl.eigvals(L, M) if Re > 0 else sl.eigvals(L, M, overwrite_a=True)
+    L, M = operator(N, epsilon, Re, blocks, diffusion)
+    lam = sl.eigvals(L, M)
     return rightmost_first(lam[np.isfinite(lam)])
 
 
