@@ -105,6 +105,8 @@ class CompileRequest:
     numeric: tuple = ()
     sites: str | None = None
     source: str = ""
+    #: Model.derivation ("auto", "symbolic", "ad"): in :meth:`key` when not "auto"
+    derivation: str = "auto"
 
     def spec_text(self) -> str:
         """The specialisation's canonical text (equal to Specialization.key() of the same specialisation)."""
@@ -118,8 +120,9 @@ class CompileRequest:
 
         if not self.digest:
             return None
+        forced = () if self.derivation == "auto" else (f"derivation={self.derivation}",)
         return content_key(REQUEST_FORMAT, sources_digest(), self.digest, self.model, self.spec_text(),
-                           ",".join(self.kernels), self.backend, str(self.cse))
+                           ",".join(self.kernels), self.backend, str(self.cse), *forced)
 
     def with_backend(self, backend: str) -> "CompileRequest":
         """The same request for another backend."""
@@ -149,7 +152,8 @@ def request_of(model: Model, spec: Specialization, *, kernels=None, backend: str
                           None if spec.active is None else tuple(spec.active),
                           tuple(sorted(set(kernels or all_kernels(model)))), backend, cse, tuple(spec.runtime),
                           free_values, kind, tuple(p.name for p in model.param_list if p.is_numeric),
-                          model.chain_spec.sites if model.is_lattice else None, model.source or model.name)
+                          model.chain_spec.sites if model.is_lattice else None, model.source or model.name,
+                          getattr(model, "derivation_mode", "auto"))
 
 
 def all_kernels(model: Model) -> tuple[str, ...]:
@@ -190,9 +194,13 @@ def derive(model: Model, spec: Specialization):
         from mechgen.symbolic.hybrid import derive_hybrid
 
         return derive_hybrid(model, spec)
-    from mechgen.symbolic.derive import derive_lumped
+    from mechgen.symbolic.derive import declared_lumped, derive_lumped
+    from mechgen.symbolic.derive_ad import derive_lumped_ad, wants_ad
 
-    return derive_lumped(model, spec)
+    declared = declared_lumped(model, spec)
+    if wants_ad(model, declared):  # a large model: derivatives by AD on the energies' graph
+        return derive_lumped_ad(model, spec, declared)
+    return derive_lumped(model, spec, declared=declared)
 
 
 def lower_all(model: Model, eqs, kernels, *, cse: bool = True) -> list[KernelIR]:
@@ -211,6 +219,12 @@ def lower_all(model: Model, eqs, kernels, *, cse: bool = True) -> list[KernelIR]
         return _with_whirl(model, irs)
     if model.is_hybrid:
         return _with_whirl(model, lower_hybrid(model, eqs, kernels, cse=cse))
+    from mechgen.codegen.lower_ad import lower_ad
+    from mechgen.symbolic.derive_ad import ADEquations
+
+    if isinstance(eqs, ADEquations):
+        irs = [lower_ad(eqs, k) for k in all_kernels(model) if k in kernels]
+        return _with_whirl(model, irs + _initial_kernel(eqs, kernels, cse))
     lower = lower_lattice if model.is_lattice else lower_lumped
     irs = [lower(eqs, k, cse=cse) for k in all_kernels(model) if k in kernels]
     return _with_whirl(model, irs + _initial_kernel(eqs, kernels, cse))

@@ -397,6 +397,43 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("start_mode", "string", "-", "An autonomous hybrid orbit: the mode the orbit starts in (the one the "
            "section's event leads to)."),
     ),
+    "phase_boundary": (
+        _o("phase_boundary", "scalar (bool)", "-", "Whether the law's stress rises, falls and rises again on "
+           "``strain_range`` (a non-convex stored energy): false means no phase boundary, and ``note`` says why."),
+        _o("note", "string", "-", "With no phase boundary: why (the stress increases over the range)."),
+        _o("maxwell_stress", "scalar or null", "Pa", "The Maxwell stress: the two phases' driving traction "
+           "f = [[W]] - sigma [[gamma]] vanishes there (equal areas); null without a phase boundary."),
+        _o("phase_strains", "(2,) or []", "-", "The phase strains [gamma_1, gamma_2] at the Maxwell stress."),
+        _o("spinodal_strains", "(2,) or []", "-", "The strains of the stress's peak and valley (sigma' = 0)."),
+        _o("peak_stress", "scalar", "Pa", "The stress at the peak ending phase 1."),
+        _o("valley_stress", "scalar", "Pa", "The stress at the valley starting phase 2."),
+        _o("equilibria", "list of {elongation, phase_fraction, boundary_position, driving_traction, family}",
+           "m, -, m, Pa", "Per ``elongation``: the Maxwell equilibrium with one boundary (phase 2 on 0 < x < s; null "
+           "entries when one phase holds the mean strain) and ``family``, the two-phase equilibria at stresses "
+           "between valley and peak with their interface's driving traction."),
+        _o("law", "{strain, stress, energy_density: (samples,)}", "-, Pa, Pa", "The law at the samples of "
+           "``strain_range``."),
+    ),
+    "phase_kinetics": (
+        _o("t", "(samples,)", "s", "The sample times."),
+        _o("s", "(samples,)", "m", "The phase boundary's position s(t) (phase 2 on 0 < x < s)."),
+        _o("stress", "(samples,)", "Pa", "The bar's stress: with ``elongation``, the hysteresis loop."),
+        _o("elongation", "(samples,)", "m", "The end's displacement delta(t)."),
+        _o("driving_traction", "(samples,)", "Pa", "The boundary's driving traction f (0 without a boundary)."),
+        _o("events", "list of {t, from, to, guard}", "s", "The run's events (nucleation, arrival, reversion, "
+           "retreat), as simulate's."),
+        _o("nucleation_time", "scalar or null", "s", "The first nucleation of phase 2 (null if none)."),
+        _o("arrival_time", "scalar or null", "s", "The first arrival of the boundary at the end x = L (null if "
+           "none)."),
+        _o("reversion_time", "scalar or null", "s", "The first nucleation of phase 1 at x = L (null if none)."),
+        _o("retreat_time", "scalar or null", "s", "The first return of the boundary to x = 0 (null if none)."),
+        _o("maxwell_stress", "scalar", "Pa", "The law's Maxwell stress (as phase_boundary's)."),
+        _o("dissipated", "scalar", "J/m^2", "int f V dt over the run, integrated with the state."),
+        _o("work", "scalar", "J/m^2", "int sigma d delta over the run, integrated with the state."),
+        _o("stored_energy_change", "scalar", "J/m^2", "E(t_end) - E(0), E = int_0^L W dx."),
+        _o("dissipation_residual", "scalar", "J/m^2", "work - stored_energy_change - dissipated: zero to the "
+           "integrator's tolerance (the dissipation check)."),
+    ),
     "cross_section": (
         _o("K", "(6, 6)", "N, N m, N m^2", "The section's stiffness ordered [K_uu, K_uw; K_wu, K_ww]."),
         _o("eigenvalues", "(6,)", "mixed (K's)", "K's eigenvalues, ascending."),

@@ -21,7 +21,8 @@ from mechgen.errors import InputError, did_you_mean
 
 __all__ = ["analysis", "campbell", "continuation", "fit", "impact", "modes", "restitution", "simulate", "stability",
            "steady", "sweep", "cross_section", "symplectic", "rod_statics", "rod_dynamics", "periodic", "periodic_orbit", "spectrum",
-           "stability_boundary", "response", "orr_sommerfeld", "shear_curve", "channel_flow", "channel_spectrum",
+           "stability_boundary", "response", "phase_boundary", "phase_kinetics", "orr_sommerfeld", "shear_curve",
+           "channel_flow", "channel_spectrum",
            "option_lines"]
 
 
@@ -379,6 +380,24 @@ def channel_spectrum(system, *, name: str | None = None, **options) -> Result:
     """The Johnson-Segalman channel linearised about its classical state: point eigenvalues at two resolutions and
     the essential band of the local law (mechgen.analyses.channel_spectrum; model ``js_channel``)."""
     return _run("channel_spectrum", system, options, name)
+
+
+def phase_boundary(system, *, name: str | None = None, **options) -> Result:
+    """The Maxwell stress, the phase strains and the equilibria with one phase boundary of a bar whose model
+    declares its law as outputs ``stress``, ``energy_density`` (and ``modulus``) of a strain ``gamma``
+    (mechgen.analyses.phase_boundary; the built-in ``phase_bar``).
+
+    A convex stored energy on ``strain_range`` gives ``phase_boundary = False`` and a ``note``, no Maxwell stress.
+    """
+    return _run("phase_boundary", system, options, name)
+
+
+def phase_kinetics(system, *, name: str | None = None, **options) -> Result:
+    """A phase boundary's nucleation, motion under the model's kinetic law and arrival at the bar's ends under a
+    quasi-static ramp of the end displacement, as an event-driven hybrid run (mechgen.analyses.phase_kinetics;
+    the built-in ``phase_bar``): s(t), the event times, the stress-elongation loop and the dissipation check.
+    """
+    return _run("phase_kinetics", system, options, name)
 
 
 def option_lines(kind: str) -> list[str]:

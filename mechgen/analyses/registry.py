@@ -33,6 +33,8 @@ MODULES = (
     "mechgen.analyses.symplectic",
     "mechgen.analyses.rod_statics",
     "mechgen.analyses.rod_dynamics",
+    "mechgen.analyses.phase_boundary",
+    "mechgen.analyses.phase_kinetics",
     "mechgen.analyses.orr_sommerfeld",
     "mechgen.analyses.shear_curve",
     "mechgen.analyses.channel_flow",

@@ -39,7 +39,7 @@ LUMPED_KERNELS = ("residual", "tangent", "flow", "linear", "force", "rates", "ra
                   "section", "rod", "lagrangian")
 
 
-def _inputs(eqs: LumpedEquations, with_accel: bool = True) -> tuple[list[Port], list]:
+def state_ports(eqs: LumpedEquations, with_accel: bool = True) -> tuple[list[Port], list]:
     n, m = len(eqs.q), len(eqs.z)
     ports = [Port("q", fixed(n))] + [Port("v", fixed(n))]
     if with_accel:
@@ -60,12 +60,12 @@ def _inputs(eqs: LumpedEquations, with_accel: bool = True) -> tuple[list[Port], 
 
 def _matrix_kernel(eqs: LumpedEquations, name: str, doc: str, mats: dict[str, sp.Matrix], *, accel: bool,
                    cse: bool, symmetric: tuple[str, ...] = (), extra: dict | None = None) -> KernelIR:
-    inputs, gathers = _inputs(eqs, accel)
+    inputs, gathers = state_ports(eqs, accel)
     outputs = [Port(k, fixed(m.rows * m.cols), shape=(m.rows, m.cols), symmetric=k in symmetric)
                for k, m in mats.items()]
     writes = [w for k, m in mats.items() for w in dense_writes(k, m)]
     block = canonical_block(gathers, writes, cse=cse, model=eqs.model)
-    return kernel(name, doc, inputs, outputs, [block], meta={**_meta(eqs), **(extra or {})})
+    return kernel(name, doc, inputs, outputs, [block], meta={**lumped_meta(eqs), **(extra or {})})
 
 
 def separable_meta(why: str | None) -> dict:
@@ -74,7 +74,7 @@ def separable_meta(why: str | None) -> dict:
     return {"separable": why is None, "separable_why": why or ""}
 
 
-def _meta(eqs: LumpedEquations) -> dict:
+def lumped_meta(eqs: LumpedEquations) -> dict:
     return {"model": eqs.model, "coordinates": list(eqs.coordinates), "internal": list(eqs.internal_names),
             "params": list(eqs.param_names), "kind": "field" if eqs.position else "lumped"}
 
@@ -92,11 +92,11 @@ def lower_lumped(eqs: LumpedEquations, name: str, *, cse: bool = True) -> Kernel
     if name == "residual":
         return _matrix_kernel(eqs, name, "Lagrange residual r = M a - f", {"r": r}, accel=True, cse=cse)
     if name == "tangent":
-        mats = {f"r_{w}": eqs.jacobian(r, w) for w in ("q", "v", "a", "z")}
+        mats = {f"r_{w}": eqs.residual_jacobian(w) for w in ("q", "v", "a", "z")}
         return _matrix_kernel(eqs, name, "Jacobians of the residual", mats, accel=True, cse=cse)
     if name == "flow":
-        at_rest = {ai: 0 for ai in eqs.a}
-        mats = {"r": r.subs(at_rest), "M": eqs.jacobian(r, "a").subs(at_rest)}
+        M, h = eqs.split()
+        mats = {"r": h, "M": M}
         return _matrix_kernel(eqs, name, "r at a = 0 and M = dr/da (dx/dt = (v, -M^-1 r))", mats, accel=False, cse=cse)
     if name == "linear":
         return _matrix_kernel(eqs, name, "M, D, G, K of the linearisation (a = 0)", eqs.linear_matrices(),
@@ -148,4 +148,4 @@ def _rod_kernel(eqs: LumpedEquations, cse: bool) -> KernelIR:
     writes = [w for k, m in mats.items() for w in dense_writes(k, m)]
     block = canonical_block(gathers, writes, cse=cse, model=eqs.model)
     return kernel("rod", "Cosserat rod: stress resultant, tangent, energy density, load", inputs, outputs, [block],
-                  meta=_meta(eqs))
+                  meta=lumped_meta(eqs))

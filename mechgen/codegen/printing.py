@@ -215,9 +215,15 @@ class CasadiPrinter(NumpyPrinter):
         return repr(float(sp.pi))
 
 
+_C_PRINTER: list = []
+
+
 def c_code(expr: sp.Expr) -> str:
-    """C99 text of an expression."""
-    return CPrinter().doprint(expr)
+    """C99 text of an expression (one printer, made once: a CodePrinter resets its state in every doprint, and
+    making one costs more than printing a small expression)."""
+    if not _C_PRINTER:
+        _C_PRINTER.append(CPrinter())
+    return _C_PRINTER[0].doprint(expr)
 
 
 def numpy_code(expr: sp.Expr) -> str:

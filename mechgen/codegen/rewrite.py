@@ -24,6 +24,10 @@ import sympy as sp
 
 #: Expressions larger than this (sympy's count_ops) are compared and rewritten as they stand.
 MAX_OPS = 200
+#: Operations (count_ops) of the expressions of one block offered to the Horner rewrite; the rest stay as
+#: derived. Each offer costs a CSE per candidate form, so without a budget the rewrite dominates the build of a
+#: large kernel (an n-link pendulum's tangent); the built-in models' blocks offer at most ~740.
+HORNER_BUDGET = 1000
 
 
 def _key(expr: sp.Expr) -> sp.Expr:
@@ -131,6 +135,17 @@ def horner(expr: sp.Expr, local: set, forms: dict) -> sp.Expr:
     return expr
 
 
+def horner_within_budget(exprs: list[sp.Expr], local: set, forms: dict) -> list[sp.Expr]:
+    """:func:`horner` on the expressions in order until they have offered :data:`HORNER_BUDGET` operations."""
+    spent, out = 0, []
+    for expr in exprs:
+        ops = sp.count_ops(expr) if spent <= HORNER_BUDGET else MAX_OPS + 1
+        offered = ops <= MAX_OPS and spent + ops <= HORNER_BUDGET
+        spent += ops if offered else 0
+        out.append(horner(expr, local, forms) if offered else expr)
+    return out
+
+
 def optimise(exprs: list[sp.Expr], local: set) -> tuple[list[tuple[sp.Symbol, sp.Expr]], list[sp.Expr]]:
     """Assignments and reduced expressions for ``exprs``: shared up to sign, Horner, CSE.
 
@@ -139,7 +154,7 @@ def optimise(exprs: list[sp.Expr], local: set) -> tuple[list[tuple[sp.Symbol, sp
     """
     reps, refs = share_writes(exprs)
     forms: dict = {}
-    reps = [horner(e, local, forms) for e in reps]
+    reps = horner_within_budget(reps, local, forms)
     subs, reduced = sp.cse(reps, symbols=sp.numbered_symbols("c", real=True), order="canonical")
     assignments = [(z, form) for form, z in forms.items()] + list(subs)
     uses = [sum(1 for r, _ in refs if r == i) for i in range(len(reps))]

@@ -16,7 +16,7 @@ K holds the centrifugal terms (-d2T/dq2) and any circulatory part of Q.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import sympy as sp
 
@@ -59,6 +59,12 @@ class LumpedEquations:
     power: sp.Matrix | None = None
     #: v.dT/dv - 2 T: zero for a kinetic energy quadratic in v (:func:`energy_powers`)
     excess: sp.Expr | None = None
+    #: M = d2T/dv dv and the bias h = r(q, v, 0, z, t) of r = M a + h, derived directly (:func:`lagrange_parts`);
+    #: None when the residual was derived in another form (its pieces are then read off it, :meth:`split`)
+    mass: sp.Matrix | None = None
+    bias: sp.Matrix | None = None
+    #: derivatives taken once and shared by the kernels that need them (bias_jacobian)
+    memo: dict = field(default_factory=dict, compare=False, repr=False)
 
     @property
     def t(self) -> sp.Symbol:
@@ -72,12 +78,37 @@ class LumpedEquations:
             return sp.zeros(what.rows, 0)
         return what.jacobian(sp.Matrix(syms))
 
-    def linear_matrices(self) -> dict[str, sp.Matrix]:
-        """M, D, G, K of the linearisation about (q, v, z) with a = 0."""
+    def split(self) -> tuple[sp.Matrix, sp.Matrix]:
+        """(M, h) of the residual r = M a + h, r linear in a: M = dr/da, h = r(a = 0).
+
+        Derived directly by :func:`derive_lumped` (no differentiation of the assembled residual, no
+        substitution over it); read off the residual otherwise (a continuum's local density, a hybrid mode).
+        """
+        if self.mass is not None and self.bias is not None:
+            return self.mass, self.bias
         at_rest = {ai: 0 for ai in self.a}
-        M = self.jacobian(self.residual, "a").subs(at_rest)
-        C = self.jacobian(self.residual, "v").subs(at_rest)
-        K = self.jacobian(self.residual, "q").subs(at_rest)
+        return self.jacobian(self.residual, "a").subs(at_rest), self.residual.subs(at_rest)
+
+    def bias_jacobian(self, wrt: str) -> sp.Matrix:
+        """dh/d(wrt) of the bias h = r(a = 0), derived once per equations (the tangent and linear kernels share it)."""
+        if wrt not in self.memo:
+            self.memo[wrt] = self.jacobian(self.split()[1], wrt)
+        return self.memo[wrt]
+
+    def residual_jacobian(self, wrt: str) -> sp.Matrix:
+        """dr/d(wrt) of r = M a + h: M for wrt = 'a', else d(M a)/d(wrt) + dh/d(wrt) (no a-terms differentiated
+        twice; read off the assembled residual when the equations carry no split)."""
+        if wrt == "a":
+            return self.split()[0]
+        if self.mass is None or self.bias is None or not self.a:
+            return self.jacobian(self.residual, wrt)
+        return self.jacobian(self.mass * sp.Matrix(self.a), wrt) + self.bias_jacobian(wrt)
+
+    def linear_matrices(self) -> dict[str, sp.Matrix]:
+        """M, D, G, K of the linearisation about (q, v, z) with a = 0: M = dr/da, C = dh/dv, K = dh/dq."""
+        M = self.split()[0]
+        C = self.bias_jacobian("v")
+        K = self.bias_jacobian("q")
         return {"M": M, "D": (C + C.T) / 2, "G": (C - C.T) / 2, "K": K}
 
     def lagrangian(self) -> dict[str, sp.Matrix]:
@@ -92,7 +123,7 @@ class LumpedEquations:
         v = sp.Matrix(self.v)
         p = sp.Matrix([sp.diff(self.kinetic, s) for s in self.v])
         p_q = self.jacobian(p, "q")
-        F = -self.residual.subs({ai: 0 for ai in self.a}) + p_q * v + p.diff(TIME)
+        F = -self.split()[1] + p_q * v + p.diff(TIME)
         return {"mom": p, "F": F, "mom_q": p_q, "mom_v": self.jacobian(p, "v"), "F_q": self.jacobian(F, "q"),
                 "F_v": self.jacobian(F, "v")}
 
@@ -147,6 +178,27 @@ def lagrange_residual(T: sp.Expr, V: sp.Expr, R: sp.Expr, q, v, a) -> list[sp.Ex
     return res
 
 
+def lagrange_parts(T: sp.Expr, V: sp.Expr, R: sp.Expr, q, v) -> tuple[sp.Matrix, list[sp.Expr]]:
+    """M and h of Lagrange's equations r = M a + h (:func:`lagrange_residual`), each derivative taken once.
+
+        M_ij = d2T/dv_i dv_j  (symmetric: the upper triangle is derived and mirrored),
+        h_i = sum_j (d2T/dv_i dq_j) v_j + d2T/dv_i dt - dT/dq_i + dV/dq_i + dR/dv_i.
+
+    The velocity terms are the directional derivative of p_i = dT/dv_i along v, never a time derivative of
+    the whole momentum, and nothing is expanded: the work is n first derivatives of T and n^2 of the p_i.
+    """
+    n = len(v)
+    p = [sp.diff(T, vi) for vi in v]
+    M = sp.zeros(n, n)
+    for i in range(n):
+        for j in range(i, n):
+            M[i, j] = M[j, i] = sp.diff(p[i], v[j])
+    zero = sp.Integer(0)
+    h = [sum((sp.diff(p[i], qj) * vj for qj, vj in zip(q, v)), zero) + sp.diff(p[i], TIME) - sp.diff(T, q[i])
+         + sp.diff(V, q[i]) + sp.diff(R, v[i]) for i in range(n)]
+    return M, h
+
+
 def energy_powers(T: sp.Expr, V: sp.Expr, R: sp.Expr, Q: list, q, v) -> tuple[sp.Matrix, sp.Expr]:
     """The terms of the energy balance along a solution of Lagrange's equations (the residual above minus Q).
 
@@ -176,9 +228,29 @@ def _energy(model: Model, scope, what: str, env) -> sp.Expr:
     return total
 
 
-def derive_lumped(model: Model, spec: Specialization, mode: str | None = None) -> LumpedEquations:
-    """Derive the residual, internal rates and outputs of a lumped model (of one mode of a hybrid model:
-    the model-wide terms plus the mode's, mechgen.symbolic.hybrid)."""
+@dataclass(frozen=True)
+class Declared:
+    """What a lumped model declares, evaluated on the state symbols: the energies T, V, Rayleigh's R, the
+    generalized forces Q, the internal rates, the outputs (energies included) and the parameter namespace."""
+
+    names: tuple[str, ...]
+    q: tuple
+    v: tuple
+    a: tuple
+    z: tuple
+    free: tuple
+    p_ns: Namespace
+    T: sp.Expr
+    V: sp.Expr
+    R: sp.Expr
+    Q: list
+    rates: list
+    outputs: dict
+
+
+def declared_lumped(model: Model, spec: Specialization, mode: str | None = None) -> Declared:
+    """The declared pieces of a lumped model (of one mode of a hybrid model: the model-wide terms plus the
+    mode's, mechgen.symbolic.hybrid), before any derivative is taken."""
     if model.is_lattice:
         raise ModelError(f"model {model.name} is a lattice; use derive_lattice", file=model.file)
     scope = model.mode_scopes[mode] if mode is not None else None
@@ -191,7 +263,6 @@ def derive_lumped(model: Model, spec: Specialization, mode: str | None = None) -
     Q = _forces(model, names, env)
     if scope is not None and scope.forces_fn is not None:
         Q = [a_ + b_ for a_, b_ in zip(Q, _forces(model, names, env, scope.forces_fn))]
-    res = [r - Qi for r, Qi in zip(lagrange_residual(T, V, R, q, v, a), Q)]
     laws = scope.rates if scope is not None else {}
     rates = [_scalar(call_declared(laws.get(i.name, i.rate), **env), f"rate of {i.name}", model)
              for i in model.internals]
@@ -199,15 +270,28 @@ def derive_lumped(model: Model, spec: Specialization, mode: str | None = None) -
     outputs = {o.name: _scalar(call_declared(own.get(o.name, o.fn), **env), f"output {o.name}", model)
                for o in model.outputs}
     outputs.update(kinetic_energy=T, potential_energy=V, energy=T + V)
-    power, excess = energy_powers(T, V, R, Q, v=v, q=q)
+    return Declared(tuple(names), q, v, a, z, free, p_ns, T, V, R, Q, rates, outputs)
+
+
+def derive_lumped(model: Model, spec: Specialization, mode: str | None = None, *,
+                  declared: Declared | None = None) -> LumpedEquations:
+    """Derive the residual, internal rates and outputs of a lumped model (of one mode of a hybrid model:
+    the model-wide terms plus the mode's, mechgen.symbolic.hybrid); ``declared``: its declared pieces when
+    already evaluated (:func:`declared_lumped`)."""
+    d = declared if declared is not None else declared_lumped(model, spec, mode)
+    names, q, v, a = d.names, d.q, d.v, d.a
+    M, h = lagrange_parts(d.T, d.V, d.R, q, v)
+    bias = sp.Matrix([hi - Qi for hi, Qi in zip(h, d.Q)]) if names else sp.zeros(0, 1)
+    res = list(M * sp.Matrix(a) + bias) if names else []
+    power, excess = energy_powers(d.T, d.V, d.R, d.Q, v=v, q=q)
     return LumpedEquations(
-        model=model.name, coordinates=names, q=q, v=v, a=a, z=z, params=free,
-        param_names=tuple(s.name for s in free), internal_names=tuple(i.name for i in model.internals),
-        kinetic=T, potential=V, residual=sp.Matrix(res) if res else sp.zeros(0, 1),
-        rates=sp.Matrix(rates) if rates else sp.zeros(0, 1), outputs=outputs,
-        initial=initial_column(model, p_ns, names, tuple(i.name for i in model.internals)),
-        section=(section := _section(model, p_ns)),
-        rod=derive_rod(model, p_ns, section, free), power=power, excess=excess,
+        model=model.name, coordinates=names, q=q, v=v, a=a, z=d.z, params=d.free,
+        param_names=tuple(s.name for s in d.free), internal_names=tuple(i.name for i in model.internals),
+        kinetic=d.T, potential=d.V, residual=sp.Matrix(res) if res else sp.zeros(0, 1),
+        rates=sp.Matrix(d.rates) if d.rates else sp.zeros(0, 1), outputs=d.outputs,
+        initial=initial_column(model, d.p_ns, names, tuple(i.name for i in model.internals)),
+        section=(section := _section(model, d.p_ns)),
+        rod=derive_rod(model, d.p_ns, section, d.free), power=power, excess=excess, mass=M, bias=bias,
     )
 
 

@@ -258,6 +258,8 @@ class Model:
         self.source: str | None = None
         self.param_list: list[Param] = []
         self.coordinate_names: list[str] = []
+        #: how Lagrange's equations are derived (:meth:`derivation`)
+        self.derivation_mode = "auto"
         self.internals: list[Internal] = []
         self.outputs: list[Output] = []
         self.shape_outputs: list[ShapeOutput] = []
@@ -321,6 +323,16 @@ class Model:
             self._claim(name, "coordinate")
             self.coordinate_names.append(name)
         return tuple(names)
+
+    def derivation(self, how: str) -> None:
+        """Choose how a lumped model's equations are differentiated: ``"symbolic"`` (sympy, exact expressions),
+        ``"ad"`` (CasADi's algorithmic differentiation on the energies' graph, mechgen.symbolic.derive_ad: the
+        build grows with the model's size, not its expansion) or ``"auto"`` (the default: AD for a plain lumped
+        model of 8 coordinates or more, or energies of more than 400 operations)."""
+        if how not in ("auto", "symbolic", "ad"):
+            raise ModelError(f"derivation {how!r} of model {self.name}", file=self.file, key="derivation",
+                             expected="'auto', 'symbolic' or 'ad'")
+        self.derivation_mode = how
 
     def internal(self, name: str, rate: Callable, *, initial: float = 0.0, doc: str = "") -> None:
         """Declare an internal variable z with its own first-order law dz/dt = rate(q, v, z, p, t).

@@ -68,6 +68,28 @@ def separable_obstacle(T: sp.Expr, V: sp.Expr, residual: sp.Matrix, q, v, a, oth
     return None
 
 
+def declared_obstacle(T: sp.Expr, V: sp.Expr, R: sp.Expr, Q: list, q, v, others, coordinates) -> str | None:
+    """:func:`separable_obstacle` decided on the declared pieces (T, V, Rayleigh's R, the forces Q) instead of the
+    derived residual, for a model derived by algorithmic differentiation (mechgen.symbolic.derive_ad): a kinetic
+    energy that names a coordinate, t or an internal variable is refused before its Hessian is taken (the mass
+    matrix of a large multibody model is never formed symbolically); then r = M a + dV/dq exactly when R = 0
+    and Q = 0 (M constant: Lagrange's velocity terms vanish)."""
+    moving = sorted(s.name for s in T.free_symbols & {*q, *others})
+    if moving:
+        return f"its kinetic energy depends on {', '.join(moving)} (its mass matrix is not constant)"
+    why = mass_obstacle(T, q, v, others, coordinates)
+    if why:
+        return why
+    names = _depends(V, (*v, *others))
+    if names:
+        return f"its potential energy depends on {', '.join(names)} (the force -dV/dq is evaluated at t = 0)"
+    for i, extra in enumerate(Q):
+        if not _zero(extra) or not _zero(sp.diff(R, v[i])):
+            return (f"its equation of {coordinates[i]} has terms besides M a + dV/dq (dissipation, a generalised "
+                    "force or gyroscopic coupling) that the splitting's force -dV/dq leaves out")
+    return None
+
+
 def lattice_obstacle(T: sp.Expr, site_V: sp.Expr, bond_V: sp.Expr, q: sp.Symbol, v: sp.Symbol,
                      coordinate: str) -> str | None:
     """Why a chain's site kinetic energy T_s(u, u') is not m u'^2 / 2 with a constant m, or its site or bond
