@@ -9,7 +9,8 @@ The public names (DESIGN.md, "the user's three jobs"), importable from ``mechgen
 * one function per analysis kind, each returning a ``Result``: ``modes``, ``stability``,
   ``steady``, ``continuation``, ``simulate``, ``sweep``, ``campbell``, ``fit``, ``impact``, ``restitution``,
   ``periodic``, ``periodic_orbit``, ``spectrum``, ``stability_boundary``, ``cross_section``, ``symplectic``, ``rod_statics``, ``rod_dynamics``,
-  ``response``, ``phase_boundary``, ``phase_kinetics``; and ``analysis(kind, system, **options)`` for any registered kind by name;
+  ``response``, ``phase_boundary``, ``phase_kinetics``, ``orr_sommerfeld``, ``shear_curve``, ``channel_flow``,
+  ``channel_spectrum``; and ``analysis(kind, system, **options)`` for any registered kind by name;
 * ``run(scene)``: a scene file (or a dict of its contents), built on the same functions;
 * the errors: ``MechgenError`` and its kinds.
 
@@ -49,6 +50,10 @@ _EXPORTS = {
     "symplectic": "mechgen.analyses.public",
     "rod_statics": "mechgen.analyses.public",
     "rod_dynamics": "mechgen.analyses.public",
+    "orr_sommerfeld": "mechgen.analyses.public",
+    "shear_curve": "mechgen.analyses.public",
+    "channel_flow": "mechgen.analyses.public",
+    "channel_spectrum": "mechgen.analyses.public",
     "phase_boundary": "mechgen.analyses.public",
     "phase_kinetics": "mechgen.analyses.public",
     "analysis": "mechgen.analyses.public",

@@ -60,7 +60,8 @@ def test_the_registry_lists_the_seven_kinds_each_with_a_function():
     assert registry.kinds()[len(KINDS):] == ("response", "fit", "impact", "restitution", "stability_boundary", "spectrum",
                                                     "periodic", "periodic_orbit",
                                                     "cross_section", "symplectic", "rod_statics", "rod_dynamics",
-                                                    "phase_boundary", "phase_kinetics")
+                                                    "phase_boundary", "phase_kinetics", "orr_sommerfeld",
+                                                    "shear_curve", "channel_flow", "channel_spectrum")
     for kind in KINDS:
         record = registry.get(kind)
         assert record.name == kind and record.schema and callable(record.run) and callable(record.summary)

@@ -21,7 +21,8 @@ from mechgen.errors import InputError, did_you_mean
 
 __all__ = ["analysis", "campbell", "continuation", "fit", "impact", "modes", "restitution", "simulate", "stability",
            "steady", "sweep", "cross_section", "symplectic", "rod_statics", "rod_dynamics", "periodic", "periodic_orbit", "spectrum",
-           "stability_boundary", "response", "phase_boundary", "phase_kinetics",
+           "stability_boundary", "response", "phase_boundary", "phase_kinetics", "orr_sommerfeld", "shear_curve",
+           "channel_flow", "channel_spectrum",
            "option_lines"]
 
 
@@ -355,6 +356,30 @@ def symplectic(system, *, name: str | None = None, **options) -> Result:
     ``recurrence_fraction``, ``t`` and ``mode_energies_series``.
     """
     return _run("symplectic", system, options, name)
+
+
+def orr_sommerfeld(system, *, name: str | None = None, **options) -> Result:
+    """Plane Poiseuille flow's Orr-Sommerfeld spectrum at the model's ``alpha``, ``Re`` by Chebyshev collocation at
+    two resolutions, and its critical point (mechgen.analyses.orr_sommerfeld; model ``plane_poiseuille``)."""
+    return _run("orr_sommerfeld", system, options, name)
+
+
+def shear_curve(system, *, name: str | None = None, **options) -> Result:
+    """A Johnson-Segalman fluid's steady shear curve T(g), its closed-form extrema (or the monotone verdict) and the
+    local law's no-Hopf verdict (mechgen.analyses.shear_curve; model ``js_local``)."""
+    return _run("shear_curve", system, options, name)
+
+
+def channel_flow(system, *, name: str | None = None, **options) -> Result:
+    """The Johnson-Segalman channel's spurt threshold, flow curve and jumping solutions from the local law, and
+    optionally the collocated steady branch (mechgen.analyses.channel_flow; model ``js_channel``)."""
+    return _run("channel_flow", system, options, name)
+
+
+def channel_spectrum(system, *, name: str | None = None, **options) -> Result:
+    """The Johnson-Segalman channel linearised about its classical state: point eigenvalues at two resolutions and
+    the essential band of the local law (mechgen.analyses.channel_spectrum; model ``js_channel``)."""
+    return _run("channel_spectrum", system, options, name)
 
 
 def phase_boundary(system, *, name: str | None = None, **options) -> Result:

@@ -35,6 +35,10 @@ MODULES = (
     "mechgen.analyses.rod_dynamics",
     "mechgen.analyses.phase_boundary",
     "mechgen.analyses.phase_kinetics",
+    "mechgen.analyses.orr_sommerfeld",
+    "mechgen.analyses.shear_curve",
+    "mechgen.analyses.channel_flow",
+    "mechgen.analyses.channel_spectrum",
 )
 
 

@@ -1,0 +1,1 @@
+"""Closed forms of non-Newtonian fluid laws in simple flows (``johnson_segalman``). Numerics only."""
