@@ -86,7 +86,9 @@ def show_model(name: str) -> str:
              "parameters:"]
     lines += [f"  {p.name:10s} = {p.default!r:10} {p.unit:10s} {p.doc}" for p in model.param_list]
     lines.append("")
-    if not hasattr(eqs, "linear_matrices") and not model.is_hybrid:  # ADEquations: graphs, not expressions
+    from mechgen.symbolic.derive_ad import ADEquations
+
+    if isinstance(eqs, ADEquations):  # graphs, not expressions
         lines += [f"derived by algorithmic differentiation ({len(eqs.q)} coordinates; Model.derivation): the "
                   "equations of motion are CasADi graphs and are not printed"]
     elif model.is_hybrid:

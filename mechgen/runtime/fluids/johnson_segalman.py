@@ -25,10 +25,17 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.optimize import brentq
 
 #: epsilon at and above which T(g) is monotone (no extrema, no spurt)
 MONOTONE_EPSILON = 0.125
+
+
+def brentq(f, a: float, b: float, **options) -> float:
+    """scipy's Brent root of f in [a, b], imported when a rate is solved for (the analyses' modules load at every
+    start, and scipy.optimize costs a tenth of a second there)."""
+    from scipy.optimize import brentq as brent
+
+    return brent(f, a, b, **options)
 
 
 def slip_factor(xi: float) -> float:

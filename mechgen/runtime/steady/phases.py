@@ -20,9 +20,16 @@ from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
-from scipy.optimize import brentq
 
 Law = Callable[[np.ndarray], np.ndarray]
+
+
+def brentq(f, a: float, b: float, **options) -> float:
+    """scipy's Brent root of f in [a, b], imported when a law is solved (the analyses' modules load at every
+    start: scipy.optimize costs a tenth of a second there)."""
+    from scipy.optimize import brentq as brent
+
+    return brent(f, a, b, **options)
 
 
 @dataclass(frozen=True)
