@@ -175,3 +175,21 @@ def test_mass_solve_cholesky_with_lu_where_not_positive_definite():
     with pytest.raises(np.linalg.LinAlgError):
         mass_solve(np.zeros((6, 6)), b)
     assert mass_solve(np.zeros((0, 0)), np.zeros(0)).shape == (0,)
+
+
+def test_program_printer_equals_the_c_printer_in_value():
+    """program_c_code writes a program block's single operations directly; each text evaluates (C99 operators
+    and functions are Python's for these forms) to the value of c_code's text."""
+    import math
+
+    from mechgen.codegen.printing import c_code, program_c_code
+
+    t0, t1 = sp.symbols("t0 t1", real=True)
+    forms = [t0 + t1, t0 * t1, t0 - t1, t0 / t1, -t0, t0**2, t0**3, 1 / t0, sp.sqrt(t0), 2.5 * t0, t0 + 3,
+             -2 * t1, sp.sin(t0), sp.cos(t1), sp.exp(t0), sp.log(t1), sp.tanh(t0), sp.Abs(t0), sp.atan(t1), t0,
+             sp.Float(0.125), sp.Integer(-3)]
+    namespace = {**{k: getattr(math, k) for k in ("sin", "cos", "exp", "log", "tanh", "fabs", "atan", "sqrt",
+                                                  "pow")}, "t0": 0.7, "t1": 1.3}
+    for expr in forms:
+        assert math.isclose(eval(program_c_code(expr, {}), namespace), eval(c_code(expr), namespace),
+                            rel_tol=1e-15), expr

@@ -14,7 +14,7 @@ from mechgen.version import __version__
 from mechgen.codegen.emit_c_loop import loop_block, stored_ports
 from mechgen.codegen.escape import c_comment, c_comment_lines, code_identifier
 from mechgen.codegen.ir import Block, KernelIR, Port
-from mechgen.codegen.printing import c_code
+from mechgen.codegen.printing import c_code, program_c_code
 from mechgen.codegen.templating import render
 
 
@@ -81,7 +81,11 @@ class _Names:
 
 def _straight(block: Block, names: _Names) -> list[str]:
     lines = [f"const double {code_identifier(g.symbol.name)} = {names.inp[g.port]}[{g.index}];" for g in block.gathers]
-    lines += [f"const double {code_identifier(s.name)} = {c_code(e)};" for s, e in block.assignments]
+    if block.program is not None:  # single operations: printed directly (mechgen.codegen.printing.program_c_code)
+        atoms: dict = {}
+        lines += [f"const double {s.name} = {program_c_code(e, atoms)};" for s, e in block.assignments]
+    else:
+        lines += [f"const double {code_identifier(s.name)} = {c_code(e)};" for s, e in block.assignments]
     lines += [f"{names.out[w.port]}[{w.index}] {'+=' if w.accumulate else '='} {c_code(w.expr)};"
               for w in block.writes]
     return ["{"] + ["    " + line for line in lines] + ["}"]

@@ -122,6 +122,10 @@ class Block:
     writes: tuple[Write, ...]
     assignments: tuple[tuple[sp.Symbol, sp.Expr], ...] = ()
     loop: Loop | None = None
+    #: a block lowered from a CasADi program (mechgen.codegen.lower_ad): (sha256 of its instructions, their
+    #: operation count), from which the kernel's signature and op count are read instead of from every
+    #: single-operation assignment (hundreds of thousands for a large model)
+    program: tuple[str, int] | None = None
 
     @property
     def entries(self) -> tuple[tuple[int, int], ...]:
@@ -207,6 +211,9 @@ class KernelIR:
         """Arithmetic operations in the kernel text (sympy's count_ops)."""
         total = 0
         for b in self.blocks:
+            if b.program is not None:
+                total += b.program[1]
+                continue
             total += sum(sp.count_ops(e) for _, e in b.assignments)
             total += sum(sp.count_ops(w.expr) for w in b.writes)
         return int(total)
@@ -218,7 +225,10 @@ class KernelIR:
         for b in self.blocks:
             lines.append(repr(b.loop))
             lines += [f"G {g.symbol.name} {g.port} {g.index} {g.relative}" for g in b.gathers]
-            lines += [f"A {s.name} {sp.srepr(e)}" for s, e in b.assignments]
+            if b.program is not None:
+                lines.append(f"P {b.program[0]} {b.program[1]}")
+            else:
+                lines += [f"A {s.name} {sp.srepr(e)}" for s, e in b.assignments]
             lines += [f"W {w.port} {w.index} {w.accumulate} {w.relative} {w.entry} {sp.srepr(w.expr)}"
                       for w in b.writes]
         return "\n".join(lines)

@@ -11,6 +11,8 @@ as :func:`mechgen.codegen.lower.dense_writes` skips them.
 """
 from __future__ import annotations
 
+import hashlib
+
 import casadi as ca
 import sympy as sp
 
@@ -45,19 +47,23 @@ def program_block(fn: ca.Function, ports: list[str], writes: list[tuple[str, int
     work: dict[int, sp.Expr] = {}
     gathers: dict[tuple[str, int], Gather] = {}
     assignments, out = [], []
+    digest, ops = hashlib.sha256(repr((ports, writes)).encode()), 0
     for k in range(fn.n_instructions()):
         op, dst, src = fn.instruction_id(k), fn.instruction_output(k), fn.instruction_input(k)
+        constant = fn.instruction_constant(k) if op == ca.OP_CONST else None
+        digest.update(f"{op} {dst} {src} {constant!r};".encode())
         if op == ca.OP_INPUT:
             key = (ports[src[0]], src[1])
             if key not in gathers:
                 gathers[key] = Gather(sp.Symbol(f"g{len(gathers)}", real=True), key[0], key[1], False)
             work[dst[0]] = gathers[key].symbol
         elif op == ca.OP_CONST:
-            work[dst[0]] = _number(fn.instruction_constant(k))
+            work[dst[0]] = _number(constant)
         elif op == ca.OP_OUTPUT:
             port, index = writes[dst[1]]
             out.append(Write(port, index, work[src[0]]))
         else:
+            ops += op != ca.OP_ASSIGN
             expr = _operation(op, [work[i] for i in src])
             if expr.is_Atom:
                 work[dst[0]] = expr
@@ -65,7 +71,7 @@ def program_block(fn: ca.Function, ports: list[str], writes: list[tuple[str, int
             temp = sp.Symbol(f"t{len(assignments)}", real=True)
             assignments.append((temp, expr))
             work[dst[0]] = temp
-    return Block(tuple(gathers.values()), tuple(out), tuple(assignments), None)
+    return Block(tuple(gathers.values()), tuple(out), tuple(assignments), None, (digest.hexdigest(), ops))
 
 
 def _operation(op: int, args: list) -> sp.Expr:

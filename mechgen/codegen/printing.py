@@ -234,3 +234,40 @@ def numpy_code(expr: sp.Expr) -> str:
 def casadi_code(expr: sp.Expr) -> str:
     """CasADi text of an expression."""
     return CasadiPrinter().doprint(expr)
+
+
+#: functions of one argument printed by :func:`program_c_code` under their C99 names
+_PROGRAM_FUNCTIONS = {sp.sin: "sin", sp.cos: "cos", sp.tan: "tan", sp.exp: "exp", sp.log: "log", sp.sinh: "sinh",
+                      sp.cosh: "cosh", sp.tanh: "tanh", sp.asin: "asin", sp.acos: "acos", sp.atan: "atan",
+                      sp.Abs: "fabs"}
+
+
+def program_c_code(expr: sp.Expr, names: dict) -> str:
+    """C99 text of one assignment of a program block (mechgen.codegen.lower_ad: a single operation on
+    temporaries, gathered locals and numbers), written directly for the forms such an operation takes: a sum or
+    product of two atoms, a function of one, an atom; anything else (a difference, a quotient, a power) through
+    :func:`c_code`. ``names``: a memo of the atoms' texts (numbers through the printer, symbols by name).
+    Equal in value to :func:`c_code` (tests/test_multibody.py evaluates both)."""
+    args = expr.args
+    if expr.is_Atom:
+        return _atom(expr, names)
+    if len(args) == 2 and args[0].is_Atom and args[1].is_Atom and not _negative(args[0]) \
+            and not _negative(args[1]):
+        if expr.is_Add:
+            return f"{_atom(args[0], names)} + {_atom(args[1], names)}"
+        if expr.is_Mul:
+            return f"{_atom(args[0], names)}*{_atom(args[1], names)}"
+    if len(args) == 1 and args[0].is_Symbol and expr.func in _PROGRAM_FUNCTIONS:
+        return f"{_PROGRAM_FUNCTIONS[expr.func]}({_atom(args[0], names)})"
+    return c_code(expr)
+
+
+def _negative(atom) -> bool:
+    return atom.is_Number and atom < 0
+
+
+def _atom(atom, names: dict) -> str:
+    text = names.get(atom)
+    if text is None:
+        text = names[atom] = c_code(atom)
+    return text
