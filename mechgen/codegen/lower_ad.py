@@ -21,11 +21,16 @@ from mechgen.codegen.lower import kernel
 from mechgen.codegen.lower_lumped import lumped_meta, separable_meta, state_ports
 from mechgen.symbolic.casadi_form import NotConvertible
 
-_BINARY = {ca.OP_ADD: lambda x, y: x + y, ca.OP_SUB: lambda x, y: x - y, ca.OP_MUL: lambda x, y: x * y,
-           ca.OP_DIV: lambda x, y: x / y, ca.OP_POW: lambda x, y: x**y, ca.OP_CONSTPOW: lambda x, y: x**_exact(y),
+_BINARY = {ca.OP_ADD: lambda x, y: sp.Add(x, y, evaluate=False),
+           ca.OP_SUB: lambda x, y: sp.Add(x, sp.Mul(-1, y, evaluate=False), evaluate=False),
+           ca.OP_MUL: lambda x, y: sp.Mul(x, y, evaluate=False),
+           ca.OP_DIV: lambda x, y: sp.Mul(x, sp.Pow(y, -1, evaluate=False), evaluate=False),
+           ca.OP_POW: lambda x, y: sp.Pow(x, y, evaluate=False),
+           ca.OP_CONSTPOW: lambda x, y: sp.Pow(x, _exact(y), evaluate=False),
            ca.OP_ATAN2: sp.atan2, ca.OP_FMIN: sp.Min, ca.OP_FMAX: sp.Max}
-_UNARY = {ca.OP_NEG: lambda x: -x, ca.OP_SQ: lambda x: x**2, ca.OP_TWICE: lambda x: 2 * x,
-          ca.OP_INV: lambda x: 1 / x, ca.OP_ASSIGN: lambda x: x, ca.OP_SQRT: sp.sqrt, ca.OP_EXP: sp.exp,
+_UNARY = {ca.OP_NEG: lambda x: sp.Mul(-1, x, evaluate=False), ca.OP_SQ: lambda x: sp.Pow(x, 2, evaluate=False),
+          ca.OP_TWICE: lambda x: sp.Mul(2, x, evaluate=False), ca.OP_INV: lambda x: sp.Pow(x, -1, evaluate=False),
+          ca.OP_ASSIGN: lambda x: x, ca.OP_SQRT: sp.sqrt, ca.OP_EXP: sp.exp,
           ca.OP_LOG: sp.log, ca.OP_SIN: sp.sin, ca.OP_COS: sp.cos, ca.OP_TAN: sp.tan, ca.OP_ASIN: sp.asin,
           ca.OP_ACOS: sp.acos, ca.OP_ATAN: sp.atan, ca.OP_SINH: sp.sinh, ca.OP_COSH: sp.cosh, ca.OP_TANH: sp.tanh,
           ca.OP_ASINH: sp.asinh, ca.OP_ACOSH: sp.acosh, ca.OP_ATANH: sp.atanh, ca.OP_FABS: sp.Abs,
