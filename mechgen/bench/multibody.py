@@ -11,6 +11,28 @@ Its equations of motion in closed form (the independent reference of the tests) 
     sum_j m l^2 c_ij [cos(theta_i - theta_j) a_j + sin(theta_i - theta_j) w_j^2] + m g l (n - i) sin(theta_i) = 0,
 
 c_ij = n - max(i, j) the number of masses beyond both links (0-based i, j).
+
+The suite (:func:`run_multibody_benchmarks`) builds the pendulum for n = 2 ... 64 (``quick``: 2, 4, 8) and a
+10 x 10 planar mass-spring lattice (:func:`lattice_model`; ``quick``: 3 x 3) with each tool of :data:`TOOLS`:
+mechgen's flow kernel only (M and h: what an explicit simulation needs, as PyDy's mass matrix and forcing),
+mechgen's every kernel (``mechgen.compile``'s default), each rebuilt from the cache it filled, PyDy's Kane's
+method with lambdify and with cython, and sympy's LagrangesMethod with lambdify. Each tool and size runs in a
+child process of its own (:func:`cell_main`, $MECHGEN_CACHE a fresh folder, one BLAS thread), which reports:
+
+* the first build, s: model declaration, derivation, code generation and compilation, imports excluded (one
+  run; PyDy has no cache and pays it in every process);
+* the right-hand side per call, s (median of 5 timed runs, each >= 20 ms of calls, after a warm-up; mechgen
+  ``system.rhs(t, x)`` and ``system.acceleration(q, v)``; PyDy's generated function);
+* a simulation: scipy ``solve_ivp`` DOP853 over 10 s at rtol 1e-8, atol 1e-10, 101 samples, from every link
+  at 0.3 rad (the lattice from its rest grid, sagging under gravity): wall time, evaluations, end state;
+* accelerations at 3 seeded random states, compared in the parent with the closed form (pendulum) or with
+  the spring forces by numpy (lattice, :func:`lattice_accelerations`): the issue's criterion is 1e-10 relative to the largest entry.
+
+A cell whose build is predicted (from the tool's last two sizes) to exceed the cap is skipped, a child whose
+build runs past it is ended, a simulation past SIM_CAP_S stops: each is marked ``skipped (> cap)``, never
+waited for. The fitted growth exponent of each tool's build time (least squares of log t on log n over
+n >= 8) is reported, not asserted. Reports: multibody_results.{csv,json,md}, multibody_ratios.json (peer
+seconds / mechgen flow seconds, like for like) and multibody_build_time.png (build time against n, log-log).
 """
 from __future__ import annotations
 
@@ -224,7 +246,7 @@ def closed_form_accelerations(theta, w, m=1.0, l=1.0, g=9.81) -> np.ndarray:
     return np.linalg.solve(m * l**2 * c * np.cos(d), -f)
 
 
-def test_states(problem: str, n: int, count: int = 3) -> list[np.ndarray]:
+def sample_states(problem: str, n: int, count: int = 3) -> list[np.ndarray]:
     """Seeded random states x = (q, v) at which every tool's accelerations are compared (n coordinates):
     pendulum angles and rates in [-1, 1]; lattice displacements and velocities in [-0.1, 0.1] (a = 1 m)."""
     rng = np.random.default_rng(32)
@@ -236,6 +258,23 @@ def initial_state(problem: str, n: int) -> np.ndarray:
     """The simulation's start: every link at 0.3 rad at rest (pendulum); the lattice at its rest grid, at rest
     (it sags under gravity)."""
     return np.r_[np.full(n, 0.3 if problem == "pendulum" else 0.0), np.zeros(n)]
+
+
+def lattice_accelerations(x, rows: int, cols: int, m=1.0, k=100.0, a=1.0, g=9.81) -> np.ndarray:
+    """The lattice's accelerations (m/s^2) at displacements x (:func:`lattice_nodes` order, x then y) by numpy:
+    each spring pulls its ends with k (|d| - a) d/|d| along d = r_b - r_a, gravity -m g in y, divided by m."""
+    nodes = lattice_nodes(rows, cols)
+    slot = {node: 2 * s for s, node in enumerate(nodes)}
+    rest = {(i, j): np.array([a * j, -a * i]) for i in range(rows) for j in range(cols)}
+    pos = {node: rest[node] + (x[slot[node]:slot[node] + 2] if node in slot else 0.0) for node in rest}
+    force = np.tile([0.0, -m * g], len(nodes))
+    for A, B in lattice_springs(rows, cols):
+        d = pos[B] - pos[A]
+        pull = k * (np.linalg.norm(d) - a) * d / np.linalg.norm(d)
+        for node, sign in ((A, 1.0), (B, -1.0)):
+            if node in slot:
+                force[slot[node]:slot[node] + 2] += sign * pull
+    return force / m
 
 
 def _build(tool: str, problem: str, size: tuple):
@@ -258,7 +297,7 @@ def _emit(**record) -> None:
 
 def cell_main(argv: list[str]) -> None:
     """A child process: build TOOL for PROBLEM SIZE (``n`` or ``rowsxcols``) and print JSON lines: build_s, then
-    (for :data:`CALLERS`) per-call seconds, accelerations at :func:`test_states` and a simulation."""
+    (for :data:`CALLERS`) per-call seconds, accelerations at :func:`sample_states` and a simulation."""
     tool, problem, size = argv[0], argv[1], tuple(int(s) for s in argv[2].split("x"))
     if tool.startswith("mechgen"):  # imports before the clock starts (mechgen's came with this module)
         import mechgen  # noqa: F401
@@ -270,7 +309,7 @@ def cell_main(argv: list[str]) -> None:
     if tool not in CALLERS:
         return
     n = _coordinates(problem, size)
-    states = test_states(problem, n)
+    states = sample_states(problem, n)
     calls = {"rhs": lambda: rhs(0.0, states[0])}
     if system is not None:
         calls["acceleration"] = lambda: system.acceleration(states[0][:n], states[0][n:])
@@ -380,17 +419,19 @@ def _size_cells(problem: str, size: tuple, tools: tuple, history: dict, cap: flo
     return cells
 
 
-def agreement(problem: str, n: int, cells: dict) -> dict:
-    """Accelerations of every tool at :func:`test_states` against the reference (the closed form for the
-    pendulum, PyDy Kane + lambdify - else mechgen flow - for the lattice), relative to its largest entry; the
-    end states of the simulations against mechgen flow's."""
+def agreement(problem: str, size: tuple, cells: dict) -> dict:
+    """Accelerations of every tool at :func:`sample_states` against the reference (the closed form for the
+    pendulum, :func:`lattice_accelerations` for the lattice), relative to its largest entry; the end states of
+    the simulations against mechgen flow's."""
+    n = _coordinates(problem, size)
     got = {t: np.array(c["accelerations"]) for t, c in cells.items() if "accelerations" in c}
     if problem == "pendulum":
-        ref = np.array([closed_form_accelerations(x[:n], x[n:]) for x in test_states(problem, n)])
+        ref = np.array([closed_form_accelerations(x[:n], x[n:]) for x in sample_states(problem, n)])
         name = "closed form"
     else:
-        name = next((t for t in ("PyDy Kane + lambdify", "mechgen flow") if t in got), None)
-        ref = got.get(name)
+        rows, cols = size
+        ref = np.array([lattice_accelerations(x[:n], rows, cols) for x in sample_states(problem, n)])
+        name = "spring forces by numpy"
     errors = {t: float(np.abs(a - ref).max() / np.abs(ref).max()) for t, a in got.items()} if ref is not None else {}
     ends = {t: np.array(c["simulation"]["end"]) for t, c in cells.items() if "end" in c.get("simulation", {})}
     base = ends.get("mechgen flow")
@@ -430,7 +471,7 @@ def run_multibody_benchmarks(out: Path, quick: bool = False, *, sizes=None, latt
             cells = _size_cells(problem, size, run_tools, history if problem == "pendulum" else {}, cap, Path(tmp))
             cells.update({t: {"status": why} for t, why in missing.items()})
             rows.append({"problem": problem, "size": "x".join(map(str, size)), "n": n, "cells": cells,
-                         "agreement": agreement(problem, n, cells)})
+                         "agreement": agreement(problem, size, cells)})
     env["loadavg_after"] = list(os.getloadavg())
     pend = {t: [(r["n"], r["cells"][t]["build_s"]) for r in rows
                 if r["problem"] == "pendulum" and "build_s" in r["cells"].get(t, {})] for t in tools}
