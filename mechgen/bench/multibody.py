@@ -26,7 +26,8 @@ child process of its own (:func:`cell_main`, $MECHGEN_CACHE a fresh folder, one 
 * a simulation: scipy ``solve_ivp`` DOP853 over 10 s at rtol 1e-8, atol 1e-10, 101 samples, from every link
   at 0.3 rad (the lattice from its rest grid, sagging under gravity): wall time, evaluations, end state;
 * accelerations at 3 seeded random states, compared in the parent with the closed form (pendulum) or with
-  the spring forces by numpy (lattice, :func:`lattice_accelerations`): the issue's criterion is 1e-10 relative to the largest entry.
+  the spring forces by numpy (lattice, :func:`lattice_accelerations`): the issue's criterion is 1e-10
+  relative to the largest entry.
 
 A cell whose build is predicted (from the tool's last two sizes) to exceed the cap is skipped, a child whose
 build runs past it is ended, a simulation past SIM_CAP_S stops: each is marked ``skipped (> cap)``, never
@@ -583,7 +584,8 @@ def markdown(data: dict) -> str:
     for r in data["rows"]:
         a = r["agreement"]
         worst = max(a["relative_error"].values(), default=float("nan"))
-        parts.append(f"| {r['problem']} {r['size']} | {r['n']} | {a['reference']} | {worst:.1e} | {a['within_1e-10']} |")
+        parts.append(f"| {r['problem']} {r['size']} | {r['n']} | {a['reference']} | {worst:.1e} | "
+                     f"{a['within_1e-10']} |")
     parts += ["", "## Growth exponent of the first build (least squares, log t on log n, n >= 8; reported, not "
               "asserted)\n", "| tool | exponent |", "|---|---|"]
     parts += [f"| {t} | {e:.2f} |" for t, e in data["growth_exponent"].items() if e is not None]
@@ -602,4 +604,5 @@ def _sim(r: dict, tool: str) -> str:
     if "skipped" in sim:
         return sim["skipped"]
     diff = r["agreement"]["end_state_difference"].get(tool)
-    return f"{sim['wall_s']:.3g} ({sim['nfev']}), {diff:.1e}" if diff is not None else f"{sim['wall_s']:.3g} ({sim['nfev']})"
+    text = f"{sim['wall_s']:.3g} ({sim['nfev']})"
+    return text if diff is None else f"{text}, {diff:.1e}"
