@@ -224,10 +224,11 @@ def pydy_rhs(eqs: dict, generator: str):
 # -- the suite ----------------------------------------------------------------------------------------------------
 #: the tools, in the order each size runs them; "cached" rows rebuild in a new process from the cache the row
 #: before filled (PyDy has no cache: every process derives and generates again)
-TOOLS = ("mechgen flow", "mechgen flow cached", "mechgen all", "mechgen all cached", "PyDy Kane + lambdify",
-         "PyDy Kane + cython", "PyDy Lagrange + lambdify")
+TOOLS = ("mechgen flow", "mechgen flow cached", "mechgen all", "mechgen all cached", "mechgen flow numpy",
+         "PyDy Kane + lambdify", "PyDy Kane + cython", "PyDy Lagrange + lambdify")
 #: the tools whose right-hand side is timed and integrated (mechgen all's flow kernel is mechgen flow's)
-CALLERS = ("mechgen flow", "PyDy Kane + lambdify", "PyDy Kane + cython", "PyDy Lagrange + lambdify")
+CALLERS = ("mechgen flow", "mechgen flow numpy", "PyDy Kane + lambdify", "PyDy Kane + cython",
+           "PyDy Lagrange + lambdify")
 SIZES, QUICK_SIZES = (2, 4, 8, 12, 16, 24, 32, 64), (2, 4, 8)
 LATTICE, QUICK_LATTICE = (10, 10), (3, 3)
 #: a cell (one tool, one size) whose predicted build exceeds CAP_S is skipped; a child still running after
@@ -284,7 +285,8 @@ def _build(tool: str, problem: str, size: tuple):
         import mechgen
 
         model = pendulum_model(*size) if problem == "pendulum" else lattice_model(*size)
-        system = mechgen.compile(model, kernels=["flow"] if "flow" in tool else None)
+        system = mechgen.compile(model, kernels=["flow"] if "flow" in tool else None,
+                                 backend="numpy" if "numpy" in tool else "c")
         return system.rhs, system
     method = "kane" if "Kane" in tool else "lagrange"
     eqs = pydy_pendulum(*size, method) if problem == "pendulum" else pydy_lattice(*size, method)
@@ -305,8 +307,9 @@ def cell_main(argv: list[str]) -> None:
     else:
         import pydy.codegen.ode_function_generators  # noqa: F401
         import sympy.physics.mechanics  # noqa: F401
+    stages = _stage_clock()
     seconds, (rhs, system) = timed(lambda: _build(tool, problem, size))
-    _emit(build_s=seconds)
+    _emit(build_s=seconds, **({"stages_s": stages} if stages else {}))
     if tool not in CALLERS:
         return
     n = _coordinates(problem, size)
@@ -317,6 +320,24 @@ def cell_main(argv: list[str]) -> None:
     _emit(per_call_s={k: float(np.median(repeat_times(f, 5, min_time=0.02))) for k, f in calls.items()})
     _emit(accelerations=[list(rhs(0.0, x)[n:]) for x in states])
     _emit(simulation=_simulate(rhs, initial_state(problem, n)))
+
+
+def _stage_clock() -> dict:
+    """A dict that fills with mechgen's build stages (derive, lower, emit, build: C compile and load; seconds)
+    when the pipeline logs "built ..." (its BuildReport's times)."""
+    import logging
+
+    stages: dict = {}
+
+    class Stages(logging.Handler):
+        def emit(self, record):
+            if str(record.msg).startswith("built") and len(record.args) > 3 and isinstance(record.args[3], dict):
+                stages.update(record.args[3])
+
+    logger = logging.getLogger("mechgen")
+    logger.setLevel(logging.INFO)
+    logger.addHandler(Stages(logging.INFO))
+    return stages
 
 
 def _coordinates(problem: str, size: tuple) -> int:
@@ -518,13 +539,20 @@ def _cell_values(r: dict, tool: str) -> dict:
     c = r["cells"].get(tool, {})
     calls, sim = c.get("per_call_s", {}), c.get("simulation", {})
     return {"problem": r["problem"], "size": r["size"], "coordinates": r["n"], "tool": tool,
-            "builds": "flow only" if "flow" in tool else ("every kernel" if "all" in tool else "M and forcing"),
+            "builds": _builds(tool),
             "status": c.get("status", ""), "build_s": c.get("build_s", ""),
             "rhs_us": calls["rhs"] * 1e6 if "rhs" in calls else "",
             "acceleration_us": calls["acceleration"] * 1e6 if "acceleration" in calls else "",
             "simulation_s": sim.get("wall_s", sim.get("skipped", "")), "simulation_nfev": sim.get("nfev", ""),
             "acceleration_relative_error": r["agreement"]["relative_error"].get(tool, ""),
             "end_state_difference": r["agreement"]["end_state_difference"].get(tool, "")}
+
+
+def _builds(tool: str) -> str:
+    """What the tool builds, in words."""
+    if not tool.startswith("mechgen"):
+        return "M and forcing"
+    return ("flow only" if "flow" in tool else "every kernel") + (", numpy backend" if "numpy" in tool else "")
 
 
 def write_reports(out: Path, data: dict, pend: dict) -> list[Path]:
@@ -579,6 +607,17 @@ def markdown(data: dict) -> str:
     for r in data["rows"]:
         cells = [_sim(r, t) for t in tools]
         parts.append(f"| {r['problem']} {r['size']} | {r['n']} | " + " | ".join(cells) + " |")
+    parts += ["", "## mechgen's first build by stage, s (derive, lower, emit, build = C compile and load; other = "
+              "declaration, specialisation, cache and load bookkeeping)\n",
+              "| problem | n | tool | derive | lower | emit | build | other | total |", "|---" * 9 + "|"]
+    for r in data["rows"]:
+        for t in tools:
+            stages = r["cells"].get(t, {}).get("stages_s")
+            if stages and "cached" not in t:
+                other = r["cells"][t]["build_s"] - sum(stages.values())
+                parts.append(f"| {r['problem']} {r['size']} | {r['n']} | {t} | " + " | ".join(
+                    f"{stages.get(k, 0.0):.3g}" for k in ("derive", "lower", "emit", "build"))
+                    + f" | {other:.3g} | {r['cells'][t]['build_s']:.3g} |")
     parts += ["", "## Agreement of the accelerations (3 random states, relative to the largest entry)\n",
               "| problem | n | reference | largest error | all within 1e-10 |", "|---|---|---|---|---|"]
     for r in data["rows"]:
