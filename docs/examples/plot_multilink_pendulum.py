@@ -1,6 +1,6 @@
 """
 A 16-link pendulum: a large multibody model derived by algorithmic differentiation
-================================================================================
+==================================================================================
 
 :math:`n = 16` rigid massless links of length :math:`l` (m) hang from a pivot, a point mass :math:`m`
 (kg) at the end of each; :math:`\\theta_i` (rad) is link :math:`i`'s angle from the downward vertical. The
