@@ -15,12 +15,13 @@ c_ij = n - max(i, j) the number of masses beyond both links (0-based i, j).
 The suite (:func:`run_multibody_benchmarks`) builds the pendulum for n = 2 ... 64 (``quick``: 2, 4, 8) and a
 10 x 10 planar mass-spring lattice (:func:`lattice_model`; ``quick``: 3 x 3) with each tool of :data:`TOOLS`:
 mechgen's flow kernel only (M and h: what an explicit simulation needs, as PyDy's mass matrix and forcing),
-mechgen's every kernel (``mechgen.compile``'s default), each rebuilt from the cache it filled, PyDy's Kane's
+mechgen's every kernel (``mechgen.compile``'s default), each rebuilt from the cache it filled, the flow kernel
+on mechgen's numpy backend, PyDy's Kane's
 method with lambdify and with cython, and sympy's LagrangesMethod with lambdify. Each tool and size runs in a
 child process of its own (:func:`cell_main`, $MECHGEN_CACHE a fresh folder, one BLAS thread), which reports:
 
 * the first build, s: model declaration, derivation, code generation and compilation, imports excluded (one
-  run; PyDy has no cache and pays it in every process);
+  run; PyDy has no cache and pays it in every process), and mechgen's stages (derive, lower, emit, build);
 * the right-hand side per call, s (median of 5 timed runs, each >= 20 ms of calls, after a warm-up; mechgen
   ``system.rhs(t, x)`` and ``system.acceleration(q, v)``; PyDy's generated function);
 * a simulation: scipy ``solve_ivp`` DOP853 over 10 s at rtol 1e-8, atol 1e-10, 101 samples, from every link
