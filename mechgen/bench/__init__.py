@@ -90,6 +90,12 @@ REGISTRY: dict[str, Suite] = {s.name: s for s in (
           "a 10^4-point Laval rotor stability sweep on the serial, local-process and Dask executors (2 workers): wall "
           "time, overhead per point, dask / processes", ("sweep.json", "sweep.md"),
           peers=("local processes (concurrent.futures)", "dask.distributed LocalCluster")),
+    Suite("multibody", "mechgen.bench.multibody", "run_multibody_benchmarks",
+          "n-link pendulums (n = 2 ... 64) and a 10 x 10 mass-spring lattice: first and cached build, right-hand "
+          "side per call, a 10 s DOP853 simulation and the accelerations' agreement, mechgen (flow only, every "
+          "kernel) against PyDy", ("multibody_results.csv", "multibody_results.json", "multibody_results.md",
+                                  "multibody_ratios.json", "multibody_build_time.png"),
+          peers=("PyDy Kane + lambdify", "PyDy Kane + cython", "PyDy/sympy Lagrange + lambdify"), standard=False),
 )}
 
 #: the suite names (``mechgen bench`` with none runs them all)
