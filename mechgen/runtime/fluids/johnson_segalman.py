@@ -30,14 +30,6 @@ import numpy as np
 MONOTONE_EPSILON = 0.125
 
 
-def brentq(f, a: float, b: float, **options) -> float:
-    """scipy's Brent root of f in [a, b], imported when a rate is solved for (the analyses' modules load at every
-    start, and scipy.optimize costs a tenth of a second there)."""
-    from scipy.optimize import brentq as brent
-
-    return brent(f, a, b, **options)
-
-
 def slip_factor(xi: float) -> float:
     """k = xi (2 - xi)."""
     return xi * (2.0 - xi)
@@ -80,6 +72,8 @@ def pair_trace(rate, epsilon: float, xi: float):
 def classical_rate(stress: float, epsilon: float, xi: float) -> float:
     """The low-rate root g of T(g) = stress on the classical branch (0 <= stress <= T_max; any stress >= 0 when T
     is monotone), by Brent's method on [0, g_max]."""
+    from scipy.optimize import brentq  # loaded on use (startup)
+
     if stress <= 0.0:
         return 0.0
     top = extrema(epsilon, xi)
@@ -137,6 +131,8 @@ def branch_flux(g1: float, g2: float, epsilon: float, xi: float) -> float:
 
 def high_rate(stress: float, epsilon: float, xi: float) -> float:
     """The root g >= g_min of T(g) = stress on the high-rate branch (stress >= T_min), by Brent's method."""
+    from scipy.optimize import brentq  # loaded on use (startup)
+
     (_, _), (g_min, T_min) = extrema(epsilon, xi)
     if stress <= T_min:
         return g_min

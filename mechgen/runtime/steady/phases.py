@@ -24,14 +24,6 @@ import numpy as np
 Law = Callable[[np.ndarray], np.ndarray]
 
 
-def brentq(f, a: float, b: float, **options) -> float:
-    """scipy's Brent root of f in [a, b], imported when a law is solved (the analyses' modules load at every
-    start: scipy.optimize costs a tenth of a second there)."""
-    from scipy.optimize import brentq as brent
-
-    return brent(f, a, b, **options)
-
-
 @dataclass(frozen=True)
 class Spinodal:
     """The peak (gamma_a, sigma_a) ending phase 1 and the valley (gamma_b, sigma_b) starting phase 2."""
@@ -48,6 +40,8 @@ def _scalar(f: Law) -> Callable[[float], float]:
 
 def _turn(slope: Callable[[float], float], a: float, b: float) -> float:
     """The strain in [a, b] where the slope changes sign (Brent; a jump of a piecewise-linear law's slope too)."""
+    from scipy.optimize import brentq  # loaded on use (startup)
+
     return brentq(slope, a, b, xtol=1e-14 * max(1.0, abs(a), abs(b)), rtol=4 * np.finfo(float).eps)
 
 
@@ -82,6 +76,8 @@ def _refine(stress: Law, modulus: Law | None, grid: np.ndarray, i: int) -> float
 
 def branch_strain(stress: Law, sigma: float, a: float, b: float) -> float:
     """The strain in [a, b] of a rising branch where sigma(gamma) = sigma."""
+    from scipy.optimize import brentq  # loaded on use (startup)
+
     s = _scalar(stress)
     return brentq(lambda g: s(g) - sigma, a, b, xtol=1e-15 * max(1.0, abs(a), abs(b)), rtol=4 * np.finfo(float).eps)
 
@@ -104,6 +100,8 @@ class Maxwell:
 def maxwell(stress: Law, energy: Law, sp_: Spinodal, low: float, high: float) -> Maxwell:
     """sigma_M: the root of f(sigma) = 0 over (sigma_b, sigma_a), phase 1 on [low, gamma_a], phase 2 on
     [gamma_b, high] (the caller checks that both branches span the bracket)."""
+    from scipy.optimize import brentq  # loaded on use (startup)
+
     def strains(sigma: float) -> tuple[float, float]:
         return branch_strain(stress, sigma, low, sp_.gamma_a), branch_strain(stress, sigma, sp_.gamma_b, high)
 
