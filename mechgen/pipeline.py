@@ -195,11 +195,15 @@ def derive(model: Model, spec: Specialization):
 
         return derive_hybrid(model, spec)
     from mechgen.symbolic.derive import declared_lumped, derive_lumped
+    from mechgen.symbolic.casadi_form import NotConvertible
     from mechgen.symbolic.derive_ad import derive_lumped_ad, wants_ad
 
     declared = declared_lumped(model, spec)
     if wants_ad(model, declared):  # a large model: derivatives by AD on the energies' graph
-        return derive_lumped_ad(model, spec, declared)
+        try:
+            return derive_lumped_ad(model, spec, declared)
+        except NotConvertible:  # a Piecewise, Heaviside, Min/Max ...: the symbolic path
+            pass
     return derive_lumped(model, spec, declared=declared)
 
 

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import casadi as ca
 import sympy as sp
 
-from mechgen.symbolic.casadi_form import NotConvertible, SXForm
+from mechgen.symbolic.casadi_form import SXForm
 from mechgen.symbolic.derive import TIME, Declared, declared_lumped
 from mechgen.symbolic.initial import initial_column
 from mechgen.symbolic.model import Model
@@ -123,8 +123,9 @@ def homogeneous_degree(expr: sp.Expr, symbols: set) -> int | None:
 
 
 def wants_ad(model: Model, declared: Declared) -> bool:
-    """Whether the model is derived by AD: forced by Model.derivation, else a plain lumped model that is large
-    (coordinates or operations) and whose declared expressions convert to SX."""
+    """Whether the model is to be derived by AD: forced by Model.derivation, else a plain lumped model that is large
+    (coordinates or operations). Whether its expressions convert is known from the one conversion
+    (:func:`derive_lumped_ad` raises NotConvertible, and the model is derived symbolically)."""
     how = getattr(model, "derivation_mode", "auto")
     plain = not (model.is_hybrid or model.is_field or model.is_lattice or model.section_fn is not None
                  or model.rod_spec is not None)
@@ -132,10 +133,6 @@ def wants_ad(model: Model, declared: Declared) -> bool:
         return False
     if how == "auto" and len(declared.names) < AD_MIN_COORDINATES \
             and sp.count_ops(declared.T) + sp.count_ops(declared.V) <= AD_MIN_OPS:
-        return False
-    try:
-        _convert(declared)
-    except NotConvertible:
         return False
     return True
 
@@ -155,7 +152,8 @@ def _convert(d: Declared):
 
 
 def derive_lumped_ad(model: Model, spec: Specialization, declared: Declared | None = None) -> ADEquations:
-    """The equations of a lumped model as SX graphs (:class:`ADEquations`)."""
+    """The equations of a lumped model as SX graphs (:class:`ADEquations`); NotConvertible where an expression
+    holds a function CasADi's path does not convert."""
     d = declared if declared is not None else declared_lumped(model, spec)
     inputs, pieces, outputs = _convert(d)
     others = (TIME, *d.z)
