@@ -1,0 +1,1 @@
+"""Plane (2D) continua: meshes, elements, assembly, the compiled system, closed forms and crack integrals."""
