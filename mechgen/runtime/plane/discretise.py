@@ -102,7 +102,7 @@ def generate_mesh(shape: str, sizes: dict, h: float, element: str, curved: bool)
         return meshes.rectangle(0.0, sizes["width"], 0.0, sizes["height"], h, element)
     if shape == "slit_plate":
         return meshes.slit_plate(sizes["W"], sizes["H"], sizes["a"], h, element)
-    return meshes.plate_with_hole(sizes["W"], sizes["H"], sizes["r"], h, element)
+    return meshes.plate_with_hole(sizes["W"], sizes["H"], sizes["r"], h, element, curved=curved)
 
 
 def _domain_piece(mesh, info: dict, degree: int) -> Piece:
