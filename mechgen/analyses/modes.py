@@ -68,6 +68,8 @@ def run_modes(system, options: dict, context: dict) -> dict:
             out["rigid_shapes"] = [_largest_one(system, res.shapes[:, j]) for j in range(res.rigid)]
     if system.is_field and options.get("count"):
         out.update(field_shapes(system, elastic, "shapes"))
+    if getattr(system, "is_plane", False):
+        out["_figure"] = system.figure_data(elastic[:, :8])
     return _with_point(out, found)
 
 

@@ -88,4 +88,5 @@ def plane_steady(system, options: dict) -> dict:
     out["reactions"] = system.reactions(q)
     out.update(point_outputs(system, q, options))
     out["_q"], out["_z"] = q, np.zeros(0)
+    out["_figure"] = {**system.figure_data(q), "stress": system.cell_stress(q)}
     return out

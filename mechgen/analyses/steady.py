@@ -342,6 +342,10 @@ def run_steady_bvp(system, options: dict, context: dict) -> dict:
 
 def plot(plt, a: dict, path: Path) -> list[Path]:
     """A continuum's deflection against s and, with two or more fields, its curve (first field against last)."""
+    if a.get("figure"):
+        from mechgen.analyses import plane_figures
+
+        return plane_figures.steady(plt, a, path)
     if not figures.shapes(plt, a, path):
         return []
     written = []

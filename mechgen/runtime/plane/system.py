@@ -271,6 +271,39 @@ class PlaneSystem:
                 out[:, c, "xy".index(k)] = rho[:, a]
         return out
 
+    def cell_stress(self, q) -> np.ndarray | None:
+        """dV/dH averaged over each element (e, fields, 2), None for a model without gradient jets."""
+        from mechgen.runtime.plane.plotting import cell_means
+
+        piece = self.disc.pieces[0]
+        index = piece.index
+        if not any(k for _, k in index):
+            return None
+        nf = len(self.info["fields"])
+        x = self.expand(q)
+        jets = assemble.point_jets(piece.T, index, x[piece.dofs].reshape(len(piece.dofs), -1, nf))
+        rho = self._evaluate("residual", (jets, 0 * jets, 0 * jets), piece.position, 0.0)["r"]
+        out = np.zeros(rho.shape[:2] + (nf, 2))
+        for a, (c, k) in enumerate(index):
+            if k:
+                out[:, :, c, k - 1] = rho[:, :, a]
+        return cell_means(piece.weights, out)
+
+    def figure_data(self, columns) -> dict:
+        """What a figure of fields on this mesh needs (lists, JSON-ready): node ``x``, ``y``, sub-triangles
+        ``triangles`` and their element ``cell``, ``fields`` names and ``values`` (columns of full nodal values,
+        one per state of ``columns``: dofs x states, free dofs only)."""
+        from mechgen.runtime.plane.plotting import triangulation
+
+        mesh = self.mesh
+        nf = len(self.info["fields"])
+        tris, cell = triangulation(mesh.cells, mesh.element)
+        cols = np.asarray(columns, float)
+        cols = cols[:, None] if cols.ndim == 1 else cols
+        values = [self.expand(cols[:, j]).reshape(-1, nf).T for j in range(cols.shape[1])]
+        return {"x": mesh.points[:, 0], "y": mesh.points[:, 1], "triangles": tris, "cell": cell,
+                "fields": list(self.info["fields"]), "values": values}
+
     def reactions(self, q, t: float = 0.0) -> dict:
         """The force each held boundary exerts on the body, per field: sum of r over its held dofs (N per unit
         thickness, the fields' force unit)."""
