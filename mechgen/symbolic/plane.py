@@ -47,6 +47,9 @@ BOUNDARIES = {"disk": ("outer",), "annulus": ("inner", "outer"), "rectangle": ("
               "slit_plate": ("bottom", "right", "top", "left", "crack_upper", "crack_lower"),
               "plate_with_hole": ("bottom", "right", "top", "left", "hole")}
 ELEMENTS = ("P1", "P2", "Q1", "Q2")
+#: the pseudo-boundary of ``fix("u", "rigid")``: pins that hold the rigid motions of a body loaded by
+#: self-equilibrated tractions alone (mechgen.runtime.plane.discretise.rigid_pins)
+RIGID = "rigid"
 
 
 @dataclass(frozen=True)
@@ -196,11 +199,12 @@ def plane_constraints(model: Model, p_ns: Namespace) -> tuple[PlaneConstraint, .
     out = []
     for item in call_declared(model.boundary_fn, p=p_ns) or ():
         ok = isinstance(item, tuple) and len(item) == 2 and all(isinstance(x, str) for x in item)
-        if not ok or item[0] not in (*spec.fields, *groups) or item[1] not in spec.domain.boundaries:
+        if not ok or item[0] not in (*spec.fields, *groups) or item[1] not in (*spec.domain.boundaries, RIGID):
             raise ModelError(f"boundary condition {item!r} of model {model.name} is not a field held at zero on a "
                              "boundary of its domain", file=model.file, key="boundary",
                              expected=f"fix(one of {', '.join((*spec.fields, *groups))}, one of "
-                                      f"{', '.join(spec.domain.boundaries)}); prescribed values are not supported")
+                                      f"{', '.join(spec.domain.boundaries)} or {RIGID!r}); prescribed values are "
+                                      "not supported")
         for f in groups.get(item[0], (item[0],)):
             out.append(PlaneConstraint(f, item[1]))
     return tuple(dict.fromkeys(out))

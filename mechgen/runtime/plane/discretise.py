@@ -19,6 +19,9 @@ from mechgen.runtime.fields.assemble import Assembler
 from mechgen.runtime.plane import assemble
 from mechgen.runtime.plane.edges import edge_tables
 
+#: the pseudo-boundary of rigid-motion pins (mechgen.symbolic.plane.RIGID; runtime never imports symbolic)
+RIGID = "rigid"
+
 #: nodes per vertex of each element family on a large mesh (P2: vertices + edge midpoints = 4 x vertices)
 NODES_PER_VERTEX = {"P1": 1, "P2": 4, "Q1": 1, "Q2": 4}
 #: local nodes per element and polynomial order
@@ -127,10 +130,26 @@ def _edge_piece(mesh, info: dict, name: str, degree: int) -> Piece:
                  Assembler(dofs, len(mesh.points) * nf, dense=False))
 
 
+def rigid_pins(mesh, fields) -> dict[str, np.ndarray]:
+    """The nodes that hold the rigid motions (``fix(..., "rigid")``): every field at the node nearest the mesh's
+    lower-left corner and, with two fields, the second (u_y) also at the node nearest the lower-right corner
+    (no translation, no rotation). With self-equilibrated loads the pins carry no force and the solution is
+    the exact one up to a rigid motion."""
+    p = mesh.points
+    low = np.array([p[:, 0].min(), p[:, 1].min()])
+    high = np.array([p[:, 0].max(), p[:, 1].min()])
+    first = int(np.argmin(np.sum((p - low) ** 2, axis=1)))
+    second = int(np.argmin(np.sum((p - high) ** 2, axis=1)))
+    pins = {f: np.array([first]) for f in fields}
+    if len(fields) == 2:
+        pins[fields[1]] = np.array([first, second])
+    return pins
+
+
 def discretise(mesh, info: dict, quadrature: int = 0) -> PlaneDisc:
     """Tables, dof maps and held dofs of a mesh for a plane model's facts ``info``."""
     nf = len(info["fields"])
-    for name in sorted({c[1] for c in info["constraints"]} | set(info["edges"])):
+    for name in sorted({c[1] for c in info["constraints"] if c[1] != RIGID} | set(info["edges"])):
         if name not in mesh.boundaries:
             raise InputError(f"the mesh has no boundary {name!r}", key="mesh",
                              expected=f"a mesh with the boundaries the model names; it has {', '.join(mesh.boundaries)}")
@@ -138,7 +157,12 @@ def discretise(mesh, info: dict, quadrature: int = 0) -> PlaneDisc:
     pieces += [_edge_piece(mesh, info, name, quadrature) for name in sorted(info["edges"])]
     ndof = len(mesh.points) * nf
     held: dict = {}
+    pins = rigid_pins(mesh, info["fields"])
     for f, boundary in info["constraints"]:
+        if boundary == RIGID:
+            if f in pins:
+                held.setdefault(boundary, {})[f] = pins[f] * nf + info["fields"].index(f)
+            continue
         nodes = np.unique(mesh.boundaries[boundary])
         held.setdefault(boundary, {})[f] = nodes * nf + info["fields"].index(f)
     mask = np.ones(ndof, bool)

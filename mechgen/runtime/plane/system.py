@@ -94,7 +94,7 @@ class PlaneSystem:
     def with_mesh(self, mesh) -> "PlaneSystem":
         """The same kernels on a given :class:`~mechgen.runtime.plane.mesh.PlaneMesh` (a gmsh file read by
         :func:`~mechgen.runtime.plane.mesh.read_msh`): its boundaries must hold the ones the model names."""
-        missing = sorted(({c[1] for c in self.info["constraints"]} | set(self.info["edges"]))
+        missing = sorted(({c[1] for c in self.info["constraints"] if c[1] != "rigid"} | set(self.info["edges"]))
                          - set(mesh.boundaries))
         if missing:
             raise InputError(f"the mesh has no boundary {missing[0]!r} that model {self.meta.get('model')} names",
