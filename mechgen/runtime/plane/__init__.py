@@ -1,0 +1,1 @@
+"""Plane (2D) continua: meshes, elements, closed-form reference fields and the fracture integrals."""
