@@ -318,7 +318,9 @@ def crack_sqrt(z, a: float) -> np.ndarray:
     Principal roots: sqrt(z + a) jumps on x < -a, sqrt(z - a) on x < a; the product jumps only on |x| < a.
     On the faces X = +i sqrt(a^2 - x^2) (y = +0.0, upper) and -i sqrt(a^2 - x^2) (y = -0.0, lower).
     """
-    return np.sqrt(z - a) * np.sqrt(z + a)
+    z = np.asarray(z, complex)
+    # z + a in complex arithmetic would turn a face's -0.0 into +0.0: build both factors part by part
+    return np.sqrt(_complex(z.real - a, z.imag)) * np.sqrt(_complex(z.real + a, z.imag))
 
 
 def griffith_field(x, y, crack: GriffithCrack, mat: PlaneElastic) -> PlaneField:
