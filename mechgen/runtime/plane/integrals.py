@@ -131,7 +131,8 @@ def polygon_contour(vertices, n_per_edge: int):
         pts.append(p + np.outer(0.5 * (t + 1.0), d))
         nrms.append(np.tile([d[1] / length, -d[0] / length], (n_per_edge, 1)))
         ws.append(0.5 * length * wt)
-    if np.sum([np.cross(p, q) for p, q in zip(V, np.roll(V, -1, axis=0))]) <= 0:
+    Vn = np.roll(V, -1, axis=0)
+    if np.sum(V[:, 0] * Vn[:, 1] - V[:, 1] * Vn[:, 0]) <= 0:          # twice the signed area
         raise InputError("the polygon's vertices must run counter-clockwise", key="contour",
                          expected="counter-clockwise vertices")
     return np.concatenate(pts), np.concatenate(nrms), np.concatenate(ws)
