@@ -43,8 +43,8 @@ __all__ = [
     "PlaneElastic", "PlaneField", "fields_from_potentials", "membrane_field", "membrane_polar_stress",
     "membrane_strain_energy", "membrane_rim_traction", "membrane_rim_reaction", "annulus_coefficients",
     "annulus_field", "annulus_strain_energy", "annulus_rim_traction", "CrackTip", "GriffithCrack", "crack_sqrt",
-    "griffith_field", "griffith_rotation_field", "griffith_sif", "williams_field", "tip_frame_field", "k_field", "t_field",
-    "point_force_field", "bueckner_weight", "bueckner_field",
+    "griffith_field", "griffith_rotation_field", "griffith_sif", "williams_field", "tip_frame_field", "k_field",
+    "t_field", "point_force_field", "bueckner_weight", "bueckner_field",
 ]
 
 
