@@ -20,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from mechgen.errors import InputError
 from mechgen.runtime.plane import closed_forms as cf
 from mechgen.runtime.plane import integrals as ig
 
@@ -41,9 +42,9 @@ def closed(crack, mat=MAT):
             "L_paper": (k + 1) * a * 2 * s["K_I"] * s["K_II"] / (4 * mu), **s}
 
 
-def local_to_global(tip, angle, pts):
-    c, s = np.cos(angle), np.sin(angle)
-    return np.asarray(tip) + pts @ np.array([[c, s], [-s, c]])
+def local_to_global(tip, pts):
+    """Global points of points given in a tip's frame: x = tip + Q x_l."""
+    return np.asarray(tip.position) + pts @ tip.rotation.T
 
 
 def field_at(crack, pts):
@@ -52,21 +53,20 @@ def field_at(crack, pts):
 
 # --- contour forms ---------------------------------------------------------------------------------------
 
-def tip_contours(tip, angle, sizes, n=400):
+def tip_contours(tip, sizes, n=400):
     """Circles of the given radii and squares of half-side h, both about a tip, ends on the faces."""
     out = []
     for rho in sizes:
-        p, nrm, w = ig.circle_contour(tip, rho, n, start=angle - np.pi)
+        p, nrm, w = ig.circle_contour(tip.position, rho, n, start=tip.angle - np.pi)
         out.append((f"circle r={rho}", p, nrm, w))
         h = rho
         V = np.array([[-h, 0.0], [-h, -h], [h, -h], [h, h], [-h, h]])
         p, nrm, w = ig.polygon_contour(V, n // 5)
-        c, s = np.cos(angle), np.sin(angle)
-        out.append((f"square h={rho}", local_to_global(tip, angle, p), nrm @ np.array([[c, s], [-s, c]]), w))
+        out.append((f"square h={rho}", local_to_global(tip, p), nrm @ tip.rotation.T, w))
     return out
 
 
-def face_term_j2(crack, tip, angle, rho, n=20):
+def face_term_j2(crack, tip, rho, n=20):
     """-int_{-rho}^0 (W^+ - W^-) dx' along the faces behind the tip (x' = -s^2 removes the r^-1/2 singularity).
 
     20 nodes: 3e-12 of J_2; more nodes lie so near the tip that x = a - s^2, rounded, loses digits of s^2
@@ -74,10 +74,10 @@ def face_term_j2(crack, tip, angle, rho, n=20):
     t, wt = np.polynomial.legendre.leggauss(n)
     s = np.sqrt(rho) * (t + 1) / 2
     w = wt * np.sqrt(rho) / 2 * 2 * s                       # dx' = 2 s ds
-    pts = local_to_global(tip, angle, np.stack([-s * s, np.zeros_like(s)], -1))
+    pts = local_to_global(tip, np.stack([-s * s, np.zeros_like(s)], -1))
     up = cf.griffith_field(pts[:, 0], np.zeros_like(s), crack, MAT)         # y = +0.0: the upper face
     lo = cf.griffith_field(pts[:, 0], -np.zeros_like(s), crack, MAT)        # y = -0.0: the lower face
-    Wp, Wm = (up.energy_density, lo.energy_density) if angle == 0.0 else (lo.energy_density, up.energy_density)
+    Wp, Wm = (up.energy_density, lo.energy_density) if tip.angle == 0.0 else (lo.energy_density, up.energy_density)
     return ig.j2_face_term(w, Wp, Wm, np.ones_like(s))
 
 
@@ -86,20 +86,20 @@ def test_tip_contours_path_independent(crack):
     """J_1 = G, J_2 + faces = -(kappa+1) K_I K_II/(4 mu), Bueckner = K_I, K_II on circles and squares of four
     sizes about each tip (the largest reaching 3/4 of the way to the other tip)."""
     ref = closed(crack)
-    for tip, angle in crack.tips():
-        for name, p, nrm, w in tip_contours(tip, angle, [0.05 * crack.a, 0.3 * crack.a, 0.8 * crack.a, 1.5 * crack.a]):
+    for tip in crack.tips():
+        for name, p, nrm, w in tip_contours(tip, [0.05 * crack.a, 0.3 * crack.a, 0.8 * crack.a, 1.5 * crack.a]):
             f = field_at(crack, p)
-            J = ig.to_tip_frame((0, 0), angle, vec=ig.contour_integral(ig.eshelby_flux(f.grad, f.stress), nrm, w))
+            J = ig.to_tip_frame(tip, vec=ig.contour_integral(ig.eshelby_flux(f.grad, f.stress), nrm, w))
             assert J[0] == pytest.approx(ref["G"], rel=1e-10), name
             for mode, key in (("I", "K_I"), ("II", "K_II")):
-                aux = cf.tip_frame_field(p[:, 0], p[:, 1], tip, angle, lambda a, b: cf.bueckner_field(a, b, mode, MAT))
+                aux = cf.tip_frame_field(p[:, 0], p[:, 1], tip, lambda a, b: cf.bueckner_field(a, b, mode, MAT))
                 B = ig.contour_integral(ig.bueckner_flux(f.u, f.stress, aux.u, aux.stress), nrm, w)
                 assert B == pytest.approx(ref[key], rel=1e-10, abs=1e-12), (name, mode)
         rho = 0.8 * crack.a
-        p, nrm, w = ig.circle_contour(tip, rho, 400, start=angle - np.pi)
+        p, nrm, w = ig.circle_contour(tip.position, rho, 400, start=tip.angle - np.pi)
         f = field_at(crack, p)
-        J = ig.to_tip_frame((0, 0), angle, vec=ig.contour_integral(ig.eshelby_flux(f.grad, f.stress), nrm, w))
-        assert J[1] + face_term_j2(crack, tip, angle, rho) == pytest.approx(ref["J2"], rel=1e-10, abs=1e-12)
+        J = ig.to_tip_frame(tip, vec=ig.contour_integral(ig.eshelby_flux(f.grad, f.stress), nrm, w))
+        assert J[1] + face_term_j2(crack, tip, rho) == pytest.approx(ref["J2"], rel=1e-10, abs=1e-12)
 
 
 @pytest.mark.parametrize("crack", LOADS)
@@ -128,8 +128,8 @@ def test_whole_crack_contours(crack):
 def tip_bueckner_rotation_sum(crack, rho, n=400):
     """I_CL + I_CR: Bueckner's integral with the rotation field on circles of radius rho about each tip."""
     tot = 0.0
-    for tip, angle in crack.tips():
-        p, nrm, w = ig.circle_contour(tip, rho, n, start=angle - np.pi)
+    for tip in crack.tips():
+        p, nrm, w = ig.circle_contour(tip.position, rho, n, start=tip.angle - np.pi)
         f, rot = field_at(crack, p), cf.griffith_rotation_field(p[:, 0], p[:, 1], crack, MAT)
         tot += ig.contour_integral(ig.bueckner_flux(f.u, f.stress, rot.u, rot.stress), nrm, w)
     return tot
@@ -162,8 +162,8 @@ def test_paper_relation_needs_zero_t_stress():
 
 # --- domain forms on scikit-fem ring meshes ----------------------------------------------------------------
 
-def ring_mesh(center, angle, r0, r1, n_r, n_t, slit):
-    """A ring r0 < rho < r1 about center in the frame turned by angle; with slit the seam at theta = +-pi is
+def ring_mesh(frame, r0, r1, n_r, n_t, slit):
+    """A ring r0 < rho < r1 about a tip (or any CrackTip as a frame); with slit the seam at theta = +-pi is
     cut (duplicate nodes: the crack faces), otherwise periodic. Returns the mesh and each node's logical
     radial coordinate s in [0, 1] (0 on the inner edge)."""
     m_t = n_t + 1 if slit else n_t
@@ -171,7 +171,7 @@ def ring_mesh(center, angle, r0, r1, n_r, n_t, slit):
     th = -np.pi + 2 * np.pi * np.arange(m_t) / n_t
     R_, T_ = np.meshgrid(rho, th, indexing="ij")
     loc = np.stack([R_ * np.cos(T_), R_ * np.sin(T_)], -1).reshape(-1, 2)
-    p = local_to_global(center, angle, loc)
+    p = local_to_global(frame, loc)
     idx = np.arange((n_r + 1) * m_t).reshape(n_r + 1, m_t)
     tris = []
     for i in range(n_r):
@@ -184,10 +184,12 @@ def ring_mesh(center, angle, r0, r1, n_r, n_t, slit):
     return mesh, s
 
 
-def ring_data(crack, center, angle, r0, r1, q_order, slit, n_r=6, n_t=72, intorder=10, rot=False):
-    """Quadrature points x (e, q, 2), weights (e, q), the exact field there, q and grad q (P1: linear in s;
-    P2: the smooth step 1 - 3 s^2 + 2 s^3 at the P2 nodes, s at an edge node the mean of its ends')."""
-    mesh, s = ring_mesh(center, angle, r0, r1, n_r, n_t, slit)
+def ring_data(crack, frame, r0, r1, q_order, slit, n_r=6, n_t=72, intorder=10, rot=False):
+    """The exact field sampled on a ring mesh (an integrals.Sample) and, with rot, the rotation field there.
+
+    q and grad q from P1 (linear in s) or P2 (the smooth step 1 - 3 s^2 + 2 s^3 at the P2 nodes, s at an edge
+    node the mean of its ends')."""
+    mesh, s = ring_mesh(frame, r0, r1, n_r, n_t, slit)
     elem = skfem.ElementTriP1() if q_order == 1 else skfem.ElementTriP2()
     basis = skfem.Basis(mesh, elem, intorder=intorder)
     if q_order == 1:
@@ -200,7 +202,9 @@ def ring_data(crack, center, angle, r0, r1, q_order, slit, n_r=6, n_t=72, intord
     x = np.moveaxis(basis.mapping.F(basis.X), 0, -1)
     f = cf.griffith_field(x[..., 0], x[..., 1], crack, MAT)
     g = cf.griffith_rotation_field(x[..., 0], x[..., 1], crack, MAT) if rot else None
-    return x, np.asarray(basis.dx), f, np.moveaxis(np.asarray(qf.grad), 0, -1), g
+    sample = ig.Sample(x=x, w=np.asarray(basis.dx), grad_q=np.moveaxis(np.asarray(qf.grad), 0, -1), grad_u=f.grad,
+                       stress=f.stress, u=f.u, q=np.asarray(qf))
+    return sample, g
 
 
 TIP_RINGS = [(0.05, 0.2), (0.2, 0.6), (0.5, 1.2)]      # radii / a: inner, outer
@@ -210,20 +214,20 @@ CRACK_RINGS = [(1.3, 2.0), (2.0, 4.0), (4.0, 10.0)]
 def tip_table(crack, q_order):
     """Per tip and ring: J_1, J_2 + faces, K_I, K_II (interaction), T (point force), K_I, K_II (Bueckner)."""
     rows = []
-    for tip, angle in crack.tips():
+    for tip in crack.tips():
         for r0, r1 in TIP_RINGS:
             r0_, r1_ = r0 * crack.a, r1 * crack.a
-            x, w, f, gq, _ = ring_data(crack, tip, angle, r0_, r1_, q_order, slit=True)
-            J = ig.j_vector(w, f.grad, f.stress, gq, angle=angle)
-            J2 = J[1] + face_term_j2(crack, tip, angle, r0_) + ring_face_term(crack, tip, angle, r0_, r1_, q_order)
-            K = ig.stress_intensity(x, w, f.grad, f.stress, gq, tip, angle, MAT)
-            T = ig.t_stress(x, w, f.grad, f.stress, gq, tip, angle, MAT)
-            B = [ig.bueckner_integral(x, w, f.u, f.stress, gq, tip, angle, MAT, m) for m in ("I", "II")]
-            rows.append((tip[0], r0, r1, J[0], J2, K[0], K[1], T, B[0], B[1]))
+            smp, _ = ring_data(crack, tip, r0_, r1_, q_order, slit=True)
+            J = ig.j_vector(smp, tip)
+            J2 = J[1] + face_term_j2(crack, tip, r0_) + ring_face_term(crack, tip, r0_, r1_, q_order)
+            K = ig.stress_intensity(smp, tip, MAT)
+            T = ig.t_stress(smp, tip, MAT)
+            B = [ig.bueckner_integral(smp, tip, MAT, m) for m in ("I", "II")]
+            rows.append((tip.position[0], r0, r1, J[0], J2, K[0], K[1], T, B[0], B[1]))
     return np.array(rows)
 
 
-def ring_face_term(crack, tip, angle, r0, r1, q_order, n_r=6, n=12):
+def ring_face_term(crack, tip, r0, r1, q_order, n_r=6, n=12):
     """-int q (W^+ - W^-) dx' over the faces inside the ring, element by element along the seam (q is the
     mesh's: linear in s for P1, the P2 interpolant of the smooth step for P2), n Gauss points per element."""
     t, wt = np.polynomial.legendre.leggauss(n)
@@ -237,10 +241,10 @@ def ring_face_term(crack, tip, angle, r0, r1, q_order, n_r=6, n=12):
         else:
             q = g(s0) * (1 - xi) * (1 - 2 * xi) + g(0.5 * (s0 + s1)) * 4 * xi * (1 - xi) + g(s1) * xi * (2 * xi - 1)
         rho = r0 + (r1 - r0) * (s0 + (s1 - s0) * xi)
-        pts = local_to_global(tip, angle, np.stack([-rho, np.zeros_like(rho)], -1))
+        pts = local_to_global(tip, np.stack([-rho, np.zeros_like(rho)], -1))
         up = cf.griffith_field(pts[:, 0], np.zeros_like(rho), crack, MAT)
         lo = cf.griffith_field(pts[:, 0], -np.zeros_like(rho), crack, MAT)
-        Wp, Wm = (up.energy_density, lo.energy_density) if angle == 0.0 else (lo.energy_density, up.energy_density)
+        Wp, Wm = (up.energy_density, lo.energy_density) if tip.angle == 0.0 else (lo.energy_density, up.energy_density)
         total += ig.j2_face_term(wt * (r1 - r0) * (s1 - s0) / 2, Wp, Wm, q)
     return total
 
@@ -269,13 +273,13 @@ def test_whole_crack_domain_integrals(q_order):
     crack = LOADS[0]
     ref = closed(crack)
     for r0, r1 in CRACK_RINGS:
-        x, w, f, gq, rot = ring_data(crack, (0.0, 0.0), 0.0, r0 * crack.a, r1 * crack.a, q_order, slit=False,
-                                     n_r=6, n_t=96, rot=True)
-        assert ig.m_integral(x, w, f.grad, f.stress, gq) == pytest.approx(ref["M"], rel=1e-12)
-        L = ig.l_integral(x, w, f.u, f.grad, f.stress, gq)
+        smp, rot = ring_data(crack, cf.CrackTip((0.0, 0.0)), r0 * crack.a, r1 * crack.a, q_order, slit=False,
+                             n_r=6, n_t=96, rot=True)
+        assert ig.m_integral(smp) == pytest.approx(ref["M"], rel=1e-12)
+        L = ig.l_integral(smp)
         assert L == pytest.approx(ref["L"], rel=1e-12)
-        np.testing.assert_allclose(ig.j_vector(w, f.grad, f.stress, gq), 0.0, atol=1e-12 * ref["G"])
-        I = float(ig.domain_integral(ig.bueckner_flux(f.u, f.stress, rot.u, rot.stress), w, gq))
+        np.testing.assert_allclose(ig.j_vector(smp), 0.0, atol=1e-12 * ref["G"])
+        I = float(ig.domain_integral(ig.bueckner_flux(smp.u, smp.stress, rot.u, rot.stress), smp.w, smp.grad_q))
         assert I == pytest.approx(2 * ref["L"], rel=1e-12)
         assert abs(L - ref["L_paper"]) > 0.3 * abs(ref["L"])     # eq. 8 misses the T-stress's face term
 
@@ -283,7 +287,48 @@ def test_whole_crack_domain_integrals(q_order):
 def test_domain_inputs_any_leading_shape():
     """The same points flattened to (n,) give the same integral as (e, q)."""
     crack = LOADS[0]
-    x, w, f, gq, _ = ring_data(crack, (1.0, 0.0), 0.0, 0.2, 0.6, 1, slit=True, n_r=3, n_t=24, intorder=4)
-    a = ig.j_vector(w, f.grad, f.stress, gq)
-    b = ig.j_vector(w.reshape(-1), f.grad.reshape(-1, 2, 2), f.stress.reshape(-1, 2, 2), gq.reshape(-1, 2))
-    np.testing.assert_allclose(a, b, rtol=1e-14)
+    smp, _ = ring_data(crack, crack.tips()[0], 0.2, 0.6, 1, slit=True, n_r=3, n_t=24, intorder=4)
+    flat = ig.Sample(x=smp.x.reshape(-1, 2), w=smp.w.reshape(-1), grad_q=smp.grad_q.reshape(-1, 2),
+                     grad_u=smp.grad_u.reshape(-1, 2, 2), stress=smp.stress.reshape(-1, 2, 2))
+    np.testing.assert_allclose(ig.j_vector(smp), ig.j_vector(flat), rtol=1e-14)
+
+
+def test_j_with_body_force_on_the_membrane():
+    """J_k with the body-force term vanishes over a defect-free disk for any q that is 0 on the rim: the
+    membrane's exact field (quadratic u, linear stress) on scikit-fem's init_circle mesh with a P2 q; the
+    integrand is a polynomial of degree 3 on straight triangles, so degree-4 quadrature is exact (round-off
+    1e-16 of the terms). Without the term J_2 is the (non-zero) int q b_i u_i,2 dA."""
+    mat, rho_g, R = cf.PlaneElastic(E=2.0, nu=0.3, plane="stress"), 1.5, 1.0
+    mesh = skfem.MeshTri.init_circle(3)
+    basis = skfem.Basis(mesh, skfem.ElementTriP2(), intorder=4)
+    xd, yd = basis.doflocs
+    bnd = basis.get_dofs().all()
+    qn = (1.0 - (xd**2 + yd**2) / np.max(xd**2 + yd**2)) * (1.0 + 0.5 * xd + 0.3 * yd)   # lopsided: the
+    # membrane's field is symmetric, and a symmetric q would make the body-force term vanish by itself
+    qn[bnd] = 0.0                                      # q = 0 on every boundary edge (vertices and midpoints)
+    qf = basis.interpolate(qn)
+    x = np.moveaxis(basis.mapping.F(basis.X), 0, -1)
+    f = cf.membrane_field(x[..., 0], x[..., 1], R, mat, rho_g)
+    body = np.broadcast_to([0.0, -rho_g], x.shape)
+    common = dict(x=x, w=np.asarray(basis.dx), grad_q=np.moveaxis(np.asarray(qf.grad), 0, -1), grad_u=f.grad,
+                  stress=f.stress, q=np.asarray(qf))
+    J = ig.j_vector(ig.Sample(**common, body=body))
+    without = ig.j_vector(ig.Sample(**common))
+    scale = abs(without[1])
+    assert scale > 1e-3
+    np.testing.assert_allclose(J, 0.0, atol=1e-13 * scale)
+    with pytest.raises(InputError):
+        ig.m_integral(ig.Sample(**common, body=body))
+
+
+def test_bad_samples_are_refused():
+    w = np.ones((2, 3))
+    with pytest.raises(InputError):
+        ig.Sample(x=np.zeros((2, 3, 2)), w=w, grad_q=np.zeros((2, 3)), grad_u=np.zeros((2, 3, 2, 2)),
+                  stress=np.zeros((2, 3, 2, 2)))
+    smp = ig.Sample(x=np.zeros((2, 3, 2)), w=w, grad_q=np.zeros((2, 3, 2)), grad_u=np.zeros((2, 3, 2, 2)),
+                    stress=np.zeros((2, 3, 2, 2)))
+    with pytest.raises(InputError):
+        ig.l_integral(smp)                       # L needs u
+    with pytest.raises(InputError):
+        ig.polygon_contour([[0, 0], [0, 1], [1, 1], [1, 0]], 4)     # clockwise

@@ -42,9 +42,9 @@ from mechgen.errors import InputError
 __all__ = [
     "PlaneElastic", "PlaneField", "fields_from_potentials", "membrane_field", "membrane_polar_stress",
     "membrane_strain_energy", "membrane_rim_traction", "membrane_rim_reaction", "annulus_coefficients",
-    "annulus_field", "annulus_strain_energy", "annulus_rim_traction", "GriffithCrack", "crack_sqrt",
-    "griffith_field", "griffith_rotation_field", "griffith_sif", "williams_field", "tip_frame_field", "k_field", "t_field",
-    "point_force_field", "bueckner_weight", "bueckner_field",
+    "annulus_field", "annulus_strain_energy", "annulus_rim_traction", "CrackTip", "GriffithCrack", "crack_sqrt",
+    "griffith_field", "griffith_rotation_field", "griffith_sif", "williams_field", "tip_frame_field", "k_field",
+    "t_field", "point_force_field", "bueckner_weight", "bueckner_field",
 ]
 
 
@@ -296,6 +296,24 @@ def _complex(x, y) -> np.ndarray:
 
 
 @dataclass(frozen=True)
+class CrackTip:
+    """A crack tip: its position (x, y) (m) and the angle (rad) of its crack's extension from the x axis.
+
+    The tip's frame has x along the extension and y to its left: Q = [[cos, -sin], [sin, cos]] maps its
+    components to global ones.
+    """
+
+    position: tuple
+    angle: float = 0.0
+
+    @property
+    def rotation(self) -> np.ndarray:
+        """Q, the rotation by angle (global = Q local)."""
+        c, s = np.cos(self.angle), np.sin(self.angle)
+        return np.array([[c, -s], [s, c]])
+
+
+@dataclass(frozen=True)
 class GriffithCrack:
     """The slit |x| < a, y = 0 in an infinite plate under remote stresses sigma11, sigma22, sigma12 (Pa)."""
 
@@ -307,9 +325,9 @@ class GriffithCrack:
     def __post_init__(self) -> None:
         _check_positive(a=self.a)
 
-    def tips(self):
-        """((x, y), direction angle) of each tip: the right tip (a, 0) faces +x, the left (-a, 0) faces -x."""
-        return (((self.a, 0.0), 0.0), ((-self.a, 0.0), np.pi))
+    def tips(self) -> tuple:
+        """The right tip (a, 0), facing +x, and the left tip (-a, 0), facing -x (angle pi)."""
+        return (CrackTip((self.a, 0.0), 0.0), CrackTip((-self.a, 0.0), np.pi))
 
 
 def crack_sqrt(z, a: float) -> np.ndarray:
@@ -445,16 +463,14 @@ def bueckner_field(x, y, mode: str, mat: PlaneElastic) -> PlaneField:
     return williams_field(x, y, -1, -weight if mode == "I" else 1j * weight, mat)
 
 
-def tip_frame_field(x, y, tip, angle: float, local) -> PlaneField:
-    """A field given in a tip's frame (origin at the tip, x along angle) evaluated at global points.
+def tip_frame_field(x, y, tip: CrackTip, local) -> PlaneField:
+    """A field given in a tip's frame (origin at the tip, x along its angle) evaluated at global points.
 
     local(xl, yl) -> PlaneField in the tip frame; x_l = Q^T (x - x_tip), u = Q u_l, grad = Q grad_l Q^T,
-    sigma = Q sigma_l Q^T with Q the rotation by angle. Points on the faces keep their side through a
-    signed zero only when angle is 0.
+    sigma = Q sigma_l Q^T (Q = tip.rotation). Points on the faces keep their side through a signed zero only
+    when the angle is 0.
     """
-    c, s = np.cos(angle), np.sin(angle)
-    dx, dy = np.asarray(x, float) - tip[0], np.asarray(y, float) - tip[1]
-    xl, yl = c * dx + s * dy, -s * dx + c * dy
-    f = local(xl, yl)
-    Q = np.array([[c, -s], [s, c]])
+    Q = tip.rotation
+    dx, dy = np.asarray(x, float) - tip.position[0], np.asarray(y, float) - tip.position[1]
+    f = local(Q[0, 0] * dx + Q[1, 0] * dy, Q[0, 1] * dx + Q[1, 1] * dy)
     return PlaneField(np.einsum("ij,...j->...i", Q, f.u), Q @ f.grad @ Q.T, Q @ f.stress @ Q.T)

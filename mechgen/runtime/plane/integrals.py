@@ -5,8 +5,8 @@ x (e, q, 2) (m), weights w (e, q) including |det J| (m^2), the displacement u (e
 grad_u[..., i, j] = u_i,j, the stress (e, q, 2, 2) (Pa), the strain energy density W (e, q) (J/m^3; computed
 as sigma_ij u_i,j / 2 when omitted), and the weight function q (e, q) with its gradient grad_q (e, q, 2)
 (1/m), interpolated by the caller from nodal values (q = 1 on the inner boundary of the ring, 0 on the
-outer). Any common leading shape works; only the last axes are fixed. Units: J_k, M per unit thickness
-in J/m^2 * m^(0, 1) (J: N/m, M: N, L: N), K in Pa m^0.5, T in Pa.
+outer). Any common leading shape works; only the last axes are fixed. Units, per unit thickness: J_k in
+N/m (= J/m^2), M and L in N (= J/m), K and Bueckner's normalised integral in Pa m^0.5, T in Pa.
 
 Every integral is the flux of a divergence-free tensor F through a closed contour C, I = oint_C F_l n_l ds,
 n the normal pointing away from what C encloses. Its domain form over a ring A between C (q = 1) and an
@@ -20,8 +20,9 @@ outer contour (q = 0) is
 * J_k (Eshelby; Rice's J = J_1 in the tip's frame): F_kl = W delta_kl - sigma_il u_i,k. J_1 is path
   independent around one tip; J_2 is not (the faces carry W n_2: J_2 on a ring misses
   -int q [[W]] dx along the faces, :func:`j2_face_term`); around the whole crack both are.
-* M (Budiansky-Rice, about an origin x0): F_l = (x_k - x0_k) F_kl; around the whole crack.
-* L (Knowles-Sternberg, the rotational integral, about x0): F_l = e_3ij ((x_j - x0_j) F_il + sigma_il u_j),
+  Write P_kl for this flux (Eshelby's tensor).
+* M (Budiansky-Rice, about an origin x0): F_l = (x_k - x0_k) P_kl; around the whole crack.
+* L (Knowles-Sternberg, the rotational integral, about x0): F_l = e_3ij ((x_j - x0_j) P_il + sigma_il u_j),
   i.e. L = oint e_3ij (W x_j n_i + T_i u_j - T_k u_k,i x_j) ds; around the whole crack.
 * Bueckner's work-conjugate integral of u with an auxiliary field v:
   F_l = u_i sigma[v]_il - v_i sigma[u]_il (Betti); path independent when both fields are traction-free
@@ -29,10 +30,14 @@ outer contour (q = 0) is
 * the interaction integral (the cross term of J_1 in the tip frame) of u with v:
   F_l = sigma[u]_ij eps[v]_ij delta_1l - sigma[u]_il v_i,1 - sigma[v]_il u_i,1.
 
-A tip is given by its position (m) and the angle (rad) of its crack's extension from the x axis; its
-frame has x along the extension and y to its left (the left tip of a crack on y = 0 has angle pi).
+The domain forms take a :class:`Sample` (the arrays above) and, for a tip's integrals, a
+:class:`closed_forms.CrackTip`: its position (m) and the angle (rad) of its crack's extension from the x
+axis; its frame has x along the extension and y to its left (the left tip of a crack on y = 0 has angle pi).
+A body force enters J_k only (- int q b_i u_i,k dA); the other integrals refuse a sample that has one.
 """
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -41,7 +46,7 @@ from mechgen.runtime.plane import closed_forms as cf
 
 __all__ = [
     "energy_density", "eshelby_flux", "m_flux", "l_flux", "bueckner_flux", "interaction_flux",
-    "domain_integral", "contour_integral", "circle_contour", "polygon_contour", "to_tip_frame",
+    "domain_integral", "contour_integral", "circle_contour", "polygon_contour", "to_tip_frame", "Sample",
     "j_vector", "j2_face_term", "m_integral", "l_integral", "bueckner_integral", "interaction_integral",
     "stress_intensity", "t_stress",
 ]
@@ -138,13 +143,12 @@ def polygon_contour(vertices, n_per_edge: int):
     return np.concatenate(pts), np.concatenate(nrms), np.concatenate(ws)
 
 
-def to_tip_frame(tip, angle: float, x=None, vec=None, tensor=None):
-    """Components in a tip's frame: x_l = Q^T (x - tip), v_l = Q^T v, A_l = Q^T A Q (Q the rotation by angle)."""
-    c, s = np.cos(angle), np.sin(angle)
-    Q = np.array([[c, -s], [s, c]])
+def to_tip_frame(tip: cf.CrackTip, x=None, vec=None, tensor=None):
+    """Components in a tip's frame: x_l = Q^T (x - tip), v_l = Q^T v, A_l = Q^T A Q (Q = tip.rotation)."""
+    Q = tip.rotation
     out = []
     if x is not None:
-        out.append(np.einsum("ji,...j->...i", Q, np.asarray(x, float) - np.asarray(tip, float)))
+        out.append(np.einsum("ji,...j->...i", Q, np.asarray(x, float) - np.asarray(tip.position, float)))
     if vec is not None:
         out.append(np.einsum("ji,...j->...i", Q, np.asarray(vec, float)))
     if tensor is not None:
@@ -152,13 +156,69 @@ def to_tip_frame(tip, angle: float, x=None, vec=None, tensor=None):
     return out[0] if len(out) == 1 else tuple(out)
 
 
-def j_vector(w, grad_u, stress, grad_q, W=None, angle: float = 0.0) -> np.ndarray:
-    """(J_1, J_2) in the tip's frame (N/m): J_k = - int P_kl q_,l dA, turned by -angle.
+@dataclass(frozen=True)
+class Sample:
+    """A field sampled at quadrature points (leading shape S, e.g. (elements, points)), for the domain forms.
 
-    J_1 = G = (K_I^2 + K_II^2)/E' around one tip; J_2 -> -2 K_I K_II/E' needs :func:`j2_face_term` added.
+    x (S, 2) points (m); w (S,) weights including |det J| (m^2); grad_q (S, 2) the weight function's gradient
+    (1/m); grad_u (S, 2, 2) with grad_u[..., i, j] = u_i,j; stress (S, 2, 2) (Pa); optional: u (S, 2) (m; L and
+    Bueckner's integral need it), W (S,) (J/m^3; else sigma_ij u_i,j/2), q (S,) and body (S, 2) the body force
+    per unit volume (N/m^3; J_k's term - int q b_i u_i,k dA needs both).
     """
-    J = domain_integral(eshelby_flux(grad_u, stress, W), w, grad_q)
-    return to_tip_frame((0.0, 0.0), angle, vec=J)
+
+    x: np.ndarray
+    w: np.ndarray
+    grad_q: np.ndarray
+    grad_u: np.ndarray
+    stress: np.ndarray
+    u: np.ndarray | None = None
+    W: np.ndarray | None = None
+    q: np.ndarray | None = None
+    body: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        S = np.shape(self.w)
+        want = {"x": S + (2,), "grad_q": S + (2,), "grad_u": S + (2, 2), "stress": S + (2, 2), "u": S + (2,),
+                "W": S, "q": S, "body": S + (2,)}
+        for key, shape in want.items():
+            value = getattr(self, key)
+            if value is not None and np.shape(value) != shape:
+                raise InputError(f"the sample's {key} has shape {np.shape(value)}, the weights {S}", key=key,
+                                 expected=f"shape {shape}")
+        if self.body is not None and self.q is None:
+            raise InputError("a body force needs q at the points (the term - int q b_i u_i,k dA)", key="q",
+                             expected="q with the weights' shape")
+
+    @property
+    def energy(self) -> np.ndarray:
+        """W, given or sigma_ij u_i,j/2."""
+        return energy_density(self.grad_u, self.stress) if self.W is None else np.asarray(self.W)
+
+    def require(self, key: str, what: str) -> np.ndarray:
+        """The optional array key, or an InputError saying that what needs it."""
+        value = getattr(self, key)
+        if value is None:
+            raise InputError(f"{what} needs the sample's {key}", key=key, expected="an array at the points")
+        return np.asarray(value)
+
+    def refuse_body(self, what: str) -> None:
+        """M, L, Bueckner's and the interaction integrals here hold without body force only."""
+        if self.body is not None:
+            raise InputError(f"{what} is implemented without body force; the sample has one", key="body",
+                             expected="no body force (or use J_k, which takes it)")
+
+
+def j_vector(s: Sample, tip: cf.CrackTip | None = None) -> np.ndarray:
+    """(J_1, J_2) (N/m): J_k = - int P_kl q_,l dA - int q b_i u_i,k dA, in the tip's frame if a tip is given.
+
+    div P_k = b_i u_i,k with a body force b, whence its term. J_1 = G = (K_I^2 + K_II^2)/E' around one tip;
+    J_2 -> -2 K_I K_II/E' needs :func:`j2_face_term` added when the ring crosses the faces.
+    """
+    J = domain_integral(eshelby_flux(s.grad_u, s.stress, s.energy), s.w, s.grad_q)
+    if s.body is not None:
+        bu = np.einsum("...i,...ik->...k", np.asarray(s.body, float), s.grad_u)
+        J = J - ((np.asarray(s.w, float) * np.asarray(s.q, float))[..., None] * bu).reshape(-1, 2).sum(0)
+    return J if tip is None else to_tip_frame(tip, vec=J)
 
 
 def j2_face_term(w_face, W_upper, W_lower, q_face) -> float:
@@ -171,56 +231,58 @@ def j2_face_term(w_face, W_upper, W_lower, q_face) -> float:
     return -float(np.sum(np.asarray(w_face) * np.asarray(q_face) * (np.asarray(W_upper) - np.asarray(W_lower))))
 
 
-def m_integral(x, w, grad_u, stress, grad_q, origin=(0.0, 0.0), W=None) -> float:
+def m_integral(s: Sample, origin=(0.0, 0.0)) -> float:
     """M = oint (W x_i n_i - T_k u_k,i x_i) ds about origin, as - int F_l q_,l dA (N)."""
-    return float(domain_integral(m_flux(x, grad_u, stress, W, origin), w, grad_q))
+    s.refuse_body("M")
+    return float(domain_integral(m_flux(s.x, s.grad_u, s.stress, s.energy, origin), s.w, s.grad_q))
 
 
-def l_integral(x, w, u, grad_u, stress, grad_q, origin=(0.0, 0.0), W=None) -> float:
+def l_integral(s: Sample, origin=(0.0, 0.0)) -> float:
     """L = oint e_3ij (W x_j n_i + T_i u_j - T_k u_k,i x_j) ds about origin, as - int F_l q_,l dA (N)."""
-    return float(domain_integral(l_flux(x, u, grad_u, stress, W, origin), w, grad_q))
+    s.refuse_body("L")
+    u = s.require("u", "L")
+    return float(domain_integral(l_flux(s.x, u, s.grad_u, s.stress, s.energy, origin), s.w, s.grad_q))
 
 
-def bueckner_integral(x, w, u, stress, grad_q, tip, angle: float, mat: cf.PlaneElastic, mode: str = "I") -> float:
+def bueckner_integral(s: Sample, tip: cf.CrackTip, mat: cf.PlaneElastic, mode: str = "I") -> float:
     """Bueckner's work-conjugate integral with his r^(-3/2) field (:func:`closed_forms.bueckner_field`).
 
     B = oint (u_i sigma^B_ij - u^B_i sigma_ij) n_j ds = - int F_l q_,l dA around one tip; normalised so that
     B = K_I (mode "I") or K_II (mode "II") of u (Pa m^0.5). Path independent: both fields are traction-free
     on the faces; rigid motions of u add nothing (the field B carries no force nor moment).
     """
-    aux = cf.tip_frame_field(np.asarray(x)[..., 0], np.asarray(x)[..., 1], tip, angle,
-                             lambda xl, yl: cf.bueckner_field(xl, yl, mode, mat))
-    return float(domain_integral(bueckner_flux(u, stress, aux.u, aux.stress), w, grad_q))
+    s.refuse_body("Bueckner's integral")
+    u = s.require("u", "Bueckner's integral")
+    aux = cf.tip_frame_field(s.x[..., 0], s.x[..., 1], tip, lambda xl, yl: cf.bueckner_field(xl, yl, mode, mat))
+    return float(domain_integral(bueckner_flux(u, s.stress, aux.u, aux.stress), s.w, s.grad_q))
 
 
-def interaction_integral(x, w, grad_u, stress, grad_q, tip, angle: float, aux) -> float:
+def interaction_integral(s: Sample, tip: cf.CrackTip, aux) -> float:
     """The interaction integral of u with an auxiliary tip field (N/m), all in the tip's frame.
 
     I = - int (sigma_ij eps^aux_ij delta_1l - sigma_il v_i,1 - sigma^aux_il u_i,1) q_,l dA, where
     aux(xl, yl) -> closed_forms.PlaneField gives the auxiliary field in the tip's frame.
     """
-    xl = to_tip_frame(tip, angle, x=x)
-    gl, sl = to_tip_frame(tip, angle, tensor=grad_u), to_tip_frame(tip, angle, tensor=stress)
-    ql = to_tip_frame((0.0, 0.0), angle, vec=grad_q)
+    s.refuse_body("the interaction integral")
+    xl = to_tip_frame(tip, x=s.x)
+    gl, sl = to_tip_frame(tip, tensor=s.grad_u), to_tip_frame(tip, tensor=s.stress)
     v = aux(xl[..., 0], xl[..., 1])
-    return float(domain_integral(interaction_flux(gl, sl, v.grad, v.stress), w, ql))
+    return float(domain_integral(interaction_flux(gl, sl, v.grad, v.stress), s.w, to_tip_frame(tip, vec=s.grad_q)))
 
 
-def stress_intensity(x, w, grad_u, stress, grad_q, tip, angle: float, mat: cf.PlaneElastic):
+def stress_intensity(s: Sample, tip: cf.CrackTip, mat: cf.PlaneElastic) -> tuple:
     """(K_I, K_II) at a tip (Pa m^0.5): I(u, K field with unit K_I or K_II) = 2 K/E', E' = 8 mu/(kappa + 1)."""
     out = []
     for kI, kII in ((1.0, 0.0), (0.0, 1.0)):
-        I = interaction_integral(x, w, grad_u, stress, grad_q, tip, angle,
-                                 lambda xl, yl: cf.k_field(xl, yl, kI, kII, mat))
+        I = interaction_integral(s, tip, lambda xl, yl: cf.k_field(xl, yl, kI, kII, mat))
         out.append(0.5 * mat.modulus * I)
     return tuple(out)
 
 
-def t_stress(x, w, grad_u, stress, grad_q, tip, angle: float, mat: cf.PlaneElastic, f: float = 1.0) -> float:
+def t_stress(s: Sample, tip: cf.CrackTip, mat: cf.PlaneElastic, f: float = 1.0) -> float:
     """T-stress at a tip (Pa) by Kfouri's point-force field: T = E' I(u, point force f at the tip)/f.
 
     The pairing picks the Williams n = 2 term (the T term) of u against the n = 0 field (stress ~ 1/r).
     """
-    I = interaction_integral(x, w, grad_u, stress, grad_q, tip, angle,
-                             lambda xl, yl: cf.point_force_field(xl, yl, f, mat))
+    I = interaction_integral(s, tip, lambda xl, yl: cf.point_force_field(xl, yl, f, mat))
     return mat.modulus * I / f
