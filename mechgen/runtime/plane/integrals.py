@@ -47,7 +47,8 @@ from mechgen.runtime.plane import closed_forms as cf
 __all__ = [
     "energy_density", "eshelby_flux", "m_flux", "l_flux", "bueckner_flux", "interaction_flux",
     "domain_integral", "contour_integral", "circle_contour", "polygon_contour", "to_tip_frame", "Sample",
-    "j_vector", "j2_face_term", "m_integral", "l_integral", "bueckner_integral", "interaction_integral",
+    "j_vector", "j2_face_term", "m_integral", "l_integral", "work_conjugate_integral", "bueckner_integral",
+    "interaction_integral",
     "stress_intensity", "t_stress",
 ]
 
@@ -244,6 +245,18 @@ def l_integral(s: Sample, origin=(0.0, 0.0)) -> float:
     return float(domain_integral(l_flux(s.x, u, s.grad_u, s.stress, s.energy, origin), s.w, s.grad_q))
 
 
+def work_conjugate_integral(s: Sample, aux: cf.PlaneField) -> float:
+    """Betti's (Bueckner's) integral of the sampled u with any auxiliary field given at the same points.
+
+    I = oint (u_i sigma^aux_ij - u^aux_i sigma_ij) n_j ds = - int F_l q_,l dA (units of u times stress);
+    path independent where both fields are traction-free on the faces the ring crosses. With
+    closed_forms.griffith_rotation_field around the whole crack it is 2 L (Shi, Liu & Li's eq. 7).
+    """
+    s.refuse_body("Bueckner's integral")
+    u = s.require("u", "Bueckner's integral")
+    return float(domain_integral(bueckner_flux(u, s.stress, aux.u, aux.stress), s.w, s.grad_q))
+
+
 def bueckner_integral(s: Sample, tip: cf.CrackTip, mat: cf.PlaneElastic, mode: str = "I") -> float:
     """Bueckner's work-conjugate integral with his r^(-3/2) field (:func:`closed_forms.bueckner_field`).
 
@@ -251,10 +264,8 @@ def bueckner_integral(s: Sample, tip: cf.CrackTip, mat: cf.PlaneElastic, mode: s
     B = K_I (mode "I") or K_II (mode "II") of u (Pa m^0.5). Path independent: both fields are traction-free
     on the faces; rigid motions of u add nothing (the field B carries no force nor moment).
     """
-    s.refuse_body("Bueckner's integral")
-    u = s.require("u", "Bueckner's integral")
     aux = cf.tip_frame_field(s.x[..., 0], s.x[..., 1], tip, lambda xl, yl: cf.bueckner_field(xl, yl, mode, mat))
-    return float(domain_integral(bueckner_flux(u, s.stress, aux.u, aux.stress), s.w, s.grad_q))
+    return work_conjugate_integral(s, aux)
 
 
 def interaction_integral(s: Sample, tip: cf.CrackTip, aux) -> float:
