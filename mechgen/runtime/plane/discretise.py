@@ -90,7 +90,7 @@ def check_domain(shape: str, sizes: dict) -> None:
                          expected=bad)
 
 
-def generate_mesh(shape: str, sizes: dict, h: float, element: str, curved: bool):
+def generate_mesh(shape: str, sizes: dict, h: float, element: str, curved: bool, grading: float = 1.0):
     """The mesh of a generated domain (mechgen.runtime.plane.mesh), refused before allocation when too large."""
     from mechgen.runtime.plane import mesh as meshes
 
@@ -104,7 +104,7 @@ def generate_mesh(shape: str, sizes: dict, h: float, element: str, curved: bool)
     if shape == "rectangle":
         return meshes.rectangle(0.0, sizes["width"], 0.0, sizes["height"], h, element)
     if shape == "slit_plate":
-        return meshes.slit_plate(sizes["W"], sizes["H"], sizes["a"], h, element)
+        return meshes.slit_plate(sizes["W"], sizes["H"], sizes["a"], h, element, grading=grading)
     return meshes.plate_with_hole(sizes["W"], sizes["H"], sizes["r"], h, element, curved=curved)
 
 
