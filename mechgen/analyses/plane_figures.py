@@ -26,7 +26,7 @@ def _deformed(fig_data: dict, values: np.ndarray):
     return x + scale * values[0], y + scale * values[1], scale
 
 
-def _panel(plt, ax, fig_data: dict, values: np.ndarray, title: str) -> None:
+def panel(plt, ax, fig_data: dict, values: np.ndarray, title: str) -> None:
     """One state: a two-field displacement on the deformed mesh coloured by |u|; one field as filled contours."""
     import matplotlib.tri as mtri
 
@@ -51,7 +51,7 @@ def steady(plt, a: dict, path: Path) -> list[Path]:
     fig, axes = plt.subplots(1, 2 if stress is not None else 1, figsize=(11 if stress is not None else 6, 4.8),
                              squeeze=False)
     values = np.asarray(data["values"][0])
-    _panel(plt, axes[0, 0], data, values, f"{a['name']}: steady state")
+    panel(plt, axes[0, 0], data, values, f"{a['name']}: steady state")
     if stress is not None:
         import matplotlib.tri as mtri
 
@@ -81,7 +81,7 @@ def modes(plt, a: dict, path: Path) -> bool:
         if k >= count:
             ax.axis("off")
             continue
-        _panel(plt, ax, data, np.asarray(data["values"][k]), f"mode {k + 1}: {freqs[k]:.5g} rad/s")
+        panel(plt, ax, data, np.asarray(data["values"][k]), f"mode {k + 1}: {freqs[k]:.5g} rad/s")
         ax.set_xticks([])
         ax.set_yticks([])
     fig.suptitle(f"{a['name']}: mode shapes", fontsize=9)
