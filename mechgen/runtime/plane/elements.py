@@ -19,7 +19,7 @@ Jet tables (:func:`jet_tables`): B[e, q, a, d] for a vector field of ``ncomp`` c
 (d = l * ncomp + c), jets a = (component, order), order in {"", "x", "y"}. Memory: B holds
 ne * nq * na * nl * ncomp doubles; for plane elasticity (4 gradient jets, 2 components) on P2 at 10^6 unknowns
 (~2.5e5 cells, 6 points a cell at degree 4) that is 2.5e5 * 6 * 4 * 12 * 8 B = 0.58 GB, and dN alone 0.14 GB;
-:func:`gradient_element_matrices` forms the element matrices of gradient and value jets from N and dN without B.
+:func:`jet_element_matrices` forms the element matrices block by block without the whole B.
 """
 from __future__ import annotations
 
@@ -194,7 +194,9 @@ class PlaneTables:
 
 def jacobians(X: np.ndarray, dNref: np.ndarray) -> np.ndarray:
     """J[e, q, i, j] = dx_i/dxi_j = sum_l X[e, l, i] dN_l/dxi_j."""
-    return np.einsum("eli,qlj->eqij", X, dNref, optimize=True)
+    nq, nl = dNref.shape[:2]
+    G = np.ascontiguousarray(dNref.transpose(0, 2, 1).reshape(nq * 2, nl))  # rows (q, j)
+    return np.matmul(G, X).reshape(len(X), nq, 2, 2).transpose(0, 1, 3, 2)
 
 
 def tables(mesh, degree: int | None = None) -> PlaneTables:
@@ -214,7 +216,7 @@ def tables(mesh, degree: int | None = None) -> PlaneTables:
     dN = np.empty(det.shape + (N.shape[1], 2))
     dN[..., 0] = (J[..., 1, 1, None] * g0 - J[..., 1, 0, None] * g1) * inv[..., None]
     dN[..., 1] = (-J[..., 0, 1, None] * g0 + J[..., 0, 0, None] * g1) * inv[..., None]
-    x = np.einsum("ql,eli->eqi", N, X, optimize=True)
+    x = np.matmul(N, X)
     return PlaneTables(x=x, w=wref[None, :] * np.abs(det), N=N, dN=dN, detJ=det, ref=ref, element=element,
                        degree=degree)
 
@@ -253,28 +255,32 @@ def jet_tables(tab: PlaneTables, ncomp: int, jets) -> np.ndarray:
     return B.reshape(ne, nq, len(jets), nl * ncomp)
 
 
-def gradient_element_matrices(tab: PlaneTables, ncomp: int, jets, coeff: np.ndarray, pairs=None) -> np.ndarray:
-    """K_e[l c, m d] = sum_q w_q sum_{a, b} phi_a[q, l] C[e, q, a, b] phi_b[q, m] with c = comp(a), d = comp(b):
-    the same as :func:`mechgen.runtime.fields.assemble.element_matrices` on :func:`jet_tables`' B, without B.
-    ``pairs``: the (a, b) with C[..., a, b] not identically zero (found if None)."""
-    from mechgen.runtime.fields.assemble import nonzero_pairs
+#: cells a block in :func:`jet_element_matrices` (the block's B: CHUNK x q x a x l ncomp doubles, a few MB)
+CHUNK = 4096
 
+
+def _jet_block(tab: PlaneTables, ncomp: int, jets: list, lo: int, hi: int) -> np.ndarray:
+    """B[e, q, a, l ncomp + c] of the cells lo:hi (:func:`jet_tables` of a slice)."""
+    nq, nl = tab.N.shape
+    B = np.zeros((hi - lo, nq, len(jets), nl, ncomp))
+    for a, (c, o) in enumerate(jets):
+        B[:, :, a, :, c] = tab.N[None] if o == "" else tab.dN[lo:hi, :, :, "xy".index(o)]
+    return B.reshape(hi - lo, nq, len(jets), nl * ncomp)
+
+
+def jet_element_matrices(tab: PlaneTables, ncomp: int, jets, coeff: np.ndarray, chunk: int = CHUNK) -> np.ndarray:
+    """K_e = sum_q w_q B_q^T C_q B_q for every cell, B the jet table of :func:`jet_tables`: the same as
+    :func:`mechgen.runtime.fields.assemble.element_matrices` on the whole B, but B built ``chunk`` cells at a time
+    (never whole: at 10^6 unknowns it would take 0.6 GB) and each block one batched product
+    (e, l, q a) @ ((e, q, a, b) @ (e, q, b, m))."""
     jets = _check_jets(ncomp, jets)
     ne, nq, nl = tab.dN.shape[:3]
-    pairs = nonzero_pairs(coeff) if pairs is None else [(int(a), int(b)) for a, b in pairs]
-    out = np.zeros((ne, nl, ncomp, nl, ncomp))
-    wc = tab.w[:, :, None, None] * coeff
-    for (ca, oa), (cb, ob), group in _pair_groups(jets, pairs):
-        left = basis_values(tab, oa)
-        right = basis_values(tab, ob)
-        weight = sum(wc[:, :, a, b] for a, b in group)
-        out[:, :, ca, :, cb] += np.matmul((left * weight[:, :, None]).transpose(0, 2, 1), right)
-    return out.reshape(ne, nl * ncomp, nl * ncomp)
-
-
-def _pair_groups(jets, pairs):
-    """The pairs grouped by (jet a, jet b) values: identical jets listed twice share one product."""
-    groups: dict = {}
-    for a, b in pairs:
-        groups.setdefault((jets[a], jets[b]), []).append((a, b))
-    return [(ja, jb, g) for (ja, jb), g in groups.items()]
+    n, na = nl * ncomp, len(jets)
+    out = np.empty((ne, n, n))
+    for lo in range(0, ne, chunk):
+        hi = min(ne, lo + chunk)
+        B = _jet_block(tab, ncomp, jets, lo, hi)
+        right = np.matmul(tab.w[lo:hi, :, None, None] * coeff[lo:hi], B)
+        np.matmul(B.reshape(hi - lo, nq * na, n).transpose(0, 2, 1), right.reshape(hi - lo, nq * na, n),
+                  out=out[lo:hi])
+    return out

@@ -467,7 +467,7 @@ def _read_meshio(path: str):
                          expected="an existing gmsh .msh file")
     try:
         return meshio.read(path, file_format="gmsh")
-    except Exception as exc:  # noqa: BLE001 - meshio raises many kinds on a file that is not a mesh
+    except (Exception, SystemExit) as exc:  # noqa: BLE001 - meshio raises many kinds (and exits) on a file that is not a mesh
         raise InputError(f"not a readable gmsh mesh ({type(exc).__name__}: {str(exc)[:200]})", file=path,
                          expected="a gmsh .msh file (format 2.2 or 4.1)") from None
 
