@@ -283,3 +283,30 @@ def test_pure_bending_with_exact_end_displacements(element):
     else:
         rates = np.log2(np.array(errors[:-1]) / errors[1:])
         assert np.all(rates > 1.85), rates  # O(h^2) nodal displacements (measured 1.91, 1.97; 1.70 from h = 1/4)
+
+
+# -- memory estimate ------------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("element", E.ELEMENTS)
+def test_assembly_bytes_bounds_the_measured_peak(element):
+    """tracemalloc's peak over tables, coefficients, element matrices, CSR pattern and matrix: the estimate is
+    above it and within 1.6x of it (the formula's constants are the measured ones rounded up)."""
+    import tracemalloc
+
+    mesh = M.rectangle(0.0, 1.0, 0.0, 1.0, 1 / 60 if element in ("P1", "Q1") else 1 / 30, element)
+    tracemalloc.start()
+    try:
+        stiffness(mesh, 1.0, 1.0)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    estimate = E.assembly_bytes(mesh, 2, 4)
+    assert peak <= estimate <= 1.6 * peak, (peak, estimate)
+
+
+def test_assembly_beyond_the_memory_limit_is_refused(monkeypatch):
+    from mechgen.errors import InputError
+
+    monkeypatch.setenv("MECHGEN_MEMORY_LIMIT", "1MB")
+    with pytest.raises(InputError, match="assembly of") as info:
+        E.require_assembly_memory(M.rectangle(0.0, 1.0, 0.0, 1.0, 0.02, "P2"), 2, 4, key="mesh.h")
+    assert info.value.key == "mesh.h"

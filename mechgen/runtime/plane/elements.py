@@ -284,3 +284,25 @@ def jet_element_matrices(tab: PlaneTables, ncomp: int, jets, coeff: np.ndarray, 
         np.matmul(B.reshape(hi - lo, nq * na, n).transpose(0, 2, 1), right.reshape(hi - lo, nq * na, n),
                   out=out[lo:hi])
     return out
+
+
+def assembly_bytes(mesh, ncomp: int, njets: int, degree: int | None = None) -> int:
+    """Peak bytes of tables + coefficients + element matrices + CSR pattern + one matrix of ``mesh`` for a field of
+    ``ncomp`` components and ``njets`` jets: 8 ne (7 n^2 + 16 q l + 2 q a^2), n = l ncomp the element's dofs, q the
+    points a cell, l its nodes, a the jets. Measured with tracemalloc (tests/test_plane_elements.py): the
+    coefficients 6 n^2 + 14 q l (+ q a^2 for C) on P1, P2, Q1, Q2; the constants rounded up."""
+    degree = DEFAULT_DEGREE[mesh.element] if degree is None else int(degree)
+    q = len(quadrature(mesh.element, degree)[1])
+    nl = NODES[mesh.element]
+    n = nl * ncomp
+    return 8 * int(mesh.n_cells) * (7 * n * n + 16 * q * nl + 2 * q * njets * njets)
+
+
+def require_assembly_memory(mesh, ncomp: int, njets: int, *, key: str, degree: int | None = None) -> None:
+    """Refuse (InputError at ``key``, nothing allocated) an assembly whose :func:`assembly_bytes` exceed the memory
+    limit of :func:`mechgen.runtime.core.memory.require`."""
+    from mechgen.runtime.core.memory import require
+
+    unknowns = mesh.n_nodes * ncomp
+    require(assembly_bytes(mesh, ncomp, njets, degree), f"the assembly of {unknowns} unknowns on "
+            f"{mesh.n_cells} {mesh.element} cells", key=key, expected="a coarser mesh")
