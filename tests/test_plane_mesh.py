@@ -227,3 +227,17 @@ def test_msh_inverted_and_degenerate_cells_are_refused(tmp_path):
     points[mesh.cells[5, 1]] = points[mesh.cells[5, 0]]
     with pytest.raises(InputError, match=r"cell \d+ .*(degenerate|inverted)"):
         M.read_msh(write_msh(tmp_path / "flat.msh", M.PlaneMesh(points, mesh.cells, "Q1", mesh.boundaries)))
+
+
+def test_msh_unused_nodes_are_dropped_and_unnamed_groups_keep_their_tag(tmp_path):
+    mesh = M.rectangle(0.0, 1.0, 0.0, 1.0, 0.5, "Q1")
+    extra = np.vstack([mesh.points, [[5.0, 5.0]]])  # a geometry point outside every cell, as gmsh writes them
+    pts = np.column_stack([extra, np.zeros(len(extra))])
+    blocks = [("vertex", np.array([[len(extra) - 1]])), ("line", mesh.boundaries["left"]), ("quad", mesh.cells)]
+    tags = [np.array([7]), np.full(len(mesh.boundaries["left"]), 3), np.full(mesh.n_cells, 4)]
+    meshio.write(str(tmp_path / "x.msh"), meshio.Mesh(pts, blocks, cell_data={"gmsh:physical": tags,
+                 "gmsh:geometrical": tags}), file_format="gmsh22", binary=False)
+    back = M.read_msh(tmp_path / "x.msh")
+    np.testing.assert_array_equal(back.points, mesh.points)
+    np.testing.assert_array_equal(back.boundaries["3"], mesh.boundaries["left"])
+    np.testing.assert_array_equal(back.groups["4"], np.arange(mesh.n_cells))
