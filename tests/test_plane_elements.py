@@ -197,32 +197,41 @@ def test_bad_jets_are_refused():
 
 # -- against scikit-fem --------------------------------------------------------------------------------------------
 skfem = pytest.importorskip("skfem")
-SKFEM = {"P1": ("MeshTri", "ElementTriP1"), "P2": ("MeshTri", "ElementTriP2"), "Q1": ("MeshQuad", "ElementQuad1"),
-         "Q2": ("MeshQuad", "ElementQuad2")}
+SKFEM = {"P1": ("MeshTri", "ElementTriP1"), "P2": ("MeshTri2", "ElementTriP2"), "Q1": ("MeshQuad", "ElementQuad1"),
+         "Q2": ("MeshQuad2", "ElementQuad2")}
 
 
 def skfem_stiffness(mesh, lam, mu):
-    """scikit-fem's linear_elasticity matrix on the same (straight-sided) cells, permuted to our dof order."""
+    """scikit-fem's linear_elasticity matrix on the same cells, permuted to our dof order. P2/Q2: its quadratic
+    meshes (MeshTri2, MeshQuad2: isoparametric, curved where our midsides are) from our midside (and centre)
+    coordinates, laid out in its own facet order (that of MeshTri/MeshQuad on the vertices)."""
     from skfem.models.elasticity import linear_elasticity
 
     verts = np.unique(mesh.vertices)
     vid = np.full(mesh.n_nodes, -1)
     vid[verts] = np.arange(len(verts))
+    t = np.ascontiguousarray(vid[mesh.vertices].T)
     mesh_cls, elem_cls = (getattr(skfem, n) for n in SKFEM[mesh.element])
-    sk = mesh_cls(np.ascontiguousarray(mesh.points[verts].T), np.ascontiguousarray(vid[mesh.vertices].T))
-    basis = skfem.Basis(sk, skfem.ElementVector(elem_cls()), intorder=E.DEFAULT_DEGREE[mesh.element])
-    K = skfem.asm(linear_elasticity(lam, mu), basis)
+    linear = (skfem.MeshTri if mesh.element[0] == "P" else skfem.MeshQuad)(np.ascontiguousarray(mesh.points[verts].T), t)
     perm = np.empty(2 * mesh.n_nodes, np.int64)
-    for c in range(2):
-        perm[2 * verts + c] = basis.nodal_dofs[c]
-    if mesh.element in ("P2", "Q2"):
-        facet = {tuple(sorted(f)): i for i, f in enumerate(sk.facets.T.tolist())}
+    if mesh.element in ("P1", "Q1"):
+        sk = linear
+    else:
+        facet = {tuple(sorted(f)): i for i, f in enumerate(linear.facets.T.tolist())}
         edges = M.cell_edges(mesh.cells, mesh.element).reshape(-1, 3)
         index = np.array([facet[tuple(sorted((vid[a], vid[b])))] for a, b in edges[:, :2].tolist()])
-        for c in range(2):
+        mid = np.empty((linear.facets.shape[1], 2))
+        mid[index] = mesh.points[edges[:, 2]]
+        parts = [mesh.points[verts], mid] + ([mesh.points[mesh.cells[:, 8]]] if mesh.element == "Q2" else [])
+        sk = mesh_cls(np.ascontiguousarray(np.vstack(parts).T), t)
+        assert np.array_equal(sk.facets, linear.facets)
+    basis = skfem.Basis(sk, skfem.ElementVector(elem_cls()), intorder=E.DEFAULT_DEGREE[mesh.element])
+    K = skfem.asm(linear_elasticity(lam, mu), basis)
+    for c in range(2):
+        perm[2 * verts + c] = basis.nodal_dofs[c]
+        if mesh.element in ("P2", "Q2"):
             perm[2 * edges[:, 2] + c] = basis.facet_dofs[c][index]
-    if mesh.element == "Q2":
-        for c in range(2):
+        if mesh.element == "Q2":
             perm[2 * mesh.cells[:, 8] + c] = basis.interior_dofs[c]
     return K[perm][:, perm]
 
@@ -236,8 +245,10 @@ def test_skfem_plane_stress_helper_is_the_pinned_meaning():
 
 @pytest.mark.parametrize("element", E.ELEMENTS)
 def test_plane_stress_stiffness_equals_skfem(element):
+    """Straight and (P2/Q2) curved isoparametric cells: the same matrix to round-off."""
     lam, mu = plane_stress_lame(2.0, 0.3)
-    for mesh in (M.disk(1.0, 0.3, element, curved=False), M.plate_with_hole(2.0, 1.0, 0.3, 0.3, element, curved=False)):
+    for mesh in (M.disk(1.0, 0.3, element, curved=False), M.plate_with_hole(2.0, 1.0, 0.3, 0.3, element, curved=False),
+                 M.disk(1.0, 0.3, element, curved=True), M.annulus(0.4, 1.0, 0.3, element, curved=True)):
         ours, theirs = stiffness(mesh, lam, mu), skfem_stiffness(mesh, lam, mu)
         assert abs(ours - theirs).max() <= ROUND_OFF * abs(theirs).max()
 

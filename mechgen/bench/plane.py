@@ -131,7 +131,7 @@ class Theirs:
         for c in range(2):
             perm[2 * self.verts + c] = self.basis.nodal_dofs[c]
         if self.mesh.element == "P2":
-            f = np.sort(self.sk_mesh.facets, axis=0)
+            f = np.sort(self.sk_mesh.facets, axis=0).astype(np.int64)  # keys f0 * nv + f1 overflow int32
             nv = len(self.verts)
             order = np.argsort(f[0] * nv + f[1])
             edges = cell_edges(self.mesh.cells, "P2").reshape(-1, 3)
