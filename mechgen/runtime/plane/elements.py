@@ -221,10 +221,16 @@ def tables(mesh, degree: int | None = None) -> PlaneTables:
                        degree=degree)
 
 
+def node_dofs(nodes: np.ndarray, ncomp: int) -> np.ndarray:
+    """(m, k * ncomp) global dofs of rows of k nodes (cells, edges), interleaved: dof = node * ncomp + component,
+    local l * ncomp + c."""
+    nodes = np.asarray(nodes, np.int64)
+    return (nodes[:, :, None] * ncomp + np.arange(ncomp)[None, None, :]).reshape(len(nodes), -1)
+
+
 def element_dofs(mesh, ncomp: int) -> np.ndarray:
-    """(ne, k * ncomp) global dofs of each cell, interleaved: dof = node * ncomp + component, local l * ncomp + c."""
-    cells = np.asarray(mesh.cells, np.int64)
-    return (cells[:, :, None] * ncomp + np.arange(ncomp)[None, None, :]).reshape(len(cells), -1)
+    """(ne, k * ncomp) global dofs of each cell (:func:`node_dofs` of the cells)."""
+    return node_dofs(mesh.cells, ncomp)
 
 
 def _check_jets(ncomp: int, jets) -> list[tuple[int, str]]:
@@ -306,3 +312,52 @@ def require_assembly_memory(mesh, ncomp: int, njets: int, *, key: str, degree: i
     unknowns = mesh.n_nodes * ncomp
     require(assembly_bytes(mesh, ncomp, njets, degree), f"the assembly of {unknowns} unknowns on "
             f"{mesh.n_cells} {mesh.element} cells", key=key, expected="a coarser mesh")
+
+
+# -- boundary edges --------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class EdgeTables:
+    """Quadrature data on boundary edges (endpoints then, for P2/Q2, the midside node).
+
+    edges (f, k) node indices; x (f, q, 2) physical points [m]; w (f, q) Gauss weights times |dx/ds| [m];
+    N (q, k) the edge's 1D Lagrange values at the reference points ref (q,) in [-1, 1] (nodes -1, 1, 0);
+    normal (f, q, 2) the unit normal (t_y, -t_x), outward where the domain lies on the edge's left (as the mesh's
+    boundaries are stored); degree.
+    """
+
+    edges: np.ndarray
+    x: np.ndarray
+    w: np.ndarray
+    N: np.ndarray
+    normal: np.ndarray
+    ref: np.ndarray
+    degree: int
+
+
+def edge_tables(mesh, edges: np.ndarray, degree: int | None = None) -> EdgeTables:
+    """Gauss tables on ``edges`` (a boundary of ``mesh``, (f, 2 | 3)): the isoparametric edge
+    x(s) = sum_k X_k n_k(s), ds = |dx/ds| ds_ref, exact for polynomials of ``degree`` in s (default 2 p)."""
+    edges = np.asarray(edges, np.int64)
+    order = edges.shape[1] - 1
+    degree = 2 * order if degree is None else int(degree)
+    s, ws = np.polynomial.legendre.leggauss(max(1, ceil((degree + 1) / 2)))
+    N, dN = _lagrange_1d(s, order)
+    X = mesh.points[edges]  # (f, k, 2)
+    x = np.matmul(N, X)
+    dx = np.matmul(dN, X)  # (f, q, 2)
+    length = np.hypot(dx[..., 0], dx[..., 1])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        normal = np.stack([dx[..., 1], -dx[..., 0]], axis=-1) / length[..., None]
+    return EdgeTables(edges=edges, x=x, w=ws[None, :] * length, N=N, normal=normal, ref=s, degree=degree)
+
+
+def edge_value_tables(etab: EdgeTables, ncomp: int) -> np.ndarray:
+    """B[f, q, c, k ncomp + c'] = N[q, k] if c == c' else 0: the values of the ``ncomp`` components on the edges
+    (jets (c, "") in component order), for :func:`mechgen.runtime.fields.assemble.element_vectors` with
+    :func:`node_dofs` of the edges; a traction t[f, q, c] gives the load r = sum w N t."""
+    nf, nq = etab.w.shape
+    nk = etab.N.shape[1]
+    B = np.zeros((nf, nq, ncomp, nk, ncomp))
+    for c in range(ncomp):
+        B[:, :, c, :, c] = etab.N[None]
+    return B.reshape(nf, nq, ncomp, nk * ncomp)
