@@ -166,7 +166,6 @@ def reference_nodes(element: str) -> np.ndarray:
         v = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
     if ORDER[element] == 1:
         return v
-    nv = len(v)
     mids = (v + np.roll(v, -1, axis=0)) / 2
     return np.vstack([v, mids] + ([v.mean(axis=0, keepdims=True)] if element == "Q2" else []))
 
