@@ -241,3 +241,15 @@ def test_msh_unused_nodes_are_dropped_and_unnamed_groups_keep_their_tag(tmp_path
     np.testing.assert_array_equal(back.points, mesh.points)
     np.testing.assert_array_equal(back.boundaries["3"], mesh.boundaries["left"])
     np.testing.assert_array_equal(back.groups["4"], np.arange(mesh.n_cells))
+
+
+@pytest.mark.parametrize("element", ["P2", "Q1"])
+def test_msh_format_41_is_read(tmp_path, element):
+    mesh = M.disk(1.0, 0.5, element)
+    pts = np.column_stack([mesh.points, np.zeros(mesh.n_nodes)])
+    cell = TYPES[element][0]
+    meshio.write(str(tmp_path / "d.msh"), meshio.Mesh(pts, [(cell, mesh.cells)]), file_format="gmsh", binary=False)
+    assert (tmp_path / "d.msh").read_text().splitlines()[1].startswith("4.1")
+    back = M.read_msh(tmp_path / "d.msh")
+    np.testing.assert_array_equal(back.cells, mesh.cells)
+    assert back.boundaries == {} and back.area() == pytest.approx(mesh.area(), rel=ON_CURVE)
