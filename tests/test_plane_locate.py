@@ -51,3 +51,18 @@ def test_points_outside_are_refused_with_their_key():
     with pytest.raises(InputError, match=r"point \(0, 0\) lies outside") as info:
         locate(mesh, [[0.8, 0.0], [0.0, 0.0]], file="s.toml", key="analysis[0].probe")
     assert info.value.key == "analysis[0].probe[1]" and info.value.file == "s.toml"
+
+
+@pytest.mark.parametrize("element", ELEMENTS)
+def test_node_gradients_of_fields_in_the_space_are_exact(element):
+    from mechgen.runtime.plane.locate import node_gradients
+
+    curved = M.disk(1.0, 0.3, element, curved=True)
+    g = node_gradients(curved, np.array([0.1, -0.2]) + curved.points @ G.T)
+    np.testing.assert_allclose(g, np.broadcast_to(G, g.shape), atol=ROUND_OFF)
+    if element in ("P2", "Q2"):
+        mesh = M.plate_with_hole(2.0, 1.0, 0.4, 0.4, element, curved=False)
+        x, y = mesh.points.T
+        g = node_gradients(mesh, np.column_stack([x * x - 2 * x * y, 3 * y * y + x * y]))
+        exact = np.stack([np.column_stack([2 * x - 2 * y, -2 * x]), np.column_stack([y, 6 * y + x])], axis=1)
+        np.testing.assert_allclose(g, exact, atol=ROUND_OFF)

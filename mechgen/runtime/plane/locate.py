@@ -4,7 +4,8 @@
 xi <- xi - J(xi)^-1 (x(xi) - p), on the cells whose vertex centroids are nearest to p (a k-d tree; all cells if
 none of those holds it), and accepts the first cell whose reference cell holds xi within ``tol``. A point on an
 edge or a vertex belongs to the first such cell found; on a slit crack's face that is the nearer face's cell.
-:func:`interpolate` evaluates u(p) = sum_l u_l N_l(xi) and grad u(p) = sum_l u_l J^-T dN_l/dxi.
+:func:`interpolate` evaluates u(p) = sum_l u_l N_l(xi) and grad u(p) = sum_l u_l J^-T dN_l/dxi;
+:func:`node_gradients` averages each cell's gradient at its nodes (nodal strains and stresses).
 """
 from __future__ import annotations
 
@@ -88,3 +89,23 @@ def interpolate(mesh, u: np.ndarray, cells: np.ndarray, xi: np.ndarray) -> tuple
     J = np.einsum("mli,mlj->mij", X, dNref)
     dN = np.linalg.solve(np.transpose(J, (0, 2, 1)), np.transpose(dNref, (0, 2, 1)))  # J^T g = dN/dxi
     return np.einsum("ml,mlc->mc", N, U), np.einsum("mlc,mil->mci", U, dN)
+
+
+def node_gradients(mesh, u: np.ndarray) -> np.ndarray:
+    """grad u at the nodes (n, c, 2): each cell's gradient at its own nodes (reference node coordinates, J^-T dN),
+    averaged over the cells that share the node (the plain mean; exact wherever the field is in the element space,
+    e.g. stresses of a linear field, or of a quadratic one on straight P2/Q2 cells)."""
+    from mechgen.runtime.plane.elements import jacobians, reference_nodes
+
+    u = np.asarray(u, float).reshape(mesh.n_nodes, -1)
+    _, dNref = shapes(mesh.element, reference_nodes(mesh.element))  # (k, l, 2) at the cell's own nodes
+    X = mesh.points[mesh.cells]
+    J = jacobians(X, dNref)  # (e, k, 2, 2)
+    rhs = np.broadcast_to(np.transpose(dNref, (0, 2, 1)), J.shape[:2] + (2, dNref.shape[1]))
+    g = np.linalg.solve(np.transpose(J, (0, 1, 3, 2)), rhs)  # J^T g = dN/dxi: g[e, k, i, l] = dN_l/dx_i
+    grads = np.einsum("elc,ekil->ekci", u[mesh.cells], g)  # (e, k, c, 2)
+    count = np.bincount(mesh.cells.ravel(), minlength=mesh.n_nodes)
+    flat = grads.reshape(-1, grads.shape[2] * 2)
+    total = np.stack([np.bincount(mesh.cells.ravel(), weights=flat[:, j], minlength=mesh.n_nodes)
+                      for j in range(flat.shape[1])], axis=1)
+    return (total / count[:, None]).reshape(mesh.n_nodes, -1, 2)
