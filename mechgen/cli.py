@@ -142,7 +142,7 @@ def _write_json(path: str, results: dict) -> None:
                          expected="a path for the JSON file in a writable folder") from None
     try:
         with os.fdopen(fd, "w") as fh:
-            json.dump(results, fh, indent=2, default=float)
+            json.dump({k: v for k, v in results.items() if not k.startswith("_")}, fh, indent=2, default=float)
         check_replaceable("--json", target, "a path for the JSON file")
         os.replace(tmp, target)
     except OSError as exc:

@@ -146,7 +146,7 @@ def file_digest(path) -> str:
 def request_of(model: Model, spec: Specialization, *, kernels=None, backend: str = "c",
                cse: bool = True) -> CompileRequest:
     """The :class:`CompileRequest` of a model and a specialisation."""
-    kind = "field" if model.is_field else "lattice" if model.is_lattice else "lumped"
+    kind = "field" if model.is_field else "plane" if model.is_plane else "lattice" if model.is_lattice else "lumped"
     free_values = tuple((n, spec.free_values.get(n, model.param(n).default)) for n in spec.free)
     return CompileRequest(model.name, file_digest(model.file), tuple(sorted(spec.values.items())), tuple(spec.free),
                           None if spec.active is None else tuple(spec.active),
@@ -165,6 +165,10 @@ def all_kernels(model: Model) -> tuple[str, ...]:
         return LATTICE_KERNELS
     if model.is_field:
         return FIELD_KERNELS
+    if model.is_plane:
+        from mechgen.codegen.lower_plane import PLANE_KERNELS
+
+        return PLANE_KERNELS
     lumped = tuple(k for k in LUMPED_KERNELS if (k != "section" or model.section_fn is not None)
                    and (k != "rod" or model.rod_spec is not None)
                    and (k != "lagrangian" or not (model.is_hybrid or model.internals)))
@@ -186,6 +190,10 @@ def derive(model: Model, spec: Specialization):
         from mechgen.symbolic.field import derive_field
 
         return derive_field(model, spec)
+    if model.is_plane:
+        from mechgen.symbolic.plane import derive_plane
+
+        return derive_plane(model, spec)
     if model.is_lattice:
         from mechgen.symbolic.lattice import derive_lattice
 
@@ -221,6 +229,10 @@ def lower_all(model: Model, eqs, kernels, *, cse: bool = True) -> list[KernelIR]
         for ir in irs:
             ir.meta["field"] = meta
         return _with_whirl(model, irs)
+    if model.is_plane:
+        from mechgen.codegen.lower_plane import lower_plane
+
+        return lower_plane(eqs, kernels, cse=cse)
     if model.is_hybrid:
         return _with_whirl(model, lower_hybrid(model, eqs, kernels, cse=cse))
     from mechgen.codegen.lower_ad import lower_ad
@@ -648,6 +660,12 @@ def compile_request(request: CompileRequest, derive_with: Callable[[], tuple], *
         names = (*_FIELD_CHOICES, *(n for n in request.runtime if n not in _FIELD_CHOICES))
         choices = {k: values[k] for k in names if k in values}
         system = FieldSystem(loaded, meta, params, fixed, choices, report.backend)
+    elif request.kind == "plane":
+        from mechgen.runtime.plane.system import PlaneSystem
+
+        fixed = {k: v for k, v in values.items() if k in request.numeric}
+        choices = {k: values[k] for k in request.runtime if k in values}
+        system = PlaneSystem(loaded, meta, params, fixed, choices, report.backend)
     elif "hybrid" in meta:
         from mechgen.runtime.core.hybrid_system import HybridSystem
 

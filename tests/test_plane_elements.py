@@ -328,49 +328,6 @@ def test_assembly_beyond_the_memory_limit_is_refused(monkeypatch):
     assert info.value.key == "mesh.h"
 
 
-# -- boundary edges -------------------------------------------------------------------------------------------------
-@pytest.mark.parametrize("element", E.ELEMENTS)
-def test_divergence_theorem_on_every_generated_boundary(element):
-    """oint x.n ds = int div x dA = 2 |Omega| and oint n ds = 0: the edge tables (curved edges included) against
-    the cell tables of the same isoparametric geometry; both integrands are polynomial in the reference
-    coordinate on these maps, so the equality holds to round-off."""
-    for mesh in (M.disk(1.0, 0.3, element), M.plate_with_hole(2.0, 1.0, 0.4, 0.35, element),
-                 M.slit_plate(1.0, 1.0, 0.4, 0.25, element)):
-        flux, net = 0.0, np.zeros(2)
-        for name in mesh.boundaries:
-            et = E.edge_tables(mesh, mesh.boundaries[name], degree=6)
-            flux += np.sum(et.w * np.sum(et.x * et.normal, axis=-1))
-            net += np.einsum("fq,fqi->i", et.w, et.normal)
-        assert flux == pytest.approx(2 * E.tables(mesh, 8).w.sum(), rel=ROUND_OFF)
-        np.testing.assert_allclose(net, 0.0, atol=ROUND_OFF)
-
-
-@pytest.mark.parametrize("element", ["P2", "Q2"])
-def test_disk_perimeter_converges_at_four_when_curved(element):
-    """Parabolic arcs through three points of each circular arc: perimeter error O(n^-4) (measured 4.0)."""
-    err = []
-    for quarters in (8, 16, 32):
-        mesh = M.disk(1.0, np.pi / 2 / (quarters - 0.5), element, curved=True)
-        err.append(abs(E.edge_tables(mesh, mesh.boundaries["outer"], degree=8).w.sum() - 2 * np.pi))
-    rates = np.log2(np.array(err[:-1]) / err[1:])
-    assert np.all(rates > 3.9), rates
-
-
-@pytest.mark.parametrize("element", E.ELEMENTS)
-def test_edge_load_vector_of_a_linear_traction(element):
-    """t = (0, 1 + x) on the top of [0, 2] x [0, 1]: total force int t dx = (0, 4) and moment int x t_y dx = 14/3
-    (closed forms), through element_vectors and the edge dofs."""
-    from mechgen.runtime.fields.assemble import element_vectors
-
-    mesh = M.rectangle(0.0, 2.0, 0.0, 1.0, 0.3, element)
-    et = E.edge_tables(mesh, mesh.boundaries["top"])
-    traction = np.stack([0 * et.x[..., 0], 1 + et.x[..., 0]], axis=-1)
-    r = element_vectors(E.edge_value_tables(et, 2), et.w, traction)
-    f = np.bincount(E.node_dofs(et.edges, 2).ravel(), weights=r.ravel(), minlength=2 * mesh.n_nodes).reshape(-1, 2)
-    np.testing.assert_allclose(f.sum(axis=0), [0.0, 4.0], atol=ROUND_OFF)
-    assert np.sum(mesh.points[:, 0] * f[:, 1]) == pytest.approx(14 / 3, rel=ROUND_OFF)
-
-
 # -- value jets: the mass matrix and a drum's first eigenvalue -------------------------------------------------------
 @pytest.mark.parametrize("element", E.ELEMENTS)
 def test_mass_matrix_equals_skfem(element):

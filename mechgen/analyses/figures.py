@@ -95,7 +95,12 @@ def linear(plt, a: dict, path: Path) -> list[Path]:
     eigen(plt, a, path)
     written = []
     shaped = path.with_name(path.stem + "_shapes.png")
-    if shapes(plt, a, shaped) or bars(plt, a, shaped):
+    if a.get("figure"):
+        from mechgen.analyses import plane_figures
+
+        if plane_figures.modes(plt, a, shaped):
+            written.append(shaped)
+    elif shapes(plt, a, shaped) or bars(plt, a, shaped):
         written.append(shaped)
     orbits = path.with_name(path.stem + "_orbits.png")
     if ellipses(plt, a, orbits):

@@ -62,12 +62,14 @@ def run_modes(system, options: dict, context: dict) -> dict:
     elastic = res.shapes[:, res.rigid:]
     out = {"frequencies": [float(f) for f in res.frequencies[res.rigid:]], "rigid_modes": int(res.rigid),
            "_shapes": elastic}
-    if not system.is_field and not system.is_lattice:
+    if not system.is_field and not system.is_lattice and not getattr(system, "is_plane", False):
         out.update(modal_outputs(system.coordinates, mats["M"], mats["K"], elastic))
         if res.rigid:
             out["rigid_shapes"] = [_largest_one(system, res.shapes[:, j]) for j in range(res.rigid)]
     if system.is_field and options.get("count"):
         out.update(field_shapes(system, elastic, "shapes"))
+    if getattr(system, "is_plane", False):
+        out["_figure"] = system.figure_data(elastic[:, :8])
     return _with_point(out, found)
 
 

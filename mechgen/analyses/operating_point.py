@@ -98,10 +98,11 @@ def equilibrium_point(system, options: dict, context: dict) -> tuple[np.ndarray,
             "and Newton "
             f"from it found none ({exc}): run a steady analysis first (with a guess) and linearise about it "
             "(about = \"<its name>\")") from exc
-    report = {"found": "newton", "start": _coordinates(system, q0) if not system.is_field else where,
+    meshed = system.is_field or getattr(system, "is_plane", False)  # thousands of dofs: not listed
+    report = {"found": "newton", "start": _coordinates(system, q0) if not meshed else where,
               "start_residual_norm": start, "residual_norm": float(res.residual_norm),
               "iterations": int(res.iterations)}
-    if not system.is_field and not system.is_lattice:
+    if not meshed and not system.is_lattice:
         report["coordinates"] = _coordinates(system, res.x)
     return np.asarray(res.x), report
 

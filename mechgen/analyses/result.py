@@ -93,7 +93,8 @@ class Result:
         plt = pyplot()
         folder = Path(directory)
         folder.mkdir(parents=True, exist_ok=True)
-        entry = {**self.to_json(), "units": self.working.get("units", {})}  # the parameters' units, for the axes
+        entry = {**self.to_json(), "units": self.working.get("units", {}),  # the parameters' units, for the axes
+                 "figure": self.working.get("_figure")}  # a plane model's mesh and nodal values
         return draw(plt, entry, folder / f"{stem or self.name}.png")
 
 

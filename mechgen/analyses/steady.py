@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mechgen.analyses import figures, schema, summary
+from mechgen.analyses import figures, plane_states, schema, summary
 from mechgen.analyses.bvp_states import (bvp_summary, parameter_namespace, shape_declarations, shape_values,
                                          stability_about)
 from mechgen.analyses.fields import field_shapes
@@ -145,6 +145,7 @@ SCHEMA = {
     "free": Option(_free, doc="the parameter solved for so that hold is met"),
     "stability": Option(schema.boolean, doc="also give the Galerkin stability verdict about the steady state"),
     "max_seconds": Option(schema.positive, doc="the wall-time budget of Newton (s, default 600)"),
+    **plane_states.OPTIONS,
 }
 
 
@@ -217,7 +218,9 @@ def run_steady(system, options: dict, context: dict) -> dict:
     """Equilibrium r(q, 0, 0, z) = 0, g(q, 0, z) = 0 by Newton with the generated Jacobians.
 
     ``method`` shooting / multiple_shooting / collocation: a continuum's steady state as a
-    boundary value problem in s (:func:`run_steady_bvp`)."""
+    boundary value problem in s (:func:`run_steady_bvp`); a plane continuum: mechgen.analyses.plane_states."""
+    if getattr(system, "is_plane", False) and options.get("method", "newton") == "newton":
+        return plane_states.plane_steady(system, options)
     if options.get("method", "newton") != "newton":
         if not system.is_field:
             raise SceneError(f"steady method {options['method']!r} is for continua", key="method",
@@ -339,6 +342,10 @@ def run_steady_bvp(system, options: dict, context: dict) -> dict:
 
 def plot(plt, a: dict, path: Path) -> list[Path]:
     """A continuum's deflection against s and, with two or more fields, its curve (first field against last)."""
+    if a.get("figure"):
+        from mechgen.analyses import plane_figures
+
+        return plane_figures.steady(plt, a, path)
     if not figures.shapes(plt, a, path):
         return []
     written = []

@@ -25,7 +25,7 @@ from mechgen import models
 from mechgen.errors import InputError, did_you_mean
 
 #: version of the JSON layout of a ModelInfo (part of its cache key)
-INFO_SCHEMA = "model-info-4"
+INFO_SCHEMA = "model-info-5"
 GENERATED = Path(__file__).resolve().parent.parent / "generated"
 
 
@@ -79,6 +79,8 @@ class ModelInfo:
     #: a hybrid model's modes (mechgen.symbolic.hybrid), the initial one first; empty for a smooth model
     modes: tuple[str, ...] = ()
     file: str | None = field(default=None, compare=False)
+    #: a plane continuum's fields (mechgen.symbolic.plane); empty for every other model
+    plane_fields: tuple[str, ...] = ()
     #: the canonical reference of the model (mechgen.models.resolve): what a scene's run compiles
     key: str = field(default="", compare=False)
 
@@ -135,7 +137,8 @@ def info_of_model(model) -> ModelInfo:
                      cont.length if cont else None, {k: tuple(v) for k, v in model.parts.items()},
                      model.complementary_fn is not None, tuple(model.field_names),
                      tuple(o.name for o in getattr(model, "shape_outputs", ())), bool(model.internals), chain,
-                     tuple(model.coordinates_all), tuple(model.part_params()), _modes(model), model.file)
+                     tuple(model.coordinates_all), tuple(model.part_params()), _modes(model), model.file,
+                     plane_fields=tuple(model.plane_spec.fields) if model.is_plane else ())
 
 
 def _modes(model) -> tuple[str, ...]:
@@ -157,7 +160,8 @@ def info_from_json(data: dict, *, file: str | None = None) -> ModelInfo:
     return ModelInfo(data["name"], params, tuple(data["coordinates"]), tuple(data["outputs"]), data["continuum"],
                      data["length"], parts, data["stress_form"], tuple(data["fields"]), tuple(data["shape_outputs"]),
                      data["internals"], tup(data["chain"]), tuple(data["coordinates_all"]),
-                     tuple(data["part_params"]), tuple(data.get("modes", ())), file)
+                     tuple(data["part_params"]), tuple(data.get("modes", ())), file,
+                     plane_fields=tuple(data.get("plane_fields", ())))
 
 
 def info_key(source: models.ModelSource) -> str | None:

@@ -51,7 +51,8 @@ def request_for(info: ModelInfo, digest: str, values: dict, *, free=(), active=N
     starts = tuple((n, values.get(n, info.params[n].default)) for n in ordered)
     if active is not None:
         active = tuple(c for c in info.coordinates_all if c in active)
-    kind = "field" if info.continuum else "lattice" if info.chain else "lumped"
+    kind = ("field" if info.continuum else "plane" if info.plane_fields else "lattice" if info.chain
+            else "lumped")
     return CompileRequest(info.name, digest, fixed, ordered, active, tuple(sorted(set(kernels))), backend, cse,
                           tuple(n for n, p in info.params.items() if p.runtime), starts, kind,
                           tuple(n for n, p in info.params.items() if p.numeric),

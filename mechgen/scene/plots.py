@@ -36,7 +36,8 @@ def plot_results(results: dict, folder: Path) -> list[Path]:
         for a in results["analyses"]:
             draw = get(a["kind"]).plot
             if draw is not None and "error" not in a:  # a failed analysis (its error in the summary) has nothing
-                entry = {**a, "units": results.get("units", {})}  # the parameters' units, for the axes
+                entry = {**a, "units": results.get("units", {}),  # the parameters' units, for the axes
+                         "figure": results.get("_figures", {}).get(a["name"])}  # a plane model's mesh and values
                 drawn = _drawn(draw, plt, entry, staging / f"{Path(results['scene']).stem}_{a['name']}.png")
                 written += [place(path, folder / path.name) for path in drawn]
     finally:

@@ -154,7 +154,13 @@ def _run_loaded(scn, backend: str | None, scheduler: str | None = None) -> dict:
             raise with_partial(exc, results, analysis, scn) from None
         context[analysis.name] = result.state
         results["analyses"].append(result.to_json())
+        if result.working.get("_figure") is not None:  # a plane model's mesh and nodal values, for --plot only
+            results.setdefault(FIGURES, {})[analysis.name] = result.working["_figure"]
     return results
+
+
+#: the results' key of the figures' working data (never written to the JSON: mechgen.cli drops it)
+FIGURES = "_figures"
 
 
 #: a parameter beyond this magnitude (or nonzero below its inverse) is at the edge of the floating-point range:

@@ -276,6 +276,10 @@ class Model:
         self.site_potential_fn: Callable | None = None
         self.bond_potential_fn: Callable | None = None
         self.continuum: Continuum | None = None
+        #: a plane continuum's fields, groups and domain (:meth:`plane`), None otherwise
+        self.plane_spec = None
+        #: a plane continuum's edge terms {boundary: {"potential" | "dissipation" | "weak": fn}}
+        self.edge_terms: dict[str, dict[str, Callable]] = {}
         self.weak_fn: Callable | None = None
         self.boundary_fn: Callable | None = None
         self.point_terms: dict[str, dict[str, Callable]] = {}
@@ -483,6 +487,71 @@ class Model:
                           choices=("eliminate", "penalty", "multiplier"), runtime=True),
                     Param("joints", "assembly", "", "segments of a scene joined by",
                           choices=("assembly", "multiplier"), runtime=True))
+
+    def plane(self, *fields: str, domain, group: str | None = None, element: str = "P2", h: float = 0.1) -> None:
+        """Declare scalar fields on a plane domain (a plane continuum, :mod:`mechgen.symbolic.plane`).
+
+        ``domain`` is a generated shape sized by parameters (declared first): ``disk("R")``,
+        ``annulus("a", "b")``, ``rectangle("Lx", "Ly")``, ``slit_plate("W", "H", "a")``,
+        ``plate_with_hole("W", "H", "r")``; ``group`` names the fields together (a displacement
+        ``u`` = (ux, uy), so that ``fix("u", "outer")`` holds both). The densities then receive the jets
+        ``u.ux``, ``u.ux_x``, ``u.ux_y``, ``u.ux_t`` ... and the position ``x``, ``y``. Adds the discretisation
+        parameters every plane continuum has: ``element`` (P1, P2, Q1, Q2 Lagrange elements), ``h`` (the
+        target edge length of the generated mesh, in the domain's length unit), ``edges`` (``curved``:
+        isoparametric P2/Q2 edges on a curved boundary; ``straight``: straight-sided) and ``quadrature``
+        (the degree of the rule, 0: twice the element's).
+        """
+        from mechgen.symbolic.plane import ELEMENTS, SHAPES, Domain, PlaneSpec
+
+        if self.plane_spec is not None or self.continuum is not None or self.coordinate_names or self.chain_spec:
+            raise ModelError(f"model {self.name} already declares its unknowns", file=self.file, key="plane",
+                             expected="one plane(...) call and no coordinates, chain or field")
+        if not isinstance(domain, Domain) or domain.shape not in SHAPES:
+            raise ModelError(f"domain {domain!r} of model {self.name} is not a plane domain", file=self.file,
+                             key="plane.domain", expected="disk(...), annulus(...), rectangle(...), slit_plate(...) "
+                                                          "or plate_with_hole(...) of mechgen.symbolic.plane")
+        for _, name in domain.sizes:
+            self.param(name)
+        for name in fields + ((group,) if group else ()):
+            self._claim(name, "field")
+        if not fields:
+            raise ModelError(f"model {self.name} declares a plane continuum without fields", file=self.file,
+                             key="plane", expected="plane('ux', 'uy', domain=..., group='u')")
+        self.plane_spec = PlaneSpec(tuple(fields), ((group, tuple(fields)),) if group else (), domain)
+        self.params(Param("element", element, "", "Lagrange element of the mesh", choices=ELEMENTS, runtime=True),
+                    Param("h", h, "", "target edge length of the generated mesh (the domain's length unit)",
+                          positive=True, runtime=True),
+                    Param("edges", "curved", "", "boundary edges of P2/Q2 elements on a curved boundary",
+                          choices=("curved", "straight"), runtime=True),
+                    Param("quadrature", 0, "", "degree of the quadrature rule (0: twice the element's)", size=True,
+                          runtime=True))
+
+    def _edge(self, kind: str, boundary: str) -> Callable:
+        if self.plane_spec is None or boundary not in self.plane_spec.domain.boundaries:
+            known = ", ".join(self.plane_spec.domain.boundaries) if self.plane_spec else "none (declare plane first)"
+            raise ModelError(f"edge term on {boundary!r} of model {self.name}: not a boundary of its domain",
+                             file=self.file, key="edge", expected=f"one of {known}")
+
+        def register(fn: Callable) -> Callable:
+            self.edge_terms.setdefault(boundary, {})[kind] = fn
+            return fn
+        return register
+
+    def edge_potential(self, boundary: str) -> Callable:
+        """Decorator (plane continuum): potential per unit length of a boundary, V_e(u, p, x, y, n) (J/m per unit
+        thickness). A traction t gives V_e = -(t_x u.ux + t_y u.uy); a pressure P on the edge with outward normal
+        ``n`` (``n.x``, ``n.y``) gives V_e = P (n.x u.ux + n.y u.uy). Only the fields' values may appear."""
+        return self._edge("potential", boundary)
+
+    def edge_dissipation(self, boundary: str) -> Callable:
+        """Decorator (plane continuum): Rayleigh dissipation per unit length of a boundary, R_e(u, p, x, y, n): a
+        dashpot layer (an absorbing boundary R_e = c/2 (u.ux_t^2 + u.uy_t^2))."""
+        return self._edge("dissipation", boundary)
+
+    def edge_weak_form(self, boundary: str) -> Callable:
+        """Decorator (plane continuum): a residual per unit length of a boundary, W_e(test, u, p, x, y, n), linear in
+        the test jets (a follower load that is not the derivative of a potential)."""
+        return self._edge("weak", boundary)
 
     def kinetic_density(self, fn: Callable) -> Callable:
         """Decorator (continuum): kinetic energy per unit length T(u, p, s, t) of the jets u.
@@ -864,6 +933,11 @@ class Model:
         return self.continuum is not None
 
     @property
+    def is_plane(self) -> bool:
+        """True for a plane continuum model (fields on a 2D domain, :meth:`plane`)."""
+        return self.plane_spec is not None
+
+    @property
     def field_names(self) -> tuple[str, ...]:
         """Names of the declared fields."""
         return self.continuum.fields if self.continuum else ()
@@ -899,6 +973,8 @@ class Model:
         if self.chain_spec:
             taken.add(self.chain_spec.coordinate)
         taken |= set(self.field_names)
+        if self.plane_spec is not None:
+            taken |= set(self.plane_spec.fields) | {g for g, _ in self.plane_spec.groups}
         if name in taken or name.endswith(("_dot", "_ddot")) and name.rsplit("_", 1)[0] in taken:
             raise ModelError(f"{what} name {name!r} is already used in model {self.name}", file=self.file,
                              key=name, expected="a name not yet declared")

@@ -109,8 +109,9 @@ class Param:
 
     @property
     def is_numeric(self) -> bool:
-        """True for parameters that may appear in expressions."""
-        return not self.is_choice and not self.size
+        """True for parameters that may appear in expressions (a runtime number, such as a plane mesh's size h,
+        never does)."""
+        return not self.is_choice and not self.size and not self.runtime
 
 
 class UnknownEntry(AttributeError, KeyError):

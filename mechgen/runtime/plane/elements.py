@@ -313,50 +313,19 @@ def require_assembly_memory(mesh, ncomp: int, njets: int, *, key: str, degree: i
             f"{mesh.n_cells} {mesh.element} cells", key=key, expected="a coarser mesh")
 
 
-# -- boundary edges --------------------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class EdgeTables:
-    """Quadrature data on boundary edges (endpoints then, for P2/Q2, the midside node).
-
-    edges (f, k) node indices; x (f, q, 2) physical points [m]; w (f, q) Gauss weights times |dx/ds| [m];
-    N (q, k) the edge's 1D Lagrange values at the reference points ref (q,) in [-1, 1] (nodes -1, 1, 0);
-    normal (f, q, 2) the unit normal (t_y, -t_x), outward where the domain lies on the edge's left (as the mesh's
-    boundaries are stored); degree.
-    """
-
-    edges: np.ndarray
-    x: np.ndarray
-    w: np.ndarray
-    N: np.ndarray
-    normal: np.ndarray
-    ref: np.ndarray
-    degree: int
-
-
-def edge_tables(mesh, edges: np.ndarray, degree: int | None = None) -> EdgeTables:
-    """Gauss tables on ``edges`` (a boundary of ``mesh``, (f, 2 | 3)): the isoparametric edge
-    x(s) = sum_k X_k n_k(s), ds = |dx/ds| ds_ref, exact for polynomials of ``degree`` in s (default 2 p)."""
-    edges = np.asarray(edges, np.int64)
-    order = edges.shape[1] - 1
-    degree = 2 * order if degree is None else int(degree)
-    s, ws = np.polynomial.legendre.leggauss(max(1, ceil((degree + 1) / 2)))
-    N, dN = _lagrange_1d(s, order)
-    X = mesh.points[edges]  # (f, k, 2)
-    x = np.matmul(N, X)
-    dx = np.matmul(dN, X)  # (f, q, 2)
-    length = np.hypot(dx[..., 0], dx[..., 1])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        normal = np.stack([dx[..., 1], -dx[..., 0]], axis=-1) / length[..., None]
-    return EdgeTables(edges=edges, x=x, w=ws[None, :] * length, N=N, normal=normal, ref=s, degree=degree)
-
-
-def edge_value_tables(etab: EdgeTables, ncomp: int) -> np.ndarray:
-    """B[f, q, c, k ncomp + c'] = N[q, k] if c == c' else 0: the values of the ``ncomp`` components on the edges
-    (jets (c, "") in component order), for :func:`mechgen.runtime.fields.assemble.element_vectors` with
-    :func:`node_dofs` of the edges; a traction t[f, q, c] gives the load r = sum w N t."""
-    nf, nq = etab.w.shape
-    nk = etab.N.shape[1]
-    B = np.zeros((nf, nq, ncomp, nk, ncomp))
-    for c in range(ncomp):
-        B[:, :, c, :, c] = etab.N[None]
-    return B.reshape(nf, nq, ncomp, nk * ncomp)
+def node_gradients(mesh, u: np.ndarray) -> np.ndarray:
+    """grad u at the nodes (n, c, 2): each cell's gradient at its own nodes (reference node coordinates, J^-T dN),
+    averaged over the cells that share the node (the plain mean; exact wherever the field is in the element space,
+    e.g. stresses of a linear field, or of a quadratic one on straight P2/Q2 cells)."""
+    u = np.asarray(u, float).reshape(mesh.n_nodes, -1)
+    _, dNref = shapes(mesh.element, reference_nodes(mesh.element))  # (k, l, 2) at the cell's own nodes
+    X = mesh.points[mesh.cells]
+    J = jacobians(X, dNref)  # (e, k, 2, 2)
+    rhs = np.broadcast_to(np.transpose(dNref, (0, 2, 1)), J.shape[:2] + (2, dNref.shape[1]))
+    g = np.linalg.solve(np.transpose(J, (0, 1, 3, 2)), rhs)  # J^T g = dN/dxi: g[e, k, i, l] = dN_l/dx_i
+    grads = np.einsum("elc,ekil->ekci", u[mesh.cells], g)  # (e, k, c, 2)
+    count = np.bincount(mesh.cells.ravel(), minlength=mesh.n_nodes)
+    flat = grads.reshape(-1, grads.shape[2] * 2)
+    total = np.stack([np.bincount(mesh.cells.ravel(), weights=flat[:, j], minlength=mesh.n_nodes)
+                      for j in range(flat.shape[1])], axis=1)
+    return (total / count[:, None]).reshape(mesh.n_nodes, -1, 2)
