@@ -98,7 +98,7 @@ REGISTRY: dict[str, Suite] = {s.name: s for s in (
           peers=("PyDy Kane + lambdify", "PyDy Kane + cython", "PyDy/sympy Lagrange + lambdify"), standard=False),
     Suite("plane", "mechgen.bench.plane", "run_plane_benchmarks",
           "plane-stress elasticity stiffness (P1, P2 triangles, ~1e5 and ~1e6 unknowns) assembled on the same mesh, "
-          "checked equal, median of interleaved repeats", ("plane_assembly.json", "plane_assembly.md"),
+          "checked equal, median of interleaved repeats; a compiled plane model's tangent() as a user runs it", ("plane_assembly.json", "plane_assembly.md"),
           peers=("scikit-fem",)),
 )}
 
