@@ -12,7 +12,7 @@ from mechgen.cli import main
 def test_list_names_every_suite(capsys):
     assert main(["bench", "--list"]) == 0
     names = [line.split()[0] for line in capsys.readouterr().out.splitlines()]
-    assert names == list(SUITES) == ["fpu", "beam", "rotor", "balloon", "startup", "impacts", "friction", "rods", "threads", "simulate", "orbits", "sweep", "multibody"]
+    assert names == list(SUITES) == ["fpu", "beam", "rotor", "balloon", "startup", "impacts", "friction", "rods", "threads", "simulate", "orbits", "sweep", "multibody", "plane"]
 
 
 def test_every_suite_names_an_entry_point_taking_out_and_quick():

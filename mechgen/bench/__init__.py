@@ -96,6 +96,10 @@ REGISTRY: dict[str, Suite] = {s.name: s for s in (
           "kernel) against PyDy", ("multibody_results.csv", "multibody_results.json", "multibody_results.md",
                                   "multibody_ratios.json", "multibody_build_time.png"),
           peers=("PyDy Kane + lambdify", "PyDy Kane + cython", "PyDy/sympy Lagrange + lambdify"), standard=False),
+    Suite("plane", "mechgen.bench.plane", "run_plane_benchmarks",
+          "plane-stress elasticity stiffness (P1, P2 triangles, ~1e5 and ~1e6 unknowns) assembled on the same mesh, "
+          "checked equal, median of interleaved repeats; a compiled plane model's tangent() as a user runs it", ("plane_assembly.json", "plane_assembly.md"),
+          peers=("scikit-fem",)),
 )}
 
 #: the suite names (``mechgen bench`` with none runs them all)

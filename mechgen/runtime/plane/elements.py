@@ -19,7 +19,7 @@ Jet tables (:func:`jet_tables`): B[e, q, a, d] for a vector field of ``ncomp`` c
 (d = l * ncomp + c), jets a = (component, order), order in {"", "x", "y"}. Memory: B holds
 ne * nq * na * nl * ncomp doubles; for plane elasticity (4 gradient jets, 2 components) on P2 at 10^6 unknowns
 (~2.5e5 cells, 6 points a cell at degree 4) that is 2.5e5 * 6 * 4 * 12 * 8 B = 0.58 GB, and dN alone 0.14 GB;
-:func:`gradient_element_matrices` forms the element matrices of gradient and value jets from N and dN without B.
+:func:`jet_element_matrices` forms the element matrices block by block without the whole B.
 """
 from __future__ import annotations
 
@@ -166,7 +166,6 @@ def reference_nodes(element: str) -> np.ndarray:
         v = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
     if ORDER[element] == 1:
         return v
-    nv = len(v)
     mids = (v + np.roll(v, -1, axis=0)) / 2
     return np.vstack([v, mids] + ([v.mean(axis=0, keepdims=True)] if element == "Q2" else []))
 
@@ -194,7 +193,9 @@ class PlaneTables:
 
 def jacobians(X: np.ndarray, dNref: np.ndarray) -> np.ndarray:
     """J[e, q, i, j] = dx_i/dxi_j = sum_l X[e, l, i] dN_l/dxi_j."""
-    return np.einsum("eli,qlj->eqij", X, dNref, optimize=True)
+    nq, nl = dNref.shape[:2]
+    G = np.ascontiguousarray(dNref.transpose(0, 2, 1).reshape(nq * 2, nl))  # rows (q, j)
+    return np.matmul(G, X).reshape(len(X), nq, 2, 2).transpose(0, 1, 3, 2)
 
 
 def tables(mesh, degree: int | None = None) -> PlaneTables:
@@ -214,15 +215,21 @@ def tables(mesh, degree: int | None = None) -> PlaneTables:
     dN = np.empty(det.shape + (N.shape[1], 2))
     dN[..., 0] = (J[..., 1, 1, None] * g0 - J[..., 1, 0, None] * g1) * inv[..., None]
     dN[..., 1] = (-J[..., 0, 1, None] * g0 + J[..., 0, 0, None] * g1) * inv[..., None]
-    x = np.einsum("ql,eli->eqi", N, X, optimize=True)
+    x = np.matmul(N, X)
     return PlaneTables(x=x, w=wref[None, :] * np.abs(det), N=N, dN=dN, detJ=det, ref=ref, element=element,
                        degree=degree)
 
 
+def node_dofs(nodes: np.ndarray, ncomp: int) -> np.ndarray:
+    """(m, k * ncomp) global dofs of rows of k nodes (cells, edges), interleaved: dof = node * ncomp + component,
+    local l * ncomp + c."""
+    nodes = np.asarray(nodes, np.int64)
+    return (nodes[:, :, None] * ncomp + np.arange(ncomp)[None, None, :]).reshape(len(nodes), -1)
+
+
 def element_dofs(mesh, ncomp: int) -> np.ndarray:
-    """(ne, k * ncomp) global dofs of each cell, interleaved: dof = node * ncomp + component, local l * ncomp + c."""
-    cells = np.asarray(mesh.cells, np.int64)
-    return (cells[:, :, None] * ncomp + np.arange(ncomp)[None, None, :]).reshape(len(cells), -1)
+    """(ne, k * ncomp) global dofs of each cell (:func:`node_dofs` of the cells)."""
+    return node_dofs(mesh.cells, ncomp)
 
 
 def _check_jets(ncomp: int, jets) -> list[tuple[int, str]]:
@@ -253,28 +260,72 @@ def jet_tables(tab: PlaneTables, ncomp: int, jets) -> np.ndarray:
     return B.reshape(ne, nq, len(jets), nl * ncomp)
 
 
-def gradient_element_matrices(tab: PlaneTables, ncomp: int, jets, coeff: np.ndarray, pairs=None) -> np.ndarray:
-    """K_e[l c, m d] = sum_q w_q sum_{a, b} phi_a[q, l] C[e, q, a, b] phi_b[q, m] with c = comp(a), d = comp(b):
-    the same as :func:`mechgen.runtime.fields.assemble.element_matrices` on :func:`jet_tables`' B, without B.
-    ``pairs``: the (a, b) with C[..., a, b] not identically zero (found if None)."""
-    from mechgen.runtime.fields.assemble import nonzero_pairs
+#: cells a block in :func:`jet_element_matrices` (the block's B: CHUNK x q x a x l ncomp doubles, a few MB)
+CHUNK = 4096
 
+
+def _jet_block(tab: PlaneTables, ncomp: int, jets: list, lo: int, hi: int) -> np.ndarray:
+    """B[e, q, a, l ncomp + c] of the cells lo:hi (:func:`jet_tables` of a slice)."""
+    nq, nl = tab.N.shape
+    B = np.zeros((hi - lo, nq, len(jets), nl, ncomp))
+    for a, (c, o) in enumerate(jets):
+        B[:, :, a, :, c] = tab.N[None] if o == "" else tab.dN[lo:hi, :, :, "xy".index(o)]
+    return B.reshape(hi - lo, nq, len(jets), nl * ncomp)
+
+
+def jet_element_matrices(tab: PlaneTables, ncomp: int, jets, coeff: np.ndarray, chunk: int = CHUNK) -> np.ndarray:
+    """K_e = sum_q w_q B_q^T C_q B_q for every cell, B the jet table of :func:`jet_tables`: the same as
+    :func:`mechgen.runtime.fields.assemble.element_matrices` on the whole B, but B built ``chunk`` cells at a time
+    (never whole: at 10^6 unknowns it would take 0.6 GB) and each block one batched product
+    (e, l, q a) @ ((e, q, a, b) @ (e, q, b, m))."""
     jets = _check_jets(ncomp, jets)
     ne, nq, nl = tab.dN.shape[:3]
-    pairs = nonzero_pairs(coeff) if pairs is None else [(int(a), int(b)) for a, b in pairs]
-    out = np.zeros((ne, nl, ncomp, nl, ncomp))
-    wc = tab.w[:, :, None, None] * coeff
-    for (ca, oa), (cb, ob), group in _pair_groups(jets, pairs):
-        left = basis_values(tab, oa)
-        right = basis_values(tab, ob)
-        weight = sum(wc[:, :, a, b] for a, b in group)
-        out[:, :, ca, :, cb] += np.matmul((left * weight[:, :, None]).transpose(0, 2, 1), right)
-    return out.reshape(ne, nl * ncomp, nl * ncomp)
+    n, na = nl * ncomp, len(jets)
+    out = np.empty((ne, n, n))
+    for lo in range(0, ne, chunk):
+        hi = min(ne, lo + chunk)
+        B = _jet_block(tab, ncomp, jets, lo, hi)
+        right = np.matmul(tab.w[lo:hi, :, None, None] * coeff[lo:hi], B)
+        np.matmul(B.reshape(hi - lo, nq * na, n).transpose(0, 2, 1), right.reshape(hi - lo, nq * na, n),
+                  out=out[lo:hi])
+    return out
 
 
-def _pair_groups(jets, pairs):
-    """The pairs grouped by (jet a, jet b) values: identical jets listed twice share one product."""
-    groups: dict = {}
-    for a, b in pairs:
-        groups.setdefault((jets[a], jets[b]), []).append((a, b))
-    return [(ja, jb, g) for (ja, jb), g in groups.items()]
+def assembly_bytes(mesh, ncomp: int, njets: int, degree: int | None = None) -> int:
+    """Peak bytes of tables + coefficients + element matrices + CSR pattern + one matrix of ``mesh`` for a field of
+    ``ncomp`` components and ``njets`` jets: 8 ne (7 n^2 + 16 q l + 2 q a^2), n = l ncomp the element's dofs, q the
+    points a cell, l its nodes, a the jets. Measured with tracemalloc (tests/test_plane_elements.py): the
+    coefficients 6 n^2 + 14 q l (+ q a^2 for C) on P1, P2, Q1, Q2; the constants rounded up."""
+    degree = DEFAULT_DEGREE[mesh.element] if degree is None else int(degree)
+    q = len(quadrature(mesh.element, degree)[1])
+    nl = NODES[mesh.element]
+    n = nl * ncomp
+    return 8 * int(mesh.n_cells) * (7 * n * n + 16 * q * nl + 2 * q * njets * njets)
+
+
+def require_assembly_memory(mesh, ncomp: int, njets: int, *, key: str, degree: int | None = None) -> None:
+    """Refuse (InputError at ``key``, nothing allocated) an assembly whose :func:`assembly_bytes` exceed the memory
+    limit of :func:`mechgen.runtime.core.memory.require`."""
+    from mechgen.runtime.core.memory import require
+
+    unknowns = mesh.n_nodes * ncomp
+    require(assembly_bytes(mesh, ncomp, njets, degree), f"the assembly of {unknowns} unknowns on "
+            f"{mesh.n_cells} {mesh.element} cells", key=key, expected="a coarser mesh")
+
+
+def node_gradients(mesh, u: np.ndarray) -> np.ndarray:
+    """grad u at the nodes (n, c, 2): each cell's gradient at its own nodes (reference node coordinates, J^-T dN),
+    averaged over the cells that share the node (the plain mean; exact wherever the field is in the element space,
+    e.g. stresses of a linear field, or of a quadratic one on straight P2/Q2 cells)."""
+    u = np.asarray(u, float).reshape(mesh.n_nodes, -1)
+    _, dNref = shapes(mesh.element, reference_nodes(mesh.element))  # (k, l, 2) at the cell's own nodes
+    X = mesh.points[mesh.cells]
+    J = jacobians(X, dNref)  # (e, k, 2, 2)
+    rhs = np.broadcast_to(np.transpose(dNref, (0, 2, 1)), J.shape[:2] + (2, dNref.shape[1]))
+    g = np.linalg.solve(np.transpose(J, (0, 1, 3, 2)), rhs)  # J^T g = dN/dxi: g[e, k, i, l] = dN_l/dx_i
+    grads = np.einsum("elc,ekil->ekci", u[mesh.cells], g)  # (e, k, c, 2)
+    count = np.bincount(mesh.cells.ravel(), minlength=mesh.n_nodes)
+    flat = grads.reshape(-1, grads.shape[2] * 2)
+    total = np.stack([np.bincount(mesh.cells.ravel(), weights=flat[:, j], minlength=mesh.n_nodes)
+                      for j in range(flat.shape[1])], axis=1)
+    return (total / count[:, None]).reshape(mesh.n_nodes, -1, 2)

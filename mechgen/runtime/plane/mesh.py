@@ -210,9 +210,9 @@ def _finish(points, cells, element, classify, groups=None) -> PlaneMesh:
     edges, owner = boundary_edges(cells, element)
     mid = (points[edges[:, 0]] + points[edges[:, 1]]) / 2
     boundaries = {name: edges[mask] for name, mask in classify(mid, owner, cells).items()}
-    for a in (points, cells, *boundaries.values()):
-        a.setflags(write=False)
     groups = groups or {"domain": np.arange(len(cells))}
+    for a in (points, cells, *boundaries.values(), *groups.values()):
+        a.setflags(write=False)
     return PlaneMesh(points=points, cells=cells, element=element, boundaries=boundaries, groups=groups)
 
 
@@ -467,7 +467,7 @@ def _read_meshio(path: str):
                          expected="an existing gmsh .msh file")
     try:
         return meshio.read(path, file_format="gmsh")
-    except Exception as exc:  # noqa: BLE001 - meshio raises many kinds on a file that is not a mesh
+    except (Exception, SystemExit) as exc:  # noqa: BLE001 - meshio raises many kinds (and exits) on a file that is not a mesh
         raise InputError(f"not a readable gmsh mesh ({type(exc).__name__}: {str(exc)[:200]})", file=path,
                          expected="a gmsh .msh file (format 2.2 or 4.1)") from None
 
@@ -532,6 +532,8 @@ def read_msh(path) -> PlaneMesh:
             raise InputError(f"boundary {name!r} has nodes that belong to no 2D cell", file=path,
                              key=f"boundaries.{name}", expected="boundary lines on the edges of the mesh's cells")
     groups = {name: np.concatenate([offsets[b] + i for b, i in parts]) for name, parts in cell_groups.items()}
+    for a in (points, cells, *boundaries.values(), *groups.values()):
+        a.setflags(write=False)
     mesh = PlaneMesh(points=points, cells=cells, element=element, boundaries=boundaries, groups=groups)
     check_cells(mesh, file=path)
     return mesh
