@@ -204,3 +204,30 @@ def test_annulus_energy_converges_at_the_boundarys_rate():
                       for h in (0.2, 0.1, 0.05)])
         rates = np.log2(e[:-1] / e[1:])
         assert np.all(np.abs(rates - rate) < 0.4), (edges, rates)
+
+
+def test_a_weak_form_load_equals_its_potential(membrane):
+    """The weight written as a weak form (test.uy rho_g: not derived from a potential) gives the potential's
+    solution: the weak form's residual is dW/dtest, the same pointwise force."""
+    m = Model("membrane_weak")
+    m.params(Param("E", E, "Pa", positive=True), Param("nu", NU, ""), Param("rho_g", RHO_G, "N/m^3"),
+             Param("R", R, "m", positive=True))
+    from mechgen.symbolic.plane import disk
+
+    m.plane("ux", "uy", domain=disk("R"), group="u", element="P2", h=0.2)
+
+    @m.potential_density
+    def potential(u, p):
+        return linear_elastic(gradient(u, "ux", "uy"), p.E, p.nu, "stress")
+
+    @m.weak_form
+    def weight(test, u, p):
+        return test.uy * p.rho_g
+
+    @m.boundary
+    def boundary():
+        return [fix("u", "outer")]
+
+    weak = plane_steady(mechgen.compile(m), {"points": {"c": [0.0, 0.0]}})
+    energy = plane_steady(membrane.with_params(h=0.2), {"points": {"c": [0.0, 0.0]}})
+    assert np.allclose(weak["c_displacement"], energy["c_displacement"], rtol=1e-12, atol=1e-15)

@@ -103,3 +103,10 @@ def test_bad_crack_keys_are_scene_errors(tmp_path):
     bad.write_text(text)
     with pytest.raises(SceneError, match="r_in < r_out"):
         run_scene(str(bad))
+
+
+def test_a_crack_ring_that_cuts_the_crack_is_refused():
+    plate = mechgen.compile("cracked_plate", {"h": 0.5}, kernels=("residual", "tangent", "outputs"))
+    with pytest.raises(SceneError, match="cuts the crack"):
+        get("crack_integrals").run(plate, {"tips": [[1.0, 0.0, 0.0], [-1.0, 0.0, math.pi]], "rings": [[0.3, 0.8]],
+                                           "crack_rings": [[0.5, 2.0]]}, {})

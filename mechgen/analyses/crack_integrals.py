@@ -161,6 +161,12 @@ def run_crack_integrals(system, options: dict, context: dict) -> dict:
     if options.get("crack_rings"):
         crack = griffith_of(system)
         center = options.get("center", [0.0, 0.0])
+        reach = max(float(np.hypot(tip[0] - center[0], tip[1] - center[1])) for tip in options["tips"])
+        inner = min(ring[0] for ring in options["crack_rings"])
+        if inner <= reach:
+            raise SceneError(f"a crack ring's inner radius {inner:g} does not enclose the crack (its tips reach "
+                             f"{reach:g} from the center): it cuts the crack", key="crack_rings",
+                             expected=f"rings about center with r_in > {reach:g}")
         whole = [crack_values(system, q, center, ring, mat, crack) for ring in options["crack_rings"]]
         out.update(whole[0])
         out["crack_contours"] = [{"ring": ring, **values} for ring, values in zip(options["crack_rings"], whole)]
