@@ -37,9 +37,9 @@ MODULES = (
     "mechgen.analyses.phase_kinetics",
     "mechgen.analyses.orr_sommerfeld",
     "mechgen.analyses.shear_curve",
-    "mechgen.analyses.crack_integrals",
     "mechgen.analyses.channel_flow",
     "mechgen.analyses.channel_spectrum",
+    "mechgen.analyses.crack_integrals",
 )
 
 

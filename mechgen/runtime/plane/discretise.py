@@ -153,6 +153,9 @@ def discretise(mesh, info: dict, quadrature: int = 0) -> PlaneDisc:
         if name not in mesh.boundaries:
             raise InputError(f"the mesh has no boundary {name!r}", key="mesh",
                              expected=f"a mesh with the boundaries the model names; it has {', '.join(mesh.boundaries)}")
+    from mechgen.runtime.plane.elements import require_assembly_memory
+
+    require_assembly_memory(mesh, nf, len(info["jets"]), key="params.h", degree=quadrature or 2 * ORDER[mesh.element])
     pieces = [_domain_piece(mesh, info, quadrature)]
     pieces += [_edge_piece(mesh, info, name, quadrature) for name in sorted(info["edges"])]
     ndof = len(mesh.points) * nf
