@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mechgen.analyses import special_points
+from mechgen.analyses import plane_states, special_points
 from mechgen.analyses.stability_boundary import own_value, spectrum
 from mechgen.analyses.steady import equilibrium_functions, newton_aliases
 from mechgen.errors import SceneError
@@ -70,9 +70,12 @@ def point(system, name: str, y: np.ndarray, p: float, options: dict) -> dict:
     moved = system.with_params(**{name: float(p)})
     n = system.n
     out: dict = {name: float(p)}
-    if not system.is_field and not system.is_lattice:
+    plane = getattr(system, "is_plane", False)
+    if not system.is_field and not system.is_lattice and not plane:
         out["coordinates"] = {c: float(v) for c, v in zip(system.coordinates, y[:n])}
     out.update(moved.outputs(y[:n], None, y[n:] if system.m else None))
+    if plane:
+        out.update(plane_states.point_outputs(moved, y[:n], options))
     out.update(newton_aliases(out, options.get("aliases", {})))
     if options.get("stability", True):
         require_dense(2 * n, 40, "the stability verdict at every branch point", key="stability",

@@ -24,12 +24,13 @@ from mechgen.runtime.core.memory import require_dense
 
 @dataclass(frozen=True)
 class NewtonResult:
-    """Solution, iterations used, final residual norm, converged flag."""
+    """Solution, iterations used, final residual norm, converged flag, the residual norms of every iterate."""
 
     x: np.ndarray
     iterations: int
     residual_norm: float
     converged: bool
+    history: tuple[float, ...] = ()
 
 
 def _why(explain, x) -> str:
@@ -78,7 +79,7 @@ def newton(residual, jacobian, x0, *, tol: float = 1e-10, max_iter: int = 50, da
     history = [float(np.linalg.norm(r))]
     for it in range(1, max_iter + 1):
         if history[-1] <= tol:
-            return NewtonResult(x, it - 1, history[-1], True)
+            return NewtonResult(x, it - 1, history[-1], True, tuple(history))
         if budget is not None:
             budget.check_time(lambda: f"Newton iteration {it} of max_iter = {max_iter}, residual norm {history[-1]:.3g}")
         dx = _step(jacobian(x), r, explain, x)
@@ -95,6 +96,6 @@ def newton(residual, jacobian, x0, *, tol: float = 1e-10, max_iter: int = 50, da
         x, r = trial, np.asarray(r_trial, float)
         history.append(norm)
         if norm <= tol or np.linalg.norm(alpha * dx) <= tol * max(1.0, np.linalg.norm(x)) and norm <= 1e3 * tol:
-            return NewtonResult(x, it, norm, True)
+            return NewtonResult(x, it, norm, True, tuple(history))
     tail = ", ".join(f"{h:.3g}" for h in history[-5:])
     raise ConvergenceError(f"Newton did not converge in {max_iter} iterations; last residual norms: {tail}")
