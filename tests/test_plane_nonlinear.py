@@ -169,3 +169,15 @@ def test_continuation_finds_the_svk_limit_point(tmp_path):
     fold = out["folds"][0]
     assert fold["P"] == pytest.approx(-SVK_FOLD, abs=1e-8)
     assert fold["corner_displacement"][0] == pytest.approx(LX * (1 / math.sqrt(3) - 1), abs=1e-6)
+
+
+def test_simulate_on_a_plane_model_is_refused(tmp_path, capsys):
+    """simulate has no flow for a plane system yet: exit 2 naming the scene file, the key and what is missing."""
+    from mechgen.cli import main
+
+    scene = tmp_path / "drum_free.toml"
+    scene.write_text('title = "drum"\nmodel = "drum"\n[params]\nh = 0.5\n'
+                     '[[analysis]]\nname = "free"\nkind = "simulate"\nt_end = 1.0\n')
+    assert main(["run", str(scene)]) == 2
+    err = capsys.readouterr().err
+    assert "drum_free.toml" in err and "'kind'" in err and "no first-order flow" in err
