@@ -19,7 +19,7 @@ import numpy as np
 from mechgen.analyses import schema
 from mechgen.errors import ConvergenceError
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget
-from mechgen.runtime.steady.newton import newton
+from mechgen.runtime.steady.newton import newton, symmetric_ordered_solve
 from mechgen.scene.expr import is_identifier
 from mechgen.scene.values import IDENTIFIER_RULE, fail, type_name
 
@@ -86,7 +86,8 @@ def solve(system, options: dict):
         return newton(system.residual, lambda q: system.tangent(q)["r_q"], q0,
                       tol=options.get("tol", 1e-10) * scale, max_iter=options.get("max_iter", 50),
                       budget=Budget("steady Newton iterations",
-                                    seconds=float(options.get("max_seconds", DEFAULT_SECONDS))))
+                                    seconds=float(options.get("max_seconds", DEFAULT_SECONDS))),
+                      solve=symmetric_ordered_solve)
     except ConvergenceError as exc:
         raise ConvergenceError(f"steady state of plane model {system.meta.get('model')}: {exc}. Under load control "
                                "there may be no equilibrium at this load (past a limit point of the law, or a load "
