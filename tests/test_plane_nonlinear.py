@@ -181,3 +181,16 @@ def test_simulate_on_a_plane_model_is_refused(tmp_path, capsys):
     assert main(["run", str(scene)]) == 2
     err = capsys.readouterr().err
     assert "drum_free.toml" in err and "'kind'" in err and "no first-order flow" in err
+
+
+@pytest.mark.slow
+def test_membrane_steady_at_1e5_unknowns():
+    """membrane_gravity, P2, curved rim, h = 0.0223: over 1e5 unknowns (measured 101,106; steady ~1 s after the
+    mesh, 1 GiB peak); u_y(0) within 1e-8 of the closed form -rho_g R^2 / (2 (lambda* + 3 mu)) (the rim's O(h^4)
+    geometry error: 2e-7 at h = 0.1, so ~1e-10 here)."""
+    system = mechgen.compile("membrane_gravity", {"h": 0.0223, "element": "P2"},
+                             kernels=("residual", "tangent", "outputs"))
+    assert system.n > 100_000
+    out = plane_steady(system, {"points": {"c": [0.0, 0.0]}})
+    mu, lam = 1 / 2.6, 0.3 / (1 - 0.09)
+    assert out["c_displacement"][1] == pytest.approx(-1 / (2 * (lam + 3 * mu)), rel=1e-8)
