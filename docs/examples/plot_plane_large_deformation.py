@@ -91,9 +91,9 @@ print(f"SVK branch: max |P - E' l (l^2 - 1)/2| over {inside.sum()} points = {svk
 
 # %%
 fig, ax = plt.subplots(figsize=(6.4, 4.2))
-grid = np.linspace(0.45, 3.0, 300)
+grid = np.linspace(0.0, 1.6, 300)
 ax.plot(grid, [E_PRIME * l * (l**2 - 1) / 2 for l in grid], "C1-", lw=1, label="SVK, closed form")
-ax.plot(ls[inside], Ps[inside], "C1o", ms=4, label="SVK, mechgen branch")
+ax.plot(ls[inside], Ps[inside], "C1o", ms=4, label="SVK, mechgen branch (past the fold: unstable)")
 ax.plot(l_fold, fold["P"], "k*", ms=12, label="limit point (fold)")
 l_nh = np.linspace(1.0, exact[-1, 0] / LX + 1, 200)
 ax.plot(l_nh, [neo_hookean(l, brentq(lambda l2: neo_hookean(l, l2)[1], 0.3, 5.0))[0] for l in l_nh], "C0-", lw=1,
