@@ -298,21 +298,9 @@ def leapfrog_masses(system, M) -> np.ndarray:
     return 1.0 / diag
 
 
-def refuse_plane(system) -> None:
-    """SceneError (exit 2) on a plane continuum: simulate's flows need x' = (v, -M^-1 r(q, v, 0)) with its Jacobian
-    (``rhs``, ``jacobian``), an initial state and the energy account, which a PlaneSystem does not provide yet."""
-    if getattr(system, "is_plane", False):
-        raise SceneError(f"simulate is not implemented for the plane model {system.meta.get('model')}: a plane "
-                         "system has no first-order flow yet (rhs and jacobian of x' = (v, -M^-1 r(q, v, 0)) with "
-                         "the sparse mass M, an initial displacement field, the energy balance)", key="kind",
-                         expected="steady, continuation or modes on a plane model (modes gives the free "
-                                  "vibration's frequencies and shapes)")
-
-
 def run_simulate(system, options: dict, context: dict) -> dict:
     """Time response: the time history (``t``, ``trajectory``), the model's outputs at t_end and the energy
     figures (mechgen.analyses.time_series)."""
-    refuse_plane(system)
     if hasattr(system, "modes"):
         from mechgen.analyses.simulate_hybrid import run_hybrid
 
