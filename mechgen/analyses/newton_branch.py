@@ -6,7 +6,10 @@ mechgen.runtime.steady.continuation (pseudo-arclength through folds, each fold l
 the steady state's point corrected at the scene's value of the parameter. F_y is the generated tangent;
 F_p = (F(y, p + h) - F(y, p - h)) / (2 h), h = 1e-6 max(1, |p|): its error, of order h^2 |F_ppp|, is in the
 bordered system's last column only, which slows the corrector but never moves a point (each point solves
-F = 0 to 1e-10). This serves lumped models and continua alike (the discretised residual at the scene's N).
+F = 0 to 1e-10). This serves lumped models and continua alike (the discretised residual at the scene's N), and
+plane models (the assembled sparse tangent; their branch points carry, instead of ``coordinates``, the
+``<name>_displacement`` / ``<name>_stress`` of the ``points`` and the ``probe_displacement`` of ``probe``:
+mechgen.analyses.plane_states.point_outputs).
 
 Every point of ``branch`` reports the parameter, a lumped model's ``coordinates``, the model's outputs and their
 ``aliases``, and with ``stability`` (default true) the ``verdict`` and ``frequencies`` of the linearisation there
