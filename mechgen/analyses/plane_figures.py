@@ -39,6 +39,8 @@ def panel(plt, ax, fig_data: dict, values: np.ndarray, title: str) -> None:
         title += f" (displacement x {scale:.3g})"
     plt.colorbar(shown, ax=ax, shrink=0.8, label="|u|" if values.shape[0] == 2 else fig_data["fields"][0])
     ax.set_aspect("equal")
+    ax.set_xlabel("x")
+    ax.set_ylabel("y")
     ax.set_title(title, fontsize=8)
 
 
@@ -60,6 +62,8 @@ def steady(plt, a: dict, path: Path) -> list[Path]:
         shown = ax.tripcolor(tri, facecolors=von_mises(np.asarray(stress))[np.asarray(data["cell"])], cmap="magma")
         plt.colorbar(shown, ax=ax, shrink=0.8, label="von Mises stress (element mean)")
         ax.set_aspect("equal")
+        ax.set_xlabel("x")
+        ax.set_ylabel("y")
         ax.set_title("von Mises stress", fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=120)

@@ -19,6 +19,7 @@ from dataclasses import InitVar, dataclass, field, replace
 import numpy as np
 
 from mechgen.errors import InputError, KernelError
+from mechgen.runtime.core.memory import require_dense
 from mechgen.runtime.core.meta import SystemMeta
 from mechgen.runtime.core.system import (Memo, folded_parameter, frozen_vector, number, read_only,
                                          replacement_vector, unknown_parameters)
@@ -231,6 +232,48 @@ class PlaneSystem:
     def tangent(self, q, v=None, a=None, z=None, t: float = 0.0) -> dict:
         """r_q, r_v, r_a (reduced, CSR) at the state."""
         return self._matrices("tangent", ("r_q", "r_v", "r_a"), q, v, a, t)
+
+    def acceleration(self, q, v, z=None, t: float = 0.0):
+        """(a, M): the acceleration solving r(q, v, a) = 0 for a residual linear in a, a = -M^-1 r(q, v, 0),
+        M = dr/da (sparse LU; m/s^2 for a displacement), and M."""
+        import scipy.sparse.linalg as spla
+
+        M = self.tangent(q, v, None, t=t)["r_a"].tocsc()
+        try:
+            return spla.splu(M).solve(-self.residual(q, v, None, t=t)), M
+        except RuntimeError:
+            raise InputError(f"the mass matrix of plane model {self.meta.get('model')} is singular: a field "
+                             "without kinetic energy, so its motion has no acceleration", key="kind",
+                             expected="a model whose kinetic density holds every field's rate (or steady, "
+                                      "continuation)") from None
+
+    def rhs(self, t: float, x) -> np.ndarray:
+        """dx/dt = (v, a) of the first-order form x = (q, v), a from :meth:`acceleration`."""
+        n = self.n
+        x = np.asarray(x, float)
+        a, _ = self.acceleration(x[:n], x[n:2 * n], t=t)
+        out = np.concatenate([x[n:2 * n], a])
+        _require_finite(self, "rate of the state", out)
+        return out
+
+    def jacobian(self, t: float, x):
+        """d(dx/dt)/dx = [[0, I], [-M^-1 r_q, -M^-1 r_v]] at the current acceleration (sparse CSC; M^-1 applied by a
+        sparse LU to the sparse blocks: for the small systems an explicit or implicit flow integrates)."""
+        import scipy.sparse as sps
+        import scipy.sparse.linalg as spla
+
+        n = self.n
+        x = np.asarray(x, float)
+        q, v = x[:n], x[n:2 * n]
+        a, M = self.acceleration(q, v, t=t)
+        tan = self.tangent(q, v, a, t=t)
+        require_dense(n, 6, "the Jacobian of a plane model's flow (implicit methods)", key="method",
+                      expected="an explicit method (DOP853, RK45) for a plane model this large, or a coarser mesh")
+        lu = spla.splu(M)
+        blocks = np.hstack([tan["r_q"].toarray(), tan["r_v"].toarray()])
+        da = -lu.solve(blocks)
+        top = sps.hstack([sps.csr_matrix((n, n)), sps.identity(n, format="csr")])
+        return sps.vstack([top, sps.csr_matrix(da)]).tocsc()
 
     def linear(self, q=None, v=None, z=None, t: float = 0.0) -> dict:
         """M, D, G, K (reduced, CSR) of the linearisation about q with zero rates."""
