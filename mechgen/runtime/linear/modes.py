@@ -191,9 +191,12 @@ def _sparse(M, K, count: int) -> ModesResult:
     ratios = kd[(kd > 0) & (md > 0)] / md[(kd > 0) & (md > 0)]
     fallback = -1e-3 * (ratios.min() if ratios.size else 1.0)
     last: Exception | None = None
+    # a fixed starting vector (ARPACK's default is random: reruns would differ in the last bits); pseudo-random,
+    # not ones, so that no symmetry class of modes is missing from the Krylov space
+    v0 = np.random.default_rng(0).standard_normal(K.shape[0])
     for sigma in (0.0, fallback):
         try:
-            lam, phi = spla.eigsh(K.tocsc(), k=count, M=M.tocsc(), sigma=sigma, which="LM")
+            lam, phi = spla.eigsh(K.tocsc(), k=count, M=M.tocsc(), sigma=sigma, which="LM", v0=v0)
             break
         except (RuntimeError, spla.ArpackError) as exc:
             last = exc
