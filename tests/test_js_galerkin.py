@@ -142,3 +142,20 @@ def test_generated_jacobian_matches_sympy():
         assert np.allclose(num, exact, rtol=0, atol=1e-12)
         lam = np.linalg.eigvals(exact)
         assert sum(1 for s in lam if s.real > 0) == positive and lam.real.sum() < 0
+
+
+def test_no_hopf_point_anywhere_on_the_branch():
+    """Routh-Hurwitz on the steady branch: with l^3 + a1 l^2 + a2 l + a3 the characteristic polynomial of the
+    projected Jacobian, a Hopf point needs a1 a2 = a3 (and a2 > 0). sympy gives a1 a2 - a3 as a ratio of
+    polynomials in A, Re, epsilon, k = xi (2 - xi) with positive coefficients only: it never vanishes, for every
+    epsilon, xi, Re > 0 (the scene's branch reports no H point)."""
+    k, lam = sp.symbols("k lambda", positive=True)
+    proj = projected_rates()
+    jac = sp.Matrix([proj[s] for s in "ABC"]).jacobian([A, B, C])
+    b_val = A / (1 + sp.Rational(48, 5) * k * A**2)
+    jac = jac.subs({C: 2 * A * B}).subs({B: b_val}).subs({xi: 1 - sp.sqrt(1 - k)})  # xi (2 - xi) = k
+    _, a1, a2, a3 = jac.charpoly(lam).all_coeffs()
+    num, den = sp.fraction(sp.factor(sp.together(sp.expand(a1 * a2 - a3))))
+    for part in (num, den):
+        coeffs = sp.Poly(sp.expand(part), A, Re, eps, k).coeffs()
+        assert coeffs and all(cf > 0 for cf in coeffs)

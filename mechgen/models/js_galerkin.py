@@ -23,8 +23,9 @@ Steady states: B = A / (1 + (48/5) k A^2), C = 2 A B, k = xi (2 - xi), and
     We = 8 epsilon A + 8 A / (1 + (48/5) k A^2) = (8 / c) T(c A),   c = sqrt(48/5),
 
 with T(g) = epsilon g + g / (1 + k g^2) the homogeneous shear curve: the steady branch in We has folds exactly at
-We = (8 / c) T_max and (8 / c) T_min (for epsilon < 1/8), the middle branch a saddle. No steady state has
-N(0) != 0 here (phi'(0) = 0), unlike the seed's Fig. 2 departures; see the README for the comparison of critical
+We = (8 / c) T_max and (8 / c) T_min (for epsilon < 1/8), the middle branch a saddle; no Hopf point for any
+epsilon, xi, Re > 0 (the Routh-Hurwitz quantity a1 a2 - a3 of the branch's Jacobian is a ratio of polynomials with
+positive coefficients). No steady state has N(0) != 0 here (phi'(0) = 0), unlike the seed's Fig. 2 departures; see the README for the comparison of critical
 Weissenberg numbers. State names: u1 = A, txy1 = B, N1 = C (S is reserved). Dimensionless.
 """
 from mechgen.symbolic.model import Model
