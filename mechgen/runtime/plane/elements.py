@@ -280,7 +280,7 @@ def blocked_element_matrices(tables, comps, weights: np.ndarray, coeff: np.ndarr
     every = len(live) == coeff.shape[2]
     for lo in range(0, ne, chunk):
         hi = min(ne, lo + chunk)
-        C = coeff[lo:hi] if every else coeff[lo:hi][:, :, live][:, :, :, live]
+        C = coeff[lo:hi] if every else coeff[lo:hi][:, :, live[:, None], live]
         B = np.zeros((hi - lo, nq, len(live), nl, ncomp))
         for j, a in enumerate(live):
             B[:, :, j, :, comps[a]] = tables[a][lo:hi]
