@@ -25,16 +25,21 @@ after one untimed warm-up of each, one BLAS thread for both:
   reduction ``K[free][:, free]``.
 
 Ratios are mechgen / scikit-fem (target <= 1); the standard ratios file records peer_s / ours_s.
-Measured on the project's 2-core machine (shared, one BLAS thread), scikit-fem 12.0.2, median of 5:
+Measured on the project's 2-core machine (shared, load average about 3, one BLAS thread), scikit-fem 12.0.2,
+median of 5 interleaved; ratio mechgen / scikit-fem:
 
-=======  ==========  ===================  ==========================
-element  unknowns    assemble (ratio)     from scratch (ratio)
-=======  ==========  ===================  ==========================
-P1       100 352     0.048 / 0.239 s 0.20  0.141 / 0.279 s 0.51
-P2       99 458      0.037 / 0.308 s 0.12  0.145 / 0.356 s 0.41
-P1       999 698     0.52 / 5.80 s 0.09    1.79 / 8.32 s 0.22
-P2       999 698     0.53 / 13.1 s 0.04    1.79 / 13.1 s 0.14
-=======  ==========  ===================  ==========================
+=======  ==========  ========  ============  ===========================
+element  unknowns    assemble  from scratch  user path (tangent: K and M)
+=======  ==========  ========  ============  ===========================
+P1       ~1.0e5      0.20      0.48          0.58 (1.2e5 unknowns)
+P2       ~1.0e5      0.13      0.43          0.33
+P1       ~1.0e6      0.08      0.25          1.38 (9.8 s against 7.1 s)
+P2       ~1.0e6      0.04      0.16          0.63
+=======  ==========  ========  ============  ===========================
+
+The user path's P1 row at 10^6 grows faster than the cell count (0.36 s at 10^5): profiled alone it spends ~2 s in
+element matrices, ~1.2 s scattering, 0.8 s in the kernel and 0.6 s in point jets (about 6 s); inside the bench run
+it is slower still. Left to study.
 
 Entry point: :func:`run_plane_benchmarks`.
 """
