@@ -665,7 +665,8 @@ def compile_request(request: CompileRequest, derive_with: Callable[[], tuple], *
 
         fixed = {k: v for k, v in values.items() if k in request.numeric}
         choices = {k: values[k] for k in request.runtime if k in values}
-        system = PlaneSystem(loaded, meta, params, fixed, choices, report.backend)
+        selections = {k: v for k, v in values.items() if isinstance(v, str) and k not in request.runtime}
+        system = PlaneSystem(loaded, meta, params, fixed, choices, report.backend, selections=selections)
     elif "hybrid" in meta:
         from mechgen.runtime.core.hybrid_system import HybridSystem
 

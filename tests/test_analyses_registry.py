@@ -61,7 +61,8 @@ def test_the_registry_lists_the_seven_kinds_each_with_a_function():
                                                     "periodic", "periodic_orbit",
                                                     "cross_section", "symplectic", "rod_statics", "rod_dynamics",
                                                     "phase_boundary", "phase_kinetics", "orr_sommerfeld",
-                                                    "shear_curve", "channel_flow", "channel_spectrum")
+                                                    "shear_curve", "channel_flow", "channel_spectrum",
+                                                        "crack_integrals")
     for kind in KINDS:
         record = registry.get(kind)
         assert record.name == kind and record.schema and callable(record.run) and callable(record.summary)

@@ -90,6 +90,7 @@ from mechgen.analyses import figures, schema, summary
 from mechgen.analyses.bvp_states import (bvp_summary, shape_declarations, shape_values, stability_about,
                                          stability_of_each)
 from mechgen.analyses.newton_branch import newton_branch
+from mechgen.analyses.plane_states import OPTIONS as PLANE_POINTS
 from mechgen.analyses.orbit_branch import FAMILY_PARAMETER, run_orbit_branch
 from mechgen.analyses.special_curves import run_curve
 from mechgen.analyses.registry import AnalysisKind, register
@@ -213,6 +214,7 @@ SCHEMA = {
                          "checked before every continuation step"),
     "progress": Option(schema.boolean, doc="draw a bar of the branch points on stderr (default true, when it is "
                        "a terminal and the branch takes over 2 s)"),
+    **PLANE_POINTS,
 }
 
 

@@ -6,7 +6,10 @@ mechgen.runtime.steady.continuation (pseudo-arclength through folds, each fold l
 the steady state's point corrected at the scene's value of the parameter. F_y is the generated tangent;
 F_p = (F(y, p + h) - F(y, p - h)) / (2 h), h = 1e-6 max(1, |p|): its error, of order h^2 |F_ppp|, is in the
 bordered system's last column only, which slows the corrector but never moves a point (each point solves
-F = 0 to 1e-10). This serves lumped models and continua alike (the discretised residual at the scene's N).
+F = 0 to 1e-10). This serves lumped models and continua alike (the discretised residual at the scene's N), and
+plane models (the assembled sparse tangent; their branch points carry, instead of ``coordinates``, the
+``<name>_displacement`` / ``<name>_stress`` of the ``points`` and the ``probe_displacement`` of ``probe``:
+mechgen.analyses.plane_states.point_outputs).
 
 Every point of ``branch`` reports the parameter, a lumped model's ``coordinates``, the model's outputs and their
 ``aliases``, and with ``stability`` (default true) the ``verdict`` and ``frequencies`` of the linearisation there
@@ -20,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mechgen.analyses import special_points
+from mechgen.analyses import plane_states, special_points
 from mechgen.analyses.stability_boundary import own_value, spectrum
 from mechgen.analyses.steady import equilibrium_functions, newton_aliases
 from mechgen.errors import SceneError
@@ -70,9 +73,12 @@ def point(system, name: str, y: np.ndarray, p: float, options: dict) -> dict:
     moved = system.with_params(**{name: float(p)})
     n = system.n
     out: dict = {name: float(p)}
-    if not system.is_field and not system.is_lattice:
+    plane = getattr(system, "is_plane", False)
+    if not system.is_field and not system.is_lattice and not plane:
         out["coordinates"] = {c: float(v) for c, v in zip(system.coordinates, y[:n])}
     out.update(moved.outputs(y[:n], None, y[n:] if system.m else None))
+    if plane:
+        out.update(plane_states.point_outputs(moved, y[:n], options))
     out.update(newton_aliases(out, options.get("aliases", {})))
     if options.get("stability", True):
         require_dense(2 * n, 40, "the stability verdict at every branch point", key="stability",

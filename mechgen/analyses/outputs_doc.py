@@ -86,7 +86,9 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("s", "(points,)", "m", "A continuum's stations along s."),
         _o("deflection", "(points,) or {field: (points,)}", MODEL_UNIT, "A continuum's steady deflection at "
            "``s`` (per field for a boundary value problem)."),
-        _o("reactions", "table", MODEL_UNIT, "A continuum solved by Newton: the constraint reactions."),
+        _o("reactions", "table", MODEL_UNIT, "A continuum solved by Newton: the constraint reactions; a plane "
+           "model's {boundary: {field: force}}, the force each held boundary exerts on the body (N per unit "
+           "thickness)."),
         _o("<output>_<end>", "scalar", "the output's", "A boundary value problem: each model output at the ends "
            "(``_start``, ``_end``) and its extremes along s (``_max``, ``_min``), e.g. ``tension_start`` "
            "(mechgen.analyses.bvp_states)."),
@@ -103,6 +105,13 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("frequencies", "(modes,)", "rad/s", "With ``stability``: the lowest frequencies of the linearisation "
            "(at most 10)."),
         _o("eigenvalues", "(n, 2)", "1/s", "With ``stability``: the eigenvalues as [re, im] pairs."),
+        _o("<point>_displacement", "(fields,)", MODEL_UNIT, "A plane model: the fields' values ([u_x, u_y]) at "
+           "each point of ``points`` (``center_displacement``)."),
+        _o("<point>_stress", "(fields, 2)", "Pa (the energy density's unit)", "A plane model with gradients: "
+           "dV/d(grad u) at each point of ``points``, rows per field, columns d/dx, d/dy ([[s_xx, s_xy], "
+           "[s_yx, s_yy]], Cauchy's stress for a linear law)."),
+        _o("probe_displacement", "(points, fields)", MODEL_UNIT, "A plane model: the fields' values at each "
+           "point of ``probe``."),
     ),
     "simulate": (
         _o("t", "(samples,)", "s", "The sample times, from 0 to ``t_end`` (or to where the run stopped)."),
@@ -510,6 +519,23 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("critical_alpha", "scalar", "1/h", "The wavenumber at critical_Re."),
         _o("critical_c", "(2,)", "U_c", "[Re c, Im c] at the critical point (Im c zero to the Newton tolerance)."),
         _o("critical_Re_change", "scalar", "-", "\\|Re_c(N) - Re_c(N_check)\\|."),
+    ),
+    "crack_integrals": (
+        _o("J", "(tips,)", "N/m", "J_1 in each tip's frame (the energy release rate G) on the first ring."),
+        _o("K_I", "(tips,)", "Pa m^0.5", "Mode I stress intensity factor per tip (interaction integral with the "
+           "Williams K field)."),
+        _o("K_II", "(tips,)", "Pa m^0.5", "Mode II stress intensity factor per tip."),
+        _o("T_stress", "(tips,)", "Pa", "The T-stress per tip (interaction with Kfouri's point-force field)."),
+        _o("bueckner_K_I", "(tips,)", "Pa m^0.5", "Bueckner's work-conjugate integral with his r^-3/2 mode I field "
+           "(normalised to give K_I)."),
+        _o("bueckner_K_II", "(tips,)", "Pa m^0.5", "The same with the mode II field (K_II)."),
+        _o("contours", "list of tables", "as above", "Every ring of ``rings``: {ring, J, K_I, K_II, T_stress, "
+           "bueckner_K_I, bueckner_K_II}, the path-independence table."),
+        _o("M", "scalar", "N", "With ``crack_rings``: the M-integral about ``center`` around the whole crack."),
+        _o("L", "scalar", "N", "With ``crack_rings``: the L-integral (rotational) about ``center``."),
+        _o("bueckner", "scalar", "N", "With ``crack_rings``: Bueckner's integral with the Griffith field's "
+           "rotation derivative (Shi, Liu & Li's supplemental field), 2 L for a Griffith crack."),
+        _o("crack_contours", "list of tables", "as above", "Every ring of ``crack_rings``: {ring, M, L, bueckner}."),
     ),
     "shear_curve": (
         _o("shear_rate", "(samples,)", "1/lambda", "The sampled shear rates, 0 to rate_max."),

@@ -26,7 +26,7 @@ def _deformed(fig_data: dict, values: np.ndarray):
     return x + scale * values[0], y + scale * values[1], scale
 
 
-def _panel(plt, ax, fig_data: dict, values: np.ndarray, title: str) -> None:
+def panel(plt, ax, fig_data: dict, values: np.ndarray, title: str) -> None:
     """One state: a two-field displacement on the deformed mesh coloured by |u|; one field as filled contours."""
     import matplotlib.tri as mtri
 
@@ -39,6 +39,8 @@ def _panel(plt, ax, fig_data: dict, values: np.ndarray, title: str) -> None:
         title += f" (displacement x {scale:.3g})"
     plt.colorbar(shown, ax=ax, shrink=0.8, label="|u|" if values.shape[0] == 2 else fig_data["fields"][0])
     ax.set_aspect("equal")
+    ax.set_xlabel("x")
+    ax.set_ylabel("y")
     ax.set_title(title, fontsize=8)
 
 
@@ -51,7 +53,7 @@ def steady(plt, a: dict, path: Path) -> list[Path]:
     fig, axes = plt.subplots(1, 2 if stress is not None else 1, figsize=(11 if stress is not None else 6, 4.8),
                              squeeze=False)
     values = np.asarray(data["values"][0])
-    _panel(plt, axes[0, 0], data, values, f"{a['name']}: steady state")
+    panel(plt, axes[0, 0], data, values, f"{a['name']}: steady state")
     if stress is not None:
         import matplotlib.tri as mtri
 
@@ -60,6 +62,8 @@ def steady(plt, a: dict, path: Path) -> list[Path]:
         shown = ax.tripcolor(tri, facecolors=von_mises(np.asarray(stress))[np.asarray(data["cell"])], cmap="magma")
         plt.colorbar(shown, ax=ax, shrink=0.8, label="von Mises stress (element mean)")
         ax.set_aspect("equal")
+        ax.set_xlabel("x")
+        ax.set_ylabel("y")
         ax.set_title("von Mises stress", fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
@@ -81,7 +85,7 @@ def modes(plt, a: dict, path: Path) -> bool:
         if k >= count:
             ax.axis("off")
             continue
-        _panel(plt, ax, data, np.asarray(data["values"][k]), f"mode {k + 1}: {freqs[k]:.5g} rad/s")
+        panel(plt, ax, data, np.asarray(data["values"][k]), f"mode {k + 1}: {freqs[k]:.5g} rad/s")
         ax.set_xticks([])
         ax.set_yticks([])
     fig.suptitle(f"{a['name']}: mode shapes", fontsize=9)

@@ -3,7 +3,8 @@
 ``steady`` on a plane model solves r(q) = 0 by Newton with the assembled sparse tangent (one step for a
 linear model), from q = 0; its ``tol`` is relative to |r(0)|, the norm of the load (a plane model's
 residual carries the units of its forces, N per unit thickness, and a steel plate's are ~1e11 times a
-rubber sheet's). Outputs: ``iterations``, ``residual_norm``, the domain integrals of the model's output
+rubber sheet's). Outputs: ``iterations``, ``residual_norm``, ``residual_history`` (|r| at every Newton iterate
+from q = 0: quadratic convergence shows as e_k+1 ~ C e_k^2), the domain integrals of the model's output
 densities and energies (``strain_energy``, ``potential_energy`` ...), ``reactions`` ({boundary: {field:
 force}}: the force each held boundary exerts on the body, N per unit thickness), and at points:
 ``points = {center = [0, 0]}`` gives ``center_displacement`` (the fields' values there, [u_x, u_y]) and,
@@ -16,8 +17,9 @@ from __future__ import annotations
 import numpy as np
 
 from mechgen.analyses import schema
+from mechgen.errors import ConvergenceError
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget
-from mechgen.runtime.steady.newton import newton
+from mechgen.runtime.steady.newton import newton, symmetric_ordered_solve
 from mechgen.scene.expr import is_identifier
 from mechgen.scene.values import IDENTIFIER_RULE, fail, type_name
 
@@ -75,15 +77,31 @@ def point_outputs(system, q: np.ndarray, options: dict) -> dict:
     return out
 
 
-def plane_steady(system, options: dict) -> dict:
-    """Newton on r(q) = 0 from q = 0 with the sparse tangent; outputs as the module doc says."""
+def solve(system, options: dict):
+    """Newton on r(q) = 0 from q = 0, tol relative to max(1, |r(0)|); a ConvergenceError names the likely cause
+    of a nonlinear law (a load past a limit point under load control) and the way out."""
     q0 = np.zeros(system.n)
     scale = max(1.0, float(np.linalg.norm(system.residual(q0))))
-    res = newton(system.residual, lambda q: system.tangent(q)["r_q"], q0,
-                 tol=options.get("tol", 1e-10) * scale, max_iter=options.get("max_iter", 50),
-                 budget=Budget("steady Newton iterations", seconds=float(options.get("max_seconds", DEFAULT_SECONDS))))
+    try:
+        return newton(system.residual, lambda q: system.tangent(q)["r_q"], q0,
+                      tol=options.get("tol", 1e-10) * scale, max_iter=options.get("max_iter", 50),
+                      budget=Budget("steady Newton iterations",
+                                    seconds=float(options.get("max_seconds", DEFAULT_SECONDS))),
+                      solve=symmetric_ordered_solve)
+    except ConvergenceError as exc:
+        raise ConvergenceError(f"steady state of plane model {system.meta.get('model')}: {exc}. Under load control "
+                               "there may be no equilibrium at this load (past a limit point of the law, or a load "
+                               "too large for one Newton solve from the reference state): follow the load with "
+                               "a continuation from a smaller one, which passes limit points and reports them as "
+                               "folds") from None
+
+
+def plane_steady(system, options: dict) -> dict:
+    """Newton on r(q) = 0 from q = 0 with the sparse tangent; outputs as the module doc says."""
+    res = solve(system, options)
     q = res.x
-    out = {"iterations": int(res.iterations), "residual_norm": float(res.residual_norm)}
+    out = {"iterations": int(res.iterations), "residual_norm": float(res.residual_norm),
+           "residual_history": [float(h) for h in res.history]}
     out.update(system.outputs(q))
     out["reactions"] = system.reactions(q)
     out.update(point_outputs(system, q, options))

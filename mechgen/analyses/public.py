@@ -22,7 +22,7 @@ from mechgen.errors import InputError, did_you_mean
 __all__ = ["analysis", "campbell", "continuation", "fit", "impact", "modes", "restitution", "simulate", "stability",
            "steady", "sweep", "cross_section", "symplectic", "rod_statics", "rod_dynamics", "periodic", "periodic_orbit", "spectrum",
            "stability_boundary", "response", "phase_boundary", "phase_kinetics", "orr_sommerfeld", "shear_curve",
-           "channel_flow", "channel_spectrum",
+           "channel_flow", "channel_spectrum", "crack_integrals",
            "option_lines"]
 
 
@@ -368,6 +368,13 @@ def shear_curve(system, *, name: str | None = None, **options) -> Result:
     """A Johnson-Segalman fluid's steady shear curve T(g), its closed-form extrema (or the monotone verdict) and the
     local law's no-Hopf verdict (mechgen.analyses.shear_curve; model ``js_local``)."""
     return _run("shear_curve", system, options, name)
+
+
+def crack_integrals(system, *, name: str | None = None, **options) -> Result:
+    """J, K_I, K_II, the T-stress and Bueckner's integrals at each crack tip and M, L and the whole-crack Bueckner
+    integral of a plane elastic steady state, in domain form on rings (mechgen.analyses.crack_integrals; model
+    ``cracked_plate``)."""
+    return _run("crack_integrals", system, options, name)
 
 
 def channel_flow(system, *, name: str | None = None, **options) -> Result:

@@ -39,6 +39,7 @@ MODULES = (
     "mechgen.analyses.shear_curve",
     "mechgen.analyses.channel_flow",
     "mechgen.analyses.channel_spectrum",
+    "mechgen.analyses.crack_integrals",
 )
 
 

@@ -168,6 +168,8 @@ def compiled_loop(system, method: str) -> tuple:
 
 def compiled_loop_problem(system, run: RunOptions, extra: int) -> str | None:
     """Why the compiled loop of ``run.method`` cannot run ``system`` (None when it can; :func:`compiled_loop`)."""
+    if getattr(system, "is_plane", False):
+        return "a plane continuum's flow (assembled over its mesh) runs in Python"
     return compiled_loop(system, run.method)[0](system, run.rtol, run.atol, extra)
 
 

@@ -31,7 +31,7 @@ def lower_plane(eqs, kernels, *, cse: bool = True) -> list[KernelIR]:
     wanted = [k for k in PLANE_KERNELS if k in kernels]
     irs = [lower_lumped(eqs.local, k, cse=cse) for k in wanted]
     irs += [replace(lower_lumped(local, k, cse=cse), name=f"{k}_at_{name}")
-            for name, (_, local) in sorted(eqs.edges.items()) for k in wanted if k != "outputs"]
+            for name, (_, local) in sorted(eqs.edges.items()) for k in wanted]
     meta = plane_meta(eqs)
     for ir in irs:
         ir.meta["plane"] = meta

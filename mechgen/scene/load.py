@@ -27,7 +27,7 @@ try:
 except ImportError:  # pragma: no cover - Python 3.10
     import tomli as tomllib  # type: ignore[no-redef]
 
-from mechgen.errors import InputError, did_you_mean
+from mechgen.errors import InputError, did_you_mean, file_kind
 from mechgen.analyses.registry import get as get_kind
 from mechgen.analyses.registry import kinds as analysis_kinds
 from mechgen.analyses.schema import AnalysisSpec, OptionContext, analysis_kind, validate
@@ -43,7 +43,9 @@ __all__ = ["AnalysisSpec", "ModelInfo", "ParamInfo", "Scene", "load_scene", "IDE
 
 BACKENDS = ("c", "numpy", "casadi")
 TOP_KEYS = ("title", "model", "backend", "free", "params", "coordinates", "analysis", "segments", "parts",
-            "limits")
+            "limits", "mesh")
+#: the largest mesh file a scene may name (bytes)
+MAX_MESH_BYTES = 2 << 30
 MAX_SCENE_BYTES = 10 * 1024 * 1024
 MAX_TITLE = 500
 
@@ -66,6 +68,8 @@ class Scene:
     source: str = ""
     #: parameter name -> the key the scene or a --set flag wrote its value at (defaults left out)
     written: Mapping[str, str] = field(default_factory=dict)
+    #: a plane model's mesh file (``mesh = "part.msh"``, resolved against the scene's folder); "" when generated
+    mesh: str = ""
 
 
 
@@ -149,6 +153,35 @@ def _top_level(file: str, data: dict, lookup_model: Callable[..., Any],
     if backend not in BACKENDS:
         raise fail(file, "backend", f"unknown backend {show(backend)}", "one of: " + ", ".join(BACKENDS))
     return title, info, backend
+
+
+def _mesh(file: str, data: dict, model, base: Path) -> str:
+    """The absolute path of ``mesh`` (a gmsh file for a plane model), checked to be a regular file of at most
+    :data:`MAX_MESH_BYTES` (opened non-blocking and checked with fstat: a FIFO never blocks); "" without one.
+    Its contents are read (and refused, naming the file, when not a mesh) when the scene runs."""
+    import os
+    import stat
+
+    if "mesh" not in data:
+        return ""
+    expected = "a gmsh .msh file for a plane model (path relative to the scene file's folder)"
+    if not getattr(model, "plane_fields", ()):
+        raise fail(file, "mesh", f"model {model.name} is not a plane continuum: it takes no mesh file", expected)
+    written = _string(file, "mesh", data["mesh"])
+    path = Path(written) if Path(written).is_absolute() else base / written
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
+    except OSError as exc:
+        raise fail(file, "mesh", f"mesh file {show(written)} cannot be read ({exc.strerror}; looked for {path})",
+                   expected) from None
+    try:
+        st = os.fstat(fd)
+    finally:
+        os.close(fd)
+    if not stat.S_ISREG(st.st_mode) or st.st_size > MAX_MESH_BYTES:
+        what = f"is {file_kind(st.st_mode)}" if not stat.S_ISREG(st.st_mode) else f"is {st.st_size} bytes"
+        raise fail(file, "mesh", f"mesh file {show(written)} {what} ({path})", expected)
+    return str(path.resolve())
 
 
 # --------------------------------------------------------------------------- parameters
@@ -393,4 +426,5 @@ def _load(path, file: str, overrides: Sequence[str], lookup_model: Callable[...,
     check_layout(file, data, model, params, segments, parts, written)
     free += sorted({n for seg in segments for n in seg.values if n not in free})
     return Scene(file, title, model.name, backend, params, tuple(free), active, analyses, segments, parts,
-                 getattr(model, "key", "") or model.name, {name: key for name, (_, key) in written.items()})
+                 getattr(model, "key", "") or model.name, {name: key for name, (_, key) in written.items()},
+                 _mesh(file, data, model, base))

@@ -47,8 +47,13 @@ def system_for(model_ref: str, values: tuple, free: tuple, active, kernels: tupl
     return build(source.key, request)
 
 
-def laid_out(system, layout: Layout | None):
-    """The system with the scene's segments and parts (a new system; the shared one stays bare)."""
+def laid_out(system, layout: Layout | None, mesh: str = ""):
+    """The system with the scene's segments and parts, or a plane model's mesh file (a new system; the shared
+    one stays bare)."""
+    if mesh:
+        from mechgen.runtime.plane.mesh import read_msh
+
+        return system.with_mesh(read_msh(mesh))
     if layout is None or not (layout.segments or layout.parts):
         return system
     return system.with_layout(layout)
@@ -56,10 +61,10 @@ def laid_out(system, layout: Layout | None):
 
 def sweep_point(task: tuple) -> dict:
     """Run the inner analysis of a sweep at one grid point (module level: picklable for worker processes)."""
-    source_key, request, values, kind, options, point, layout = task
+    source_key, request, values, mesh, kind, options, point, layout = task
     info = model_info(source_key)  # the canonical reference: resolves in a worker process too
     system, _ = system_of(source_key, point_request(request, info, point) or request)
-    system = laid_out(system, layout).with_param_vector(
+    system = laid_out(system, layout, mesh).with_param_vector(
         [float(point.get(n, dict(values).get(n, info.param(n).default))) for n in system.metadata.params])
     return run_at_point(kind, system, options)
 
@@ -135,12 +140,12 @@ def _run_loaded(scn, backend: str | None, scheduler: str | None = None) -> dict:
     started = time.perf_counter()
     system, report = system_of(plan.source.key, plan.main)
     layout = Layout(scn.segments, scn.parts)
-    system = laid_out(system, layout)
+    system = laid_out(system, layout, scn.mesh)
     results = {"scene": Path(scn.path).name, "title": scn.title, "model": scn.model, "backend": report.backend,
                "params": dict(scn.params), "units": model_info(scn.source).units() if scn.source else {},
                "build": report.to_json(), "versions": versions(), "analyses": []}
     results["build"]["seconds_total"] = time.perf_counter() - started
-    scene_inputs = (plan.source.key, plan.main, fixed)
+    scene_inputs = (plan.source.key, plan.main, fixed, scn.mesh)
     context: dict = {POINTS: PointRunner(sweep_point, partial(_point_task, scene_inputs, layout))}
     if scheduler is not None:
         context[SCHEDULER] = scheduler

@@ -499,7 +499,8 @@ class Model:
         parameters every plane continuum has: ``element`` (P1, P2, Q1, Q2 Lagrange elements), ``h`` (the
         target edge length of the generated mesh, in the domain's length unit), ``edges`` (``curved``:
         isoparametric P2/Q2 edges on a curved boundary; ``straight``: straight-sided) and ``quadrature``
-        (the degree of the rule, 0: twice the element's).
+        (the degree of the rule, 0: twice the element's); a ``slit_plate`` also ``grading`` (power grading of
+        the cells toward the crack tips, 1: uniform).
         """
         from mechgen.symbolic.plane import ELEMENTS, SHAPES, Domain, PlaneSpec
 
@@ -525,6 +526,9 @@ class Model:
                           choices=("curved", "straight"), runtime=True),
                     Param("quadrature", 0, "", "degree of the quadrature rule (0: twice the element's)", size=True,
                           runtime=True))
+        if domain.shape == "slit_plate":  # a crack's r^(1/2) field: cells graded toward the tips (h_tip ~ h^grading)
+            self.params(Param("grading", 1.0, "", "power grading of the cells toward the crack tips (1: uniform)",
+                              minimum=1.0, maximum=4.0, runtime=True))
 
     def _edge(self, kind: str, boundary: str) -> Callable:
         if self.plane_spec is None or boundary not in self.plane_spec.domain.boundaries:

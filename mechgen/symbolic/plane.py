@@ -73,12 +73,12 @@ def _domain(shape: str, names: tuple[str, ...]) -> Domain:
 
 
 def disk(R: str = "R") -> Domain:
-    """The disk x^2 + y^2 < R^2; boundary ``outer``."""
+    """The disk ``x^2 + y^2 < R^2``; boundary ``outer``."""
     return _domain("disk", (R,))
 
 
 def annulus(a: str = "a", b: str = "b") -> Domain:
-    """The annulus a^2 < x^2 + y^2 < b^2; boundaries ``inner`` and ``outer``."""
+    """The annulus ``a^2 < x^2 + y^2 < b^2``; boundaries ``inner`` and ``outer``."""
     return _domain("annulus", (a, b))
 
 
@@ -88,7 +88,7 @@ def rectangle(width: str = "Lx", height: str = "Ly") -> Domain:
 
 
 def slit_plate(W: str = "W", H: str = "H", a: str = "a") -> Domain:
-    """The plate [-W, W] x [-H, H] with a slit crack |x| < a on y = 0: the sides and ``crack_upper``/``crack_lower``."""
+    """The plate [-W, W] x [-H, H] with a slit crack ``|x| < a`` on y = 0: the sides and ``crack_upper``/``crack_lower``."""
     return _domain("slit_plate", (W, H, a))
 
 

@@ -90,7 +90,7 @@ def check_domain(shape: str, sizes: dict) -> None:
                          expected=bad)
 
 
-def generate_mesh(shape: str, sizes: dict, h: float, element: str, curved: bool):
+def generate_mesh(shape: str, sizes: dict, h: float, element: str, curved: bool, grading: float = 1.0):
     """The mesh of a generated domain (mechgen.runtime.plane.mesh), refused before allocation when too large."""
     from mechgen.runtime.plane import mesh as meshes
 
@@ -104,7 +104,7 @@ def generate_mesh(shape: str, sizes: dict, h: float, element: str, curved: bool)
     if shape == "rectangle":
         return meshes.rectangle(0.0, sizes["width"], 0.0, sizes["height"], h, element)
     if shape == "slit_plate":
-        return meshes.slit_plate(sizes["W"], sizes["H"], sizes["a"], h, element)
+        return meshes.slit_plate(sizes["W"], sizes["H"], sizes["a"], h, element, grading=grading)
     return meshes.plate_with_hole(sizes["W"], sizes["H"], sizes["r"], h, element, curved=curved)
 
 
@@ -153,6 +153,9 @@ def discretise(mesh, info: dict, quadrature: int = 0) -> PlaneDisc:
         if name not in mesh.boundaries:
             raise InputError(f"the mesh has no boundary {name!r}", key="mesh",
                              expected=f"a mesh with the boundaries the model names; it has {', '.join(mesh.boundaries)}")
+    from mechgen.runtime.plane.elements import require_assembly_memory
+
+    require_assembly_memory(mesh, nf, len(info["jets"]), key="params.h", degree=quadrature or 2 * ORDER[mesh.element])
     pieces = [_domain_piece(mesh, info, quadrature)]
     pieces += [_edge_piece(mesh, info, name, quadrature) for name in sorted(info["edges"])]
     ndof = len(mesh.points) * nf

@@ -20,6 +20,7 @@ import numpy as np
 import scipy.sparse as sps
 
 from mechgen.errors import InputError, KernelError
+from mechgen.runtime.core.memory import require_dense
 from mechgen.runtime.core.meta import SystemMeta
 from mechgen.runtime.core.system import (Memo, folded_parameter, frozen_vector, number, read_only,
                                          replacement_vector, unknown_parameters)
@@ -46,6 +47,8 @@ class PlaneSystem:
     rebuild: object = field(default=None, repr=False)
     folded: tuple[str, ...] = ()
     facts: object = field(default=None, repr=False, compare=False)
+    #: the model's choices folded into the kernels (a plane law's ``plane = "strain"``), for reading only
+    selections: dict = field(default_factory=dict)
     _memo: Memo = field(init=False, repr=False)
 
     is_plane = True
@@ -55,7 +58,7 @@ class PlaneSystem:
 
     def __post_init__(self, _cache) -> None:
         object.__setattr__(self, "params", frozen_vector(self.params))
-        for name in ("kernels", "meta", "fixed", "choices"):
+        for name in ("kernels", "meta", "fixed", "choices", "selections"):
             object.__setattr__(self, name, read_only(getattr(self, name)))
         object.__setattr__(self, "folded", tuple(self.folded))
         object.__setattr__(self, "_memo", Memo(32))
@@ -125,7 +128,8 @@ class PlaneSystem:
 
     def _mesh_key(self) -> tuple:
         sizes = tuple(self.value(n) for n in self.info["sizes"].values())
-        return (sizes, float(self.choices["h"]), self.choices["element"], self.choices["edges"])
+        return (sizes, float(self.choices["h"]), self.choices["element"], self.choices["edges"],
+                float(self.choices.get("grading", 1.0)))
 
     @property
     def mesh(self):
@@ -135,7 +139,7 @@ class PlaneSystem:
         sizes = {role: self.value(n) for role, n in self.info["sizes"].items()}
         return self._memo.get(("mesh", *self._mesh_key()), lambda: generate_mesh(
             self.info["shape"], sizes, float(self.choices["h"]), self.choices["element"],
-            self.choices["edges"] == "curved"))
+            self.choices["edges"] == "curved", float(self.choices.get("grading", 1.0))))
 
     @property
     def disc(self) -> PlaneDisc:
@@ -235,20 +239,60 @@ class PlaneSystem:
         """r_q, r_v, r_a (reduced, CSR) at the state."""
         return self._matrices("tangent", ("r_q", "r_v", "r_a"), q, v, a, t)
 
+    def acceleration(self, q, v, z=None, t: float = 0.0):
+        """(a, M): the acceleration solving r(q, v, a) = 0 for a residual linear in a, a = -M^-1 r(q, v, 0),
+        M = dr/da (sparse LU; m/s^2 for a displacement), and M."""
+        import scipy.sparse.linalg as spla
+
+        M = self.tangent(q, v, None, t=t)["r_a"].tocsc()
+        try:
+            return spla.splu(M).solve(-self.residual(q, v, None, t=t)), M
+        except RuntimeError:
+            raise InputError(f"the mass matrix of plane model {self.meta.get('model')} is singular: a field "
+                             "without kinetic energy, so its motion has no acceleration", key="kind",
+                             expected="a model whose kinetic density holds every field's rate (or steady, "
+                                      "continuation)") from None
+
+    def rhs(self, t: float, x) -> np.ndarray:
+        """dx/dt = (v, a) of the first-order form x = (q, v), a from :meth:`acceleration`."""
+        n = self.n
+        x = np.asarray(x, float)
+        a, _ = self.acceleration(x[:n], x[n:2 * n], t=t)
+        out = np.concatenate([x[n:2 * n], a])
+        _require_finite(self, "rate of the state", out)
+        return out
+
+    def jacobian(self, t: float, x):
+        """d(dx/dt)/dx = [[0, I], [-M^-1 r_q, -M^-1 r_v]] at the current acceleration (sparse CSC; M^-1 applied by a
+        sparse LU to the sparse blocks: for the small systems an explicit or implicit flow integrates)."""
+        import scipy.sparse as sps
+        import scipy.sparse.linalg as spla
+
+        n = self.n
+        x = np.asarray(x, float)
+        q, v = x[:n], x[n:2 * n]
+        a, M = self.acceleration(q, v, t=t)
+        tan = self.tangent(q, v, a, t=t)
+        require_dense(n, 6, "the Jacobian of a plane model's flow (implicit methods)", key="method",
+                      expected="an explicit method (DOP853, RK45) for a plane model this large, or a coarser mesh")
+        lu = spla.splu(M)
+        blocks = np.hstack([tan["r_q"].toarray(), tan["r_v"].toarray()])
+        da = -lu.solve(blocks)
+        top = sps.hstack([sps.csr_matrix((n, n)), sps.identity(n, format="csr")])
+        return sps.vstack([top, sps.csr_matrix(da)]).tocsc()
+
     def linear(self, q=None, v=None, z=None, t: float = 0.0) -> dict:
         """M, D, G, K (reduced, CSR) of the linearisation about q with zero rates."""
         return self._matrices("linear", ("M", "D", "G", "K"), q, None, None, t)
 
     def outputs(self, q, v=None, z=None, t: float = 0.0) -> dict[str, float]:
-        """The domain integrals of the model's output densities (and of the energies)."""
-        disc = self.disc
-        piece = disc.pieces[0]
-        full = self._states(q, v, None)
-        nf = len(self.info["fields"])
-        states = [assemble.point_jets(piece.T, piece.index, x[piece.dofs].reshape(len(piece.dofs), -1, nf))
-                  for x in full]
-        local = self._evaluate("outputs", states, piece.position, t)
-        return {k: float(np.sum(piece.weights * val[..., 0])) for k, val in local.items()}
+        """The domain integrals of the model's output densities and of the energies; the edge terms' energies
+        (a traction's potential -t.u) are added to ``potential_energy``, ``kinetic_energy`` and ``energy``."""
+        out: dict[str, float] = {}
+        for piece, local in self._pieces("outputs", self._states(q, v, None), t):
+            for k, val in local.items():
+                out[k] = out.get(k, 0.0) + float(np.sum(piece.weights * val[..., 0]))
+        return out
 
     def field_at(self, q, points) -> tuple[np.ndarray, np.ndarray]:
         """Values (p, fields) and gradients (p, fields, 2) of the fields at points (x, y) of the mesh."""
@@ -295,6 +339,38 @@ class PlaneSystem:
                 out[:, :, c, k - 1] = rho[:, :, a]
         return cell_means(piece.weights, out)
 
+    def quadrature_state(self, q) -> dict:
+        """A state at the domain's quadrature points: ``x`` (e, g, 2), ``w`` (e, g), ``u`` (e, g, fields),
+        ``grad_u`` (e, g, fields, 2), ``stress`` dV/d(grad u) (e, g, fields, 2), ``body`` the residual's value
+        entries at zero rates (e, g, fields: minus the body force), ``N`` (g, l) and ``dN`` (e, g, l, 2)."""
+        piece = self.disc.pieces[0]
+        nf = len(self.info["fields"])
+        x = self.expand(q)
+        local = x[piece.dofs].reshape(len(piece.dofs), -1, nf)
+        T0, Tx, Ty = piece.T
+        u = np.einsum("egl,elf->egf", T0, local)
+        grad = np.stack([np.einsum("egl,elf->egf", Tx, local), np.einsum("egl,elf->egf", Ty, local)], axis=-1)
+        jets = assemble.point_jets(piece.T, piece.index, local)
+        rho = self._evaluate("residual", (jets, 0 * jets, 0 * jets), piece.position, 0.0)["r"]
+        stress, body = np.zeros_like(grad), np.zeros_like(u)
+        for a, (c, k) in enumerate(piece.index):
+            if k:
+                stress[..., c, k - 1] = rho[..., a]
+            else:
+                body[..., c] = rho[..., a]
+        return {"x": piece.position, "w": piece.weights, "u": u, "grad_u": grad, "stress": stress, "body": body,
+                "N": T0[0], "dN": np.stack([Tx, Ty], axis=-1)}
+
+    def require_no_body_force(self, q) -> None:
+        """InputError when the residual has value entries at rest (a body force): the crack integrals' domain
+        forms here hold without one."""
+        data = self.quadrature_state(q)
+        scale = max(float(np.abs(data["stress"]).max()), 1e-300)
+        if np.abs(data["body"]).max() > 1e-12 * scale:
+            raise InputError(f"model {self.meta.get('model')} has a body force (or a value-dependent energy): M, L, "
+                             "Bueckner's and the interaction integrals are implemented without one", key="kind",
+                             expected="a model whose energy depends on the displacement gradient only")
+
     def figure_data(self, columns) -> dict:
         """What a figure of fields on this mesh needs (lists, JSON-ready): node ``x``, ``y``, sub-triangles
         ``triangles`` and their element ``cell``, ``fields`` names and ``values`` (columns of full nodal values,
@@ -335,6 +411,11 @@ def _choice(name: str, value):
         if not h > 0:
             raise InputError(f"h = {value!r} is not a positive mesh size", key=name, expected="a number > 0")
         return h
+    if name == "grading":
+        g = number(name, value)
+        if not 1.0 <= g <= 4.0:
+            raise InputError(f"grading = {value!r} is outside [1, 4]", key=name, expected="a number from 1 to 4")
+        return g
     allowed = CHOICE_VALUES.get(name)
     if allowed is not None and value not in allowed:
         raise InputError(f"{name} = {value!r} is not a choice the runtime knows", key=name,
