@@ -37,9 +37,10 @@ P1       ~1.0e6      0.08      0.25          1.38 (9.8 s against 7.1 s)
 P2       ~1.0e6      0.04      0.16          0.63
 =======  ==========  ========  ============  ===========================
 
-The user path's P1 row at 10^6 grows faster than the cell count (0.36 s at 10^5): profiled alone it spends ~2 s in
-element matrices, ~1.2 s scattering, 0.8 s in the kernel and 0.6 s in point jets (about 6 s); inside the bench run
-it is slower still. Left to study.
+The user path's P1 row at 10^6 grows faster than the cell count (0.36 s at 10^5). In a process of its own the same
+``tangent()`` takes 3.0-4.1 s once warm (13 s the first call, which builds the tables and CSR patterns), which
+would be about 0.5 x scikit-fem; inside the bench, beside scikit-fem's multi-GB arrays, its median is 9.8 s.
+Profiled alone: element matrices ~2 s, scatter ~1.2 s, the kernel 0.8 s, point jets 0.6 s. Left to study.
 
 Entry point: :func:`run_plane_benchmarks`.
 """
