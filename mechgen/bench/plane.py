@@ -21,19 +21,26 @@ after one untimed warm-up of each, one BLAS thread for both:
 
 * ``user path``: as a user runs it -- ``tangent()`` of the compiled model ``membrane_gravity`` on a disk mesh of
   the same size (the generated pointwise kernel at every point, the system's own element matrices and scatter,
-  the rim's dofs removed) against ``skfem.asm`` and the same reduction ``K[free][:, free]``.
+  the rim's dofs removed; it returns K and M) against ``skfem.asm`` of the elasticity and mass forms and the same
+  reduction ``K[free][:, free]``.
 
 Ratios are mechgen / scikit-fem (target <= 1); the standard ratios file records peer_s / ours_s.
-Measured on the project's 2-core machine (shared, one BLAS thread), scikit-fem 12.0.2, median of 5:
+Measured on the project's 2-core machine (shared, load average about 3, one BLAS thread), scikit-fem 12.0.2,
+median of 5 interleaved; ratio mechgen / scikit-fem:
 
-=======  ==========  ===================  ==========================
-element  unknowns    assemble (ratio)     from scratch (ratio)
-=======  ==========  ===================  ==========================
-P1       100 352     0.048 / 0.239 s 0.20  0.141 / 0.279 s 0.51
-P2       99 458      0.037 / 0.308 s 0.12  0.145 / 0.356 s 0.41
-P1       999 698     0.52 / 5.80 s 0.09    1.79 / 8.32 s 0.22
-P2       999 698     0.53 / 13.1 s 0.04    1.79 / 13.1 s 0.14
-=======  ==========  ===================  ==========================
+=======  ==========  ========  ============  ===========================
+element  unknowns    assemble  from scratch  user path (tangent: K and M)
+=======  ==========  ========  ============  ===========================
+P1       ~1.0e5      0.20      0.48          0.58 (1.2e5 unknowns)
+P2       ~1.0e5      0.13      0.43          0.33
+P1       ~1.0e6      0.08      0.25          1.38 (9.8 s against 7.1 s)
+P2       ~1.0e6      0.04      0.16          0.63
+=======  ==========  ========  ============  ===========================
+
+The user path's P1 row at 10^6 grows faster than the cell count (0.36 s at 10^5). In a process of its own the same
+``tangent()`` takes 3.0-4.1 s once warm (13 s the first call, which builds the tables and CSR patterns), which
+would be about 0.5 x scikit-fem; inside the bench, beside scikit-fem's multi-GB arrays, its median is 9.8 s.
+Profiled alone: element matrices ~2 s, scatter ~1.2 s, the kernel 0.8 s, point jets 0.6 s. Left to study.
 
 Entry point: :func:`run_plane_benchmarks`.
 """
@@ -203,24 +210,29 @@ def disk_mesh(unknowns: int, element: str):
 
 
 def user_path(unknowns: int, element: str, repeats: int) -> dict:
-    """As a user runs it: ``tangent()`` of the compiled model ``membrane_gravity`` (plane stress, E = 1, nu = 0.3; the
-    generated pointwise kernel at every point, element matrices, scatter, the rim's dofs removed) on a disk mesh,
-    against scikit-fem's ``asm`` of linear_elasticity and the same reduction (``K[free][:, free]``)."""
+    """As a user runs it: ``tangent()`` of the compiled model ``membrane_gravity`` (plane stress, E = 1, nu = 0.3,
+    rho = 1; the generated pointwise kernel at every point, element matrices, scatter, the rim's dofs removed: r_q = K,
+    r_a = M, r_v = 0) on a disk mesh, against scikit-fem's ``asm`` of linear_elasticity and of rho u.v with the same
+    reduction (``K[free][:, free]``)."""
     import mechgen
+    from skfem import BilinearForm
+    from skfem.helpers import dot
 
     mesh = disk_mesh(unknowns, element)
-    system = mechgen.compile("membrane_gravity", {"E": E_MODULUS, "nu": NU, "rho_g": 1.0, "R": 1.0},
+    system = mechgen.compile("membrane_gravity", {"E": E_MODULUS, "nu": NU, "rho_g": 1.0, "rho": 1.0, "R": 1.0},
                              kernels=("tangent",)).with_mesh(mesh)
     theirs = Theirs(mesh)
     keep = theirs.permutation()[system.disc.free]
-    ours = lambda: system.tangent(np.zeros(system.n))["r_q"]  # noqa: E731
-    peer = lambda: theirs.assemble()[keep][:, keep]  # noqa: E731
-    K, Ks = ours(), peer()
-    error = float(abs(K - Ks).max() / abs(Ks).max())
-    if error > CHECK_TOL:
+    mass = BilinearForm(lambda u, v, w: dot(u, v))
+    ours = lambda: system.tangent(np.zeros(system.n))  # noqa: E731
+    peer = lambda: {"r_q": theirs.assemble()[keep][:, keep],  # noqa: E731
+                    "r_a": theirs.skfem.asm(mass, theirs.basis)[keep][:, keep]}
+    mats, ref = ours(), peer()
+    error = max(float(abs(mats[k] - ref[k]).max() / abs(ref[k]).max()) for k in ref)
+    if error > CHECK_TOL or mats["r_v"].nnz and abs(mats["r_v"]).max() > 0:
         raise AssertionError(f"membrane_gravity's tangent and scikit-fem differ ({error:.2e}) on {element}")
     a, b = interleaved(ours, peer, repeats)
-    return {"element": element, "unknowns": int(2 * mesh.n_nodes), "free": int(K.shape[0]),
+    return {"element": element, "unknowns": int(2 * mesh.n_nodes), "free": int(ref["r_q"].shape[0]),
             "max_rel_difference": error, "mechgen_s": statistics.median(a), "skfem_s": statistics.median(b),
             "ratio": statistics.median(a) / statistics.median(b), "repeats": repeats}
 
@@ -242,7 +254,7 @@ def markdown(rows: list[dict], versions: dict) -> str:
 
 def user_markdown(rows: list[dict]) -> str:
     """The user-path comparison as a markdown table."""
-    lines = ["## As a user runs it: membrane_gravity's tangent() against scikit-fem asm + the same reduction", "",
+    lines = ["## As a user runs it: membrane_gravity's tangent() (K and M) against scikit-fem asm of both + the same reduction", "",
              "| element | unknowns | free | mechgen s | scikit-fem s | ratio | max rel. difference |",
              "|---|---:|---:|---:|---:|---:|---:|"]
     lines += [f"| {r['element']} | {r['unknowns']} | {r['free']} | {r['mechgen_s']:.4f} | {r['skfem_s']:.4f} | "

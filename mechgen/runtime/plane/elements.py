@@ -264,31 +264,40 @@ def jet_tables(tab: PlaneTables, ncomp: int, jets) -> np.ndarray:
 CHUNK = 4096
 
 
-def _jet_block(tab: PlaneTables, ncomp: int, jets: list, lo: int, hi: int) -> np.ndarray:
-    """B[e, q, a, l ncomp + c] of the cells lo:hi (:func:`jet_tables` of a slice)."""
-    nq, nl = tab.N.shape
-    B = np.zeros((hi - lo, nq, len(jets), nl, ncomp))
-    for a, (c, o) in enumerate(jets):
-        B[:, :, a, :, c] = tab.N[None] if o == "" else tab.dN[lo:hi, :, :, "xy".index(o)]
-    return B.reshape(hi - lo, nq, len(jets), nl * ncomp)
+def blocked_element_matrices(tables, comps, weights: np.ndarray, coeff: np.ndarray, ncomp: int,
+                             chunk: int = CHUNK) -> np.ndarray:
+    """K_e[(l, c), (m, d)] = sum_q w sum_{a, b} phi_a[e, q, l] C[e, q, a, b] phi_b[e, q, m] with c = comps[a],
+    d = comps[b], phi_a = tables[a] (e, q, l) (a broadcast view is fine): B[e, q, a, l ncomp + c] built ``chunk``
+    cells at a time for the jets that meet a non-zero coefficient only, each block one batched product
+    (e, l, q a) @ ((e, q, a, b) @ (e, q, b, m))."""
+    ne, nq, nl = tables[0].shape
+    n = nl * ncomp
+    out = np.zeros((ne, n, n))
+    nonzero = np.any(coeff != 0, axis=(0, 1))
+    live = np.flatnonzero(nonzero.any(axis=0) | nonzero.any(axis=1))
+    if not len(live):
+        return out
+    every = len(live) == coeff.shape[2]
+    for lo in range(0, ne, chunk):
+        hi = min(ne, lo + chunk)
+        C = coeff[lo:hi] if every else coeff[lo:hi][:, :, live[:, None], live]
+        B = np.zeros((hi - lo, nq, len(live), nl, ncomp))
+        for j, a in enumerate(live):
+            B[:, :, j, :, comps[a]] = tables[a][lo:hi]
+        B = B.reshape(hi - lo, nq, len(live), n)
+        right = np.matmul(weights[lo:hi, :, None, None] * C, B)
+        np.matmul(B.reshape(hi - lo, nq * len(live), n).transpose(0, 2, 1), right.reshape(hi - lo, -1, n),
+                  out=out[lo:hi])
+    return out
 
 
 def jet_element_matrices(tab: PlaneTables, ncomp: int, jets, coeff: np.ndarray, chunk: int = CHUNK) -> np.ndarray:
     """K_e = sum_q w_q B_q^T C_q B_q for every cell, B the jet table of :func:`jet_tables`: the same as
-    :func:`mechgen.runtime.fields.assemble.element_matrices` on the whole B, but B built ``chunk`` cells at a time
-    (never whole: at 10^6 unknowns it would take 0.6 GB) and each block one batched product
-    (e, l, q a) @ ((e, q, a, b) @ (e, q, b, m))."""
+    :func:`mechgen.runtime.fields.assemble.element_matrices` on the whole B, but through
+    :func:`blocked_element_matrices` (B a block of cells at a time: at 10^6 unknowns the whole would take 0.6 GB)."""
     jets = _check_jets(ncomp, jets)
-    ne, nq, nl = tab.dN.shape[:3]
-    n, na = nl * ncomp, len(jets)
-    out = np.empty((ne, n, n))
-    for lo in range(0, ne, chunk):
-        hi = min(ne, lo + chunk)
-        B = _jet_block(tab, ncomp, jets, lo, hi)
-        right = np.matmul(tab.w[lo:hi, :, None, None] * coeff[lo:hi], B)
-        np.matmul(B.reshape(hi - lo, nq * na, n).transpose(0, 2, 1), right.reshape(hi - lo, nq * na, n),
-                  out=out[lo:hi])
-    return out
+    tables = [basis_values(tab, o) for _, o in jets]
+    return blocked_element_matrices(tables, [c for c, _ in jets], tab.w, coeff, ncomp, chunk)
 
 
 def assembly_bytes(mesh, ncomp: int, njets: int, degree: int | None = None) -> int:

@@ -17,6 +17,7 @@ from __future__ import annotations
 from dataclasses import InitVar, dataclass, field, replace
 
 import numpy as np
+import scipy.sparse as sps
 
 from mechgen.errors import InputError, KernelError
 from mechgen.runtime.core.memory import require_dense
@@ -218,12 +219,17 @@ class PlaneSystem:
             na = len(piece.index)
             for k in names:
                 coeff = local[k].reshape(local[k].shape[:-1] + (na, na))
+                if not coeff.any():  # NaN counts as non-zero: it reaches the finiteness check
+                    continue  # identically zero here (r_v, r_a of a static model): nothing to scatter
                 K_e = assemble.element_matrices(piece.T, piece.index, piece.weights, coeff, nf)
                 mat = piece.assembler.matrix(K_e)
                 total[k] = mat if total[k] is None else total[k] + mat
         free = disc.free
         out = {}
         for k, mat in total.items():
+            if mat is None:
+                out[k] = sps.csr_matrix((len(free), len(free)))
+                continue
             reduced = mat.tocsr()[free][:, free].tocsr()
             _require_finite(self, k, reduced.data)
             out[k] = reduced
