@@ -23,7 +23,8 @@ def plane_meta(eqs) -> dict:
             "sizes": {role: name for role, name in eqs.domain.sizes},
             "constraints": [[c.field, c.boundary] for c in eqs.constraints],
             "edges": {name: [list(j) for j in jets] for name, (jets, _) in sorted(eqs.edges.items())},
-            "outputs": sorted(eqs.local.outputs)}
+            "outputs": sorted(eqs.local.outputs),
+            "points": {name: list(xy) for name, xy in sorted(eqs.points.items())}}
 
 
 def lower_plane(eqs, kernels, *, cse: bool = True) -> list[KernelIR]:

@@ -280,6 +280,8 @@ class Model:
         self.plane_spec = None
         #: a plane continuum's edge terms {boundary: {"potential" | "dissipation" | "weak": fn}}
         self.edge_terms: dict[str, dict[str, Callable]] = {}
+        #: a plane continuum's point terms {name: (x, y)}, numbers or parameter names (:meth:`point_potential_at`)
+        self.plane_points: dict[str, tuple] = {}
         self.weak_fn: Callable | None = None
         self.boundary_fn: Callable | None = None
         self.point_terms: dict[str, dict[str, Callable]] = {}
@@ -551,6 +553,31 @@ class Model:
         """Decorator (plane continuum): Rayleigh dissipation per unit length of a boundary, R_e(u, p, x, y, n): a
         dashpot layer (an absorbing boundary R_e = c/2 (u.ux_t^2 + u.uy_t^2))."""
         return self._edge("dissipation", boundary)
+
+    def point_potential_at(self, name: str, x, y) -> Callable:
+        """Decorator (plane continuum): a potential concentrated at the point (x, y) of the domain, V_P(u, p) (J per
+        unit thickness): a point load F is V_P = -(F_x u.ux + F_y u.uy), a spring to ground k/2 u.ux^2. ``x`` and
+        ``y`` are numbers or names of length parameters (m); only the fields' values may appear. The point must lie
+        in the mesh (InputError naming it otherwise); its load enters through the shape functions of the cell that
+        holds it, r += N(x_P)^T dV_P/du."""
+        check_identifier(name, what="point", file=self.file)
+        if self.plane_spec is None or name in self.plane_spec.domain.boundaries or name in self.plane_points:
+            raise ModelError(f"point term {name!r} of model {self.name}: declare plane(...) first, and name it "
+                             "apart from the boundaries and the other points", file=self.file, key="point",
+                             expected="a new name, e.g. load_point")
+        for value in (x, y):
+            if isinstance(value, str):
+                self.param(value)
+            elif isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise ModelError(f"point {name!r} of model {self.name}: coordinate {value!r} is neither a number "
+                                 "nor a parameter name", file=self.file, key=f"point.{name}",
+                                 expected="x and y as numbers (m) or names of declared parameters")
+        self.plane_points[name] = (x if isinstance(x, str) else float(x), y if isinstance(y, str) else float(y))
+
+        def register(fn: Callable) -> Callable:
+            self.edge_terms.setdefault(name, {})["potential"] = fn
+            return fn
+        return register
 
     def edge_weak_form(self, boundary: str) -> Callable:
         """Decorator (plane continuum): a residual per unit length of a boundary, W_e(test, u, p, x, y, n), linear in

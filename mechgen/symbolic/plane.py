@@ -188,6 +188,8 @@ class PlaneEquations:
     domain: Domain
     constraints: tuple[PlaneConstraint, ...]
     edges: dict = field(default_factory=dict)
+    #: the edge terms that are point terms: {name: (x, y)} (numbers or parameter names)
+    points: dict = field(default_factory=dict)
 
 
 def plane_constraints(model: Model, p_ns: Namespace) -> tuple[PlaneConstraint, ...]:
@@ -291,4 +293,5 @@ def derive_plane(model: Model, spec: Specialization) -> PlaneEquations:
                              key=f"edge.{name}", expected="values of the fields only (u.ux, u.uy, u.ux_t)")
         edge_jets = _jets_of(list(eu.used) + list(etest.used), plane.fields)
         edges[name] = (edge_jets, _equations(model, pieces, edge_jets, eu, etest, free, (X, Y, *NORMAL)))
-    return PlaneEquations(local, jets, plane.fields, plane.groups, plane.domain, constraints, edges)
+    return PlaneEquations(local, jets, plane.fields, plane.groups, plane.domain, constraints, edges,
+                          dict(model.plane_points))

@@ -146,10 +146,25 @@ def rigid_pins(mesh, fields) -> dict[str, np.ndarray]:
     return pins
 
 
-def discretise(mesh, info: dict, quadrature: int = 0) -> PlaneDisc:
+def _point_piece(mesh, info: dict, name: str, xy) -> Piece:
+    """A point term as a piece of one 'element' (the cell that holds the point) with one point of weight 1."""
+    from mechgen.runtime.plane.points import locate, point_shapes
+
+    nf = len(info["fields"])
+    cells, refs = locate(mesh, [xy])
+    N, _ = point_shapes(mesh, cells, refs)
+    dofs = assemble.element_dofs(mesh.cells[cells], nf)
+    position = np.array([[[xy[0], xy[1], 0.0, 0.0]]])
+    index = assemble.jet_index(info["edges"][name], info["fields"])
+    return Piece(name, (N[None, :, :], None, None), index, np.ones((1, 1)), position, dofs,
+                 Assembler(dofs, len(mesh.points) * nf, dense=False))
+
+
+def discretise(mesh, info: dict, quadrature: int = 0, points: dict | None = None) -> PlaneDisc:
     """Tables, dof maps and held dofs of a mesh for a plane model's facts ``info``."""
     nf = len(info["fields"])
-    for name in sorted({c[1] for c in info["constraints"] if c[1] != RIGID} | set(info["edges"])):
+    points = points or {}
+    for name in sorted({c[1] for c in info["constraints"] if c[1] != RIGID} | set(info["edges"]) - set(points)):
         if name not in mesh.boundaries:
             raise InputError(f"the mesh has no boundary {name!r}", key="mesh",
                              expected=f"a mesh with the boundaries the model names; it has {', '.join(mesh.boundaries)}")
@@ -157,7 +172,8 @@ def discretise(mesh, info: dict, quadrature: int = 0) -> PlaneDisc:
 
     require_assembly_memory(mesh, nf, len(info["jets"]), key="params.h", degree=quadrature or 2 * ORDER[mesh.element])
     pieces = [_domain_piece(mesh, info, quadrature)]
-    pieces += [_edge_piece(mesh, info, name, quadrature) for name in sorted(info["edges"])]
+    pieces += [_point_piece(mesh, info, name, points[name]) if name in points else
+               _edge_piece(mesh, info, name, quadrature) for name in sorted(info["edges"])]
     ndof = len(mesh.points) * nf
     held: dict = {}
     pins = rigid_pins(mesh, info["fields"])

@@ -98,7 +98,8 @@ class PlaneSystem:
     def with_mesh(self, mesh) -> "PlaneSystem":
         """The same kernels on a given :class:`~mechgen.runtime.plane.mesh.PlaneMesh` (a gmsh file read by
         :func:`~mechgen.runtime.plane.mesh.read_msh`): its boundaries must hold the ones the model names."""
-        missing = sorted(({c[1] for c in self.info["constraints"] if c[1] != "rigid"} | set(self.info["edges"]))
+        missing = sorted(({c[1] for c in self.info["constraints"] if c[1] != "rigid"}
+                          | (set(self.info["edges"]) - set(self.info.get("points", {}))))
                          - set(mesh.boundaries))
         if missing:
             raise InputError(f"the mesh has no boundary {missing[0]!r} that model {self.meta.get('model')} names",
@@ -144,9 +145,15 @@ class PlaneSystem:
     @property
     def disc(self) -> PlaneDisc:
         """Tables, dof maps, held dofs and the assembler of the current mesh."""
+        points = self.point_positions()
         key = ("disc", id(self.given_mesh) if self.given_mesh is not None else self._mesh_key(),
-               int(self.choices["quadrature"]))
-        return self._memo.get(key, lambda: discretise(self.mesh, self.info, int(self.choices["quadrature"])))
+               int(self.choices["quadrature"]), tuple(sorted(points.items())))
+        return self._memo.get(key, lambda: discretise(self.mesh, self.info, int(self.choices["quadrature"]), points))
+
+    def point_positions(self) -> dict:
+        """{name: (x, y)} of the model's point terms at the current parameter values (m)."""
+        return {name: tuple(self.value(v) if isinstance(v, str) else float(v) for v in xy)
+                for name, xy in self.info.get("points", {}).items()}
 
     @property
     def n(self) -> int:
