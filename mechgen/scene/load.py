@@ -168,6 +168,10 @@ def _mesh(file: str, data: dict, model, base: Path) -> str:
     if not getattr(model, "plane_fields", ()):
         raise fail(file, "mesh", f"model {model.name} is not a plane continuum: it takes no mesh file", expected)
     written = _string(file, "mesh", data["mesh"])
+    if written.lower().endswith(".geo"):
+        raise fail(file, "mesh", f"mesh file {show(written)} is a gmsh geometry: a .geo file is a program (it may "
+                   "run commands and write files), which a scene, being data, cannot run", expected + "; mesh the "
+                   "geometry once (gmsh -2 part.geo, or mechgen.runtime.plane.gmsh_geo.mesh_from_geo in Python)")
     path = Path(written) if Path(written).is_absolute() else base / written
     try:
         fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
