@@ -262,3 +262,23 @@ def test_a_point_load_on_a_drum_matches_greens_function():
     assert out["reactions"]["outer"]["w"] == pytest.approx(-1.0, rel=1e-12)
     with pytest.raises(InputError, match="not in the mesh"):
         mechgen.compile(m, {"x0": 3.0}).n
+
+
+def test_nodal_fields_of_the_membrane_converge_to_its_closed_form(membrane):
+    """``nodal = true`` against Michell's field u_y = c (r^2 - R^2), c = rho_g/(2(lambda* + 3 mu)), eps_yy = 2 c y
+    (P2, curved edges, h = 0.2, 0.1, 0.05). Measured: nodal displacement error 1.2e-4, 1.6e-5, 2.0e-6 of c (rate 3);
+    the averaged nodal strain 3.7e-3, 9.4e-4, 2.4e-4 (rate 2: the rim's isoparametric cells; inside r < 0.9 the
+    errors are 6e-4, 3e-5, 3e-7). The nodal stress is Hooke's law of the nodal gradient to round-off (the kernel
+    evaluated at the nodal jets)."""
+    c = RHO_G / (2 * (LAM + 3 * MU))
+    eu, es = [], []
+    for h in (0.2, 0.1, 0.05):
+        out = plane_steady(membrane.with_params(h=h), {"nodal": True})["nodal"]
+        x, y = np.array(out["x"]), np.array(out["y"])
+        eu.append(np.abs(np.array(out["displacement"]["uy"]) - c * (x**2 + y**2 - R**2)).max() / c)
+        es.append(np.abs(np.array(out["strain"]["yy"]) - 2 * c * y).max() / (2 * c))
+        eps = np.array([out["strain"]["xx"], out["strain"]["yy"], out["strain"]["xy"]])
+        sigma_yy = LAM * (eps[0] + eps[1]) + 2 * MU * eps[1]
+        assert np.allclose(np.array(out["stress"]["uy"])[:, 1], sigma_yy, rtol=0, atol=1e-12)
+    assert np.all(np.log2(np.array(eu[:-1]) / np.array(eu[1:])) > 2.7), eu
+    assert np.all(np.log2(np.array(es[:-1]) / np.array(es[1:])) > 1.8), es

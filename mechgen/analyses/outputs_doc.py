@@ -112,6 +112,9 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
            "[s_yx, s_yy]], Cauchy's stress for a linear law)."),
         _o("probe_displacement", "(points, fields)", MODEL_UNIT, "A plane model: the fields' values at each "
            "point of ``probe``."),
+        _o("nodal", "table", MODEL_UNIT, "A plane model with ``nodal = true``: the state at every node, {x, y, "
+           "displacement {field: (n,)}, gradient {field: (n, 2)}, stress {field: (n, 2)} (dV/d(grad u)), strain "
+           "{xx, yy, xy} (a displacement's symmetric gradient)}; gradients averaged over the cells at a node."),
     ),
     "simulate": (
         _o("t", "(samples,)", "s", "The sample times, from 0 to ``t_end`` (or to where the run stopped)."),

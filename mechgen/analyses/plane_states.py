@@ -48,7 +48,14 @@ def probe(ctx, key: str, value: object) -> list[list[float]]:
     return [point(ctx, f"{key}[{i}]", v) for i, v in enumerate(value)]
 
 
+def nodal_option(ctx, key: str, value: object) -> bool:
+    """true or false."""
+    return schema.boolean(ctx, key, value)
+
+
 OPTIONS = {
+    "nodal": schema.Option(nodal_option, doc="a plane model's fields at every node: nodes (x, y), displacement, "
+                           "strain and stress per field (true or false; the JSON grows with the mesh)"),
     "points": schema.Option(named_points, doc="a plane model's named points, name = [x, y] (m): reported as "
                             "<name>_displacement and <name>_stress"),
     "probe": schema.Option(probe, doc="a plane model's points [[x, y], ...] (m): reported as probe_displacement"),
@@ -72,6 +79,8 @@ def point_outputs(system, q: np.ndarray, options: dict) -> dict:
             out[f"{name}_displacement"] = _rounded(values[i])
             if stress is not None:
                 out[f"{name}_stress"] = _rounded(stress[i])
+    if options.get("nodal"):
+        out.update(nodal_outputs(system, q))
     if options.get("probe"):
         out["probe_displacement"] = _rounded(system.field_at(q, np.array(options["probe"], float))[0])
     return out
@@ -94,6 +103,25 @@ def solve(system, options: dict):
                                "too large for one Newton solve from the reference state): follow the load with "
                                "a continuation from a smaller one, which passes limit points and reports them as "
                                "folds") from None
+
+
+def nodal_outputs(system, q) -> dict:
+    """``nodal``: the state at every node of the mesh, {``x``, ``y`` (n,), ``displacement`` {field: (n,)},
+    ``gradient`` {field: (n, 2)} (d/dx, d/dy; each cell's at its nodes, averaged), ``stress`` {field: (n, 2)}
+    (dV/d(grad u) at those nodal jets) and, for a displacement (ux, uy), ``strain`` {xx, yy, xy} (the symmetric
+    part of the gradient)}."""
+    data = system.nodal_fields(q)
+    fields = system.info["fields"]
+    nodal = {"x": _rounded(data["x"]), "y": _rounded(data["y"]),
+             "displacement": {f: _rounded(data["values"][:, c]) for c, f in enumerate(fields)},
+             "gradient": {f: _rounded(data["gradients"][:, c]) for c, f in enumerate(fields)}}
+    if np.isfinite(data["stress"]).any():
+        nodal["stress"] = {f: _rounded(data["stress"][:, c]) for c, f in enumerate(fields)}
+    if len(fields) == 2:
+        H = data["gradients"]
+        nodal["strain"] = {"xx": _rounded(H[:, 0, 0]), "yy": _rounded(H[:, 1, 1]),
+                           "xy": _rounded((H[:, 0, 1] + H[:, 1, 0]) / 2)}
+    return {"nodal": nodal}
 
 
 def plane_steady(system, options: dict) -> dict:

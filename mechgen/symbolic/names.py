@@ -44,7 +44,7 @@ RESULT_KEYS = ("iterations", "residual_norm", "coordinates", "reactions", "metho
                "verdict", "frequencies", "eigenvalues", "growth_rate", "refinement", "rigid_modes", "energy_drift",
                "t_end", "mode_energies", "t", "energy_series", "grid", "parameter", "shape_outputs", "branch", "folds",
                "events", "final_mode", "t_final", "mode_series", "trajectory", "series_note", "zeno", "loop", "plot",
-               "energy_balance_error", "work", "dissipated", "energy_note")
+               "energy_balance_error", "work", "dissipated", "energy_note", "nodal", "probe_displacement")
 #: a jet's suffix after ``<field>_``: space derivatives, then at most two time derivatives
 JET_SUFFIX = re.compile(r"(s*)(t{0,2})\Z")
 #: what the ends of a continuum's outputs are reported as (mechgen.analyses.bvp_states)

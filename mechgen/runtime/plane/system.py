@@ -393,6 +393,29 @@ class PlaneSystem:
         return {"x": mesh.points[:, 0], "y": mesh.points[:, 1], "triangles": tris, "cell": cell,
                 "fields": list(self.info["fields"]), "values": values}
 
+    def nodal_fields(self, q) -> dict:
+        """The state at the mesh's nodes: ``x``, ``y`` (n,), ``values`` (n, fields), ``gradients`` (n, fields, 2)
+        (each cell's gradient at its nodes, averaged over the cells that share a node: mechgen.runtime.plane
+        .elements.node_gradients) and ``stress`` (n, fields, 2), dV/d(grad u) from the residual kernel at those
+        nodal jets (a node's position as the kernel's (x, y))."""
+        from mechgen.runtime.plane.elements import node_gradients
+
+        mesh = self.mesh
+        nf = len(self.info["fields"])
+        values = self.expand(q).reshape(-1, nf)
+        grads = node_gradients(mesh, values)
+        fields = self.info["fields"]
+        index = [(fields.index(f), k) for f, k in self.info["jets"]]
+        jets = np.stack([values[:, c] if k == "" else grads[:, c, "xy".index(k)] for c, k in index], axis=1)
+        stress = np.full(grads.shape, np.nan)
+        if any(k for _, k in index):
+            rho = self._evaluate("residual", (jets, 0 * jets, 0 * jets), mesh.points, 0.0)["r"]
+            for a, (c, k) in enumerate(index):
+                if k:
+                    stress[:, c, "xy".index(k)] = rho[:, a]
+        return {"x": mesh.points[:, 0], "y": mesh.points[:, 1], "values": values, "gradients": grads,
+                "stress": stress}
+
     def reactions(self, q, t: float = 0.0) -> dict:
         """The force each held boundary exerts on the body, per field: sum of r over its held dofs (N per unit
         thickness, the fields' force unit)."""
