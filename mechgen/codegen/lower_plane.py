@@ -16,9 +16,17 @@ from mechgen.codegen.lower_lumped import lower_lumped
 PLANE_KERNELS = ("residual", "tangent", "linear", "outputs")
 
 
+def constant_mass(eqs) -> bool:
+    """Whether d rho/dj_tt of the domain and of every edge term is free of the state and of time (a mass matrix
+    the runtime may factor once per parameter vector)."""
+    pieces = [eqs.local, *(local for _, local in eqs.edges.values())]
+    return all(not (local.jacobian(local.residual, "a").free_symbols
+                    & (set(local.q) | set(local.v) | set(local.a) | {local.t})) for local in pieces)
+
+
 def plane_meta(eqs) -> dict:
     """Fields, groups, jets, domain (shape and size parameters), constraints and edge jets of a plane model."""
-    return {"fields": list(eqs.fields), "groups": {g: list(fs) for g, fs in eqs.groups},
+    return {"constant_mass": constant_mass(eqs), "fields": list(eqs.fields), "groups": {g: list(fs) for g, fs in eqs.groups},
             "jets": [list(j) for j in eqs.jets], "shape": eqs.domain.shape,
             "sizes": {role: name for role, name in eqs.domain.sizes},
             "constraints": [[c.field, c.boundary] for c in eqs.constraints],

@@ -249,16 +249,28 @@ class PlaneSystem:
     def acceleration(self, q, v, z=None, t: float = 0.0):
         """(a, M): the acceleration solving r(q, v, a) = 0 for a residual linear in a, a = -M^-1 r(q, v, 0),
         M = dr/da (sparse LU; m/s^2 for a displacement), and M."""
-        import scipy.sparse.linalg as spla
-
-        M = self.tangent(q, v, None, t=t)["r_a"].tocsc()
         try:
-            return spla.splu(M).solve(-self.residual(q, v, None, t=t)), M
+            M, lu = self.mass_factor(q, v, t)
+            return lu.solve(-self.residual(q, v, None, t=t)), M
         except RuntimeError:
             raise InputError(f"the mass matrix of plane model {self.meta.get('model')} is singular: a field "
                              "without kinetic energy, so its motion has no acceleration", key="kind",
                              expected="a model whose kinetic density holds every field's rate (or steady, "
                                       "continuation)") from None
+
+    def mass_factor(self, q, v, t: float = 0.0):
+        """(M, its sparse LU) at the state; a model whose mass is constant (meta ``constant_mass``) assembles and
+        factors it once per parameter vector and mesh (memoised), not at every call of :meth:`rhs`."""
+        import scipy.sparse.linalg as spla
+
+        def make():
+            M = self._matrices("tangent", ("r_a",), q, v, None, t)["r_a"].tocsc()
+            return M, spla.splu(M)
+        if not self.info.get("constant_mass"):
+            return make()
+        key = ("mass", self.params.tobytes(), id(self.given_mesh) if self.given_mesh is not None else self._mesh_key(),
+               int(self.choices["quadrature"]))
+        return self._memo.get(key, make)
 
     def rhs(self, t: float, x) -> np.ndarray:
         """dx/dt = (v, a) of the first-order form x = (q, v), a from :meth:`acceleration`."""
@@ -273,7 +285,6 @@ class PlaneSystem:
         """d(dx/dt)/dx = [[0, I], [-M^-1 r_q, -M^-1 r_v]] at the current acceleration (sparse CSC; M^-1 applied by a
         sparse LU to the sparse blocks: for the small systems an explicit or implicit flow integrates)."""
         import scipy.sparse as sps
-        import scipy.sparse.linalg as spla
 
         n = self.n
         x = np.asarray(x, float)
@@ -282,7 +293,7 @@ class PlaneSystem:
         tan = self.tangent(q, v, a, t=t)
         require_dense(n, 6, "the Jacobian of a plane model's flow (implicit methods)", key="method",
                       expected="an explicit method (DOP853, RK45) for a plane model this large, or a coarser mesh")
-        lu = spla.splu(M)
+        lu = self.mass_factor(q, v, t)[1]
         blocks = np.hstack([tan["r_q"].toarray(), tan["r_v"].toarray()])
         da = -lu.solve(blocks)
         top = sps.hstack([sps.csr_matrix((n, n)), sps.identity(n, format="csr")])
