@@ -152,3 +152,29 @@ def test_bad_declarations_are_refused():
     with pytest.raises(ModelError, match="outer"):
         derive_plane(m, all_free(m))
     assert plane_jet("w_xt", ("w",)) == ("w", "x", 1) and plane_jet("w_xy", ("w",)) is None
+
+
+def test_mooney_rivlin_sheet_and_small_strain_limit():
+    """Incompressible sheet, equibiaxial stretch l: W = C1 (2 l^2 + l^-4 - 3) + C2 (2 l^-2 + l^4 - 3) (Treloar's
+    sheet); plane strain at H = 0: zero stress and Hooke's tangent with mu = 2 (C1 + C2), lambda = K - 2 mu / 3."""
+    from mechgen.symbolic.plane_materials import mooney_rivlin
+
+    lam, C1, C2 = sp.symbols("l C1 C2", positive=True)
+    H = sp.Matrix([[lam - 1, 0], [0, lam - 1]])
+    W = mooney_rivlin(H, C1, C2, "stress")
+    assert sp.simplify(W - (C1 * (2 * lam**2 + lam**-4 - 3) + C2 * (2 * lam**-2 + lam**4 - 3))) == 0
+    Hs = sp.Matrix(2, 2, sp.symbols("h0:4", real=True))
+    c1, c2, K = sp.Rational(1, 3), sp.Rational(1, 5), sp.Rational(7, 2)
+    W = mooney_rivlin(Hs, c1, c2, "strain", bulk=K)
+    mu = 2 * (c1 + c2)
+    lame = K - 2 * mu / 3
+    d = lambda i, j: 1 if i == j else 0  # noqa: E731
+    C = lambda i, j, k, l: lame * d(i, j) * d(k, l) + mu * (d(i, k) * d(j, l) + d(i, l) * d(j, k))  # noqa: E731
+    at0 = {h: 0 for h in Hs}
+    flat = [(0, 0), (0, 1), (1, 0), (1, 1)]
+    for i, j in flat:
+        assert sp.simplify(sp.diff(W, Hs[i, j]).subs(at0)) == 0
+        for k, l in flat:
+            assert sp.simplify(sp.diff(W, Hs[i, j], Hs[k, l]).subs(at0) - C(i, j, k, l)) == 0
+    with pytest.raises(ModelError, match="bulk"):
+        mooney_rivlin(Hs, c1, c2, "strain")

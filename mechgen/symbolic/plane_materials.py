@@ -8,7 +8,7 @@ i.e. J/m^2 per unit thickness) of a 2D state of
   measure (linear elasticity in eps, Saint Venant-Kirchhoff in the Green strain E) this only replaces
   Lame's lambda by lambda* = 2 lambda mu / (lambda + 2 mu) = E nu / (1 - nu^2); for an incompressible
   neo-Hookean sheet F_33 = 1 / det F. A compressible neo-Hookean law has no closed plane-stress form and is
-  refused.
+  refused. :func:`mooney_rivlin` (constants C1, C2, and a bulk modulus in plane strain) follows the same rule.
 
 Lame constants from Young's modulus E and Poisson's ratio nu: mu = E / (2 (1 + nu)),
 lambda = E nu / ((1 + nu)(1 - 2 nu)). Kolosov's constant kappa = 3 - 4 nu (plane strain),
@@ -81,6 +81,28 @@ def neo_hookean(H: sp.Matrix, E, nu, plane: str):
         lam, mu = lame(E, nu, "strain")
         return mu / 2 * (I1 + 1 - 3) - mu * sp.log(J) + lam / 2 * sp.log(J) ** 2
     return E / 6 * (I1 + J**-2 - 3)
+
+
+def mooney_rivlin(H: sp.Matrix, C1, C2, plane: str, bulk=None):
+    """A Mooney-Rivlin solid (J/m^3), small-strain shear modulus mu = 2 (C1 + C2).
+
+    Plane stress: the incompressible sheet (F_33 = 1/J, J = det F): with C = F^T F (2 x 2),
+    I1 = tr C + J^-2, I2 = tr C / J^2 + J^2, W = C1 (I1 - 3) + C2 (I2 - 3) (equibiaxial stretch l:
+    C1 (2 l^2 + l^-4 - 3) + C2 (2 l^-2 + l^4 - 3), the classical sheet).
+    Plane strain (F_33 = 1): compressible, W = C1 (J^-2/3 I1 - 3) + C2 (J^-4/3 I2 - 3) + bulk/2 (ln J)^2 with
+    I1 = tr C + 1, I2 = tr C + J^2 and ``bulk`` the small-strain bulk modulus K (required), so that at small
+    strain lambda = K - 2 mu / 3 (3D Lame constants; Pa).
+    """
+    F = sp.eye(2) + H
+    J = F.det()
+    trC = sum(F[i, j] ** 2 for i in range(2) for j in range(2))
+    if _plane(plane, "mooney_rivlin") == "stress":
+        return C1 * (trC + J**-2 - 3) + C2 * (trC / J**2 + J**2 - 3)
+    if bulk is None:
+        raise ModelError("mooney_rivlin in plane strain needs the bulk modulus", key="bulk",
+                         expected="mooney_rivlin(H, C1, C2, 'strain', bulk=K)")
+    return (C1 * (J ** sp.Rational(-2, 3) * (trC + 1) - 3) + C2 * (J ** sp.Rational(-4, 3) * (trC + J**2) - 3)
+            + bulk / 2 * sp.log(J) ** 2)
 
 
 def plane_law(name: str, H: sp.Matrix, E, nu, plane: str):
