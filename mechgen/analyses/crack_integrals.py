@@ -14,8 +14,9 @@ the origin). Outputs, per tip in the order of ``tips`` on the first ring: ``J`` 
 point-force field, Pa), ``bueckner_K_I``, ``bueckner_K_II`` (Bueckner's r^-3/2 field, Pa m^0.5); about the whole
 crack on the first crack ring: ``M`` (N), ``L`` (N, about ``center``) and ``bueckner`` (Betti's integral with the
 Griffith field's rigid-rotation derivative, Shi, Liu & Li's supplemental field: 2 L when the crack is
-Griffith's; N); and ``contours``: every ring's values ({"ring", "J", "K_I", ...}), ``crack_contours`` likewise:
-the path-independence table. The material is the model's ``mu`` (or ``E``), ``nu`` and ``plane``.
+Griffith's; N); and ``contours``, the path-independence table: every output on every contour, {``rings``,
+``J``, ``K_I``, ... (one list per ring, one value per tip), ``crack_rings``, ``M``, ``L``, ``bueckner`` (one value
+per crack ring)}. The material is the model's ``mu`` (or ``E``), ``nu`` and ``plane``.
 A model with a body force is refused (these forms hold without one), as is a ring that leaves the mesh.
 """
 from __future__ import annotations
@@ -156,8 +157,8 @@ def run_crack_integrals(system, options: dict, context: dict) -> dict:
     system.require_no_body_force(q)
     per_ring = [[tip_values(system, q, tip, ring, mat) for tip in options["tips"]] for ring in options["rings"]]
     out = {name: [v[name] for v in per_ring[0]] for name in per_ring[0][0]}
-    out["contours"] = [{"ring": ring, **{name: [v[name] for v in values] for name in values[0]}}
-                       for ring, values in zip(options["rings"], per_ring)]
+    contours = {"rings": [list(r) for r in options["rings"]],
+                **{name: [[v[name] for v in values] for values in per_ring] for name in per_ring[0][0]}}
     if options.get("crack_rings"):
         crack = griffith_of(system)
         center = options.get("center", [0.0, 0.0])
@@ -169,7 +170,9 @@ def run_crack_integrals(system, options: dict, context: dict) -> dict:
                              expected=f"rings about center with r_in > {reach:g}")
         whole = [crack_values(system, q, center, ring, mat, crack) for ring in options["crack_rings"]]
         out.update(whole[0])
-        out["crack_contours"] = [{"ring": ring, **values} for ring, values in zip(options["crack_rings"], whole)]
+        contours["crack_rings"] = [list(r) for r in options["crack_rings"]]
+        contours.update({name: [values[name] for values in whole] for name in whole[0]})
+    out["contours"] = contours
     return out
 
 

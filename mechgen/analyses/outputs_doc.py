@@ -532,13 +532,13 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("bueckner_K_I", "(tips,)", "Pa m^0.5", "Bueckner's work-conjugate integral with his r^-3/2 mode I field "
            "(normalised to give K_I)."),
         _o("bueckner_K_II", "(tips,)", "Pa m^0.5", "The same with the mode II field (K_II)."),
-        _o("contours", "list of tables", "as above", "Every ring of ``rings``: {ring, J, K_I, K_II, T_stress, "
-           "bueckner_K_I, bueckner_K_II}, the path-independence table."),
+        _o("contours", "table", "as above", "The path-independence table: ``rings`` and ``crack_rings`` as given, "
+           "and every integral on every contour: J, K_I, K_II, T_stress, bueckner_K_I, bueckner_K_II (one list per "
+           "ring, one value per tip), M, L, bueckner (one value per crack ring)."),
         _o("M", "scalar", "N", "With ``crack_rings``: the M-integral about ``center`` around the whole crack."),
         _o("L", "scalar", "N", "With ``crack_rings``: the L-integral (rotational) about ``center``."),
         _o("bueckner", "scalar", "N", "With ``crack_rings``: Bueckner's integral with the Griffith field's "
            "rotation derivative (Shi, Liu & Li's supplemental field), 2 L for a Griffith crack."),
-        _o("crack_contours", "list of tables", "as above", "Every ring of ``crack_rings``: {ring, M, L, bueckner}."),
     ),
     "shear_curve": (
         _o("shear_rate", "(samples,)", "1/lambda", "The sampled shear rates, 0 to rate_max."),
