@@ -102,6 +102,34 @@ def unknown_parameters(model, unknown: list, known) -> InputError:
                       expected="one of: " + (", ".join(sorted(known)) or "none"))
 
 
+def with_values(system, values: dict, choice):
+    """``system.with_params(**values)`` of a continuum (a FieldSystem or a PlaneSystem: free numeric parameters,
+    runtime ``choices``, names folded into the kernels through ``rebuild``): a new system, the given one unchanged
+    (itself when nothing changes). ``choice(name, value)`` validates a runtime choice's new value. Unknown names and
+    a folded name without ``rebuild`` are InputErrors listing what is known."""
+    from dataclasses import replace
+
+    names = list(system.meta.get("params", []))
+    folded = [*system.fixed, *(k for k in system.folded if k not in system.fixed)]
+    unknown = [k for k in values if k not in names and k not in system.choices and k not in folded]
+    if unknown:
+        raise unknown_parameters(system.meta.get("model"), unknown, names + list(system.choices) + folded)
+    hit = [k for k in values if k in folded and k not in names and k not in system.choices]
+    if hit:
+        if system.rebuild is None:
+            raise folded_parameter(system.meta.get("model"), hit[0])
+        return system.rebuild(system, dict(values))
+    choices = {k: choice(k, v) for k, v in values.items() if k in system.choices and k not in names}
+    out = system
+    if any(choices[k] != system.choices[k] for k in choices):
+        out = replace(system, choices={**system.choices, **choices})
+    params = np.array(system.params)
+    for name, value in values.items():
+        if name in names:
+            params[names.index(name)] = number(name, value)
+    return out.with_param_vector(params)
+
+
 def folded_parameter(model, name: str) -> InputError:
     """The error for a name folded into the kernels at compile time when no rebuild is wired."""
     return InputError(f"parameter {name!r} of model {model} was folded into the compiled kernels (a fixed value "

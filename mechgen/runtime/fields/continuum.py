@@ -40,8 +40,7 @@ from mechgen.runtime.core.kernels import Kernel
 from mechgen.runtime.core.memory import dense_bytes, require, require_dense
 from mechgen.runtime.core.meta import SystemMeta
 from mechgen.runtime.fields.mesh import Layout, build_mesh
-from mechgen.runtime.core.system import (Memo, folded_parameter, frozen_vector, number, read_only,
-                                         replacement_vector, unknown_parameters)
+from mechgen.runtime.core.system import Memo, frozen_vector, read_only, replacement_vector, with_values
 
 
 #: the values a continuum's runtime choices take (others, such as a model's own runtime choices, are strings)
@@ -139,25 +138,7 @@ class FieldSystem:
         kernels at compile time (``fixed``, ``folded``) a recompiled system through
         ``rebuild`` (InputError without one); any other name an InputError listing the known ones.
         """
-        names = list(self.meta.get("params", []))
-        folded = [*self.fixed, *(k for k in self.folded if k not in self.fixed)]
-        unknown = [k for k in values if k not in names and k not in self.choices and k not in folded]
-        if unknown:
-            raise unknown_parameters(self.meta.get("model"), unknown, names + list(self.choices) + folded)
-        hit = [k for k in values if k in folded and k not in names and k not in self.choices]
-        if hit:
-            if self.rebuild is None:
-                raise folded_parameter(self.meta.get("model"), hit[0])
-            return self.rebuild(self, dict(values))
-        choices = {k: _choice(k, v) for k, v in values.items() if k in self.choices and k not in names}
-        out = self
-        if any(choices[k] != self.choices[k] for k in choices):
-            out = replace(self, choices={**self.choices, **choices})
-        params = np.array(self.params)
-        for name, value in values.items():
-            if name in names:
-                params[names.index(name)] = number(name, value)
-        return out.with_param_vector(params)
+        return with_values(self, values, _choice)
 
     def with_layout(self, layout: Layout | None) -> "FieldSystem":
         """The same kernels, parameters and choices with segments and parts ``layout`` (a new memo)."""

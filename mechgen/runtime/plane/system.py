@@ -22,8 +22,7 @@ import scipy.sparse as sps
 from mechgen.errors import InputError, KernelError
 from mechgen.runtime.core.memory import require_dense
 from mechgen.runtime.core.meta import SystemMeta
-from mechgen.runtime.core.system import (Memo, folded_parameter, frozen_vector, number, read_only,
-                                         replacement_vector, unknown_parameters)
+from mechgen.runtime.core.system import Memo, frozen_vector, number, read_only, replacement_vector, with_values
 from mechgen.runtime.plane import assemble
 from mechgen.runtime.plane.discretise import PlaneDisc, discretise, generate_mesh
 
@@ -76,24 +75,7 @@ class PlaneSystem:
     def with_params(self, **values) -> "PlaneSystem":
         """A new system with these values: free numeric parameters, runtime choices (element, h, edges,
         quadrature and the model's own), or a folded name through ``rebuild``."""
-        names = list(self.meta.get("params", []))
-        folded = [*self.fixed, *(k for k in self.folded if k not in self.fixed)]
-        unknown = [k for k in values if k not in names and k not in self.choices and k not in folded]
-        if unknown:
-            raise unknown_parameters(self.meta.get("model"), unknown, names + list(self.choices) + folded)
-        hit = [k for k in values if k in folded and k not in names and k not in self.choices]
-        if hit:
-            if self.rebuild is None:
-                raise folded_parameter(self.meta.get("model"), hit[0])
-            return self.rebuild(self, dict(values))
-        choices = {k: _choice(k, v) for k, v in values.items() if k in self.choices and k not in names}
-        out = replace(self, choices={**self.choices, **choices}) if any(
-            choices[k] != self.choices[k] for k in choices) else self
-        params = np.array(self.params)
-        for name, value in values.items():
-            if name in names:
-                params[names.index(name)] = number(name, value)
-        return out.with_param_vector(params)
+        return with_values(self, values, _choice)
 
     def with_mesh(self, mesh) -> "PlaneSystem":
         """The same kernels on a given :class:`~mechgen.runtime.plane.mesh.PlaneMesh` (a gmsh file read by
