@@ -111,3 +111,10 @@ def test_a_crack_ring_that_cuts_the_crack_is_refused():
     with pytest.raises(SceneError, match="cuts the crack"):
         get("crack_integrals").run(plate, {"tips": [[1.0, 0.0, 0.0], [-1.0, 0.0, math.pi]], "rings": [[0.3, 0.8]],
                                            "crack_rings": [[0.5, 2.0]]}, {})
+
+
+def test_crack_integrals_refuse_a_finite_strain_law():
+    """The auxiliary fields are linear elastic: a neo-Hookean plate (plane_block) is refused, not integrated."""
+    block = mechgen.compile("plane_block", {"law": "neo_hookean", "P": 0.1}, kernels=("residual", "tangent", "outputs"))
+    with pytest.raises(InputError, match="not linear"):
+        get("crack_integrals").run(block, {"tips": [[0.5, 0.5, 0.0]], "rings": [[0.1, 0.2]]}, {})

@@ -72,13 +72,26 @@ def material(system):
     from mechgen.runtime.plane.closed_forms import PlaneElastic
 
     values = {**system.fixed, **dict(zip(system.meta.get("params", []), map(float, system.params)))}
-    plane = system.selections.get("plane", "stress")
-    if "nu" not in values or not ("mu" in values or "E" in values):
-        raise InputError(f"model {system.meta.get('model')} has no parameters nu and mu (or E)", key="kind",
-                         expected="a plane elastic model with parameters mu or E, nu and plane")
+    plane = system.selections.get("plane")
+    if "nu" not in values or not ("mu" in values or "E" in values) or plane not in ("stress", "strain"):
+        raise InputError(f"model {system.meta.get('model')} has no parameters nu and mu (or E) and no choice "
+                         "plane = 'stress' | 'strain': the auxiliary fields need its material", key="kind",
+                         expected="a plane elastic model with parameters mu or E, nu and the choice plane")
     nu = float(values["nu"])
     E = float(values["E"]) if "E" in values else 2 * float(values["mu"]) * (1 + nu)
     return PlaneElastic(E, nu, plane)
+
+
+def require_linear_law(system, q) -> None:
+    """InputError unless the stress is linear in the displacement gradient at this state (sigma(2 u) = 2 sigma(u)
+    at every quadrature point, to 1e-9): the interaction and Bueckner integrals pair the state with linear-elastic
+    auxiliary fields, so a finite-strain law's K would be wrong, not approximate."""
+    once = system.quadrature_state(q)["stress"]
+    twice = system.quadrature_state(2 * np.asarray(q))["stress"]
+    if np.abs(twice - 2 * once).max() > 1e-9 * max(float(np.abs(twice).max()), 1e-300):
+        raise InputError(f"model {system.meta.get('model')}'s stress is not linear in the displacement gradient: "
+                         "K, T and Bueckner's integrals here assume linear elasticity", key="kind",
+                         expected="a linear elastic plane model (plane_materials.linear_elastic)")
 
 
 def state_of(system, options: dict, context: dict) -> np.ndarray:
@@ -155,6 +168,7 @@ def run_crack_integrals(system, options: dict, context: dict) -> dict:
     mat = material(system)
     q = state_of(system, options, context)
     system.require_no_body_force(q)
+    require_linear_law(system, q)
     per_ring = [[tip_values(system, q, tip, ring, mat) for tip in options["tips"]] for ring in options["rings"]]
     out = {name: [v[name] for v in per_ring[0]] for name in per_ring[0][0]}
     contours = {"rings": [list(r) for r in options["rings"]],

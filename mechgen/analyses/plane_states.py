@@ -48,13 +48,8 @@ def probe(ctx, key: str, value: object) -> list[list[float]]:
     return [point(ctx, f"{key}[{i}]", v) for i, v in enumerate(value)]
 
 
-def nodal_option(ctx, key: str, value: object) -> bool:
-    """true or false."""
-    return schema.boolean(ctx, key, value)
-
-
 OPTIONS = {
-    "nodal": schema.Option(nodal_option, doc="a plane model's fields at every node: nodes (x, y), displacement, "
+    "nodal": schema.Option(schema.boolean, doc="a plane model's fields at every node: nodes (x, y), displacement, "
                            "strain and stress per field (true or false; the JSON grows with the mesh)"),
     "points": schema.Option(named_points, doc="a plane model's named points, name = [x, y] (m): reported as "
                             "<name>_displacement and <name>_stress"),
@@ -62,7 +57,8 @@ OPTIONS = {
 }
 
 
-def _rounded(a) -> list:
+def _listed(a) -> list:
+    """An array as nested lists of floats (JSON-ready)."""
     return np.asarray(a, float).tolist()
 
 
@@ -76,13 +72,13 @@ def point_outputs(system, q: np.ndarray, options: dict) -> dict:
         has_gradient = any(k for _, k in system.info["jets"])
         stress = system.stress_at(q, xy) if has_gradient else None
         for i, name in enumerate(named):
-            out[f"{name}_displacement"] = _rounded(values[i])
+            out[f"{name}_displacement"] = _listed(values[i])
             if stress is not None:
-                out[f"{name}_stress"] = _rounded(stress[i])
+                out[f"{name}_stress"] = _listed(stress[i])
     if options.get("nodal"):
         out.update(nodal_outputs(system, q))
     if options.get("probe"):
-        out["probe_displacement"] = _rounded(system.field_at(q, np.array(options["probe"], float))[0])
+        out["probe_displacement"] = _listed(system.field_at(q, np.array(options["probe"], float))[0])
     return out
 
 
@@ -112,15 +108,15 @@ def nodal_outputs(system, q) -> dict:
     part of the gradient)}."""
     data = system.nodal_fields(q)
     fields = system.info["fields"]
-    nodal = {"x": _rounded(data["x"]), "y": _rounded(data["y"]),
-             "displacement": {f: _rounded(data["values"][:, c]) for c, f in enumerate(fields)},
-             "gradient": {f: _rounded(data["gradients"][:, c]) for c, f in enumerate(fields)}}
+    nodal = {"x": _listed(data["x"]), "y": _listed(data["y"]),
+             "displacement": {f: _listed(data["values"][:, c]) for c, f in enumerate(fields)},
+             "gradient": {f: _listed(data["gradients"][:, c]) for c, f in enumerate(fields)}}
     if np.isfinite(data["stress"]).any():
-        nodal["stress"] = {f: _rounded(data["stress"][:, c]) for c, f in enumerate(fields)}
+        nodal["stress"] = {f: _listed(data["stress"][:, c]) for c, f in enumerate(fields)}
     if len(fields) == 2:
         H = data["gradients"]
-        nodal["strain"] = {"xx": _rounded(H[:, 0, 0]), "yy": _rounded(H[:, 1, 1]),
-                           "xy": _rounded((H[:, 0, 1] + H[:, 1, 0]) / 2)}
+        nodal["strain"] = {"xx": _listed(H[:, 0, 0]), "yy": _listed(H[:, 1, 1]),
+                           "xy": _listed((H[:, 0, 1] + H[:, 1, 0]) / 2)}
     return {"nodal": nodal}
 
 

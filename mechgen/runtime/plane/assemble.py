@@ -56,9 +56,3 @@ def element_matrices(T, index, weights: np.ndarray, coeff: np.ndarray, nfields: 
     from mechgen.runtime.plane.elements import blocked_element_matrices
 
     return blocked_element_matrices([T[k] for _, k in index], [c for c, _ in index], weights, coeff, nfields)
-
-
-def element_dofs(cells: np.ndarray, nfields: int) -> np.ndarray:
-    """dof(e, l * nfields + c) = cells[e, l] * nfields + c."""
-    cells = np.asarray(cells, np.int64)
-    return (cells[:, :, None] * nfields + np.arange(nfields)).reshape(len(cells), -1)

@@ -18,6 +18,7 @@ from mechgen.runtime.core.memory import require
 from mechgen.runtime.fields.assemble import Assembler
 from mechgen.runtime.plane import assemble
 from mechgen.runtime.plane.edges import edge_tables
+from mechgen.runtime.plane.elements import node_dofs
 
 #: the pseudo-boundary of rigid-motion pins (mechgen.symbolic.plane.RIGID; runtime never imports symbolic)
 RIGID = "rigid"
@@ -113,7 +114,7 @@ def _domain_piece(mesh, info: dict, degree: int) -> Piece:
 
     tab = tables(mesh, degree or 2 * ORDER[mesh.element])
     nf = len(info["fields"])
-    dofs = assemble.element_dofs(mesh.cells, nf)
+    dofs = node_dofs(mesh.cells, nf)
     T = assemble.order_tables(tab.N, tab.dN)
     index = assemble.jet_index(info["jets"], info["fields"])
     return Piece(None, T, index, tab.w, tab.x, dofs, Assembler(dofs, len(mesh.points) * nf, dense=False))
@@ -124,7 +125,7 @@ def _edge_piece(mesh, info: dict, name: str, degree: int) -> Piece:
     tab = edge_tables(mesh.points, mesh.cells, mesh.boundaries[name], degree or 2 * ORDER[mesh.element])
     ne, ng = tab.weights.shape
     N = np.broadcast_to(tab.values, (ne, ng, tab.values.shape[1]))
-    dofs = assemble.element_dofs(tab.nodes, nf)
+    dofs = node_dofs(tab.nodes, nf)
     index = assemble.jet_index(info["edges"][name], info["fields"])
     return Piece(name, (N, None, None), index, tab.weights, tab.position, dofs,
                  Assembler(dofs, len(mesh.points) * nf, dense=False))
@@ -153,7 +154,7 @@ def _point_piece(mesh, info: dict, name: str, xy) -> Piece:
     nf = len(info["fields"])
     cells, refs = locate(mesh, [xy])
     N, _ = point_shapes(mesh, cells, refs)
-    dofs = assemble.element_dofs(mesh.cells[cells], nf)
+    dofs = node_dofs(mesh.cells[cells], nf)
     position = np.array([[[xy[0], xy[1], 0.0, 0.0]]])
     index = assemble.jet_index(info["edges"][name], info["fields"])
     return Piece(name, (N[None, :, :], None, None), index, np.ones((1, 1)), position, dofs,
