@@ -367,3 +367,22 @@ def test_van_der_pol_limit_cycle_from_its_hopf_point():
     best = minimize_scalar(lambda s: -abs(sol.sol(s)[0]), bounds=(t[k - 1], t[k + 1]), method="bounded",
                            options={"xatol": 1e-12})
     assert last["amplitude"]["x"] == pytest.approx(-best.fun, abs=1e-8)
+
+
+def test_bisection_is_bounded_when_corrected_points_leave_the_bracket(monkeypatch):
+    """A fold cascade (js_fluid past its first fold) once made the BP bisection loop for minutes: the points corrected
+    onto the branch jumped to another sheet, so the bracket's length never shrank. The location now stops after
+    BISECT_STEPS halvings and returns the secant point between the last two corrected points."""
+    from mechgen.runtime.steady import branch_scan, special_points
+
+    calls = []
+
+    def jumping(eqs, xa, xb, theta):  # every "corrected" point lands a unit away from both ends
+        calls.append(theta)
+        return np.array([float(len(calls) % 2) + 5.0, 1.0])
+
+    monkeypatch.setattr(branch_scan, "point_between", jumping)
+    values = iter([1.0, -1.0] + [1.0] * 1000)
+    x = special_points.bisect(None, np.zeros(2), np.ones(2), lambda x: next(values))
+    assert len(calls) == special_points.BISECT_STEPS
+    assert np.all(np.isfinite(x))

@@ -512,6 +512,8 @@ def _families(points: list) -> list[list[dict]]:
     return list(groups.values())
 
 
+#: the legend's name for branch points without a verdict (``stability = false``)
+UNJUDGED = "no verdict (stability = false)"
 #: the markers of the special points besides folds (BP: square, H: star)
 _SPECIAL_MARKS = {"BP": "s", "H": "*"}
 
@@ -522,7 +524,7 @@ def _branch(plt, a: dict, path: Path) -> bool:
     out = a["outputs"]
     if not out.get("branch"):
         return False
-    colours = figures.VERDICT_COLOURS
+    colours = {**figures.VERDICT_COLOURS, UNJUDGED: "0.55"}  # stability = false: no verdict, not "stable"
     name, output, shapes = _branch_axes(out)
     fig, ax = plt.subplots(figsize=(7, 5))
     for family in _families(out["branch"]):
@@ -530,7 +532,7 @@ def _branch(plt, a: dict, path: Path) -> bool:
         val = [p.get(output, float("nan")) for p in family]
         ax.plot(lam, val, "-", color="0.75", lw=0.8, zorder=1)
         for verdict in colours:
-            sel = [i for i, p in enumerate(family) if p.get("verdict", "stable") == verdict]
+            sel = [i for i, p in enumerate(family) if p.get("verdict", UNJUDGED) == verdict]
             if sel:
                 ax.plot([lam[i] for i in sel], [val[i] for i in sel], ".", ms=3, color=colours[verdict], zorder=2)
         for key in shapes:
@@ -556,10 +558,13 @@ def _branch(plt, a: dict, path: Path) -> bool:
                     mfc="none", color="k")
             ax.annotate(special["type"], (special[name], special.get(output, float("nan"))), fontsize=7,
                         xytext=(5, -9), textcoords="offset points")
-    handles = [plt.Line2D([], [], ls="", marker=".", color=c, label=v) for v, c in colours.items()]
-    handles += [plt.Line2D([], [], ls="", marker="x", color="tab:purple", label="fold"),
-                plt.Line2D([], [], ls="", marker="d", mfc="none", color="tab:orange", label="stability change"),
-                plt.Line2D([], [], ls="", marker="o", mfc="none", color="tab:green", label="at")]
+    seen = {p.get("verdict", UNJUDGED) for p in out["branch"]}
+    handles = [plt.Line2D([], [], ls="", marker=".", color=c, label=v) for v, c in colours.items() if v in seen]
+    marks = [("x", "tab:purple", "fold", bool(out.get("folds"))),
+             ("d", "tab:orange", "stability change", bool(out.get("stability_changes"))),
+             ("o", "tab:green", "at", any(k.startswith("at_") for k in out))]
+    handles += [plt.Line2D([], [], ls="", marker=m, mfc="tab:purple" if m == "x" else "none", color=c, label=label)
+                for m, c, label, shown in marks if shown]
     ax.legend(handles=handles, fontsize=7, loc="best")
     ax.set_xlabel(figures.labelled(a, name))
     ax.set_ylabel(output)

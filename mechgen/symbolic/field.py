@@ -208,7 +208,9 @@ def _powers(pieces: tuple, jets, u: Jets, test: Jets) -> tuple:
     return energy_powers(T, V, R, Q, q=q, v=v)
 
 
-def _equations(model: Model, pieces: tuple, rho: list, jets, u: Jets, free, test: Jets) -> LumpedEquations:
+def _equations(model: Model, pieces: tuple, rho: list, jets, u: Jets, free, test: Jets,
+               integrated: dict | None = None) -> LumpedEquations:
+    """One piece's equations; ``integrated``: the domain's integrated output densities (none at the ends)."""
     T, V = pieces[0], pieces[1]
     q = tuple(u.symbol(f, k, 0) for f, k in jets)
     power, excess = _powers(pieces, jets, u, test)
@@ -217,7 +219,8 @@ def _equations(model: Model, pieces: tuple, rho: list, jets, u: Jets, free, test
         v=tuple(u.symbol(f, k, 1) for f, k in jets), a=tuple(u.symbol(f, k, 2) for f, k in jets), z=(),
         params=free, param_names=tuple(s.name for s in free), internal_names=(), kinetic=T, potential=V,
         residual=sp.Matrix(rho) if rho else sp.zeros(0, 1), rates=sp.zeros(0, 1),
-        outputs={"kinetic_energy": T, "potential_energy": V, "energy": T + V}, position=(POSITION,),
+        outputs={**(integrated or {}), "kinetic_energy": T, "potential_energy": V, "energy": T + V},
+        position=(POSITION,),
         power=power, excess=excess,
     )
 
@@ -233,6 +236,7 @@ def derive_field(model: Model, spec: Specialization) -> FieldEquations:
     fns = {"kinetic": model.kinetic_fn, "potential": model.potential_fn, "dissipation": model.dissipation_fn,
            "weak": model.weak_fn}
     domain = _local(model, fns, env, u, test)
+    integrated = {o.name: density_expr(model, o.fn, f"output {o.name}", env) for o in model.outputs if o.integrate}
     ends = {}
     for at in sorted(model.point_terms):
         here = dict(env)
@@ -250,7 +254,7 @@ def derive_field(model: Model, spec: Specialization) -> FieldEquations:
     if any(key[2] > 2 for key in u.used):
         raise ModelError(f"densities of {model.name} use more than two time derivatives", file=model.file)
     jets = tuple((f, k) for f in model.field_names for k in range(orders[f] + 1))
-    local = _equations(model, domain, _residual(model, domain, jets, u, test), jets, u, free, test)
+    local = _equations(model, domain, _residual(model, domain, jets, u, test), jets, u, free, test, integrated)
     points = {at: _equations(model, pieces, _residual(model, pieces, jets, u, test), jets, u, free, test)
               for at, pieces in ends.items()}
     parts = {kind: [f"{kind}_{n}" for n in names] for kind, names in model.parts.items()}

@@ -39,6 +39,8 @@ class Output:
     fn: Callable
     unit: str = ""
     doc: str = ""
+    #: a 1D continuum's output reported as the integral of ``fn`` over s (on Galerkin states), not pointwise
+    integrate: bool = False
 
 
 @dataclass(frozen=True)
@@ -352,7 +354,7 @@ class Model:
         self._claim(name, "internal variable")
         self.internals.append(Internal(name, rate, float(initial), doc))
 
-    def output(self, name: str, fn: Callable, *, unit: str = "", doc: str = "") -> None:
+    def output(self, name: str, fn: Callable, *, unit: str = "", doc: str = "", integrate: bool = False) -> None:
         """Declare a named output: a scalar expression reported beside the state.
 
         In a lumped model ``fn`` receives, by parameter name, any of ``q``, ``v``, ``z``, ``p``, ``t`` and returns
@@ -362,10 +364,20 @@ class Model:
         ``doc`` document it. The name must not be one mechgen reports itself
         (:data:`mechgen.symbolic.names.BUILTIN_OUTPUTS`, :data:`~mechgen.symbolic.names.RESULT_KEYS`: ``energy``,
         ``iterations`` ...). Example: ``model.output("height", lambda q, p: -p.l * sp.cos(q.theta), unit="m")``.
+
+        ``integrate=True`` (a continuum, after :meth:`field`): the output is the integral of ``fn`` over
+        s in [0, L], reported on the Galerkin states (``steady`` by Newton, ``continuation``, ``simulate``) by the
+        same quadrature as the residual, e.g. a channel's flow rate Q = int u dy,
+        ``model.output("flow_rate", lambda u: u.u, integrate=True)``; a plane continuum's outputs are integrals
+        over its domain always.
         """
         self._claim(name, "output")
         self._unreported(name, "output")
-        self.outputs.append(Output(name, fn, unit, doc))
+        if integrate and self.continuum is None and self.plane_spec is None:
+            raise ModelError(f"output {name!r} of model {self.name} is integrated, but the model declares no "
+                             "continuum", file=self.file, key=f"output.{name}",
+                             expected="model.field(...) or model.plane(...) before an integrated output")
+        self.outputs.append(Output(name, fn, unit, doc, bool(integrate)))
 
     def shape_output(self, name: str, fn: Callable, *, start: Callable | None = None, doc: str = "") -> None:
         """Declare a number measured on a steady state of a continuum, sampled along s (a balloon's loops).

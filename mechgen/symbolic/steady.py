@@ -88,7 +88,7 @@ def derive_steady(model: Model, spec: Specialization) -> LumpedEquations:
     rho = [r + d for r, d in zip(lagrange_residual(Pi, sp.Integer(0), sp.Integer(0), q, v, a), drag)]
     stress = Namespace({f: sp.diff(V, sl) for f, sl in zip(fields, v)})  # n = dV/du_s
     outputs = {}
-    for out in model.outputs:
+    for out in (o for o in model.outputs if not o.integrate):  # integrated outputs: Galerkin states only
         value = as_expr(call_declared(out.fn, n=stress, **{k: env[k] for k in ("u", "p", "s")}),
                         f"output {out.name}", model)
         outputs[out.name] = value.xreplace(still).xreplace({POSITION: TIME})
@@ -145,7 +145,7 @@ def derive_steady_hamiltonian(model: Model, spec: Specialization) -> LumpedEquat
     drag = [sp.diff(R, r).xreplace(still).xreplace({POSITION: TIME}).xreplace(to_slopes) for r in rates]
     dn = [-sp.diff(H, qf) - d for qf, d in zip(q, drag)]
     outputs = {}
-    for out in model.outputs:
+    for out in (o for o in model.outputs if not o.integrate):  # integrated outputs: Galerkin states only
         value = as_expr(call_declared(out.fn, n=n_ns, **{k: env[k] for k in ("u", "p", "s")}),
                         f"output {out.name}", model)
         outputs[out.name] = value.xreplace(still).xreplace({POSITION: TIME}).xreplace(to_slopes)

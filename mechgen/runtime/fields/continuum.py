@@ -715,12 +715,26 @@ class FieldSystem:
         if self.info.get("constant_mass"):
             def factor():
                 M = self.tangent(np.zeros(self.n), t=t)["r_a"]
+                self._require_mass(M)
                 return (spla.splu(sps.csc_matrix(M)).solve if sps.issparse(M)
                         else (lambda b, f=sla.cho_factor(M): sla.cho_solve(f, b)))
 
             return self._memo.get(("mass", *self._reduction_key(), self._pkey), factor)(rhs)
         M = self.tangent(q, v, t=t)["r_a"]
+        self._require_mass(M)
         return spla.spsolve(sps.csc_matrix(M), rhs) if sps.issparse(M) else sla.solve(M, rhs)
+
+    def _require_mass(self, M) -> None:
+        """Refuse a mass matrix with zero rows: fields without kinetic energy obey first-order (or algebraic) laws,
+        D(q) q' + f(q) = 0, which the second-order integration (q, v) cannot run."""
+        rows = np.asarray(abs(M).sum(axis=1)).ravel() if sps.issparse(M) else np.abs(np.asarray(M)).sum(axis=1)
+        empty = int(np.count_nonzero(rows == 0.0))
+        if empty:
+            raise InputError(f"model {self.meta.get('model')}: {empty} of {self.n} unknowns carry no mass (fields "
+                             "without a kinetic density obey first-order or algebraic laws, D(q) q' + f(q) = 0); "
+                             "simulate integrates continua with a mass on every field", key="kind",
+                             expected="steady, stability or continuation for a first-order continuum (js_fluid), or "
+                                      "a kinetic density on every field")
 
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
         """dx/dt = (v, -M^-1 r(q, v, 0))."""

@@ -52,6 +52,9 @@ LYAPUNOV_STEP = 1e-3
 HOPF_IMAG_SHARE = 1e-7
 #: bisection tolerance along a segment (its share of the chord; :func:`bisect`)
 LOCATE_TOL = 1e-10
+#: the most bisection steps of a location: 2^-60 of the chord is far below LOCATE_TOL (34 steps reach it when the
+#: corrected points stay on the bracket's piece of branch)
+BISECT_STEPS = 60
 
 
 @dataclass(frozen=True)
@@ -174,13 +177,15 @@ def other_direction(eqs, x: np.ndarray, known: np.ndarray) -> np.ndarray:
 def bisect(eqs, xa: np.ndarray, xb: np.ndarray, value: Callable) -> np.ndarray:
     """The zero of the test function ``value`` between the branch points xa and xb (opposite signs): bisection
     along the segment (points corrected onto the branch, mechgen.runtime.steady.branch_scan.point_between) to
-    LOCATE_TOL of it, or until a point cannot be corrected (near a BP the bordered system is singular), then one
-    secant step between the last two corrected points, x = x_a + (x_b - x_a) v_a / (v_a - v_b): off the branch
+    LOCATE_TOL of it (at most BISECT_STEPS halvings), or until a point cannot be corrected (near a BP the bordered
+    system is singular), then one secant step between the last two corrected points, x = x_a + (x_b - x_a) v_a / (v_a - v_b): off the branch
     by the square of the last bracket (the branch's curvature times it)."""
     x_lo, x_hi = np.asarray(xa, float), np.asarray(xb, float)
     v_lo, v_hi = value(x_lo), value(x_hi)
     width = float(np.linalg.norm(x_hi - x_lo))
-    while np.linalg.norm(x_hi - x_lo) > LOCATE_TOL * width:
+    for _ in range(BISECT_STEPS):  # the chord halves each step; the corrected points may not follow it (a sheet
+        if np.linalg.norm(x_hi - x_lo) <= LOCATE_TOL * width:  # jumped near a fold cascade): bounded, never a hang
+            break
         try:  # the middle of the current bracket: its chord's error shrinks with the square of its length
             x = branch_scan.point_between(eqs, x_lo, x_hi, 0.5)
         except ConvergenceError:
