@@ -625,7 +625,8 @@ def test_a_hybrid_event_store_past_the_memory_is_refused(tmp_path, capsys, monke
     body = (f'model = "{BALL}"\n[[analysis]]\nname = "d"\nkind = "simulate"\nmethod = "DOP853"\nt_end = 1.0\n'
             'q0 = {{ y = 1.0 }}\n{extra}')
     monkeypatch.setenv("MECHGEN_MEMORY_LIMIT", "1GiB")
-    scene.write_text(body.format(extra="max_events = 1000000000\nmax_steps = 1000000000\n"))
+    # max_seconds raised so that the event count passes the time estimate (10^9 x EVENT_SECONDS = 10^4 s)
+    scene.write_text(body.format(extra="max_events = 1000000000\nmax_steps = 1000000000\nmax_seconds = 100000\n"))
     code, err = _run(["run", str(scene)], capsys)
     assert code == 2 and "at key 'max_events'" in err, err
     assert f"{10**9 * (EVENT_BYTES + 48) / 2**30:.3g} GiB" in err, err
@@ -643,7 +644,8 @@ def periodic_scene() -> str:
 
 @pytest.mark.parametrize("extra, key", [("max_events = 1000000000", "analysis[1].max_events"),
                                         ("zeno_events = 20000", "analysis[1].zeno_events"),
-                                        ("max_events = 1000000000\nmax_steps = 1000000000", "max_events")])
+                                        ("max_events = 1000000000\nmax_steps = 1000000000\nmax_seconds = 100000",
+                                         "max_events")])
 def test_periodic_event_limits_are_bounded_up_front(tmp_path, capsys, extra, key):
     """The hybrid periodic kind refuses max_events above its step budget (default 10^5 steps) and zeno_events above
     max_events at load, as simulate does, and an event store past the memory before it runs."""
@@ -676,6 +678,104 @@ def test_a_huge_rod_is_refused_before_it_starts(tmp_path, capsys, monkeypatch, s
     code, err = _run(["run", str(tmp_path / scene)], capsys)
     assert code == 2 and "'elements'" in err and f"{100_000 * per_element / 2**30:.3g} GiB" in err, err
     assert time.monotonic() - started < 30
+
+
+# ------------------------------------------------------------- item 5: wall time estimated before the work starts
+
+
+def _one_analysis(tmp_path, scene: str, analysis: str, extra: str = "") -> Path:
+    """A copy of a shipped scene holding its analysis ``analysis`` alone, with ``extra`` lines in that table."""
+    text = (SCENES_DIR / scene).read_text().split("\n[[analysis]]\nname = ")
+    kept = [t for t in text[1:] if t.startswith(f'"{analysis}"')]
+    assert len(kept) == 1, scene
+    path = tmp_path / scene
+    path.write_text(text[0] + "\n[[analysis]]\nname = " + kept[0].rstrip() + "\n" + extra)
+    return path
+
+
+def test_a_sparse_eigenproblem_past_its_wall_time_is_refused_up_front(tmp_path, capsys):
+    """Beck's column with count at N = 2 x 10^5 and max_seconds = 10: sparse_seconds (c n^(4/3) per solve,
+    measured) for the solve of 4 x 10^5 unknowns and its 2N check is about 93 s, refused at the flag that set N
+    before anything is factorised (the solve itself would take about 2 minutes here); refine = false drops the 2N
+    solve from the estimate (25 s, still refused)."""
+    import time
+
+    from mechgen.runtime.linear.stability import sparse_seconds
+
+    n = 4 * 10**5  # hermite: 2 unknowns per node
+    for extra, seconds in [("", sparse_seconds(n, general=True) + sparse_seconds(2 * n, general=True)),
+                           ("refine = false\n", sparse_seconds(n, general=True))]:
+        scene = _one_analysis(tmp_path, "beck_column.toml", "at_P", "max_seconds = 10\n" + extra)
+        started = time.monotonic()
+        code, err = _run(["run", str(scene), "--set", "N=200000"], capsys)
+        elapsed = time.monotonic() - started
+        message = err.strip().splitlines()[-1]
+        assert code == 2 and "at key '--set N'" in message and "max_seconds = 10" in message, message
+        assert f"max_seconds raised above {seconds:.3g}" in message, message
+        assert elapsed < 5, elapsed  # refused before assembly and factorisation (about 0.5 s here)
+
+
+def test_a_sparse_eigenproblem_within_its_wall_time_runs(tmp_path, capsys):
+    """Beck's column at N = 5000 (10^4 unknowns, sparse path): the estimate (about 0.7 s) is far below the
+    max_seconds = 30 given, and the run ends with a verdict (exit 0): the estimate refuses nothing it should run."""
+    from mechgen.runtime.linear.stability import sparse_seconds
+
+    assert sparse_seconds(10**4, general=True) + sparse_seconds(2 * 10**4, general=True) < 1.0
+    scene = _one_analysis(tmp_path, "beck_column.toml", "at_P", "max_seconds = 30\n")
+    code, err = _run(["run", str(scene), "--set", "N=5000"], capsys)
+    assert code == 0, err
+
+
+@pytest.mark.parametrize("scene, extra, least", [
+    # 5 load steps (ceil(10 / 2)) x 10^5 elements x 40 us
+    ("rod_tip_load.toml", "elements = 100000\nsteps = 10\nmax_seconds = 5\n", 5 * 10**5 * 4.0e-5),
+    # 400 steps (t_end / dt) x 2 x 10^4 elements x 2.8 us
+    ("rod_dynamics.toml", "elements = 20000\nmax_seconds = 5\n", 400 * 2 * 10**4 * 2.8e-6)])
+def test_a_rod_past_its_wall_time_is_refused_up_front(tmp_path, capsys, scene, extra, least):
+    """The rods' least wall time (measured cost per element of a Newton iteration or solve, times the least count of
+    them) above max_seconds is refused at 'elements' in well under a second, before any element is built."""
+    import time
+
+    text = re.sub(r"(elements|steps) = \d+\n", "", (SCENES_DIR / scene).read_text())
+    (tmp_path / scene).write_text(text.rstrip() + "\n" + extra)
+    started = time.monotonic()
+    code, err = _run(["run", str(tmp_path / scene)], capsys)
+    assert code == 2 and "at key 'elements'" in err and f"max_seconds raised above {least:.3g}" in err, err
+    assert time.monotonic() - started < 5
+
+
+@pytest.mark.parametrize("scene", ["rod_tip_load.toml", "rod_dynamics.toml", "rod_end_torque.toml"])
+def test_the_shipped_rods_are_not_refused(scene, capsys):
+    """The shipped rod scenes run (exit 0) under the default max_seconds: their estimates are far below it."""
+    code, err = _run(["run", str(SCENES_DIR / scene)], capsys)
+    assert code == 0, err
+
+
+@pytest.mark.parametrize("extra, key", [
+    ("zeno_events = 100000000\nmax_events = 100000000\nmax_steps = 100000000\n", "analysis[1].zeno_events"),
+    ("max_events = 100000000\nmax_steps = 100000000\n", "analysis[1].max_events"),
+    ("max_events = 1000000\nmax_steps = 1000000\nmax_seconds = 5\n", "analysis[1].max_events")])
+def test_event_counts_past_the_wall_time_are_refused_at_load(tmp_path, capsys, extra, key):
+    """10^8 events at EVENT_SECONDS (10 us, the compiled loop's measured 13-15 us on a bouncing ball rounded down)
+    take at least 1000 s, more than max_seconds = 600: a Zeno limit or an event limit the budget cannot reach is
+    refused at its key at load (zeno_events first: it is what would end a Zeno run); 10^6 under max_seconds = 5 too."""
+    (tmp_path / "ball.py").write_text(Path(BALL).read_text())
+    scene = tmp_path / "ball.toml"
+    scene.write_text('model = "ball.py"\n[[analysis]]\nname = "d"\nkind = "simulate"\nt_end = 1.0\n'
+                     'q0 = { y = 1.0 }\n' + extra)
+    code, err = _run(["run", str(scene)], capsys)
+    assert code == 2 and f"at key '{key}'" in err and "max_seconds" in err, err
+
+
+def test_event_counts_within_the_wall_time_run(tmp_path, capsys):
+    """max_events = 10^6 (at least 10 s of events, under the default 600 s) is accepted: the ball's run to
+    t_end = 1 s (its one impact at t = 0.45 s, before the Zeno time 4.1 s) ends normally (exit 0)."""
+    (tmp_path / "ball.py").write_text(Path(BALL).read_text())
+    scene = tmp_path / "ball.toml"
+    scene.write_text('model = "ball.py"\n[[analysis]]\nname = "d"\nkind = "simulate"\nt_end = 1.0\n'
+                     'q0 = { y = 1.0 }\nmax_events = 1000000\nmax_steps = 1000000\n')
+    code, err = _run(["run", str(scene)], capsys)
+    assert code == 0, err
 
 
 @pytest.mark.parametrize("exc", [MemoryError(), SystemError("SuperLU: out of memory"),

@@ -29,10 +29,11 @@ from mechgen.analyses.operating_point import equilibrium_point, linear_about
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import LINEAR_OPTIONS
 from mechgen.analyses.whirl import is_gyroscopic, run_damped_modes
+from mechgen.runtime.core.budget import DEFAULT_SECONDS, require_seconds
 from mechgen.runtime.core.memory import require
 from mechgen.runtime.fields.constrain import warn_penalty_errors
 from mechgen.runtime.linear.modes import modes as solve_modes
-from mechgen.runtime.linear.stability import SPARSE_BYTES_PER_UNKNOWN
+from mechgen.runtime.linear.stability import SPARSE_BYTES_PER_UNKNOWN, sparse_seconds
 
 def needs(options: dict, *, internal: bool) -> set[str]:
     """M, D, G, K: the linear kernel; the residual too, to check that the point is an equilibrium (no ``about``)."""
@@ -77,7 +78,9 @@ def require_sparse_modes(system, options: dict) -> None:
     """Refuse up front (exit 2 at params.N) a continuum's sparse modes solve (``count`` of a large N) whose memory,
     SPARSE_BYTES_PER_UNKNOWN x its unknowns (2n for a rotor's first-order whirl problem), exceeds the limit: the
     symmetric solve measured 1.7 kB per unknown (Euler-Bernoulli beam, quintic, count = 5: peak RSS 154 MB at
-    N = 10^4, 769 MB at N = 10^5, 4 unknowns per element), under the stability solve's 2.8 kB."""
+    N = 10^4, 769 MB at N = 10^5, 4 unknowns per element), under the stability solve's 2.8 kB.
+    Refused too when its wall time, sparse_seconds(n) (the non-symmetric one for a rotor's whirl), exceeds
+    ``max_seconds``."""
     if not (options.get("count") and getattr(system, "is_field", False)):
         return
     n = int(system.n)
@@ -85,6 +88,9 @@ def require_sparse_modes(system, options: dict) -> None:
     if largest > 200:
         require(SPARSE_BYTES_PER_UNKNOWN * largest, f"the sparse modes solve of {largest} unknowns", key="params.N",
                 expected="a smaller N")
+        require_seconds(sparse_seconds(n, general=bool(system.metadata.whirl)),
+                        float(options.get("max_seconds", DEFAULT_SECONDS)), f"the sparse modes solve of {n} unknowns",
+                        key="params.N", basis="c n^(4/3), measured", expected="a smaller N")
 
 
 def modal_outputs(names, M, K, phi: np.ndarray) -> dict:

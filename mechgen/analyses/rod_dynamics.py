@@ -32,6 +32,7 @@ Newton iteration fails even when split 12 times is a ConvergenceError naming the
 """
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -42,6 +43,7 @@ from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.rod_statics import AXES, MAX_ELEMENTS, bounded, rod_of, vector3
 from mechgen.analyses.schema import Option
 from mechgen.errors import InputError
+from mechgen.runtime.core.budget import DEFAULT_SECONDS, require_seconds
 from mechgen.runtime.core.memory import require
 from mechgen.runtime.rods.ends import ENDS
 from mechgen.scene.values import fail
@@ -54,6 +56,11 @@ if TYPE_CHECKING:
 ELEMENT_BYTES = 32_000
 
 MAX_STEPS = 10_000_000
+#: wall time per element of one Newton solve of a midpoint step (residual, banded solve; the Jacobian is refreshed
+#: now and then), seconds: measured 2.85 us per element and solve on a 2-core machine (issue 33:
+#: scenes/rod_dynamics.toml at 2 000 elements, 40 steps, 205 solves in 1.17 s; 14.6-15.5 us per element and step
+#: at 2 000-8 000 elements, about 5 solves a step)
+SOLVE_SECONDS = 2.8e-6
 
 
 _elements = bounded(1, MAX_ELEMENTS)
@@ -158,6 +165,16 @@ def initial_state(body: RodBody, elements: int, v0, w0):
     return st
 
 
+def require_dynamics_time(options: dict) -> None:
+    """Refuse up front (exit 2 at ``elements``) a run whose least wall time exceeds ``max_seconds``: ceil(t_end / dt)
+    steps of at least one Newton solve each, SOLVE_SECONDS per element a solve."""
+    n, steps = int(options["elements"]), max(math.ceil(options["t_end"] / options["dt"] - 1e-9), 0)
+    require_seconds(SOLVE_SECONDS * n * steps, float(options.get("max_seconds", DEFAULT_SECONDS)),
+                    f"rod dynamics with {n} elements and {steps:,} steps", key="elements",
+                    basis=f"at least one Newton solve a step, {SOLVE_SECONDS * 1e6:.3g} us per element, measured",
+                    expected="fewer elements, or a larger dt or shorter t_end")
+
+
 def run_rod_dynamics(system, options: dict, context: dict) -> dict:
     """March the midpoint step; the saved tip path and energies and the final fields."""
     from mechgen.runtime.rods.dynamics import Discrete, simulate
@@ -167,6 +184,7 @@ def run_rod_dynamics(system, options: dict, context: dict) -> dict:
     n = options["elements"]
     require(ELEMENT_BYTES * n, f"rod dynamics with {n} elements", key="elements",
             expected="fewer elements (the midpoint rule converges at order 2 in space)")
+    require_dynamics_time(options)
     disc = Discrete(body, n, options["base"], options["tip"])
     st = initial_state(body, n, options["initial_velocity"], options["initial_angular_velocity"])
     axis = AXES[options["bending_axis"]]

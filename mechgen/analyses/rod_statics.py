@@ -39,6 +39,7 @@ from mechgen.analyses.cross_section import STRAINS, checked_stiffness
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import Option
 from mechgen.errors import InputError
+from mechgen.runtime.core.budget import DEFAULT_SECONDS, require_seconds
 from mechgen.runtime.core.memory import require
 from mechgen.runtime.rods.ends import ENDS, UNCONSTRAINED
 from mechgen.scene.values import fail, show, type_name
@@ -64,6 +65,11 @@ MAX_ELEMENTS = 100_000
 #: took 1.7 GiB within 15 s and ran on)
 ELEMENT_BYTES = 48_000
 MAX_STEPS = 10_000
+#: wall time per element of one Newton iteration (the element residuals and Jacobian, the sparse or 12 x 12 solve),
+#: seconds: measured on a 2-core machine (issue 33) for scenes/rod_end_torque.toml and rod_tip_load.toml:
+#: collocation 40-51 us at 1 000-4 000 elements and 102 us at 16 000, shooting (RKMK4 with the AD Jacobian through
+#: the steps) 395-408 us at 1 000-4 000 steps; rounded down
+ITERATION_SECONDS = {"collocation": 4.0e-5, "shooting": 3.9e-4}
 
 
 def bounded(low: int, high: int):
@@ -186,6 +192,19 @@ def _check_spd(system, K: np.ndarray) -> None:
                          expected="EA, GA, GJ, EI > 0 (a symmetric positive definite K)")
 
 
+def require_statics_time(options: dict) -> None:
+    """Refuse up front (exit 2 at ``elements``) a solve whose least wall time exceeds ``max_seconds``: every load
+    step takes at least one Newton iteration and the load path at least ceil(steps / 2) steps (a step grows to at
+    most 2 / steps; shooting solves the unloaded state first), at ITERATION_SECONDS[method] per element each."""
+    method, n = options["method"], int(options["elements"])
+    iterations = -(-int(options["steps"]) // 2) + (method == "shooting")
+    seconds = ITERATION_SECONDS[method] * n * iterations
+    require_seconds(seconds, float(options.get("max_seconds", DEFAULT_SECONDS)), f"rod statics ({method}) with {n} "
+                    "elements", key="elements", basis=f"at least {iterations} Newton iterations of "
+                    f"{ITERATION_SECONDS[method] * 1e6:.3g} us per element, measured",
+                    expected="fewer elements (a few hundred resolve most rods)")
+
+
 def _point(rod: Rod, state, axis) -> dict:
     from mechgen.runtime.rods.statics import turning_angle
 
@@ -205,6 +224,7 @@ def run_rod_statics(system, options: dict, context: dict) -> dict:
     require(ELEMENT_BYTES * options["elements"], f"rod statics ({options['method']}) with {options['elements']} "
             "elements", key="elements", expected="fewer elements (the midpoint collocation converges at order 2: "
             "a few hundred elements resolve most rods)")
+    require_statics_time(options)
     path = solve_statics(rod, method=options["method"], elements=options["elements"], steps=options["steps"],
                          tol=options["tol"], min_step=options["min_step"], jacobian=options["jacobian"])
     final, axis = path.final, AXES[options["bending_axis"]]

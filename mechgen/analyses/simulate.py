@@ -188,10 +188,17 @@ def check(ctx, base: str, options: dict) -> None:
     check_event_bounds(ctx, base, options)
 
 
+#: the least wall time of one event of a hybrid run, seconds: the compiled loop (the quicker one) on the smallest model,
+#: a bouncing ball (2 states, DOP853, the event located and the state reset), measured 13-15 us per event over 10^4
+#: and 10^5 events on a 2-core machine (the Python loop: 1.4 ms); rounded down (issue 33)
+EVENT_SECONDS = 1.0e-5
+
+
 def check_event_bounds(ctx, base: str, options: dict) -> None:
     """max_events <= max_steps (every event but one at a mode's start ends an accepted step, so a larger count
     can never be reached within the step budget) and zeno_events <= max_events (issue 33: a run with both at
-    10^9 ran on, its Zeno ring alone 8 GB); refused up front at the key."""
+    10^9 ran on, its Zeno ring alone 8 GB); refused up front at the key. A ``zeno_events`` or ``max_events`` given
+    whose events would take more than ``max_seconds`` at EVENT_SECONDS each is refused too (:func:`check_event_time`)."""
     from mechgen.runtime.integration.run_options import EventRules
 
     method = options.get("method", "auto")
@@ -204,6 +211,21 @@ def check_event_bounds(ctx, base: str, options: dict) -> None:
     if "zeno_events" in options and int(options["zeno_events"]) > events:
         raise fail(ctx.file, f"{base}.zeno_events", f"zeno_events = {int(options['zeno_events']):,} exceeds "
                    f"max_events = {events:,}: the Zeno test could never end the run", "zeno_events <= max_events")
+    check_event_time(ctx, base, options)
+
+
+def check_event_time(ctx, base: str, options: dict) -> None:
+    """Refuse at load (exit 2 at the key) a ``zeno_events`` (first) or ``max_events`` the scene gives that the
+    wall-time budget could not reach: count x EVENT_SECONDS > max_seconds (the Zeno test, or the event limit,
+    could then never be what ends the run)."""
+    seconds = float(options.get("max_seconds", DEFAULT_SECONDS))
+    for key, role in (("zeno_events", "the Zeno test"), ("max_events", "the event limit")):
+        if key in options and int(options[key]) * EVENT_SECONDS > seconds:
+            count = int(options[key])
+            raise fail(ctx.file, f"{base}.{key}", f"{key} = {count:,} events would take at least "
+                       f"{count * EVENT_SECONDS:.3g} s ({EVENT_SECONDS * 1e6:.3g} us an event, measured), more than "
+                       f"the wall-time budget max_seconds = {seconds:g}: {role} could never end the run",
+                       f"{key} <= {int(seconds / EVENT_SECONDS):,}, or max_seconds raised with it")
 
 
 def needs(options: dict, *, internal: bool) -> set[str]:

@@ -27,9 +27,11 @@ from mechgen.analyses import figures, schema, summary
 from mechgen.analyses.operating_point import equilibrium_point, linear_about
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import LINEAR_OPTIONS, Option
+from mechgen.runtime.core.budget import DEFAULT_SECONDS, require_seconds
 from mechgen.runtime.core.memory import require, require_dense
 from mechgen.runtime.linear.stability import stability as solve_stability
-from mechgen.runtime.linear.stability import SPARSE_BYTES_PER_UNKNOWN, stability_first_order, stability_sparse
+from mechgen.runtime.linear.stability import (SPARSE_BYTES_PER_UNKNOWN, sparse_seconds, stability_first_order,
+                                              stability_sparse)
 
 #: above this many unknowns, a stability analysis with a ``count`` of sparse matrices uses shift-invert
 SPARSE_STABILITY_N = 400
@@ -63,7 +65,8 @@ def _stability_of(system, q, options: dict, context: dict):
 
 def require_sparse_stability(system, options: dict) -> None:
     """Refuse up front (exit 2 at params.N) a continuum's sparse stability solve whose memory, SPARSE_BYTES_PER_UNKNOWN
-    x the unknowns of its largest solve (2n when refined at 2N), exceeds the limit (mechgen.runtime.core.memory)."""
+    x the unknowns of its largest solve (2n when refined at 2N), exceeds the limit (mechgen.runtime.core.memory), or
+    whose wall time, sparse_seconds(n) (+ sparse_seconds(2n) refined), exceeds ``max_seconds``."""
     if not (options.get("count") and getattr(system, "is_field", False)):
         return
     n = int(system.n)
@@ -74,6 +77,11 @@ def require_sparse_stability(system, options: dict) -> None:
     require(SPARSE_BYTES_PER_UNKNOWN * largest, f"the sparse stability solve of {largest} unknowns"
             + (f" (refined at 2N from {n})" if refined else ""), key="params.N",
             expected="a smaller N" + (", or refine = false" if refined else ""))
+    seconds = sparse_seconds(n, general=True) + (sparse_seconds(2 * n, general=True) if refined else 0.0)
+    require_seconds(seconds, float(options.get("max_seconds", DEFAULT_SECONDS)), f"the sparse stability solve of {n} "
+                    "unknowns" + (f" and its check at 2N ({2 * n} unknowns)" if refined else ""), key="params.N",
+                    basis="c n^(4/3) per solve of n unknowns, measured", expected="a smaller N"
+                    + (", or refine = false" if refined else ""))
 
 
 def refinement_verdict(verdicts: list[str], structures: list[tuple[int, int]]) -> str:

@@ -29,7 +29,7 @@ import threading
 import time
 from typing import Callable
 
-from mechgen.errors import MechgenError
+from mechgen.errors import InputError, MechgenError
 
 #: default wall-time budget of an analysis, seconds (the longest shipped scene's analysis takes ~20 s)
 DEFAULT_SECONDS = 600.0
@@ -146,6 +146,23 @@ class Budget:
                 sys.stderr.write(f"mechgen: {self.what}: {total:,} {self.unit} will take about "
                                  f"{_duration(estimate)} ({self.seconds_key} = {self.seconds:g})\n")
         self.check_time(reached, elapsed)  # the same reading: past the budget, the estimate (>= it) said so first
+
+
+def require_seconds(estimate: float, seconds: float | None, what: str, *, key: str, basis: str,
+                    expected: str | None = None) -> None:
+    """Refuse up front (InputError, exit 2 at ``key``, the scene key that sets the size of the work) work whose
+    wall time, estimated before it starts as ``estimate`` seconds (``basis``: the measured unit cost times the
+    units, as the caller states it), exceeds the analysis's budget ``seconds`` (max_seconds; None: no budget).
+
+    Estimates are made from per-unit costs measured on a 2-core machine (the constants beside each caller) and
+    count the least work the run can do, so that a run refused here would have been stopped by the budget anyway;
+    nothing has started when this raises."""
+    if seconds is None or not estimate > seconds:
+        return
+    hint = expected or f"a smaller {key.rpartition('.')[2]}"
+    raise InputError(f"{what} would take about {_duration(estimate)} ({basis}), more than the wall-time budget "
+                     f"{SECONDS_KEY} = {seconds:g}; nothing was started", key=key,
+                     expected=f"{hint}, or {SECONDS_KEY} raised above {estimate:.3g} in the analysis's table")
 
 
 def _text(reached: Callable[[], str] | str) -> str:

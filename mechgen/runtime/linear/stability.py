@@ -300,6 +300,22 @@ def stability_first_order(A, E, *, tolerance: float | None = None) -> StabilityR
 #: at 2N (hermite: 2 per node): 2.8 kB per unknown, with a margin (issue 33: N = 10^6 ran 10 min past 3.4 GiB)
 SPARSE_BYTES_PER_UNKNOWN = 4_000
 
+#: wall time of one sparse shift-invert eigen-solve of n unknowns (n: the size of M and K; the non-symmetric solve
+#: works on the first-order pencil of size 2n), c n^(4/3) seconds: ARPACK's iterations grow with n, so the time
+#: per unknown does too. Measured on a 2-core machine (issue 33): Beck's column (scenes/beck_column.toml,
+#: stability, count = 3, solves at N and 2N, c (n^(4/3) + (2n)^(4/3))) 1.91 s at N = 10^4 and 40.9 s at N = 10^5
+#: (c = 1.00e-6 and 0.99e-6: exponent 1.33); the Euler-Bernoulli beam's modes (quintic, count = 5) 0.37 s at
+#: 4 x 10^4 unknowns and 6.5 s at 4 x 10^5 (c = 2.7e-7 and 2.2e-7: exponent 1.25), the string's (lagrange1) about a
+#: minute at 2 x 10^6 (c n^(4/3) = 50 s); rounded down. Beck's column at N = 10^6: about 15 min (issue 33: it ran
+#: past 10 minutes).
+SPARSE_SECONDS = {"symmetric": 2.0e-7, "general": 9.0e-7}
+
+
+def sparse_seconds(n: int, *, general: bool) -> float:
+    """The estimated wall time (s) of one sparse shift-invert eigen-solve of n unknowns: c n^(4/3), c from
+    SPARSE_SECONDS (``general``: the non-symmetric solve of stability and damped modes; else K x = w^2 M x)."""
+    return SPARSE_SECONDS["general" if general else "symmetric"] * float(n) ** (4.0 / 3.0)
+
 
 def low_shift(M, K, scale: float, steps: int = 8) -> float:
     """The shift sigma = -1e-3 omega_low of the sparse stability solve, omega_low^2 the Rayleigh quotient
