@@ -7,6 +7,9 @@ accuracy, mechgen.runtime.linear.modes.rigid_count; they are not frequencies, an
 the elastic modes after them) with, for a lumped model, ``rigid_shapes`` (one {coordinate: value}
 per rigid mode, largest entry 1); ``operating_point`` when the point given (``at``, or zero) was
 not an equilibrium and Newton found one (mechgen.analyses.operating_point.equilibrium_point).
+A continuum's ``count`` (the sparse shift-invert path) is estimated before it starts, memory and wall time
+(c n^(4/3), mechgen.runtime.linear.stability.sparse_seconds), and refused with exit 2 at ``params.N`` beyond the
+memory limit or ``max_seconds``.
 
 A lumped model (not a continuum, not a chain) also gets ``shapes``: one {coordinate: value} per elastic
 mode, in the order of ``frequencies``, mass-normalised (phi^T M phi = 1) and signed so that the first

@@ -27,7 +27,9 @@ order-2 error), ``orthonormality_error`` (max |R^T R - I| over the final nodes),
 line), ``shapes`` (saved), ``strain``/``stress_resultant`` (final, per element: eps = f - f0 and sigma =
 K eps), ``steps``, ``newton_iterations``, ``jacobians``, ``splits`` (steps split in halves for Newton),
 ``dt``, ``elements``. Bad input (exit 2): M not diag(rhoA I, J) with rhoA > 0 and J SPD (key ``params``), the
-stiffness checks of ``rod_statics``; dt > t_end or more than 10^7 steps (``<analysis>.dt``). A step whose
+stiffness checks of ``rod_statics``; dt > t_end or more than 10^7 steps (``<analysis>.dt``); ``elements`` whose
+memory or least wall time (ceil(t_end / dt) Newton solves of SOLVE_SECONDS per element) exceeds the memory limit or
+``max_seconds``. A step whose
 Newton iteration fails even when split 12 times is a ConvergenceError naming the time reached (exit 1).
 """
 from __future__ import annotations

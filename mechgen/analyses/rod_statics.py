@@ -24,8 +24,9 @@ in the section frame, n x 6: N, N m), ``branch`` (per load step: ``load`` factor
 ``tip_torque``, ``tip_position``, ``tip_rotation``, ``shape``), ``velocity`` (eta = (R^T (Omega x r), R^T Omega),
 n x 6, m/s and rad/s in the section frame), ``orthonormality_error`` (max |R^T R - I|),
 ``iterations`` (Newton, last step). Bad input (exit 2): K not symmetric positive definite (key ``params``),
-L <= 0 (``params.L``), ends that leave the rod free to move rigidly (``<analysis>.tip``). A load path that
-does not converge is a ConvergenceError naming the last load factor reached (exit 1).
+L <= 0 (``params.L``), ends that leave the rod free to move rigidly (``<analysis>.tip``), ``elements`` whose
+memory or least wall time (ceil(steps / 2) Newton iterations of ITERATION_SECONDS per element) exceeds the memory
+limit or ``max_seconds`` (key ``elements``). A load path that does not converge is a ConvergenceError naming the last load factor reached (exit 1).
 """
 from __future__ import annotations
 

@@ -14,7 +14,8 @@ history; left out: kept while small, mechgen.analyses.time_series), ``samples``,
 ``energy_drift`` (a conservative run) or ``energy_balance_error``, ``work`` and ``dissipated``
 (mechgen.analyses.energy_balance), ``t_end``, ``method`` and ``loop`` (what ran); a fixed-end chain also
 ``mode_energies``. A model with modes is run by mechgen.analyses.simulate_hybrid, with the keys ``mode``,
-``max_events``, ``zeno_events``, ``zeno_span`` and ``on_zeno``.
+``max_events``, ``zeno_events``, ``zeno_span`` and ``on_zeno``; a ``zeno_events`` or ``max_events`` given that
+could not be reached within ``max_seconds`` at EVENT_SECONDS an event is refused at load (exit 2 at that key).
 
 Work budget (mechgen.runtime.core.budget): ``max_steps`` (integrator steps; default 10^7 for the
 leapfrog, whose t_end / dt steps are refused before the first one when they exceed it, and 10^5

@@ -7,7 +7,9 @@ condition number times the round-off of the solve, mechgen.runtime.linear.stabil
 physical damping shifts no stability boundary by more than that accuracy; ``tolerance = 1e-8``
 (a number): a fixed threshold of that much times the spectrum's scale (the largest |s|) for every
 eigenvalue, the rule before (the sparse path, above SPARSE_STABILITY_N unknowns with ``count``,
-uses 1e-8 when none is given: ARPACK's accuracy).
+uses 1e-8 when none is given: ARPACK's accuracy). That sparse path is estimated before it starts, memory and wall
+time (c n^(4/3) per solve, mechgen.runtime.linear.stability.sparse_seconds, the 2N check included), and refused
+with exit 2 at ``params.N`` beyond the memory limit or ``max_seconds``.
 
 Outputs: ``eigenvalues`` (list of [re, im]; with ``count``, the 2 count of smallest |s|, from which the
 ``count`` lowest ``frequencies`` are taken; the verdict is that of the whole computed spectrum),
