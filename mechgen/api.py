@@ -57,7 +57,7 @@ def compile(model, params: Mapping | None = None, *, free=None, backend: str = "
         raise InputError(f"model is {type(model).__name__}", key="model",
                          expected="a mechgen.Model or a model reference (a name, a .py path, module:attribute)")
     values = _values(model, params)
-    layout = _layout(model, segments, parts)
+    layout = _layout(model, segments, parts, values)
     free = _free(model, free, layout)
     spec = specialize(model, values, free=free)
     wanted = all_kernels(model) if kernels is None else _kernel_names(kernels)
@@ -146,7 +146,7 @@ def _kernel_names(kernels) -> tuple[str, ...]:
     return names
 
 
-def _layout(model, segments, parts):
+def _layout(model, segments, parts, values: dict):
     """A :class:`~mechgen.runtime.fields.mesh.Layout` of the given segments and parts (None when there are none)."""
     from mechgen.runtime.fields.mesh import Layout, Part, Segment
 
@@ -184,4 +184,18 @@ def _layout(model, segments, parts):
             raise InputError(f"part kind {part.kind!r} is not declared by model {model.name}", key=f"parts[{i}].kind",
                              expected="one of: " + (", ".join(sorted(kinds)) or "none (the model declares no parts)"))
         out_parts.append(part)
+    _check_parts(model, out_parts, values)
     return Layout(tuple(out_segments), tuple(out_parts))
+
+
+def _check_parts(model, parts, values: dict) -> None:
+    """Each part's values against its kind's declared checks (Model.part), as a scene's [[parts]] are: InputError at
+    ``parts[i].<key>``; a value the part leaves out is the compile's ``<kind>_<name>`` or the declared default."""
+    if not any(model.part_checks.get(part.kind) for part in parts):
+        return
+    from mechgen.scene.info import info_of_model
+    from mechgen.scene.layout import check_part
+
+    info = info_of_model(model)
+    for i, part in enumerate(parts, 1):
+        check_part(None, f"parts[{i}]", info, part.kind, dict(part.values), values)

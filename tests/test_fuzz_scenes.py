@@ -191,6 +191,7 @@ EXPLICIT = {
                             (2,), "kind", None),
     # issue 33, the fuzz corpus of 500 (tests/fuzzing.py --examples 500 --seed 1 --limit 10): a disk's bore above
     # its outer diameter makes M singular; the message named only the internal key 'M' and the params, not the part
+    # (now refused at load, at parts[1].inner, by the disk's declared check: Model.part's checks)
     "ross_disk_inner_999999": (lambda: _edit("ross_example_rotor", [(("parts", 0, "inner"), 999999)], limit=60.0),
                                (2,), "parts", None),
     # the same corpus re-run: 216 mode shapes of a 216-element beam at 3 sweep points tabulated the basis row by row

@@ -70,7 +70,9 @@ model.whirl_pair("ux", "uy")
 model.part("disk", Param("m", 0.0, "kg", "mass"), Param("Id", 0.0, "kg m^2", "diametral moment of inertia"),
            Param("Ip", 0.0, "kg m^2", "polar moment of inertia"), Param("rho", 0.0, "kg/m^3", "density"),
            Param("width", 0.0, "m", "axial width"), Param("outer", 0.0, "m", "outer diameter"),
-           Param("inner", 0.0, "m", "inner (bore) diameter"))
+           Param("inner", 0.0, "m", "inner (bore) diameter"),
+           checks={"inner": ("inner < outer or inner == 0 and outer == 0",
+                             "an inner (bore) diameter below the outer diameter (both 0: no disk geometry)")})
 model.part("bearing", *(Param(f"k{ij}", 0.0, "N/m", f"stiffness {ij}") for ij in ("xx", "xy", "yx", "yy")),
            *(Param(f"c{ij}", 0.0, "N s/m", f"damping {ij}") for ij in ("xx", "xy", "yx", "yy")))
 

@@ -313,3 +313,71 @@ def _value(name: str, values: Mapping[str, Any], expr: Expression) -> float:
         return float(value)
     except OverflowError:
         raise expr._error(f"value of '{name}' is too large", "a finite value") from None
+
+
+# ------------------------------------------------------------------------------------------------ conditions
+
+_COMPARE = {ast.Lt: "<", ast.LtE: "<=", ast.Gt: ">", ast.GtE: ">=", ast.Eq: "==", ast.NotEq: "!="}
+_TESTS: dict[str, Callable[[float, float], bool]] = {
+    "<": lambda a, b: a < b, "<=": lambda a, b: a <= b, ">": lambda a, b: a > b, ">=": lambda a, b: a >= b,
+    "==": lambda a, b: a == b, "!=": lambda a, b: a != b}
+CONDITION = ("comparisons (< <= > >= == !=, chained as in 'a < b <= c') of arithmetic expressions, joined by "
+             "'and' / 'or' with parentheses")
+
+
+@dataclass(frozen=True)
+class Condition:
+    """A validated condition: comparisons of arithmetic expressions (:class:`Expression`, the same whitelist) joined
+    by ``and`` / ``or``, e.g. ``"inner < outer or inner == 0 and outer == 0"``. A model declares such conditions on
+    its part kinds (Model.part's ``checks``); nothing is evaluated as Python.
+
+    Attributes:
+        text: the source text.
+        names: the free names used, in order of first use.
+    """
+
+    text: str
+    names: tuple[str, ...]
+    tree: tuple = ()
+
+    def holds(self, values: Mapping[str, float]) -> bool:
+        """Whether the condition holds with ``values`` bound to its names (InputError as Expression.evaluate)."""
+        return _holds(self.tree, values)
+
+
+def parse_condition(text: str, *, file: str | None = None, key: str | None = None) -> Condition:
+    """Parse and validate a condition string (:class:`Condition`); InputError for anything outside its grammar."""
+    if not isinstance(text, str) or not text.strip() or len(text) > MAX_LENGTH:
+        raise InputError(f"condition is {_show(str(text))}", file=file, key=key,
+                         expected=f"a non-empty string of at most {MAX_LENGTH} characters: {CONDITION}")
+    stripped = text.strip()
+    tree = _parse_tree(stripped, file, key, CONDITION)
+    names: list[str] = []
+    node = _condition(tree.body, stripped, names, file, key)
+    return Condition(text, tuple(names), node)
+
+
+def _condition(node: ast.AST, text: str, names: list[str], file: str | None, key: str | None) -> tuple:
+    """A BoolOp of conditions, or a (chained) comparison whose operands are arithmetic expressions."""
+    if isinstance(node, ast.BoolOp):
+        tag = "and" if isinstance(node.op, ast.And) else "or"
+        return (tag, tuple(_condition(v, text, names, file, key) for v in node.values))
+    if isinstance(node, ast.Compare) and all(type(op) in _COMPARE for op in node.ops):
+        sides = []
+        for operand in (node.left, *node.comparators):
+            expr = parse_expression(ast.get_source_segment(text, operand) or "", file=file, key=key)
+            names.extend(n for n in expr.names if n not in names)
+            sides.append(expr)
+        return ("cmp", tuple(sides), tuple(_COMPARE[type(op)] for op in node.ops))
+    segment = ast.get_source_segment(text, node) or text
+    raise InputError(f"condition {_show(text)}: {_show(segment, 40)} is not a comparison", file=file, key=key,
+                     expected=CONDITION)
+
+
+def _holds(node: tuple, values: Mapping[str, float]) -> bool:
+    if node[0] == "and":
+        return all(_holds(child, values) for child in node[1])
+    if node[0] == "or":
+        return any(_holds(child, values) for child in node[1])
+    numbers_ = [side.evaluate(values) for side in node[1]]
+    return all(_TESTS[op](a, b) for op, a, b in zip(node[2], numbers_, numbers_[1:]))

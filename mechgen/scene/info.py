@@ -25,7 +25,7 @@ from mechgen import models
 from mechgen.errors import InputError, did_you_mean
 
 #: version of the JSON layout of a ModelInfo (part of its cache key)
-INFO_SCHEMA = "model-info-5"
+INFO_SCHEMA = "model-info-6"
 GENERATED = Path(__file__).resolve().parent.parent / "generated"
 
 
@@ -81,6 +81,8 @@ class ModelInfo:
     file: str | None = field(default=None, compare=False)
     #: a plane continuum's fields (mechgen.symbolic.plane); empty for every other model
     plane_fields: tuple[str, ...] = ()
+    #: each part kind's declared checks (Model.part): {kind: ((key, condition, expected), ...)}
+    part_checks: dict = field(default_factory=dict)
     #: the canonical reference of the model (mechgen.models.resolve): what a scene's run compiles
     key: str = field(default="", compare=False)
 
@@ -104,6 +106,7 @@ class ModelInfo:
         # orders matter (free names and parts follow the declaration): pairs, not objects that sort_keys reorders
         data["params"] = [[k, v] for k, v in data["params"].items()]
         data["parts"] = None if self.parts is None else [[k, list(v)] for k, v in self.parts.items()]
+        data["part_checks"] = [[k, [list(c) for c in v]] for k, v in self.part_checks.items() if v]
         return data
 
 
@@ -138,7 +141,31 @@ def info_of_model(model) -> ModelInfo:
                      model.complementary_fn is not None, tuple(model.field_names),
                      tuple(o.name for o in getattr(model, "shape_outputs", ())), bool(model.internals), chain,
                      tuple(model.coordinates_all), tuple(model.part_params()), _modes(model), model.file,
-                     plane_fields=tuple(model.plane_spec.fields) if model.is_plane else ())
+                     plane_fields=tuple(model.plane_spec.fields) if model.is_plane else (),
+                     part_checks=_part_checks(model))
+
+
+def _part_checks(model) -> dict:
+    """The model's part checks (Model.part), each condition parsed once here: ModelError naming the model file at a
+    condition outside the grammar or one that names something other than the part's parameters."""
+    from mechgen.errors import ModelError
+    from mechgen.scene.expr import parse_condition
+
+    out = {}
+    for kind, checks in getattr(model, "part_checks", {}).items():
+        for key, text, _ in checks:
+            where = f"part {kind!r} check at {key!r}"
+            try:
+                names = parse_condition(text).names
+            except InputError as exc:
+                raise ModelError(f"{where}: {exc.message}", file=model.file, key="part", expected=exc.expected) from None
+            unknown = [n for n in names if n not in model.parts[kind]]
+            if unknown:
+                raise ModelError(f"{where}: condition {text!r} names {unknown[0]!r}, not a parameter of the part",
+                                 file=model.file, key="part", expected="one of: " + ", ".join(model.parts[kind]))
+        if checks:
+            out[kind] = tuple(tuple(c) for c in checks)
+    return out
 
 
 def _modes(model) -> tuple[str, ...]:
@@ -161,7 +188,8 @@ def info_from_json(data: dict, *, file: str | None = None) -> ModelInfo:
                      data["length"], parts, data["stress_form"], tuple(data["fields"]), tuple(data["shape_outputs"]),
                      data["internals"], tup(data["chain"]), tuple(data["coordinates_all"]),
                      tuple(data["part_params"]), tuple(data.get("modes", ())), file,
-                     plane_fields=tuple(data.get("plane_fields", ())))
+                     plane_fields=tuple(data.get("plane_fields", ())),
+                     part_checks={k: tuple(tuple(c) for c in v) for k, v in data.get("part_checks", ())})
 
 
 def info_key(source: models.ModelSource) -> str | None:

@@ -101,8 +101,28 @@ def _parts(file: str, data: dict, model: Any, params: dict) -> tuple[Part, ...]:
             full = f"{kind}_{name}"
             if full in model.params:
                 check_value(file, join(base, name), name, model.params[full], values[name], LIMITS)
+        check_part(file, base, model, kind, values, params)
         out.append(Part(kind, at, values))
     return tuple(out)
+
+
+def check_part(file: str | None, base: str, model: Any, kind: str, values: dict, params: dict) -> None:
+    """The part kind's declared checks (Model.part's ``checks``, in the model's facts) on one part's values, what the
+    part leaves out being the scene's ``<kind>_<name>`` in ``params`` or the declared default: the first check that
+    fails is refused (exit 2) at ``<base>.<key>``, naming the values it compared."""
+    checks = (getattr(model, "part_checks", None) or {}).get(kind, ())
+    if not checks:
+        return
+    from mechgen.scene.expr import parse_condition
+
+    full = {}
+    for n in model.parts[kind]:
+        full[n] = float(values[n] if n in values else params.get(f"{kind}_{n}", model.params[f"{kind}_{n}"].default))
+    for key, text, expected in checks:
+        condition = parse_condition(text, file=file, key=join(base, key))
+        if not condition.holds(full):
+            shown = ", ".join(f"{n} = {full[n]:g}" for n in condition.names)
+            raise fail(file, join(base, key), f"a {kind} with {shown} fails the model's check {text!r}", expected)
 
 
 def load_layout(file: str, data: dict, model: Any, params: dict) -> tuple[tuple[Segment, ...], tuple[Part, ...]]:

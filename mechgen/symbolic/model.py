@@ -288,6 +288,8 @@ class Model:
         self.boundary_fn: Callable | None = None
         self.point_terms: dict[str, dict[str, Callable]] = {}
         self.parts: dict[str, tuple[str, ...]] = {}
+        #: each part kind's declared checks (:meth:`part`): (key, condition, expected) per check, in order
+        self.part_checks: dict[str, tuple[tuple[str, str, str], ...]] = {}
         self.shear_pairs: list[tuple[str, str, int]] = []
         #: the whirl stations (Model.whirl_pair): x1, y1[, x2, y2, ...]; None when the model declares none
         self.whirl: tuple[str, ...] | None = None
@@ -675,7 +677,7 @@ class Model:
         self.weak_fn = fn
         return fn
 
-    def part(self, kind: str, *params: Param, doc: str = "") -> None:
+    def part(self, kind: str, *params: Param, doc: str = "", checks: dict | None = None) -> None:
         """Declare a kind of lumped part that a scene places along a continuum (a disk, a bearing).
 
         Its energies are point terms, ``@model.point_kinetic(kind)`` etc., whose
@@ -687,6 +689,19 @@ class Model:
         continuum into ``[[segments]]`` (``length``, ``elements`` and per-segment values of numeric model
         parameters); :func:`mechgen.compile` takes the same as ``parts=[...]`` and ``segments=[...]``.
         Call :meth:`field` first.
+
+        ``checks`` states what the values of one part must satisfy together (each parameter's own
+        bounds, ``positive``/``minimum``/``maximum``, are checked alone): ``{key: (condition, expected)}``,
+        ``condition`` comparisons (``< <= > >= == !=``) of arithmetic expressions of the part's parameters
+        joined by ``and``/``or`` (the scene expression grammar, mechgen.scene.expr.Condition), evaluated on
+        each part's values (the declared defaults where a part leaves one out) when a scene is loaded or
+        :func:`mechgen.compile` is called; a part for which it fails is refused there (exit 2) at
+        ``parts[i].<key>``, with ``expected`` as what would be accepted. Example, a disk whose bore must be
+        smaller than its outer diameter unless both are left at 0::
+
+            model.part("disk", Param("outer", 0.0, "m"), Param("inner", 0.0, "m"),
+                       checks={"inner": ("inner < outer or inner == 0 and outer == 0",
+                                         "an inner (bore) diameter below the outer diameter")})
         """
         if self.continuum is None:
             raise ModelError(f"part {kind!r} of model {self.name} declared before its fields", file=self.file,
@@ -701,6 +716,24 @@ class Model:
             self.params(full)
             names.append(prm.name)
         self.parts[kind] = tuple(names)
+        self.part_checks[kind] = self._part_checks(kind, names, checks or {})
+
+    def _part_checks(self, kind: str, names: list[str], checks) -> tuple[tuple[str, str, str], ...]:
+        """The checks of :meth:`part` as (key, condition, expected) triples; ModelError for a malformed one (the
+        condition's grammar and names are checked when the model's facts are made, mechgen.scene.info)."""
+        if not isinstance(checks, dict):
+            raise ModelError(f"checks of part {kind!r} is {type(checks).__name__}", file=self.file, key="part",
+                             expected="a dict {key: (condition, expected)}")
+        out = []
+        for key, value in checks.items():
+            if key not in names:
+                raise ModelError(f"check of part {kind!r} at {key!r}, not a parameter of the part", file=self.file,
+                                 key="part", expected="one of: " + ", ".join(names))
+            if not (isinstance(value, tuple) and len(value) == 2 and all(isinstance(v, str) and v for v in value)):
+                raise ModelError(f"check of part {kind!r} at {key!r} is {value!r}", file=self.file, key="part",
+                                 expected="a pair of non-empty strings (condition, expected)")
+            out.append((key, value[0], value[1]))
+        return tuple(out)
 
     def shear_pair(self, displacement: str, rotation: str, sign: int = 1) -> None:
         """Declare that field ``rotation`` is the section rotation whose shear-free value is sign * d(displacement)/ds.
