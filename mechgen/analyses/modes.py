@@ -16,7 +16,10 @@ mode, in the order of ``frequencies``, mass-normalised (phi^T M phi = 1) and sig
 largest |entry| is positive; ``modal_mass`` (phi^T M phi as computed from the model's M: 1 to round-off)
 and ``modal_stiffness`` (phi^T K phi = omega^2, (rad/s)^2) per mode (:func:`modal_outputs`). A continuum
 with ``count`` gets ``s`` and ``shapes`` (per field, one curve per mode, largest |value| 1); a chain
-reports frequencies only (its shapes would be N x N).
+reports frequencies only (its shapes would be N x N). A continuum's undamped modes also report ``roundoff_bound``,
+the bound on the lowest frequency's relative error from round-off in the assembled M and K (:func:`require_roundoff`,
+about eps (omega_max / omega_1)^2, N^4 eps for a beam), and are refused with exit 2 at ``params.N`` when it exceeds
+``roundoff_rtol`` (default 1e-2: a Hermite beam near N = 4000 elements).
 
 A system with damping, gyroscopic terms or a non-symmetric stiffness, and any rotor, gets its damped
 modes (mechgen.analyses.whirl) with ``eigenvalues``, ``log_dec``, for a lumped model complex ``shapes``
@@ -35,7 +38,9 @@ from mechgen.analyses.whirl import is_gyroscopic, run_damped_modes
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, require_seconds
 from mechgen.runtime.core.memory import require
 from mechgen.runtime.fields.constrain import warn_penalty_errors
+from mechgen.errors import InputError
 from mechgen.runtime.linear.modes import modes as solve_modes
+from mechgen.runtime.linear.modes import roundoff_bound
 from mechgen.runtime.linear.stability import SPARSE_BYTES_PER_UNKNOWN, sparse_seconds
 
 def needs(options: dict, *, internal: bool) -> set[str]:
@@ -66,6 +71,9 @@ def run_modes(system, options: dict, context: dict) -> dict:
     elastic = res.shapes[:, res.rigid:]
     out = {"frequencies": [float(f) for f in res.frequencies[res.rigid:]], "rigid_modes": int(res.rigid),
            "_shapes": elastic}
+    if system.is_field and elastic.shape[1]:
+        out["roundoff_bound"] = require_roundoff(system, mats["M"], mats["K"], elastic[:, 0],
+                                                 float(res.eigenvalues[res.rigid]), options)
     if not system.is_field and not system.is_lattice and not getattr(system, "is_plane", False):
         out.update(modal_outputs(system.coordinates, mats["M"], mats["K"], elastic))
         if res.rigid:
@@ -94,6 +102,25 @@ def require_sparse_modes(system, options: dict) -> None:
         require_seconds(sparse_seconds(n, general=bool(system.metadata.whirl)),
                         float(options.get("max_seconds", DEFAULT_SECONDS)), f"the sparse modes solve of {n} unknowns",
                         key="params.N", basis="c n^(4/3), measured", expected="a smaller N")
+
+
+def require_roundoff(system, M, K, phi: np.ndarray, lam: float, options: dict, what: str = "modes") -> float:
+    """The bound on the relative error of a continuum's lowest elastic frequency omega_1 = sqrt(lam) that round-off in
+    the assembled M and K allows, half that on lam (mechgen.runtime.linear.modes.roundoff_bound: about
+    eps (omega_max / omega_1)^2, growing as N^4 for a beam); refused (InputError, exit 2 at params.N) above the
+    analysis's ``roundoff_rtol`` (default 1e-2): a Hermite beam near N = 4000 elements, where refining further
+    only loses accuracy."""
+    bound = 0.5 * roundoff_bound(M, K, phi, lam)
+    tol = float(options.get("roundoff_rtol", 1e-2))
+    if not bound <= tol:
+        size = system.choices.get("N") if hasattr(system, "choices") else None
+        raise InputError(f"{what}: round-off in the assembled K and M bounds the lowest frequency's relative error "
+                         f"by {bound:.2g}" + (f" at N = {size}" if size is not None else "") + " (eps (|phi|^T |K| "
+                         "|phi| + lam |phi|^T |M| |phi|) / (2 lam phi^T M phi), about eps (omega_max / omega_1)^2: it "
+                         f"grows with N), more than roundoff_rtol = {tol:g}", key="params.N",
+                         expected="a smaller N (the elements' own error falls with N while round-off grows), or a "
+                         "larger roundoff_rtol")
+    return bound
 
 
 def modal_outputs(names, M, K, phi: np.ndarray) -> dict:

@@ -60,6 +60,10 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("orbits", "list of {major, minor, angle}", "-, angle in rad", "Rotors only: per mode, the ellipse "
            "of the normalised shape at the whirl station with the largest orbit (semi-axes and the major "
            "axis's angle from x towards y)."),
+        _o("roundoff_bound", "scalar", "-", "A continuum's undamped modes: the bound on the lowest frequency's "
+           "relative error from round-off in the assembled M and K (about eps (omega_max / omega_1)^2, growing "
+           "as N^4 for a beam; mechgen.runtime.linear.modes.roundoff_bound); above ``roundoff_rtol`` the run is "
+           "refused at params.N."),
     ),
     "stability": (
         _o("eigenvalues", "(n, 2)", "1/s", "The eigenvalues s of M q'' + (D + G) q' + K q = 0 as [re, im] "
@@ -74,7 +78,12 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("operating_point", "{coordinate: value}", MODEL_UNIT,
            "The equilibrium Newton found, when the given point was not one."),
         _o("refinement", "table", "-", "With ``refine``: sizes, verdicts, ``unstable`` and growth rates at N "
-           "and 2N and whether they agree to ``refine_rtol`` (``growth_rate_converged``)."),
+           "and 2N and whether they agree to ``refine_rtol`` (``growth_rate_converged``), and a continuum's "
+           "``roundoff_bounds`` at N and 2N."),
+        _o("roundoff_bound", "scalar", "-", "A continuum (without internal variables): the bound on the lowest "
+           "frequency's relative error from round-off in the assembled M and K, as modes' (lam = min \\|s\\|^2, "
+           "the spread from the symmetric pencil's lowest mode); above ``roundoff_rtol``, at N or at the 2N check, "
+           "the run is refused at params.N."),
     ),
     "steady": (
         _o("iterations", "scalar (int)", "-", "Newton iterations (or the BVP solver's)."),

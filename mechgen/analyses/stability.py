@@ -19,7 +19,10 @@ rigid), ``rigid_modes`` (how many), ``unstable`` ({real, complex}: eigenvalues w
 threshold, complex ones counted once per pair), ``operating_point`` (when the given point was not an
 equilibrium and Newton found one: mechgen.analyses.operating_point.equilibrium_point) and, refined,
 ``refinement``: the sizes, verdicts, sign structures (``unstable``) and growth rates at N and 2N, what
-was ``compared`` and whether the growth rates agree to ``refine_rtol`` (``growth_rate_converged``).
+was ``compared`` and whether the growth rates agree to ``refine_rtol`` (``growth_rate_converged``). A continuum
+also reports ``roundoff_bound`` (as modes': the bound on the lowest frequency's relative error from round-off,
+about eps (omega_max / omega_1)^2) and is refused with exit 2 at ``params.N`` when it exceeds ``roundoff_rtol``
+(default 1e-2) at N or at the 2N check (Beck's column: from N = 2000 with the check, 4000 without).
 """
 from __future__ import annotations
 
@@ -28,7 +31,9 @@ import numpy as np
 from mechgen.analyses import figures, schema, summary
 from mechgen.analyses.operating_point import equilibrium_point, linear_about
 from mechgen.analyses.registry import AnalysisKind, register
+from mechgen.analyses.modes import require_roundoff
 from mechgen.analyses.schema import LINEAR_OPTIONS, Option
+from mechgen.runtime.linear.modes import modes as solve_modes
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, require_seconds
 from mechgen.runtime.core.memory import require, require_dense
 from mechgen.runtime.linear.stability import stability as solve_stability
@@ -51,18 +56,38 @@ def needs(options: dict, *, internal: bool) -> set[str]:
     return {"linear"} if options.get("about") else {"linear", "residual"}
 
 
-def _stability_of(system, q, options: dict, context: dict):
+def _stability_of(system, q, options: dict, context: dict, what: str = "stability"):
+    """(the eigenvalues and verdict, a continuum's round-off bound on its lowest frequency or None)."""
     tol = options.get("tolerance")
     if system.m:
         z = np.asarray(context[options["about"]]["_z"]) if options.get("about") else np.zeros(system.m)
         A = system.jacobian(0.0, np.concatenate([q, np.zeros(system.n), z]))
-        return stability_first_order(A, np.eye(A.shape[0]), tolerance=tol)
+        return stability_first_order(A, np.eye(A.shape[0]), tolerance=tol), None
     mats = linear_about(system, q, options, context)
     if options.get("count") and hasattr(mats["M"], "toarray") and system.n > SPARSE_STABILITY_N:
-        return stability_sparse(mats["M"], mats["D"] + mats["G"], mats["K"], 2 * options["count"], tolerance=tol)
-    require_dense(system.n, 40, "the dense stability eigenproblem", expected="a count with finite elements (sparse)")
-    dense = {k: (v.toarray() if hasattr(v, "toarray") else v) for k, v in mats.items()}
-    return solve_stability(dense["M"], dense["D"] + dense["G"], dense["K"], tolerance=tol)
+        res = stability_sparse(mats["M"], mats["D"] + mats["G"], mats["K"], 2 * options["count"], tolerance=tol)
+    else:
+        require_dense(system.n, 40, "the dense stability eigenproblem",
+                      expected="a count with finite elements (sparse)")
+        dense = {k: (v.toarray() if hasattr(v, "toarray") else v) for k, v in mats.items()}
+        res = solve_stability(dense["M"], dense["D"] + dense["G"], dense["K"], tolerance=tol)
+    return res, stability_roundoff(system, mats, res, options, what)
+
+
+def stability_roundoff(system, mats: dict, res, options: dict, what: str = "stability") -> float | None:
+    """A continuum's bound on the relative error of its lowest frequency from round-off in the assembled M and K
+    (mechgen.analyses.modes.require_roundoff: exit 2 at params.N above ``roundoff_rtol``), lam = min |s|^2 of the
+    computed (non-rigid) eigenvalues, the spread |phi|^T |K| |phi| from the lowest elastic mode phi of the symmetric
+    pencil ((K + K^T) / 2, M) (one more sparse solve for one mode); None for a lumped model or no eigenvalue."""
+    s = np.asarray(res.eigenvalues)
+    if not getattr(system, "is_field", False) or not s.size:
+        return None
+    M, K = mats["M"], mats["K"]
+    sym = solve_modes(M, (K + K.T) / 2, count=1)
+    if sym.shapes.shape[1] <= sym.rigid:
+        return None
+    lam = float(np.min(np.abs(s))) ** 2
+    return require_roundoff(system, M, K, sym.shapes[:, sym.rigid], lam, options, what=what)
 
 
 def require_sparse_stability(system, options: dict) -> None:
@@ -129,17 +154,19 @@ def run_stability(system, options: dict, context: dict) -> dict:
     """
     require_sparse_stability(system, options)
     q, found = equilibrium_point(system, options, context)
-    res = _stability_of(system, q, options, context)
+    res, bound = _stability_of(system, q, options, context)
     eig, freqs = _trimmed(res, options.get("count"))
     out = {"eigenvalues": eig, "verdict": res.verdict, "frequencies": freqs, "growth_rate": float(res.growth_rate),
            "rigid_modes": int(res.rigid), "unstable": _structure(res)}
+    if bound is not None:
+        out["roundoff_bound"] = bound
     if found is not None:
         out["operating_point"] = found
     if hasattr(system, "refined") and options.get("refine", True) and not options.get("about"):
         size = int(system.choices["N"])
         fine = system.refined(2 * size)
         q_fine = equilibrium_point(fine, options, context)[0] if found is not None else np.zeros(fine.n)
-        res2 = _stability_of(fine, q_fine, options, context)
+        res2, bound2 = _stability_of(fine, q_fine, options, context, f"stability (its check at 2N = {2 * size})")
         out["verdict"] = refinement_verdict([res.verdict, res2.verdict], [res.unstable, res2.unstable])
         g0, g1 = float(res.growth_rate), float(res2.growth_rate)
         rtol = options.get("refine_rtol", 1e-2)
@@ -149,6 +176,8 @@ def run_stability(system, options: dict, context: dict) -> dict:
                              "growth_rate_converged": bool(abs(g0 - g1) <= rtol * max(abs(g0), abs(g1)) + floor),
                              "compared": "verdict and sign structure (numbers of growing real and complex "
                                          "eigenvalues) at N and 2N; growth rates reported, to refine_rtol"}
+        if bound is not None and bound2 is not None:
+            out["refinement"]["roundoff_bounds"] = [bound, bound2]
     return out
 
 
