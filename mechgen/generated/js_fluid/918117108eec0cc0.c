@@ -204,3 +204,45 @@ int mg_outputs(const double *const *in, double *const *out, const long *sizes, l
     }
     return 0;
 }
+
+/* energy_rates: internal rates and the energy balance's powers
+ *   in[0]  q: length 8 per state
+ *   in[1]  v: length 8 per state
+ *   in[2]  z: length 0 per state
+ *   in[3]  t: length 1 per state
+ *   in[4]  s: length 1 per state
+ *   in[5]  p: length 1
+ *   out[0] g: length 3 per state shape (3, 1)
+ *   out[1] excess: length 1 per state shape (1, 1)
+ */
+int mg_energy_rates(const double *const *in, double *const *out, const long *sizes, long nbatch)
+{
+    (void)sizes;
+    const long len_in0 = 8;
+    const long len_in1 = 8;
+    const double *const in5 = in[5];
+    const long len_out0 = 3;
+    const long len_out1 = 1;
+    for (long b = 0; b < nbatch; ++b) {
+        const double *const in0 = in[0] + b * len_in0;
+        const double *const in1 = in[1] + b * len_in1;
+        double *const out0 = out[0] + b * len_out0;
+        for (long i = 0; i < len_out0; ++i) out0[i] = 0.0;
+        double *const out1 = out[1] + b * len_out1;
+        for (long i = 0; i < len_out1; ++i) out1[i] = 0.0;
+        {
+            const double g0 = in0[1];
+            const double g1 = in0[2];
+            const double g2 = in0[4];
+            const double g3 = in0[6];
+            const double g4 = in1[0];
+            const double g5 = in1[1];
+            const double g6 = in1[2];
+            const double g7 = in1[4];
+            const double g8 = in1[6];
+            const double g9 = in5[0];
+            out0[0] = g4*(-g4 + g9) + g5*(-0.06*g0 - g3) + g6*(1.8*g0*g3 - g1 - g6) + g7*(-0.2*g0*g3 - g2 - g7) + g8*(g0*(-0.1*g1 + 0.9*g2 + 1.0) - g3 - g8);
+        }
+    }
+    return 0;
+}
