@@ -183,3 +183,21 @@ def test_integrated_output_needs_a_continuum():
     lumped.coordinates("x")
     with pytest.raises(ModelError, match="integrated, but the model declares no continuum"):
         lumped.output("total", lambda q: q.x, integrate=True)
+
+
+def test_two_stress_form_is_the_invariant_manifold():
+    """js_fluid_reduced (the seed's N, S) has js_fluid's steady state (same mesh: to round-off) and its spectrum is
+    js_fluid's with the 2N + 1 eigenvalues -1 of the off-manifold combination removed."""
+    N = 8
+    params = {"epsilon": EPS, "xi": XI, "G": 0.5, "Re": 1.0, "N": N}
+    full, reduced = mechgen.compile("js_fluid", params), mechgen.compile("js_fluid_reduced", params)
+    q_full = mechgen.steady(full, tol=1e-13).outputs
+    q_reduced = mechgen.steady(reduced, tol=1e-13).outputs
+    assert q_reduced["flow_rate"] == pytest.approx(q_full["flow_rate"], abs=1e-13)
+    assert q_reduced["first_normal_stress_integral"] == pytest.approx(q_full["first_normal_stress_integral"],
+                                                                      abs=1e-12)
+    lam_full, lam_reduced = spectrum(full), spectrum(reduced)
+    assert lam_full.size - lam_reduced.size == 2 * N + 1
+    assert np.all(nearest_errors(lam_full, lam_reduced) < 1e-9)
+    others = lam_full[np.abs(lam_full + 1) > 1e-9]
+    assert np.all(nearest_errors(lam_reduced, others) < 1e-9)
