@@ -201,3 +201,20 @@ def test_two_stress_form_is_the_invariant_manifold():
     assert np.all(nearest_errors(lam_full, lam_reduced) < 1e-9)
     others = lam_full[np.abs(lam_full + 1) > 1e-9]
     assert np.all(nearest_errors(lam_reduced, others) < 1e-9)
+
+
+def test_banded_states_change_stability_at_their_folds():
+    """Past the spurt fold the discretised branch zigzags (the jump between the stable limbs of the local curve moves
+    inward node by node): each fold is a real eigenvalue through zero, so the verdict changes at the folds and
+    nowhere else, and the upper (top-jumping) pieces are stable again. The changes are located along the branch
+    independently of the folds (bisection on the verdict vs the fold's turning point of G)."""
+    sysm = system(G=0.5, N=8)
+    out = mechgen.continuation(sysm, about=mechgen.steady(sysm), parameter="G", stop=1.0, max_points=40,
+                               progress=False).outputs
+    folds = [f["G"] for f in out["folds"]]
+    changes = [c["G"] for c in out["stability_changes"]]
+    assert len(folds) >= 2 and len(changes) == len(folds)
+    assert np.allclose(changes, folds, atol=1e-6)
+    first, second = out["stability_changes"][:2]
+    assert (first["from"], first["to"], second["from"], second["to"]) == ("stable", "divergence", "divergence",
+                                                                         "stable")
