@@ -202,6 +202,65 @@ class NumpyPrinter(_Numbers, PythonCodePrinter):
         return f"({lhs} {expr.rel_op} {rhs})"
 
 
+class MathPrinter(NumpyPrinter):
+    """Printer for one point on Python floats (module ``math``): the numpy backend's single-point path, where a
+    numpy call per operation on 1-element arrays would cost ten times the arithmetic. A domain error raises
+    (ValueError, ArithmeticError) instead of giving nan or inf: the caller then runs the numpy path, whose values
+    and diagnostics stand."""
+
+    _module = "math"
+    _INF = "math.inf"
+    _NAN = "math.nan"
+    _np_names = {"Abs": "fabs"}
+
+    def _print_Function(self, expr):
+        fname = type(expr).__name__
+        args = [self._print(a) for a in expr.args]
+        if fname in ("Max", "Min"):
+            if len(args) != 2:
+                raise NotImplementedError("Max/Min of more than two arguments")
+            return f"{fname.lower()}({args[0]}, {args[1]})"
+        if fname == "sign":
+            return f"(({args[0]} > 0) - ({args[0]} < 0))"
+        return super()._print_Function(expr)
+
+    _print_sin = _print_cos = _print_tan = _print_asin = _print_acos = _print_atan = _print_Function
+    _print_atan2 = _print_sinh = _print_cosh = _print_tanh = _print_exp = _print_log = _print_Function
+    _print_Abs = _print_sign = _print_Max = _print_Min = _print_Function
+
+    def _print_signed_power(self, expr):
+        x, n = (self._print(a) for a in expr.args)
+        return f"math.copysign(math.pow(math.fabs({x}), {n}), {x})"
+
+    def _print_abs_power(self, expr):
+        x, n = (self._print(a) for a in expr.args)
+        return f"math.pow(math.fabs({x}), {n})"
+
+    def _print_Pow(self, expr, rational=False):
+        text = _power_text(self, expr)
+        if text is not None:
+            return text
+        base, exp = expr.as_base_exp()
+        if exp == sp.Rational(1, 2):
+            return f"math.sqrt({self._print(base)})"
+        return f"math.pow({self._print(base)}, {self._print(sp.Float(exp) if exp.is_Rational else exp)})"
+
+    def _print_Piecewise(self, expr):
+        """(e1 if c1 else (e2 if c2 else ...)); the last condition is True."""
+        *pieces, (last, cond) = expr.args
+        if cond != sp.true:
+            raise NotImplementedError("a Piecewise without a final True branch has no value everywhere")
+        text = self._print(last)
+        for e, c in reversed(pieces):
+            text = f"({self._print(e)} if {self._print(c)} else {text})"
+        return text
+
+
+def math_code(expr: sp.Expr) -> str:
+    """Python text of an expression on floats (module ``math``)."""
+    return MathPrinter().doprint(expr)
+
+
 class CasadiPrinter(NumpyPrinter):
     """Printer for CasADi SX construction code (module imported as ``ca``; numpy as ``np``, whose ``np.inf`` and
     ``np.nan`` are the non-finite constants)."""
