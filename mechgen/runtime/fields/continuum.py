@@ -29,7 +29,7 @@ import scipy.linalg as sla
 import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
-from mechgen.errors import InputError, KernelError
+from mechgen.errors import ConvergenceError, InputError, KernelError
 from mechgen.runtime.fields.assemble import Assembler, element_matrices, element_vectors, jets_at_points
 from mechgen.runtime.fields import constrain
 from mechgen.runtime.fields.constrain import (  # noqa: F401 (PENALTY_FACTOR: importable from here before)
@@ -741,16 +741,21 @@ class FieldSystem:
         in the rates); a singular r_v (an unknown without a rate: Re = 0 in js_fluid) is refused, a DAE."""
         q = np.asarray(q, float)
         v = np.zeros(self.n)
+        r = self.residual(q, v, None, None, t)
+        start = np.linalg.norm(r)
         for _ in range(FIRST_ORDER_NEWTON):
-            r = self.residual(q, v, None, None, t)
             if not np.all(np.isfinite(r)):
                 raise KernelError(f"residual of {self.meta.get('model')} gave NaN/Inf at t = {t}")
-            r_v = self.tangent(q, v, t=t)["r_v"]
-            dv = self._rate_solve(r_v, -r)
-            v = v + dv
-            if np.linalg.norm(dv) <= 1e-13 * (1.0 + np.linalg.norm(v)):
+            tan = self.tangent(q, v, t=t)
+            v = v + self._rate_solve(tan["r_v"], -r)
+            r = self.residual(q, v, None, None, t)
+            # converged: |r| down by 1/FIRST_ORDER_RTOL, or at the round-off of its terms (a state near steady has a
+            # tiny |r(q, 0, 0)| itself), eps |terms| ~ eps (|r_q| |q| + |r_v| |v| + |r(q, 0, 0)|)
+            terms = np.linalg.norm(abs(tan["r_q"]) @ np.abs(q) + abs(tan["r_v"]) @ np.abs(v)) + start
+            if np.linalg.norm(r) <= max(FIRST_ORDER_RTOL * start, ROUND_OFF * terms):
                 return v
-        return v
+        raise ConvergenceError(f"the rates of {self.meta.get('model')} at t = {t}: Newton on r(q, q', 0) = 0 left "
+                               f"|r| = {np.linalg.norm(r):.3g} after {FIRST_ORDER_NEWTON} steps (from {start:.3g})")
 
     def first_order_jacobian(self, t: float, q: np.ndarray):
         """d q'/dq = -r_v^-1 r_q at (q, q'(q)) (dense; a first-order continuum's implicit integration)."""
@@ -807,6 +812,10 @@ class FieldSystem:
 
 #: Newton steps of a first-order continuum's rate q' (one suffices when r is linear in the rates)
 FIRST_ORDER_NEWTON = 20
+#: ... until |r(q, q', 0)| falls below this fraction of |r(q, 0, 0)| (a linear r: round-off, ~1e-15, at once)
+FIRST_ORDER_RTOL = 1e-10
+#: ... or below this many machine epsilons of the size of its terms
+ROUND_OFF = 1e3 * np.finfo(float).eps
 
 
 def _choice(name: str, value):
