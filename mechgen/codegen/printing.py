@@ -172,7 +172,11 @@ class NumpyPrinter(_Numbers, PythonCodePrinter):
         base, exp = expr.as_base_exp()
         if exp == sp.Rational(1, 2):
             return f"{self._module}.sqrt({self._print(base)})"
-        return f"{self.parenthesize(base, 60)}**{self.parenthesize(sp.Float(exp) if exp.is_Rational else exp, 60)}"
+        return self._general_power(base, sp.Float(exp) if exp.is_Rational else exp)
+
+    def _general_power(self, base, exp) -> str:
+        """base**exp for an exponent that is neither a small integer nor 1/2."""
+        return f"{self.parenthesize(base, 60)}**{self.parenthesize(exp, 60)}"
 
     def _print_Rational(self, expr):
         text = self._rational(expr)
@@ -194,8 +198,12 @@ class NumpyPrinter(_Numbers, PythonCodePrinter):
             raise NotImplementedError("a Piecewise without a final True branch has no value everywhere")
         text = self._print(last)
         for e, c in reversed(pieces):
-            text = f"{self._IF}({self._print(c)}, {self._print(e)}, {text})"
+            text = self._choice(self._print(c), self._print(e), text)
         return text
+
+    def _choice(self, cond: str, then: str, otherwise: str) -> str:
+        """The text of "then where cond, else otherwise"."""
+        return f"{self._IF}({cond}, {then}, {otherwise})"
 
     def _print_Relational(self, expr):
         lhs, rhs = (self.parenthesize(a, 40) for a in (expr.lhs, expr.rhs))
@@ -236,24 +244,12 @@ class MathPrinter(NumpyPrinter):
         x, n = (self._print(a) for a in expr.args)
         return f"math.pow(math.fabs({x}), {n})"
 
-    def _print_Pow(self, expr, rational=False):
-        text = _power_text(self, expr)
-        if text is not None:
-            return text
-        base, exp = expr.as_base_exp()
-        if exp == sp.Rational(1, 2):
-            return f"math.sqrt({self._print(base)})"
-        return f"math.pow({self._print(base)}, {self._print(sp.Float(exp) if exp.is_Rational else exp)})"
+    def _general_power(self, base, exp) -> str:
+        """math.pow: a negative base with a fractional exponent raises (Python's ** would give a complex)."""
+        return f"math.pow({self._print(base)}, {self._print(exp)})"
 
-    def _print_Piecewise(self, expr):
-        """(e1 if c1 else (e2 if c2 else ...)); the last condition is True."""
-        *pieces, (last, cond) = expr.args
-        if cond != sp.true:
-            raise NotImplementedError("a Piecewise without a final True branch has no value everywhere")
-        text = self._print(last)
-        for e, c in reversed(pieces):
-            text = f"({self._print(e)} if {self._print(c)} else {text})"
-        return text
+    def _choice(self, cond: str, then: str, otherwise: str) -> str:
+        return f"({then} if {cond} else {otherwise})"
 
 
 def math_code(expr: sp.Expr) -> str:
