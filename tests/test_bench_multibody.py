@@ -99,3 +99,18 @@ def test_pydy_side_agrees_with_the_references(tmp_path):
 def test_closed_form_of_a_single_pendulum():
     """n = 1: a = -(g/l) sin(theta)."""
     assert closed_form_accelerations(np.array([0.4]), np.array([2.0]))[0] == pytest.approx(-9.81 * np.sin(0.4))
+
+
+def test_lambdified_peer_agrees_with_the_closed_form_and_the_numpy_backend():
+    """The numpy backend's like-for-like peer (sympy's lambdify of mechgen's own M and h) gives the n-link pendulum's
+    closed-form accelerations, as does the numpy backend's one-point path, to 1e-10 (the bench's criterion)."""
+    from mechgen.bench.multibody import lambdified_equations, pendulum_model
+
+    n = 4
+    peer = lambdified_equations(pendulum_model(n))
+    ours = mechgen.compile(pendulum_model(n), backend="numpy", kernels=["flow"])
+    for x in random_states("pendulum", n):
+        exact = closed_form_accelerations(x[:n], x[n:])
+        scale = np.max(np.abs(exact))
+        assert np.max(np.abs(peer(0.0, x)[n:] - exact)) < 1e-10 * scale
+        assert np.max(np.abs(ours.rhs(0.0, x)[n:] - exact)) < 1e-10 * scale

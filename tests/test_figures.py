@@ -22,7 +22,7 @@ SCENES = ("beam_modes", "beck_column", "fpu_chain", "fpu_recurrence", "friction_
           "van_der_pol_limit_cycle", "duffing_frequency_response", "duffing_softening", "duffing_backbone",
           "rotor_whirl_limit_cycle", "impact_oscillator_bifurcation", "van_der_pol_from_hopf",
           "belt_stick_slip", "phase_bar", "phase_bar_cubic", "orr_sommerfeld", "js_shear", "js_channel", "js_galerkin",
-          "plane_block_continuation")
+          "js_fluid", "plane_block_continuation")
 #: the shipped scenes that take 7 to 25 s each (the rest of the shipped scenes with figures)
 SLOW_SCENES = ("balloon_branches", "balloon_frequencies", "rate_state_stick_slip", "ross_example_rotor",
                "stepped_rotor", "fpu_large")

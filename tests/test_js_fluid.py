@@ -120,9 +120,52 @@ def test_inertialess_channel_spectrum_reaches_the_band_edge():
     assert edge - rates[1] < 3e-3
 
 
-def test_simulate_refuses_a_first_order_continuum():
-    with pytest.raises(InputError, match="carry no mass"):
-        mechgen.simulate(system(N=4), t_end=0.1)
+def oldroyd_b_start_up(t: np.ndarray, G: float, Re: float, terms: int = 4000) -> np.ndarray:
+    """Q(t) of the Oldroyd-B (xi = 0) channel started from rest, as a series: u = sum a_n cos(k_n y),
+    tau_xy = sum b_n (cos(k_n y))', k_n = (2n - 1) pi / 2 (u = 0 at y = +-1), G = sum g_n cos(k_n y) with
+    g_n = 2 G (-1)^(n+1) / k_n, so Re a' = g_n - eps k^2 a - k^2 b, b' = -b + a (the normal stresses do not feed
+    back at xi = 0), each pair solved exactly by its eigenvectors; Q = sum a_n 2 (-1)^(n+1) / k_n."""
+    Q = np.zeros_like(t)
+    for n in range(1, terms + 1):
+        k, sign = (2 * n - 1) * np.pi / 2, (-1.0) ** (n + 1)
+        A = np.array([[-EPS * k**2 / Re, -k**2 / Re], [1.0, -1.0]])
+        steady = -np.linalg.solve(A, [2 * G * sign / k / Re, 0.0])
+        w, V = np.linalg.eig(A)
+        c = np.linalg.solve(V, -steady)
+        Q += (steady[0] + np.real((V[0] * c) @ np.exp(np.outer(w, t)))) * 2 * sign / k
+    return Q
+
+
+def test_start_up_flow_matches_the_oldroyd_b_series():
+    """simulate of the first-order fields from rest (BDF on q' = v(q)): Q(t) with its elastic overshoot against the
+    series, at the P2 rate (over 12 per halving of the elements), 2e-7 at N = 32."""
+    t = np.array([0.5, 1.0, 2.0, 5.0])
+    reference = oldroyd_b_start_up(t, G=0.5, Re=1.0)
+    assert reference[1] > 1.5 * 2 * 0.5 / 3 / (1 + EPS)  # the overshoot above the steady Q = 2G / (3 (1 + eps))
+    errors = []
+    for N in (16, 32):
+        out = mechgen.simulate(system(xi=0.0, G=0.5, Re=1.0, N=N), t_end=5.0, samples=11, rtol=1e-10,
+                               atol=1e-12).outputs
+        assert out["method"] == "BDF"
+        found = np.interp(t, out["t"], out["trajectory"]["flow_rate"])
+        errors.append(np.abs(found - reference))
+    assert np.all(errors[1] < 2e-7)
+    assert np.all(errors[0] / errors[1] > 12)
+
+
+def test_start_up_reaches_the_steady_state():
+    """xi = 0.2, G = 0.5: from rest the flow settles on the steady Newton state (the slowest decay is -0.607)."""
+    sysm = system(G=0.5, N=8)
+    steady = mechgen.steady(sysm, tol=1e-13).outputs["flow_rate"]
+    out = mechgen.simulate(sysm, t_end=40.0, samples=5).outputs
+    assert out["flow_rate"] == pytest.approx(steady, abs=1e-8)
+
+
+def test_inertialess_start_up_is_refused_as_a_dae():
+    with pytest.raises(InputError, match="neither mass nor a rate"):
+        mechgen.simulate(system(N=4, Re=0.0), t_end=0.1)
+    with pytest.raises(InputError, match="first-order continuum"):
+        mechgen.simulate(system(N=4), t_end=0.1, method="leapfrog", dt=0.01)
 
 
 def test_scene_runs(tmp_path):
@@ -140,3 +183,38 @@ def test_integrated_output_needs_a_continuum():
     lumped.coordinates("x")
     with pytest.raises(ModelError, match="integrated, but the model declares no continuum"):
         lumped.output("total", lambda q: q.x, integrate=True)
+
+
+def test_two_stress_form_is_the_invariant_manifold():
+    """js_fluid_reduced (the seed's N, S) has js_fluid's steady state (same mesh: to round-off) and its spectrum is
+    js_fluid's with the 2N + 1 eigenvalues -1 of the off-manifold combination removed."""
+    N = 8
+    params = {"epsilon": EPS, "xi": XI, "G": 0.5, "Re": 1.0, "N": N}
+    full, reduced = mechgen.compile("js_fluid", params), mechgen.compile("js_fluid_reduced", params)
+    q_full = mechgen.steady(full, tol=1e-13).outputs
+    q_reduced = mechgen.steady(reduced, tol=1e-13).outputs
+    assert q_reduced["flow_rate"] == pytest.approx(q_full["flow_rate"], abs=1e-13)
+    assert q_reduced["first_normal_stress_integral"] == pytest.approx(q_full["first_normal_stress_integral"],
+                                                                      abs=1e-12)
+    lam_full, lam_reduced = spectrum(full), spectrum(reduced)
+    assert lam_full.size - lam_reduced.size == 2 * N + 1
+    assert np.all(nearest_errors(lam_full, lam_reduced) < 1e-9)
+    others = lam_full[np.abs(lam_full + 1) > 1e-9]
+    assert np.all(nearest_errors(lam_reduced, others) < 1e-9)
+
+
+def test_banded_states_change_stability_at_their_folds():
+    """Past the spurt fold the discretised branch zigzags (the jump between the stable limbs of the local curve moves
+    inward node by node): each fold is a real eigenvalue through zero, so the verdict changes at the folds and
+    nowhere else, and the upper (top-jumping) pieces are stable again. The changes are located along the branch
+    independently of the folds (bisection on the verdict vs the fold's turning point of G)."""
+    sysm = system(G=0.5, N=8)
+    out = mechgen.continuation(sysm, about=mechgen.steady(sysm), parameter="G", stop=1.0, max_points=40,
+                               progress=False).outputs
+    folds = [f["G"] for f in out["folds"]]
+    changes = [c["G"] for c in out["stability_changes"]]
+    assert len(folds) >= 2 and len(changes) == len(folds)
+    assert np.allclose(changes, folds, atol=1e-6)
+    first, second = out["stability_changes"][:2]
+    assert (first["from"], first["to"], second["from"], second["to"]) == ("stable", "divergence", "divergence",
+                                                                         "stable")

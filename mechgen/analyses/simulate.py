@@ -14,8 +14,10 @@ history; left out: kept while small, mechgen.analyses.time_series), ``samples``,
 ``energy_drift`` (a conservative run) or ``energy_balance_error``, ``work`` and ``dissipated``
 (mechgen.analyses.energy_balance), ``t_end``, ``method`` and ``loop`` (what ran); a fixed-end chain also
 ``mode_energies``. A model with modes is run by mechgen.analyses.simulate_hybrid, with the keys ``mode``,
-``max_events``, ``zeno_events``, ``zeno_span`` and ``on_zeno``; a ``zeno_events`` or ``max_events`` given that
-could not be reached within ``max_seconds`` at EVENT_SECONDS an event is refused at load (exit 2 at that key).
+``max_events``, ``zeno_events``, ``zeno_span`` and ``on_zeno``; a continuum whose fields carry no mass (first-order
+fields, ``js_fluid``) by mechgen.analyses.simulate_first_order: the state is q, its rate the root of
+r(q, q', 0) = 0 (``auto``: BDF). A ``zeno_events`` or ``max_events`` given that could not be reached within
+``max_seconds`` at EVENT_SECONDS an event is refused at load (exit 2 at that key).
 
 Work budget (mechgen.runtime.core.budget): ``max_steps`` (integrator steps; default 10^7 for the
 leapfrog, whose t_end / dt steps are refused before the first one when they exceed it, and 10^5
@@ -330,7 +332,12 @@ def run_simulate(system, options: dict, context: dict) -> dict:
         return run_hybrid(system, options, context)
     q0, v0 = initial_state(system, options)
     method, desc = options.get("method", "auto"), context.get(NAME, "simulate")
-    if method == "leapfrog":
+    if getattr(system, "first_order", False):  # fields without mass: q' from r(q, q', 0) = 0
+        from mechgen.analyses.simulate_first_order import first_order_run
+
+        t, X, how = first_order_run(system, options, q0, budget_of(options, "BDF" if method == "auto" else method),
+                                      desc)
+    elif method == "leapfrog":
         require_separable(system, "method", "method 'leapfrog'", INSTEAD)
         t, X = _leapfrog_run(system, options, q0, v0, budget_of(options, method), desc)
         how = {"method": method, "loop": "python"}

@@ -226,10 +226,12 @@ def pydy_rhs(eqs: dict, generator: str):
 #: the tools, in the order each size runs them; "cached" rows rebuild in a new process from the cache the row
 #: before filled (PyDy has no cache: every process derives and generates again)
 TOOLS = ("mechgen flow", "mechgen flow cached", "mechgen all", "mechgen all cached", "mechgen flow numpy",
-         "PyDy Kane + lambdify", "PyDy Kane + cython", "PyDy Lagrange + lambdify")
+         "sympy lambdify of mechgen's M, h", "PyDy Kane + lambdify", "PyDy Kane + cython", "PyDy Lagrange + lambdify")
 #: the tools whose right-hand side is timed and integrated (mechgen all's flow kernel is mechgen flow's)
-CALLERS = ("mechgen flow", "mechgen flow numpy", "PyDy Kane + lambdify", "PyDy Kane + cython",
-           "PyDy Lagrange + lambdify")
+CALLERS = ("mechgen flow", "mechgen flow numpy", "sympy lambdify of mechgen's M, h", "PyDy Kane + lambdify",
+           "PyDy Kane + cython", "PyDy Lagrange + lambdify")
+#: the like-for-like peer of the numpy backend (issue 32 item 2): the same derived equations through sympy's lambdify
+LAMBDIFY_OWN = "sympy lambdify of mechgen's M, h"
 SIZES, QUICK_SIZES = (2, 4, 8, 12, 16, 24, 32, 64), (2, 4, 8)
 LATTICE, QUICK_LATTICE = (10, 10), (3, 3)
 #: a cell (one tool, one size) whose predicted build exceeds CAP_S is skipped; a child still running after
@@ -289,9 +291,35 @@ def _build(tool: str, problem: str, size: tuple):
         system = mechgen.compile(model, kernels=["flow"] if "flow" in tool else None,
                                  backend="numpy" if "numpy" in tool else "c")
         return system.rhs, system
+    if tool == LAMBDIFY_OWN:
+        model = pendulum_model(*size) if problem == "pendulum" else lattice_model(*size)
+        return lambdified_equations(model), None
     method = "kane" if "Kane" in tool else "lagrange"
     eqs = pydy_pendulum(*size, method) if problem == "pendulum" else pydy_lattice(*size, method)
     return pydy_rhs(eqs, "cython" if "cython" in tool else "lambdify"), None
+
+
+def lambdified_equations(model: Model):
+    """f(t, x) = (v, M^-1 (-h)) with M(q, p) and h(q, v, p) of mechgen's own derivation (derive.lagrange_parts on the
+    declared energies, every numeric parameter kept free as in mechgen's default build) through sympy's lambdify
+    (numpy module, cse) and numpy's solve: the numpy backend's like-for-like peer."""
+    import sympy as sp
+
+    from mechgen.symbolic.derive import declared_lumped, lagrange_parts
+    from mechgen.symbolic.specialize import specialize
+
+    free = tuple(p.name for p in model.param_list if p.is_numeric)
+    d = declared_lumped(model, specialize(model, {}, free=free))
+    M, h = lagrange_parts(d.T, d.V, d.R, d.q, d.v)
+    f = sp.lambdify([d.q, d.v, d.free], [M, sp.Matrix(h)], modules="numpy", cse=True)
+    defaults = {p.name: p.default for p in model.param_list}
+    values = np.array([defaults[s.name] for s in d.free], float)
+    n = len(d.q)
+
+    def rhs(t, x):
+        M_, h_ = f(x[:n], x[n:], values)
+        return np.concatenate([x[n:], np.linalg.solve(np.asarray(M_, float), -np.asarray(h_, float).ravel())])
+    return rhs
 
 
 def _emit(**record) -> None:
@@ -303,8 +331,9 @@ def cell_main(argv: list[str]) -> None:
     """A child process: build TOOL for PROBLEM SIZE (``n`` or ``rowsxcols``) and print JSON lines: build_s, then
     (for :data:`CALLERS`) per-call seconds, accelerations at :func:`sample_states` and a simulation."""
     tool, problem, size = argv[0], argv[1], tuple(int(s) for s in argv[2].split("x"))
-    if tool.startswith("mechgen"):  # imports before the clock starts (mechgen's came with this module)
+    if tool.startswith("mechgen") or tool == LAMBDIFY_OWN:  # imports before the clock starts
         import mechgen  # noqa: F401
+        import sympy  # noqa: F401
     else:
         import pydy.codegen.ode_function_generators  # noqa: F401
         import sympy.physics.mechanics  # noqa: F401
@@ -532,6 +561,12 @@ def _ratios(rows: list[dict]) -> list[dict]:
                     out.append({"peer": peer, "what": what, "ours_s": a, "peer_s": b, "ratio": b / a,
                                 "condition": f"{r['problem']} {r['size']} ({r['n']} coordinates), mechgen builds "
                                              "'flow' only (M and h), PyDy M and the forcing"})
+        ours, peer = r["cells"].get("mechgen flow numpy", {}), r["cells"].get(LAMBDIFY_OWN, {})
+        a, b = (ours.get("per_call_s") or {}).get("rhs"), (peer.get("per_call_s") or {}).get("rhs")
+        if a and b:
+            out.append({"peer": LAMBDIFY_OWN, "what": "rhs per call, numpy backend", "ours_s": a, "peer_s": b,
+                        "ratio": b / a, "condition": f"{r['problem']} {r['size']} ({r['n']} coordinates): the same "
+                                                     "derived M and h, parameters free on both sides, numpy's solve"})
     return out
 
 
@@ -551,6 +586,8 @@ def _cell_values(r: dict, tool: str) -> dict:
 
 def _builds(tool: str) -> str:
     """What the tool builds, in words."""
+    if tool == LAMBDIFY_OWN:
+        return "mechgen's derived M and h, lambdified"
     if not tool.startswith("mechgen"):
         return "M and forcing"
     return ("flow only" if "flow" in tool else "every kernel") + (", numpy backend" if "numpy" in tool else "")

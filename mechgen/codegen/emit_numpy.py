@@ -9,7 +9,7 @@ from __future__ import annotations
 from mechgen.version import __version__
 from mechgen.codegen.escape import code_identifier, py_docstring, py_literal
 from mechgen.codegen.ir import Block, KernelIR
-from mechgen.codegen.printing import numpy_code
+from mechgen.codegen.printing import math_code, numpy_code
 from mechgen.codegen.spec import kernel_spec
 from mechgen.codegen.templating import render
 
@@ -94,6 +94,24 @@ def kernel_body(ir: KernelIR) -> list[str]:
     return lines
 
 
+def point_body(ir: KernelIR) -> list[str] | None:
+    """Python lines of the kernel at one point on Python floats (module ``math``), or None for a kernel with a
+    loop block: the inputs read once as lists, each output gathered in a list and stored in one assignment, so that
+    a domain error (raised by ``math``) leaves the outputs untouched for the numpy path that follows."""
+    if any(block.loop for block in ir.blocks):
+        return None
+    idx = _Indexed(ir)
+    lines = [f"in{i} = ins[{i}]{'[0]' if port.batched else ''}.tolist()" for i, port in enumerate(ir.inputs)]
+    lines += [f"out{i} = [0.0] * outs[{i}].shape[1]" for i, _ in enumerate(ir.outputs)]
+    for block in ir.blocks:
+        lines += [f"{code_identifier(g.symbol.name)} = in{idx.inp[g.port][0]}[{g.index}]" for g in block.gathers]
+        lines += [f"{code_identifier(sym.name)} = {math_code(e)}" for sym, e in block.assignments]
+        lines += [f"out{idx.out[w.port]}[{w.index}] {'+=' if w.accumulate else '='} {math_code(w.expr)}"
+                  for w in block.writes]
+    lines += [f"outs[{i}][0] = out{i}" for i, _ in enumerate(ir.outputs)]
+    return lines
+
+
 def emit_numpy(irs: list[KernelIR], *, model: str, title: str) -> str:
     """The module text of all kernels of one model specialisation (numpy).
 
@@ -104,4 +122,4 @@ def emit_numpy(irs: list[KernelIR], *, model: str, title: str) -> str:
     spec = py_literal({ir.name: kernel_spec(ir) for ir in irs})
     return render("numpy/kernels.py.j2", version=__version__, model=py_docstring(model), title=py_docstring(title),
                   spec=spec, kernels=[{"name": code_identifier(ir.name), "doc": py_docstring(ir.doc),
-                                       "body": kernel_body(ir)} for ir in irs])
+                                       "body": kernel_body(ir), "point": point_body(ir)} for ir in irs])

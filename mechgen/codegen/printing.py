@@ -172,7 +172,11 @@ class NumpyPrinter(_Numbers, PythonCodePrinter):
         base, exp = expr.as_base_exp()
         if exp == sp.Rational(1, 2):
             return f"{self._module}.sqrt({self._print(base)})"
-        return f"{self.parenthesize(base, 60)}**{self.parenthesize(sp.Float(exp) if exp.is_Rational else exp, 60)}"
+        return self._general_power(base, sp.Float(exp) if exp.is_Rational else exp)
+
+    def _general_power(self, base, exp) -> str:
+        """base**exp for an exponent that is neither a small integer nor 1/2."""
+        return f"{self.parenthesize(base, 60)}**{self.parenthesize(exp, 60)}"
 
     def _print_Rational(self, expr):
         text = self._rational(expr)
@@ -194,12 +198,63 @@ class NumpyPrinter(_Numbers, PythonCodePrinter):
             raise NotImplementedError("a Piecewise without a final True branch has no value everywhere")
         text = self._print(last)
         for e, c in reversed(pieces):
-            text = f"{self._IF}({self._print(c)}, {self._print(e)}, {text})"
+            text = self._choice(self._print(c), self._print(e), text)
         return text
+
+    def _choice(self, cond: str, then: str, otherwise: str) -> str:
+        """The text of "then where cond, else otherwise"."""
+        return f"{self._IF}({cond}, {then}, {otherwise})"
 
     def _print_Relational(self, expr):
         lhs, rhs = (self.parenthesize(a, 40) for a in (expr.lhs, expr.rhs))
         return f"({lhs} {expr.rel_op} {rhs})"
+
+
+class MathPrinter(NumpyPrinter):
+    """Printer for one point on Python floats (module ``math``): the numpy backend's single-point path, where a
+    numpy call per operation on 1-element arrays would cost ten times the arithmetic. A domain error raises
+    (ValueError, ArithmeticError) instead of giving nan or inf: the caller then runs the numpy path, whose values
+    and diagnostics stand."""
+
+    _module = "math"
+    _INF = "math.inf"
+    _NAN = "math.nan"
+    _np_names = {"Abs": "fabs"}
+
+    def _print_Function(self, expr):
+        fname = type(expr).__name__
+        args = [self._print(a) for a in expr.args]
+        if fname in ("Max", "Min"):
+            if len(args) != 2:
+                raise NotImplementedError("Max/Min of more than two arguments")
+            return f"{fname.lower()}({args[0]}, {args[1]})"
+        if fname == "sign":
+            return f"(({args[0]} > 0) - ({args[0]} < 0))"
+        return super()._print_Function(expr)
+
+    _print_sin = _print_cos = _print_tan = _print_asin = _print_acos = _print_atan = _print_Function
+    _print_atan2 = _print_sinh = _print_cosh = _print_tanh = _print_exp = _print_log = _print_Function
+    _print_Abs = _print_sign = _print_Max = _print_Min = _print_Function
+
+    def _print_signed_power(self, expr):
+        x, n = (self._print(a) for a in expr.args)
+        return f"math.copysign(math.pow(math.fabs({x}), {n}), {x})"
+
+    def _print_abs_power(self, expr):
+        x, n = (self._print(a) for a in expr.args)
+        return f"math.pow(math.fabs({x}), {n})"
+
+    def _general_power(self, base, exp) -> str:
+        """math.pow: a negative base with a fractional exponent raises (Python's ** would give a complex)."""
+        return f"math.pow({self._print(base)}, {self._print(exp)})"
+
+    def _choice(self, cond: str, then: str, otherwise: str) -> str:
+        return f"({then} if {cond} else {otherwise})"
+
+
+def math_code(expr: sp.Expr) -> str:
+    """Python text of an expression on floats (module ``math``)."""
+    return MathPrinter().doprint(expr)
 
 
 class CasadiPrinter(NumpyPrinter):

@@ -35,7 +35,7 @@ BUILTIN = ("balloon_string", "euler_bernoulli_beam", "follower_column", "fpu_cha
            "stick_slip_contact",
            "curved_beam_stiffness", "cosserat_rod", "van_der_pol", "duffing", "impact_oscillator", "belt_stick_slip",
            "van_der_pol_hopf", "phase_bar",
-           "plane_poiseuille", "js_local", "js_channel", "js_local_reduced", "js_galerkin", "js_fluid", "membrane_gravity",
+           "plane_poiseuille", "js_local", "js_channel", "js_local_reduced", "js_galerkin", "js_fluid", "js_fluid_reduced", "membrane_gravity",
            "annulus_gravity", "drum", "cracked_plate", "plane_block")
 HERE = Path(__file__).resolve().parent
 #: the entry-point group installed packages register their models under (value ``module:attribute``)

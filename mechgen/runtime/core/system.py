@@ -391,7 +391,13 @@ class System:
         return mass_solve(M, -r), M
 
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
-        """dx/dt of the first-order form."""
+        """dx/dt of the first-order form (a smooth model without internal variables on the C backend: in one
+        compiled call, mechgen.runtime.core.point_rhs)."""
+        from mechgen.runtime.core.point_rhs import point_rhs
+
+        fast = point_rhs(self)
+        if fast is not None:
+            return fast(t, np.asarray(x, dtype=float))
         q, v, z = self.split(x)
         a, _ = self.acceleration(q, v, z, t)
         n = q.size

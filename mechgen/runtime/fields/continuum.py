@@ -29,7 +29,7 @@ import scipy.linalg as sla
 import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
-from mechgen.errors import InputError, KernelError
+from mechgen.errors import ConvergenceError, InputError, KernelError
 from mechgen.runtime.fields.assemble import Assembler, element_matrices, element_vectors, jets_at_points
 from mechgen.runtime.fields import constrain
 from mechgen.runtime.fields.constrain import (  # noqa: F401 (PENALTY_FACTOR: importable from here before)
@@ -724,6 +724,59 @@ class FieldSystem:
         self._require_mass(M)
         return spla.spsolve(sps.csc_matrix(M), rhs) if sps.issparse(M) else sla.solve(M, rhs)
 
+    @property
+    def first_order(self) -> bool:
+        """True when no unknown carries mass (no kinetic density, a constant M = 0): every field obeys a first-order
+        (or algebraic) law r(q, q', 0) = 0, D(q) q' + f(q) = 0 for a weak form linear in the rates (js_fluid)."""
+        if not self.info.get("constant_mass") or self.reduction.multiplier_rows is not None:
+            return False
+
+        def empty() -> bool:
+            M = self.tangent(np.zeros(self.n))["r_a"]
+            return not (M.count_nonzero() if sps.issparse(M) else np.count_nonzero(M))
+        return self._memo.get(("first_order", *self._reduction_key(), self._pkey), empty)
+
+    def first_order_rate(self, t: float, q: np.ndarray) -> np.ndarray:
+        """q' of a first-order continuum: the root v of r(q, v, 0) = 0 by Newton on r_v (one step when r is linear
+        in the rates); a singular r_v (an unknown without a rate: Re = 0 in js_fluid) is refused, a DAE."""
+        q = np.asarray(q, float)
+        v = np.zeros(self.n)
+        r = self.residual(q, v, None, None, t)
+        start = np.linalg.norm(r)
+        for _ in range(FIRST_ORDER_NEWTON):
+            if not np.all(np.isfinite(r)):
+                raise KernelError(f"residual of {self.meta.get('model')} gave NaN/Inf at t = {t}")
+            tan = self.tangent(q, v, t=t)
+            v = v + self._rate_solve(tan["r_v"], -r)
+            r = self.residual(q, v, None, None, t)
+            # converged: |r| down by 1/FIRST_ORDER_RTOL, or at the round-off of its terms (a state near steady has a
+            # tiny |r(q, 0, 0)| itself), eps |terms| ~ eps (|r_q| |q| + |r_v| |v| + |r(q, 0, 0)|)
+            terms = np.linalg.norm(abs(tan["r_q"]) @ np.abs(q) + abs(tan["r_v"]) @ np.abs(v)) + start
+            if np.linalg.norm(r) <= max(FIRST_ORDER_RTOL * start, ROUND_OFF * terms):
+                return v
+        raise ConvergenceError(f"the rates of {self.meta.get('model')} at t = {t}: Newton on r(q, q', 0) = 0 left "
+                               f"|r| = {np.linalg.norm(r):.3g} after {FIRST_ORDER_NEWTON} steps (from {start:.3g})")
+
+    def first_order_jacobian(self, t: float, q: np.ndarray):
+        """d q'/dq = -r_v^-1 r_q at (q, q'(q)) (dense; a first-order continuum's implicit integration)."""
+        v = self.first_order_rate(t, q)
+        require_dense(self.n, 8, "the dense first-order Jacobian (implicit time integration)",
+                      expected="a smaller N, or an explicit method (RK45, DOP853)")
+        tan = self.tangent(q, v, t=t)
+        r_q = tan["r_q"].toarray() if sps.issparse(tan["r_q"]) else np.asarray(tan["r_q"])
+        return -self._rate_solve(tan["r_v"], r_q)
+
+    def _rate_solve(self, r_v, rhs: np.ndarray) -> np.ndarray:
+        """r_v^-1 rhs, refusing rows without a rate (an algebraic unknown: a DAE)."""
+        rows = np.asarray(abs(r_v).sum(axis=1)).ravel() if sps.issparse(r_v) else np.abs(r_v).sum(axis=1)
+        empty = int(np.count_nonzero(rows == 0.0))
+        if empty:
+            raise InputError(f"model {self.meta.get('model')}: {empty} of {self.n} unknowns have neither mass nor a "
+                             "rate (algebraic, a DAE: an inertialess field); simulate integrates ODEs",
+                             key="kind", expected="a rate on every field (js_fluid: Re > 0), or steady / stability")
+        A = sps.csc_matrix(r_v) if sps.issparse(r_v) else np.asarray(r_v)
+        return spla.spsolve(A, rhs) if sps.issparse(r_v) else sla.solve(A, rhs)
+
     def _require_mass(self, M) -> None:
         """Refuse a mass matrix with zero rows: fields without kinetic energy obey first-order (or algebraic) laws,
         D(q) q' + f(q) = 0, which the second-order integration (q, v) cannot run."""
@@ -732,9 +785,8 @@ class FieldSystem:
         if empty:
             raise InputError(f"model {self.meta.get('model')}: {empty} of {self.n} unknowns carry no mass (fields "
                              "without a kinetic density obey first-order or algebraic laws, D(q) q' + f(q) = 0); "
-                             "simulate integrates continua with a mass on every field", key="kind",
-                             expected="steady, stability or continuation for a first-order continuum (js_fluid), or "
-                                      "a kinetic density on every field")
+                             "simulate integrates continua with a mass on every field, or on none (first-order fields)",
+                             key="kind", expected="a kinetic density on every field, or on none of them")
 
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
         """dx/dt = (v, -M^-1 r(q, v, 0))."""
@@ -756,6 +808,14 @@ class FieldSystem:
         da = -self._mass_solve(q, v, t, np.hstack([dense(tan["r_q"]), dense(tan["r_v"])]))
         n = self.n
         return np.block([[np.zeros((n, n)), np.eye(n)], [da]])
+
+
+#: Newton steps of a first-order continuum's rate q' (one suffices when r is linear in the rates)
+FIRST_ORDER_NEWTON = 20
+#: ... until |r(q, q', 0)| falls below this fraction of |r(q, 0, 0)| (a linear r: round-off, ~1e-15, at once)
+FIRST_ORDER_RTOL = 1e-10
+#: ... or below this many machine epsilons of the size of its terms
+ROUND_OFF = 1e3 * np.finfo(float).eps
 
 
 def _choice(name: str, value):
