@@ -34,6 +34,7 @@ from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.modes import require_roundoff
 from mechgen.analyses.schema import LINEAR_OPTIONS, Option
 from mechgen.runtime.linear.modes import modes as solve_modes
+from mechgen.errors import InputError
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, require_seconds
 from mechgen.runtime.core.memory import require, require_dense
 from mechgen.runtime.linear.stability import stability as solve_stability
@@ -78,12 +79,18 @@ def stability_roundoff(system, mats: dict, res, options: dict, what: str = "stab
     """A continuum's bound on the relative error of its lowest frequency from round-off in the assembled M and K
     (mechgen.analyses.modes.require_roundoff: exit 2 at params.N above ``roundoff_rtol``), lam = min |s|^2 of the
     computed (non-rigid) eigenvalues, the spread |phi|^T |K| |phi| from the lowest elastic mode phi of the symmetric
-    pencil ((K + K^T) / 2, M) (one more sparse solve for one mode); None for a lumped model or no eigenvalue."""
+    pencil ((K + K^T) / 2, M) (one more sparse solve for one mode); None for a lumped model, no eigenvalue, or a
+    mass that is not positive definite (massless first-order fields, multipliers: that pencil has no modes)."""
     s = np.asarray(res.eigenvalues)
     if not getattr(system, "is_field", False) or not s.size:
         return None
     M, K = mats["M"], mats["K"]
-    sym = solve_modes(M, (K + K.T) / 2, count=1)
+    if getattr(system, "has_multipliers", False) or not np.all(np.asarray(M.diagonal()) > 0):
+        return None
+    try:
+        sym = solve_modes(M, (K + K.T) / 2, count=1)
+    except InputError:  # M not positive definite after all (its diagonal is)
+        return None
     if sym.shapes.shape[1] <= sym.rigid:
         return None
     lam = float(np.min(np.abs(s))) ** 2
