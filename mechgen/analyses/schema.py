@@ -378,9 +378,9 @@ LINEAR_OPTIONS = {
     "at": Option(coordinate_table, doc="the operating point's coordinates (a table coordinate = value; left "
                  "out: zero), re-solved by Newton when it is not an equilibrium"),
     "count": Option(count, doc="how many of the lowest (elastic) modes to compute; left out: all of them"),
-    "roundoff_rtol": Option(positive, 1e-2, doc="a continuum's largest accepted bound on the lowest frequency's "
-                            "relative error from round-off (output roundoff_bound); above it the run is refused at "
-                            "params.N"),
+    "roundoff_rtol": Option(positive, doc="a continuum's largest accepted bound on the lowest frequency's "
+                            "relative error from round-off (output roundoff_bound; default 1e-2); above it the run is "
+                            "refused at params.N"),
 }
 
 

@@ -93,7 +93,10 @@ def stability_roundoff(system, mats: dict, res, options: dict, what: str = "stab
         return None
     if sym.shapes.shape[1] <= sym.rigid:
         return None
-    lam = float(np.min(np.abs(s))) ** 2
+    elastic = np.sort(np.abs(s))[2 * int(res.rigid):]  # a rigid mode is a double zero of the first-order form
+    if not elastic.size:
+        return None
+    lam = float(elastic[0]) ** 2
     return require_roundoff(system, M, K, sym.shapes[:, sym.rigid], lam, options, what=what)
 
 
