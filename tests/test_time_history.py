@@ -308,3 +308,14 @@ def test_a_model_of_internal_variables_only_is_drawn_in_panels(tmp_path):
     r = mechgen.simulate(slider, t_end=1.0, method="Radau")
     assert "trajectory" in r and not any(name.endswith("_dot") for name in r["trajectory"])
     assert [p.name for p in r.plot(tmp_path)] == ["simulate.png"]
+
+
+def test_a_continuum_run_draws_its_declared_outputs(tmp_path):
+    """A continuum's unknowns are more than the coordinate figure shows (its first 8): the declared outputs (js_fluid's
+    flow rate, from rest towards the steady Newton state) get their own figure, <stem>_outputs.png."""
+    pytest.importorskip("matplotlib")
+    system = mechgen.compile("js_fluid", {"N": 4})
+    r = mechgen.simulate(system, t_end=2.0, samples=21)
+    paths = r.plot(tmp_path)
+    assert [p.name for p in paths] == ["simulate.png", "simulate_outputs.png"]
+    assert paths[1].stat().st_size > 5000 and r["trajectory"]["flow_rate"][0] == 0.0

@@ -1,7 +1,8 @@
 """The figures of a time history (``simulate``'s default plot; ``--plot DIR``, ``Result.plot``).
 
 ``plot = "time"`` (the default): each coordinate against t, up to :data:`MAX_CURVES` of them (the first ones,
-the title says so), and the energy against t as a companion ``<stem>_energy.png``; ``plot = "phase"``: each
+the title says so), and the energy against t as a companion ``<stem>_energy.png``; a model with more unknowns
+than that (a continuum, a chain) and declared outputs also gets them against t, ``<stem>_outputs.png``; ``plot = "phase"``: each
 coordinate against its velocity (a phase portrait, one panel per coordinate, up to :data:`MAX_PANELS`).
 """
 from __future__ import annotations
@@ -34,14 +35,20 @@ def time_history(plt, a: dict, path: Path) -> list[Path]:
     written = [against_time(plt, a, names, path) if names else stacked(plt, a, path)]
     if any(out.get("energy_series") or ()):  # a model with no energy (first-order laws only) has nothing to draw
         written.append(energy(plt, a, path.with_name(path.stem + "_energy.png")))
+    declared = [n for n in out["trajectory"] if n not in ENERGIES and n not in names
+                and not (n.endswith("_dot") and n[:-4] in names)]
+    if len(names) > MAX_CURVES and declared:  # a continuum or a chain: its outputs say more than its first dofs
+        written.append(stacked(plt, a, path.with_name(path.stem + "_outputs.png"), declared))
     return written
 
 
-def stacked(plt, a: dict, path: Path) -> Path:
-    """A model without coordinates (internal variables only): each variable in its own panel against t (up to
-    MAX_PANELS; their scales differ), the energies left out."""
+def stacked(plt, a: dict, path: Path, names: list[str] | None = None) -> Path:
+    """Each of ``names`` in its own panel against t (up to MAX_PANELS; their scales differ): by default every
+    series but the energies (a model without coordinates: its internal variables); a continuum's or a chain's
+    declared outputs (flow rate, tip deflection) beside the figure of its first unknowns."""
     out = a["outputs"]
-    names = [n for n in out["trajectory"] if n not in ENERGIES][:MAX_PANELS]
+    title = "outputs" if names is not None else "time history"
+    names = (names if names is not None else [n for n in out["trajectory"] if n not in ENERGIES])[:MAX_PANELS]
     fig, axes = plt.subplots(len(names) or 1, 1, figsize=(7, 1.8 * max(len(names), 1) + 0.6), sharex=True,
                              squeeze=False)
     for ax, name in zip(axes[:, 0], names):
@@ -49,7 +56,7 @@ def stacked(plt, a: dict, path: Path) -> Path:
         _events(ax, out)
         ax.set_ylabel(name)
     axes[-1, 0].set_xlabel(TIME_LABEL)
-    fig.suptitle(f"{a['name']}: time history")
+    fig.suptitle(f"{a['name']}: {title}")
     return _save(plt, fig, path)
 
 
