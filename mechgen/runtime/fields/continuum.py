@@ -768,8 +768,7 @@ class FieldSystem:
 
     def _rate_solve(self, r_v, rhs: np.ndarray) -> np.ndarray:
         """r_v^-1 rhs, refusing rows without a rate (an algebraic unknown: a DAE)."""
-        rows = np.asarray(abs(r_v).sum(axis=1)).ravel() if sps.issparse(r_v) else np.abs(r_v).sum(axis=1)
-        empty = int(np.count_nonzero(rows == 0.0))
+        empty = empty_rows(r_v)
         if empty:
             raise InputError(f"model {self.meta.get('model')}: {empty} of {self.n} unknowns have neither mass nor a "
                              "rate (algebraic, a DAE: an inertialess field); simulate integrates ODEs",
@@ -780,8 +779,7 @@ class FieldSystem:
     def _require_mass(self, M) -> None:
         """Refuse a mass matrix with zero rows: fields without kinetic energy obey first-order (or algebraic) laws,
         D(q) q' + f(q) = 0, which the second-order integration (q, v) cannot run."""
-        rows = np.asarray(abs(M).sum(axis=1)).ravel() if sps.issparse(M) else np.abs(np.asarray(M)).sum(axis=1)
-        empty = int(np.count_nonzero(rows == 0.0))
+        empty = empty_rows(r_v)
         if empty:
             raise InputError(f"model {self.meta.get('model')}: {empty} of {self.n} unknowns carry no mass (fields "
                              "without a kinetic density obey first-order or algebraic laws, D(q) q' + f(q) = 0); "
@@ -808,6 +806,12 @@ class FieldSystem:
         da = -self._mass_solve(q, v, t, np.hstack([dense(tan["r_q"]), dense(tan["r_v"])]))
         n = self.n
         return np.block([[np.zeros((n, n)), np.eye(n)], [da]])
+
+
+def empty_rows(A) -> int:
+    """How many rows of A (dense or sparse) are entirely zero."""
+    rows = np.asarray(abs(A).sum(axis=1)).ravel() if sps.issparse(A) else np.abs(np.asarray(A)).sum(axis=1)
+    return int(np.count_nonzero(rows == 0.0))
 
 
 #: Newton steps of a first-order continuum's rate q' (one suffices when r is linear in the rates)
