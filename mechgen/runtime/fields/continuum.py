@@ -779,7 +779,7 @@ class FieldSystem:
     def _require_mass(self, M) -> None:
         """Refuse a mass matrix with zero rows: fields without kinetic energy obey first-order (or algebraic) laws,
         D(q) q' + f(q) = 0, which the second-order integration (q, v) cannot run."""
-        empty = empty_rows(r_v)
+        empty = empty_rows(M)
         if empty:
             raise InputError(f"model {self.meta.get('model')}: {empty} of {self.n} unknowns carry no mass (fields "
                              "without a kinetic density obey first-order or algebraic laws, D(q) q' + f(q) = 0); "
