@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Callable
 import numpy as np
 
 from mechgen import buildlock
+from mechgen.stage_clock import collecting, timed_stage
 from mechgen.errors import CompilerUnavailable, InputError, MechgenError
 from mechgen.runtime.core.kernels import c_kernels, casadi_kernels, load_module, numpy_kernels
 from mechgen.runtime.core.system import System
@@ -48,6 +49,9 @@ _warned_no_compiler = False
 @dataclass
 class BuildReport:
     """What a compilation did: kernels, operation counts, stage times (s), cache use.
+
+    ``seconds``: derive, lower, emit and build (C compile and load), which add up to the build; and, where they
+    ran, declare (within derive), rewrite and cse (within lower).
 
     ``origin`` says where the generated text came from: ``"derived"`` (derived and emitted now),
     ``"cache"`` (the user compile cache) or ``"generated"`` (the committed mechgen/generated/).
@@ -206,7 +210,8 @@ def derive(model: Model, spec: Specialization):
     from mechgen.symbolic.casadi_form import NotConvertible
     from mechgen.symbolic.derive_ad import derive_lumped_ad, wants_ad
 
-    declared = declared_lumped(model, spec)
+    with timed_stage("declare"):
+        declared = declared_lumped(model, spec)
     if wants_ad(model, declared):  # a large model: derivatives by AD on the energies' graph
         try:
             return derive_lumped_ad(model, spec, declared)
@@ -418,12 +423,18 @@ def _load(backend: str, text: str, specs: dict, key: str, report: BuildReport):
 
 def generate(model: Model, spec: Specialization, kernels, backend: str, cse: bool = True,
              report: BuildReport | None = None) -> dict:
-    """derive -> lower -> emit; returns {'text', 'specs'} (timed into ``report`` when given)."""
+    """derive -> lower -> emit; returns {'text', 'specs'} (timed into ``report`` when given: the stages, and
+    within them declare, rewrite and cse, :mod:`mechgen.stage_clock`)."""
+    report = report if report is not None else BuildReport(backend)
+    with collecting(report.seconds):
+        return _generate(model, spec, set(kernels), backend, cse, report)
+
+
+def _generate(model: Model, spec: Specialization, kernels: set, backend: str, cse: bool,
+              report: BuildReport) -> dict:
     from mechgen.codegen.lower_lumped import lower_lumped
     from mechgen.codegen.spec import kernel_spec
 
-    report = report if report is not None else BuildReport(backend)
-    kernels = set(kernels)
     clock = time.perf_counter()
     hamiltonian_only = model.is_field and set(kernels) <= set(HAMILTONIAN_KERNELS)
     # a steady state in stress form needs no dynamics (an inextensible string has no strain energy)
