@@ -8,7 +8,11 @@
  * singular M: code 1 when singular). The Python side (mechgen/runtime/core/point_rhs.py) calls mgp_rhs with one
  * pointer, the state and the parameters already in the buffers the struct points to.
  *
- * Codes: 0 done; 1 M singular; 2 a non-finite dx/dt; 3 the kernel's own nonzero code (in kernel_rc).
+ * A non-finite r or M is code 2 before any solve (an overflowed entry would factor into finite nonsense).
+ * mgp_jacobian gives d(dx/dt)/dx in the same call: the tangent kernel at the acceleration just found, and
+ * da/dx = -M^-1 (r_q r_v) with the same factor of M (for the implicit integrators).
+ *
+ * Codes: 0 done; 1 M singular; 2 a non-finite dx/dt (mgp_rhs only); 3 the kernel's own nonzero code (in kernel_rc).
  */
 #include <math.h>
 #include <string.h>
@@ -29,15 +33,22 @@ typedef struct {
     const double *x;           /* 2n: the state (q, v) */
     double *f;                 /* 2n: dx/dt */
     double *out[MGP_PORTS];    /* the kernel's outputs (r: n, M: n x n row-major) */
-    double *zeros;             /* n: a = 0 and z */
-    double *work;              /* n x n: the factor */
+    double *zeros;             /* 2n: a = 0 and z (n zeros), then a column of mgp_jacobian's solve (n) */
+    double *work;              /* n x n: the factor of M */
+    long *piv;                 /* n: LU's row swaps */
+    long lu;                   /* 1 when work holds LU (M not positive definite), 0 Cholesky */
+    mgp_fn tangent;            /* the tangent kernel (NULL: no mgp_jacobian) */
+    long tin, rq_index, rv_index;
+    long tports[MGP_PORTS];    /* MGP_IN_* of each tangent input */
+    double *tout[MGP_PORTS];   /* the tangent's outputs (r_q, r_v, r_a: n x n row-major; r_z) */
+    double *J;                 /* 2n x 2n: mgp_jacobian's result */
 } mgp_point;
 
 long mgp_layout(void);
 long mgp_layout(void) { return (long)sizeof(mgp_point); }
 
-/* b = M^-1 b by Cholesky of the lower triangle of M (copied into L); 1 when M is not positive definite */
-static int cholesky_solve(long n, const double *M, double *L, double *b)
+/* L L^T = M (the lower triangle of M, into L); 1 when M is not positive definite */
+static int cholesky_factor(long n, const double *M, double *L)
 {
     long i, j, k;
     double s;
@@ -55,6 +66,14 @@ static int cholesky_solve(long n, const double *M, double *L, double *b)
             L[i * n + j] = s / L[j * n + j];
         }
     }
+    return 0;
+}
+
+/* b = (L L^T)^-1 b */
+static void cholesky_apply(long n, const double *L, double *b)
+{
+    long i, k;
+    double s;
     for (i = 0; i < n; ++i) {   /* L y = b */
         s = b[i];
         for (k = 0; k < i; ++k)
@@ -67,11 +86,10 @@ static int cholesky_solve(long n, const double *M, double *L, double *b)
             s -= L[k * n + i] * b[k];
         b[i] = s / L[i * n + i];
     }
-    return 0;
 }
 
-/* b = M^-1 b, Gaussian elimination with partial pivoting on a copy A of M; 1 if singular */
-static int lu_solve(long n, const double *M, double *A, double *b)
+/* P M = L U in A (a copy of M, unit L below the diagonal), row k swapped with piv[k]; 1 if singular */
+static int lu_factor(long n, const double *M, double *A, long *piv)
 {
     long i, j, k, p;
     double big, l, s;
@@ -86,30 +104,75 @@ static int lu_solve(long n, const double *M, double *A, double *b)
             }
         if (big == 0.0)
             return 1;
-        if (p != k) {
+        piv[k] = p;
+        if (p != k)
             for (j = 0; j < n; ++j) {
                 s = A[k * n + j];
                 A[k * n + j] = A[p * n + j];
                 A[p * n + j] = s;
             }
-            s = b[k];
-            b[k] = b[p];
-            b[p] = s;
-        }
         for (i = k + 1; i < n; ++i) {
             l = A[i * n + k] / A[k * n + k];
+            A[i * n + k] = l;
             for (j = k + 1; j < n; ++j)
                 A[i * n + j] -= l * A[k * n + j];
-            b[i] -= l * b[k];
         }
+    }
+    return 0;
+}
+
+/* b = M^-1 b from lu_factor's A and piv */
+static void lu_apply(long n, const double *A, const long *piv, double *b)
+{
+    long i, k;
+    double s;
+    for (k = 0; k < n; ++k) {
+        if (piv[k] != k) {
+            s = b[k];
+            b[k] = b[piv[k]];
+            b[piv[k]] = s;
+        }
+        for (i = k + 1; i < n; ++i)
+            b[i] -= A[i * n + k] * b[k];
     }
     for (k = n - 1; k >= 0; --k) {
         s = b[k];
-        for (j = k + 1; j < n; ++j)
-            s -= A[k * n + j] * b[j];
+        for (i = k + 1; i < n; ++i)
+            s -= A[k * n + i] * b[i];
         b[k] = s / A[k * n + k];
     }
-    return 0;
+}
+
+/* factor M into P->work (Cholesky, else LU: P->lu set); 1 if M is singular */
+static int factor(mgp_point *P, const double *M)
+{
+    P->lu = cholesky_factor(P->n, M, P->work);
+    return P->lu ? lu_factor(P->n, M, P->work, P->piv) : 0;
+}
+
+/* b = M^-1 b with the factor of the last factor() */
+static void apply(const mgp_point *P, double *b)
+{
+    if (P->lu)
+        lu_apply(P->n, P->work, P->piv, b);
+    else
+        cholesky_apply(P->n, P->work, b);
+}
+
+/* the kernel inputs of the state: q, v and t from the struct, a = accel (NULL: zeros), z = zeros */
+static void inputs(const mgp_point *P, const long *ports, long nin, const double *accel, const double **in)
+{
+    long i, n = P->n;
+    for (i = 0; i < nin; ++i) {
+        switch (ports[i]) {
+        case MGP_IN_Q: in[i] = P->x; break;
+        case MGP_IN_V: in[i] = P->x + n; break;
+        case MGP_IN_T: in[i] = &P->t; break;
+        case MGP_IN_P: in[i] = P->p; break;
+        case MGP_IN_A: in[i] = accel ? accel : P->zeros; break;
+        default: in[i] = P->zeros; break;
+        }
+    }
 }
 
 int mgp_rhs(mgp_point *P);
@@ -119,31 +182,61 @@ int mgp_rhs(mgp_point *P)
     long n = P->n, i, sizes = 0;
     double *a = P->f + n;
     int rc;
-    for (i = 0; i < P->nin; ++i) {
-        switch (P->ports[i]) {
-        case MGP_IN_Q: in[i] = P->x; break;
-        case MGP_IN_V: in[i] = P->x + n; break;
-        case MGP_IN_T: in[i] = &P->t; break;
-        case MGP_IN_P: in[i] = P->p; break;
-        default: in[i] = P->zeros; break;
-        }
-    }
+    inputs(P, P->ports, P->nin, NULL, in);
     rc = P->flow(in, P->out, &sizes, 1);
     if (rc != 0) {
         P->kernel_rc = rc;
         return 3;
     }
+    for (i = 0; i < n * n; ++i)   /* an overflowed M (a Cholesky of inf entries would give finite nonsense) */
+        if (!isfinite(P->out[P->M_index][i]) || (i < n && !isfinite(P->out[P->r_index][i])))
+            return 2;
+    if (factor(P, P->out[P->M_index]))
+        return 1;
     for (i = 0; i < n; ++i)
         a[i] = -P->out[P->r_index][i];
-    if (cholesky_solve(n, P->out[P->M_index], P->work, a)) {
-        for (i = 0; i < n; ++i)
-            a[i] = -P->out[P->r_index][i];
-        if (lu_solve(n, P->out[P->M_index], P->work, a))
-            return 1;
-    }
+    apply(P, a);
     memcpy(P->f, P->x + n, (size_t)n * sizeof(double));
     for (i = 0; i < 2 * n; ++i)
         if (!isfinite(P->f[i]))
             return 2;
+    return 0;
+}
+
+/* J = d(dx/dt)/dx (2n x 2n, row-major) at the state: rows 0..n-1 (0 I); rows n..2n-1 da/dx = -M^-1 (r_q r_v), the
+ * tangent kernel evaluated at the acceleration of mgp_rhs (which also leaves dx/dt in f and M's factor in work) */
+int mgp_jacobian(mgp_point *P);
+int mgp_jacobian(mgp_point *P)
+{
+    const double *in[MGP_PORTS];
+    long n = P->n, i, j, sizes = 0;
+    const double *rq, *rv;
+    double *J = P->J, *col = P->zeros + n;
+    int rc = mgp_rhs(P);
+    if (rc == 1 || rc == 3)
+        return rc;
+    if (rc == 2) {   /* a non-finite M, r or dx/dt: no finite J (the Python path's NaN, no error) */
+        for (i = 0; i < 4 * n * n; ++i)
+            J[i] = i < 2 * n * n ? (i % (2 * n) == n + i / (2 * n)) : NAN;
+        return 0;
+    }
+    inputs(P, P->tports, P->tin, P->f + n, in);
+    rc = P->tangent(in, P->tout, &sizes, 1);
+    if (rc != 0) {
+        P->kernel_rc = rc;
+        return 3;
+    }
+    rq = P->tout[P->rq_index];
+    rv = P->tout[P->rv_index];
+    memset(J, 0, (size_t)(4 * n * n) * sizeof(double));
+    for (i = 0; i < n; ++i)
+        J[i * 2 * n + n + i] = 1.0;
+    for (j = 0; j < 2 * n; ++j) {
+        for (i = 0; i < n; ++i)
+            col[i] = -(j < n ? rq[i * n + j] : rv[i * n + j - n]);
+        apply(P, col);
+        for (i = 0; i < n; ++i)
+            J[(n + i) * 2 * n + j] = col[i];
+    }
     return 0;
 }
