@@ -1,7 +1,7 @@
 """dx/dt of a smooth lumped model in one compiled call (issue 32 item 2): ``System.rhs`` on the C backend.
 
 The flow kernel (r at a = 0 and M = dr/da) and the solve M a = -r (Cholesky, LU where M is not positive
-definite) run in C (``codegen/templates/c99/point_rhs.c``, built once per machine like the time loops); Python
+definite) run in C (``runtime/csrc/point_rhs.c``, built once per machine like the time loops); Python
 copies the state into a buffer, makes one ctypes call and copies dx/dt out. :class:`PointRhs` is prepared once per
 set of kernels (shared by the systems of other parameter values, like mechgen.runtime.core.system.BoundKernel) and
 pointed at a system's parameters on every call. A model with internal variables, a chain, a continuum, another
@@ -13,15 +13,15 @@ import ctypes
 import logging
 from ctypes import POINTER, c_double, c_long, c_void_p
 from functools import lru_cache
-from pathlib import Path
 
 import numpy as np
 
 from mechgen.errors import BuildError, CompilerUnavailable, KernelError
+from mechgen.runtime import csrc
 
 log = logging.getLogger(__name__)
 
-SOURCE = Path(__file__).resolve().parent.parent.parent / "codegen" / "templates" / "c99" / "point_rhs.c"
+SOURCE = csrc.path("point_rhs.c")
 PORTS = 8
 #: the kernel input names and their codes in point_rhs.c (MGP_IN_*)
 CODES = {"q": 0, "v": 1, "a": 2, "z": 3, "t": 4, "p": 5}

@@ -103,7 +103,7 @@ typedef struct {
     long carried;              /* the state's last `carried` entries (<= m) pass through resets unchanged: integrals
                                   carried across events; the reset kernels give the nx - carried before them */
     /* a provider of dx/dt = f[0 .. 2n + m) at (t, x) in place of the residual, tangent and rates kernels (a
-       continuum: mechgen/codegen/templates/c99/field_flow.c), returning 0 or a kernel's nonzero code; NULL: none */
+       continuum: mechgen/runtime/csrc/field_flow.c), returning 0 or a kernel's nonzero code; NULL: none */
     int (*flow)(void *data, double t, const double *x, double *f);
     void *flow_data;
 } mgh_problem;
