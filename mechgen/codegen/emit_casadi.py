@@ -87,7 +87,7 @@ def kernel_body(ir: KernelIR) -> list[str]:
 
 def casadi_name(name: str) -> str:
     """The label of a kernel's casadi.Function: CasADi refuses consecutive underscores, which the kernels of a
-    hybrid model's modes carry (``residual__0``, mechgen.pipeline.lower_hybrid), so runs of them become one."""
+    hybrid model's modes carry (``residual__0``, mechgen.codegen.lower_model.lower_hybrid), so runs of them become one."""
     return re.sub(r"_{2,}", "_", name)
 
 
