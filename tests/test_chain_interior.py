@@ -185,3 +185,21 @@ def test_recomputed_bond_values_equal_the_numpy_kernel_exactly(ends):
     for u in (rng.normal(scale=0.3, size=1000), rng.normal(scale=0.3, size=(7, 1000))):
         fc, fp = c.call("force", q=u)["f"], py.call("force", q=u)["f"]
         assert np.array_equal(fc, fp)
+
+
+def test_native_tuning_builds_another_library_with_the_same_values(monkeypatch):
+    """$MECHGEN_NATIVE=1 builds for the host processor (-march=native, no FMA contraction), under another build key
+    that names the processor: the force equals the default build's bit for bit."""
+    from mechgen.codegen import build
+
+    model = _chain("fixed", onsite=False)
+    spec = specialize(model, {"N": 2000, **VALUES})
+    u = np.random.default_rng(6).normal(scale=0.3, size=(3, 2000))
+    probe = "double mg_probe(double x);\ndouble mg_probe(double x) { return 2.0 * x; }\n"
+    default, _ = compile_model(model, spec, kernels={"force"}, backend="c")
+    generic = build.build_shared(probe, stem="native_probe")
+    monkeypatch.setenv(build.NATIVE_ENV, "1")
+    assert build.native_tuning() == (build.NATIVE_FLAGS, (build.processor_identity(),))
+    assert build.build_shared(probe, stem="native_probe") != generic      # another cache entry
+    native, _ = compile_model(model, spec, kernels={"force"}, backend="c")
+    assert np.array_equal(native.call("force", q=u)["f"], default.call("force", q=u)["f"])

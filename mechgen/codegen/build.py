@@ -57,6 +57,12 @@ COMPILE_TIMEOUT = 120.0
 VERSION_TIMEOUT = 30.0
 _STEM_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,63}")
 MGCALL_SOURCE = Path(__file__).parent / "templates" / "c99" / "mgcall.c"
+#: environment variable: "1" builds every library for this machine's processor (:data:`NATIVE_FLAGS`)
+NATIVE_ENV = "MECHGEN_NATIVE"
+#: the host tuning: the processor's vector instructions (GCC and Clang vectorise the chain loops with them: the
+#: FPU force at N = 10^6 in 243 us instead of 496), and no contraction of a*b + c into an FMA, so the values stay
+#: those of the default build (GCC does not contract in ISO C mode; Clang would)
+NATIVE_FLAGS = ("-march=native", "-ffp-contract=off")
 
 #: Counters of this process: "compile" (compiler runs), "hit" (cache hits), "miss".
 STATS: Counter = Counter()
@@ -256,7 +262,9 @@ def _build_entry(source: str, *, stem: str, output_name: str, cflags: Sequence[s
         raise CompilerUnavailable(f"CC={cc!r} does not run ({cc} --version failed)" if cc else
                                   "no working C compiler found (set CC, or install cc/gcc/clang)")
     command, identity = found
-    cflags, include_dirs, ldflags = tuple(cflags), tuple(map(str, include_dirs)), tuple(ldflags)
+    tuning, processor = native_tuning()
+    cflags, include_dirs, ldflags = tuple(cflags) + tuning, tuple(map(str, include_dirs)), tuple(ldflags)
+    extra_key = tuple(extra_key) + processor
     # the file names are part of the entry: the same source under another stem is another entry
     key = build_key(source, cflags, include_dirs, ldflags, identity, stem, output_name, *extra_key)
     source_name = f"lib{stem}.c"
@@ -285,6 +293,31 @@ def _build_entry(source: str, *, stem: str, output_name: str, cflags: Sequence[s
     entry, created = cache.get_or_create(KIND, key, fill, entry_check(key, source_name, built, output_name))
     STATS["miss" if created else "hit"] += 1
     return entry / output_name
+
+
+def native_tuning() -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """(flags, key parts) of the host tuning $MECHGEN_NATIVE=1 asks for: :data:`NATIVE_FLAGS`, keyed by
+    :func:`processor_identity` (a cache shared by machines of other processors never hands one theirs); both
+    empty otherwise."""
+    if os.environ.get(NATIVE_ENV, "") != "1":
+        return (), ()
+    return NATIVE_FLAGS, (processor_identity(),)
+
+
+@lru_cache(maxsize=1)
+def processor_identity() -> str:
+    """The host processor: its model and feature flags as /proc/cpuinfo states them (Linux), else platform's
+    machine and processor names."""
+    fields: dict[str, str] = {}
+    try:
+        for line in Path("/proc/cpuinfo").read_text(encoding="utf-8", errors="replace").splitlines():
+            name, _, value = line.partition(":")
+            name = name.strip()
+            if name in ("model name", "flags", "Features", "CPU part", "CPU implementer") and name not in fields:
+                fields[name] = " ".join(value.split())
+    except OSError:
+        pass
+    return " | ".join([platform.machine(), platform.processor(), *(f"{k}: {v}" for k, v in sorted(fields.items()))])
 
 
 def build_shared(source: str, *, stem: str, cflags: Sequence[str] = DEFAULT_CFLAGS,
