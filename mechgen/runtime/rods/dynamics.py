@@ -427,6 +427,8 @@ class Trajectory:
     newton_iterations: int = 0
     jacobians: int = 0
     splits: int = 0
+    #: the most Newton solves one step attempt took (a failed attempt, before its split, included)
+    most_step_iterations: int = 0
 
 
 class _Solver:
@@ -438,6 +440,7 @@ class _Solver:
         self.dt = None
         self.iterations = 0
         self.jacobians = 0
+        self.most = 0                                    # the most solves of one step attempt
         size = 6 * (disc.elements + 1)
         self.scale = np.tile(np.concatenate([np.full(3, disc.body.rod.L), np.ones(3)]), size // 6)
 
@@ -457,6 +460,14 @@ class _Solver:
         return float(np.max(np.abs(dz.ravel()) / self.scale))
 
     def step(self, st: State, dt: float, z0: np.ndarray):
+        """:meth:`attempt`, counting its solves in ``most``."""
+        start = self.iterations
+        try:
+            return self.attempt(st, dt, z0)
+        finally:
+            self.most = max(self.most, self.iterations - start)
+
+    def attempt(self, st: State, dt: float, z0: np.ndarray):
         """The converged increments z and the midpoint external wrench, or None when Newton fails.
 
         Newton's corrections dz = -J^-1 r(z) use a factorised Jacobian J taken at some iterate, possibly of an
@@ -584,6 +595,7 @@ def simulate(disc: Discrete, state: State, *, dt: float, t_end: float, save_ever
             record(min(k * dt, t_end), k // save_every)
     out.final = st
     out.newton_iterations, out.jacobians = solver.iterations, solver.jacobians
+    out.most_step_iterations = solver.most
     if shape_every and (steps // save_every) % shape_every:   # the final shape always (once)
         out.shapes.append(st.x.copy())
     return out
