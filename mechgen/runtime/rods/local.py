@@ -321,14 +321,18 @@ class Batched:
         self.out = np.zeros((count, function.nnz_out(0)))     # the output's structural nonzeros
         self.rows = function.numel_out(0)
         self.at = np.asarray(function.sparsity_out(0).find(), dtype=np.intp)   # their places in the column
-        self.buffer, self.run = self.function.buffer()
-        self.buffer.set_arg(0, memoryview(self.data))
-        self.buffer.set_arg(1, memoryview(self.par))
-        self.buffer.set_res(0, memoryview(self.out))
+        self.buffer = None
+        if hasattr(self.function, "buffer"):            # a CasADi without FunctionBuffer: the ordinary call
+            self.buffer, self.run = self.function.buffer()
+            self.buffer.set_arg(0, memoryview(self.data))
+            self.buffer.set_arg(1, memoryview(self.par))
+            self.buffer.set_res(0, memoryview(self.out))
 
     def __call__(self, data: np.ndarray, par: np.ndarray) -> np.ndarray:
         """The outputs (count, output rows; structural zeros filled in) at ``data`` (count, rows) and
         ``par``; a new array."""
+        if self.buffer is None:
+            return np.asarray(self.function(np.asarray(data, dtype=float).T, np.asarray(par, dtype=float))).T.copy()
         self.data[...] = data
         self.par[...] = par
         self.run()
