@@ -47,7 +47,8 @@ def compile(model, params: Mapping | None = None, *, free=None, backend: str = "
         The system, whose ``with_params(**values)`` gives a new system and never changes it.
     """
     from mechgen import models
-    from mechgen.pipeline import all_kernels, compile_model
+    from mechgen.codegen.kernel_names import all_kernels
+    from mechgen.pipeline import compile_model
     from mechgen.symbolic.model import Model
     from mechgen.symbolic.specialize import specialize
 

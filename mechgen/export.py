@@ -128,7 +128,7 @@ def write_atomically(out: Path, contents: dict) -> list[Path]:
 
 
 def _kernels(model, wanted) -> tuple[str, ...]:
-    from mechgen.pipeline import all_kernels
+    from mechgen.codegen.kernel_names import all_kernels
 
     available = all_kernels(model)
     if wanted is None:
@@ -155,7 +155,8 @@ def _specialised(model, values: dict):
 
 
 def _lowered(model, spec, kernels):
-    from mechgen.pipeline import derive, lower_all
+    from mechgen.codegen.lower_model import lower_all
+    from mechgen.pipeline import derive
 
     return lower_all(model, derive(model, spec), set(kernels))
 

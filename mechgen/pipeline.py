@@ -19,9 +19,14 @@ from typing import TYPE_CHECKING, Callable
 import numpy as np
 
 from mechgen import buildlock
+from mechgen.stage_clock import collecting, timed_stage
 from mechgen.errors import CompilerUnavailable, InputError, MechgenError
 from mechgen.runtime.core.kernels import c_kernels, casadi_kernels, load_module, numpy_kernels
 from mechgen.runtime.core.system import System
+# the kernel catalogue and the lowering live in codegen; their names stay importable from here
+from mechgen.codegen.kernel_names import (FIELD_KERNELS, HAMILTONIAN_KERNELS, SALTATION,  # noqa: F401
+                                          STEADY_KERNELS, all_kernels)
+from mechgen.codegen.lower_model import lower_all  # noqa: F401
 
 if TYPE_CHECKING:  # the symbolic side is imported only where text is derived (a cached run never needs it)
     from mechgen.codegen.ir import KernelIR
@@ -30,12 +35,7 @@ if TYPE_CHECKING:  # the symbolic side is imported only where text is derived (a
 
 log = logging.getLogger("mechgen")
 BACKENDS = ("c", "numpy", "casadi")
-FIELD_KERNELS = ("residual", "tangent", "linear", "outputs", "energy_rates")
 _FIELD_CHOICES = ("discretisation", "N", "quadrature", "constraints", "joints")
-#: kernels of a continuum's steady boundary value problem (mechgen.symbolic.steady)
-STEADY_KERNELS = ("bvp_residual", "bvp_tangent", "bvp_outputs")
-#: kernels of its Hamiltonian (stress) form, y = (u, n) (mechgen.symbolic.steady.derive_steady_hamiltonian)
-HAMILTONIAN_KERNELS = ("hbvp_rates", "hbvp_rates_tangent", "hbvp_outputs")
 #: version of the request key (bump when what a key covers changes)
 REQUEST_FORMAT = "request-1"
 #: the committed layer of generated text for the built-in models (written by ``mechgen regen``, read-only)
@@ -48,6 +48,9 @@ _warned_no_compiler = False
 @dataclass
 class BuildReport:
     """What a compilation did: kernels, operation counts, stage times (s), cache use.
+
+    ``seconds``: derive, lower, emit and build (C compile and load), which add up to the build; and, where they
+    ran, declare (within derive), rewrite and cse (within lower).
 
     ``origin`` says where the generated text came from: ``"derived"`` (derived and emitted now),
     ``"cache"`` (the user compile cache) or ``"generated"`` (the committed mechgen/generated/).
@@ -156,31 +159,6 @@ def request_of(model: Model, spec: Specialization, *, kernels=None, backend: str
                           getattr(model, "derivation_mode", "auto"))
 
 
-def all_kernels(model: Model) -> tuple[str, ...]:
-    """Every kernel a model can have."""
-    from mechgen.codegen.lower_lattice import LATTICE_KERNELS
-    from mechgen.codegen.lower_lumped import LUMPED_KERNELS
-
-    if model.is_lattice:
-        return LATTICE_KERNELS
-    if model.is_field:
-        return FIELD_KERNELS
-    if model.is_plane:
-        from mechgen.codegen.lower_plane import PLANE_KERNELS
-
-        return PLANE_KERNELS
-    lumped = tuple(k for k in LUMPED_KERNELS if (k != "section" or model.section_fn is not None)
-                   and (k != "rod" or model.rod_spec is not None)
-                   and (k != "lagrangian" or not (model.is_hybrid or model.internals)))
-    if not model.coordinate_names and not model.internals:  # no state: a section's stiffness, a rod, the outputs
-        return tuple(k for k in lumped if k in ("outputs", "section", "rod"))
-    if model.is_hybrid:  # the event derivatives of saltation matrices (lower_hybrid)
-        lumped = lumped + (SALTATION,)
-    if model.internals:  # a model of internal variables only (no coordinate) has no potential force
-        return tuple(k for k in lumped if k != "force" or model.coordinate_names)
-    return tuple(k for k in lumped if not k.startswith("rates"))
-
-
 def derive(model: Model, spec: Specialization):
     """Derived equations (lumped or lattice) of a specialisation."""
     from mechgen.symbolic.hybrid import check_hybrid
@@ -206,154 +184,14 @@ def derive(model: Model, spec: Specialization):
     from mechgen.symbolic.casadi_form import NotConvertible
     from mechgen.symbolic.derive_ad import derive_lumped_ad, wants_ad
 
-    declared = declared_lumped(model, spec)
+    with timed_stage("declare"):
+        declared = declared_lumped(model, spec)
     if wants_ad(model, declared):  # a large model: derivatives by AD on the energies' graph
         try:
             return derive_lumped_ad(model, spec, declared)
         except NotConvertible:  # a Piecewise, Heaviside, Min/Max ...: the symbolic path
             pass
     return derive_lumped(model, spec, declared=declared)
-
-
-def lower_all(model: Model, eqs, kernels, *, cse: bool = True) -> list[KernelIR]:
-    """KernelIRs of the requested kernels, in canonical order."""
-    from mechgen.codegen.lower_lattice import lower_lattice
-    from mechgen.codegen.lower_lumped import lower_lumped
-
-    if model.is_field:
-        wanted = [k for k in all_kernels(model) if k in kernels]
-        irs = [lower_lumped(eqs.local, k, cse=cse) for k in wanted]
-        irs += [replace(lower_lumped(local, k, cse=cse), name=f"{k}_at_{at}") for at, local in eqs.points.items()
-                for k in wanted]
-        meta = field_meta(eqs)
-        for ir in irs:
-            ir.meta["field"] = meta
-        return _with_whirl(model, irs)
-    if model.is_plane:
-        from mechgen.codegen.lower_plane import lower_plane
-
-        return lower_plane(eqs, kernels, cse=cse)
-    if model.is_hybrid:
-        return _with_whirl(model, lower_hybrid(model, eqs, kernels, cse=cse))
-    from mechgen.codegen.lower_ad import lower_ad
-    from mechgen.symbolic.derive_ad import ADEquations
-
-    if isinstance(eqs, ADEquations):
-        irs = [lower_ad(eqs, k) for k in all_kernels(model) if k in kernels]
-        return _with_whirl(model, irs + _initial_kernel(eqs, kernels, cse))
-    lower = lower_lattice if model.is_lattice else lower_lumped
-    irs = [lower(eqs, k, cse=cse) for k in all_kernels(model) if k in kernels]
-    return _with_whirl(model, irs + _initial_kernel(eqs, kernels, cse))
-
-
-def _initial_kernel(eqs, kernels, cse: bool) -> list[KernelIR]:
-    """The ``initial`` kernel (the declared initial state, mechgen.symbolic.initial) beside a time response's."""
-    from mechgen.codegen.lower_lumped import lower_matrices
-
-    column = getattr(eqs, "initial", None)
-    if column is None or not {"residual", "force", "lagrangian"} & set(kernels):
-        return []
-    return [lower_matrices(eqs, "initial", "the declared initial state (q, v, z)", {"x": column}, cse=cse)]
-
-
-def lower_hybrid(model: Model, eqs, kernels, *, cse: bool = True) -> list[KernelIR]:
-    """The kernels of a hybrid model (mechgen.symbolic.hybrid.HybridEquations): each requested kernel per mode
-    (``<kernel>__i``) and, with a residual or force, the guards of each mode and the resets; every kernel's
-    meta holds the modes and guards (``meta["hybrid"]``)."""
-    import sympy as sp
-
-    from mechgen.codegen.lower_lumped import lower_lumped, lower_matrices
-
-    wanted = [k for k in all_kernels(model) if k in kernels and k != SALTATION]
-    irs = [replace(lower_lumped(mode_eqs, k, cse=cse), name=f"{k}__{i}")
-           for k in wanted for i, mode_eqs in enumerate(eqs.equations)]
-    if SALTATION in kernels:
-        irs += saltation_kernels(eqs, cse)
-    if {"residual", "force"} & set(kernels):
-        for i, (mode_eqs, guards) in enumerate(zip(eqs.equations, eqs.guards)):
-            if not guards:
-                continue
-            g = sp.Matrix([ge.g for ge in guards])
-            g_t = sp.Matrix([ge.g_t for ge in guards])
-            irs.append(lower_matrices(mode_eqs, f"guards__{i}", f"guards leaving mode {i} and their rates",
-                                      {"g": g, "g_t": g_t}, cse=cse, accel=True))
-        for j, column in enumerate(eqs.resets):
-            irs.append(lower_matrices(eqs.equations[0], f"reset__{j}", f"state after reset {j}", {"x": column},
-                                      cse=cse))
-    irs += _initial_kernel(eqs.equations[0], kernels, cse)
-    meta = eqs.meta()
-    for ir in irs:
-        ir.meta["hybrid"] = meta
-    return irs
-
-
-#: the pseudo-kernel of a hybrid model that asks for the derivatives its saltation matrices need
-SALTATION = "saltation"
-
-
-def saltation_kernels(eqs, cse: bool) -> list[KernelIR]:
-    """The derivatives of a hybrid model's events, for the saltation matrices of its periodic orbits
-    (mechgen.runtime.core.hybrid_system.HybridSystem.saltation): ``guard_jacobian__i`` g_x = dg/dx of the
-    guards leaving mode i (x = (q, v, z)), ``reset_jacobian__j`` R_x = dx+/dx and R_t = dx+/dt of reset j."""
-    import sympy as sp
-
-    from mechgen.codegen.lower_lumped import lower_matrices
-    from mechgen.symbolic.derive import TIME
-
-    first = eqs.equations[0]
-    x = sp.Matrix(list(first.q) + list(first.v) + list(first.z))
-    irs = []
-    for i, (mode_eqs, guards) in enumerate(zip(eqs.equations, eqs.guards)):
-        if guards:
-            g = sp.Matrix([ge.g for ge in guards])
-            irs.append(lower_matrices(mode_eqs, f"guard_jacobian__{i}", f"dg/dx of the guards leaving mode {i}",
-                                      {"g_x": g.jacobian(x)}, cse=cse))
-    for j, column in enumerate(eqs.resets):
-        irs.append(lower_matrices(first, f"reset_jacobian__{j}", f"dx+/dx and dx+/dt of reset {j}",
-                                  {"R_x": column.jacobian(x), "R_t": column.diff(TIME)}, cse=cse))
-    return irs
-
-
-def _constraint_kernel(model: Model, spec: Specialization, eqs, cse: bool) -> list[KernelIR]:
-    """The ``constraint`` and ``strain`` kernels (g_j, g_jj) of a continuum that declares them, beside its linear one."""
-    from mechgen.codegen.lower_lumped import lower_matrices
-    from mechgen.symbolic.constraint import constraint_matrices, constraint_of
-
-    irs = []
-    for name, fn, doc in (("constraint", model.constraint_fn, "the pointwise constraint g(jets) = 0"),
-                          ("strain", model.strain_fn, "the axial strain measure g(jets)")):
-        g = constraint_of(model, spec, fn)
-        if g is not None:
-            ir = lower_matrices(eqs.local, name, f"derivatives of {doc}", constraint_matrices(g, eqs.local, model),
-                                cse=cse)
-            ir.meta["field"] = field_meta(eqs)
-            irs.append(ir)
-    return irs
-
-
-def field_meta(eqs) -> dict:
-    """What the runtime needs to know of a continuum: fields, jets, length, ends, parts, constraints."""
-    state = set(eqs.local.q + eqs.local.v) | {eqs.local.t}
-    constant_mass = all(not (local.jacobian(local.residual, "a").free_symbols & state)
-                        for local in [eqs.local, *eqs.points.values()])
-    meta = {"fields": list(eqs.fields), "jets": [list(j) for j in eqs.jets],
-            "length": eqs.length, "points": sorted(at for at in eqs.points if at not in eqs.parts),
-            "constant_mass": constant_mass, "constraints": [[c.field, c.order, c.at] for c in eqs.constraints]}
-    if eqs.parts:
-        meta["parts"] = {k: list(v) for k, v in sorted(eqs.parts.items())}
-    if eqs.shear_pairs:
-        meta["shear_pairs"] = [list(p) for p in eqs.shear_pairs]
-    if any(c.value != 0 for c in eqs.constraints):
-        meta["boundary_values"] = True
-    return meta
-
-
-def _with_whirl(model: Model, irs: list[KernelIR]) -> list[KernelIR]:
-    """Record the model's whirl pair (Model.whirl_pair) in every kernel's meta."""
-    if model.whirl:
-        for ir in irs:
-            ir.meta["whirl"] = list(model.whirl)
-    return irs
 
 
 def emit(backend: str, irs: list[KernelIR], *, model: str, title: str) -> str:
@@ -418,40 +256,25 @@ def _load(backend: str, text: str, specs: dict, key: str, report: BuildReport):
 
 def generate(model: Model, spec: Specialization, kernels, backend: str, cse: bool = True,
              report: BuildReport | None = None) -> dict:
-    """derive -> lower -> emit; returns {'text', 'specs'} (timed into ``report`` when given)."""
-    from mechgen.codegen.lower_lumped import lower_lumped
+    """derive -> lower -> emit; returns {'text', 'specs'} (timed into ``report`` when given: the stages, and
+    within them declare, rewrite and cse, :mod:`mechgen.stage_clock`)."""
+    report = report if report is not None else BuildReport(backend)
+    with collecting(report.seconds):
+        return _generate(model, spec, set(kernels), backend, cse, report)
+
+
+def _generate(model: Model, spec: Specialization, kernels: set, backend: str, cse: bool,
+              report: BuildReport) -> dict:
+    from mechgen.codegen.lower_model import lower_model
     from mechgen.codegen.spec import kernel_spec
 
-    report = report if report is not None else BuildReport(backend)
-    kernels = set(kernels)
     clock = time.perf_counter()
     hamiltonian_only = model.is_field and set(kernels) <= set(HAMILTONIAN_KERNELS)
     # a steady state in stress form needs no dynamics (an inextensible string has no strain energy)
     eqs = None if hamiltonian_only else derive(model, spec)
     report.seconds["derive"] = time.perf_counter() - clock
     clock = time.perf_counter()
-    irs = [] if hamiltonian_only else lower_all(model, eqs, kernels, cse=cse)
-    if model.is_field and "linear" in kernels and not hamiltonian_only:
-        irs += _constraint_kernel(model, spec, eqs, cse)
-    steady = [k for k in STEADY_KERNELS if k in kernels] if model.is_field else []
-    if steady:
-        from mechgen.symbolic.steady import derive_steady
-
-        form = derive_steady(model, spec)
-        for k in steady:
-            ir = replace(lower_lumped(form, k.removeprefix("bvp_"), cse=cse), name=k)
-            ir.meta["field"] = field_meta(eqs)
-            irs.append(_with_whirl(model, [ir])[0])
-    hamiltonian = [k for k in HAMILTONIAN_KERNELS if k in kernels] if model.is_field else []
-    if hamiltonian:
-        from mechgen.symbolic.steady import derive_steady_hamiltonian, steady_field_meta
-
-        form = derive_steady_hamiltonian(model, spec)
-        meta = steady_field_meta(model, spec) if eqs is None else field_meta(eqs)
-        for k in hamiltonian:
-            ir = replace(lower_lumped(form, k.removeprefix("hbvp_"), cse=cse), name=k)
-            ir.meta["field"] = meta
-            irs.append(ir)
+    irs = lower_model(model, spec, eqs, kernels, cse=cse)
     report.seconds["lower"] = time.perf_counter() - clock
     clock = time.perf_counter()
     text = emit(backend, irs, model=model.name, title=spec.key())

@@ -245,3 +245,27 @@ def test_a_kind_registered_at_run_time_runs_through_the_scene_the_summary_and_th
     finally:
         registry.unregister("mass_trace")
     assert registry.kinds()[:len(KINDS)] == KINDS and "mass_trace" not in registry.kinds()
+
+
+def test_a_scene_loads_only_the_kinds_it_names():
+    """Loading laval_rotor.toml (stability, modes and a sweep of stability) imports those kinds' modules and no
+    other kind's (a start pays for what the scene runs); an unknown kind still lists every kind."""
+    import subprocess
+    import sys
+
+    code = ("import sys; from mechgen import models; from mechgen.scene.load import load_scene; "
+            "from mechgen.scene.info import lookup_model; "
+            "load_scene('scenes/laval_rotor.toml', lookup_model=lookup_model, model_names=models.known); "
+            "print(' '.join(sorted(m for m in sys.modules if m.startswith('mechgen.analyses.'))))")
+    root = Path(__file__).resolve().parent.parent
+    loaded = set(subprocess.run([sys.executable, "-c", code], cwd=root, capture_output=True, text=True,
+                                check=True).stdout.split())
+    kinds = {m.rsplit(".", 1)[1] for m in registry.MODULES}
+    assert {"sweep", "stability"} <= loaded_kinds(loaded, kinds) <= {"sweep", "stability", "modes", "campbell",
+                                                                       "simulate"}
+    with pytest.raises(InputError, match="one of: modes, stability"):
+        registry.get("no_such_kind")
+
+
+def loaded_kinds(modules: set, kinds: set) -> set:
+    return {m.rsplit(".", 1)[1] for m in modules} & kinds

@@ -71,6 +71,31 @@ def test_small_run_writes_reports_and_skips_over_the_cap(tmp_path):
     assert json.loads((tmp_path / "multibody_results.json").read_text())["tools"] == list(data["tools"])
     text = (tmp_path / "multibody_results.md").read_text()
     assert "First build" in text and "skipped (> cap" in text
+    assert "| derive | lower | emit | build | declare | rewrite | cse |" in text
+
+
+@pytest.mark.parametrize("links, path", [(2, "symbolic"), (9, "ad")])
+def test_build_report_times_the_inner_stages_within_the_outer(links, path, tmp_path, monkeypatch):
+    """A first build reports declare within derive and, on the symbolic path, rewrite and cse within lower (the
+    AD path runs neither: CasADi's program is already shared); the outer stages never exceed the whole."""
+    import time
+
+    from mechgen.bench.multibody import pendulum_model
+    from mechgen.pipeline import compile_model
+    from mechgen.symbolic.specialize import all_free
+
+    monkeypatch.setenv("MECHGEN_CACHE", str(tmp_path))
+    model = pendulum_model(links)
+    start = time.perf_counter()
+    _, report = compile_model(model, all_free(model), backend="numpy")
+    whole = time.perf_counter() - start
+    s = report.seconds
+    assert report.origin == "derived" and 0 < s["declare"] <= s["derive"]
+    assert sum(s[k] for k in ("derive", "lower", "emit", "build")) <= whole
+    if path == "symbolic":
+        assert 0 < s["rewrite"] + s["cse"] <= s["lower"]
+    else:
+        assert "rewrite" not in s and "cse" not in s
 
 
 @pytest.mark.slow  # two child processes with PyDy's derivation: ~8 s on a loaded 2-core machine

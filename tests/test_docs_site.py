@@ -380,7 +380,7 @@ def test_decorators_page_examples_declare_models_that_derive():
     its energy loss against closed forms); every model they declare is derived and compiled (numpy backend),
     the string also with its steady and stress-form kernels (only the stress form when inextensible)."""
     import mechgen
-    from mechgen.pipeline import HAMILTONIAN_KERNELS, STEADY_KERNELS
+    from mechgen.codegen.kernel_names import HAMILTONIAN_KERNELS, STEADY_KERNELS
 
     text = (DOCS / "decorators.md").read_text(encoding="utf-8")
     namespace, models = {}, []

@@ -10,7 +10,8 @@ import time
 import pytest
 
 from mechgen import models
-from mechgen.pipeline import derive, lower_all
+from mechgen.codegen.lower_model import lower_all
+from mechgen.pipeline import derive
 from mechgen.symbolic.specialize import specialize
 
 

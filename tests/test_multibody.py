@@ -177,19 +177,39 @@ def test_mass_solve_cholesky_with_lu_where_not_positive_definite():
     assert mass_solve(np.zeros((0, 0)), np.zeros(0)).shape == (0,)
 
 
-def test_program_printer_equals_the_c_printer_in_value():
-    """program_c_code writes a program block's single operations directly; each text evaluates (C99 operators
-    and functions are Python's for these forms) to the value of c_code's text."""
+def test_program_text_equals_the_sympy_printers_in_value():
+    """mechgen.codegen.program_text prints a program block's operations without sympy; in each dialect every
+    operation's text evaluates to the value of sympy's printers on the same operation (operation_expr): C99's
+    forms evaluate as Python here (its functions are math's), numpy's on 1-element arrays."""
     import math
 
-    from mechgen.codegen.printing import c_code, program_c_code
+    from mechgen.codegen.ir import Operation
+    from mechgen.codegen.printing import c_code, math_code, numpy_code
+    from mechgen.codegen.program_text import OPERATIONS, operation_expr, operation_text
 
-    t0, t1 = sp.symbols("t0 t1", real=True)
-    forms = [t0 + t1, t0 * t1, t0 - t1, t0 / t1, -t0, t0**2, t0**3, 1 / t0, sp.sqrt(t0), 2.5 * t0, t0 + 3,
-             -2 * t1, sp.sin(t0), sp.cos(t1), sp.exp(t0), sp.log(t1), sp.tanh(t0), sp.Abs(t0), sp.atan(t1), t0,
-             sp.Float(0.125), sp.Integer(-3)]
-    namespace = {**{k: getattr(math, k) for k in ("sin", "cos", "exp", "log", "tanh", "fabs", "atan", "sqrt",
-                                                  "pow")}, "t0": 0.7, "t1": 1.3}
-    for expr in forms:
-        assert math.isclose(eval(program_c_code(expr, {}), namespace), eval(c_code(expr), namespace),
-                            rel_tol=1e-15), expr
+    binary = [("t0", "t1"), ("t0", 2.5), ("t0", -3.0), (0.125, "t1")]
+    constpow = [2.0, 3.0, -2.0, -1.0, 0.5, -0.5, 1.7, 9.0]
+    ops = [Operation("t9", op, a) for op in ("add", "sub", "mul", "div", "pow", "atan2", "fmin", "fmax")
+           for a in binary]
+    ops += [Operation("t9", "constpow", ("t0", e)) for e in constpow]
+    domain = {"asin": ("t2", -0.3), "acos": ("t2", -0.3), "atanh": ("t2", -0.3), "acosh": ("t1", 1.5),
+              "sqrt": ("t1", 0.4), "log": ("t1", 0.4)}         # arguments where the function is real
+    ops += [Operation("t9", op, (a,)) for op in OPERATIONS - {"add", "sub", "mul", "div", "pow", "atan2", "fmin",
+                                                                "fmax", "constpow"}
+            for a in domain.get(op, ("t1", -0.4, "t2"))]
+    assert {o.op for o in ops} == OPERATIONS
+    c_names = {k: getattr(math, k) for k in ("sin", "cos", "tan", "exp", "log", "sqrt", "pow", "atan2", "asin",
+                                              "acos", "atan", "sinh", "cosh", "tanh", "asinh", "acosh",
+                                              "atanh", "fabs")}
+    point = {"t0": 0.7, "t1": 1.3, "t2": 0.4}
+    for o in ops:
+        value = float(operation_expr(o).subs({sp.Symbol(k, real=True): v for k, v in point.items()}).evalf(20))
+        c_scope = {**c_names, "fmin": min, "fmax": max, **point}
+        np_scope = {"np": np, **{k: np.array([v]) for k, v in point.items()}}
+        for text, scope in ((operation_text(o, "c"), c_scope), (c_code(operation_expr(o)), c_scope),
+                            (operation_text(o, "math"), {"math": math, **point}),
+                            (math_code(operation_expr(o)), {"math": math, **point}),
+                            (operation_text(o, "numpy"), np_scope)):
+            got = float(np.asarray(eval(text, scope)).ravel()[0])
+            assert math.isclose(got, value, rel_tol=1e-14, abs_tol=1e-15), (o, text, got, value)
+        assert numpy_code(operation_expr(o))                    # the sympy numpy printer prints it too

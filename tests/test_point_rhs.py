@@ -69,3 +69,74 @@ def test_singular_mass_and_nan_as_the_python_path():
         system.rhs(0.0, np.array([1.0, -1.0, 0.1, 0.1]))
     x = np.array([0.5, 2.0, 0.1, -0.3])
     assert np.allclose(system.rhs(0.0, x), python_rhs(system, 0.0, x), rtol=1e-13)
+
+
+def python_jacobian(system, t, x):
+    """The Python path of System.jacobian (the compiled call switched off for this system)."""
+    key = ("point_rhs",)
+    kept = system.patterns.get(key)
+    system.patterns[key] = None
+    try:
+        return system.jacobian(t, x)
+    finally:
+        system.patterns[key] = kept
+
+
+@pytest.mark.parametrize("model", ["spring_pendulum", "duffing", "van_der_pol", "laval_rotor"])
+def test_jacobian_equal_to_the_python_path(model):
+    """df/dx = ((0, I), -M^-1 (r_q, r_v)) in one compiled call: equal to the Python path (tangent kernel, LAPACK) to
+    round-off."""
+    system = mechgen.compile(model, kernels=["flow", "residual", "tangent"])
+    assert point_rhs(system).J is not None
+    rng = np.random.default_rng(4)
+    for _ in range(3):
+        x = rng.standard_normal(2 * system.n)
+        fast, slow = system.jacobian(0.4, x), python_jacobian(system, 0.4, x)
+        assert np.allclose(fast, slow, rtol=1e-12, atol=1e-12 * np.max(np.abs(slow)))
+
+
+@pytest.mark.parametrize("n", [3, 12])
+def test_pendulum_jacobian_against_differences_of_the_closed_form(n):
+    """The lower block da/dx against central differences (h = 1e-5) of the closed-form accelerations: their
+    truncation error, O(h^2 a''') ~ 1e-9 here, sets the tolerance."""
+    system = mechgen.compile(pendulum_model(n), kernels=["flow", "tangent"])
+    x = 0.5 * np.random.default_rng(n).standard_normal(2 * n)
+    J = system.jacobian(0.0, x)
+    h = 1e-5
+
+    def accel(y):
+        return closed_form_accelerations(y[:n], y[n:])
+    fd = np.column_stack([(accel(x + h * e) - accel(x - h * e)) / (2 * h) for e in np.eye(2 * n)])
+    assert np.array_equal(J[:n], np.hstack([np.zeros((n, n)), np.eye(n)]))
+    assert np.max(np.abs(J[n:] - fd)) < 1e-7 * np.max(np.abs(fd))
+
+
+def test_jacobian_at_a_singular_mass_as_the_python_path():
+    from mechgen import Model
+
+    model = Model("massless_at_zero_j")
+    model.coordinates("x", "y")
+    model.kinetic(lambda q, v: (q.x**2 * v.x**2 + v.y**2) / 2)
+    model.potential(lambda q: (q.x**2 + q.y**4) / 2)
+    system = mechgen.compile(model, kernels=["flow", "tangent"])
+    assert point_rhs(system).J is not None
+    with pytest.raises(np.linalg.LinAlgError):
+        system.jacobian(0.0, np.array([0.0, 1.0, 0.1, 0.1]))
+    x = np.array([0.5, 2.0, 0.1, -0.3])
+    assert np.allclose(system.jacobian(0.0, x), python_jacobian(system, 0.0, x), rtol=1e-12, atol=1e-14)
+
+
+def test_an_indefinite_mass_takes_the_lu_branch():
+    """T = (v_x^2 + v_x v_y - v_y^2)/2 has M = ((1, 1/2), (1/2, -1)), indefinite: Cholesky fails and LU with partial
+    pivoting solves, for dx/dt and for each column of the Jacobian (against numpy's solve on the same r and M)."""
+    from mechgen import Model
+
+    model = Model("indefinite_mass")
+    model.coordinates("x", "y")
+    model.kinetic(lambda q, v: (v.x**2 + v.x * v.y - v.y**2) / 2 + q.x**2 * v.y**2 / 8)
+    model.potential(lambda q: (q.x**2 + 3 * q.y**2) / 2 + q.x * q.y**3)
+    system = mechgen.compile(model, kernels=["flow", "tangent"])
+    assert point_rhs(system).J is not None
+    x = np.array([0.3, -0.2, 0.5, 0.1])
+    assert np.allclose(system.rhs(0.0, x), python_rhs(system, 0.0, x), rtol=1e-13)
+    assert np.allclose(system.jacobian(0.0, x), python_jacobian(system, 0.0, x), rtol=1e-12, atol=1e-14)

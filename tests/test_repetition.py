@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from mechgen import models
-from mechgen.pipeline import compile_model, derive, lower_all
+from mechgen.codegen.lower_model import lower_all
+from mechgen.pipeline import compile_model, derive
 from mechgen.symbolic.specialize import specialize
 
 KERNELS = {"residual", "tangent", "linear", "force", "outputs"}

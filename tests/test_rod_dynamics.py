@@ -257,7 +257,7 @@ def test_same_run_twice_gives_the_same_numbers():
 
 
 def test_compiled_elements_match_the_numpy_reference_including_near_pi(monkeypatch):
-    """codegen/templates/c99/rod_elements.c against Discrete.internal (numpy): the same operations, so equal to
+    """runtime/csrc/rod_elements.c against Discrete.internal (numpy): the same operations, so equal to
     round-off; a relative rotation of 3.1 rad takes log's near-pi branch. And a whole run without the library
     (no compiler) gives the compiled run's numbers to rounding."""
     from mechgen.runtime.rods import dynamics

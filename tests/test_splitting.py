@@ -133,3 +133,25 @@ def test_without_a_compiler_the_numpy_stepper_runs(monkeypatch, tmp_path):
         build.reset_compiler_cache()
         symplectic_c.forget_library()
     assert symplectic_c.c_unavailable(system) is None
+
+
+def test_the_diagonal_mass_is_read_off_the_kinetic_energy():
+    """The splittings' fitness reads m_i of T = sum m_i v_i^2 / 2 off T's polynomial in v (no Hessian); a cross
+    term, a cubic term or a non-polynomial T gives None and the Hessian path names what breaks the form, as it
+    always did; a mass depending on q is caught by that path too."""
+    import sympy as sp
+
+    from mechgen.symbolic.separable import diagonal_masses, mass_obstacle
+
+    q1, q2, v1, v2, m = sp.symbols("q1 q2 v1 v2 m", real=True)
+    v, q = (v1, v2), (q1, q2)
+    assert diagonal_masses(m * v1**2 / 2 + 3 * v2**2, v) == [m, 6]
+    assert mass_obstacle(m * v1**2 / 2 + 3 * v2**2, q, v, (), ("x", "y")) is None
+    assert diagonal_masses(v1 * v2 + v1**2, v) is None
+    assert "not diagonal" in mass_obstacle(v1 * v2 + v1**2, q, v, (), ("x", "y"))
+    assert diagonal_masses(v1**3 + v2**2, v) is None
+    assert diagonal_masses(sp.cos(v1) + v2**2, v) is None
+    assert "depends on v1" in mass_obstacle(v1**4 + v2**2, q, v, (), ("x", "y"))
+    assert diagonal_masses(v1**2 + v1, v) is None
+    assert "quadratic form" in mass_obstacle(v1**2 + v1, q, v, (), ("x", "y"))
+    assert "depends on q1" in mass_obstacle((1 + q1**2) * v1**2 + v2**2, q, v, (), ("x", "y"))

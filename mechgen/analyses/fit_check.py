@@ -13,7 +13,7 @@ import numpy as np
 
 from mechgen.analyses import fit_data, schema
 from mechgen.analyses.fit_model import OUTPUT
-from mechgen.analyses.registry import get, kinds
+from mechgen.analyses.registry import get, sweepable_kinds
 from mechgen.analyses.schema import ABSENT, REQUIRED, AnalysisSpec, Option
 from mechgen.errors import SceneError
 from mechgen.scene.bounds import check_value
@@ -216,7 +216,7 @@ def _check_analysis(ctx, base: str, options: dict) -> None:
                 raise fail(ctx.file, key, f"{data.where(row, name)}: {exc.message}", exc.expected) from None
     table = options["analysis"]
     key = f"{base}.analysis"
-    kind = schema.analysis_kind(ctx, key, table, [k for k in kinds() if get(k).sweepable])
+    kind = schema.analysis_kind(ctx, key, table, sweepable_kinds(table.get("kind") if isinstance(table, dict) else None))
     saved, ctx.swept = ctx.swept, tuple(dict.fromkeys([*ctx.swept, *names, *inputs]))
     try:
         inner = schema.validate(ctx, key, get(kind), {k: v for k, v in table.items() if k != "kind"})

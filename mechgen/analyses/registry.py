@@ -126,13 +126,24 @@ def _load() -> None:
 def kinds() -> tuple[str, ...]:
     """The registered kinds' names, in the order of :data:`MODULES`."""
     _load()
+    return names()
+
+
+def names() -> tuple[str, ...]:
+    """The kinds' names without importing their modules: the built-in ones (a kind's module is named as the kind)
+    in the order of :data:`MODULES`, then those registered at run time."""
     order = [m.rsplit(".", 1)[1] for m in MODULES]
-    return tuple(sorted(_KINDS, key=lambda k: order.index(k) if k in order else len(order)))
+    return tuple(order) + tuple(sorted(k for k in _KINDS if k not in order))
 
 
 def get(name: str) -> AnalysisKind:
-    """The kind called ``name``; an InputError listing the kinds when there is none."""
-    _load()
+    """The kind called ``name`` (importing only its own module: a scene's start loads the kinds it names, not all
+    of them); an InputError listing the kinds when there is none."""
+    module = f"mechgen.analyses.{name}"
+    if name not in _KINDS and module in MODULES:
+        importlib.import_module(module)
+    if name not in _KINDS:
+        _load()
     if name not in _KINDS:
         raise InputError(f"unknown analysis kind {name!r}{did_you_mean(name, kinds())}", key="kind", expected="one of: " + ", ".join(kinds()))
     return _KINDS[name]
@@ -141,3 +152,11 @@ def get(name: str) -> AnalysisKind:
 def needs(kind: str, options: Mapping[str, Any], *, internal: bool) -> set[str]:
     """The kernels an analysis of ``kind`` with ``options`` needs (``internal``: the model has internal variables)."""
     return get(kind).needs(options, internal=internal)
+
+
+def sweepable_kinds(candidate: object = None) -> list[str]:
+    """The kinds a sweep or a fit may repeat, as far as checking ``candidate`` needs them: ``[candidate]`` when it
+    is one (only its module is imported), else every sweepable kind (all modules: for the message)."""
+    if isinstance(candidate, str) and candidate in names() and get(candidate).sweepable:
+        return [candidate]
+    return [k for k in kinds() if get(k).sweepable]

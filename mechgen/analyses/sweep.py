@@ -25,7 +25,7 @@ from pathlib import Path
 from mechgen.analyses import figures, schema, summary
 from mechgen.analyses.context import NAME, POINTS, PointRunner, run_at_point, scheduler_of
 from mechgen.analyses.parameters import with_free_params
-from mechgen.analyses.registry import AnalysisKind, get, kinds, register
+from mechgen.analyses.registry import AnalysisKind, get, register, sweepable_kinds
 from mechgen.analyses.schema import ABSENT, REQUIRED, AnalysisSpec, Option
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget
 from mechgen.runtime.core.sweep import ON_ERROR, OK, SweepExecutor, sweep_points
@@ -34,10 +34,9 @@ from mechgen.scene.values import fail, type_name
 
 def _inner(ctx, key: str, value: object) -> AnalysisSpec:
     """The analysis a sweep repeats: a table with ``kind`` (a sweepable kind) and that kind's keys."""
-    inner_kinds = [k for k in kinds() if get(k).sweepable]
     if not isinstance(value, dict):
         raise fail(ctx.file, key, f"value is {type_name(value)}", "a table with kind and its options")
-    kind = schema.analysis_kind(ctx, key, value, inner_kinds)
+    kind = schema.analysis_kind(ctx, key, value, sweepable_kinds(value.get("kind")))
     options = schema.validate(ctx, key, get(kind), {k: v for k, v in value.items() if k != "kind"})
     options.update({k: v for k, v in get(kind).point_defaults.items() if k not in value})
     return AnalysisSpec(ctx.current, kind, options)

@@ -11,7 +11,7 @@ default 0: about 40 outputs per period T_1 = 2 pi / omega_1 of the lowest linear
 cos(2 pi k n / N)), ``modes`` (8: modal energies reported per output), ``loop`` (auto | c | numpy),
 ``max_steps`` (10^9, refused up front).
 
-The steps run in C (mechgen/codegen/templates/c99/symplectic_loop.c) in chunks of ``stride`` steps; between
+The steps run in C (mechgen/runtime/csrc/symplectic_loop.c) in chunks of ``stride`` steps; between
 chunks the modal energies E_k = (P_k^2 + omega_k^2 Q_k^2)/2 come from a sine transform (fixed ends,
 mechgen.runtime.linear.chain_modes; O(N log N) per output).
 
@@ -101,7 +101,7 @@ def _kicks(split) -> int:
 
 
 def loop_bytes_per_step(n: int, split, scaled: bool = False) -> float:
-    """Bytes the C loop's step really moves (codegen/templates/c99/symplectic_loop.c), 8 n per array streamed:
+    """Bytes the C loop's step really moves (runtime/csrc/symplectic_loop.c), 8 n per array streamed:
     per force call f zeroed (8 n), q read (8 n) and f read and written by the accumulating kernel (16 n): 32 n; per
     kick v and f read, v written: 24 n (32 n with the inverse masses read, ``scaled``); per drift q and v read, q
     written: 24 n. Leapfrog: 80 n (88 n scaled)."""

@@ -21,7 +21,8 @@ method with lambdify and with cython, and sympy's LagrangesMethod with lambdify.
 child process of its own (:func:`cell_main`, $MECHGEN_CACHE a fresh folder, one BLAS thread), which reports:
 
 * the first build, s: model declaration, derivation, code generation and compilation, imports excluded (one
-  run; PyDy has no cache and pays it in every process), and mechgen's stages (derive, lower, emit, build);
+  run; PyDy has no cache and pays it in every process), and mechgen's stages (derive, lower, emit, build, and
+  within them declare, rewrite and cse: :data:`STAGES`, :data:`INNER_STAGES`);
 * the right-hand side per call, s (median of 5 timed runs, each >= 20 ms of calls, after a warm-up; mechgen
   ``system.rhs(t, x)`` and ``system.acceleration(q, v)``; PyDy's generated function);
 * a simulation: scipy ``solve_ivp`` DOP853 over 10 s at rtol 1e-8, atol 1e-10, 101 samples, from every link
@@ -352,6 +353,11 @@ def cell_main(argv: list[str]) -> None:
     _emit(simulation=_simulate(rhs, initial_state(problem, n)))
 
 
+#: mechgen's build stages, which add up to its build (BuildReport.seconds), and the inner ones within them
+STAGES = ("derive", "lower", "emit", "build")
+INNER_STAGES = ("declare", "rewrite", "cse")
+
+
 def _stage_clock() -> dict:
     """A dict that fills with mechgen's build stages (derive, lower, emit, build: C compile and load; seconds)
     when the pipeline logs "built ..." (its BuildReport's times)."""
@@ -646,15 +652,17 @@ def markdown(data: dict) -> str:
         cells = [_sim(r, t) for t in tools]
         parts.append(f"| {r['problem']} {r['size']} | {r['n']} | " + " | ".join(cells) + " |")
     parts += ["", "## mechgen's first build by stage, s (derive, lower, emit, build = C compile and load; other = "
-              "declaration, specialisation, cache and load bookkeeping)\n",
-              "| problem | n | tool | derive | lower | emit | build | other | total |", "|---" * 9 + "|"]
+              "cache and load bookkeeping; declare = calling the declared energies and specialising them, within "
+              "derive; rewrite = Horner rewrites and cse = sympy's CSE, within lower, symbolic derivation only)\n",
+              "| problem | n | tool | " + " | ".join(STAGES + INNER_STAGES) + " | other | total |",
+              "|---" * (5 + len(STAGES + INNER_STAGES)) + "|"]
     for r in data["rows"]:
         for t in tools:
             stages = r["cells"].get(t, {}).get("stages_s")
             if stages and "cached" not in t:
-                other = r["cells"][t]["build_s"] - sum(stages.values())
+                other = r["cells"][t]["build_s"] - sum(stages.get(k, 0.0) for k in STAGES)
                 parts.append(f"| {r['problem']} {r['size']} | {r['n']} | {t} | " + " | ".join(
-                    f"{stages.get(k, 0.0):.3g}" for k in ("derive", "lower", "emit", "build"))
+                    f"{stages[k]:.3g}" if k in stages else "-" for k in STAGES + INNER_STAGES)
                     + f" | {other:.3g} | {r['cells'][t]['build_s']:.3g} |")
     parts += ["", "## Agreement of the accelerations (3 random states, relative to the largest entry)\n",
               "| problem | n | reference | largest error | all within 1e-10 |", "|---|---|---|---|---|"]

@@ -14,7 +14,8 @@ from mechgen.version import __version__
 from mechgen.codegen.emit_c_loop import loop_block, stored_ports
 from mechgen.codegen.escape import c_comment, c_comment_lines, code_identifier
 from mechgen.codegen.ir import Block, KernelIR, Port
-from mechgen.codegen.printing import c_code, program_c_code
+from mechgen.codegen.printing import c_code
+from mechgen.codegen.program_text import operation_text
 from mechgen.codegen.templating import render
 
 
@@ -81,11 +82,8 @@ class _Names:
 
 def _straight(block: Block, names: _Names) -> list[str]:
     lines = [f"const double {code_identifier(g.symbol.name)} = {names.inp[g.port]}[{g.index}];" for g in block.gathers]
-    if block.program is not None:  # single operations: printed directly (mechgen.codegen.printing.program_c_code)
-        atoms: dict = {}
-        lines += [f"const double {s.name} = {program_c_code(e, atoms)};" for s, e in block.assignments]
-    else:
-        lines += [f"const double {code_identifier(s.name)} = {c_code(e)};" for s, e in block.assignments]
+    lines += [f"const double {o.target} = {operation_text(o, 'c')};" for o in block.operations]
+    lines += [f"const double {code_identifier(s.name)} = {c_code(e)};" for s, e in block.assignments]
     lines += [f"{names.out[w.port]}[{w.index}] {'+=' if w.accumulate else '='} {c_code(w.expr)};"
               for w in block.writes]
     return ["{"] + ["    " + line for line in lines] + ["}"]
@@ -116,7 +114,7 @@ def quick_build(ir: KernelIR) -> str:
     statements are built at -O1 and over 15,000 at -O0, where compiling would cost more than the calls save.
     Small and looping kernels keep -O3; Clang ignores the request (it has no such pragma).
     """
-    statements = sum(len(b.assignments) + len(b.writes) for b in ir.blocks if not b.loop)
+    statements = sum(len(b.assignments) + len(b.operations) + len(b.writes) for b in ir.blocks if not b.loop)
     low, none = QUICK_BUILD_STATEMENTS
     return "O0" if statements > none else "O1" if statements > low else ""
 

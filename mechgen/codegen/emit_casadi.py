@@ -14,6 +14,7 @@ from mechgen.codegen.emit_numpy import extent_expr
 from mechgen.codegen.escape import code_identifier, py_docstring, py_literal
 from mechgen.codegen.ir import Block, KernelIR
 from mechgen.codegen.printing import casadi_code
+from mechgen.codegen.program_text import operation_expr
 from mechgen.codegen.spec import kernel_spec
 from mechgen.codegen.templating import render
 
@@ -29,6 +30,7 @@ def _head(ir: KernelIR) -> list[str]:
 
 def _straight(block: Block, inp: dict, out: dict) -> list[str]:
     lines = [f"{code_identifier(g.symbol.name)} = in{inp[g.port]}[{g.index}]" for g in block.gathers]
+    lines += [f"{o.target} = {casadi_code(operation_expr(o))}" for o in block.operations]
     lines += [f"{code_identifier(s.name)} = {casadi_code(e)}" for s, e in block.assignments]
     for w in block.writes:
         op = "+" if w.accumulate else ""
@@ -85,7 +87,7 @@ def kernel_body(ir: KernelIR) -> list[str]:
 
 def casadi_name(name: str) -> str:
     """The label of a kernel's casadi.Function: CasADi refuses consecutive underscores, which the kernels of a
-    hybrid model's modes carry (``residual__0``, mechgen.pipeline.lower_hybrid), so runs of them become one."""
+    hybrid model's modes carry (``residual__0``, mechgen.codegen.lower_model.lower_hybrid), so runs of them become one."""
     return re.sub(r"_{2,}", "_", name)
 
 

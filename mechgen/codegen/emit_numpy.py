@@ -10,6 +10,7 @@ from mechgen.version import __version__
 from mechgen.codegen.escape import code_identifier, py_docstring, py_literal
 from mechgen.codegen.ir import Block, KernelIR
 from mechgen.codegen.printing import math_code, numpy_code
+from mechgen.codegen.program_text import operation_text
 from mechgen.codegen.spec import kernel_spec
 from mechgen.codegen.templating import render
 
@@ -32,6 +33,7 @@ def _head(ir: KernelIR) -> list[str]:
 def _straight(block: Block, idx: "_Indexed") -> list[str]:
     lines = [f"{code_identifier(g.symbol.name)} = in{idx.inp[g.port][0]}[{':, ' if idx.inp[g.port][1] else ''}"
              f"{g.index}]" for g in block.gathers]
+    lines += [f"{o.target} = {operation_text(o, 'numpy')}" for o in block.operations]
     lines += [f"{code_identifier(s.name)} = {numpy_code(e)}" for s, e in block.assignments]
     lines += [f"out{idx.out[w.port]}[:, {w.index}] {'+=' if w.accumulate else '='} {numpy_code(w.expr)}"
               for w in block.writes]
@@ -105,6 +107,7 @@ def point_body(ir: KernelIR) -> list[str] | None:
     lines += [f"out{i} = [0.0] * outs[{i}].shape[1]" for i, _ in enumerate(ir.outputs)]
     for block in ir.blocks:
         lines += [f"{code_identifier(g.symbol.name)} = in{idx.inp[g.port][0]}[{g.index}]" for g in block.gathers]
+        lines += [f"{o.target} = {operation_text(o, 'math')}" for o in block.operations]
         lines += [f"{code_identifier(sym.name)} = {math_code(e)}" for sym, e in block.assignments]
         lines += [f"out{idx.out[w.port]}[{w.index}] {'+=' if w.accumulate else '='} {math_code(w.expr)}"
                   for w in block.writes]

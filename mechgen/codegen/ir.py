@@ -115,6 +115,17 @@ class Write:
 
 
 @dataclass(frozen=True)
+class Operation:
+    """target = op(args): one operation of a program block (mechgen.codegen.lower_ad). ``op`` is one of
+    :data:`mechgen.codegen.program_text.OPERATIONS` (add, sub, mul, div, neg, sq, sin, constpow ...), each
+    argument the name of a temporary or gathered local (str) or a number (float)."""
+
+    target: str
+    op: str
+    args: tuple
+
+
+@dataclass(frozen=True)
 class Block:
     """Straight-line code, or a loop body when ``loop`` is set."""
 
@@ -126,6 +137,9 @@ class Block:
     #: operation count), from which the kernel's signature and op count are read instead of from every
     #: single-operation assignment (hundreds of thousands for a large model)
     program: tuple[str, int] | None = None
+    #: a program block's operations, in order (its ``assignments`` are empty): printed by
+    #: mechgen.codegen.program_text without a sympy object per operation
+    operations: tuple[Operation, ...] = ()
 
     @property
     def entries(self) -> tuple[tuple[int, int], ...]:

@@ -4,9 +4,10 @@ The kernels, their ports and their meaning are those of :mod:`mechgen.codegen.lo
 ``tangent``, ``flow``, ``linear``, ``force``, ``rates``, ``rates_tangent``, ``energy_rates``, ``outputs``,
 ``lagrangian``). Each is a ``casadi.Function`` of the state whose algorithm, CasADi's straight-line program
 with its common subexpressions already shared, becomes one block: an input instruction a gathered local
-``g``, each operation an assignment to a fresh temporary ``t`` (single assignment: CasADi reuses its work
-registers, the IR does not), an output instruction a write. No sympy CSE or Horner pass runs over it, so the
-lowering is linear in the program's length. Structural zeros (entries that are the constant 0) are not written,
+``g``, each operation an :class:`~mechgen.codegen.ir.Operation` assigning a fresh temporary ``t`` (single
+assignment: CasADi reuses its work registers, the IR does not), an output instruction a write. No sympy object
+is made per operation and no sympy CSE or Horner pass runs over it (the backends print operations from
+:mod:`mechgen.codegen.program_text`), so the lowering is linear in the program's length. Structural zeros (entries that are the constant 0) are not written,
 as :func:`mechgen.codegen.lower.dense_writes` skips them.
 """
 from __future__ import annotations
@@ -16,42 +17,35 @@ import hashlib
 import casadi as ca
 import sympy as sp
 
-from mechgen.codegen.ir import Block, Gather, KernelIR, Port, Write, fixed
+from mechgen.codegen.ir import Block, Gather, KernelIR, Operation, Port, Write, fixed
 from mechgen.codegen.lower import kernel
 from mechgen.codegen.lower_lumped import lumped_meta, separable_meta, state_ports
 from mechgen.symbolic.casadi_form import NotConvertible
 
-_BINARY = {ca.OP_ADD: lambda x, y: sp.Add(x, y, evaluate=False),
-           ca.OP_SUB: lambda x, y: sp.Add(x, sp.Mul(-1, y, evaluate=False), evaluate=False),
-           ca.OP_MUL: lambda x, y: sp.Mul(x, y, evaluate=False),
-           ca.OP_DIV: lambda x, y: sp.Mul(x, sp.Pow(y, -1, evaluate=False), evaluate=False),
-           ca.OP_POW: lambda x, y: sp.Pow(x, y, evaluate=False),
-           ca.OP_CONSTPOW: lambda x, y: sp.Pow(x, _exact(y), evaluate=False),
-           ca.OP_ATAN2: sp.atan2, ca.OP_FMIN: sp.Min, ca.OP_FMAX: sp.Max}
-_UNARY = {ca.OP_NEG: lambda x: sp.Mul(-1, x, evaluate=False), ca.OP_SQ: lambda x: sp.Pow(x, 2, evaluate=False),
-          ca.OP_TWICE: lambda x: sp.Mul(2, x, evaluate=False), ca.OP_INV: lambda x: sp.Pow(x, -1, evaluate=False),
-          ca.OP_ASSIGN: lambda x: x, ca.OP_SQRT: sp.sqrt, ca.OP_EXP: sp.exp,
-          ca.OP_LOG: sp.log, ca.OP_SIN: sp.sin, ca.OP_COS: sp.cos, ca.OP_TAN: sp.tan, ca.OP_ASIN: sp.asin,
-          ca.OP_ACOS: sp.acos, ca.OP_ATAN: sp.atan, ca.OP_SINH: sp.sinh, ca.OP_COSH: sp.cosh, ca.OP_TANH: sp.tanh,
-          ca.OP_ASINH: sp.asinh, ca.OP_ACOSH: sp.acosh, ca.OP_ATANH: sp.atanh, ca.OP_FABS: sp.Abs,
-          ca.OP_SIGN: sp.sign}
+#: CasADi's operation codes -> the Kernel IR's operation names (mechgen.codegen.program_text)
+_OPERATIONS = {ca.OP_ADD: "add", ca.OP_SUB: "sub", ca.OP_MUL: "mul", ca.OP_DIV: "div", ca.OP_POW: "pow",
+               ca.OP_CONSTPOW: "constpow", ca.OP_ATAN2: "atan2", ca.OP_FMIN: "fmin", ca.OP_FMAX: "fmax",
+               ca.OP_NEG: "neg", ca.OP_SQ: "sq", ca.OP_TWICE: "twice", ca.OP_INV: "inv", ca.OP_SQRT: "sqrt",
+               ca.OP_EXP: "exp", ca.OP_LOG: "log", ca.OP_SIN: "sin", ca.OP_COS: "cos", ca.OP_TAN: "tan",
+               ca.OP_ASIN: "asin", ca.OP_ACOS: "acos", ca.OP_ATAN: "atan", ca.OP_SINH: "sinh", ca.OP_COSH: "cosh",
+               ca.OP_TANH: "tanh", ca.OP_ASINH: "asinh", ca.OP_ACOSH: "acosh", ca.OP_ATANH: "atanh",
+               ca.OP_FABS: "fabs", ca.OP_SIGN: "sign"}
+_TWO = frozenset({"add", "sub", "mul", "div", "pow", "constpow", "atan2", "fmin", "fmax"})
 
 
-def _exact(value):
-    """An integral constant exponent as a sympy Integer (printed as a product, x**3 -> x*x*x)."""
-    return sp.Integer(int(value)) if getattr(value, "is_Float", False) and value == int(value) else value
-
-
-def _number(value: float) -> sp.Expr:
+def _write_expr(value) -> sp.Expr:
+    """A written value (a temporary's or local's name, or a number) as a sympy atom."""
+    if isinstance(value, str):
+        return sp.Symbol(value, real=True)
     return sp.Integer(int(value)) if value == int(value) and abs(value) < 2**53 else sp.Float(value, 17)
 
 
 def program_block(fn: ca.Function, ports: list[str], writes: list[tuple[str, int]]) -> Block:
     """The Block of an SX function: inputs ``ports`` (in order), one output whose entries are ``writes``
-    ((port, index) each)."""
-    work: dict[int, sp.Expr] = {}
+    ((port, index) each). A work register holds a name (str) or a number (float); an assignment copies."""
+    work: dict[int, str | float] = {}
     gathers: dict[tuple[str, int], Gather] = {}
-    assignments, out = [], []
+    operations, out = [], []
     digest, ops = hashlib.sha256(repr((ports, writes)).encode()), 0
     for k in range(fn.n_instructions()):
         op, dst, src = fn.instruction_id(k), fn.instruction_output(k), fn.instruction_input(k)
@@ -61,30 +55,26 @@ def program_block(fn: ca.Function, ports: list[str], writes: list[tuple[str, int
             key = (ports[src[0]], src[1])
             if key not in gathers:
                 gathers[key] = Gather(sp.Symbol(f"g{len(gathers)}", real=True), key[0], key[1], False)
-            work[dst[0]] = gathers[key].symbol
+            work[dst[0]] = gathers[key].symbol.name
         elif op == ca.OP_CONST:
-            work[dst[0]] = _number(constant)
+            work[dst[0]] = float(constant)
         elif op == ca.OP_OUTPUT:
             port, index = writes[dst[1]]
-            out.append(Write(port, index, work[src[0]]))
+            out.append(Write(port, index, _write_expr(work[src[0]])))
+        elif op == ca.OP_ASSIGN:
+            work[dst[0]] = work[src[0]]
         else:
-            ops += op != ca.OP_ASSIGN
-            expr = _operation(op, [work[i] for i in src])
-            if expr.is_Atom:
-                work[dst[0]] = expr
-                continue
-            temp = sp.Symbol(f"t{len(assignments)}", real=True)
-            assignments.append((temp, expr))
-            work[dst[0]] = temp
-    return Block(tuple(gathers.values()), tuple(out), tuple(assignments), None, (digest.hexdigest(), ops))
+            ops += 1
+            operations.append(_operation(op, f"t{len(operations)}", [work[i] for i in src]))
+            work[dst[0]] = operations[-1].target
+    return Block(tuple(gathers.values()), tuple(out), (), None, (digest.hexdigest(), ops), tuple(operations))
 
 
-def _operation(op: int, args: list) -> sp.Expr:
-    if op in _BINARY and len(args) == 2:
-        return _BINARY[op](*args)
-    if op in _UNARY:
-        return _UNARY[op](args[0])
-    raise NotConvertible(f"CasADi operation {op} has no Kernel IR form")
+def _operation(op: int, target: str, args: list) -> Operation:
+    name = _OPERATIONS.get(op)
+    if name is None or len(args) != (2 if name in _TWO else 1):
+        raise NotConvertible(f"CasADi operation {op} has no Kernel IR form")
+    return Operation(target, name, tuple(args))
 
 
 def lower_sx(eqs, name: str, doc: str, mats: dict[str, ca.SX], *, accel: bool, symmetric: tuple[str, ...] = (),

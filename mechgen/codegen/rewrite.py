@@ -22,6 +22,8 @@ from __future__ import annotations
 
 import sympy as sp
 
+from mechgen.stage_clock import timed_stage
+
 #: Expressions larger than this (sympy's count_ops) are compared and rewritten as they stand.
 MAX_OPS = 200
 #: Operations (count_ops) of the expressions of one block offered to the Horner rewrite; the rest stay as
@@ -154,8 +156,10 @@ def optimise(exprs: list[sp.Expr], local: set) -> tuple[list[tuple[sp.Symbol, sp
     """
     reps, refs = share_writes(exprs)
     forms: dict = {}
-    reps = horner_within_budget(reps, local, forms)
-    subs, reduced = sp.cse(reps, symbols=sp.numbered_symbols("c", real=True), order="canonical")
+    with timed_stage("rewrite"):
+        reps = horner_within_budget(reps, local, forms)
+    with timed_stage("cse"):
+        subs, reduced = sp.cse(reps, symbols=sp.numbered_symbols("c", real=True), order="canonical")
     assignments = [(z, form) for form, z in forms.items()] + list(subs)
     uses = [sum(1 for r, _ in refs if r == i) for i in range(len(reps))]
     for i, expr in enumerate(reduced):

@@ -29,7 +29,7 @@ except ImportError:  # pragma: no cover - Python 3.10
 
 from mechgen.errors import InputError, did_you_mean, file_kind
 from mechgen.analyses.registry import get as get_kind
-from mechgen.analyses.registry import kinds as analysis_kinds
+from mechgen.analyses.registry import names as analysis_kinds
 from mechgen.analyses.schema import AnalysisSpec, OptionContext, analysis_kind, validate
 from mechgen.scene.expr import CONSTANTS, Expression, is_identifier
 from mechgen.scene.bounds import check_params, scene_limits

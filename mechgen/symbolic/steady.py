@@ -170,7 +170,7 @@ def derive_steady_hamiltonian(model: Model, spec: Specialization) -> LumpedEquat
 
 
 def steady_field_meta(model: Model, spec: Specialization) -> dict:
-    """The runtime's description of a continuum (mechgen.pipeline.field_meta) when only its steady
+    """The runtime's description of a continuum (mechgen.codegen.lower_model.field_meta) when only its steady
     Hamiltonian form is built: fields, their values and slopes as jets, length, end conditions."""
     p_ns, _ = param_namespace(model, spec)
     constraints = boundary_constraints(model, p_ns)

@@ -1,6 +1,6 @@
 """A compiled hybrid system: one set of kernels per mode, the guards leaving each mode and the resets.
 
-The kernels of mode i are named ``<kernel>__i`` (mechgen.pipeline.lower_hybrid); the system itself
+The kernels of mode i are named ``<kernel>__i`` (mechgen.codegen.lower_model.lower_hybrid); the system itself
 answers for its *initial* mode under the plain names (``residual``, ``linear`` ...), so every
 smooth analysis (modes, stability, steady) sees the model in the mode it starts in, and
 :meth:`HybridSystem.mode` gives the plain :class:`~mechgen.runtime.core.system.System` of any mode.

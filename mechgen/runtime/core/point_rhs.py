@@ -1,7 +1,7 @@
 """dx/dt of a smooth lumped model in one compiled call (issue 32 item 2): ``System.rhs`` on the C backend.
 
 The flow kernel (r at a = 0 and M = dr/da) and the solve M a = -r (Cholesky, LU where M is not positive
-definite) run in C (``codegen/templates/c99/point_rhs.c``, built once per machine like the time loops); Python
+definite) run in C (``runtime/csrc/point_rhs.c``, built once per machine like the time loops); Python
 copies the state into a buffer, makes one ctypes call and copies dx/dt out. :class:`PointRhs` is prepared once per
 set of kernels (shared by the systems of other parameter values, like mechgen.runtime.core.system.BoundKernel) and
 pointed at a system's parameters on every call. A model with internal variables, a chain, a continuum, another
@@ -13,15 +13,15 @@ import ctypes
 import logging
 from ctypes import POINTER, c_double, c_long, c_void_p
 from functools import lru_cache
-from pathlib import Path
 
 import numpy as np
 
 from mechgen.errors import BuildError, CompilerUnavailable, KernelError
+from mechgen.runtime import csrc
 
 log = logging.getLogger(__name__)
 
-SOURCE = Path(__file__).resolve().parent.parent.parent / "codegen" / "templates" / "c99" / "point_rhs.c"
+SOURCE = csrc.path("point_rhs.c")
 PORTS = 8
 #: the kernel input names and their codes in point_rhs.c (MGP_IN_*)
 CODES = {"q": 0, "v": 1, "a": 2, "z": 3, "t": 4, "p": 5}
@@ -33,7 +33,9 @@ class CPoint(ctypes.Structure):
     _fields_ = [("flow", c_void_p), ("n", c_long), ("nin", c_long), ("r_index", c_long), ("M_index", c_long),
                 ("kernel_rc", c_long), ("ports", c_long * PORTS), ("p", c_void_p), ("t", c_double),
                 ("x", c_void_p), ("f", c_void_p), ("out", c_void_p * PORTS), ("zeros", c_void_p),
-                ("work", c_void_p)]
+                ("work", c_void_p), ("piv", c_void_p), ("lu", c_long), ("tangent", c_void_p), ("tin", c_long),
+                ("rq_index", c_long), ("rv_index", c_long), ("tports", c_long * PORTS),
+                ("tout", c_void_p * PORTS), ("J", c_void_p)]
 
 
 @lru_cache(maxsize=None)
@@ -43,7 +45,7 @@ def _library():
 
     try:
         lib = load_shared_once(SOURCE.read_text(encoding="utf-8"), stem="mechgen_point_rhs", ldflags=("-lm",),
-                               symbols=("mgp_rhs", "mgp_layout"))
+                               symbols=("mgp_rhs", "mgp_jacobian", "mgp_layout"))
     except (CompilerUnavailable, BuildError, OSError) as exc:
         log.info("compiled point right-hand side unavailable (%s)", exc)
         return None, str(exc)
@@ -51,6 +53,7 @@ def _library():
     if lib.mgp_layout() != ctypes.sizeof(CPoint):
         return None, "point_rhs.c's layout differs from its Python mirror"
     lib.mgp_rhs.argtypes, lib.mgp_rhs.restype = [c_void_p], ctypes.c_int
+    lib.mgp_jacobian.argtypes, lib.mgp_jacobian.restype = [c_void_p], ctypes.c_int
     return lib, None
 
 
@@ -60,7 +63,8 @@ def forget_library() -> None:
 
 
 class PointRhs:
-    """f(t, x) = (v, -M^-1 r(q, v, 0, t)) of one system's flow kernel in one compiled call (module doc)."""
+    """f(t, x) = (v, -M^-1 r(q, v, 0, t)) of one system's flow kernel in one compiled call (module doc), and where
+    the system has a tangent kernel its Jacobian df/dx = ((0, I), -M^-1 (r_q, r_v)) in another (:meth:`jacobian`)."""
 
     def __init__(self, system, lib) -> None:
         kernel = system.kernels["flow"]
@@ -72,17 +76,41 @@ class PointRhs:
         self.params = np.array(system.params, dtype=float)
         self._source = system.params
         self.buffers = [np.zeros(n if name == "r" else n * n) for name in outs]
-        self.zeros, self.work = np.zeros(max(n, 1)), np.zeros(max(n * n, 1))
+        self.zeros, self.work = np.zeros(2 * n), np.zeros(n * n)
+        self.piv = np.zeros(n, dtype=np.dtype(c_long))
         s = CPoint(flow=kernel.address, n=n, nin=len(names), r_index=outs.index("r"), M_index=outs.index("M"),
                    p=self.params.ctypes.data, t=0.0, x=self.x.ctypes.data, f=self.f.ctypes.data,
-                   zeros=self.zeros.ctypes.data, work=self.work.ctypes.data)
+                   zeros=self.zeros.ctypes.data, work=self.work.ctypes.data, piv=self.piv.ctypes.data)
         for i, name in enumerate(names):
             s.ports[i] = CODES[name]
         for i, buf in enumerate(self.buffers):
             s.out[i] = buf.ctypes.data
         self.struct = s
+        self.J = self._point_tangent(system, s)
         self._address = ctypes.addressof(s)
-        self._call = lib.mgp_rhs
+        self._call, self._jacobian = lib.mgp_rhs, lib.mgp_jacobian
+
+    def _point_tangent(self, system, s: CPoint) -> np.ndarray | None:
+        """Point the struct at the tangent kernel and its output buffers; the Jacobian's buffer, or None where the
+        system has no usable tangent kernel (its Jacobian then runs in Python)."""
+        tangent = system.kernels.get("tangent")
+        if tangent is None or tangent.address is None:
+            return None
+        names = [p["name"] for p in tangent.spec["inputs"]]
+        outs = [p["name"] for p in tangent.spec["outputs"]]
+        if not {"r_q", "r_v"} <= set(outs) or any(n not in CODES for n in names) or len(names) > PORTS \
+                or len(outs) > PORTS:
+            return None
+        n = self.n
+        self.tangent_buffers = [np.zeros(max(n * n, 1)) for _ in outs]
+        s.tangent, s.tin, s.rq_index, s.rv_index = tangent.address, len(names), outs.index("r_q"), outs.index("r_v")
+        for i, name in enumerate(names):
+            s.tports[i] = CODES[name]
+        for i, buf in enumerate(self.tangent_buffers):
+            s.tout[i] = buf.ctypes.data
+        J = np.zeros((2 * n, 2 * n))
+        s.J = J.ctypes.data
+        return J
 
     def use(self, params: np.ndarray) -> None:
         """Evaluate with ``params`` from now on (copied into the buffer the struct points to)."""
@@ -97,6 +125,15 @@ class PointRhs:
         if rc:
             raise self._failure(rc, t, x)
         return self.f.copy()
+
+    def jacobian(self, t: float, x: np.ndarray) -> np.ndarray:
+        """d(dx/dt)/dx at (t, x): a copy of the compiled call's 2n x 2n result (requires :attr:`J`)."""
+        self.x[...] = x
+        self.struct.t = t
+        rc = self._jacobian(self._address)
+        if rc:
+            raise self._failure(rc, t, x)
+        return self.J.copy()
 
     def _failure(self, rc: int, t: float, x) -> Exception:
         """The exception the Python path raises in the same case (numpy's LinAlgError for a singular M, which the

@@ -1,7 +1,7 @@
 """The compiled symplectic time loop: :func:`evolve_system`, a splitting method run in C.
 
 A separable system (a chain: H = sum v^2 / (2 m) + V(q)) on the C backend is stepped by one C
-function (``mgs_run`` in mechgen/codegen/templates/c99/symplectic_loop.c, built once into the compile
+function (``mgs_run`` in mechgen/runtime/csrc/symplectic_loop.c, built once into the compile
 cache as ``libmgsymplectic``) that calls the model's own ``force`` and ``outputs`` kernels through
 their addresses: no Python runs per step. The steps of a splitting
 (:mod:`mechgen.runtime.core.splitting`) are those of the numpy stepper
@@ -15,16 +15,16 @@ from __future__ import annotations
 import ctypes
 import logging
 from functools import lru_cache
-from pathlib import Path
 
 import numpy as np
 
 from mechgen.errors import BuildError, CompilerUnavailable, KernelError
+from mechgen.runtime import csrc
 from mechgen.runtime.core.splitting import Splitting, evolve, method
 
 log = logging.getLogger("mechgen")
 
-SOURCE = Path(__file__).resolve().parent.parent.parent / "codegen" / "templates" / "c99" / "symplectic_loop.c"
+SOURCE = csrc.path("symplectic_loop.c")
 STEM = "mgsymplectic"
 c_long, c_double, c_void_p = ctypes.c_long, ctypes.c_double, ctypes.c_void_p
 LONG = np.dtype(f"i{ctypes.sizeof(c_long)}")

@@ -411,7 +411,13 @@ class System:
         return out
 
     def jacobian(self, t: float, x: np.ndarray):
-        """d(dx/dt)/dx, exact: da/dx = -M^-1 [r_q, r_v, r_z] at the current acceleration."""
+        """d(dx/dt)/dx, exact: da/dx = -M^-1 [r_q, r_v, r_z] at the current acceleration (a smooth model without
+        internal variables on the C backend: in one compiled call, mechgen.runtime.core.point_rhs)."""
+        from mechgen.runtime.core.point_rhs import point_rhs
+
+        fast = point_rhs(self)
+        if fast is not None and fast.J is not None:
+            return fast.jacobian(t, np.asarray(x, dtype=float))
         q, v, z = self.split(x)
         a, _ = self.acceleration(q, v, z, t)
         n, m = self.n, self.m

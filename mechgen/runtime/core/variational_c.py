@@ -1,7 +1,7 @@
 """The compiled loop of the variational integrator: :func:`compiled_stepper`.
 
 A system on the C backend is stepped by one C function (``mgv_run`` in
-mechgen/codegen/templates/c99/variational_loop.c, built once into the compile cache as ``libmgvariational``)
+mechgen/runtime/csrc/variational_loop.c, built once into the compile cache as ``libmgvariational``)
 that calls the model's own ``lagrangian`` kernel through its address: no Python runs per step. Its rules
 are those of the Python stepper (mechgen.runtime.core.variational.python_stepper): the same stage
 equations, Jacobian, Newton stop (NEWTON_RTOL, STALL, MAX_NEWTON), accepted point and records; the two
@@ -13,18 +13,18 @@ from __future__ import annotations
 import ctypes
 import logging
 from functools import lru_cache
-from pathlib import Path
 from typing import Callable
 
 import numpy as np
 
 from mechgen.errors import BuildError, CompilerUnavailable, KernelError
+from mechgen.runtime import csrc
 from mechgen.runtime.core.variational import (MAX_NEWTON, NEWTON_RTOL, STALL, Tableau, newton_failure, nonfinite,
                                               singular)
 
 log = logging.getLogger("mechgen")
 
-SOURCE = Path(__file__).resolve().parent.parent.parent / "codegen" / "templates" / "c99" / "variational_loop.c"
+SOURCE = csrc.path("variational_loop.c")
 STEM = "mgvariational"
 INPUTS = ["q", "v", "z", "t", "p"]
 OUTPUTS = ["mom", "F", "mom_q", "mom_v", "F_q", "F_v"]

@@ -3,7 +3,7 @@
 FieldSystem.rhs is precomputed once per parameter set as sparse operators around the pointwise residual
 (mechgen.runtime.fields.operators: the jets J_b of each block of points, their weights w_b, the penalty P, the
 banded Cholesky factor of the constant mass). In C
-(``codegen/templates/c99/field_flow.c``, built once as ``libmgfield``) the rhs is then, for x = (q, v),
+(``runtime/csrc/field_flow.c``, built once as ``libmgfield``) the rhs is then, for x = (q, v),
 
     dq/dt = v,   dv/dt = -M^-1 (sum_b J_b^T (w_b .* rho_b(J_b q, J_b v, 0, t, s_b, p_b)) + P q),
 
@@ -19,19 +19,19 @@ from __future__ import annotations
 import ctypes
 import logging
 from functools import lru_cache
-from pathlib import Path
 
 import numpy as np
 import scipy.sparse as sps
 
 from mechgen.errors import BuildError, CompilerUnavailable
+from mechgen.runtime import csrc
 from mechgen.runtime.integration.events_c import LONG, integrate_hybrid_c
 from mechgen.runtime.core.pattern import extent
 from mechgen.runtime.fields.operators import Block, Operators, blocks_of, field_operators
 
 log = logging.getLogger("mechgen")
 
-SOURCE = Path(__file__).resolve().parent.parent.parent / "codegen" / "templates" / "c99" / "field_flow.c"
+SOURCE = csrc.path("field_flow.c")
 STEM = "mgfield"
 PORTS = 8
 INPUTS = {"q": 0, "v": 1, "a": 2, "z": 3, "t": 4, "s": 5, "p": 6}

@@ -1,7 +1,7 @@
 """The compiled event loop: :func:`integrate_hybrid_c`, the rules of mechgen.runtime.integration.events in C.
 
 A hybrid lumped system on the C backend is integrated by one C function (``mgh_run`` in
-mechgen/codegen/templates/c99/hybrid_loop.c, built once into the compile cache as ``libmghybrid``)
+mechgen/runtime/csrc/hybrid_loop.c, built once into the compile cache as ``libmghybrid``)
 that calls the model's own kernels through their addresses: in mode i
 
     dq/dt = v,   dv/dt = a = -M^-1 r(q, v, 0, z, t)   (M = dr/da, ``tangent__i``; LU with partial pivoting),
@@ -27,11 +27,11 @@ import logging
 import math
 import threading
 from functools import lru_cache
-from pathlib import Path
 
 import numpy as np
 
 from mechgen.errors import BuildError, CompilerUnavailable, ConvergenceError, KernelError
+from mechgen.runtime import csrc
 from mechgen.runtime.core.budget import BudgetExceeded, Progress
 from mechgen.runtime.integration.events import (ZENO_HINT, Event, HybridTrajectory, ZenoApproach, diagnosis,
                                                  unnoticed)
@@ -40,7 +40,7 @@ from mechgen.runtime.core.pattern import extent
 
 log = logging.getLogger("mechgen")
 
-SOURCE = Path(__file__).resolve().parent.parent.parent / "codegen" / "templates" / "c99" / "hybrid_loop.c"
+SOURCE = csrc.path("hybrid_loop.c")
 STEM = "mghybrid"
 #: the C loop hands back to Python (budget clock, progress bar) after this many steps
 SLICE = 20_000

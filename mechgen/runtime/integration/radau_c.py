@@ -7,7 +7,7 @@ For x = (q, v, z) (and the energy balance's integrals after z, mechgen.runtime.i
 
 from the model's ``flow`` (or ``residual`` and ``tangent``), ``tangent`` (at the current acceleration), ``rates``
 (``energy_rates`` with the integrals) and ``rates_tangent`` kernels called by address, stepped by the implicit
-Radau IIA method of order 5 exactly as scipy.integrate.Radau steps it (``codegen/templates/c99/radau_loop.c``'s
+Radau IIA method of order 5 exactly as scipy.integrate.Radau steps it (``runtime/csrc/radau_loop.c``'s
 doc), the samples at ``t_eval`` from its collocation polynomial. No Python runs between the steps: the C function
 returns every :data:`SLICE` steps (budget clock, progress bar) and at the end. Dense LU (real and complex, partial
 pivoting) of the nx x nx Newton matrices: states up to :data:`MAX_STATES` entries.
@@ -17,11 +17,11 @@ from __future__ import annotations
 import ctypes
 import logging
 from functools import lru_cache
-from pathlib import Path
 
 import numpy as np
 
 from mechgen.errors import BuildError, CompilerUnavailable, ConvergenceError, KernelError
+from mechgen.runtime import csrc
 from mechgen.runtime.core.budget import BudgetExceeded, Progress
 from mechgen.runtime.core.integrate import CHECK_EVERY, project_steps, reached_at
 from mechgen.runtime.core.pattern import extent
@@ -29,7 +29,7 @@ from mechgen.runtime.integration.events_c import INPUTS, kernel_call_problem
 
 log = logging.getLogger("mechgen")
 
-SOURCE = Path(__file__).resolve().parent.parent.parent / "codegen" / "templates" / "c99" / "radau_loop.c"
+SOURCE = csrc.path("radau_loop.c")
 STEM = "mgradau"
 #: the C loop hands back to Python (budget clock and projection, progress bar) after this many steps: the Python
 #: path's CHECK_EVERY, so that the step-size projection (integrate.project_steps) refuses at the same step

@@ -1,7 +1,7 @@
 """The compiled DOP853 loop for a smooth lumped model: the event loop with one mode and no guards.
 
 A smooth model is the hybrid case without guards, so one compiled loop serves both
-(mechgen.runtime.integration.events_c, ``codegen/templates/c99/hybrid_loop.c``): in C, for x = (q, v, z),
+(mechgen.runtime.integration.events_c, ``runtime/csrc/hybrid_loop.c``): in C, for x = (q, v, z),
 
     dq/dt = v,   dv/dt = -M^-1 r(q, v, 0, z, t)   (M = dr/da from ``tangent``, LU with partial pivoting),
     dz/dt = rates(q, v, z, t),

@@ -57,12 +57,12 @@ import ctypes
 import logging
 from dataclasses import dataclass, field
 from functools import lru_cache
-from pathlib import Path
 
 import numpy as np
 from scipy.linalg import lapack
 
 from mechgen.errors import ConvergenceError
+from mechgen.runtime import csrc
 from mechgen.runtime.rods.liegroup import cross3, exp_so3, hat3, jac_left_so3, jac_left_so3_inv, log_so3
 from mechgen.runtime.rods.statics import Rod
 from mechgen.runtime.rods.ends import ENDS
@@ -77,7 +77,7 @@ MAX_SPLITS = 12
 REFRESH = 0.2
 
 
-SOURCE = Path(__file__).resolve().parent.parent.parent / "codegen" / "templates" / "c99" / "rod_elements.c"
+SOURCE = csrc.path("rod_elements.c")
 
 
 @lru_cache(maxsize=1)
@@ -255,7 +255,7 @@ class Discrete:
 
     def weighted_internal(self, st: State, z: np.ndarray, *, compiled: bool = True):
         """The configuration x + alpha dx, R exp(alpha theta) at increments z (..., n, 6) and its internal
-        forces and moments: in C (codegen/templates/c99/rod_elements.c, the same operations) when a compiler
+        forces and moments: in C (runtime/csrc/rod_elements.c, the same operations) when a compiler
         is there, else numpy (:meth:`internal`)."""
         al = self.body.alpha
         lib = element_library() if compiled else None
