@@ -252,3 +252,20 @@ def test_the_jacobian_key_from_scenes_and_python(tmp_path, capsys):
     assert main(["run", str(scene)]) == 2
     err = capsys.readouterr().err
     assert "jacobian" in err and "bad.toml" in err and "Traceback" not in err
+
+
+def test_batched_buffers_give_the_ordinary_calls_numbers():
+    """local.Batched (CasADi's FunctionBuffer on bound numpy arrays, the dynamics Jacobian's path) against the
+    ordinary mapped call of the same function, the sparse node piece's structural zeros included, and its
+    fallback for a CasADi without FunctionBuffer: equal exactly (the same compiled code on the same numbers)."""
+    from mechgen.runtime.rods import local
+
+    rng = np.random.default_rng(4)
+    for name in ("dynamics_element", "dynamics_node"):
+        g = local.native(name)
+        batched = local.Batched(g, 7)
+        data, par = rng.normal(size=(7, g.nnz_in(0))), rng.normal(size=g.nnz_in(1))
+        ordinary = np.asarray(local.mapped(g, 7)(data.T, par)).T
+        assert np.array_equal(batched(data, par), ordinary)
+        batched.buffer = None
+        assert np.array_equal(batched(data, par), ordinary)

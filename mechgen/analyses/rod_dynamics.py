@@ -19,6 +19,11 @@ Euler: numerical dissipation of the stiff shear/axial modes a sudden load excite
 (ad, the default: the step's band Jacobian by CasADi AD of the element energy and the node rows; fd:
 finite differences).
 
+Newton (mechgen.runtime.rods.dynamics): a factorised band Jacobian kept while each correction is at most
+REFRESH = 0.2 times the one before and taken again at the current iterate as soon as one is larger (or a
+kept Jacobian's full correction fails the monotonicity test); a step that still fails is split in halves
+(``splits``).
+
 Outputs: ``t`` (s), ``tip_trajectory`` (n x 3, m), ``tip_rotations`` (rad about the bending axis per saved
 point, unwrapped along the rod), ``tip_position``, ``tip_rotation``, ``tip_orientation`` (final), ``energy``
 (kinetic + elastic, J, per saved point), ``work`` (of the loads and the damping since t = 0, J),

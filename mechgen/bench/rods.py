@@ -62,6 +62,9 @@ Parts:
   PyElastica over an N ladder (20 .. 160, ``pyelastica_ladder``, one run each at 0.5 x its limit at that N,
   first order in N); the target error is PyElastica's finest, each side's least time meeting it.
 
+Every mechgen row of the dynamic, gravity and stiff ladders carries its Newton counts (``newton_iterations``,
+``jacobians``, ``splits``: rod_dynamics' outputs), the work behind its time.
+
 Newton's Jacobians (mechgen only): the AD ones (the default) against finite differences on the same
 states, collocation, shooting and the dynamics step over an N ladder: seconds per Jacobian and their
 difference (the FD error), in ``rods.json`` ("jacobians") and ``rods.md``.
@@ -422,6 +425,10 @@ def _dynamics_available() -> bool:
     return hasattr(mechgen, "rod_dynamics")
 
 
+#: the Newton counts of a mechgen run that the dynamic ladders report beside its time (rod_dynamics outputs)
+NEWTON_COUNTS = ("newton_iterations", "jacobians", "splits")
+
+
 def _mechgen_dynamic(system, n: int, dt: float, t_end: float, force, save_every: int = 1) -> dict:
     import mechgen
 
@@ -430,7 +437,8 @@ def _mechgen_dynamic(system, n: int, dt: float, t_end: float, force, save_every:
     return {"t": np.asarray(res.outputs["t"], dtype=float),
             "tip_trajectory": np.asarray(res.outputs["tip_trajectory"], dtype=float),
             "energy_error": float(np.max(np.abs(np.asarray(res.outputs["energy_error"], dtype=float)))),
-            "orthonormality_error": float(np.max(res.outputs["orthonormality_error"]))}
+            "orthonormality_error": float(np.max(res.outputs["orthonormality_error"])),
+            "newton": {key: int(res.outputs[key]) for key in NEWTON_COUNTS}}
 
 
 def _traj_error(t, tip, t_ref, tip_ref, scale: float) -> float:
@@ -487,7 +495,8 @@ def dynamic_study(quick: bool, repeats: int, have_elastica: bool, case: str = "t
             rows.append({"side": f"mechgen N={m}", "n": m, "dt": dt, "seconds": seconds, "steps": steps,
                          "seconds_per_step": seconds / steps,
                          "error": _traj_error(run["t"], run["tip_trajectory"], t_ref, tip_ref, scale),
-                         "energy_error": run["energy_error"], "orthonormality_error": run["orthonormality_error"]})
+                         "energy_error": run["energy_error"], "orthonormality_error": run["orthonormality_error"],
+                         **run["newton"]})
             if m == n:
                 runs_at_n[dt] = run
     out = {"case": case, "section": sec.__dict__, "params": params, "tip_force": force, "gravity": list(gravity),
@@ -596,7 +605,7 @@ def stiff_study(quick: bool, repeats: int, have_elastica: bool) -> dict:
             grid.append({"side": f"mechgen N={m}", "n": m, "dt": dt, "dt_over_pyelastica_limit": dt / sec.stable_dt(m),
                          "seconds": seconds, "steps": steps, "seconds_per_step": seconds / steps,
                          "energy_error": run["energy_error"], "orthonormality_error": run["orthonormality_error"],
-                         "error": _traj_error(run["t"], run["tip_trajectory"], t_c, tip_c, c_scale)})
+                         "error": _traj_error(run["t"], run["tip_trajectory"], t_c, tip_c, c_scale), **run["newton"]})
             if m == n:
                 rows.append({"side": f"stiff mechgen N={n}", "n": n, "dt": dt, "dt_over_pyelastica_limit": dt / limit,
                              "seconds": seconds, "energy_error": run["energy_error"],

@@ -43,9 +43,13 @@ Kinetic energy of the rotation is conserved exactly by the gyroscopic term (omeg
 omega_mid = 0); for the elastic energy the step is second-order (energy error O(dt^2), bounded, no drift).
 The coupled increments are found by Newton's method on a banded system (node-major order, bandwidth 11)
 whose Jacobian is CasADi's AD of the element energy's gradient and of the nodes' rows (mechgen.runtime.rods.
-local; finite differences over three colours of nodes with ``jacobian="fd"``) and kept over steps while the
-iteration contracts fast (simplified Newton); a step that does not converge is split in two, down to 2^-12
-of dt, before a ConvergenceError names the time reached.
+local; finite differences over three colours of nodes with ``jacobian="fd"``), factorised and kept over
+iterations and steps while the corrections contract fast (simplified Newton). The refresh rule
+(:meth:`_Solver.attempt`): the Jacobian is taken again at the current iterate as soon as one correction
+contracts slower than REFRESH = 0.2 (at any iteration, the first of a step included) or a kept Jacobian's
+full correction fails the monotonicity test; only a Jacobian taken at the current iterate damps the step.
+A step that does not converge even so is split in two, down to 2^-12 of dt, before a ConvergenceError names
+the time reached.
 """
 from __future__ import annotations
 
@@ -67,7 +71,9 @@ from mechgen.runtime.rods.ends import ENDS
 BAND = 11
 log = logging.getLogger("mechgen")
 MAX_SPLITS = 12
-#: simplified Newton's largest accepted contraction rate before the Jacobian is taken again
+#: simplified Newton's largest accepted contraction rate |dz_k+1|/|dz_k| before the Jacobian is taken again at the
+#: current iterate. A Jacobian costs about 6 residual solves (N = 40: 0.31 ms against 0.06 ms), so a rate of
+#: 0.2, which gains 7 digits in 10 corrections, is about where taking it again starts to pay.
 REFRESH = 0.2
 
 
@@ -197,6 +203,7 @@ class Discrete:
         object.__setattr__(self, "_f0_c", np.ascontiguousarray(self.body.rod.f0, dtype=float))
         object.__setattr__(self, "_pattern", self._band_pattern())
         object.__setattr__(self, "_blocks", self._block_pattern())
+        object.__setattr__(self, "_evaluators", {})       # the AD Jacobian's buffers (_batched)
         rod = self.body.rod
         # a uniform load (gravity) lumped once: w_i g, and its torque part (None when zero)
         uniform = torque = None
@@ -356,7 +363,6 @@ class Discrete:
             return self._jacobian_band_fd(st, z, dt, r0)
         if method != "ad":
             raise ValueError(f"unknown Jacobian method {method!r}: ad or fd")
-        from mechgen.runtime.rods import local
         from mechgen.runtime.rods.statics import load_and_gradient
 
         body, rod = self.body, self.body.rod
@@ -364,15 +370,15 @@ class Discrete:
         R = st.R.reshape(n, 9)
         nodes = np.concatenate([st.x, R, z], axis=1)
         par = np.concatenate([[self.h, al], self._K_c.ravel(), self._f0_c])
-        Je = -np.asarray(local.mapped(local.native("dynamics_element"), n - 1)(
-            np.concatenate([nodes[:-1], nodes[1:]], axis=1).T, par)).T.reshape(n - 1, 12, 12)
+        Je = -self._batched("dynamics_element", n - 1)(np.concatenate([nodes[:-1], nodes[1:]], axis=1),
+                                                         par).reshape(n - 1, 12, 12)
         xa = st.x + al * z[:, :3]
         g0, G = load_and_gradient(rod, xa)
         tip = np.zeros((n, 6))
         tip[-1] = np.concatenate([rod.tip_force, rod.tip_torque])
         data = np.concatenate([R, st.v, st.w, z, self.weights[:, None], g0, G.reshape(n, 18), xa, tip, st.x], axis=1)
         npar = np.concatenate([[dt, al, body.rhoA, body.damping], body.J_rho.ravel()])
-        Jn = np.asarray(local.mapped(local.native("dynamics_node"), n)(data.T, npar)).T.reshape(n, 6, 6)
+        Jn = self._batched("dynamics_node", n)(data, npar).reshape(n, 6, 6)
         element_at, node_at, element_fixed = self._blocks
         Je[element_fixed] = 0.0                      # rows of fixed unknowns: z itself, scaled
         Jn[self.fixed] = 0.0
@@ -383,6 +389,16 @@ class Discrete:
         ab = np.bincount(element_at, Je.ravel(), minlength=(3 * BAND + 1) * size)
         ab += np.bincount(node_at, Jn.ravel(), minlength=(3 * BAND + 1) * size)
         return ab.reshape(3 * BAND + 1, size)
+
+    def _batched(self, name: str, count: int):
+        """The compiled rod piece ``name`` (local.native) over ``count`` columns, on buffers of this rod's own
+        (local.Batched), made at its first use."""
+        got = self._evaluators.get((name, count))
+        if got is None:
+            from mechgen.runtime.rods import local
+
+            got = self._evaluators[(name, count)] = local.Batched(local.native(name), count)
+        return got
 
     def _jacobian_band_fd(self, st: State, z: np.ndarray, dt: float, r0: np.ndarray | None) -> np.ndarray:
         n = z.shape[0]
@@ -417,10 +433,13 @@ class Trajectory:
     newton_iterations: int = 0
     jacobians: int = 0
     splits: int = 0
+    #: the most Newton solves one step attempt took (a failed attempt, before its split, included)
+    most_step_iterations: int = 0
 
 
 class _Solver:
-    """Newton on the midpoint equations with a factorised band Jacobian kept across steps."""
+    """Newton on the midpoint equations with a factorised band Jacobian kept across iterations and steps
+    while it serves (the refresh rule: :meth:`attempt`)."""
 
     def __init__(self, disc: Discrete, tol: float, max_iter: int, jacobian: str = "ad"):
         self.disc, self.tol, self.max_iter, self.jacobian = disc, tol, max_iter, jacobian
@@ -428,6 +447,7 @@ class _Solver:
         self.dt = None
         self.iterations = 0
         self.jacobians = 0
+        self.most = 0                                    # the most solves of one step attempt
         size = 6 * (disc.elements + 1)
         self.scale = np.tile(np.concatenate([np.full(3, disc.body.rod.L), np.ones(3)]), size // 6)
 
@@ -447,17 +467,30 @@ class _Solver:
         return float(np.max(np.abs(dz.ravel()) / self.scale))
 
     def step(self, st: State, dt: float, z0: np.ndarray):
+        """:meth:`attempt`, counting its solves in ``most``."""
+        start = self.iterations
+        try:
+            return self.attempt(st, dt, z0)
+        finally:
+            self.most = max(self.most, self.iterations - start)
+
+    def attempt(self, st: State, dt: float, z0: np.ndarray):
         """The converged increments z and the midpoint external wrench, or None when Newton fails.
 
-        Damped Newton with the natural monotonicity test (Deuflhard): a step lam dz is accepted when the
-        next correction, J^-1 r(z + lam dz) with the same Jacobian, is at most (1 - lam/4) |dz|; else lam is
-        halved (down to 1/64). The kept Jacobian is taken again at the current iterate when the corrections
-        contract slower than REFRESH; converged when the estimated error after the last correction,
+        Newton's corrections dz = -J^-1 r(z) use a factorised Jacobian J taken at some iterate, possibly of an
+        earlier step (simplified Newton), and the refresh rule is: J is taken again at the current iterate z
+        whenever (a) the corrections contract slower than REFRESH, |dz_k+1| > REFRESH |dz_k|, at any iteration
+        (the first one of a step included) or (b) the full correction fails the monotonicity test below, unless
+        J was already taken at this z. With J taken at z, (b) is Deuflhard's damped Newton (natural monotonicity
+        test): lam dz is accepted when the next correction, J^-1 r(z + lam dz) with the same J, is at most
+        (1 - lam/4) |dz|, else lam is halved (down to 1/64; below it the step fails and is split). So a stale J
+        never damps nor slows a step for more than one iteration: a stiff step costs a handful of corrections
+        and one or two Jacobians. Converged when the estimated error after the last correction,
         |dz| rate/(1 - rate), is below tol (units of L and rad)."""
         z = z0.copy()
         r, Fx, Mx = self.disc.residual(st, z, dt)
-        fresh = self.lu is None or self.dt != dt
-        if fresh:
+        here = self.lu is None or self.dt != dt          # J taken at the current iterate z
+        if here:
             self._factor(st, z, dt, r)
         dz = self._solve(r)
         size = self._norm(dz)
@@ -467,39 +500,45 @@ class _Solver:
         if size < 0.01 * self.tol:
             return z, Fx, Mx
         for _ in range(self.max_iter):
-            lam = 1.0
-            while True:
-                zt = z + lam * dz
-                rt, Fxt, Mxt = self.disc.residual(st, zt, dt)
-                dzt = self._solve(rt)
-                new = self._norm(dzt)
-                if np.isfinite(new) and new <= (1.0 - lam / 4.0) * size:
-                    break
-                lam *= 0.5
-                if lam < 1.0 / 64.0:
-                    break
-            if lam < 1.0 / 64.0:
-                if fresh:
+            lam, zt, rt, Fxt, Mxt, dzt, new = self._damped(st, dt, z, dz, size, here)
+            if lam is None:
+                if here:
                     break
                 self._factor(st, z, dt, r)                 # a stale Jacobian: take it again here
-                fresh = True
+                here = True
                 dz = self._solve(r)
                 size = self._norm(dz)
                 continue
-            z, r, Fx, Mx = zt, rt, Fxt, Mxt
+            z, r, Fx, Mx, here = zt, rt, Fxt, Mxt, False
             rate = new / max(size, 1e-300)
             if lam == 1.0 and (new < 0.01 * self.tol or (rate < 1.0 and new * rate / (1.0 - rate) < self.tol)):
                 # the last correction is taken (its size bounds the error of z); the wrench of the loads is
                 # the one at z, off by O(|dzt|)
                 return z + dzt, Fx, Mx
-            if rate > REFRESH and not fresh:
+            if rate > REFRESH:
                 self._factor(st, z, dt, r)
-                fresh = True
+                here = True
                 dzt = self._solve(r)
                 new = self._norm(dzt)
             dz, size = dzt, new
         self.lu = None
         return None
+
+    def _damped(self, st: State, dt: float, z: np.ndarray, dz: np.ndarray, size: float, here: bool):
+        """The first lam = 1, 1/2, ... >= 1/64 whose next correction passes |dz(z + lam dz)| <= (1 - lam/4)
+        |dz| (lam = 1 only when the Jacobian is stale: ``here`` False), with the trial's z, r, Fx, Mx, dz and
+        |dz|; lam None when none passes."""
+        lam = 1.0
+        while True:
+            zt = z + lam * dz
+            rt, Fxt, Mxt = self.disc.residual(st, zt, dt)
+            dzt = self._solve(rt)
+            new = self._norm(dzt)
+            if np.isfinite(new) and new <= (1.0 - lam / 4.0) * size:
+                return lam, zt, rt, Fxt, Mxt, dzt, new
+            lam *= 0.5
+            if not here or lam < 1.0 / 64.0:
+                return None, None, None, None, None, None, None
 
 
 def advance(disc: Discrete, st: State, z: np.ndarray, dt: float, Fx, Mx) -> tuple[State, float]:
@@ -563,6 +602,7 @@ def simulate(disc: Discrete, state: State, *, dt: float, t_end: float, save_ever
             record(min(k * dt, t_end), k // save_every)
     out.final = st
     out.newton_iterations, out.jacobians = solver.iterations, solver.jacobians
+    out.most_step_iterations = solver.most
     if shape_every and (steps // save_every) % shape_every:   # the final shape always (once)
         out.shapes.append(st.x.copy())
     return out
