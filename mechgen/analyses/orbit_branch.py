@@ -45,7 +45,8 @@ import numpy as np
 from mechgen.analyses.branch_points import branch_point
 from mechgen.analyses.hybrid_orbit import run_hybrid_branch
 from mechgen.analyses.newton_branch import arclength_steps
-from mechgen.analyses.periodic_orbit import DEFAULT_HARMONICS, compiled_run, integrator_tolerances, peak
+from mechgen.analyses.periodic_orbit import DEFAULT_HARMONICS, compiled_run, integrator_tolerances
+from mechgen.runtime.periodic.fourier import peak
 from mechgen.analyses.schema import ParamExpression
 from mechgen.analyses.stability_boundary import own_value
 from mechgen.analyses.time_series import state_names

@@ -133,6 +133,7 @@ from mechgen.analyses.schema import ABSENT, Option
 from mechgen.errors import ConvergenceError, SceneError
 from mechgen.runtime.core.memory import dense_bytes, require
 from mechgen.runtime.periodic import floquet, fourier
+from mechgen.runtime.periodic.fourier import peak
 from mechgen.runtime.periodic.collocation import Collocation
 from mechgen.runtime.periodic.cycle_guess import closed_cycle
 from mechgen.runtime.periodic.flow import compiled_flow, states_at, variational_flow
@@ -699,19 +700,6 @@ def report(system, options: dict, found: dict, method: str, *, autonomous: bool,
             "harmonics": fourier.harmonics_table(U, names), "multipliers": floquet.as_pairs(mu),
             "stability": floquet.stability(mu, autonomous, trivial=2 if conservative else None), "method": method, "residual": float(found["residual"]),
             "iterations": int(found["iterations"]), "loop": "c" if found.get("run") is not None else "python"}
-
-
-def peak(values: np.ndarray) -> float:
-    """max |q| of a periodic signal at equally spaced phases, refined by the parabola through the largest sample
-    and its two neighbours (wrapping around the period): the grid's O(h^2) error becomes O(h^3)."""
-    y = np.abs(np.asarray(values, float))
-    k = int(np.argmax(y))
-    a, b, c = y[k - 1], y[k], y[(k + 1) % y.size]
-    curvature = a - 2 * b + c
-    if curvature >= 0:
-        return float(b)
-    shift = 0.5 * (a - c) / curvature
-    return float(b - 0.25 * (a - c) * shift)
 
 
 def plot(plt, a: dict, path) -> list:
