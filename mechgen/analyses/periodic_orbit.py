@@ -130,6 +130,7 @@ from mechgen.analyses.free_orbit import is_conservative, orbit_energy, solve_fre
 from mechgen.analyses.linear_start import linear_coefficients
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import ABSENT, Option
+from mechgen.analyses.simulate_start import declared_start, initial_state
 from mechgen.errors import ConvergenceError, SceneError
 from mechgen.runtime.core.memory import dense_bytes, require
 from mechgen.runtime.periodic import floquet, fourier
@@ -400,7 +401,6 @@ def first_harmonic_states(x0: np.ndarray, omega: float, times: np.ndarray, n: in
 def guess(system, options: dict, omega) -> Guess:
     """The guess of ``q0`` / ``v0`` (tables over the declared initial state, zero when none): the first harmonic
     through them, of the forcing's period or the guessed one; p the coordinate with the largest |q0|."""
-    from mechgen.analyses.simulate import initial_state
 
     q0, v0 = initial_state(system, options)
     x0 = np.concatenate([q0, v0, internal_start(system, options.get("z0"))])
@@ -425,7 +425,6 @@ def linear_guess(system, options: dict, omega: float) -> Guess:
 def internal_start(system, table: dict | None = None) -> np.ndarray:
     """The internal variables' guess: ``table`` (``z0``) over their declared initial values (zero when none are
     declared); an unknown name is a SceneError at ``z0``."""
-    from mechgen.analyses.simulate import declared_start
 
     start = declared_start(system)
     z = np.zeros(system.m) if start is None or not system.m else np.asarray(start[2 * system.n:], float).copy()
