@@ -18,7 +18,7 @@ from urllib.parse import unquote, urlsplit
 
 import pytest
 
-from mechgen.analyses import reference
+from mechgen.analyses import option_text, reference
 from mechgen.analyses.outputs_doc import OUTPUTS, outputs_of
 from mechgen.analyses.registry import get, kinds
 from mechgen.symbolic.names import BUILTIN_OUTPUTS
@@ -265,7 +265,7 @@ def test_option_meanings_come_from_the_schema_and_the_module():
         "*Described:* the time history. *Accepts:* true or false.")
     assert reference.described("x ``a`` (b (c) d) e", "a") == "b (c) d"
     assert reference.described("x ``a`` b", "a") == ""
-    assert reference.toml_literal({"a": [1.0, True], "b": "auto"}) == '{ a = [1.0, true], b = "auto" }'
+    assert option_text.toml_literal({"a": [1.0, True], "b": "auto"}) == '{ a = [1.0, true], b = "auto" }'
 
 
 def option_rows(kind: str) -> dict[str, str]:
@@ -304,7 +304,7 @@ def test_analysis_functions_list_their_options_and_outputs():
             if output.unit.strip() not in ("", "-"):
                 assert f"* ``{output.name}`` [{output.unit}]" in outputs, (kind, output.name)
         assert not re.search(r":\w+:`", outputs), kind  # a role of the pages' own folder breaks elsewhere
-    assert reference.first_sentence("A list, e.g. a pair. Then more.") == "A list, e.g. a pair."
+    assert option_text.first_sentence("A list, e.g. a pair. Then more.") == "A list, e.g. a pair."
 
 
 def test_a_dash_cell_renders_as_text_not_as_an_empty_bullet():

@@ -14,6 +14,7 @@ from __future__ import annotations
 import re
 from typing import Any, Mapping
 
+from mechgen.analyses.option_text import default_text, escape_bars, first_sentence
 from mechgen.analyses.registry import get, kinds
 from mechgen.analyses.result import Result, run_analysis
 from mechgen.analyses.schema import OptionContext, validate
@@ -409,9 +410,8 @@ def phase_kinetics(system, *, name: str | None = None, **options) -> Result:
 
 def option_lines(kind: str) -> list[str]:
     """One line per option of ``kind``, from the schema the scene loader validates against: its name, its
-    default as the reference pages write it (mechgen.analyses.reference.default_text) and its meaning (the
+    default as the reference pages write it (mechgen.analyses.option_text.default_text) and its meaning (the
     Option's ``doc``, its bars escaped for reStructuredText as on the reference pages)."""
-    from mechgen.analyses.reference import default_text, escape_bars
 
     return [f"``{name}`` ({default_text(option).replace('**', '').replace(' (no default)', '')}): "
             f"{escape_bars(option.doc)}".rstrip(": ") for name, option in get(kind).schema.items()]
@@ -422,7 +422,6 @@ def output_lines(kind: str) -> list[str]:
     its name, its unit (left out where it has none) and the first sentence of its meaning, a Sphinx role in it
     written as a plain literal (a docstring is read outside the pages too, and from another page)."""
     from mechgen.analyses.outputs_doc import outputs_of
-    from mechgen.analyses.reference import first_sentence
 
     lines = []
     for output in outputs_of(kind):

@@ -11,23 +11,16 @@ from __future__ import annotations
 
 import importlib
 import inspect
-import json
-import re
 from pathlib import Path
 from typing import Any
 
+from mechgen.analyses.option_text import default_text, escape_bars
 from mechgen.analyses.outputs_doc import outputs_of
 from mechgen.analyses.registry import MODULES, get, kinds
 from mechgen.analyses.schema import ABSENT, ALL_OUTPUTS, REQUIRED, Option
 
 #: where a kind's page lives relative to the documentation's root (``kinds/<kind>``)
 FOLDER = "kinds"
-
-
-def escape_bars(line: str) -> str:
-    """``|`` outside inline literals escaped (a docstring's |x| is a norm, not a substitution)."""
-    parts = line.split("``")
-    return "``".join(part if i % 2 else part.replace("|", "\\|") for i, part in enumerate(parts))
 
 
 def docstring_rst(text: str | None) -> str:
@@ -60,31 +53,6 @@ def docstring_rst(text: str | None) -> str:
     return "\n".join(out)
 
 
-def default_text(option: Option) -> str:
-    """An option's default as a reader sees it: ``required``, ``optional`` (no default), every output, or the
-    value as TOML-like literal text."""
-    if option.default is REQUIRED:
-        return "**required**"
-    if option.default is ABSENT:
-        return "optional (no default)"
-    if option.default is ALL_OUTPUTS:
-        return "every model output"
-    return f"``{toml_literal(option.default)}``"
-
-
-def toml_literal(value: Any) -> str:
-    """A default as a scene writes it: ``"auto"``, ``true``, ``1e-08``, ``[1.0]``, ``{ a = 1 }``."""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, str):
-        return json.dumps(value)
-    if isinstance(value, (list, tuple)):
-        return "[" + ", ".join(toml_literal(v) for v in value) + "]"
-    if isinstance(value, dict):
-        return "{ " + ", ".join(f"{k} = {toml_literal(v)}" for k, v in value.items()) + " }" if value else "{}"
-    return repr(value)
-
-
 def described(doc: str, name: str) -> str:
     """What a kind's module docstring says of option ``name``: the parenthesis right after its first
     ``name`` (``series`` (the time history; ...)), brackets balanced; empty when it says nothing so."""
@@ -99,14 +67,6 @@ def described(doc: str, name: str) -> str:
         if depth == 0:
             return text[i + 1:j]
     return ""
-
-
-def first_sentence(text: str) -> str:
-    """The first sentence of a meaning (up to the first full stop followed by a capital letter or the end;
-    "e.g." and "i.e." do not end one), its spaces joined."""
-    text = " ".join(text.split())
-    match = re.search(r"(?<!e\.g)(?<!i\.e)\.(\s+(?=[A-Z`(*])|$)", text)
-    return text[:match.start() + 1] if match else text
 
 
 def first_paragraph(text: str | None) -> str:
