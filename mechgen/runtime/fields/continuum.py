@@ -18,6 +18,12 @@ every analysis runs on it; :meth:`refined` gives the same model at another size.
 
 A FieldSystem is immutable like a System: :meth:`FieldSystem.with_params` and
 :meth:`FieldSystem.with_layout` give new ones.
+
+The class holds the state and the public interface; the work lives in modules that take the system:
+``point_kernels`` (kernel calls at points, per segment, end term and part), ``discretised`` (the discretisation at
+the current size and length), ``conditions`` (essential conditions, joints, the reduction, the penalty),
+``global_forms`` (the assembled residual, matrices and reactions), ``field_outputs`` (outputs, field and nodal
+values) and ``time_rates`` (the first-order form of time integration).
 """
 from __future__ import annotations
 
@@ -51,8 +57,9 @@ SIZE_CHOICES = ("N", "quadrature")
 class FieldSystem:
     """Kernels of a continuum's local piece, parameter values and the discretisation choices. Immutable.
 
-    ``info`` (from the kernel meta): fields, jets [[field, order]], length
-    parameter, constraints [[field, order, 'start'|'end']]. ``choices``:
+    ``field_meta`` (:class:`~mechgen.runtime.fields.meta.FieldMeta`, from the kernel meta's ``info`` dict): fields,
+    jets (field, order), length parameter, constraints (field, order, 'start'|'end'), end terms, part kinds,
+    shear pairs; ``metadata`` the typed rest of the kernel meta (model, params). ``choices``:
     discretisation, N, quadrature, constraints (method), joints and the model's other
     runtime choices; ``fixed``: the numeric values folded into the kernels.
 
