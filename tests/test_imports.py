@@ -15,6 +15,7 @@ codegen.emit_casadi importing emit_numpy._extent, ...).
 from __future__ import annotations
 
 import ast
+import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -205,3 +206,27 @@ def test_no_private_names_across_modules():
     modules = _sources("mechgen", "tests", "benchmarks")
     found = [use for name, path in modules.items() for use in _private_uses(name, path, modules)]
     assert not found, "private names used across modules (make them public where they live):\n" + "\n".join(found)
+
+
+def _every_import(tree: ast.Module):
+    """Every Import/ImportFrom node of the module, those inside functions included (not under TYPE_CHECKING)."""
+    skipped = {id(n) for node in ast.walk(tree) if isinstance(node, ast.If) and _is_type_checking(node)
+               for n in ast.walk(node)}
+    return (node for node in ast.walk(tree) if isinstance(node, (ast.Import, ast.ImportFrom)) and id(node) not in skipped)
+
+
+#: circles that run only through imports inside functions and are still to be undone (issue 30, house): the model
+#: and its extensions, the package's lazy public entry points, the public functions and their reference pages. A new circle fails the test below; an undone one must leave here.
+KNOWN_FUNCTION_LEVEL_CIRCLES = [
+    ["mechgen.symbolic.derive", "mechgen.symbolic.field", "mechgen.symbolic.hybrid", "mechgen.symbolic.initial",
+     "mechgen.symbolic.model", "mechgen.symbolic.plane", "mechgen.symbolic.rod", "mechgen.symbolic.specialize"],
+    ["mechgen", "mechgen.analyses.result", "mechgen.pipeline", "mechgen.scene.info", "mechgen.scene.load",
+     "mechgen.scene.plan", "mechgen.scene.run"],
+    ["mechgen.analyses.public", "mechgen.analyses.reference"],
+]
+
+
+def test_no_new_function_level_import_circles(monkeypatch):
+    """Imports inside functions counted too: the circles are exactly the known ones, none added."""
+    monkeypatch.setattr(sys.modules[__name__], "_top_level_imports", _every_import)
+    assert sorted(_cycles(_graph())) == sorted(KNOWN_FUNCTION_LEVEL_CIRCLES)

@@ -22,7 +22,7 @@ import numpy as np
 
 from mechgen.analyses.free_orbit import orbit_energy
 from mechgen.analyses.newton_branch import arclength_steps
-from mechgen.analyses.orbit_branch import FAMILY_PARAMETER, Orbits, record
+from mechgen.analyses.orbit_family import FAMILY_PARAMETER, Orbits, record
 from mechgen.analyses.periodic_orbit import DEFAULT_HARMONICS, compiled_run, integrator_tolerances
 from mechgen.analyses.stability_boundary import own_value
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from mechgen.analyses.parametrised import Parametrised
 from mechgen.analyses.periodic_orbit import compiled_run, integrator_tolerances, settings
 from mechgen.errors import ConvergenceError, SceneError
 from mechgen.runtime.periodic.newton import newton
@@ -31,7 +32,7 @@ CYCLE_OPTIONS = {"rtol": 1e-9, "atol": 1e-12, "max_iterations": 50, "loop": "aut
 
 
 def corrected(model, y: np.ndarray, p: float, iterations: int = 8) -> np.ndarray:
-    """The equilibrium near y at p (Newton on the static residual, ``model``: special_curves.Parametrised with the
+    """The equilibrium near y at p (Newton on the static residual, ``model``: parametrised.Parametrised with the
     same parameter as first and second)."""
     for _ in range(iterations):
         r = model.residual(y, p, p)
@@ -48,8 +49,6 @@ def critical(model, y: np.ndarray, p: float) -> complex:
 
 def first_cycle(system, name: str, x_h: np.ndarray, l1: float) -> tuple:
     """(the system at the first cycle's p, the shooting problem, its unknowns u, p, (p_H, omega, alpha'))."""
-    from mechgen.analyses.special_curves import Parametrised
-
     model = Parametrised(system, name, name)
     y_h, p_h = x_h[:-1], float(x_h[-1])
     h = 1e-5 * (1.0 + abs(p_h))

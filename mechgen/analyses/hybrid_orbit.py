@@ -36,6 +36,7 @@ from mechgen.runtime.integration.events import integrate_hybrid
 from mechgen.runtime.integration.hybrid_monodromy import periodic_orbit
 from mechgen.runtime.integration.run_options import RunOptions
 from mechgen.runtime.periodic import floquet, fourier
+from mechgen.runtime.periodic.fourier import peak
 
 #: phases at which amplitudes and harmonics are taken
 FINE = 4096
@@ -94,7 +95,7 @@ def run_autonomous(system, options: dict, guess: np.ndarray, rtol: float, atol: 
 def amplitudes(system, states: np.ndarray, period: float, events) -> dict:
     """{name: max |value|} over one period (the coordinates, then the internal variables), from the states (rows) at
     the equally spaced phases period * k / rows and the states on both sides of the ``events``: the largest sample
-    refined by the parabola through it and its neighbours (mechgen.analyses.periodic_orbit.peak) unless an event
+    refined by the parabola through it and its neighbours (mechgen.runtime.periodic.fourier.peak) unless an event
     falls between those neighbours (a kink, where the parabola would overshoot: a flat slip phase meets a stick
     phase), then the larger of that sample and the event states."""
     n, names = system.n, time_series.state_names(system)
@@ -106,7 +107,6 @@ def amplitudes(system, states: np.ndarray, period: float, events) -> dict:
 
 def kinked_peak(values: np.ndarray, period: float, event_times: np.ndarray, event_values: np.ndarray) -> float:
     """max |value| of a piecewise-smooth periodic signal sampled at period * k / values.size (amplitudes' doc)."""
-    from mechgen.analyses.periodic_orbit import peak
 
     y = np.abs(np.asarray(values, float))
     k, h = int(np.argmax(y)), period / y.size

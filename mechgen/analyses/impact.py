@@ -27,6 +27,7 @@ from mechgen.analyses import figures, schema, summary
 from mechgen.analyses.operating_point import vector
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import ABSENT, REQUIRED, Option
+from mechgen.analyses.simulate_start import budget_of, declared_start
 from mechgen.errors import SceneError
 from mechgen.runtime.integration.events import LOOPS, integrate_hybrid
 from mechgen.scene.values import fail, listing, show
@@ -91,7 +92,6 @@ def needs(options: dict, *, internal: bool) -> set[str]:
 
 def measure(system, options: dict) -> dict:
     """One impact: restitution, contact duration, energy lost, released (and the hysteresis with ``curve``)."""
-    from mechgen.analyses.simulate import budget_of
 
     if not hasattr(system, "modes"):
         raise SceneError(f"model {system.metadata.model} has no modes", key="kind",
@@ -99,7 +99,6 @@ def measure(system, options: dict) -> dict:
     n = system.n
     coordinate = options.get("coordinate", system.coordinates[0])
     i = list(system.coordinates).index(coordinate)
-    from mechgen.analyses.simulate import declared_start
 
     start = declared_start(system)
     if start is None and not options.get("v0"):

@@ -14,7 +14,7 @@ import numpy as np
 import scipy.sparse as sps
 
 from mechgen.analyses.newton_branch import arclength_steps
-from mechgen.analyses.orbit_branch import Orbits, record
+from mechgen.analyses.orbit_family import Orbits, record
 from mechgen.errors import SceneError
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget
 from mechgen.runtime.periodic.branch import OrbitBranch, residual_only

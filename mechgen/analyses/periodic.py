@@ -37,6 +37,7 @@ import numpy as np
 from mechgen.analyses import figures, schema, summary
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import ABSENT, REQUIRED, Option
+from mechgen.analyses.simulate_start import budget_of, declared_start
 from mechgen.errors import ConvergenceError, SceneError
 from mechgen.runtime.integration.events import LOOPS, integrate_hybrid
 
@@ -102,7 +103,6 @@ def loop_outputs(system, traj, names: tuple[str, str]) -> np.ndarray:
 def steady_period(system, x0, mode, period: float, options: dict, run: dict) -> tuple[int, float, object]:
     """(k, error, trajectory): the first period [(k-1)T, kT] whose end state and loop point repeat its start
     (module doc)."""
-    from mechgen.analyses.simulate import budget_of
     from mechgen.analyses.simulate_hybrid import require_event_memory, rules_of
 
     require_event_memory(options, np.asarray(x0).size)
@@ -148,7 +148,6 @@ def quadrature(breaks, nodes: int, pieces: int):
 
 def run_periodic(system, options: dict, context: dict) -> dict:
     """See the module doc."""
-    from mechgen.analyses.simulate import declared_start
     from mechgen.analyses.simulate_hybrid import event_log, rules_of, start_mode
 
     if not hasattr(system, "modes"):

@@ -130,9 +130,11 @@ from mechgen.analyses.free_orbit import is_conservative, orbit_energy, solve_fre
 from mechgen.analyses.linear_start import linear_coefficients
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import ABSENT, Option
+from mechgen.analyses.simulate_start import declared_start, initial_state
 from mechgen.errors import ConvergenceError, SceneError
 from mechgen.runtime.core.memory import dense_bytes, require
 from mechgen.runtime.periodic import floquet, fourier
+from mechgen.runtime.periodic.fourier import peak
 from mechgen.runtime.periodic.collocation import Collocation
 from mechgen.runtime.periodic.cycle_guess import closed_cycle
 from mechgen.runtime.periodic.flow import compiled_flow, states_at, variational_flow
@@ -399,7 +401,6 @@ def first_harmonic_states(x0: np.ndarray, omega: float, times: np.ndarray, n: in
 def guess(system, options: dict, omega) -> Guess:
     """The guess of ``q0`` / ``v0`` (tables over the declared initial state, zero when none): the first harmonic
     through them, of the forcing's period or the guessed one; p the coordinate with the largest |q0|."""
-    from mechgen.analyses.simulate import initial_state
 
     q0, v0 = initial_state(system, options)
     x0 = np.concatenate([q0, v0, internal_start(system, options.get("z0"))])
@@ -424,7 +425,6 @@ def linear_guess(system, options: dict, omega: float) -> Guess:
 def internal_start(system, table: dict | None = None) -> np.ndarray:
     """The internal variables' guess: ``table`` (``z0``) over their declared initial values (zero when none are
     declared); an unknown name is a SceneError at ``z0``."""
-    from mechgen.analyses.simulate import declared_start
 
     start = declared_start(system)
     z = np.zeros(system.m) if start is None or not system.m else np.asarray(start[2 * system.n:], float).copy()
@@ -699,19 +699,6 @@ def report(system, options: dict, found: dict, method: str, *, autonomous: bool,
             "harmonics": fourier.harmonics_table(U, names), "multipliers": floquet.as_pairs(mu),
             "stability": floquet.stability(mu, autonomous, trivial=2 if conservative else None), "method": method, "residual": float(found["residual"]),
             "iterations": int(found["iterations"]), "loop": "c" if found.get("run") is not None else "python"}
-
-
-def peak(values: np.ndarray) -> float:
-    """max |q| of a periodic signal at equally spaced phases, refined by the parabola through the largest sample
-    and its two neighbours (wrapping around the period): the grid's O(h^2) error becomes O(h^3)."""
-    y = np.abs(np.asarray(values, float))
-    k = int(np.argmax(y))
-    a, b, c = y[k - 1], y[k], y[(k + 1) % y.size]
-    curvature = a - 2 * b + c
-    if curvature >= 0:
-        return float(b)
-    shift = 0.5 * (a - c) / curvature
-    return float(b - 0.25 * (a - c) * shift)
 
 
 def plot(plt, a: dict, path) -> list:

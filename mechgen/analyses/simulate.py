@@ -46,35 +46,27 @@ import numpy as np
 
 from mechgen.analyses import energy_balance, schema, simulate_flow, summary, time_figures, time_series
 from mechgen.analyses.context import NAME
-from mechgen.analyses.operating_point import vector
 from mechgen.analyses.registry import AnalysisKind, register
 from mechgen.analyses.schema import ABSENT, ALL_OUTPUTS, REQUIRED, Option
+from mechgen.analyses.simulate_start import (DEFAULT_STEPS, FIXED_STEP, balanced, budget_of, declared_start,
+                                             initial_state, report)
 from mechgen.analyses.simulate_variational import check_fixed_step, simulate_variational
-from mechgen.errors import ConvergenceError, SceneError
-from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget, BudgetExceeded
+from mechgen.errors import ConvergenceError
+from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget
 from mechgen.runtime.core.integrate import MIN_RTOL, leapfrog
 from mechgen.runtime.core.splitting import require_separable
 from mechgen.runtime.core.sundials import cvodes_problem
-from mechgen.runtime.linear.modes import modes as solve_modes
 from mechgen.scene.values import fail, listing, show, type_name
 
 METHODS = ("auto", "BDF", "Radau", "LSODA", "RK45", "DOP853", "leapfrog", "cvodes", "variational")
-#: the fixed-step methods (a dt, a step budget refused up front)
-FIXED_STEP = ("leapfrog", "variational")
 #: the default figure: coordinates against time, or each coordinate against its velocity
 PLOTS = ("time", "phase")
 #: what a hybrid run does when its events accumulate (Zeno): end with an error, or stop there
 ON_ZENO = ("error", "stop")
 STEP = "a number > 0 (or an expression)"
-#: default max_steps: the leapfrog's fixed steps, the adaptive methods' accepted steps
-DEFAULT_STEPS = {"leapfrog": 10_000_000, "adaptive": 100_000}
-#: stability intervals of the explicit methods, doubled (RK45: ~3.3, DOP853: ~6): steps >= t_end |lambda| / c
-EXPLICIT_REACH = {"RK45": 7.0, "DOP853": 12.0}
 #: what a model unfit for the leapfrog uses instead (mechgen.runtime.core.splitting.require_separable)
 INSTEAD = ("method = 'variational' (a variational integrator of the model's own Lagrangian, any kinetic energy), "
            "or an adaptive one ('auto', the default, or 'Radau')")
-#: the explicit methods' up-front stiffness estimate is made for first-order states up to this size
-ESTIMATE_SIZE = 400
 
 
 def _outputs(ctx, key: str, value: object) -> list[str]:
@@ -242,32 +234,6 @@ def needs(options: dict, *, internal: bool) -> set[str]:
             | ({"rates", "rates_tangent"} if internal else set()))
 
 
-def declared_start(system) -> np.ndarray | None:
-    """The model's declared initial state (q, v, z) at the system's parameters (kernel ``initial``), or None."""
-    if "initial" not in system.kernels:
-        return None
-    return np.asarray(system.call("initial")["x"], float).ravel()
-
-
-def initial_state(system, options: dict) -> tuple[np.ndarray, np.ndarray]:
-    """(q0, v0) from the options: tables of coordinates over the model's declared initial state (zero when it
-    declares none), or a linear mode times an amplitude."""
-    start = declared_start(system)
-    n = system.n
-    q0 = vector(system, options.get("q0"), None if start is None else start[:n])
-    v0 = vector(system, options.get("v0"), None if start is None else start[n:2 * n])
-    if options.get("initial_mode"):
-        k = int(options["initial_mode"])
-        if k > system.n:
-            raise SceneError(f"initial_mode {k} exceeds the {system.n} degrees of freedom", key="initial_mode",
-                             expected=f"an integer from 1 to {system.n}")
-        mats = system.linear(np.zeros(system.n))
-        shapes = solve_modes(mats["M"], mats["K"], count=k).shapes  # sparse shift-invert for a long chain
-        shape = shapes[:, k - 1] / np.max(np.abs(shapes[:, k - 1]))
-        q0 = q0 + options.get("amplitude", 1.0) * shape * np.sign(shape[np.argmax(np.abs(shape))])
-    return q0, v0
-
-
 def mode_energies(system, q: np.ndarray, v: np.ndarray, count: int = 8) -> list[float]:
     """Harmonic energies E_k = (P_k^2 + omega_k^2 Q_k^2)/2 of a fixed-end chain (FPU's observable).
 
@@ -281,35 +247,6 @@ def mode_energies(system, q: np.ndarray, v: np.ndarray, count: int = 8) -> list[
     omega2 = np.einsum("ki,ik->k", S, mats["K"] @ S.T)  # K stays sparse (a chain of 1e6 sites)
     Q, P = S @ q, S @ v
     return [float(e) for e in 0.5 * (P**2 + omega2 * Q**2)]
-
-
-def budget_of(options: dict, method: str) -> Budget:
-    """The run's work budget: ``max_steps`` (default DEFAULT_STEPS of the method) and ``max_seconds``."""
-    steps = options.get("max_steps", DEFAULT_STEPS["leapfrog" if method in FIXED_STEP else "adaptive"])
-    what = f"{method} steps"
-    return Budget(what, limit=int(steps), key="max_steps", seconds=float(options.get("max_seconds", DEFAULT_SECONDS)))
-
-
-def refuse_explicit_stiff(system, x0: np.ndarray, t_end: float, method: str, budget: Budget,
-                          rates: np.ndarray | None = None) -> None:
-    """An explicit method needs at least t_end |lambda|max / c steps for stability alone (|lambda|max: the
-    largest eigenvalue magnitude of d(dx/dt)/dx at the start, ``rates`` when the caller has them, else
-    simulate_flow.start_rates; c: EXPLICIT_REACH); refuse when that is more than the budget (the problem is
-    stiff: the implicit methods have no such stability limit). Beyond ESTIMATE_SIZE states only a continuum has an
-    estimate (its largest rates, simulate_flow.largest_rates)."""
-    if method not in EXPLICIT_REACH or (x0.size > ESTIMATE_SIZE and not system.is_field) or budget.limit is None:
-        return
-    rates = simulate_flow.start_rates(system, x0) if rates is None else rates
-    if rates is None:  # no estimate: the step budget still holds during the run
-        return
-    fastest = float(np.max(np.abs(rates), initial=0.0))
-    needed = t_end * fastest / EXPLICIT_REACH[method]
-    if needed > budget.limit:
-        raise BudgetExceeded(f"{method} steps: an explicit method needs at least {needed:.3g} steps to stay stable "
-                             f"over t_end = {t_end:g} (the fastest rate at the start is |lambda| = {fastest:.3g}/s), "
-                             f"more than max_steps = {budget.limit:,}; the problem is stiff: the implicit methods "
-                             "BDF and Radau are not bound by this limit", key="max_steps",
-                             reached="nothing (refused before starting)")
 
 
 def leapfrog_masses(system, M) -> np.ndarray:
@@ -346,7 +283,7 @@ def run_simulate(system, options: dict, context: dict) -> dict:
     else:
         start = declared_start(system)
         x0 = np.concatenate([q0, v0, np.zeros(system.m) if start is None else start[2 * system.n:]])
-        rates = simulate_flow.start_rates(system, x0) if method in ("auto", *EXPLICIT_REACH) else None
+        rates = simulate_flow.start_rates(system, x0) if method in ("auto", *simulate_flow.EXPLICIT_REACH) else None
         if method == "auto":
             limit = budget_of(options, "DOP853").limit
             method = simulate_flow.chosen_method(system, x0, float(options["t_end"]), limit, rates=rates)
@@ -364,36 +301,6 @@ def run_simulate(system, options: dict, context: dict) -> dict:
     if system.is_lattice and system.metadata.ends == "fixed":
         out["mode_energies"] = mode_energies(system, X[-1, :n], X[-1, n:2 * n])
     return out
-
-
-def report(system, options: dict, t: np.ndarray, X: np.ndarray, series: dict) -> dict:
-    """The outputs of a run sampled at ``t`` (states X, one row a sample; ``series``: the model's outputs at each
-    sample): the outputs at the last sample (those asked for), ``energy_drift``, ``t_end`` and, when kept, the
-    time history."""
-    wanted = options.get("outputs")
-    out = {k: float(v[-1]) for k, v in series.items() if not wanted or k in wanted}
-    out["energy_drift"] = time_series.energy_drift(series)
-    out["t_end"] = float(options["t_end"])
-    keep, note = time_series.keep_series(options, X.shape[1], len(wanted or series), len(t))
-    if keep:
-        out.update(time_series.time_history(system, t, X, series, wanted))
-        if options.get("plot") == "phase":
-            out["plot"] = "phase"
-    elif note:
-        out["series_note"] = note
-    return out
-
-
-def balanced(out: dict, balance: dict | None) -> None:
-    """A run that is not conservative reports its energy balance (mechgen.analyses.energy_balance) instead of
-    ``energy_drift``; with the trajectory, ``work`` and ``dissipated`` at each sample too."""
-    if balance is None:
-        return
-    del out["energy_drift"]
-    work, dissipated = balance.pop("_work_series"), balance.pop("_dissipated_series")
-    out.update(balance)
-    if "trajectory" in out:
-        out["trajectory"]["work"], out["trajectory"]["dissipated"] = work.tolist(), dissipated.tolist()
 
 
 def _leapfrog_run(system, options: dict, q0, v0, budget: Budget, desc: str) -> tuple[np.ndarray, np.ndarray]:

@@ -26,7 +26,7 @@ import numpy as np
 from mechgen.analyses import energy_balance
 from mechgen.errors import InputError
 from mechgen.runtime.integration.augmented import AugmentedFlow
-from mechgen.runtime.core.budget import Budget
+from mechgen.runtime.core.budget import Budget, BudgetExceeded
 from mechgen.runtime.core.diagnose import explain_state
 from mechgen.runtime.core.integrate import integrate_first_order
 from mechgen.runtime.core.memory import dense_bytes, require
@@ -43,6 +43,8 @@ DOP853_REACH = 12.0
 #: stability alone needs more than STIFF_STEPS such steps is stiff: its fastest modes are artefacts of the mesh
 #: that an implicit method need not resolve (a lumped model's fast oscillation is physics: any method resolves it)
 DOP853_MESH_STEP = 2.0
+#: stability intervals of the explicit methods, doubled (RK45: ~3.3, DOP853: ~6): steps >= t_end |lambda| / c
+EXPLICIT_REACH = {"RK45": 7.0, "DOP853": 12.0}
 #: ``auto`` estimates the start's rates for first-order states up to this size (a dense eigen-solve)
 ESTIMATE_SIZE = 400
 #: above it, a continuum's estimate is this many eigenvalues of largest magnitude (ARPACK)
@@ -116,8 +118,6 @@ def adaptive_run(system, options: dict, x0: np.ndarray, method: str, budget: Bud
     from x0 (``rates``: the start's eigenvalues, when already solved for), sampled at ``samples`` equally spaced
     times; ``_extra`` integrals of the energy balance
     (mechgen.analyses.energy_balance) follow the state in each row where the run integrates them."""
-    from mechgen.analyses.simulate import refuse_explicit_stiff
-
     t_end = float(options["t_end"])
     refuse_explicit_stiff(system, x0, t_end, method, budget, rates)
     extra = energy_balance.EXTRA if energy_balance.accounted(system, method) else 0
@@ -191,3 +191,25 @@ def cvodes_run(system, x0, t_end: float, run: RunOptions):
     return integrate_cvodes(system, x0, t_end, t_eval=run.t_eval, rtol=run.rtol, atol=run.atol, budget=run.budget,
                             progress=run.progress, desc=run.desc, explain=run.explain,
                             integrals=x0.size - (2 * system.n + system.m))
+
+
+def refuse_explicit_stiff(system, x0: np.ndarray, t_end: float, method: str, budget: Budget,
+                          rates: np.ndarray | None = None) -> None:
+    """An explicit method needs at least t_end |lambda|max / c steps for stability alone (|lambda|max: the
+    largest eigenvalue magnitude of d(dx/dt)/dx at the start, ``rates`` when the caller has them, else
+    start_rates; c: EXPLICIT_REACH); refuse when that is more than the budget (the problem is
+    stiff: the implicit methods have no such stability limit). Beyond ESTIMATE_SIZE states only a continuum has an
+    estimate (its largest rates, largest_rates)."""
+    if method not in EXPLICIT_REACH or (x0.size > ESTIMATE_SIZE and not system.is_field) or budget.limit is None:
+        return
+    rates = start_rates(system, x0) if rates is None else rates
+    if rates is None:  # no estimate: the step budget still holds during the run
+        return
+    fastest = float(np.max(np.abs(rates), initial=0.0))
+    needed = t_end * fastest / EXPLICIT_REACH[method]
+    if needed > budget.limit:
+        raise BudgetExceeded(f"{method} steps: an explicit method needs at least {needed:.3g} steps to stay stable "
+                             f"over t_end = {t_end:g} (the fastest rate at the start is |lambda| = {fastest:.3g}/s), "
+                             f"more than max_steps = {budget.limit:,}; the problem is stiff: the implicit methods "
+                             "BDF and Radau are not bound by this limit", key="max_steps",
+                             reached="nothing (refused before starting)")

@@ -23,6 +23,7 @@ import numpy as np
 
 from mechgen.analyses import energy_balance, time_series
 from mechgen.analyses.context import NAME
+from mechgen.analyses.simulate_start import balanced, budget_of, declared_start, initial_state, report
 from mechgen.errors import SceneError
 from mechgen.runtime.integration.augmented import BalancedHybrid
 from mechgen.runtime.core.diagnose import explain_state
@@ -73,7 +74,6 @@ def event_log(system, events) -> list[dict]:
 
 def run_hybrid(system, options: dict, context: dict) -> dict:
     """Time response of a hybrid system; see the module doc."""
-    from mechgen.analyses.simulate import balanced, declared_start, initial_state, report
 
     if options.get("method") == "leapfrog":
         raise SceneError("method 'leapfrog' cannot integrate a hybrid model (its modes switch at events)",
@@ -117,7 +117,6 @@ def hybrid_run(system, options: dict, x0: np.ndarray, desc: str):
     """(the HybridTrajectory, whether it ended at a Zeno approach, the method that ran): ``on_zeno = "stop"`` keeps
     the run up to the event that made it Zeno (mechgen.runtime.integration.events.ZenoApproach); the default lets the
     error end it. ``method = "auto"`` is decided on the initial mode (mechgen.analyses.simulate_flow)."""
-    from mechgen.analyses.simulate import budget_of
 
     plain = getattr(system, "system", system)  # a BalancedHybrid's own system: the state without the integrals
     method, t_end = options.get("method", "auto"), float(options["t_end"])

@@ -23,7 +23,8 @@ import numpy as np
 
 from mechgen.errors import InputError
 from mechgen.runtime.core.memory import dense_bytes, require
-from mechgen.runtime.core.variational import STAGES, VariationalOptions, run_variational, steps_for
+from mechgen.runtime.core.variational import VariationalOptions, run_variational, steps_for
+from mechgen.runtime.core.variational_rules import STAGES
 from mechgen.scene.values import fail
 
 

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from mechgen.analyses.newton_branch import arclength_steps
-from mechgen.analyses.steady import equilibrium_functions
+from mechgen.analyses.parametrised import Parametrised
 from mechgen.errors import SceneError
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget
 from mechgen.runtime.steady import codim2
@@ -23,34 +23,6 @@ from mechgen.runtime.steady.continuation import continuation
 
 #: keys of a continuation that a curve of special points does not take
 CURVE_REFUSES = ("method", "stages", "bounds", "at", "minimize", "switch_branches", "eigenvalues")
-
-
-class Parametrised:
-    """F, F_y and the first-order A of ``system`` at two parameter values (a memo of the last few systems)."""
-
-    def __init__(self, system, first: str, second: str) -> None:
-        self.system, self.first, self.second = system, first, second
-        self.memo: dict = {}
-
-    def at(self, a: float, b: float):
-        key = (float(a), float(b))
-        if key not in self.memo:
-            if len(self.memo) > 16:
-                self.memo.clear()
-            moved = self.system.with_params(**{self.first: key[0], self.second: key[1]})
-            self.memo[key] = (moved, *equilibrium_functions(moved))
-        return self.memo[key]
-
-    def residual(self, y, a, b):
-        return np.asarray(self.at(a, b)[1](y), float)
-
-    def jacobian(self, y, a, b):
-        J = self.at(a, b)[2](y)
-        return J.toarray() if hasattr(J, "toarray") else np.asarray(J, float)
-
-    def state_jacobian(self, y, a, b):
-        moved, n = self.at(a, b)[0], self.system.n
-        return np.asarray(moved.jacobian(0.0, np.concatenate([y[:n], np.zeros(n), y[n:]])), float)
 
 
 def refuse_keys(options: dict) -> None:

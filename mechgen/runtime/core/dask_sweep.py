@@ -32,7 +32,7 @@ from collections import Counter
 
 from mechgen.errors import InputError
 from mechgen.runtime.core.budget import BudgetExceeded
-from mechgen.runtime.core.sweep import OK, SweepError, describe, guarded, inner_budget
+from mechgen.runtime.core.sweep_tasks import OK, SweepError, describe, guarded, inner_budget
 from mechgen.runtime.core.threads import single_thread_worker
 
 #: the scheduler event topic chunk starts are logged under
@@ -114,7 +114,7 @@ def configured_scheduler() -> str | None:
     Dask config file: the user's environment), checked; None when it names none."""
     import dask
 
-    from mechgen.runtime.core.sweep import SCHEDULER_FORM, scheduler_address
+    from mechgen.runtime.core.sweep_tasks import SCHEDULER_FORM, scheduler_address
 
     value = dask.config.get("scheduler-address", None)
     if value is None or value == "":

@@ -19,8 +19,8 @@ import numpy as np
 
 from mechgen.errors import BuildError, CompilerUnavailable, KernelError
 from mechgen.runtime import csrc
-from mechgen.runtime.core.variational import (MAX_NEWTON, NEWTON_RTOL, STALL, Tableau, newton_failure, nonfinite,
-                                              singular)
+from mechgen.runtime.core.variational_rules import (MAX_NEWTON, NEWTON_RTOL, STALL, Tableau, newton_failure,
+                                                    nonfinite, singular)
 
 log = logging.getLogger("mechgen")
 

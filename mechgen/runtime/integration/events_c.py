@@ -33,8 +33,8 @@ import numpy as np
 from mechgen.errors import BuildError, CompilerUnavailable, ConvergenceError, KernelError
 from mechgen.runtime import csrc
 from mechgen.runtime.core.budget import BudgetExceeded, Progress
-from mechgen.runtime.integration.events import (ZENO_HINT, Event, HybridTrajectory, ZenoApproach, diagnosis,
-                                                 unnoticed)
+from mechgen.runtime.integration.event_records import (ZENO_HINT, Event, HybridTrajectory, ZenoApproach,
+                                                        diagnosis, unnoticed)
 from mechgen.runtime.integration.run_options import RunOptions
 from mechgen.runtime.core.pattern import extent
 
