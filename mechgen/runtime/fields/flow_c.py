@@ -212,9 +212,9 @@ def field_loop_problem(system, rtol=1e-8, atol=1e-10, extra: int = 0) -> str | N
         return f"the system's kernels are {getattr(system, 'backend', 'unknown')} ones, not compiled C"
     if system.has_multipliers:
         return "the unknowns include Lagrange multipliers (a DAE)"
-    if not system.info.get("constant_mass"):
+    if not system.field_meta.constant_mass:
         return "the mass matrix depends on the state"
-    na = len(system.info["jets"])
+    na = system.field_meta.njets
     wanted = [("residual", "r", na)] + ([("energy_rates", "g", extra)] if extra else [])
     for kernel, output, size in wanted:
         for name in [kernel] + [f"{kernel}_at_{at}" for at, _, _ in system.placed_points()]:

@@ -183,7 +183,7 @@ def integrated_series(system, kernel: str, t: np.ndarray, X: np.ndarray) -> dict
             values[name] = values[name] + summed if name in values else summed
     bad = [k for k, v in values.items() if not np.all(np.isfinite(v))]
     if bad:
-        raise KernelError(f"{kernel} of {system.meta.get('model')} is NaN/Inf: {', '.join(bad)}")
+        raise KernelError(f"{kernel} of {system.metadata.model} is NaN/Inf: {', '.join(bad)}")
     return values
 
 
