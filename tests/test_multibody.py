@@ -213,3 +213,24 @@ def test_program_text_equals_the_sympy_printers_in_value():
             got = float(np.asarray(eval(text, scope)).ravel()[0])
             assert math.isclose(got, value, rel_tol=1e-14, abs_tol=1e-15), (o, text, got, value)
         assert numpy_code(operation_expr(o))                    # the sympy numpy printer prints it too
+
+
+def test_a_large_source_compiled_as_units_gives_the_same_library(monkeypatch, tmp_path):
+    """A marked source over UNIT_LINES lines is compiled one kernel per translation unit, several at once, and
+    linked: the kernels give the one-unit build's values bit for bit (threshold lowered to 0 so that a 9-link
+    pendulum takes that path; its own cache so that it is built, not found)."""
+    from mechgen.codegen import build
+
+    model = pendulum_model(9)
+    whole = mechgen.compile(model, kernels=["flow", "tangent"])
+    monkeypatch.setenv("MECHGEN_CACHE", str(tmp_path))
+    monkeypatch.setattr(build, "UNIT_LINES", 0)
+    compiles = build.STATS["compile"]
+    split = mechgen.compile(model, kernels=["flow", "tangent"])
+    assert build.STATS["compile"] - compiles >= 2                     # one per kernel unit
+    x = np.random.default_rng(2).uniform(-1, 1, 18)
+    assert np.array_equal(split.rhs(0.0, x), whole.rhs(0.0, x))
+    assert np.array_equal(split.jacobian(0.0, x), whole.jacobian(0.0, x))
+    assert build.units("int a;\n") is None
+    assert build.units(f"#include <math.h>\n{build.UNIT_MARK}\nint f(void);\n{build.UNIT_MARK}\nint g(void);\n") == \
+        ["#include <math.h>\n\nint f(void);\n", "#include <math.h>\n\nint g(void);\n"]
