@@ -108,55 +108,158 @@ static void mtv(const double *A, const double *b, double *y) {      /* A^T b */
     for (int i = 0; i < 3; ++i) y[i] = A[i] * b[0] + A[3 + i] * b[1] + A[6 + i] * b[2];
 }
 
+/* one rod's weighted configuration and internal forces (the header's equations) at increments zb (n x 6) */
+static void internal_one(long n, double h, double alpha, const double *K, const double *f0, const double *x,
+                         const double *R, const double *zb, double *xb, double *Rb, double *Fb, double *Mbb) {
+    for (long i = 0; i < n; ++i) {
+        double th[3] = {alpha * zb[6 * i + 3], alpha * zb[6 * i + 4], alpha * zb[6 * i + 5]}, E[9];
+        for (int k = 0; k < 3; ++k) xb[3 * i + k] = x[3 * i + k] + alpha * zb[6 * i + k];
+        exp3(th, E);
+        matmul(R + 9 * i, E, Rb + 9 * i);
+    }
+    memset(Fb, 0, sizeof(double) * 3 * n);
+    memset(Mbb, 0, sizeof(double) * 3 * n);
+    for (long e = 0; e + 1 < n; ++e) {
+        const double *Ri = Rb + 9 * e, *Rj = Rb + 9 * (e + 1);
+        double Q[9], Psi[3], half[3], Rh[9], Re[9], d[3], nu[3], eps[6], sig[6];
+        matTmul(Ri, Rj, Q);
+        log3(Q, Psi);
+        for (int k = 0; k < 3; ++k) half[k] = 0.5 * Psi[k];
+        exp3(half, Rh);
+        matmul(Ri, Rh, Re);
+        for (int k = 0; k < 3; ++k) d[k] = xb[3 * (e + 1) + k] - xb[3 * e + k];
+        mtv(Re, d, nu);
+        for (int k = 0; k < 3; ++k) { nu[k] /= h; eps[k] = nu[k] - f0[k]; eps[3 + k] = Psi[k] / h - f0[3 + k]; }
+        for (int r = 0; r < 6; ++r) {
+            double acc = 0.0;
+            for (int s = 0; s < 6; ++s) acc += eps[s] * K[6 * s + r];      /* (f - f0) @ K */
+            sig[r] = acc;
+        }
+        double Fe[3];
+        mv(Re, sig, Fe);
+        for (int k = 0; k < 3; ++k) { Fb[3 * e + k] += Fe[k]; Fb[3 * (e + 1) + k] -= Fe[k]; }
+        double a[3] = {h * (sig[1] * nu[2] - sig[2] * nu[1]), h * (sig[2] * nu[0] - sig[0] * nu[2]),
+                       h * (sig[0] * nu[1] - sig[1] * nu[0])};
+        /* J_r(Psi/2) = J_l(-Psi/2) = I - a1 hat(Psi/2) + a2 hat(Psi/2)^2, at t/2 */
+        double th = norm3(half), Jr[9], ca[3], c[3], Jli[9], Jri[9], bpsi = binv_(norm3(Psi));
+        double mhalf[3] = {-half[0], -half[1], -half[2]};
+        poly3(mhalf, a1_(th), a2_(th), Jr);
+        mtv(Jr, a, ca);
+        for (int k = 0; k < 3; ++k) c[k] = sig[3 + k] + 0.5 * ca[k];
+        poly3(Psi, -0.5, bpsi, Jli);              /* J_l(Psi)^-1 = I - hat/2 + b hat^2 */
+        poly3(Psi, 0.5, bpsi, Jri);               /* J_r(Psi)^-1 = I + hat/2 + b hat^2 */
+        double Rha[3], Jc[3], Jrc[3];
+        mv(Rh, a, Rha);
+        mtv(Jli, c, Jc);
+        mtv(Jri, c, Jrc);
+        for (int k = 0; k < 3; ++k) { Mbb[3 * e + k] -= Rha[k] - Jc[k]; Mbb[3 * (e + 1) + k] -= Jrc[k]; }
+    }
+}
+
 int mgr_internal(long batch, long n, double h, double alpha, const double *K, const double *f0,
                  const double *x, const double *R, const double *z,
                  double *xm, double *Rm, double *F, double *Mb) {
-    for (long b = 0; b < batch; ++b) {
-        const double *zb = z + b * n * 6;
-        double *xb = xm + b * n * 3, *Rb = Rm + b * n * 9, *Fb = F + b * n * 3, *Mbb = Mb + b * n * 3;
-        for (long i = 0; i < n; ++i) {
-            double th[3] = {alpha * zb[6 * i + 3], alpha * zb[6 * i + 4], alpha * zb[6 * i + 5]}, E[9];
-            for (int k = 0; k < 3; ++k) xb[3 * i + k] = x[3 * i + k] + alpha * zb[6 * i + k];
-            exp3(th, E);
-            matmul(R + 9 * i, E, Rb + 9 * i);
+    for (long b = 0; b < batch; ++b)
+        internal_one(n, h, alpha, K, f0, x, R, z + b * n * 6, xm + b * n * 3, Rm + b * n * 9, F + b * n * 3,
+                     Mb + b * n * 3);
+    return 0;
+}
+
+/* The whole step residual of Discrete.residual (mechgen/runtime/rods/dynamics.py) for `batch` increments z.
+ * Mirrored field for field by mechgen/runtime/rods/compiled.py's CStep (mgr_layout checks the size). */
+typedef struct {
+    long n, batch, load_stride;                 /* load_stride: 0 one lumped load for all, 6 n one per z */
+    double h, alpha, dt, rhoA, damping;
+    const double *K, *f0, *J;                   /* 6 x 6 (N, N m^2), 6, J_rho 3 x 3 (kg m) */
+    const double *weights, *fixed_unit;         /* nodal lengths w_i (m); the fixed rows' scale times dt^2 (6) */
+    const double *fixed;                        /* n x 6: 1 where the unknown is fixed, else 0 */
+    const double *x, *R, *v, *w, *z;            /* the state at t_n; increments (batch, n, 6) */
+    const double *load;                         /* lumped spatial load w_i q (n, 6) or NULL */
+    const double *tip;                          /* the dead tip force and torque (6, spatial) */
+    double *xm, *Rm, *F, *Mb;                   /* work: (batch, n, 3 | 9) */
+    double *r, *Fx, *Mx;                        /* out: residual (batch, n, 6), external wrench (batch, n, 3) */
+} mgr_step;
+
+long mgr_layout(void) { return (long)sizeof(mgr_step); }
+
+/* the external wrench at node i: Fx = w_i q_f (+ tip force), Mx = Rm^T w_i q_l (+ Rm^T tip torque) */
+static void external_node(const mgr_step *s, const double *load, const double *Rmi, long i, double *fx,
+                          double *mx) {
+    double ql[3] = {0.0, 0.0, 0.0};
+    for (int k = 0; k < 3; ++k) { fx[k] = 0.0; mx[k] = 0.0; }
+    if (load) for (int k = 0; k < 3; ++k) { fx[k] += load[6 * i + k]; ql[k] = load[6 * i + 3 + k]; }
+    if (i == s->n - 1) for (int k = 0; k < 3; ++k) { fx[k] += s->tip[k]; ql[k] += s->tip[3 + k]; }
+    mtv(Rmi, ql, mx);
+}
+
+/* r_t = m_i ((v_mid - v)/(alpha dt) + c v_mid) - F - Fx,
+ * r_r = w_i (J ((w_mid - w)/(alpha dt) + c w_mid) + w_mid x J w_mid) - Mb - Mx,  r = z dt^-2 unit on fixed rows */
+static void rows_one(const mgr_step *s, const double *zb, const double *load, const double *Rb, const double *Fb,
+                     const double *Mbb, double *rb, double *Fxb, double *Mxb) {
+    double dt = s->dt, adt = s->alpha * dt, c = s->damping, dt2 = dt * dt;
+    for (long i = 0; i < s->n; ++i) {
+        const double *zi = zb + 6 * i, *J = s->J;
+        double vm[3], wm[3], acc[3], Ja[3], Jw[3], m = s->rhoA * s->weights[i];
+        external_node(s, load, Rb + 9 * i, i, Fxb + 3 * i, Mxb + 3 * i);
+        for (int k = 0; k < 3; ++k) {
+            vm[k] = zi[k] / dt;
+            wm[k] = zi[3 + k] / dt;
+            rb[6 * i + k] = m * ((vm[k] - s->v[3 * i + k]) / adt + c * vm[k]) - Fb[3 * i + k] - Fxb[3 * i + k];
+            acc[k] = (wm[k] - s->w[3 * i + k]) / adt + c * wm[k];
         }
-        memset(Fb, 0, sizeof(double) * 3 * n);
-        memset(Mbb, 0, sizeof(double) * 3 * n);
-        for (long e = 0; e + 1 < n; ++e) {
-            const double *Ri = Rb + 9 * e, *Rj = Rb + 9 * (e + 1);
-            double Q[9], Psi[3], half[3], Rh[9], Re[9], d[3], nu[3], eps[6], sig[6];
-            matTmul(Ri, Rj, Q);
-            log3(Q, Psi);
-            for (int k = 0; k < 3; ++k) half[k] = 0.5 * Psi[k];
-            exp3(half, Rh);
-            matmul(Ri, Rh, Re);
-            for (int k = 0; k < 3; ++k) d[k] = xb[3 * (e + 1) + k] - xb[3 * e + k];
-            mtv(Re, d, nu);
-            for (int k = 0; k < 3; ++k) { nu[k] /= h; eps[k] = nu[k] - f0[k]; eps[3 + k] = Psi[k] / h - f0[3 + k]; }
-            for (int r = 0; r < 6; ++r) {
-                double acc = 0.0;
-                for (int s = 0; s < 6; ++s) acc += eps[s] * K[6 * s + r];      /* (f - f0) @ K */
-                sig[r] = acc;
-            }
-            double Fe[3];
-            mv(Re, sig, Fe);
-            for (int k = 0; k < 3; ++k) { Fb[3 * e + k] += Fe[k]; Fb[3 * (e + 1) + k] -= Fe[k]; }
-            double a[3] = {h * (sig[1] * nu[2] - sig[2] * nu[1]), h * (sig[2] * nu[0] - sig[0] * nu[2]),
-                           h * (sig[0] * nu[1] - sig[1] * nu[0])};
-            /* J_r(Psi/2) = J_l(-Psi/2) = I - a1 hat(Psi/2) + a2 hat(Psi/2)^2, at t/2 */
-            double th = norm3(half), Jr[9], ca[3], c[3], Jli[9], Jri[9], bpsi = binv_(norm3(Psi));
-            double mhalf[3] = {-half[0], -half[1], -half[2]};
-            poly3(mhalf, a1_(th), a2_(th), Jr);
-            mtv(Jr, a, ca);
-            for (int k = 0; k < 3; ++k) c[k] = sig[3 + k] + 0.5 * ca[k];
-            poly3(Psi, -0.5, bpsi, Jli);              /* J_l(Psi)^-1 = I - hat/2 + b hat^2 */
-            poly3(Psi, 0.5, bpsi, Jri);               /* J_r(Psi)^-1 = I + hat/2 + b hat^2 */
-            double Rha[3], Jc[3], Jrc[3];
-            mv(Rh, a, Rha);
-            mtv(Jli, c, Jc);
-            mtv(Jri, c, Jrc);
-            for (int k = 0; k < 3; ++k) { Mbb[3 * e + k] -= Rha[k] - Jc[k]; Mbb[3 * (e + 1) + k] -= Jrc[k]; }
-        }
+        mv(J, acc, Ja);
+        mv(J, wm, Jw);
+        double cr[3] = {wm[1] * Jw[2] - wm[2] * Jw[1], wm[2] * Jw[0] - wm[0] * Jw[2], wm[0] * Jw[1] - wm[1] * Jw[0]};
+        for (int k = 0; k < 3; ++k)
+            rb[6 * i + 3 + k] = s->weights[i] * (Ja[k] + cr[k]) - Mbb[3 * i + k] - Mxb[3 * i + k];
+        for (int k = 0; k < 6; ++k)
+            if (s->fixed[6 * i + k] != 0.0) rb[6 * i + k] = zi[k] * (s->fixed_unit[k] / dt2);
     }
+}
+
+int mgr_residual(const mgr_step *s) {
+    long n = s->n;
+    for (long b = 0; b < s->batch; ++b) {
+        const double *zb = s->z + b * n * 6, *load = s->load ? s->load + b * s->load_stride : 0;
+        double *Rb = s->Rm + b * n * 9, *Fb = s->F + b * n * 3, *Mbb = s->Mb + b * n * 3;
+        internal_one(n, s->h, s->alpha, s->K, s->f0, s->x, s->R, zb, s->xm + b * n * 3, Rb, Fb, Mbb);
+        rows_one(s, zb, load, Rb, Fb, Mbb, s->r + b * n * 6, s->Fx + b * n * 3, s->Mx + b * n * 3);
+    }
+    return 0;
+}
+
+/* What a saved point needs (Discrete.elastic_energy, kinetic_energy, statics.turning_angle):
+ * out[0] = V = sum_e h/2 (f_e - f0)^T K (f_e - f0), out[1] = T = sum_i w_i (rhoA |v_i|^2 + w_i^T J w_i)/2 (J),
+ * out[2] = sum_e a . R_e0 Psi_e, the turning about the unit axis a (rad), Psi_e = log(R_i^T R_{i+1}). */
+int mgr_record(long n, double h, double rhoA, const double *K, const double *f0, const double *J,
+               const double *weights, const double *axis, const double *x, const double *R, const double *v,
+               const double *w, double *out) {
+    double V = 0.0, T = 0.0, turn = 0.0;
+    for (long e = 0; e + 1 < n; ++e) {
+        const double *Ri = R + 9 * e;
+        double Q[9], Psi[3], half[3], Rh[9], Re[9], d[3], nu[3], eps[6], sp[3];
+        matTmul(Ri, R + 9 * (e + 1), Q);
+        log3(Q, Psi);
+        for (int k = 0; k < 3; ++k) half[k] = 0.5 * Psi[k];
+        exp3(half, Rh);
+        matmul(Ri, Rh, Re);
+        for (int k = 0; k < 3; ++k) d[k] = x[3 * (e + 1) + k] - x[3 * e + k];
+        mtv(Re, d, nu);
+        for (int k = 0; k < 3; ++k) { eps[k] = nu[k] / h - f0[k]; eps[3 + k] = Psi[k] / h - f0[3 + k]; }
+        for (int r = 0; r < 6; ++r)
+            for (int c = 0; c < 6; ++c) V += eps[r] * K[6 * r + c] * eps[c];
+        mv(Ri, Psi, sp);
+        turn += sp[0] * axis[0] + sp[1] * axis[1] + sp[2] * axis[2];
+    }
+    for (long i = 0; i < n; ++i) {
+        double Jw[3];
+        mv(J, w + 3 * i, Jw);
+        const double *vi = v + 3 * i, *wi = w + 3 * i;
+        T += weights[i] * (rhoA * (vi[0] * vi[0] + vi[1] * vi[1] + vi[2] * vi[2])
+                           + wi[0] * Jw[0] + wi[1] * Jw[1] + wi[2] * Jw[2]);
+    }
+    out[0] = 0.5 * h * V;
+    out[1] = 0.5 * T;
+    out[2] = turn;
     return 0;
 }

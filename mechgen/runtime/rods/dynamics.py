@@ -63,6 +63,7 @@ from scipy.linalg import lapack
 
 from mechgen.errors import ConvergenceError
 from mechgen.runtime import csrc
+from mechgen.runtime.rods import compiled as compiled_step
 from mechgen.runtime.rods.liegroup import cross3, exp_so3, hat3, jac_left_so3, jac_left_so3_inv, log_so3
 from mechgen.runtime.rods.statics import Rod
 from mechgen.runtime.rods.ends import ENDS
@@ -87,13 +88,17 @@ def element_library():
     from mechgen.errors import BuildError, CompilerUnavailable
 
     try:
-        lib = load_shared(SOURCE.read_text(encoding="utf-8"), stem="mgrod", ldflags=("-lm",), symbols=("mgr_internal",))
+        lib = load_shared(SOURCE.read_text(encoding="utf-8"), stem="mgrod", ldflags=("-lm",),
+                          symbols=("mgr_internal", "mgr_residual", "mgr_record", "mgr_layout"))
     except (CompilerUnavailable, BuildError, OSError) as exc:
         log.info("C rod elements unavailable (%s): numpy forces", exc)
         return None
     c_long, c_double, c_void_p = ctypes.c_long, ctypes.c_double, ctypes.c_void_p
     lib.mgr_internal.argtypes = [c_long, c_long, c_double, c_double] + [c_void_p] * 9
     lib.mgr_internal.restype = ctypes.c_int
+    if not compiled_step.declare(lib):
+        log.info("rod_elements.c's mgr_step differs from its Python mirror: numpy forces")
+        return None
     return lib
 
 
@@ -210,11 +215,11 @@ class Discrete:
         if rod.load is not None and rod.load_uniform:
             uniform = np.asarray(rod.load(np.zeros((1, 3))), dtype=float).reshape(6) * wts[:, None]
             torque = uniform[:, 3:] if np.any(uniform[:, 3:]) else None
-        object.__setattr__(self, "_uniform_load", uniform)
+        object.__setattr__(self, "uniform_load", uniform)
         object.__setattr__(self, "_uniform_torque", torque)
         body = self.body
         unit = np.concatenate([np.full(3, body.rhoA * h), np.full(3, float(np.max(np.diag(body.J_rho))) * h)])
-        object.__setattr__(self, "_fixed_unit", unit / body.alpha)
+        object.__setattr__(self, "fixed_unit", unit / body.alpha)
 
     # ------------------------------------------------------------------ energy and forces
     # Every array below may carry leading batch axes (..., n, 3): the finite-difference Jacobian evaluates
@@ -282,8 +287,8 @@ class Discrete:
         rod = self.body.rod
         F = np.zeros_like(x)
         Mb = np.zeros_like(x)
-        if self._uniform_load is not None:
-            F += self._uniform_load[:, :3]
+        if self.uniform_load is not None:
+            F += self.uniform_load[:, :3]
             if self._uniform_torque is not None:
                 Mb += _mtv(R, self._uniform_torque)
         elif rod.load is not None:
@@ -296,6 +301,23 @@ class Discrete:
             Mb[..., -1, :] += _mtv(R[..., -1, :, :], rod.tip_torque)
         return F, Mb
 
+    def saved_point(self, st: State, axis: np.ndarray, *, compiled: bool = True) -> tuple[float, float]:
+        """(T + V, the turning angle about the unit ``axis``) of a state to be saved (J, rad): one C call
+        (rod_elements.c's mgr_record) when a compiler is there, else :meth:`kinetic_energy`,
+        :meth:`elastic_energy` and statics.turning_angle."""
+        lib = element_library() if compiled else None
+        if lib is None:
+            from mechgen.runtime.rods.statics import turning_angle
+
+            H = np.zeros((len(st.x), 4, 4))
+            H[:, :3, :3], H[:, :3, 3] = st.R, st.x
+            return (self.kinetic_energy(st.v, st.w) + self.elastic_energy(st.x, st.R), turning_angle(H, axis))
+        rec = self._evaluators.get("record")
+        if rec is None:
+            rec = self._evaluators["record"] = compiled_step.Recorder(self, lib)
+        V, T, turn = rec(st, axis)
+        return T + V, turn
+
     def kinetic_energy(self, v: np.ndarray, w: np.ndarray) -> float:
         """T = sum_i m_i |v_i|^2/2 + w_i^T J_i w_i/2 (J)."""
         J = self.body.J_rho
@@ -303,8 +325,31 @@ class Discrete:
                                                   + np.einsum("ni,ij,nj->n", w, J, w))))
 
     # ------------------------------------------------------------------ the midpoint step
-    def residual(self, st: State, z: np.ndarray, dt: float):
-        """Midpoint equations at increments z = (dx, theta) (..., n, 6); also the external wrench there."""
+    def residual(self, st: State, z: np.ndarray, dt: float, *, compiled: bool = True):
+        """Midpoint equations at increments z = (dx, theta) (..., n, 6); also the external wrench there: in one
+        C call (rod_elements.c's mgr_residual, mechgen.runtime.rods.compiled) when a compiler is there, else
+        numpy (:meth:`residual_numpy`, the reference)."""
+        lib = element_library() if compiled else None
+        if lib is None:
+            return self.residual_numpy(st, z, dt)
+        n = self.elements + 1
+        lead = z.shape[:-2]
+        batch = int(np.prod(lead)) if lead else 1
+        step = self._evaluators.get(("residual", batch))
+        if step is None:
+            step = self._evaluators[("residual", batch)] = compiled_step.StepResidual(self, lib, batch)
+        load = None
+        rod = self.body.rod
+        if rod.load is not None and self.uniform_load is None:
+            xa = st.x + self.body.alpha * z[..., :3]
+            load = np.asarray(rod.load(xa.reshape(-1, 3)), dtype=float).reshape(xa.shape[:-1] + (6,))
+            load = load * self.weights[:, None]
+        r, Fx, Mx = step(st, z, dt, load)
+        return r.reshape(z.shape), Fx.reshape(lead + (n, 3)), Mx.reshape(lead + (n, 3))
+
+    def residual_numpy(self, st: State, z: np.ndarray, dt: float):
+        """:meth:`residual` in numpy: the element forces by :meth:`weighted_internal` (itself in C where it can),
+        the loads by :meth:`external`, the rows (the midpoint equations of the module doc) in numpy."""
         dx, th = z[..., :3], z[..., 3:]
         al = self.body.alpha
         xm, Rm, F, Mb = self.weighted_internal(st, z)
@@ -321,7 +366,7 @@ class Discrete:
 
     def _fixed_scale(self, dt: float) -> np.ndarray:
         """Rows of fixed degrees of freedom: z itself, scaled like the inertia rows (m / (alpha dt^2))."""
-        return self._fixed_unit / dt**2
+        return self.fixed_unit / dt**2
 
     def _band_pattern(self):
         """Index arrays of the colour-grouped finite differences: perturbation b = 6 colour + k moves unknown k
@@ -564,22 +609,20 @@ def simulate(disc: Discrete, state: State, *, dt: float, t_end: float, save_ever
     ``jacobian``: the step Jacobian by AD (``ad``) or finite differences (``fd``), :meth:`Discrete.jacobian_band`."""
     if jacobian not in ("ad", "fd"):
         raise ValueError(f"unknown Jacobian method {jacobian!r}: ad or fd")
-    from mechgen.runtime.rods.statics import turning_angle
-
     steps = max(int(np.ceil(t_end / dt - 1e-9)), 0)
     solver = _Solver(disc, tol, max_iter, jacobian)
     out = Trajectory()
     st = state.copy()
     work = 0.0
     axis = np.asarray(axis, dtype=float)
+    axis = axis / np.linalg.norm(axis)
 
     def record(t: float, saves: int):
         out.t.append(t)
         out.tip.append(st.x[-1].copy())
-        H = np.zeros((len(st.x), 4, 4))
-        H[:, :3, :3], H[:, :3, 3] = st.R, st.x
-        out.tip_rotation.append(turning_angle(H, axis))
-        out.energy.append(disc.kinetic_energy(st.v, st.w) + disc.elastic_energy(st.x, st.R))
+        energy, turn = disc.saved_point(st, axis)
+        out.tip_rotation.append(turn)
+        out.energy.append(energy)
         out.work.append(work)
         if shape_every and saves % shape_every == 0:
             out.shapes.append(st.x.copy())

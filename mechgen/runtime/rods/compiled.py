@@ -1,0 +1,113 @@
+"""The rod's midpoint-step residual and a saved point's energies in one compiled call each.
+
+``runtime/csrc/rod_elements.c``'s ``mgr_residual`` evaluates the whole of
+:meth:`mechgen.runtime.rods.dynamics.Discrete.residual` (the weighted configuration x + alpha dx, R exp(alpha
+theta), the element forces, the lumped loads and dead tip wrench, the inertial, gyroscopic and damping rows and
+the fixed rows) for a batch of increments; ``mgr_record`` the elastic and kinetic energies and the turning
+angle of a saved state. :class:`StepResidual` holds the buffers and the filled ``mgr_step`` structure of one
+rod and batch size, made once: a call copies the state and the increments in, makes one ctypes call and copies
+the residual and the external wrench out (the caller keeps them across later calls). The numpy path of
+dynamics.Discrete stays the reference and the fallback without a compiler; a load that depends on the
+position is evaluated in Python at x + alpha dx (it is a Python callable) and handed over lumped.
+"""
+from __future__ import annotations
+
+import ctypes
+from ctypes import c_double, c_long, c_void_p
+
+import numpy as np
+
+
+class CStep(ctypes.Structure):
+    """The Python mirror of rod_elements.c's mgr_step (field for field)."""
+
+    _fields_ = [("n", c_long), ("batch", c_long), ("load_stride", c_long),
+                ("h", c_double), ("alpha", c_double), ("dt", c_double), ("rhoA", c_double), ("damping", c_double),
+                ("K", c_void_p), ("f0", c_void_p), ("J", c_void_p), ("weights", c_void_p), ("fixed_unit", c_void_p),
+                ("fixed", c_void_p), ("x", c_void_p), ("R", c_void_p), ("v", c_void_p), ("w", c_void_p),
+                ("z", c_void_p), ("load", c_void_p), ("tip", c_void_p),
+                ("xm", c_void_p), ("Rm", c_void_p), ("F", c_void_p), ("Mb", c_void_p),
+                ("r", c_void_p), ("Fx", c_void_p), ("Mx", c_void_p)]
+
+
+def declare(lib) -> bool:
+    """Set the argument types of mgr_residual and mgr_record on ``lib``; False when the C structure's size
+    differs from :class:`CStep` (then the numpy path runs)."""
+    lib.mgr_layout.argtypes, lib.mgr_layout.restype = [], c_long
+    if lib.mgr_layout() != ctypes.sizeof(CStep):
+        return False
+    lib.mgr_residual.argtypes, lib.mgr_residual.restype = [ctypes.POINTER(CStep)], ctypes.c_int
+    lib.mgr_record.argtypes = [c_long, c_double, c_double] + [c_void_p] * 10
+    lib.mgr_record.restype = ctypes.c_int
+    return True
+
+
+class StepResidual:
+    """mgr_residual on the buffers of one rod (``disc``: a dynamics.Discrete) and ``batch`` increments."""
+
+    def __init__(self, disc, lib, batch: int) -> None:
+        body, rod = disc.body, disc.body.rod
+        n = disc.elements + 1
+        self.lib, self.n, self.batch = lib, n, batch
+        keep = self.keep = {
+            "K": np.ascontiguousarray(rod.K, dtype=float), "f0": np.ascontiguousarray(rod.f0, dtype=float),
+            "J": np.ascontiguousarray(body.J_rho, dtype=float),
+            "weights": np.ascontiguousarray(disc.weights, dtype=float),
+            "fixed_unit": np.ascontiguousarray(disc.fixed_unit, dtype=float),
+            "fixed": np.ascontiguousarray(disc.fixed, dtype=float),
+            "tip": np.concatenate([rod.tip_force, rod.tip_torque]).astype(float),
+            "x": np.zeros((n, 3)), "R": np.zeros((n, 3, 3)), "v": np.zeros((n, 3)), "w": np.zeros((n, 3)),
+            "z": np.zeros((batch, n, 6)), "xm": np.zeros((batch, n, 3)), "Rm": np.zeros((batch, n, 3, 3)),
+            "F": np.zeros((batch, n, 3)), "Mb": np.zeros((batch, n, 3)), "r": np.zeros((batch, n, 6)),
+            "Fx": np.zeros((batch, n, 3)), "Mx": np.zeros((batch, n, 3)), "load": np.zeros((batch, n, 6))}
+        s = self.s = CStep(n=n, batch=batch, load_stride=6 * n, h=disc.h, alpha=body.alpha, dt=1.0,
+                           rhoA=body.rhoA, damping=body.damping)
+        for name, array in keep.items():
+            setattr(s, name, array.ctypes.data)
+        self.uniform = disc.uniform_load
+        if self.uniform is not None:
+            keep["uniform"] = np.ascontiguousarray(self.uniform, dtype=float)
+            s.load, s.load_stride = keep["uniform"].ctypes.data, 0
+        elif rod.load is None:
+            s.load = None
+        self.ref = ctypes.byref(s)
+
+    def __call__(self, st, z: np.ndarray, dt: float, load: np.ndarray | None = None):
+        """(r (batch, n, 6), Fx, Mx (batch, n, 3)), fresh arrays, at increments z (batch, n, 6) from state ``st``
+        over dt (s); ``load``: the lumped position-dependent load at x + alpha dx (batch, n, 6), when there is one."""
+        k = self.keep
+        np.copyto(k["x"], st.x)
+        np.copyto(k["R"], st.R)
+        np.copyto(k["v"], st.v)
+        np.copyto(k["w"], st.w)
+        np.copyto(k["z"], z)
+        if load is not None:
+            np.copyto(k["load"], load)
+        self.s.dt = dt
+        self.lib.mgr_residual(self.ref)
+        return k["r"].copy(), k["Fx"].copy(), k["Mx"].copy()
+
+
+class Recorder:
+    """mgr_record on buffers of one rod (``disc``: a dynamics.Discrete), made once."""
+
+    def __init__(self, disc, lib) -> None:
+        body, rod = disc.body, disc.body.rod
+        n = disc.elements + 1
+        self.lib, self.n, self.h, self.rhoA = lib, n, disc.h, body.rhoA
+        self.x, self.R, self.v, self.w = np.zeros((n, 3)), np.zeros((n, 3, 3)), np.zeros((n, 3)), np.zeros((n, 3))
+        self.axis, self.out = np.zeros(3), np.zeros(3)
+        self.keep = [np.ascontiguousarray(a, dtype=float) for a in (rod.K, rod.f0, body.J_rho, disc.weights)]
+        self.pointers = [a.ctypes.data for a in (*self.keep, self.axis, self.x, self.R, self.v, self.w, self.out)]
+
+    def __call__(self, st, axis: np.ndarray) -> tuple[float, float, float]:
+        """(V, T, turning) of state ``st``: the elastic energy sum_e h/2 (f_e - f0)^T K (f_e - f0) and the kinetic
+        energy sum_i w_i (rhoA |v_i|^2 + w_i^T J w_i)/2 (J), the turning angle about the unit ``axis`` (rad;
+        statics.turning_angle: sum_e axis . R_e0 log(R_e0^T R_e1))."""
+        for buf, a in ((self.x, st.x), (self.R, st.R), (self.v, st.v), (self.w, st.w), (self.axis, axis)):
+            np.copyto(buf, a)
+        self.lib.mgr_record(self.n, self.h, self.rhoA, *self.pointers)
+        return float(self.out[0]), float(self.out[1]), float(self.out[2])
+
+
+__all__ = ["CStep", "StepResidual", "declare", "Recorder"]
