@@ -20,12 +20,32 @@
 
 static double fact(int n) { double f = 1.0; for (int i = 2; i <= n; ++i) f *= i; return f; }
 
-/* sum_m (-1)^m t^(2m) / (2m + k)!  (k = 1: sin t/t, 2: (1 - cos t)/t^2, 3: (t - sin t)/t^3) */
-static double series(double t, int k) {
+/* the series' coefficients, made once: COEF[k - 1][m] = (-1)^m / (2m + k)! (k = 1, 2, 3) and
+ * COEF[3][n] = |B_2n| / (2n + 2)! (the same values the loops computed at every call before: equal results) */
+static double COEF[4][TERMS];
+static volatile int coef_ready = 0;
+
+static void coefficients(void) {
+    static const double B[TERMS] = {1.0 / 6, 1.0 / 30, 1.0 / 42, 1.0 / 30, 5.0 / 66, 691.0 / 2730, 7.0 / 6,
+                                    3617.0 / 510, 43867.0 / 798, 174611.0 / 330, 854513.0 / 138,
+                                    236364091.0 / 2730};
+    for (int m = 0; m < TERMS; ++m) {
+        for (int k = 1; k <= 3; ++k) COEF[k - 1][m] = ((m % 2) ? -1.0 : 1.0) / fact(2 * m + k);
+        COEF[3][m] = B[m] / fact(2 * m + 2);
+    }
+    coef_ready = 1;   /* a second thread racing here writes the same values */
+}
+
+/* sum_m c_m t^(2m) by Horner with the coefficient row `row` */
+static double horner(double t, int row) {
+    if (!coef_ready) coefficients();
     double t2 = t * t, acc = 0.0;
-    for (int m = TERMS - 1; m >= 0; --m) acc = acc * t2 + ((m % 2) ? -1.0 : 1.0) / fact(2 * m + k);
+    for (int m = TERMS - 1; m >= 0; --m) acc = acc * t2 + COEF[row][m];
     return acc;
 }
+
+/* sum_m (-1)^m t^(2m) / (2m + k)!  (k = 1: sin t/t, 2: (1 - cos t)/t^2, 3: (t - sin t)/t^3) */
+static double series(double t, int k) { return horner(t, k - 1); }
 
 static double sinc_(double t) { return t < 1.0 ? series(t, 1) : sin(t) / t; }
 static double a1_(double t) { return t < 1.0 ? series(t, 2) : (1.0 - cos(t)) / (t * t); }
@@ -33,13 +53,8 @@ static double a2_(double t) { return t < 1.0 ? series(t, 3) : (t - sin(t)) / (t 
 
 /* (1 - (t/2) cot(t/2))/t^2 = sum_n |B_2n| t^(2n-2)/(2n)! below 1 rad */
 static double binv_(double t) {
-    static const double B[TERMS] = {1.0 / 6, 1.0 / 30, 1.0 / 42, 1.0 / 30, 5.0 / 66, 691.0 / 2730, 7.0 / 6,
-                                    3617.0 / 510, 43867.0 / 798, 174611.0 / 330, 854513.0 / 138,
-                                    236364091.0 / 2730};
     if (t >= 1.0) return (1.0 - t * sin(t) / (2.0 * (1.0 - cos(t)))) / (t * t);
-    double t2 = t * t, acc = 0.0;
-    for (int n = TERMS - 1; n >= 0; --n) acc = acc * t2 + B[n] / fact(2 * n + 2);
-    return acc;
+    return horner(t, 3);
 }
 
 static double norm3(const double *w) { return sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]); }
