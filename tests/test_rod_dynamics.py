@@ -340,8 +340,9 @@ def test_compiled_step_residual_matches_the_numpy_reference(ends, load, uniform,
     the same operations in another order, so equal to round-off (1e-12 of the largest entry: a few hundred ulps
     of sums of terms up to that size); at random states with a near-pi relative rotation, fixed and free ends,
     a tip wrench, damping, a uniform load (force and torque) or a position-dependent one, alpha 1/2 .. 1; single
-    and batched increments; and the saved point's energies and turning angle against the numpy ones."""
-    from mechgen.runtime.rods import dynamics
+    and batched increments; the saved point's energies and turning angle, and the step's rotations, against
+    the numpy ones."""
+    from mechgen.runtime.rods import compiled, dynamics
 
     loads = {None: None,
              "gravity": lambda r: np.tile([0.0, -9.81, 0.0, 0.0, 0.0, 0.0], (len(r), 1)),
@@ -366,3 +367,7 @@ def test_compiled_step_residual_matches_the_numpy_reference(ends, load, uniform,
     energy, turn = d.saved_point(st, np.array([0.0, 0.6, 0.8]))
     e_ref, t_ref = d.saved_point(st, np.array([0.0, 0.6, 0.8]), compiled=False)
     assert abs(energy - e_ref) <= 1e-13 * abs(e_ref) and abs(turn - t_ref) <= 1e-13 * max(abs(t_ref), 1.0)
+    # the step's new rotations R exp(theta) (mgr_rotate), angles from 0 over the series' 1 rad switch to 3
+    theta = rng.normal(size=(9, 3)) * np.linspace(0.0, 3.0, 9)[:, None] / np.sqrt(3.0)
+    rotated = compiled.rotate(dynamics.element_library(), st.R, theta)
+    assert np.max(np.abs(rotated - st.R @ exp_so3(theta))) <= 1e-14      # entries of size <= 1: ulps

@@ -278,3 +278,13 @@ int mgr_record(long n, double h, double rhoA, const double *K, const double *f0,
     out[2] = turn;
     return 0;
 }
+
+/* out_i = R_i exp(hat theta_i), i < n: the rotations after a step's increments (dynamics.advance) */
+int mgr_rotate(long n, const double *R, const double *theta, double *out) {
+    for (long i = 0; i < n; ++i) {
+        double E[9];
+        exp3(theta + 3 * i, E);
+        matmul(R + 9 * i, E, out + 9 * i);
+    }
+    return 0;
+}

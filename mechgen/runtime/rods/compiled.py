@@ -31,7 +31,7 @@ class CStep(ctypes.Structure):
 
 
 def declare(lib) -> bool:
-    """Set the argument types of mgr_residual and mgr_record on ``lib``; False when the C structure's size
+    """Set the argument types of mgr_residual, mgr_record and mgr_rotate on ``lib``; False when the C structure's size
     differs from :class:`CStep` (then the numpy path runs)."""
     lib.mgr_layout.argtypes, lib.mgr_layout.restype = [], c_long
     if lib.mgr_layout() != ctypes.sizeof(CStep):
@@ -39,6 +39,7 @@ def declare(lib) -> bool:
     lib.mgr_residual.argtypes, lib.mgr_residual.restype = [ctypes.POINTER(CStep)], ctypes.c_int
     lib.mgr_record.argtypes = [c_long, c_double, c_double] + [c_void_p] * 10
     lib.mgr_record.restype = ctypes.c_int
+    lib.mgr_rotate.argtypes, lib.mgr_rotate.restype = [c_long] + [c_void_p] * 3, ctypes.c_int
     return True
 
 
@@ -110,4 +111,13 @@ class Recorder:
         return float(self.out[0]), float(self.out[1]), float(self.out[2])
 
 
-__all__ = ["CStep", "StepResidual", "declare", "Recorder"]
+def rotate(lib, R: np.ndarray, theta: np.ndarray) -> np.ndarray:
+    """R_i exp(hat theta_i) (n, 3, 3) by mgr_rotate, for rotations R (n, 3, 3) and rotation vectors theta (n, 3)."""
+    R = np.ascontiguousarray(R, dtype=float)
+    theta = np.ascontiguousarray(theta, dtype=float)
+    out = np.empty_like(R)
+    lib.mgr_rotate(len(R), R.ctypes.data, theta.ctypes.data, out.ctypes.data)
+    return out
+
+
+__all__ = ["CStep", "StepResidual", "declare", "Recorder", "rotate"]

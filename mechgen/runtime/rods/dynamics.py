@@ -89,7 +89,7 @@ def element_library():
 
     try:
         lib = load_shared(SOURCE.read_text(encoding="utf-8"), stem="mgrod", ldflags=("-lm",),
-                          symbols=("mgr_internal", "mgr_residual", "mgr_record", "mgr_layout"))
+                          symbols=("mgr_internal", "mgr_residual", "mgr_record", "mgr_rotate", "mgr_layout"))
     except (CompilerUnavailable, BuildError, OSError) as exc:
         log.info("C rod elements unavailable (%s): numpy forces", exc)
         return None
@@ -597,7 +597,9 @@ def advance(disc: Discrete, st: State, z: np.ndarray, dt: float, Fx, Mx) -> tupl
         work -= c * float(np.sum(m * np.sum(vm * dx, axis=1))
                           + np.sum(disc.weights * np.einsum("ni,ij,nj->n", th, disc.body.J_rho, wm)))
     al = disc.body.alpha
-    new = State(st.x + dx, st.R @ exp_so3(th), (vm - (1.0 - al) * st.v) / al, (wm - (1.0 - al) * st.w) / al)
+    lib = element_library()
+    R = st.R @ exp_so3(th) if lib is None else compiled_step.rotate(lib, st.R, th)
+    new = State(st.x + dx, R, (vm - (1.0 - al) * st.v) / al, (wm - (1.0 - al) * st.w) / al)
     return new, work
 
 
