@@ -64,10 +64,10 @@ ELEMENT_BYTES = 32_000
 
 MAX_STEPS = 10_000_000
 #: wall time per element of one Newton solve of a midpoint step (residual, banded solve; the Jacobian is refreshed
-#: now and then), seconds: measured 2.85 us per element and solve on a 2-core machine (issue 33:
-#: scenes/rod_dynamics.toml at 2 000 elements, 40 steps, 205 solves in 1.17 s; 14.6-15.5 us per element and step
-#: at 2 000-8 000 elements, about 5 solves a step)
-SOLVE_SECONDS = 2.8e-6
+#: now and then), seconds: measured 1.27 us per element and solve on a 2-core machine (issue 30, the residual in
+#: one C call: scenes/rod_dynamics.toml at 2 000 elements, 40 steps, 198 solves and 25 Jacobians in 0.50 s;
+#: 2.85 us, then 1.9 us, before)
+SOLVE_SECONDS = 1.2e-6
 
 
 _elements = bounded(1, MAX_ELEMENTS)

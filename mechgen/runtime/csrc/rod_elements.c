@@ -12,6 +12,11 @@
  *
  * writing xm (batch, n, 3), Rm (batch, n, 3, 3), F and Mb (batch, n, 3): spatial forces (N) and body moments
  * (N m), minus the exact gradient of V = sum_e h/2 (f_e - f0)^T K (f_e - f0). Row-major 3 x 3 matrices.
+ *
+ * mgr_residual: the whole step residual of Discrete.residual in one call (the element forces above, the lumped
+ * loads and dead tip wrench, the inertial, gyroscopic, damping and fixed rows; the structure mgr_step is
+ * mirrored by mechgen/runtime/rods/compiled.py). mgr_record: a saved state's elastic and kinetic energies and
+ * turning angle. mgr_rotate: a step's new rotations R exp(theta). numpy (dynamics.py) is their reference.
  */
 #include <math.h>
 #include <string.h>
