@@ -223,6 +223,9 @@ class Discrete:
             uniform = np.asarray(rod.load(np.zeros((1, 3))), dtype=float).reshape(6) * wts[:, None]
             torque = uniform[:, 3:] if np.any(uniform[:, 3:]) else None
         object.__setattr__(self, "uniform_load", uniform)
+        if uniform is not None:                           # the band Jacobian's g(x) (per length) and dg/dx = 0
+            g = np.asarray(rod.load(np.zeros((1, 3))), dtype=float).reshape(6)
+            object.__setattr__(self, "_uniform_gradient", (np.tile(g, (n, 1)), np.zeros((n, 6, 3))))
         object.__setattr__(self, "_uniform_torque", torque)
         body = self.body
         unit = np.concatenate([np.full(3, body.rhoA * h), np.full(3, float(np.max(np.diag(body.J_rho))) * h)])
@@ -425,7 +428,10 @@ class Discrete:
         Je = -self._batched("dynamics_element", n - 1)(np.concatenate([nodes[:-1], nodes[1:]], axis=1),
                                                          par).reshape(n - 1, 12, 12)
         xa = st.x + al * z[:, :3]
-        g0, G = load_and_gradient(rod, xa)
+        if self.uniform_load is not None:              # the same value everywhere, no gradient: made once
+            g0, G = self._uniform_gradient
+        else:
+            g0, G = load_and_gradient(rod, xa)
         tip = np.zeros((n, 6))
         tip[-1] = np.concatenate([rod.tip_force, rod.tip_torque])
         data = np.concatenate([R, st.v, st.w, z, self.weights[:, None], g0, G.reshape(n, 18), xa, tip, st.x], axis=1)
