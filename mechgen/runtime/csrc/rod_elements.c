@@ -293,3 +293,30 @@ int mgr_rotate(long n, const double *R, const double *theta, double *out) {
     }
     return 0;
 }
+
+/* dz = -A^-1 r with LAPACK dgbtrf's band LU of A (column-major, ldab = 2 kl + ku + 1, 0-based pivots), the
+ * operations of LAPACK's dgbtrs (no transpose: row swaps and L's columns, then U by columns as dtbsv); returns
+ * max_i |dz_i| / scale_i (the Newton correction's size in units of L and rad). */
+double mgr_band_solve(long n, long kl, long ku, const double *ab, const int *ipiv, const double *r,
+                      const double *scale, double *dz) {
+    long ld = 2 * kl + ku + 1, kd = kl + ku, k = kl + ku;
+    for (long i = 0; i < n; ++i) dz[i] = -r[i];
+    for (long j = 0; j + 1 < n; ++j) {
+        long lm = kl < n - j - 1 ? kl : n - j - 1, l = ipiv[j];
+        if (l != j) { double t = dz[l]; dz[l] = dz[j]; dz[j] = t; }
+        for (long i = 1; i <= lm; ++i) dz[j + i] -= ab[ld * j + kd + i] * dz[j];
+    }
+    for (long j = n - 1; j >= 0; --j) {
+        if (dz[j] == 0.0) continue;
+        dz[j] /= ab[ld * j + k];
+        double t = dz[j];
+        long lo = j - k > 0 ? j - k : 0;
+        for (long i = j - 1; i >= lo; --i) dz[i] -= t * ab[ld * j + k + i - j];
+    }
+    double size = 0.0;
+    for (long i = 0; i < n; ++i) {
+        double a = fabs(dz[i]) / scale[i];
+        if (!(a <= size)) size = a;            /* a NaN propagates */
+    }
+    return size;
+}

@@ -40,6 +40,7 @@ def declare(lib) -> bool:
     lib.mgr_record.argtypes = [c_long, c_double, c_double] + [c_void_p] * 10
     lib.mgr_record.restype = ctypes.c_int
     lib.mgr_rotate.argtypes, lib.mgr_rotate.restype = [c_long] + [c_void_p] * 3, ctypes.c_int
+    lib.mgr_band_solve.argtypes, lib.mgr_band_solve.restype = [c_long] * 3 + [c_void_p] * 5, c_double
     return True
 
 
@@ -111,6 +112,30 @@ class Recorder:
         return float(self.out[0]), float(self.out[1]), float(self.out[2])
 
 
+class BandSolve:
+    """dz = -J^-1 r and max |dz_i| / scale_i in one call (mgr_band_solve) with LAPACK dgbtrf's band factors of J."""
+
+    def __init__(self, lib, lu: np.ndarray, piv: np.ndarray, band: int, scale: np.ndarray) -> None:
+        self.lib, self.lu, self.piv, self.band = lib, lu, piv, band
+        self.scale = np.ascontiguousarray(scale, dtype=float)
+        self.r, self.dz = np.zeros(lu.shape[1]), np.zeros(lu.shape[1])
+        self.args = (lu.shape[1], band, band, lu.ctypes.data, piv.ctypes.data, self.r.ctypes.data,
+                     self.scale.ctypes.data, self.dz.ctypes.data)
+
+    @classmethod
+    def of(cls, lib, lu: np.ndarray, piv: np.ndarray, band: int, scale: np.ndarray) -> "BandSolve | None":
+        """The solver on these factors, or None where their layout is not LAPACK's (column-major lu of 3 band + 1
+        rows, 32-bit pivots): then scipy's dgbtrs runs."""
+        if lu.flags.f_contiguous and lu.shape[0] == 3 * band + 1 and piv.dtype == np.int32 and piv.flags.c_contiguous:
+            return cls(lib, lu, piv, band, scale)
+        return None
+
+    def __call__(self, r: np.ndarray) -> tuple[np.ndarray, float]:
+        np.copyto(self.r, r.reshape(-1))
+        size = self.lib.mgr_band_solve(*self.args)
+        return self.dz.copy(), float(size)
+
+
 def rotate(lib, R: np.ndarray, theta: np.ndarray) -> np.ndarray:
     """R_i exp(hat theta_i) (n, 3, 3) by mgr_rotate, for rotations R (n, 3, 3) and rotation vectors theta (n, 3)."""
     R = np.ascontiguousarray(R, dtype=float)
@@ -120,4 +145,4 @@ def rotate(lib, R: np.ndarray, theta: np.ndarray) -> np.ndarray:
     return out
 
 
-__all__ = ["CStep", "StepResidual", "declare", "Recorder", "rotate"]
+__all__ = ["BandSolve", "CStep", "StepResidual", "declare", "Recorder", "rotate"]

@@ -96,7 +96,8 @@ def element_library():
 
     try:
         lib = load_shared(SOURCE.read_text(encoding="utf-8"), stem="mgrod", ldflags=("-lm",),
-                          symbols=("mgr_internal", "mgr_residual", "mgr_record", "mgr_rotate", "mgr_layout"))
+                          symbols=("mgr_internal", "mgr_residual", "mgr_record", "mgr_rotate", "mgr_band_solve",
+                                   "mgr_layout"))
     except (CompilerUnavailable, BuildError, OSError) as exc:
         log.info("C rod elements unavailable (%s): numpy forces", exc)
         return None
@@ -502,6 +503,7 @@ class _Solver:
     def __init__(self, disc: Discrete, tol: float, max_iter: int, jacobian: str = "ad"):
         self.disc, self.tol, self.max_iter, self.jacobian = disc, tol, max_iter, jacobian
         self.lu = None
+        self.band = None                                 # the compiled solve with the factors (_factor)
         self.dt = None
         self.iterations = 0
         self.jacobians = 0
@@ -516,10 +518,18 @@ class _Solver:
             raise ConvergenceError(f"the rod's step Jacobian is singular (LAPACK dgbtrf info {info})")
         self.lu, self.piv, self.dt = lu, piv, dt
         self.jacobians += 1
+        lib = element_library()
+        self.band = None if lib is None else compiled_step.BandSolve.of(lib, lu, piv, BAND, self.scale)
 
-    def _solve(self, r: np.ndarray) -> np.ndarray:
+    def _solve(self, r: np.ndarray) -> tuple[np.ndarray, float]:
+        """The correction dz = -J^-1 r (shaped like r) and its size max |dz_i| / scale_i (units of L and rad): in
+        one C call (rod_elements.c's mgr_band_solve, LAPACK dgbtrs' operations) where the library is there."""
         self.iterations += 1
-        return lapack.dgbtrs(self.lu, BAND, BAND, -r.ravel(), self.piv)[0].reshape(r.shape)
+        if self.band is not None:
+            dz, size = self.band(r)
+            return dz.reshape(r.shape), size
+        dz = lapack.dgbtrs(self.lu, BAND, BAND, -r.ravel(), self.piv)[0].reshape(r.shape)
+        return dz, self._norm(dz)
 
     def _norm(self, dz: np.ndarray) -> float:
         return float(np.max(np.abs(dz.ravel()) / self.scale))
@@ -550,8 +560,7 @@ class _Solver:
         here = self.lu is None or self.dt != dt          # J taken at the current iterate z
         if here:
             self._factor(st, z, dt, r)
-        dz = self._solve(r)
-        size = self._norm(dz)
+        dz, size = self._solve(r)
         if not np.isfinite(size):
             self.lu = None
             return None
@@ -564,8 +573,7 @@ class _Solver:
                     break
                 self._factor(st, z, dt, r)                 # a stale Jacobian: take it again here
                 here = True
-                dz = self._solve(r)
-                size = self._norm(dz)
+                dz, size = self._solve(r)
                 continue
             z, r, Fx, Mx, here = zt, rt, Fxt, Mxt, False
             rate = new / max(size, 1e-300)
@@ -576,8 +584,7 @@ class _Solver:
             if rate > REFRESH:
                 self._factor(st, z, dt, r)
                 here = True
-                dzt = self._solve(r)
-                new = self._norm(dzt)
+                dzt, new = self._solve(r)
             dz, size = dzt, new
         self.lu = None
         return None
@@ -590,8 +597,7 @@ class _Solver:
         while True:
             zt = z + lam * dz
             rt, Fxt, Mxt = self.disc.residual(st, zt, dt)
-            dzt = self._solve(rt)
-            new = self._norm(dzt)
+            dzt, new = self._solve(rt)
             if np.isfinite(new) and new <= (1.0 - lam / 4.0) * size:
                 return lam, zt, rt, Fxt, Mxt, dzt, new
             lam *= 0.5
