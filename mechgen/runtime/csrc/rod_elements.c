@@ -16,7 +16,8 @@
  * mgr_residual: the whole step residual of Discrete.residual in one call (the element forces above, the lumped
  * loads and dead tip wrench, the inertial, gyroscopic, damping and fixed rows; the structure mgr_step is
  * mirrored by mechgen/runtime/rods/compiled.py). mgr_record: a saved state's elastic and kinetic energies and
- * turning angle. mgr_rotate: a step's new rotations R exp(theta). numpy (dynamics.py) is their reference.
+ * turning angle. mgr_rotate: a step's new rotations R exp(theta). mgr_band_solve: a Newton correction from
+ * LAPACK's band factors. numpy and scipy (dynamics.py) are their reference.
  */
 #include <math.h>
 #include <string.h>

@@ -52,11 +52,12 @@ A step that does not converge even so is split in two, down to 2^-12 of dt, befo
 the time reached.
 
 Where a C compiler is there, a Newton iteration's whole residual (:meth:`Discrete.residual`: the weighted
-configuration, element forces, loads, inertial, gyroscopic, damping and fixed rows), a saved point's energies
-and turning angle (:meth:`Discrete.saved_point`) and a step's new rotations (:func:`advance`) are one ctypes call
-each into runtime/csrc/rod_elements.c on buffers made once per rod (mechgen.runtime.rods.compiled): about 10 us
-a residual at N = 40 against 45-55 us in numpy. The numpy path (:meth:`Discrete.residual_numpy`) is the reference
-they are tested against (equal to round-off) and runs without a compiler.
+configuration, element forces, loads, inertial, gyroscopic, damping and fixed rows), its correction from the
+band factors with its size (:meth:`_Solver._solve`), a saved point's energies and turning angle
+(:meth:`Discrete.saved_point`) and a step's new rotations (:func:`advance`) are one ctypes call each into
+runtime/csrc/rod_elements.c on buffers made once (mechgen.runtime.rods.compiled): about 11 us a residual at
+N = 40 against 45-55 us in numpy. The numpy path (:meth:`Discrete.residual_numpy`, scipy's dgbtrs) is the
+reference they are tested against (equal to round-off) and runs without a compiler.
 """
 from __future__ import annotations
 
