@@ -87,7 +87,7 @@ def element_library():
     from mechgen.errors import BuildError, CompilerUnavailable
 
     try:
-        lib = load_shared(SOURCE.read_text(encoding="utf-8"), stem="mgrod", ldflags=("-lm",), symbols=("mgr_internal",))
+        lib = load_shared(csrc.source(SOURCE), stem="mgrod", ldflags=("-lm",), symbols=("mgr_internal",))
     except (CompilerUnavailable, BuildError, OSError) as exc:
         log.info("C rod elements unavailable (%s): numpy forces", exc)
         return None
