@@ -226,7 +226,7 @@ def run_steady(system, options: dict, context: dict) -> dict:
             raise SceneError(f"steady method {options['method']!r} is for continua", key="method",
                              expected="'newton' for a lumped or chain model")
         return run_steady_bvp(system, options, context)
-    if system.is_field and system.info.get("boundary_values"):
+    if system.is_field and system.field_meta.boundary_values:
         raise SceneError(f"model {system.metadata.model} fixes its ends at nonzero values: its steady state is "
                          "a boundary value problem in s", key="method",
                          expected="method = 'collocation', 'shooting' or 'multiple_shooting'")
