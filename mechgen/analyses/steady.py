@@ -266,7 +266,7 @@ def _start_with_shape(system, bvp, options: dict, method: str):
     p = parameter_namespace(system, bvp.start)
     tol = options.get("tol", 1e-10)
     gave = []
-    from mechgen.symbolic.model import call_declared
+    from mechgen.symbolic.declared import call_declared
 
     for guess in call_declared(declared[name].start, value=float(value), s=L * sigma, p=p):
         u = np.array([np.broadcast_to(np.asarray(guess["u"][f], float), sigma.shape) for f in bvp.fields])
