@@ -177,7 +177,7 @@ def derive(model: Model, spec: Specialization):
 
         return derive_lattice(model, spec)
     if model.is_hybrid:
-        from mechgen.symbolic.hybrid import derive_hybrid
+        from mechgen.symbolic.hybrid_derive import derive_hybrid
 
         return derive_hybrid(model, spec)
     from mechgen.symbolic.derive import declared_lumped, derive_lumped

@@ -140,3 +140,16 @@ def test_an_indefinite_mass_takes_the_lu_branch():
     x = np.array([0.3, -0.2, 0.5, 0.1])
     assert np.allclose(system.rhs(0.0, x), python_rhs(system, 0.0, x), rtol=1e-13)
     assert np.allclose(system.jacobian(0.0, x), python_jacobian(system, 0.0, x), rtol=1e-12, atol=1e-14)
+
+
+def test_runtime_sources_inline_their_shared_header():
+    """point_rhs.c and radau_loop.c take LU and its solve from one header (runtime/csrc/dense_lu.h), inlined into
+    the text each library is built from; no source of the folder keeps an include of a local header."""
+    from mechgen.runtime import csrc
+
+    header = csrc.path("dense_lu.h").read_text(encoding="utf-8")
+    for name in ("point_rhs.c", "radau_loop.c"):
+        text = csrc.source(name)
+        assert header in text and '#include "dense_lu.h"' not in text and text.count("mg_lu_factor(long n") == 1
+    for path in csrc.FOLDER.glob("*.c"):
+        assert '#include "' not in csrc.source(path.name), path.name

@@ -73,7 +73,7 @@ def shape_values(system, bvp, result) -> dict:
         return {}
     s = np.linspace(0.0, bvp.length_of(result), SHAPE_SAMPLES)
     y = bvp.values(result, s)
-    from mechgen.symbolic.model import call_declared
+    from mechgen.symbolic.declared import call_declared
     from mechgen.symbolic.params import Namespace
 
     u = Namespace({**{f: y[i] for i, f in enumerate(bvp.fields)},

@@ -226,7 +226,7 @@ def run_steady(system, options: dict, context: dict) -> dict:
             raise SceneError(f"steady method {options['method']!r} is for continua", key="method",
                              expected="'newton' for a lumped or chain model")
         return run_steady_bvp(system, options, context)
-    if system.is_field and system.info.get("boundary_values"):
+    if system.is_field and system.field_meta.boundary_values:
         raise SceneError(f"model {system.metadata.model} fixes its ends at nonzero values: its steady state is "
                          "a boundary value problem in s", key="method",
                          expected="method = 'collocation', 'shooting' or 'multiple_shooting'")
@@ -266,7 +266,7 @@ def _start_with_shape(system, bvp, options: dict, method: str):
     p = parameter_namespace(system, bvp.start)
     tol = options.get("tol", 1e-10)
     gave = []
-    from mechgen.symbolic.model import call_declared
+    from mechgen.symbolic.declared import call_declared
 
     for guess in call_declared(declared[name].start, value=float(value), s=L * sigma, p=p):
         u = np.array([np.broadcast_to(np.asarray(guess["u"][f], float), sigma.shape) for f in bvp.fields])

@@ -92,7 +92,7 @@ def initial_kernel(eqs, kernels, cse: bool) -> list[KernelIR]:
 
 
 def lower_hybrid(model: Model, eqs, kernels, *, cse: bool = True) -> list[KernelIR]:
-    """The kernels of a hybrid model (mechgen.symbolic.hybrid.HybridEquations): each requested kernel per mode
+    """The kernels of a hybrid model (mechgen.symbolic.hybrid_derive.HybridEquations): each requested kernel per mode
     (``<kernel>__i``) and, with a residual or force, the guards of each mode and the resets; every kernel's
     meta holds the modes and guards (``meta["hybrid"]``)."""
     import sympy as sp

@@ -85,7 +85,7 @@ def operation_text(operation: Operation, dialect: str) -> str:
 
 def _constant_power(base: str, exponent: float, dialect: str) -> str:
     """base**exponent for a constant exponent: a bracketed product for small integers, sqrt for 1/2."""
-    if exponent == int(exponent) and 1 < abs(exponent) <= MAX_UNROLLED_POWER:
+    if math.isfinite(exponent) and exponent == int(exponent) and 1 < abs(exponent) <= MAX_UNROLLED_POWER:
         product = "*".join([base] * int(abs(exponent)))
         return f"({product})" if exponent > 0 else f"(1.0/({product}))"
     if exponent == -1:

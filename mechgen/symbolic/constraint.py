@@ -19,7 +19,8 @@ import sympy as sp
 from mechgen.errors import ModelError
 from mechgen.symbolic.derive import LumpedEquations
 from mechgen.symbolic.field import POSITION, Jets
-from mechgen.symbolic.model import Model, as_expr, call_declared
+from mechgen.symbolic.model import Model
+from mechgen.symbolic.declared import as_expr, call_declared
 from mechgen.symbolic.specialize import Specialization, param_namespace
 
 

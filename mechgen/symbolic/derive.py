@@ -21,7 +21,8 @@ from dataclasses import dataclass, field
 import sympy as sp
 
 from mechgen.errors import ModelError
-from mechgen.symbolic.model import Model, as_expr, call_declared
+from mechgen.symbolic.model import Model
+from mechgen.symbolic.declared import as_expr, call_declared
 from mechgen.symbolic.initial import initial_column
 from mechgen.symbolic.params import Namespace
 from mechgen.symbolic.rod import derive_rod

@@ -30,7 +30,8 @@ import sympy as sp
 
 from mechgen.errors import ModelError
 from mechgen.symbolic.derive import TIME, LumpedEquations, energy_powers, lagrange_residual
-from mechgen.symbolic.model import Model, as_expr, call_declared
+from mechgen.symbolic.model import Model
+from mechgen.symbolic.declared import as_expr, call_declared
 from mechgen.symbolic.names import jet_of
 from mechgen.symbolic.params import Namespace
 from mechgen.symbolic.specialize import Specialization, param_namespace

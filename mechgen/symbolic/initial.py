@@ -16,7 +16,7 @@ from mechgen.errors import ModelError
 def initial_column(model, p_ns, coordinates, internal_names) -> sp.Matrix | None:
     """The initial state of ``model`` as a column of 2n + m expressions of the parameters ``p_ns`` (the active
     ``coordinates``, then their velocities, then the internal variables); None when none is declared."""
-    from mechgen.symbolic.model import as_expr, call_declared
+    from mechgen.symbolic.declared import as_expr, call_declared
 
     fn = getattr(model, "initial_fn", None)
     if fn is None:

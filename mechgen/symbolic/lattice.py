@@ -15,7 +15,8 @@ from dataclasses import dataclass
 import sympy as sp
 
 from mechgen.errors import ModelError
-from mechgen.symbolic.model import Model, as_expr, call_declared
+from mechgen.symbolic.model import Model
+from mechgen.symbolic.declared import as_expr, call_declared
 from mechgen.symbolic.params import Namespace
 from mechgen.symbolic.specialize import Specialization, param_namespace
 

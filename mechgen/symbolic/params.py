@@ -119,7 +119,7 @@ class UnknownEntry(AttributeError, KeyError):
 
     An AttributeError (and, for ``ns["kk"]``, a KeyError) that knows the namespace, the
     name asked for and the names it holds, so that the caller of a declared function can
-    say which function asked for what (:func:`mechgen.symbolic.model.call_declared`).
+    say which function asked for what (:func:`mechgen.symbolic.declared.call_declared`).
     """
 
     def __init__(self, namespace: "Namespace", name: str) -> None:

@@ -30,8 +30,11 @@ import sympy as sp
 from mechgen.errors import ModelError
 from mechgen.symbolic.derive import TIME, LumpedEquations, energy_powers, lagrange_residual
 from mechgen.symbolic.field import density_expr
-from mechgen.symbolic.model import Model, call_declared
+from mechgen.symbolic.model import Model
+from mechgen.symbolic.declared import call_declared
 from mechgen.symbolic.params import Namespace
+from mechgen.symbolic.plane_domain import (BOUNDARIES, ELEMENTS, RIGID, SHAPES, Domain, PlaneSpec,  # noqa: F401
+                                           annulus, disk, plate_with_hole, rectangle, slit_plate)
 from mechgen.symbolic.specialize import Specialization, param_namespace
 
 X, Y = sp.Symbol("x", real=True), sp.Symbol("y", real=True)
@@ -40,72 +43,6 @@ NORMAL = (sp.Symbol("n_x", real=True), sp.Symbol("n_y", real=True))
 #: a plane jet's suffix after ``<field>_``: at most one space derivative (C0 Lagrange elements), then time
 PLANE_SUFFIX = re.compile(r"([xy]?)(t{0,2})\Z")
 ORDERS = ("", "x", "y")
-SHAPES = {"disk": ("R",), "annulus": ("a", "b"), "rectangle": ("width", "height"),
-          "slit_plate": ("W", "H", "a"), "plate_with_hole": ("W", "H", "r")}
-#: the named boundaries of each generated shape (mechgen.runtime.plane.mesh)
-BOUNDARIES = {"disk": ("outer",), "annulus": ("inner", "outer"), "rectangle": ("bottom", "right", "top", "left"),
-              "slit_plate": ("bottom", "right", "top", "left", "crack_upper", "crack_lower"),
-              "plate_with_hole": ("bottom", "right", "top", "left", "hole")}
-ELEMENTS = ("P1", "P2", "Q1", "Q2")
-#: the pseudo-boundary of ``fix("u", "rigid")``: pins that hold the rigid motions of a body loaded by
-#: self-equilibrated tractions alone (mechgen.runtime.plane.discretise.rigid_pins)
-RIGID = "rigid"
-
-
-@dataclass(frozen=True)
-class Domain:
-    """A generated plane domain: its shape and the model parameters that size it (by role)."""
-
-    shape: str
-    sizes: tuple[tuple[str, str], ...]
-
-    @property
-    def boundaries(self) -> tuple[str, ...]:
-        """The boundary names a mesh of this shape has."""
-        return BOUNDARIES[self.shape]
-
-
-def _domain(shape: str, names: tuple[str, ...]) -> Domain:
-    if not all(isinstance(n, str) for n in names):
-        raise ModelError(f"a {shape} domain is sized by parameter names, got {names!r}", key="domain",
-                         expected=f"{shape}({', '.join(repr(r) for r in SHAPES[shape])}) with names of parameters")
-    return Domain(shape, tuple(zip(SHAPES[shape], names)))
-
-
-def disk(R: str = "R") -> Domain:
-    """The disk ``x^2 + y^2 < R^2``; boundary ``outer``."""
-    return _domain("disk", (R,))
-
-
-def annulus(a: str = "a", b: str = "b") -> Domain:
-    """The annulus ``a^2 < x^2 + y^2 < b^2``; boundaries ``inner`` and ``outer``."""
-    return _domain("annulus", (a, b))
-
-
-def rectangle(width: str = "Lx", height: str = "Ly") -> Domain:
-    """The rectangle [0, width] x [0, height]; boundaries ``bottom``, ``right``, ``top``, ``left``."""
-    return _domain("rectangle", (width, height))
-
-
-def slit_plate(W: str = "W", H: str = "H", a: str = "a") -> Domain:
-    """The plate [-W, W] x [-H, H] with a slit crack ``|x| < a`` on y = 0: the sides and ``crack_upper``/``crack_lower``."""
-    return _domain("slit_plate", (W, H, a))
-
-
-def plate_with_hole(W: str = "W", H: str = "H", r: str = "r") -> Domain:
-    """The plate [-W, W] x [-H, H] with a circular hole of radius r at the origin: the sides and ``hole``."""
-    return _domain("plate_with_hole", (W, H, r))
-
-
-@dataclass(frozen=True)
-class PlaneSpec:
-    """The declared unknowns of a plane model: scalar fields, named groups of them (a displacement), the domain."""
-
-    fields: tuple[str, ...]
-    groups: tuple[tuple[str, tuple[str, ...]], ...]
-    domain: Domain
-
-
 def plane_jet(name: str, fields) -> tuple[str, str, int] | None:
     """(field, space order '' | 'x' | 'y', time order) of a jet name such as ``ux_xt``, or None."""
     for f in sorted(fields, key=len, reverse=True):

@@ -106,7 +106,7 @@ def _vector(raw, n: int, what: str, model, allowed: set) -> sp.Matrix:
 def derive_rod(model, p_ns, K: sp.Matrix | None, params: tuple[sp.Symbol, ...]) -> RodPieces | None:
     """The rod's local pieces (None when the model declares no rod). ``K`` is the declared section's
     stiffness, used when the rod names none."""
-    from mechgen.symbolic.model import call_declared
+    from mechgen.symbolic.declared import call_declared
     from mechgen.symbolic.params import Namespace
 
     spec = getattr(model, "rod_spec", None)

@@ -46,7 +46,8 @@ import sympy as sp
 from mechgen.errors import ModelError
 from mechgen.symbolic.derive import TIME, LumpedEquations, lagrange_residual
 from mechgen.symbolic.field import POSITION, Jets, boundary_constraints, density_expr
-from mechgen.symbolic.model import Model, as_expr, call_declared
+from mechgen.symbolic.model import Model
+from mechgen.symbolic.declared import as_expr, call_declared
 from mechgen.symbolic.params import Namespace
 from mechgen.symbolic.specialize import Specialization, param_namespace
 

@@ -44,7 +44,7 @@ def _library():
     from mechgen.buildlock import load_shared_once
 
     try:
-        lib = load_shared_once(SOURCE.read_text(encoding="utf-8"), stem="mechgen_point_rhs", ldflags=("-lm",),
+        lib = load_shared_once(csrc.source(SOURCE), stem="mechgen_point_rhs", ldflags=("-lm",),
                                symbols=("mgp_rhs", "mgp_jacobian", "mgp_layout"))
     except (CompilerUnavailable, BuildError, OSError) as exc:
         log.info("compiled point right-hand side unavailable (%s)", exc)

@@ -39,7 +39,7 @@ def _library():
     from mechgen.buildlock import load_shared_once as load_shared  # compiled once across processes
 
     try:
-        lib = load_shared(SOURCE.read_text(encoding="utf-8"), stem=STEM, ldflags=("-lm",), symbols=("mgv_run",))
+        lib = load_shared(csrc.source(SOURCE), stem=STEM, ldflags=("-lm",), symbols=("mgv_run",))
     except (CompilerUnavailable, BuildError, OSError) as exc:
         log.info("C variational loop unavailable (%s)", exc)
         return None, f"the C variational loop cannot be built ({exc})"

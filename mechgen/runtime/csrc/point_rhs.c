@@ -17,6 +17,8 @@
 #include <math.h>
 #include <string.h>
 
+#include "dense_lu.h"
+
 typedef int (*mgp_fn)(const double *const *in, double *const *out, const long *sizes, long nbatch);
 
 #define MGP_PORTS 8
@@ -88,73 +90,21 @@ static void cholesky_apply(long n, const double *L, double *b)
     }
 }
 
-/* P M = L U in A (a copy of M, unit L below the diagonal), row k swapped with piv[k]; 1 if singular */
-static int lu_factor(long n, const double *M, double *A, long *piv)
-{
-    long i, j, k, p;
-    double big, l, s;
-    memcpy(A, M, (size_t)(n * n) * sizeof(double));
-    for (k = 0; k < n; ++k) {
-        p = k;
-        big = fabs(A[k * n + k]);
-        for (i = k + 1; i < n; ++i)
-            if (fabs(A[i * n + k]) > big) {
-                big = fabs(A[i * n + k]);
-                p = i;
-            }
-        if (big == 0.0)
-            return 1;
-        piv[k] = p;
-        if (p != k)
-            for (j = 0; j < n; ++j) {
-                s = A[k * n + j];
-                A[k * n + j] = A[p * n + j];
-                A[p * n + j] = s;
-            }
-        for (i = k + 1; i < n; ++i) {
-            l = A[i * n + k] / A[k * n + k];
-            A[i * n + k] = l;
-            for (j = k + 1; j < n; ++j)
-                A[i * n + j] -= l * A[k * n + j];
-        }
-    }
-    return 0;
-}
-
-/* b = M^-1 b from lu_factor's A and piv */
-static void lu_apply(long n, const double *A, const long *piv, double *b)
-{
-    long i, k;
-    double s;
-    for (k = 0; k < n; ++k) {
-        if (piv[k] != k) {
-            s = b[k];
-            b[k] = b[piv[k]];
-            b[piv[k]] = s;
-        }
-        for (i = k + 1; i < n; ++i)
-            b[i] -= A[i * n + k] * b[k];
-    }
-    for (k = n - 1; k >= 0; --k) {
-        s = b[k];
-        for (i = k + 1; i < n; ++i)
-            s -= A[k * n + i] * b[i];
-        b[k] = s / A[k * n + k];
-    }
-}
-
 /* factor M into P->work (Cholesky, else LU: P->lu set); 1 if M is singular */
 static int factor(mgp_point *P, const double *M)
 {
     P->lu = cholesky_factor(P->n, M, P->work);
-    return P->lu ? lu_factor(P->n, M, P->work, P->piv) : 0;
+    if (!P->lu)
+        return 0;
+    memcpy(P->work, M, (size_t)(P->n * P->n) * sizeof(double));   /* LU of a copy of M (dense_lu.h) */
+    return mg_lu_factor(P->n, P->work, P->piv);
 }
 
 /* b = M^-1 b with the factor of the last factor() */
 static void apply(const mgp_point *P, double *b)
 {
     if (P->lu)
-        lu_apply(P->n, P->work, P->piv, b);
+        mg_lu_apply(P->n, P->work, P->piv, b);
     else
         cholesky_apply(P->n, P->work, b);
 }

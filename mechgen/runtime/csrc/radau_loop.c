@@ -28,6 +28,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "dense_lu.h"
+
 typedef int (*mgr_fn)(const double *const *in, double *const *out, const long *sizes, long nbatch);
 
 #define MGR_PORTS 8
@@ -167,61 +169,7 @@ static void fail_at(mgr_state *S, mgr_work *w, double t, const double *x)
     memcpy(S->err_x, x, (size_t)w->nx * sizeof(double));
 }
 
-/* LU with partial pivoting of A (n x n row-major, in place; piv[k]: the row swapped with k); 1 if singular */
-static int lu_real(long n, double *A, long *piv)
-{
-    long i, j, k, p;
-    double big, l, s;
-    for (k = 0; k < n; ++k) {
-        p = k;
-        big = fabs(A[k * n + k]);
-        for (i = k + 1; i < n; ++i)
-            if (fabs(A[i * n + k]) > big) {
-                big = fabs(A[i * n + k]);
-                p = i;
-            }
-        piv[k] = p;
-        if (big == 0.0)
-            return 1;
-        if (p != k)
-            for (j = 0; j < n; ++j) {
-                s = A[k * n + j];
-                A[k * n + j] = A[p * n + j];
-                A[p * n + j] = s;
-            }
-        for (i = k + 1; i < n; ++i) {
-            l = A[i * n + k] /= A[k * n + k];
-            if (l != 0.0)
-                for (j = k + 1; j < n; ++j)
-                    A[i * n + j] -= l * A[k * n + j];
-        }
-    }
-    return 0;
-}
-
-/* b = A^-1 b from lu_real's factors */
-static void solve_real(long n, const double *A, const long *piv, double *b)
-{
-    long i, j;
-    double s;
-    for (i = 0; i < n; ++i) {
-        if (piv[i] != i) {
-            s = b[i];
-            b[i] = b[piv[i]];
-            b[piv[i]] = s;
-        }
-        for (j = 0; j < i; ++j)
-            b[i] -= A[i * n + j] * b[j];
-    }
-    for (i = n - 1; i >= 0; --i) {
-        s = b[i];
-        for (j = i + 1; j < n; ++j)
-            s -= A[i * n + j] * b[j];
-        b[i] = s / A[i * n + i];
-    }
-}
-
-/* lu_real over the complex numbers (pivot on |Re| + |Im|, as LAPACK's zgetrf) */
+/* mg_lu_factor (dense_lu.h) over the complex numbers (pivot on |Re| + |Im|, as LAPACK's zgetrf) */
 static int lu_complex(long n, double _Complex *A, long *piv)
 {
     long i, j, k, p;
@@ -305,12 +253,12 @@ static int rhs(const mgr_problem *P_, mgr_state *S, mgr_work *w, double t, const
     int rc;
     if ((rc = mass_and_residual(P_, S, w, t, x)) != 0)
         return rc;
-    if (lu_real(n, w->M, w->piv_r + w->nx)) {
+    if (mg_lu_factor(n, w->M, w->piv_r + w->nx)) {
         fail_at(S, w, t, x);
         S->err_kind = 0;
         return MGR_E_SINGULAR;
     }
-    solve_real(n, w->M, w->piv_r + w->nx, w->B);
+    mg_lu_apply(n, w->M, w->piv_r + w->nx, w->B);
     memcpy(f, x + n, (size_t)n * sizeof(double));
     memcpy(f + n, w->B, (size_t)n * sizeof(double));
     if (nz > 0) {
@@ -344,7 +292,7 @@ static int jacobian(const mgr_problem *P_, mgr_state *S, mgr_work *w, double t, 
             for (j = 0; j < width; ++j)
                 w->B[i * cols + k * n + j] = blk[i * width + j];
     }
-    if (lu_real(n, w->M, w->piv_r + nx)) {
+    if (mg_lu_factor(n, w->M, w->piv_r + nx)) {
         fail_at(S, w, t, x);
         S->err_kind = 0;
         return MGR_E_SINGULAR;
@@ -352,7 +300,7 @@ static int jacobian(const mgr_problem *P_, mgr_state *S, mgr_work *w, double t, 
     for (j = 0; j < cols; ++j) {          /* column j of -M^-1 B */
         for (i = 0; i < n; ++i)
             w->ytmp[i] = w->B[i * cols + j];
-        solve_real(n, w->M, w->piv_r + nx, w->ytmp);
+        mg_lu_apply(n, w->M, w->piv_r + nx, w->ytmp);
         for (i = 0; i < n; ++i)
             w->J[(n + i) * nx + j] = -w->ytmp[i];
     }
@@ -403,7 +351,7 @@ static int factorise(mgr_state *S, mgr_work *w, double h, double t)
         w->LUc[i * nx + i] += MU_COMPLEX / h;
     }
     S->nlu += 2;
-    if (lu_real(nx, w->LUr, w->piv_r) || lu_complex(nx, w->LUc, w->piv_c)) {
+    if (mg_lu_factor(nx, w->LUr, w->piv_r) || lu_complex(nx, w->LUc, w->piv_c)) {
         fail_at(S, w, t, w->y);
         S->err_kind = 1;
         return MGR_E_SINGULAR;
@@ -441,7 +389,7 @@ static int collocation(const mgr_problem *P_, mgr_state *S, mgr_work *w, double 
             w->fc[j] = F0 * (TI[1][0] + TI[2][0] * I) + F1 * (TI[1][1] + TI[2][1] * I)
                        + F2 * (TI[1][2] + TI[2][2] * I) - Mc * (w->W[nx + j] + w->W[2 * nx + j] * I);
         }
-        solve_real(nx, w->LUr, w->piv_r, w->fr);
+        mg_lu_apply(nx, w->LUr, w->piv_r, w->fr);
         solve_complex(nx, w->LUc, w->piv_c, w->fc);
         for (j = 0; j < nx; ++j) {
             w->dW[j] = w->fr[j];
@@ -512,7 +460,7 @@ static int error_estimate(const mgr_problem *P_, mgr_state *S, mgr_work *w, doub
         w->ZE[j] = (w->Z[j] * E[0] + w->Z[nx + j] * E[1] + w->Z[2 * nx + j] * E[2]) / h;
         w->err[j] = w->f[j] + w->ZE[j];
     }
-    solve_real(nx, w->LUr, w->piv_r, w->err);
+    mg_lu_apply(nx, w->LUr, w->piv_r, w->err);
     for (j = 0; j < nx; ++j)
         w->scale[j] = P_->atol + fmax(fabs(w->y[j]), fabs(w->y_new[j])) * P_->rtol;
     *error_norm = rms(w->err, w->scale, nx, nx);
@@ -523,7 +471,7 @@ static int error_estimate(const mgr_problem *P_, mgr_state *S, mgr_work *w, doub
             return rc;
         for (j = 0; j < nx; ++j)
             w->err[j] += w->ZE[j];
-        solve_real(nx, w->LUr, w->piv_r, w->err);
+        mg_lu_apply(nx, w->LUr, w->piv_r, w->err);
         *error_norm = rms(w->err, w->scale, nx, nx);
     }
     return 0;

@@ -64,7 +64,7 @@ def _library():
     from mechgen.buildlock import load_shared_once as load_shared  # compiled once across processes
 
     try:
-        lib = load_shared(SOURCE.read_text(encoding="utf-8"), stem=STEM, symbols=("mgf_rhs", "mgf_layout"))
+        lib = load_shared(csrc.source(SOURCE), stem=STEM, symbols=("mgf_rhs", "mgf_layout"))
     except (CompilerUnavailable, BuildError, OSError) as exc:
         log.info("C field flow unavailable (%s)", exc)
         return None, f"the C field flow cannot be built ({exc})"

@@ -118,7 +118,7 @@ def _library(n: int | None = None, m: int | None = None):
     cache) and loaded once per process. With sizes (n, m): the loop built for exactly those (MGH_FIXED_N/M)."""
     from mechgen.buildlock import load_shared_once as load_shared  # compiled once across processes
 
-    source, stem = SOURCE.read_text(encoding="utf-8"), STEM
+    source, stem = csrc.source(SOURCE), STEM
     if n is not None:
         source = f"#define MGH_FIXED_N {int(n)}\n#define MGH_FIXED_M {int(m)}\n" + source
         stem = f"{STEM}_{int(n)}_{int(m)}"

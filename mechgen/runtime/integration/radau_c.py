@@ -81,7 +81,7 @@ def library():
     from mechgen.buildlock import load_shared_once as load_shared  # compiled once across processes
 
     try:
-        lib = load_shared(SOURCE.read_text(encoding="utf-8"), stem=STEM, ldflags=("-lm",),
+        lib = load_shared(csrc.source(SOURCE), stem=STEM, ldflags=("-lm",),
                           symbols=("mgr_run", "mgr_free", "mgr_layout"))
     except (CompilerUnavailable, BuildError, OSError) as exc:
         log.info("C Radau loop unavailable (%s)", exc)

@@ -96,7 +96,7 @@ def element_library():
     from mechgen.errors import BuildError, CompilerUnavailable
 
     try:
-        lib = load_shared(SOURCE.read_text(encoding="utf-8"), stem="mgrod", ldflags=("-lm",),
+        lib = load_shared(csrc.source(SOURCE), stem="mgrod", ldflags=("-lm",),
                           symbols=("mgr_internal", "mgr_residual", "mgr_record", "mgr_rotate", "mgr_band_solve",
                                    "mgr_layout"))
     except (CompilerUnavailable, BuildError, OSError) as exc:

@@ -122,8 +122,8 @@ def _end_conditions(start, end, size: int, n_p: int) -> tuple:
 def _layout(field_system) -> tuple:
     """(fields, the free parameters' names, the length's index among them or None, the fixed length)."""
     names = tuple(field_system.metadata.params)
-    length = field_system.info["length"]
-    return (tuple(field_system.info["fields"]), names, names.index(length) if length in names else None,
+    length = field_system.field_meta.length
+    return (field_system.field_meta.fields, names, names.index(length) if length in names else None,
             field_system.value(length))
 
 
@@ -134,7 +134,7 @@ def steady_bvp(field_system) -> SteadyBVP:
     n = len(fields)
     bc = st.outputs(np.zeros(n), np.ones(n))  # boundary values depend on parameters only (unit slopes: finite)
     conditions = []
-    for f, k, at in field_system.info["constraints"]:
+    for f, k, at in field_system.field_meta.constraints:
         if k > 1:
             raise InputError(f"steady BVP: condition on {f} of order {k}", key="boundary",
                              expected="values and slopes only (first-order densities)")
@@ -239,7 +239,7 @@ def hamiltonian_bvp(field_system) -> SteadyBVP:
                        form="hamiltonian")
     bc = kernels["outputs"].evaluate(reader._state(np.ones((2 * n, 1)), np.zeros(1), params0))
     start, end = [], []
-    for f, k, at in field_system.info["constraints"]:
+    for f, k, at in field_system.field_meta.constraints:
         if k > 0:
             raise InputError(f"the Hamiltonian steady form fixes field values only, not {f} of order {k}",
                              key="form", expected="form = 'lagrangian' for conditions on slopes")
