@@ -58,13 +58,13 @@ def test_quick_run_writes_the_reports(tmp_path):
     common = stiff["common_reference"]
     compared = [r["error"] for r in stiff["grid"] + stiff.get("pyelastica_ladder", []) if r["error"] is not None]
     assert max(common["self_convergence_half_elements"], common["self_convergence_double_dt"]) < 0.2 * min(compared)
-    # mechgen's grid, at dt 280 .. 570 x PyElastica's limit at its N, stays within 3 % of the max deflection of
-    # the common reference (1.1 .. 1.4 % at 280 x, 2.0 .. 2.2 % at 570 x: the midpoint rule keeps the higher
+    # mechgen's grid, at dt 280 .. 570 x PyElastica's limit at its N, stays within 2 % of the max deflection of
+    # the common reference at 280 x (1.1 .. 1.4 %) and 3 % at 570 x (2.0 .. 2.2 %: the midpoint rule keeps the higher
     # bending modes' amplitudes but not their phase at dt near their periods, plus N = 10's spatial error), with
     # orthonormal frames. (Before issue 30's Newton refresh rule the 570 x runs read 1.1 .. 1.4 % too: Newton
     # failed there and split most steps in halves, a finer dt than the row's.)
-    assert all(r["dt_over_pyelastica_limit"] > 100 and r["error"] < 3e-2 and r["orthonormality_error"] < 1e-12
-               for r in stiff["grid"])
+    assert all(r["dt_over_pyelastica_limit"] > 100 and r["orthonormality_error"] < 1e-12 for r in stiff["grid"])
+    assert all(r["error"] < (2e-2 if r["dt_over_pyelastica_limit"] < 400 else 3e-2) for r in stiff["grid"])
     grav = res["gravity"]
     assert all(r["orthonormality_error"] < 1e-12 and r["error"] < 3e-2 for r in grav["rows"])
     # Newton's counts beside each time; the tip-load and gravity ladders take every step whole (issue 30's
