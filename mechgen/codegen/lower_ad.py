@@ -20,6 +20,7 @@ import sympy as sp
 from mechgen.codegen.ir import Block, Gather, KernelIR, Operation, Port, Write, fixed
 from mechgen.codegen.lower import kernel
 from mechgen.codegen.lower_lumped import lumped_meta, separable_meta, state_ports
+from mechgen.codegen.program_text import atom_expr
 from mechgen.symbolic.casadi_form import NotConvertible
 
 #: CasADi's operation codes -> the Kernel IR's operation names (mechgen.codegen.program_text)
@@ -31,13 +32,6 @@ _OPERATIONS = {ca.OP_ADD: "add", ca.OP_SUB: "sub", ca.OP_MUL: "mul", ca.OP_DIV: 
                ca.OP_TANH: "tanh", ca.OP_ASINH: "asinh", ca.OP_ACOSH: "acosh", ca.OP_ATANH: "atanh",
                ca.OP_FABS: "fabs", ca.OP_SIGN: "sign"}
 _TWO = frozenset({"add", "sub", "mul", "div", "pow", "constpow", "atan2", "fmin", "fmax"})
-
-
-def _write_expr(value) -> sp.Expr:
-    """A written value (a temporary's or local's name, or a number) as a sympy atom."""
-    if isinstance(value, str):
-        return sp.Symbol(value, real=True)
-    return sp.Integer(int(value)) if value == int(value) and abs(value) < 2**53 else sp.Float(value, 17)
 
 
 def program_block(fn: ca.Function, ports: list[str], writes: list[tuple[str, int]]) -> Block:
@@ -60,7 +54,7 @@ def program_block(fn: ca.Function, ports: list[str], writes: list[tuple[str, int
             work[dst[0]] = float(constant)
         elif op == ca.OP_OUTPUT:
             port, index = writes[dst[1]]
-            out.append(Write(port, index, _write_expr(work[src[0]])))
+            out.append(Write(port, index, atom_expr(work[src[0]])))
         elif op == ca.OP_ASSIGN:
             work[dst[0]] = work[src[0]]
         else:

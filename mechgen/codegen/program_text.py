@@ -98,7 +98,9 @@ def _constant_power(base: str, exponent: float, dialect: str) -> str:
     return _BINARY["pow"][DIALECTS.index(dialect)].format(base, number_text(exponent, dialect))
 
 
-def _sympy_atom(arg) -> sp.Expr:
+def atom_expr(arg) -> sp.Expr:
+    """A program's atom as sympy: a name (a temporary or gathered local) as a real Symbol, a number as an Integer
+    where it is one exactly, else a 17-digit Float (inf and nan included)."""
     if isinstance(arg, str):
         return sp.Symbol(arg, real=True)
     if math.isfinite(arg) and arg == int(arg) and abs(arg) < 2**53:
@@ -117,6 +119,6 @@ _SYMPY_UNARY = {"neg": lambda x: -x, "sq": lambda x: x**2, "twice": lambda x: 2 
 
 def operation_expr(operation: Operation) -> sp.Expr:
     """The operation as a sympy expression of real symbols named as its arguments."""
-    args = [_sympy_atom(a) for a in operation.args]
+    args = [atom_expr(a) for a in operation.args]
     table = _SYMPY_BINARY if len(args) == 2 else _SYMPY_UNARY
     return table[operation.op](*args)
