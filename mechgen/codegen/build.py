@@ -214,6 +214,11 @@ def run_compiler(command: str, source_path: Path, output: Path, cflags: Sequence
     argv = [*shlex.split(command), *cflags, *(f"-I{d}" for d in include_dirs),
             "-o", str(output), str(source_path), *ldflags]
     STATS["compile"] += 1
+    return _run(command, argv)
+
+
+def _run(command: str, argv: list[str]) -> subprocess.CompletedProcess:
+    """The compiler's run (within COMPILE_TIMEOUT); CompilerUnavailable if it cannot be started."""
     try:
         return subprocess.run(argv, capture_output=True, text=True, timeout=COMPILE_TIMEOUT, check=False)
     except OSError as exc:
@@ -257,11 +262,7 @@ def compile_units(command: str, parts: list[str], output: Path, cflags: Sequence
         failed = next((d for d in done if d.returncode != 0), None)
         if failed is not None:
             return failed
-        argv = [*shlex.split(command), *cflags, "-o", str(output), *map(str, objects), *ldflags]
-        try:
-            return subprocess.run(argv, capture_output=True, text=True, timeout=COMPILE_TIMEOUT, check=False)
-        except OSError as exc:
-            raise CompilerUnavailable(f"cannot run C compiler {command!r}: {exc}") from exc
+        return _run(command, [*shlex.split(command), *cflags, "-o", str(output), *map(str, objects), *ldflags])
 
 
 def trivial_problem(command: str, cflags: Sequence[str], include_dirs: Sequence[str],
