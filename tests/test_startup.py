@@ -61,3 +61,15 @@ def test_shipped_scene_runs_from_the_committed_layer_without_sympy(scene, tmp_pa
             np.testing.assert_allclose(x, y, rtol=1e-12, atol=1e-12 * max(1.0, abs(x)))
         else:
             assert x == y
+
+
+def test_a_small_stability_scene_starts_without_scipy(tmp_path):
+    """Issue 30 (start): the Laval rotor's stability and Campbell sweep (8 states, conservative gyroscopic: numpy's
+    Cholesky and eigvalsh) load neither scipy.linalg nor scipy.sparse (0.2-0.4 s of import, more than the scene
+    needs to run); scipy's modules are imported at first use (mechgen.runtime.core.lazy_import)."""
+    code = ("import json, sys\nfrom mechgen.scene.run import run_scene\nrun_scene(sys.argv[1])\n"
+            "print(json.dumps(sorted(m for m in sys.modules if m.startswith(('scipy.linalg', 'scipy.sparse')))))")
+    env = {**os.environ, "MECHGEN_CACHE": str(tmp_path), "PYTHONPATH": str(ROOT)}
+    out = subprocess.run([sys.executable, "-c", code, str(ROOT / "scenes" / "laval_rotor.toml")], env=env,
+                         capture_output=True, text=True, check=True)
+    assert json.loads(out.stdout.strip().splitlines()[-1]) == []

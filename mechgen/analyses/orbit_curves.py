@@ -11,15 +11,17 @@ the second parameter b by pseudo-arclength (so the curve is followed round a cus
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sps
 
 from mechgen.analyses.newton_branch import arclength_steps
 from mechgen.analyses.orbit_family import Orbits, record
 from mechgen.errors import SceneError
 from mechgen.runtime.core.budget import DEFAULT_SECONDS, Budget
+from mechgen.runtime.core.lazy_import import lazy_module
 from mechgen.runtime.periodic.branch import OrbitBranch, residual_only
 from mechgen.runtime.steady import codim2
 from mechgen.runtime.steady.continuation import continuation
+
+sps = lazy_module("scipy.sparse")
 
 
 #: G's difference step for orbits (mechgen.runtime.steady.codim2): a shooting R_u by differences of the compiled

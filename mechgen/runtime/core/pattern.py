@@ -19,7 +19,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sps
 
 
 def extent(ext: dict, sizes: dict) -> int:
@@ -41,8 +40,10 @@ class Pattern:
         """Stored entries."""
         return int(self.indices.size)
 
-    def matrix(self, data: np.ndarray) -> sps.csr_matrix:
-        """The CSR matrix with this pattern and ``data``."""
+    def matrix(self, data: np.ndarray):
+        """The CSR matrix (scipy.sparse.csr_matrix) with this pattern and ``data``."""
+        import scipy.sparse as sps
+
         return sps.csr_matrix((data, self.indices, self.indptr), shape=(self.n, self.n))
 
 

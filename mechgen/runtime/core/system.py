@@ -14,6 +14,7 @@ construction, and a new value gives a new system (:meth:`System.with_params`).
 """
 from __future__ import annotations
 
+import functools
 import math
 from collections import OrderedDict
 from dataclasses import dataclass, field, replace
@@ -21,10 +22,6 @@ from types import MappingProxyType
 from typing import Callable
 
 import numpy as np
-import scipy.linalg as sla
-from scipy.linalg.lapack import dposv
-import scipy.sparse as sps
-import scipy.sparse.linalg as spla
 
 from mechgen.errors import InputError, KernelError, did_you_mean
 from mechgen.runtime.core.kernels import Kernel
@@ -324,6 +321,8 @@ class System:
         """M, D, G, K of the linearisation at (q, v, z, t) (a = 0)."""
         mats = self.call("linear", q=q, v=v, z=z, t=t)
         if self.is_lattice:
+            import scipy.sparse as sps
+
             mats["G"] = sps.csr_matrix((self.n, self.n))
         return mats
 
@@ -369,10 +368,14 @@ class System:
         return x[:n], x[n:2 * n], x[2 * n:]
 
     def _solve(self, M, rhs):
-        if sps.issparse(M):
+        if not isinstance(M, np.ndarray):  # a scipy.sparse matrix (chains, lattices)
+            import scipy.sparse.linalg as spla
+
             return spla.spsolve(M.tocsc(), rhs)
         if M.shape[0] <= SMALL_DENSE and np.isfinite(M).all() and np.isfinite(rhs).all():
             return np.linalg.solve(M, rhs)  # LAPACK's gesv without scipy's other checks (tens of microseconds)
+        import scipy.linalg as sla
+
         return sla.solve(M, rhs, assume_a="sym") if rhs.ndim == 1 else sla.solve(M, rhs)
 
     def acceleration(self, q, v, z=None, t=0.0) -> tuple[np.ndarray, object]:
@@ -428,6 +431,9 @@ class System:
             tan = {k: raw[k].reshape(n, m if k == "r_z" else n) for k in raw}
         blocks = [tan["r_q"], tan["r_v"]] + ([tan["r_z"]] if m else [])
         if self.is_lattice:
+            import scipy.sparse as sps
+            import scipy.sparse.linalg as spla
+
             rhs = sps.hstack(blocks).tocsc()
             da = -spla.spsolve(tan["r_a"].tocsc(), rhs)
             top = sps.hstack([sps.csr_matrix((n, n)), sps.identity(n), sps.csr_matrix((n, m))])
@@ -442,13 +448,22 @@ class System:
         return J
 
 
+@functools.cache
+def lapack_dposv():
+    """LAPACK's dposv through scipy, imported at the first solve (a scene that never solves with M starts without
+    scipy.linalg, 0.2-0.3 s of import)."""
+    from scipy.linalg.lapack import dposv
+
+    return dposv
+
+
 def mass_solve(M: np.ndarray, b: np.ndarray) -> np.ndarray:
     """M^-1 b for a mass matrix M = d2T/dv2: Cholesky (LAPACK dposv, one call, about 1 us for a handful of
     coordinates against 4 us for numpy's LU), and LU (numpy, which raises on a singular M) where M is not
     positive definite."""
     if not M.size:  # a model of internal variables only
         return np.zeros_like(b)
-    _, x, info = dposv(M, b)
+    _, x, info = lapack_dposv()(M, b)
     return x if info == 0 else np.linalg.solve(M, b)
 
 

@@ -10,7 +10,11 @@ exactly). Sweep worker processes run on one thread each (the parallelism is the 
 """
 from __future__ import annotations
 
+import importlib.abc
+import importlib.machinery
 import os
+import sys
+import threading
 from contextlib import nullcontext
 
 #: at most this many unknowns: one BLAS thread (a dense 512 x 512 LU is ~0.1 GFLOP, a few ms on one core)
@@ -25,23 +29,95 @@ def user_chose_threads() -> bool:
 
 
 def controller():
-    """The threadpoolctl controller of the loaded BLAS/OpenMP libraries, built once per process.
+    """The threadpoolctl controller of the loaded BLAS/OpenMP libraries, built once per set of libraries.
 
-    numpy and scipy each ship their own OpenBLAS; scipy's is loaded only when scipy.linalg is first
-    imported, and a limit applies only to the libraries loaded when it is set, so scipy.linalg is
-    imported first (else the first analysis of a process, which imports it inside the limit, would run
-    scipy's dense work on the default threads). Built once, a limit costs microseconds; a fresh
-    ``threadpool_limits`` rescans the process's libraries each time (1-20 ms, per analysis and per
-    sweep point).
+    numpy and scipy each ship their own OpenBLAS; scipy's is loaded only when scipy.linalg (or sparse) is
+    first imported, which mechgen does at first use (``lazy_import``), so a small scene may never load it. A
+    limit applies only to the libraries loaded when it is set: the controller is rebuilt when scipy's library
+    has appeared since, and a library loaded while a limit is in force joins that limit (:func:`library_loaded`).
+    Built once, a limit costs microseconds; a fresh ``threadpool_limits`` rescans the process's libraries each
+    time (1-20 ms, per analysis and per sweep point).
     """
-    global _CONTROLLER
-    if _CONTROLLER is None:
+    global _CONTROLLER, _CONTROLLER_KEY
+    key = _scipy_loaded()
+    if _CONTROLLER is None or key != _CONTROLLER_KEY:
         import numpy  # noqa: F401  (numpy's BLAS)
-        import scipy.linalg  # noqa: F401  (scipy's own BLAS, see above)
         from threadpoolctl import ThreadpoolController
 
-        _CONTROLLER = ThreadpoolController()
+        _CONTROLLER, _CONTROLLER_KEY = ThreadpoolController(), key
     return _CONTROLLER
+
+
+def _scipy_loaded() -> bool:
+    return "scipy.linalg" in sys.modules or "scipy.sparse.linalg" in sys.modules
+
+
+class OneThreadBlas:
+    """A context in which every loaded BLAS runs on one thread, and one that loads inside it too."""
+
+    def __enter__(self):
+        with _LOCK:
+            self._limits = [controller().limit(limits=1, user_api="blas")]
+            self._key = _CONTROLLER_KEY
+            if not _IN_FORCE and not self._key:
+                sys.meta_path.insert(0, _WATCH)
+            _IN_FORCE.append(self)
+        return self
+
+    def extend(self) -> None:
+        """Limit the libraries loaded since the context was entered (called by :func:`library_loaded`)."""
+        if _scipy_loaded() != self._key:
+            self._limits.append(controller().limit(limits=1, user_api="blas"))
+            self._key = _CONTROLLER_KEY
+
+    def __exit__(self, *exc) -> None:
+        with _LOCK:
+            for limit in reversed(self._limits):
+                limit.restore_original_limits()
+            _IN_FORCE.remove(self)
+            if not _IN_FORCE and _WATCH in sys.meta_path:
+                sys.meta_path.remove(_WATCH)
+
+
+def library_loaded() -> None:
+    """scipy.linalg or scipy.sparse.linalg (which bring scipy's own BLAS) was just imported: the limits in force
+    take it in, so that scipy's dense work inside a one-thread limit runs on one thread as numpy's does."""
+    with _LOCK:
+        for context in _IN_FORCE:
+            context.extend()
+
+
+class _NotifyingLoader:
+    """A module's own loader, and :func:`library_loaded` once the module has run."""
+
+    def __init__(self, loader) -> None:
+        self._loader = loader
+
+    def create_module(self, spec):
+        return self._loader.create_module(spec)
+
+    def exec_module(self, module) -> None:
+        self._loader.exec_module(module)
+        library_loaded()
+
+    def __getattr__(self, name: str):
+        return getattr(self._loader, name)
+
+
+class _ScipyWatch(importlib.abc.MetaPathFinder):
+    """On ``sys.meta_path`` only while a one-thread limit is in force and scipy's BLAS is not loaded yet: the
+    import of scipy.linalg or scipy.sparse.linalg (scipy's OpenBLAS) is found as usual, and its loader tells
+    the limits when it has run."""
+
+    WATCHED = ("scipy.linalg", "scipy.sparse.linalg")
+
+    def find_spec(self, name, path, target=None):
+        if name not in self.WATCHED:
+            return None
+        spec = importlib.machinery.PathFinder.find_spec(name, path, target)
+        if spec is not None and spec.loader is not None:
+            spec.loader = _NotifyingLoader(spec.loader)
+        return spec
 
 
 def blas_threads_for(unknowns: int):
@@ -49,17 +125,23 @@ def blas_threads_for(unknowns: int):
     user chose, a context that changes nothing)."""
     if unknowns > SMALL or user_chose_threads():
         return nullcontext()
-    return controller().limit(limits=1, user_api="blas")
+    return OneThreadBlas()
 
 
 def single_thread_worker() -> None:
     """Process-pool initializer: this worker's BLAS (numpy's and scipy's) on one thread, for the worker's
-    lifetime."""
+    lifetime (scipy.linalg is imported here, so that its library is there to limit)."""
     if user_chose_threads():
         return
+    import scipy.linalg  # noqa: F401
+
     global _WORKER_LIMIT
     _WORKER_LIMIT = controller().limit(limits=1, user_api="blas")
 
 
 _CONTROLLER = None
+_CONTROLLER_KEY = False
 _WORKER_LIMIT = None
+_IN_FORCE: list[OneThreadBlas] = []
+_LOCK = threading.RLock()
+_WATCH = _ScipyWatch()

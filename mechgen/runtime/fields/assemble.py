@@ -22,9 +22,12 @@ matmul per pair. Results equal the plain sums up to round-off.
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sps
 
+from mechgen.runtime.core.lazy_import import lazy_module
 from mechgen.runtime.core.memory import require_dense
+
+sps = lazy_module("scipy.sparse")
+
 
 _SHARED_PRODUCTS_MAX = 1 << 22  # entries of the (points, pairs, dofs, dofs) product table of the shared path
 

@@ -25,9 +25,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg as sla
-import scipy.sparse as sps
-import scipy.sparse.linalg as spla
+
+from mechgen.runtime.core.lazy_import import lazy_module
+
+sla = lazy_module("scipy.linalg")
+sps = lazy_module("scipy.sparse")
+spla = lazy_module("scipy.sparse.linalg")
+
 
 PENALTY_FACTOR = 1e6  # the paper's fixed factor (seed 002); kept as a name, used only through FIXED_FACTOR
 

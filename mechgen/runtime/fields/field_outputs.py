@@ -8,12 +8,14 @@ The functions take a :class:`~mechgen.runtime.fields.continuum.FieldSystem`.
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sps
 
 from mechgen.errors import InputError, KernelError
+from mechgen.runtime.core.lazy_import import lazy_module
 from mechgen.runtime.core.memory import dense_bytes, require
 from mechgen.runtime.fields.elements import reference
 from mechgen.runtime.fields.point_kernels import ends, full_states, jets_of, pointwise
+
+sps = lazy_module("scipy.sparse")
 
 
 def outputs(system, q, v=None, t: float = 0.0) -> dict[str, float]:

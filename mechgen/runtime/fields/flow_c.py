@@ -21,13 +21,16 @@ import logging
 from functools import lru_cache
 
 import numpy as np
-import scipy.sparse as sps
 
 from mechgen.errors import BuildError, CompilerUnavailable
 from mechgen.runtime import csrc
+from mechgen.runtime.core.lazy_import import lazy_module
 from mechgen.runtime.integration.events_c import LONG, integrate_hybrid_c
 from mechgen.runtime.core.pattern import extent
 from mechgen.runtime.fields.operators import Block, Operators, blocks_of, field_operators
+
+sps = lazy_module("scipy.sparse")
+
 
 log = logging.getLogger("mechgen")
 

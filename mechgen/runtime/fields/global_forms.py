@@ -13,13 +13,15 @@ The functions take a :class:`~mechgen.runtime.fields.continuum.FieldSystem`.
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sps
 
 from mechgen.errors import KernelError
+from mechgen.runtime.core.lazy_import import lazy_module
 from mechgen.runtime.fields.assemble import element_matrices, element_vectors
 from mechgen.runtime.fields.conditions import constraint_rows, row_penalties
 from mechgen.runtime.fields.constrain import binding
 from mechgen.runtime.fields.point_kernels import coefficients, ends, full_states, jets_of, pointwise
+
+sps = lazy_module("scipy.sparse")
 
 
 def point_terms(terms, shape) -> sps.csr_matrix:

@@ -23,12 +23,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg as sla
-import scipy.sparse as sps
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
 from mechgen.errors import KernelError
+from mechgen.runtime.core.lazy_import import lazy_module
 from mechgen.runtime.core.memory import dense_bytes, require
+
+sla = lazy_module("scipy.linalg")
+sps = lazy_module("scipy.sparse")
 
 
 @dataclass(frozen=True)

@@ -9,10 +9,12 @@ positions (B_x, the jets at s = x), and the reshaping of flat kernel outputs int
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sps
 
 from mechgen.errors import InputError, KernelError
+from mechgen.runtime.core.lazy_import import lazy_module
 from mechgen.runtime.fields.assemble import jets_at_points
+
+sps = lazy_module("scipy.sparse")
 
 
 def params_with(system, values: dict, prefix: str = "", what: str = "segment") -> np.ndarray:

@@ -9,13 +9,16 @@ The functions take a :class:`~mechgen.runtime.fields.continuum.FieldSystem`.
 from __future__ import annotations
 
 import numpy as np
-import scipy.linalg as sla
-import scipy.sparse as sps
-import scipy.sparse.linalg as spla
 
 from mechgen.errors import ConvergenceError, InputError, KernelError
+from mechgen.runtime.core.lazy_import import lazy_module
 from mechgen.runtime.core.memory import require_dense
 from mechgen.runtime.fields.conditions import reduction_key
+
+sla = lazy_module("scipy.linalg")
+sps = lazy_module("scipy.sparse")
+spla = lazy_module("scipy.sparse.linalg")
+
 
 #: Newton steps of a first-order continuum's rate q' (one suffices when r is linear in the rates)
 FIRST_ORDER_NEWTON = 20

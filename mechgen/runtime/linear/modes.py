@@ -22,12 +22,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg as sla
-import scipy.sparse as sps
-import scipy.sparse.linalg as spla
 
 from mechgen.errors import InputError
+from mechgen.runtime.core.lazy_import import lazy_module
 from mechgen.runtime.core.memory import require_dense
+
+sla = lazy_module("scipy.linalg")
+sps = lazy_module("scipy.sparse")
+spla = lazy_module("scipy.sparse.linalg")
 
 
 @dataclass(frozen=True)

@@ -50,7 +50,11 @@ from dataclasses import dataclass, field, replace
 from math import factorial as math_factorial
 
 import numpy as np
-import scipy.sparse as sps
+
+from mechgen.runtime.core.lazy_import import lazy_module
+
+sps = lazy_module("scipy.sparse")
+
 
 #: the polynomial degree m on each interval (m Gauss points: order 2m = 8 at the mesh points)
 DEGREE = 4

@@ -17,14 +17,17 @@ from __future__ import annotations
 from dataclasses import InitVar, dataclass, field, replace
 
 import numpy as np
-import scipy.sparse as sps
 
 from mechgen.errors import InputError, KernelError
+from mechgen.runtime.core.lazy_import import lazy_module
 from mechgen.runtime.core.memory import require_dense
 from mechgen.runtime.core.meta import SystemMeta
 from mechgen.runtime.core.system import Memo, frozen_vector, number, read_only, replacement_vector, with_values
 from mechgen.runtime.plane import assemble
 from mechgen.runtime.plane.discretise import PlaneDisc, discretise, generate_mesh
+
+sps = lazy_module("scipy.sparse")
+
 
 #: the runtime choices of every plane continuum and the values they take
 CHOICE_VALUES = {"element": ("P1", "P2", "Q1", "Q2"), "edges": ("curved", "straight")}

@@ -46,13 +46,14 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
-import scipy.sparse as sps
-import scipy.sparse.linalg as spla
 
 from mechgen.errors import ConvergenceError
+from mechgen.runtime.core.lazy_import import lazy_module
 from mechgen.runtime.rods.ends import ENDS, UNCONSTRAINED
 from mechgen.runtime.rods.liegroup import coad6, exp_se3, inverse, jac_right_se3, log_se3, log_so3, vee3
 
+sps = lazy_module("scipy.sparse")
+spla = lazy_module("scipy.sparse.linalg")
 
 
 @dataclass(frozen=True)

@@ -19,10 +19,12 @@ from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
-import scipy.linalg as sl
 
+from mechgen.runtime.core.lazy_import import lazy_module
 from mechgen.runtime.spectral.chebyshev import clenshaw_curtis, differentiation
 from mechgen.runtime.steady.continuation import continuation
+
+sl = lazy_module("scipy.linalg")
 
 
 @dataclass(frozen=True)

@@ -17,9 +17,12 @@ from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
-import scipy.linalg as sl
 
+from mechgen.runtime.core.lazy_import import lazy_module
 from mechgen.runtime.spectral.chebyshev import clamped_fourth, dirichlet_second, resolved
+
+sl = lazy_module("scipy.linalg")
+
 
 #: a base flow: y (interior points) -> (U, U'')
 Profile = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]

@@ -22,11 +22,13 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
-import scipy.sparse as sps
-import scipy.sparse.linalg as spla
 
 from mechgen.errors import ConvergenceError, InputError
+from mechgen.runtime.core.lazy_import import lazy_module
 from mechgen.runtime.steady.continuation import Branch, ContinuationOptions, continue_bvp
+
+sps = lazy_module("scipy.sparse")
+spla = lazy_module("scipy.sparse.linalg")
 
 DIRECTIONS = ("increasing", "decreasing", "both")
 

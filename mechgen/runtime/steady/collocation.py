@@ -39,12 +39,14 @@ unknown parameters) of f_p are evaluated when the problem's f_p takes ``cols``.
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sps
-import scipy.sparse.linalg as spla
 
 from mechgen.errors import ConvergenceError, InputError
+from mechgen.runtime.core.lazy_import import lazy_module
 from mechgen.runtime.steady.bvp import (BVP, BVPResult, BudgetSpent, IVPFailure, IVPOptions, ShootingResidual,
                                         full_parameters, ivp_options, mesh_nodes)
+
+sps = lazy_module("scipy.sparse")
+spla = lazy_module("scipy.sparse.linalg")
 
 METHODS = ("collocation", "gauss", "multiple_shooting")
 

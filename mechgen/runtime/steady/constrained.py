@@ -30,11 +30,13 @@ cannot follow nearly inextensional motions of a curved string).
 from __future__ import annotations
 
 import numpy as np
-import scipy.linalg as sla
 
 from mechgen.errors import InputError
+from mechgen.runtime.core.lazy_import import lazy_module
 from mechgen.runtime.core.memory import require_dense
 from mechgen.runtime.fields.assemble import element_matrices, element_vectors
+
+sla = lazy_module("scipy.linalg")
 
 
 def linear_about_bvp(system, bvp, result) -> dict:
