@@ -8,7 +8,9 @@ this writes, under ``mechgen/generated/<model>/``:
 * ``<key[:16]>.c`` - the generated source (readable; built once per machine into the user cache),
 * ``<key[:16]>.c.json`` - the full request key, the request, the text's sha256 and the kernel specs,
 
-and ``info.json`` (:mod:`mechgen.scene.info`) for every built-in model. The runtime loads these
+and ``info.json`` (:mod:`mechgen.scene.info`) for every built-in model, and ``liegroup/``: the runtime's
+numeric Lie-group maps (numpy and CasADi) generated from mechgen.symbolic.liegroup
+(:mod:`mechgen.codegen.lower_liegroup`). The runtime loads these
 when a request's key matches (mechgen.pipeline.generated_text), so a shipped scene starts without
 deriving anything or importing sympy. Files that no request names are removed. Output is
 byte-for-byte deterministic across processes and hash seeds.
@@ -17,7 +19,8 @@ byte-for-byte deterministic across processes and hash seeds.
 scene or mechgen source changed: the key covers them), a committed file is one no request names,
 or the committed kernels differ from freshly generated ones structurally (kernel names, ports,
 shapes, sparsity, sizes, operation counts) or numerically (each kernel evaluated at seeded random
-inputs, to 1e-12 relative). Text is not compared: its formatting may change with the sympy version.
+inputs, to 1e-12 relative). Text is not compared: its formatting may change with the sympy version. The
+``liegroup/`` modules are compared as text (byte for byte): an edit of the sympy source without a regen fails.
 A passing check is remembered in the user cache for these sources and committed bytes, so a hook
 that runs it again finds the answer at once.
 """
@@ -94,9 +97,17 @@ def _info_documents() -> dict[Path, str]:
     return docs
 
 
+def _liegroup_documents() -> dict[Path, str]:
+    """relative path -> text of the generated Lie-group maps (mechgen/generated/liegroup/)."""
+    from mechgen.codegen.lower_liegroup import generated_texts
+
+    return {Path(rel): text for rel, text in generated_texts().items()}
+
+
 def _existing(root: Path) -> set[Path]:
     """Committed files below the model folders, relative to root."""
-    return {p.relative_to(root) for p in root.glob("*/*") if p.is_file() and not p.name.startswith(".")} | \
+    return {p.relative_to(root) for p in root.glob("*/*")
+            if p.is_file() and not p.name.startswith(".") and "__pycache__" not in p.parts} | \
         {p.relative_to(root) for p in root.glob("*/__init__.py")}
 
 
@@ -107,7 +118,7 @@ def regen(*, check: bool = False, root: Path = GENERATED, scenes=None) -> list[s
 
 def write_generated(root: Path = GENERATED, scenes=None) -> list[str]:
     """Write every planned request's text and JSON and every info.json, remove the rest; returns changed paths."""
-    wanted: dict[Path, str] = dict(_info_documents())
+    wanted: dict[Path, str] = {**_info_documents(), **_liegroup_documents()}
     for source, request in planned_requests(scenes):
         key = request.key()
         text_path, json_path = committed_paths(request.model, key, request.backend, Path("."))
@@ -171,6 +182,12 @@ def check_generated(root: Path = GENERATED, scenes=None) -> list[str]:
         problem = compare_generated(committed, fresh(source, request), request.backend)
         if problem:
             stale.append(f"{label}: {problem}")
+    for rel, text in _liegroup_documents().items():
+        named.add(rel)
+        path = root / rel
+        if not path.is_file() or path.read_bytes() != text.encode("utf-8"):
+            stale.append(f"{rel} (not the text that mechgen.codegen.lower_liegroup writes from "
+                         "mechgen/symbolic/liegroup.py)")
     stale += [f"{rel} (no request names it)" for rel in sorted(_existing(root) - named)]
     if not stale:
         get_or_create("regen-check", stamp, lambda folder: (folder / "ok").write_text(stamp))

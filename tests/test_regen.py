@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from mechgen import models
+from mechgen.codegen.lower_liegroup import generated_texts
 from mechgen.pipeline import GENERATED, committed_paths, read_committed, request_of
 from mechgen.regen import planned_requests
 from mechgen.scene.info import cached_info, info_from_json, info_of_model, model_info
@@ -44,7 +45,8 @@ def test_every_planned_request_is_committed_and_nothing_else():
         assert read_committed(request.model, key, request.backend) is not None, request.describe()
         named |= set(committed_paths(request.model, key, request.backend))
     named |= {GENERATED / name / "info.json" for name in models.names()}
-    present = {p for p in GENERATED.glob("*/*") if p.is_file() and p.suffix in (".c", ".json", ".py")}
+    named |= {GENERATED / rel for rel in generated_texts()}   # the Lie-group maps (codegen/lower_liegroup.py)
+    present = {p for p in GENERATED.glob("*/*") if p.is_file() and p.suffix in (".c", ".json", ".py", ".h")}
     assert present == named
 
 

@@ -61,6 +61,16 @@ class SafeFunctionBase(sp.Function):
     def fdiff(self, argindex=1):
         return derivative_of(type(self))(self.args[0])
 
+    @classmethod
+    def coefficients(cls) -> tuple:
+        """The exact Taylor coefficients c_0, c_1, ... at 0 (f(x) = sum_k c_k x^k)."""
+        return cls._coeffs
+
+    @classmethod
+    def series_below(cls) -> sp.Expr:
+        """The series interval's bound: the series is used where |x| < this."""
+        return cls._below
+
     def closed(self) -> sp.Expr:
         """The closed form at this argument."""
         return self._closed.xreplace({_X: self.args[0]})

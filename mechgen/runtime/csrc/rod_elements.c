@@ -22,71 +22,12 @@
 #include <math.h>
 #include <string.h>
 
-#define TERMS 12
-
-static double fact(int n) { double f = 1.0; for (int i = 2; i <= n; ++i) f *= i; return f; }
-
-/* the series' coefficients, made once: COEF[k - 1][m] = (-1)^m / (2m + k)! (k = 1, 2, 3) and
- * COEF[3][n] = |B_2n| / (2n + 2)! (the same values the loops computed at every call before: equal results) */
-static double COEF[4][TERMS];
-static volatile int coef_ready = 0;
-
-static void coefficients(void) {
-    static const double B[TERMS] = {1.0 / 6, 1.0 / 30, 1.0 / 42, 1.0 / 30, 5.0 / 66, 691.0 / 2730, 7.0 / 6,
-                                    3617.0 / 510, 43867.0 / 798, 174611.0 / 330, 854513.0 / 138,
-                                    236364091.0 / 2730};
-    for (int m = 0; m < TERMS; ++m) {
-        for (int k = 1; k <= 3; ++k) COEF[k - 1][m] = ((m % 2) ? -1.0 : 1.0) / fact(2 * m + k);
-        COEF[3][m] = B[m] / fact(2 * m + 2);
-    }
-    coef_ready = 1;   /* a second thread racing here writes the same values */
-}
-
-/* sum_m c_m t^(2m) by Horner with the coefficient row `row` */
-static double horner(double t, int row) {
-    if (!coef_ready) coefficients();
-    double t2 = t * t, acc = 0.0;
-    for (int m = TERMS - 1; m >= 0; --m) acc = acc * t2 + COEF[row][m];
-    return acc;
-}
-
-/* sum_m (-1)^m t^(2m) / (2m + k)!  (k = 1: sin t/t, 2: (1 - cos t)/t^2, 3: (t - sin t)/t^3) */
-static double series(double t, int k) { return horner(t, k - 1); }
-
-static double sinc_(double t) { return t < 1.0 ? series(t, 1) : sin(t) / t; }
-static double a1_(double t) { return t < 1.0 ? series(t, 2) : (1.0 - cos(t)) / (t * t); }
-static double a2_(double t) { return t < 1.0 ? series(t, 3) : (t - sin(t)) / (t * t * t); }
-
-/* (1 - (t/2) cot(t/2))/t^2 = sum_n |B_2n| t^(2n-2)/(2n)! below 1 rad */
-static double binv_(double t) {
-    if (t >= 1.0) return (1.0 - t * sin(t) / (2.0 * (1.0 - cos(t)))) / (t * t);
-    return horner(t, 3);
-}
+/* exp_so3, jac_left_so3, jac_left_so3_inv and the angle functions of the squared angle (series below 1 rad,
+ * closed forms above), generated from mechgen/symbolic/liegroup.py by `mechgen regen`
+ * (mechgen/generated/liegroup/liegroup_maps.h, inlined by mechgen.runtime.csrc.source) */
+#include "liegroup_maps.h"
 
 static double norm3(const double *w) { return sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]); }
-
-static void hat(const double *w, double *W) {
-    W[0] = 0.0;   W[1] = -w[2]; W[2] = w[1];
-    W[3] = w[2];  W[4] = 0.0;   W[5] = -w[0];
-    W[6] = -w[1]; W[7] = w[0];  W[8] = 0.0;
-}
-
-/* exp(hat w) = cos t I + sinc(t) hat w + a1(t) w w^T */
-static void exp3(const double *w, double *E) {
-    double t = norm3(w), s = sinc_(t), a = a1_(t), c = cos(t), W[9];
-    hat(w, W);
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) E[3 * i + j] = a * w[i] * w[j] + s * W[3 * i + j] + (i == j ? c : 0.0);
-}
-
-/* I + p hat w + q hat(w)^2, hat(w)^2 = w w^T - t^2 I */
-static void poly3(const double *w, double p, double q, double *J) {
-    double t2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2], W[9];
-    hat(w, W);
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-            J[3 * i + j] = (i == j ? 1.0 - q * t2 : 0.0) + p * W[3 * i + j] + q * w[i] * w[j];
-}
 
 /* w with exp(hat w) = R, |w| <= pi (liegroup.log_so3: from the skew part, near pi from R + R^T) */
 static void log3(const double *R, double *w) {
@@ -94,7 +35,7 @@ static void log3(const double *R, double *w) {
     double c = 0.5 * (R[0] + R[4] + R[8] - 1.0);
     double t = atan2(norm3(s), c);
     if (c >= -0.9) {
-        double k = 1.0 / sinc_(t);
+        double k = 1.0 / mgl_sinc(t * t);
         for (int i = 0; i < 3; ++i) w[i] = s[i] * k;
         return;
     }
@@ -135,7 +76,7 @@ static void internal_one(long n, double h, double alpha, const double *K, const 
     for (long i = 0; i < n; ++i) {
         double th[3] = {alpha * zb[6 * i + 3], alpha * zb[6 * i + 4], alpha * zb[6 * i + 5]}, E[9];
         for (int k = 0; k < 3; ++k) xb[3 * i + k] = x[3 * i + k] + alpha * zb[6 * i + k];
-        exp3(th, E);
+        mgl_exp_so3(th, E);
         matmul(R + 9 * i, E, Rb + 9 * i);
     }
     memset(Fb, 0, sizeof(double) * 3 * n);
@@ -146,7 +87,7 @@ static void internal_one(long n, double h, double alpha, const double *K, const 
         matTmul(Ri, Rj, Q);
         log3(Q, Psi);
         for (int k = 0; k < 3; ++k) half[k] = 0.5 * Psi[k];
-        exp3(half, Rh);
+        mgl_exp_so3(half, Rh);
         matmul(Ri, Rh, Re);
         for (int k = 0; k < 3; ++k) d[k] = xb[3 * (e + 1) + k] - xb[3 * e + k];
         mtv(Re, d, nu);
@@ -161,14 +102,16 @@ static void internal_one(long n, double h, double alpha, const double *K, const 
         for (int k = 0; k < 3; ++k) { Fb[3 * e + k] += Fe[k]; Fb[3 * (e + 1) + k] -= Fe[k]; }
         double a[3] = {h * (sig[1] * nu[2] - sig[2] * nu[1]), h * (sig[2] * nu[0] - sig[0] * nu[2]),
                        h * (sig[0] * nu[1] - sig[1] * nu[0])};
-        /* J_r(Psi/2) = J_l(-Psi/2) = I - a1 hat(Psi/2) + a2 hat(Psi/2)^2, at t/2 */
-        double th = norm3(half), Jr[9], ca[3], c[3], Jli[9], Jri[9], bpsi = binv_(norm3(Psi));
+        /* J_r(Psi/2) = J_l(-Psi/2) */
+        double Jr[9], ca[3], c[3], Jli[9], Jri[9];
         double mhalf[3] = {-half[0], -half[1], -half[2]};
-        poly3(mhalf, a1_(th), a2_(th), Jr);
+        mgl_jac_left_so3(mhalf, Jr);
         mtv(Jr, a, ca);
         for (int k = 0; k < 3; ++k) c[k] = sig[3 + k] + 0.5 * ca[k];
-        poly3(Psi, -0.5, bpsi, Jli);              /* J_l(Psi)^-1 = I - hat/2 + b hat^2 */
-        poly3(Psi, 0.5, bpsi, Jri);               /* J_r(Psi)^-1 = I + hat/2 + b hat^2 */
+        mgl_jac_left_so3_inv(Psi, Jli);           /* J_l(Psi)^-1 = I - hat/2 + b hat^2 */
+        /* J_r(Psi)^-1 = J_l(-Psi)^-1 = J_l(Psi)^-1 + hat(Psi) (= I + hat/2 + b hat^2) */
+        memcpy(Jri, Jli, sizeof Jri);
+        Jri[1] -= Psi[2]; Jri[2] += Psi[1]; Jri[3] += Psi[2]; Jri[5] -= Psi[0]; Jri[6] -= Psi[1]; Jri[7] += Psi[0];
         double Rha[3], Jc[3], Jrc[3];
         mv(Rh, a, Rha);
         mtv(Jli, c, Jc);
@@ -262,7 +205,7 @@ int mgr_record(long n, double h, double rhoA, const double *K, const double *f0,
         matTmul(Ri, R + 9 * (e + 1), Q);
         log3(Q, Psi);
         for (int k = 0; k < 3; ++k) half[k] = 0.5 * Psi[k];
-        exp3(half, Rh);
+        mgl_exp_so3(half, Rh);
         matmul(Ri, Rh, Re);
         for (int k = 0; k < 3; ++k) d[k] = x[3 * (e + 1) + k] - x[3 * e + k];
         mtv(Re, d, nu);
@@ -289,7 +232,7 @@ int mgr_record(long n, double h, double rhoA, const double *K, const double *f0,
 int mgr_rotate(long n, const double *R, const double *theta, double *out) {
     for (long i = 0; i < n; ++i) {
         double E[9];
-        exp3(theta + 3 * i, E);
+        mgl_exp_so3(theta + 3 * i, E);
         matmul(R + 9 * i, E, out + 9 * i);
     }
     return 0;

@@ -9,10 +9,13 @@ log of a product of exponentials) swell; AD does not.
 
 Conventions are liegroup's: twists (v, w) translation first, poses as (R, p), angles in radians. The angle
 functions switch to their Taylor series in t^2 below t = 1 exactly as the numpy maps do (same coefficients,
-:func:`liegroup.angle_series`), so the derivative at zero angle is the series' (no 0/0). CasADi's if_else on
-SX evaluates both branches and multiplies the unused one by zero without reading it (a NaN of a closed form
-at t = 0 does not leak). The logarithm here is for rotations away from pi (|angle| < pi - 1e-3 keeps its
-derivative to about 1e-6; the Jacobians of element increments and node updates never come near it);
+:func:`liegroup.angle_series`), so the derivative at zero angle is the series' (no 0/0). The formulas
+of exp_so3, jac_left_so3(_inv), q_block and exp_se3, and the angle functions' closed forms and coefficients, are
+generated from mechgen.symbolic.liegroup into mechgen/generated/liegroup/casadi_maps.py (``mechgen regen``);
+this module holds the series/closed-form switch (:func:`angle`) and the maps that are not formula copies.
+CasADi's if_else on SX evaluates both branches and multiplies the unused one by zero without reading it (a NaN
+of a closed form at t = 0 does not leak). The logarithm here is for rotations away from pi (|angle| < pi - 1e-3
+keeps its derivative to about 1e-6; the Jacobians of element increments and node updates never come near it);
 the residuals themselves keep liegroup's log with its branch near pi.
 """
 from __future__ import annotations
@@ -21,10 +24,11 @@ import math
 
 import casadi as ca
 
+from mechgen.generated.liegroup import casadi_maps as maps
 from mechgen.runtime.rods.liegroup import angle_series
 
-#: below this t^2 the angle functions are their series (t < 1, as in liegroup)
-SERIES_BELOW = 1.0
+#: below this t^2 the angle functions are their series (t < 1, as in liegroup; from the sympy source)
+SERIES_BELOW = maps.SERIES_BELOW
 #: below this |sin t|^2 (and cos t > 0) log's t/sin t is the series of asin(x)/x (10 terms: < 1e-19)
 LOG_SERIES_BELOW = 0.01
 _ASIN_OVER_X = tuple(math.factorial(2 * n) / (4**n * math.factorial(n) ** 2 * (2 * n + 1)) for n in range(10))
@@ -48,41 +52,31 @@ def vee3(W):
     return 0.5 * ca.vertcat(W[2, 1] - W[1, 2], W[0, 2] - W[2, 0], W[1, 0] - W[0, 1])
 
 
-_CLOSED = {"sinc": lambda t, t2: ca.sin(t) / t, "a1": lambda t, t2: (1 - ca.cos(t)) / t2,
-           "a2": lambda t, t2: (t - ca.sin(t)) / (t2 * t),
-           "a3": lambda t, t2: (t2 + 2 * ca.cos(t) - 2) / (2 * t2 * t2),
-           "a4": lambda t, t2: (2 * t - 3 * ca.sin(t) + t * ca.cos(t)) / (2 * t2 * t2 * t)}
+_CLOSED = {"sinc": maps.closed_sinc, "a1": maps.closed_a1, "a2": maps.closed_a2, "a3": maps.closed_a3,
+           "a4": maps.closed_a4, "b": maps.closed_b, "jl_inv": maps.closed_b}
 
 
 def angle(name: str, t2):
-    """sinc, a1 … a4 (liegroup's angle functions) of t = sqrt(t2): the series below t = 1, else the closed form."""
-    t = ca.sqrt(t2)
-    closed = _CLOSED[name](t, t2)
+    """sinc, a1 … a4, b (liegroup's angle functions) of t = sqrt(t2): the series below t = 1, else the closed
+    form."""
+    closed = _CLOSED[name](ca.sqrt(t2))
     return ca.if_else(t2 < SERIES_BELOW, horner(angle_series(name), t2), closed)
 
 
 def exp_so3(w):
-    """exp(hat3 w) = I + sinc(t) hat3 w + a1(t) hat3(w)^2."""
-    t2 = ca.dot(w, w)
-    W = hat3(w)
-    return ca.SX.eye(3) + angle("sinc", t2) * W + angle("a1", t2) * (W @ W)
+    """exp(hat3 w) = I + sinc(t) hat3 w + a1(t) hat3(w)^2 (generated)."""
+    return maps.exp_so3(w, angle)
 
 
 def jac_left_so3(w):
-    """J_l(w) = I + a1(t) hat3 w + a2(t) hat3(w)^2."""
-    t2 = ca.dot(w, w)
-    W = hat3(w)
-    return ca.SX.eye(3) + angle("a1", t2) * W + angle("a2", t2) * (W @ W)
+    """J_l(w) = I + a1(t) hat3 w + a2(t) hat3(w)^2 (generated)."""
+    return maps.jac_left_so3(w, angle)
 
 
 def jac_left_so3_inv(w):
-    """J_l(w)^-1 = I - hat3(w)/2 + b(t) hat3(w)^2, b = (1 - t sin t/(2(1 - cos t)))/t^2 (series below t = 1)."""
-    t2 = ca.dot(w, w)
-    t = ca.sqrt(t2)
-    closed = (1 - t * ca.sin(t) / (2 * (1 - ca.cos(t)))) / t2
-    b = ca.if_else(t2 < SERIES_BELOW, horner(angle_series("jl_inv"), t2), closed)
-    W = hat3(w)
-    return ca.SX.eye(3) - 0.5 * W + b * (W @ W)
+    """J_l(w)^-1 = I - hat3(w)/2 + b(t) hat3(w)^2, b = (1 - t sin t/(2(1 - cos t)))/t^2 (series below t = 1;
+    generated)."""
+    return maps.jac_left_so3_inv(w, angle)
 
 
 def log_so3(R):
@@ -97,13 +91,8 @@ def log_so3(R):
 
 
 def q_block(v, w):
-    """The upper-right block Q(v, w) of the SE(3) left Jacobian (Barfoot & Furgale 2014, eq. (102))."""
-    t2 = ca.dot(w, w)
-    V, W = hat3(v), hat3(w)
-    WV, VW = W @ V, V @ W
-    WVW = WV @ W
-    return (0.5 * V + angle("a2", t2) * (WV + VW + WVW) + angle("a3", t2) * (W @ WV + VW @ W - 3 * WVW)
-            + angle("a4", t2) * (WVW @ W + W @ WVW))
+    """The upper-right block Q(v, w) of the SE(3) left Jacobian (Barfoot & Furgale 2014, eq. (102); generated)."""
+    return maps.q_block(v, w, angle)
 
 
 def dexp_inv_right(theta, xi):
@@ -116,9 +105,9 @@ def dexp_inv_right(theta, xi):
 
 
 def exp_se3(xi):
-    """exp(hat6(v, w)) as (R, p) = (exp_so3 w, J_l(w) v)."""
-    v, w = xi[:3], xi[3:]
-    return exp_so3(w), jac_left_so3(w) @ v
+    """exp(hat6(v, w)) as (R, p) = (exp_so3 w, J_l(w) v) (generated)."""
+    H = maps.exp_se3(xi, angle)
+    return H[:3, :3], H[:3, 3]
 
 
 def log_se3(R, p):

@@ -18,6 +18,12 @@ left Jacobian (tangent operator) are the series
 summed in closed form (Rodrigues; Barfoot & Furgale 2014, eq. (102) for the Q block) with the angle
 functions switched to their Taylor series for theta < 1, where the closed forms lose digits to cancellation
 (the last coefficient of Q loses eps/theta^4). Angles are radians, lengths in the caller's units.
+
+The formulas of exp_so3, jac_left_so3(_inv), q_block, exp_se3 and jac_left/right_se3, the angle functions'
+closed forms and series coefficients are generated from their sympy source, mechgen.symbolic.liegroup, into
+mechgen/generated/liegroup/numpy_maps.py (``mechgen regen``; mechgen.codegen.lower_liegroup); this module
+holds the batching glue (the series/closed-form switch, :func:`angle_of_square`) and the hand-written maps
+that are not formula copies: hat/vee, the adjoints, the logarithms with their branch near pi.
 """
 from __future__ import annotations
 
@@ -25,58 +31,30 @@ import math
 
 import numpy as np
 
-_SERIES_BELOW = 1.0   # rad: below this the angle functions are summed as series (12 terms: < 1e-20 truncation)
-_TERMS = 12
+from mechgen.generated.liegroup import numpy_maps as maps
 
-
-def _fact(n: int) -> float:
-    return float(math.factorial(n))
-
-
-_BERNOULLI_ABS = (1 / 6, 1 / 30, 1 / 42, 1 / 30, 5 / 66, 691 / 2730, 7 / 6, 3617 / 510, 43867 / 798,
-                  174611 / 330, 854513 / 138, 236364091 / 2730)    # |B_2| … |B_24|
-_INV_SERIES = [b / _fact(2 * n + 2) for n, b in enumerate(_BERNOULLI_ABS)]
-
-
-# a_j(theta) = sum_m (-1)^m c_jm theta^(2m): the angle functions of exp and its Jacobians, as series.
-_SERIES = {
-    "sinc": [(-1) ** m / _fact(2 * m + 1) for m in range(_TERMS)],           # sin t / t
-    "a1": [(-1) ** m / _fact(2 * m + 2) for m in range(_TERMS)],             # (1 - cos t)/t^2
-    "a2": [(-1) ** m / _fact(2 * m + 3) for m in range(_TERMS)],             # (t - sin t)/t^3
-    "a3": [(-1) ** m / _fact(2 * m + 4) for m in range(_TERMS)],             # (t^2 + 2 cos t - 2)/(2 t^4)
-    "a4": [(-1) ** m * (m + 1) / _fact(2 * m + 5) for m in range(_TERMS)],   # (2t - 3 sin t + t cos t)/(2 t^5)
-}
+#: below this squared angle s = t^2 the angle functions are summed as series (generated from the sympy source)
+SERIES_BELOW = maps.SERIES_BELOW
+_CLOSED = {"sinc": maps.closed_sinc, "a1": maps.closed_a1, "a2": maps.closed_a2, "a3": maps.closed_a3,
+           "a4": maps.closed_a4, "b": maps.closed_b}
+_ALIASES = {"jl_inv": "b"}
 
 
 def angle_series(name: str) -> tuple[float, ...]:
-    """The Taylor coefficients c_m of an angle function (sinc, a1 … a4) in powers t^(2m), and ``"jl_inv"``:
-    b(t) of :func:`jac_left_so3_inv` (Bernoulli numbers); 12 terms, for t < 1 (round-off there)."""
-    if name == "jl_inv":
-        return tuple(_INV_SERIES)
-    return tuple(_SERIES[name])
+    """The Taylor coefficients c_m of an angle function (sinc, a1 … a4) in powers t^(2m), and ``"jl_inv"`` (or
+    ``"b"``): b(t) of :func:`jac_left_so3_inv` (Bernoulli numbers); those of mechgen.symbolic.liegroup (16 terms,
+    generated), for t < 1."""
+    return maps.COEFFS[_ALIASES.get(name, name)]
 
 
-def _closed(name: str, t: np.ndarray) -> np.ndarray:
-    if name == "sinc":
-        return np.sin(t) / t
-    if name == "a1":
-        return (1.0 - np.cos(t)) / t**2
-    if name == "a2":
-        return (t - np.sin(t)) / t**3
-    if name == "a3":
-        return (t**2 + 2.0 * np.cos(t) - 2.0) / (2.0 * t**4)
-    return (2.0 * t - 3.0 * np.sin(t) + t * np.cos(t)) / (2.0 * t**5)
-
-
-def _limits(name: str) -> list[float]:
-    """For m = 1 … 12 terms, the largest angle whose first neglected term c_m t^(2m) is below 1e-18 of the
+def _limits(coeffs) -> list[float]:
+    """For m = 1 … M terms, the largest angle whose first neglected term c_m t^(2m) is below 1e-18 of the
     function's value at 0 (|c_0|; the functions stay within a factor 2 of it for t < 1)."""
-    coeffs = _SERIES[name]
     return [(1e-18 * abs(coeffs[0]) / abs(coeffs[m])) ** (1.0 / (2 * m)) if m < len(coeffs) else math.inf
             for m in range(1, len(coeffs) + 1)]
 
 
-_LIMITS = {name: _limits(name) for name in _SERIES}
+_LIMITS = {name: _limits(coeffs) for name, coeffs in maps.COEFFS.items()}
 
 
 def _terms(name: str, t_max: float) -> int:
@@ -84,31 +62,38 @@ def _terms(name: str, t_max: float) -> int:
     for m, limit in enumerate(_LIMITS[name], 1):
         if t_max <= limit:
             return m
-    return len(_SERIES[name])
+    return len(_LIMITS[name])
 
 
-def _series(name: str, t: np.ndarray) -> np.ndarray:
-    """The series of an angle function by Horner's rule in t^2, with only the terms the batch's largest angle
-    needs."""
-    coeffs = _SERIES[name][:_terms(name, float(np.max(t)) if t.size else 0.0)]
-    t2 = t * t
-    acc = np.full_like(t2, coeffs[-1])
+def _series(name: str, s: np.ndarray) -> np.ndarray:
+    """The series of an angle function by Horner's rule in s = t^2, with only the terms the batch's largest
+    angle needs."""
+    coeffs = maps.COEFFS[name][:_terms(name, math.sqrt(float(np.max(s))) if s.size else 0.0)]
+    acc = np.full_like(s, coeffs[-1])
     for c in reversed(coeffs[:-1]):
-        acc *= t2
+        acc *= s
         acc += c
     return acc
+
+
+def angle_of_square(name: str, s) -> np.ndarray:
+    """An angle function (sinc, a1 … a4, b; module docstring) at the squared angle s = t^2 >= 0: its series
+    below t = 1, its closed form above (both generated from mechgen.symbolic.liegroup); round-off everywhere."""
+    name = _ALIASES.get(name, name)
+    s = np.asarray(s, dtype=float)
+    small = s < SERIES_BELOW
+    if small.all():
+        return _series(name, s)
+    if not small.any():
+        return _CLOSED[name](np.sqrt(s))
+    closed = _CLOSED[name](np.sqrt(np.where(small, SERIES_BELOW, s)))
+    return np.where(small, _series(name, np.where(small, s, 0.0)), closed)
 
 
 def angle_function(name: str, theta) -> np.ndarray:
     """One of sinc, a1 … a4 (module docstring) at theta >= 0, accurate to round-off at every angle."""
     t = np.asarray(theta, dtype=float)
-    small = t < _SERIES_BELOW
-    if small.all():
-        return _series(name, t)
-    if not small.any():
-        return _closed(name, t)
-    safe = np.where(small, 1.0, t)
-    return np.where(small, _series(name, np.where(small, t, 0.0)), _closed(name, safe))
+    return angle_of_square(name, t * t)
 
 
 def cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -196,43 +181,22 @@ def _theta(w: np.ndarray) -> np.ndarray:
 
 
 def exp_so3(w) -> np.ndarray:
-    """Rodrigues: exp(hat3 w) = I + sinc(t) hat3 w + a1(t) hat3(w)^2 = cos t I + sinc(t) hat3 w + a1(t) w w^T,
-    t = |w| (hat3(w)^2 = w w^T - t^2 I; cos t = 1 - a1 t^2)."""
-    w = np.asarray(w, dtype=float)
-    t = _theta(w)
-    a1 = angle_function("a1", t)
-    out = (a1[..., None, None] * w[..., :, None]) * w[..., None, :]
-    out += angle_function("sinc", t)[..., None, None] * hat3(w)
-    c = np.cos(t)
-    for i in range(3):
-        out[..., i, i] += c
-    return out
+    """Rodrigues: exp(hat3 w) = I + sinc(t) hat3 w + a1(t) hat3(w)^2, t = |w| (generated from
+    mechgen.symbolic.liegroup.exp_so3)."""
+    return maps.exp_so3(np.asarray(w, dtype=float), angle_of_square)
 
 
 def jac_left_so3(w) -> np.ndarray:
-    """Left Jacobian of SO(3): J_l(w) = I + a1(t) hat3 w + a2(t) hat3(w)^2."""
-    w = np.asarray(w, dtype=float)
-    t = _theta(w)
-    W = hat3(w)
-    return (np.eye(3) + angle_function("a1", t)[..., None, None] * W
-            + angle_function("a2", t)[..., None, None] * (W @ W))
+    """Left Jacobian of SO(3): J_l(w) = I + a1(t) hat3 w + a2(t) hat3(w)^2 (generated)."""
+    return maps.jac_left_so3(np.asarray(w, dtype=float), angle_of_square)
 
 
 def jac_left_so3_inv(w) -> np.ndarray:
-    """J_l(w)^-1 = I - hat3(w)/2 + b(t) hat3(w)^2, b = (1 - t sin t/(2(1 - cos t)))/t^2 (1/12 + t^2/720 + …).
+    """J_l(w)^-1 = I - hat3(w)/2 + b(t) hat3(w)^2, b = (1 - t sin t/(2(1 - cos t)))/t^2 (1/12 + t^2/720 + …;
+    generated).
 
     Singular at t = 2 pi k (k >= 1), where the exponential map is not a local diffeomorphism."""
-    w = np.asarray(w, dtype=float)
-    t = _theta(w)
-    W = hat3(w)
-    small = t < _SERIES_BELOW
-    ts = np.where(small, 1.0, t)
-    closed = (1.0 - ts * np.sin(ts) / (2.0 * (1.0 - np.cos(ts)))) / ts**2
-    t2 = t * t
-    # (1 - (t/2) cot(t/2))/t^2 = sum_n |B_2n| t^(2n-2)/(2n)! (Bernoulli numbers; converges for t < 2 pi)
-    series = np.polynomial.polynomial.polyval(t * t, _INV_SERIES)
-    b = np.where(small, series, closed)
-    return np.eye(3) - 0.5 * W + b[..., None, None] * (W @ W)
+    return maps.jac_left_so3_inv(np.asarray(w, dtype=float), angle_of_square)
 
 
 def log_so3(R) -> np.ndarray:
@@ -256,24 +220,14 @@ def log_so3(R) -> np.ndarray:
     return w
 
 
-def _q_block(v: np.ndarray, w: np.ndarray) -> np.ndarray:
-    """The upper-right block of J_l(xi) (Barfoot & Furgale 2014, eq. (102))."""
-    t = _theta(w)
-    V, W = hat3(v), hat3(w)
-    WV, VW = W @ V, V @ W
-    WVW = WV @ W
-    a2, a3, a4 = (angle_function(n, t)[..., None, None] for n in ("a2", "a3", "a4"))
-    return 0.5 * V + a2 * (WV + VW + WVW) + a3 * (W @ WV + VW @ W - 3.0 * WVW) + a4 * (WVW @ W + W @ WVW)
+def q_block(v, w) -> np.ndarray:
+    """The upper-right block Q(v, w) of J_l(xi) (Barfoot & Furgale 2014, eq. (102); generated)."""
+    return maps.q_block(np.asarray(v, dtype=float), np.asarray(w, dtype=float), angle_of_square)
 
 
 def exp_se3(xi) -> np.ndarray:
-    """exp(hat6(v, w)) = [[exp_so3 w, J_l(w) v], [0, 1]]."""
-    xi = np.asarray(xi, dtype=float)
-    out = np.zeros(xi.shape[:-1] + (4, 4))
-    out[..., :3, :3] = exp_so3(xi[..., 3:])
-    out[..., :3, 3] = np.einsum("...ij,...j->...i", jac_left_so3(xi[..., 3:]), xi[..., :3])
-    out[..., 3, 3] = 1.0
-    return out
+    """exp(hat6(v, w)) = [[exp_so3 w, J_l(w) v], [0, 1]] (generated)."""
+    return maps.exp_se3(np.asarray(xi, dtype=float), angle_of_square)
 
 
 def log_se3(H) -> np.ndarray:
@@ -285,20 +239,14 @@ def log_se3(H) -> np.ndarray:
 
 
 def jac_left_se3(xi) -> np.ndarray:
-    """J_l(xi) = sum_k ad_xi^k/(k+1)! = [[J_l(w), Q(v, w)], [0, J_l(w)]] (6x6)."""
-    xi = np.asarray(xi, dtype=float)
-    v, w = xi[..., :3], xi[..., 3:]
-    J = jac_left_so3(w)
-    out = np.zeros(xi.shape[:-1] + (6, 6))
-    out[..., :3, :3] = J
-    out[..., 3:, 3:] = J
-    out[..., :3, 3:] = _q_block(v, w)
-    return out
+    """J_l(xi) = sum_k ad_xi^k/(k+1)! = [[J_l(w), Q(v, w)], [0, J_l(w)]] (6x6; generated)."""
+    return maps.jac_left_se3(np.asarray(xi, dtype=float), angle_of_square)
 
 
 def jac_right_se3(xi) -> np.ndarray:
-    """J_r(xi) = J_l(-xi) = sum_k (-ad_xi)^k/(k+1)!: exp(hat(xi + d)) = exp(hat xi) exp(hat(J_r d)) + O(d^2)."""
-    return jac_left_se3(-np.asarray(xi, dtype=float))
+    """J_r(xi) = J_l(-xi) = sum_k (-ad_xi)^k/(k+1)!: exp(hat(xi + d)) = exp(hat xi) exp(hat(J_r d)) + O(d^2)
+    (generated)."""
+    return maps.jac_right_se3(np.asarray(xi, dtype=float), angle_of_square)
 
 
 def orthonormality_error(R) -> float:

@@ -1,0 +1,1 @@
+"""Generated Lie-group maps (mechgen.codegen.lower_liegroup)."""
