@@ -240,6 +240,8 @@ def conservative_gyroscopic(M, C, K) -> np.ndarray | None:
     G = np.linalg.solve(LM, np.linalg.solve(LM, 0.5 * (C - C.T)).T).T
     B = np.linalg.solve(LM, LK)
     S = np.block([[-G, -B], [B.T, np.zeros((n, n))]])
+    if not np.isfinite(S).all():  # an overflow in the factors (scipy's solves raise the same ValueError)
+        raise ValueError("array must not contain infs or NaNs")
     mu = np.linalg.eigvalsh(-1j * S)
     return 1j * mu
 
