@@ -499,7 +499,8 @@ def _run(system, x, t, callback, opts: ContinuationOptions, until: Callable | No
             if step < opts.ds_min:
                 status = "min_step"
                 message = (f"the step fell below ds_min = {opts.ds_min:.3g} at lam = {x_i[n]:.10g} (the corrector "
-                           "fails or the branch turns too sharply: a singular point, or tol below the residual's noise)")
+                           "fails or the branch turns too sharply: a singular point, or tol below the residual's "
+                           "noise)")
                 break
             continue
         x_new, iters, t_new = got
