@@ -497,10 +497,7 @@ def _run(system, x, t, callback, opts: ContinuationOptions, until: Callable | No
         if got is None:
             step *= 0.5
             if step < opts.ds_min:
-                status = "min_step"
-                message = (f"the step fell below ds_min = {opts.ds_min:.3g} at lam = {x_i[n]:.10g} (the corrector "
-                           "fails or the branch turns too sharply: a singular point, or tol below the residual's "
-                           "noise)")
+                status, message = "min_step", _min_step_message(opts.ds_min, x_i[n])
                 break
             continue
         x_new, iters, t_new = got
@@ -521,6 +518,11 @@ def _run(system, x, t, callback, opts: ContinuationOptions, until: Callable | No
         step = _next_step(step, iters, opts)
     bar.close()
     return walk.branch(status, message)
+
+
+def _min_step_message(ds_min: float, lam: float) -> str:
+    return (f"the step fell below ds_min = {ds_min:.3g} at lam = {lam:.10g} (the corrector fails or the branch "
+            "turns too sharply: a singular point, or tol below the residual's noise)")
 
 
 def _next_step(step: float, iters: int, opts: ContinuationOptions) -> float:
