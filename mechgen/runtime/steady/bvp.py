@@ -520,26 +520,32 @@ def _newton_loop(evaluate, x0, *, solve, tol, max_iter, method):
                                    "parameter without a boundary condition), the guess is degenerate, or the "
                                    "problem is too ill-conditioned for this method (use more shooting nodes or "
                                    "collocation)") from None
-        alpha, why = 1.0, ""
-        while True:
-            trial = x + alpha * dx
-            try:
-                r_t, J_t = evaluate(trial)
-                n_t = float(np.linalg.norm(r_t))
-            except IVPFailure as exc:
-                n_t, why = np.inf, str(exc)
-            if n_t <= (1.0 - 1e-4 * alpha) * norm:
-                break
-            alpha *= 0.5
-            if alpha < 2.0 ** -24:
-                extra = f"; the trial trajectories fail: {why}" if why and not np.isfinite(n_t) else ""
-                raise ConvergenceError(f"{method}: the line search found no decrease of the residual at "
-                                       f"iteration {it}; residual norm {norm:.3g} > tol {tol:.1e}{extra}. The "
-                                       "problem is too ill-conditioned for this method or the tolerance is "
-                                       "below the integration error")
-        x, r, J, norm = trial, r_t, J_t, n_t
+        x, r, J, norm = _line_search(evaluate, (x, dx, norm), tol, it, method)
         history.append(norm)
     return x, it, norm, J
+
+
+def _line_search(evaluate, step: tuple, tol: float, it: int, method: str) -> tuple:
+    """Backtracking from x along the Newton step dx (``step`` = (x, dx, ||R(x)||)) until ||R|| decreases by
+    the Armijo factor 1 - 1e-4 alpha: (x + alpha dx, R, J, ||R||) there; ConvergenceError below alpha = 2^-24."""
+    x, dx, norm = step
+    alpha, why = 1.0, ""
+    while True:
+        trial = x + alpha * dx
+        try:
+            r_t, J_t = evaluate(trial)
+            n_t = float(np.linalg.norm(r_t))
+        except IVPFailure as exc:
+            n_t, why = np.inf, str(exc)
+        if n_t <= (1.0 - 1e-4 * alpha) * norm:
+            return trial, r_t, J_t, n_t
+        alpha *= 0.5
+        if alpha < 2.0 ** -24:
+            extra = f"; the trial trajectories fail: {why}" if why and not np.isfinite(n_t) else ""
+            raise ConvergenceError(f"{method}: the line search found no decrease of the residual at "
+                                   f"iteration {it}; residual norm {norm:.3g} > tol {tol:.1e}{extra}. The "
+                                   "problem is too ill-conditioned for this method or the tolerance is "
+                                   "below the integration error")
 
 
 # ----------------------------------------------------------------------------- single shooting
@@ -561,18 +567,31 @@ def shoot(problem: BVP, guess, *, p=None, tol: float = 1e-10, max_iter: int = 40
     p = full_parameters(problem, p)
     y0 = _state(problem, guess, "guess")
     problem.check(y0, p)
-    opts = ivp_options(problem, options)
-    n, unk = problem.n, list(problem.unknown)
-    a, b = problem.interval
+    shot = _SingleShot(problem, p, ivp_options(problem, options))
+    x0 = np.concatenate([y0, p[shot.unk]])
+    x, it, norm, _ = _damped_newton(shot.evaluate, x0, solve=_dense_solve, tol=tol, max_iter=max_iter,
+                                    method="single shooting")
+    return shot.result(x, it, norm)
 
-    def unpack(x):
-        q = p.copy()
-        q[unk] = x[n:]
+
+class _SingleShot:
+    """Single shooting's residual g(y(a), y(b), p) with y(b) the flow of x = (y(a), p[unknown]) and its
+    Jacobian [G_a + G_b Phi, G_b Psi + G_p] (the variational equations); ``opts`` as :func:`ivp_options`'s."""
+
+    def __init__(self, problem: BVP, p, opts: dict) -> None:
+        self.problem, self.p, self.opts = problem, p, opts
+        self.unk = list(problem.unknown)
+
+    def unpack(self, x):
+        n = self.problem.n
+        q = self.p.copy()
+        q[self.unk] = x[n:]
         return x[:n], q
 
-    def evaluate(x):
-        ya, q = unpack(x)
-        yb, Phi, Psi, _ = _flow(problem, (a, b), ya, q, unk, opts)
+    def evaluate(self, x):
+        problem, unk = self.problem, self.unk
+        ya, q = self.unpack(x)
+        yb, Phi, Psi, _ = _flow(problem, problem.interval, ya, q, unk, self.opts)
         R = problem.bc(ya, yb, q)
         Ga, Gb, Gp = problem.bc_jac(ya, yb, q)
         J = np.hstack([Ga + Gb @ Phi, Gb @ Psi + Gp[:, unk]])
@@ -580,17 +599,15 @@ def shoot(problem: BVP, guess, *, p=None, tol: float = 1e-10, max_iter: int = 40
             raise IVPFailure("the boundary residual or its Jacobian is not finite")
         return R, J
 
-    x0 = np.concatenate([y0, p[unk]])
-    x, it, norm, _ = _damped_newton(evaluate, x0, solve=_dense_solve, tol=tol, max_iter=max_iter,
-                                    method="single shooting")
-    ya, q = unpack(x)
-    opts["budget"].used = 0
-    try:
-        _, _, _, sol = _flow(problem, (a, b), ya, q, None, opts, dense=True)
-    except (IVPFailure, BudgetSpent) as exc:  # pragma: no cover - the same trajectory just succeeded
-        raise ConvergenceError(f"single shooting: the final trajectory failed: {exc}") from None
-    dense = sol.sol
-    return BVPResult(sol.t, sol.y, q, norm, it, "single shooting", dense)
+    def result(self, x, it: int, norm: float) -> BVPResult:
+        """The BVPResult of the converged x: its trajectory integrated again with dense output."""
+        ya, q = self.unpack(x)
+        self.opts["budget"].used = 0
+        try:
+            _, _, _, sol = _flow(self.problem, self.problem.interval, ya, q, None, self.opts, dense=True)
+        except (IVPFailure, BudgetSpent) as exc:  # pragma: no cover - the same trajectory just succeeded
+            raise ConvergenceError(f"single shooting: the final trajectory failed: {exc}") from None
+        return BVPResult(sol.t, sol.y, q, norm, it, "single shooting", sol.sol)
 
 
 # ----------------------------------------------------------------------------- multiple shooting
