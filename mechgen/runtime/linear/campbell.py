@@ -218,28 +218,33 @@ def fit_speed_polynomial(evaluate, lo: float, hi: float, *, rtol: float = 1e-12,
     if any(set(d) != set(keys) for d in (at_hi, at_probe)):
         return None
     scale = {k: max(matrix_norm(d[k]) for d in (at_lo, at_hi, at_probe)) for k in keys}
-
-    def fitted(terms: dict) -> SpeedPolynomial | None:
-        for key, coefs in terms.items():
-            for k in range(1, len(coefs)):
-                if matrix_norm(coefs[k]) <= 1e-14 * scale[key]:
-                    coefs[k] = None
-            if matrix_norm(_evaluate({key: coefs}, probe)[key] - at_probe[key]) > rtol * scale[key]:
-                return None
-            while coefs[-1] is None and len(coefs) > 1:
-                coefs.pop()
-        return SpeedPolynomial(terms, center, half)
-
     # linear first (three evaluations), then quadratic through lo, centre, hi (the probe checks either)
-    poly = fitted({k: [0.5 * (at_hi[k] + at_lo[k]), 0.5 * (at_hi[k] - at_lo[k])] for k in keys})
+    poly = _fitted({k: [0.5 * (at_hi[k] + at_lo[k]), 0.5 * (at_hi[k] - at_lo[k])] for k in keys}, scale,
+                   (probe, at_probe, rtol), center, half)
     if poly is not None:
         return poly
     at_mid = evaluate(center)
     if set(at_mid) != set(keys):
         return None
     scale = {k: max(scale[k], matrix_norm(at_mid[k])) for k in keys}
-    return fitted({k: [at_mid[k], 0.5 * (at_hi[k] - at_lo[k]), 0.5 * (at_hi[k] + at_lo[k]) - at_mid[k]]
-                   for k in keys})
+    return _fitted({k: [at_mid[k], 0.5 * (at_hi[k] - at_lo[k]), 0.5 * (at_hi[k] + at_lo[k]) - at_mid[k]]
+                    for k in keys}, scale, (probe, at_probe, rtol), center, half)
+
+
+def _fitted(terms: dict, scale: dict, check: tuple, center: float, half: float) -> SpeedPolynomial | None:
+    """The SpeedPolynomial of the coefficient lists ``terms`` (in t = (w - center) / half), coefficients below
+    1e-14 of the matrix's ``scale`` dropped, when every matrix matches its sample at the probe:
+    ``check`` = (probe t, the matrices there, rtol relative to ``scale``); else None."""
+    probe, at_probe, rtol = check
+    for key, coefs in terms.items():
+        for k in range(1, len(coefs)):
+            if matrix_norm(coefs[k]) <= 1e-14 * scale[key]:
+                coefs[k] = None
+        if matrix_norm(_evaluate({key: coefs}, probe)[key] - at_probe[key]) > rtol * scale[key]:
+            return None
+        while coefs[-1] is None and len(coefs) > 1:
+            coefs.pop()
+    return SpeedPolynomial(terms, center, half)
 
 
 # ----------------------------------------------------------------------------------------- reduced model
