@@ -459,7 +459,7 @@ class _CLoop:
             budget.spend(state.counted, lambda: self.where(state.t, state.mode))
         if rc < 0:
             self.new_events()
-            error = _error(rc, self.system, state, self.arrays["err_x"], self.where, self.options, self.zeno_span)
+            error = _error(rc, self)
             if isinstance(error, ZenoApproach):  # the run so far, up to the event that made it Zeno
                 raise error.with_trajectory(_zeno_trajectory(self.arrays, state, self.events))
             raise error
@@ -502,10 +502,41 @@ def _zeno_trajectory(arrays: dict, state: CState, events: list) -> HybridTraject
                             {"loop": "c", "rate_evaluations": int(state.nrate)})
 
 
-def _error(rc: int, system, state: CState, err_x: np.ndarray, where, options: RunOptions,
-           zeno_span: float) -> Exception:
+def _error(rc: int, loop: _CLoop) -> Exception:
     """The exception the Python loop raises for the C loop's error code ``rc``."""
-    rules, explain = options.rules, options.explain
+    if rc in (E_KERNEL, E_RHS, E_STATE, E_RESET, E_GUARD):
+        return _kernel_error(rc, loop)
+    state, where, rules = loop.state, loop.where, loop.options.rules
+    system, t, seg = loop.system, float(state.err_t), int(state.err_mode)
+    if rc in (E_SINGULAR, E_SMALL):
+        if rc == E_SMALL:
+            return ConvergenceError(f"DOP853 stopped at {where(t, seg)}: Required step size is less than "
+                                    "spacing between numbers")
+        err_x, explain = loop.arrays["err_x"], loop.options.explain
+        why = diagnosis(system, seg, t, err_x.copy()) or (explain(t, err_x.copy()) if explain is not None else "")
+        return ConvergenceError(f"DOP853 failed near {where(t, seg)} (Singular matrix)" + (f"; {why}" if why else ""))
+    if rc == E_EVENTS:
+        return BudgetExceeded(f"events: more than max_events = {rules.max_events:,} events", key="max_events",
+                              reached=where(t, seg))
+    if rc == E_ZENO:
+        count = max(2, rules.zeno_events + 1)
+        return ZenoApproach(f"events: {count} events within {state.err_span:.3g} (more than zeno_events = "
+                            f"{rules.zeno_events} within zeno_span = {loop.zeno_span:.3g}): a Zeno or chattering "
+                            f"approach (guard {system.guards(seg)[state.err_guard].name} of mode {system.modes[seg]}); "
+                            f"{ZENO_HINT}", key="zeno_events", reached=where(t, seg))
+    if rc == E_LEFT:
+        guard = system.guards(seg)[state.err_guard]
+        return unnoticed(guard.name, guard.direction, system.modes[seg], float(state.err_span), t, where(t, seg))
+    if rc == E_BUDGET:
+        return BudgetExceeded("DOP853 steps: stopped by the step budget", key="max_steps", reached=where(t, seg))
+    if rc == E_MEMORY:
+        return MemoryError("the C event loop could not allocate its workspace")
+    return RuntimeError(f"the C event loop refused its input (code {rc})")
+
+
+def _kernel_error(rc: int, loop: _CLoop) -> KernelError:
+    """The KernelError of a kernel's error code or a NaN/Inf (in dx/dt, the state, a reset or a guard)."""
+    state, where, system, err_x = loop.state, loop.where, loop.system, loop.arrays["err_x"]
     t, seg = float(state.err_t), int(state.err_mode)
     model = system.metadata.model
     if rc == E_KERNEL:
@@ -520,29 +551,5 @@ def _error(rc: int, system, state: CState, err_x: np.ndarray, where, options: Ru
     if rc == E_RESET:
         return KernelError(f"reset of guard {system.guards(seg)[state.err_guard].name} gave NaN/Inf at "
                            f"{where(t, seg)}")
-    if rc == E_GUARD:
-        return KernelError(f"guard {system.guards(seg)[state.err_guard].name} of {model} gave NaN/Inf at "
-                           f"{where(t, seg)}, x = {err_x[:6]}")
-    if rc in (E_SINGULAR, E_SMALL):
-        if rc == E_SMALL:
-            return ConvergenceError(f"DOP853 stopped at {where(t, seg)}: Required step size is less than "
-                                    "spacing between numbers")
-        why = diagnosis(system, seg, t, err_x.copy()) or (explain(t, err_x.copy()) if explain is not None else "")
-        return ConvergenceError(f"DOP853 failed near {where(t, seg)} (Singular matrix)" + (f"; {why}" if why else ""))
-    if rc == E_EVENTS:
-        return BudgetExceeded(f"events: more than max_events = {rules.max_events:,} events", key="max_events",
-                              reached=where(t, seg))
-    if rc == E_ZENO:
-        count = max(2, rules.zeno_events + 1)
-        return ZenoApproach(f"events: {count} events within {state.err_span:.3g} (more than zeno_events = "
-                            f"{rules.zeno_events} within zeno_span = {zeno_span:.3g}): a Zeno or chattering approach "
-                            f"(guard {system.guards(seg)[state.err_guard].name} of mode {system.modes[seg]}); "
-                            f"{ZENO_HINT}", key="zeno_events", reached=where(t, seg))
-    if rc == E_LEFT:
-        guard = system.guards(seg)[state.err_guard]
-        return unnoticed(guard.name, guard.direction, system.modes[seg], float(state.err_span), t, where(t, seg))
-    if rc == E_BUDGET:
-        return BudgetExceeded("DOP853 steps: stopped by the step budget", key="max_steps", reached=where(t, seg))
-    if rc == E_MEMORY:
-        return MemoryError("the C event loop could not allocate its workspace")
-    return RuntimeError(f"the C event loop refused its input (code {rc})")
+    return KernelError(f"guard {system.guards(seg)[state.err_guard].name} of {model} gave NaN/Inf at "
+                       f"{where(t, seg)}, x = {err_x[:6]}")
