@@ -209,47 +209,66 @@ def leapfrog(acceleration, q0, v0, dt: float, n_steps: int, *, record_every: int
     ``budget`` refuses n_steps above its limit before the first step and checks its wall time every
     CHECK_EVERY steps; a NaN/Inf state stops the run at the check that sees it.
     """
-    t_end = n_steps * dt
     if budget is not None:
         budget.refuse(n_steps, f"nothing (refused before starting: t_end / dt = {n_steps:,} steps)")
     q, v = np.array(q0, float), np.array(v0, float)
     a = np.asarray(acceleration(q), float)
-    n_rec = n_steps // record_every + 1
-    require(dense_bytes(n_rec, 2 * q.size + 2), f"the leapfrog record of {n_rec} states of {q.size} coordinates",
-            key="params.N")
-    ts, qs, vs = np.empty(n_rec), np.empty((n_rec, q.size)), np.empty((n_rec, q.size))
-    energies = []
-    half = 0.5 * dt
-
-    def record(k: int, step: int) -> None:
-        ts[k], qs[k], vs[k] = step * dt, q, v
-        if energy is not None:
-            energies.append(float(energy(q, v)))
-
-    def unstable(step: int) -> KernelError:
-        return KernelError(f"leapfrog state became NaN/Inf by t = {step * dt:.6g} of t_end = {t_end:.6g} "
-                           f"(step {step:,} of {n_steps:,}; time step dt = {dt:g} too large for the stiffest mode?)")
-
-    record(0, 0)
-    k = 1
+    rec = _LeapfrogRecord(q.size, dt, n_steps, record_every, energy)
+    rec.record(0, q, v)
     with Progress(n_steps, desc=desc, unit="step", enabled=progress) as bar:
-        for step in range(1, n_steps + 1):
-            v += half * a
-            q += dt * v
-            a = np.asarray(acceleration(q), float)
-            v += half * a
-            if step % record_every == 0:
-                record(k, step)
-                k += 1
-            if step % CHECK_EVERY == 0:
-                if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
-                    raise unstable(step)
-                if budget is not None:
-                    budget.check_time(lambda: reached_at(step * dt, t_end, step))
-                bar.to(step)
+        q, v = _verlet(acceleration, (q, v, a), rec, budget, bar)
     if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
-        raise unstable(n_steps)
-    return Trajectory(ts[:k], q=qs[:k], v=vs[:k], energy=energies, nfev=n_steps + 1, steps=n_steps)
+        raise rec.unstable(n_steps)
+    return Trajectory(rec.ts[:rec.k], q=rec.qs[:rec.k], v=rec.vs[:rec.k], energy=rec.energies, nfev=n_steps + 1,
+                      steps=n_steps)
+
+
+class _LeapfrogRecord:
+    """The leapfrog's samples: (t, q, v) every ``every`` steps (and the start), with energy(q, v) when given."""
+
+    def __init__(self, size: int, dt: float, n_steps: int, every: int, energy) -> None:
+        self.dt, self.n_steps, self.every, self.energy = dt, n_steps, every, energy
+        self.t_end = n_steps * dt
+        n_rec = n_steps // every + 1
+        require(dense_bytes(n_rec, 2 * size + 2), f"the leapfrog record of {n_rec} states of {size} coordinates",
+                key="params.N")
+        self.ts, self.qs, self.vs = np.empty(n_rec), np.empty((n_rec, size)), np.empty((n_rec, size))
+        self.energies: list = []
+        self.k = 0
+
+    def record(self, step: int, q, v) -> None:
+        k = self.k
+        self.ts[k], self.qs[k], self.vs[k] = step * self.dt, q, v
+        if self.energy is not None:
+            self.energies.append(float(self.energy(q, v)))
+        self.k = k + 1
+
+    def unstable(self, step: int) -> KernelError:
+        return KernelError(f"leapfrog state became NaN/Inf by t = {step * self.dt:.6g} of t_end = {self.t_end:.6g} "
+                           f"(step {step:,} of {self.n_steps:,}; time step dt = {self.dt:g} too large for the "
+                           "stiffest mode?)")
+
+
+def _verlet(acceleration, start: tuple, rec: _LeapfrogRecord, budget: Budget | None, bar) -> tuple:
+    """The velocity Verlet steps from ``start`` = (q, v, a(q)) (updated in place), recorded in ``rec``; the
+    finiteness, the budget's wall time and the bar checked every CHECK_EVERY steps. Returns (q, v)."""
+    q, v, a = start
+    dt, n_steps, every, t_end = rec.dt, rec.n_steps, rec.every, rec.t_end
+    half = 0.5 * dt
+    for step in range(1, n_steps + 1):
+        v += half * a
+        q += dt * v
+        a = np.asarray(acceleration(q), float)
+        v += half * a
+        if step % every == 0:
+            rec.record(step, q, v)
+        if step % CHECK_EVERY == 0:
+            if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
+                raise rec.unstable(step)
+            if budget is not None:
+                budget.check_time(lambda: reached_at(step * dt, t_end, step))
+            bar.to(step)
+    return q, v
 
 
 __all__ = ["Budget", "BudgetExceeded", "IMPLICIT", "METHODS", "MIN_RTOL", "Trajectory", "integrate_first_order",
