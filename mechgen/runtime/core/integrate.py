@@ -72,86 +72,120 @@ def integrate_first_order(rhs, x0, t_end: float, *, jac=None, options: RunOption
     :class:`~mechgen.runtime.core.budget.Progress`).
     """
     options = RunOptions.of(options or RunOptions(method="BDF"), **changes)
-    method, rtol, atol, t_eval, budget = options.method, options.rtol, options.atol, options.t_eval, options.budget
-    progress, desc, explain = options.progress, options.desc, options.explain
+    method = options.method
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}; expected one of {METHODS}")
     t_end = float(t_end)
-    last: list = [0.0, np.asarray(x0, float)]
-    accepted: list = [0.0, np.asarray(x0, float)]
-
-    def fun(t, x):  # remembers the state of the latest evaluation, for the failure message
-        last[0], last[1] = t, x
-        return rhs(t, x)
-
-    def jacobian(t, x):
-        last[0], last[1] = t, x
-        return jac(t, x)
-
-    kwargs = {"jac": jacobian} if (jac is not None and method in IMPLICIT) else {}
-
-    def note() -> str:
-        """explain() at the latest evaluated state, or at the last accepted one when that one is not finite."""
-        if explain is None:
-            return ""
-        t_x, x = last[0], np.asarray(last[1], float)
-        if not np.all(np.isfinite(x)):
-            t_x, x = accepted[0], np.asarray(accepted[1], float)
-        return explain(t_x, x)
-
-    def failed(what: str) -> str:
-        why = note()
-        return f"{method} {what}" + (f"; {why}" if why else "")
-
+    watch = _Watched(rhs, jac, x0, method, options.explain)
     from numpy.linalg import LinAlgError
 
-    t_eval = None if t_eval is None else np.asarray(t_eval, float)
-    ts: list = []
-    ys: list = []
-    i_eval, steps, t = 0, 0, 0.0
+    samples = _Samples(options.t_eval)
     try:
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # its first step's size, checked below
-            solver = _solver_class(method)(fun, 0.0, np.asarray(x0, float), t_end, rtol=rtol, atol=atol, **kwargs)
-        with Progress(t_end, desc=desc, unit="t", enabled=progress) as bar:
-            while solver.status == "running":
-                with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # finiteness is checked here
-                    message = solver.step()
-                if solver.status == "failed":
-                    raise ConvergenceError(failed(f"stopped at {reached_at(solver.t, t_end, steps)}: "
-                                                  f"{str(message).rstrip('.')}"))
-                steps += 1
-                t = solver.t
-                accepted[0], accepted[1] = t, solver.y
-                if t_eval is None:
-                    ts.append(t)
-                    ys.append(solver.y.copy())
-                else:
-                    i_new = int(np.searchsorted(t_eval, t, side="right"))
-                    if i_new > i_eval:
-                        ts.append(t_eval[i_eval:i_new])
-                        ys.append(solver.dense_output()(t_eval[i_eval:i_new]).T)
-                        i_eval = i_new
-                if budget is not None:
-                    budget.spend(1, lambda: reached_at(t, t_end, steps))
-                    if steps % CHECK_EVERY == 0:
-                        project_steps(budget, method, steps, t, t - solver.t_old, t_end)
-                bar.to(t)
+            solver = _solver_class(method)(watch.fun, 0.0, np.asarray(x0, float), t_end, rtol=options.rtol,
+                                           atol=options.atol, **watch.solver_options())
+        with Progress(t_end, desc=options.desc, unit="t", enabled=options.progress) as bar:
+            steps, t = _march(solver, watch, samples, options, t_end, bar)
     except (LinAlgError, ZeroDivisionError, ValueError) as exc:  # a singular M; a NaN met by a check_finite solve
-        raise ConvergenceError(failed(f"failed at t = {last[0]:.6g} of t_end = {t_end:.6g} ({exc})")) from exc
+        raise ConvergenceError(watch.failed(f"failed at t = {watch.last[0]:.6g} of t_end = {t_end:.6g} ({exc})")) \
+            from exc
     except KernelError as exc:
-        why = note()
+        why = watch.note()
         if not why:
             raise
-        raise KernelError(f"{method} at t = {last[0]:.6g} of t_end = {t_end:.6g}: {why}") from exc
-    if t_eval is None:
-        t_out, x_out = np.array(ts), np.array(ys).reshape(len(ts), -1)
-    else:
-        t_out = np.hstack(ts) if ts else np.empty(0)
-        x_out = np.vstack(ys) if ys else np.empty((0, np.size(x0)))
+        raise KernelError(f"{method} at t = {watch.last[0]:.6g} of t_end = {t_end:.6g}: {why}") from exc
+    t_out, x_out = samples.arrays(np.size(x0))
     if not np.all(np.isfinite(x_out)):
-        raise KernelError(failed(f"state became NaN/Inf by t = {t:.6g} of t_end = {t_end:.6g}"))
+        raise KernelError(watch.failed(f"state became NaN/Inf by t = {t:.6g} of t_end = {t_end:.6g}"))
     return Trajectory(t_out, x_out, nfev=solver.nfev, njev=solver.njev, success=True,
                       message="The solver successfully reached the end of the integration interval.", steps=steps)
+
+
+class _Watched:
+    """dx/dt = rhs(t, x) and its Jacobian for scipy's stepper, remembering the latest evaluated and the last
+    accepted state, so that a failure says where (``explain(t, x)``, or None, adds what went wrong there)."""
+
+    def __init__(self, rhs, jac, x0, method: str, explain) -> None:
+        self.rhs, self.jac, self.method, self.explain = rhs, jac, method, explain
+        self.last: list = [0.0, np.asarray(x0, float)]
+        self.accepted: list = [0.0, np.asarray(x0, float)]
+
+    def fun(self, t, x):  # remembers the state of the latest evaluation, for the failure message
+        self.last[0], self.last[1] = t, x
+        return self.rhs(t, x)
+
+    def jacobian(self, t, x):
+        self.last[0], self.last[1] = t, x
+        return self.jac(t, x)
+
+    def solver_options(self) -> dict:
+        return {"jac": self.jacobian} if (self.jac is not None and self.method in IMPLICIT) else {}
+
+    def note(self) -> str:
+        """explain() at the latest evaluated state, or at the last accepted one when that one is not finite."""
+        if self.explain is None:
+            return ""
+        t_x, x = self.last[0], np.asarray(self.last[1], float)
+        if not np.all(np.isfinite(x)):
+            t_x, x = self.accepted[0], np.asarray(self.accepted[1], float)
+        return self.explain(t_x, x)
+
+    def failed(self, what: str) -> str:
+        why = self.note()
+        return f"{self.method} {what}" + (f"; {why}" if why else "")
+
+
+class _Samples:
+    """The samples of a run: at ``t_eval`` (from each step's dense output), or at every step end (None)."""
+
+    def __init__(self, t_eval) -> None:
+        self.t_eval = None if t_eval is None else np.asarray(t_eval, float)
+        self.ts: list = []
+        self.ys: list = []
+        self.i_eval = 0
+
+    def take(self, solver) -> None:
+        """The samples of the step the solver has just taken."""
+        t, t_eval = solver.t, self.t_eval
+        if t_eval is None:
+            self.ts.append(t)
+            self.ys.append(solver.y.copy())
+            return
+        i_new = int(np.searchsorted(t_eval, t, side="right"))
+        if i_new > self.i_eval:
+            self.ts.append(t_eval[self.i_eval:i_new])
+            self.ys.append(solver.dense_output()(t_eval[self.i_eval:i_new]).T)
+            self.i_eval = i_new
+
+    def arrays(self, size: int) -> tuple[np.ndarray, np.ndarray]:
+        """(t, x rows) of the samples; ``size`` the state's."""
+        ts, ys = self.ts, self.ys
+        if self.t_eval is None:
+            return np.array(ts), np.array(ys).reshape(len(ts), -1)
+        return (np.hstack(ts) if ts else np.empty(0)), (np.vstack(ys) if ys else np.empty((0, size)))
+
+
+def _march(solver, watch: _Watched, samples: _Samples, options: RunOptions, t_end: float, bar) -> tuple[int, float]:
+    """Step the solver to t_end, sampling each step and spending one unit of the budget per step (with the
+    projection of :func:`project_steps` every CHECK_EVERY steps): (accepted steps, t reached)."""
+    budget, method = options.budget, options.method
+    steps, t = 0, 0.0
+    while solver.status == "running":
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # finiteness is checked here
+            message = solver.step()
+        if solver.status == "failed":
+            raise ConvergenceError(watch.failed(f"stopped at {reached_at(solver.t, t_end, steps)}: "
+                                                f"{str(message).rstrip('.')}"))
+        steps += 1
+        t = solver.t
+        watch.accepted[0], watch.accepted[1] = t, solver.y
+        samples.take(solver)
+        if budget is not None:
+            budget.spend(1, lambda: reached_at(t, t_end, steps))
+            if steps % CHECK_EVERY == 0:
+                project_steps(budget, method, steps, t, t - solver.t_old, t_end)
+        bar.to(t)
+    return steps, t
 
 
 def project_steps(budget: Budget, method: str, steps: int, t: float, h: float, t_end: float) -> None:
@@ -175,47 +209,66 @@ def leapfrog(acceleration, q0, v0, dt: float, n_steps: int, *, record_every: int
     ``budget`` refuses n_steps above its limit before the first step and checks its wall time every
     CHECK_EVERY steps; a NaN/Inf state stops the run at the check that sees it.
     """
-    t_end = n_steps * dt
     if budget is not None:
         budget.refuse(n_steps, f"nothing (refused before starting: t_end / dt = {n_steps:,} steps)")
     q, v = np.array(q0, float), np.array(v0, float)
     a = np.asarray(acceleration(q), float)
-    n_rec = n_steps // record_every + 1
-    require(dense_bytes(n_rec, 2 * q.size + 2), f"the leapfrog record of {n_rec} states of {q.size} coordinates",
-            key="params.N")
-    ts, qs, vs = np.empty(n_rec), np.empty((n_rec, q.size)), np.empty((n_rec, q.size))
-    energies = []
-    half = 0.5 * dt
-
-    def record(k: int, step: int) -> None:
-        ts[k], qs[k], vs[k] = step * dt, q, v
-        if energy is not None:
-            energies.append(float(energy(q, v)))
-
-    def unstable(step: int) -> KernelError:
-        return KernelError(f"leapfrog state became NaN/Inf by t = {step * dt:.6g} of t_end = {t_end:.6g} "
-                           f"(step {step:,} of {n_steps:,}; time step dt = {dt:g} too large for the stiffest mode?)")
-
-    record(0, 0)
-    k = 1
+    rec = _LeapfrogRecord(q.size, dt, n_steps, record_every, energy)
+    rec.record(0, q, v)
     with Progress(n_steps, desc=desc, unit="step", enabled=progress) as bar:
-        for step in range(1, n_steps + 1):
-            v += half * a
-            q += dt * v
-            a = np.asarray(acceleration(q), float)
-            v += half * a
-            if step % record_every == 0:
-                record(k, step)
-                k += 1
-            if step % CHECK_EVERY == 0:
-                if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
-                    raise unstable(step)
-                if budget is not None:
-                    budget.check_time(lambda: reached_at(step * dt, t_end, step))
-                bar.to(step)
+        q, v = _verlet(acceleration, (q, v, a), rec, budget, bar)
     if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
-        raise unstable(n_steps)
-    return Trajectory(ts[:k], q=qs[:k], v=vs[:k], energy=energies, nfev=n_steps + 1, steps=n_steps)
+        raise rec.unstable(n_steps)
+    return Trajectory(rec.ts[:rec.k], q=rec.qs[:rec.k], v=rec.vs[:rec.k], energy=rec.energies, nfev=n_steps + 1,
+                      steps=n_steps)
+
+
+class _LeapfrogRecord:
+    """The leapfrog's samples: (t, q, v) every ``every`` steps (and the start), with energy(q, v) when given."""
+
+    def __init__(self, size: int, dt: float, n_steps: int, every: int, energy) -> None:
+        self.dt, self.n_steps, self.every, self.energy = dt, n_steps, every, energy
+        self.t_end = n_steps * dt
+        n_rec = n_steps // every + 1
+        require(dense_bytes(n_rec, 2 * size + 2), f"the leapfrog record of {n_rec} states of {size} coordinates",
+                key="params.N")
+        self.ts, self.qs, self.vs = np.empty(n_rec), np.empty((n_rec, size)), np.empty((n_rec, size))
+        self.energies: list = []
+        self.k = 0
+
+    def record(self, step: int, q, v) -> None:
+        k = self.k
+        self.ts[k], self.qs[k], self.vs[k] = step * self.dt, q, v
+        if self.energy is not None:
+            self.energies.append(float(self.energy(q, v)))
+        self.k = k + 1
+
+    def unstable(self, step: int) -> KernelError:
+        return KernelError(f"leapfrog state became NaN/Inf by t = {step * self.dt:.6g} of t_end = {self.t_end:.6g} "
+                           f"(step {step:,} of {self.n_steps:,}; time step dt = {self.dt:g} too large for the "
+                           "stiffest mode?)")
+
+
+def _verlet(acceleration, start: tuple, rec: _LeapfrogRecord, budget: Budget | None, bar) -> tuple:
+    """The velocity Verlet steps from ``start`` = (q, v, a(q)) (updated in place), recorded in ``rec``; the
+    finiteness, the budget's wall time and the bar checked every CHECK_EVERY steps. Returns (q, v)."""
+    q, v, a = start
+    dt, n_steps, every, t_end = rec.dt, rec.n_steps, rec.every, rec.t_end
+    half = 0.5 * dt
+    for step in range(1, n_steps + 1):
+        v += half * a
+        q += dt * v
+        a = np.asarray(acceleration(q), float)
+        v += half * a
+        if step % every == 0:
+            rec.record(step, q, v)
+        if step % CHECK_EVERY == 0:
+            if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
+                raise rec.unstable(step)
+            if budget is not None:
+                budget.check_time(lambda: reached_at(step * dt, t_end, step))
+            bar.to(step)
+    return q, v
 
 
 __all__ = ["Budget", "BudgetExceeded", "IMPLICIT", "METHODS", "MIN_RTOL", "Trajectory", "integrate_first_order",

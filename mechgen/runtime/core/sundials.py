@@ -95,77 +95,96 @@ def integrate_cvodes(system, x0, t_end: float, *, t_eval, rtol: float = 1e-8, at
     """Integrate the system's dx/dt = f(t, x) from 0 to t_end with CVODES; states at the uniform ``t_eval``
     (from 0 to t_end; module doc for pieces, budget and failures); ``integrals`` = 3: x0 and the states carry
     the energy balance's integrals after (q, v, z) (first_order_expression)."""
-    import casadi as ca
-
     t_eval = np.asarray(t_eval, float)
     if t_eval.size < 2 or t_eval[0] != 0.0 or not np.allclose(np.diff(t_eval), t_eval[1] - t_eval[0], rtol=1e-9):
         raise ValueError("integrate_cvodes samples a uniform grid from t = 0")
-    x_sym, t_sym, p_sym, f = first_order_expression(system, integrals)
-    t0, tau = ca.MX.sym("t0"), ca.MX.sym("tau")
-    dae = {"x": x_sym, "t": tau, "p": ca.vertcat(p_sym, t0), "ode": ca.substitute(f, t_sym, t0 + tau)}
+    run = _CvodesRun(system, t_end, (rtol, atol), budget, explain, integrals)
     sub = max(1, -(-CHUNKS // (t_eval.size - 1)))  # grid points per sample interval: at least CHUNKS pieces
     h = float(t_eval[1] - t_eval[0]) / sub
-    intervals = (t_eval.size - 1) * sub
-    per = max(1, -(-intervals // CHUNKS))  # grid intervals per piece
-    limit = budget.limit if budget is not None and budget.limit is not None else 100_000
-    options = {"abstol": float(atol), "reltol": float(rtol), "max_num_steps": int(limit),
-               "disable_internal_warnings": True, "show_eval_warnings": False, "newton_scheme": "direct", "linear_solver": "csparse"}
-    integrators: dict = {}
+    with Progress(t_end, desc=desc, unit="t", enabled=progress) as bar:
+        grid = run.march(np.asarray(x0, float).copy(), h, (t_eval.size - 1) * sub, bar)
+    rows = np.array(grid)[::sub]
+    return Trajectory(t_eval.copy(), rows, nfev=run.nfev, njev=run.njev, success=True,
+                      message="CVODES reached the end of the integration interval.", steps=run.steps)
 
-    def integrator(k: int, step: float):
+
+class _CvodesRun:
+    """One run of :func:`integrate_cvodes`: the CasADi problem (time as t0 + tau, t0 a parameter), the CVODES
+    integrators built on use per (outputs, step), the statistics so far (steps, nfev, njev) and what a failure
+    reports (``budget``, ``explain``)."""
+
+    def __init__(self, system, t_end: float, tolerances: tuple, budget: Budget | None, explain, integrals: int):
+        import casadi as ca
+
+        rtol, atol = tolerances
+        x_sym, t_sym, p_sym, f = first_order_expression(system, integrals)
+        t0, tau = ca.MX.sym("t0"), ca.MX.sym("tau")
+        self.dae = {"x": x_sym, "t": tau, "p": ca.vertcat(p_sym, t0), "ode": ca.substitute(f, t_sym, t0 + tau)}
+        self.limit = budget.limit if budget is not None and budget.limit is not None else 100_000
+        self.options = {"abstol": float(atol), "reltol": float(rtol), "max_num_steps": int(self.limit),
+                        "disable_internal_warnings": True, "show_eval_warnings": False, "newton_scheme": "direct",
+                        "linear_solver": "csparse"}
+        self.integrators: dict = {}
+        self.params = np.asarray(system.params, float)
+        self.t_end, self.budget, self.explain = t_end, budget, explain
+        self.steps = self.nfev = self.njev = 0
+
+    def integrator(self, k: int, step: float):
         """CVODES from tau = 0 with outputs at step, 2 step, ... k step (built once per (k, step))."""
-        if (k, step) not in integrators:
-            integrators[k, step] = ca.integrator("cvodes", "cvodes", dae, 0.0, [step * (i + 1) for i in range(k)],
-                                                 options)
-        return integrators[k, step]
+        if (k, step) not in self.integrators:
+            import casadi as ca
 
-    def advance(x, start: float, k: int, step: float):
+            self.integrators[k, step] = ca.integrator("cvodes", "cvodes", self.dae, 0.0,
+                                                      [step * (i + 1) for i in range(k)], self.options)
+        return self.integrators[k, step]
+
+    def advance(self, x, start: float, k: int, step: float):
         """States at start + step, ..., start + k step (rows), and CVODES's statistics."""
-        F = integrator(k, step)
-        out = F(x0=x, p=np.concatenate([params, [start]]))
+        F = self.integrator(k, step)
+        out = F(x0=x, p=np.concatenate([self.params, [start]]))
         return np.asarray(out["xf"], float).reshape(x.size, k).T, F.stats()
 
-    def failure(exc: RuntimeError, x, start: float, span: float) -> Exception:
+    def march(self, x, h: float, intervals: int, bar) -> list:
+        """The states at 0, h, ..., intervals h from x, in pieces of at least intervals / CHUNKS steps h; the
+        budget is spent and the bar moved after every piece."""
+        per = max(1, -(-intervals // CHUNKS))  # grid intervals per piece
+        grid, done, t_end = [x.copy()], 0, float(self.t_end)
+        while done < intervals:
+            k = min(per, intervals - done)
+            start = done * h
+            try:
+                block, stats = self.advance(x, start, k, h)
+            except RuntimeError as exc:
+                raise self.failure(exc, x, start, k * h) from exc
+            self.steps += int(stats.get("nsteps", 0))
+            self.nfev += int(stats.get("nfevals", 0))
+            self.njev += int(stats.get("nlinsetups", 0))
+            if not np.all(np.isfinite(block)):
+                raise KernelError(f"{NAME}: state became NaN/Inf between t = {start:.6g} and {start + k * h:.6g} "
+                                  f"of t_end = {t_end:.6g}")
+            grid.extend(block)
+            x = block[-1].copy()
+            done += k
+            t_now = done * h
+            if self.budget is not None:
+                self.budget.spend(int(stats.get("nsteps", 0)), lambda: f"t = {t_now:.6g} of t_end = {t_end:.6g}")
+            bar.to(t_now)
+        return grid
+
+    def failure(self, exc: RuntimeError, x, start: float, span: float) -> Exception:
         """The error of a piece that failed: located to one of LOCATE parts of it, diagnosed at that part's start."""
         flag = _flag(str(exc))
         step, t_a = span / LOCATE, start
         for _ in range(LOCATE):
             try:
-                x = advance(x, t_a, 1, step)[0][-1]
+                x = self.advance(x, t_a, 1, step)[0][-1]
             except RuntimeError:
                 break
             t_a += step
-        where = f"between t = {t_a:.6g} and {t_a + step:.6g} of t_end = {float(t_end):.6g}"
+        where = f"between t = {t_a:.6g} and {t_a + step:.6g} of t_end = {float(self.t_end):.6g}"
         if flag == "CV_TOO_MUCH_WORK":
-            return BudgetExceeded(f"{NAME} steps: more than max_steps = {limit:,} steps within {span:.3g} of t",
+            budget = self.budget
+            return BudgetExceeded(f"{NAME} steps: more than max_steps = {self.limit:,} steps within {span:.3g} of t",
                                   key=budget.key if budget is not None else "max_steps", reached=where)
-        why = explain(t_a, x) if explain is not None and np.all(np.isfinite(x)) else ""
+        why = self.explain(t_a, x) if self.explain is not None and np.all(np.isfinite(x)) else ""
         return ConvergenceError(f"{NAME} failed {where} ({flag})" + (f"; {why}" if why else ""))
-
-    params = np.asarray(system.params, float)
-    x = np.asarray(x0, float).copy()
-    grid, steps, nfev, njev, done = [x.copy()], 0, 0, 0, 0
-    with Progress(t_end, desc=desc, unit="t", enabled=progress) as bar:
-        while done < intervals:
-            k = min(per, intervals - done)
-            start = done * h
-            try:
-                block, stats = advance(x, start, k, h)
-            except RuntimeError as exc:
-                raise failure(exc, x, start, k * h) from exc
-            steps += int(stats.get("nsteps", 0))
-            nfev += int(stats.get("nfevals", 0))
-            njev += int(stats.get("nlinsetups", 0))
-            if not np.all(np.isfinite(block)):
-                raise KernelError(f"{NAME}: state became NaN/Inf between t = {start:.6g} and {start + k * h:.6g} "
-                                  f"of t_end = {float(t_end):.6g}")
-            grid.extend(block)
-            x = block[-1].copy()
-            done += k
-            t_now = done * h
-            if budget is not None:
-                budget.spend(int(stats.get("nsteps", 0)), lambda: f"t = {t_now:.6g} of t_end = {float(t_end):.6g}")
-            bar.to(t_now)
-    rows = np.array(grid)[::sub]
-    return Trajectory(t_eval.copy(), rows, nfev=nfev, njev=njev, success=True,
-                      message="CVODES reached the end of the integration interval.", steps=steps)

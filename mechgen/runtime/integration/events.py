@@ -233,8 +233,33 @@ def integrate_hybrid(system, x0, t_end: float, *, mode: int | None = None, optio
     the C backend) or "auto" (the compiled one where it can run, else this one).
     """
     options = RunOptions.of(options, **changes)
+    compiled = _compiled_loop(system, x0, t_end, mode, options)
+    if compiled is not None:
+        return compiled
+    if options.method not in METHODS:
+        raise ValueError(f"unknown method {options.method!r}; expected one of {METHODS}")
+    run = _EventRun(system, float(t_end), options, np.size(x0))
+    mode = system.initial_mode if mode is None else int(mode)
+    t, x = 0.0, np.array(x0, float)
+    run.record(t, x, mode)
+    try:
+        with Progress(run.t_end, desc=options.desc, unit="t", enabled=options.progress) as bar:
+            mode, t, x = _run_modes(run, mode, (t, x), options, bar)
+    except ZenoApproach as exc:  # the run so far, up to the event that made it Zeno (on_zeno = "stop")
+        last = run.events[-1]
+        run.stats["zeno"] = exc
+        mode = last.source if last.target is None else last.target
+        t, x, run.terminated = last.t, last.x_after, True
+    trajectory = run.trajectory(mode, t, x)
+    if "zeno" in run.stats:
+        raise run.stats["zeno"].with_trajectory(trajectory)
+    return trajectory
+
+
+def _compiled_loop(system, x0, t_end: float, mode, options: RunOptions) -> HybridTrajectory | None:
+    """The run by the compiled DOP853 loop (mechgen.runtime.integration.events_c) where ``loop`` allows it and it
+    can run; None for this loop (InputError when ``loop`` is 'c' and it cannot run)."""
     method, rtol, atol = options.method, options.rtol, options.atol
-    # -- loop dispatch: the compiled DOP853 loop (mechgen.runtime.integration.events_c) where it applies ---------
     if options.loop not in LOOPS:
         raise ValueError(f"unknown loop {options.loop!r}; expected one of {LOOPS}")
     if options.loop != "python" and method in METHODS:
@@ -246,49 +271,46 @@ def integrate_hybrid(system, x0, t_end: float, *, mode: int | None = None, optio
         if options.loop == "c":
             raise InputError(f"loop 'c' cannot run here: {why}", key="loop",
                              expected="method DOP853 on the C backend with a C compiler, or loop 'auto'/'python'")
-    # -- end of the loop dispatch ------------------------------------------------------------------------
-    if method not in METHODS:
-        raise ValueError(f"unknown method {method!r}; expected one of {METHODS}")
-    run = _EventRun(system, float(t_end), options, np.size(x0))
-    mode = system.initial_mode if mode is None else int(mode)
-    t, x = 0.0, np.array(x0, float)
-    run.record(t, x, mode)
-    try:
-        with Progress(run.t_end, desc=options.desc, unit="t", enabled=options.progress) as bar:
-            while True:
-                seg = run.segment(mode)
-                g0, d0 = _start_values(seg, t, x, method, run.where)
-                sign, at_once = start_signs(g0, d0, seg.directions, time_tolerance(t, run.t_end))
-                if at_once:  # the guards are in priority order: terminal first, then declared order
-                    target, x = run.fire(seg, at_once[0], t, x)
-                    run.record(t, x, mode if target is None else target)
-                elif t >= run.t_end:
-                    break
-                else:
-                    hit = _integrate_segment(seg, (t, x), (g0, d0), sign, options, run.stats,
-                                             _Hooks(run.sample_until, run.record, bar, run.where))
-                    if hit is None:
-                        t, x = run.t_end, run.stats["y_end"]
-                        break
-                    k, t, x_before = hit
-                    run.sample_until(t, run.stats["dense"], mode, inclusive=True)
-                    target, x = run.fire(seg, k, t, x_before)
-                    run.record(t, x_before, mode)
-                    run.record(t, x, mode if target is None else target)
-                if target is None or (options.stop_after is not None and options.stop_after(run.events[-1])):
-                    run.terminated = True
-                    mode = mode if target is None else target
-                    break
-                mode = target
-    except ZenoApproach as exc:  # the run so far, up to the event that made it Zeno (on_zeno = "stop")
-        last = run.events[-1]
-        run.stats["zeno"] = exc
-        mode = last.source if last.target is None else last.target
-        t, x, run.terminated = last.t, last.x_after, True
-    trajectory = run.trajectory(mode, t, x)
-    if "zeno" in run.stats:
-        raise run.stats["zeno"].with_trajectory(trajectory)
-    return trajectory
+    return None
+
+
+def _run_modes(run: "_EventRun", mode: int, state: tuple, options: RunOptions, bar) -> tuple:
+    """Mode after mode from ``state`` = (t, x) until t_end, a terminal event or ``stop_after``: the last
+    (mode, t, x)."""
+    t, x = state
+    while True:
+        t, x, target, ended = _next_event(run, mode, (t, x), options, bar)
+        if ended:
+            return mode, t, x
+        if target is None or (options.stop_after is not None and options.stop_after(run.events[-1])):
+            run.terminated = True
+            return (mode if target is None else target), t, x
+        mode = target
+
+
+def _next_event(run: "_EventRun", mode: int, state: tuple, options: RunOptions, bar) -> tuple:
+    """From ``state`` = (t, x) at the start of ``mode``: (t, x, the mode entered (None: terminal), False) after
+    the next event (a guard active at once, or one that fires during the mode), or (t, x, None, True) at t_end."""
+    t, x = state
+    seg = run.segment(mode)
+    g0, d0 = _start_values(seg, t, x, options.method, run.where)
+    sign, at_once = start_signs(g0, d0, seg.directions, time_tolerance(t, run.t_end))
+    if at_once:  # the guards are in priority order: terminal first, then declared order
+        target, x = run.fire(seg, at_once[0], t, x)
+        run.record(t, x, mode if target is None else target)
+        return t, x, target, False
+    if t >= run.t_end:
+        return t, x, None, True
+    hit = _integrate_segment(seg, (t, x), (g0, d0), sign, options, run.stats,
+                             _Hooks(run.sample_until, run.record, bar, run.where))
+    if hit is None:
+        return run.t_end, run.stats["y_end"], None, True
+    k, t, x_before = hit
+    run.sample_until(t, run.stats["dense"], mode, inclusive=True)
+    target, x = run.fire(seg, k, t, x_before)
+    run.record(t, x_before, mode)
+    run.record(t, x, mode if target is None else target)
+    return t, x, target, False
 
 
 class _EventRun:
@@ -419,56 +441,80 @@ def _integrate_segment(seg, state: tuple, start, sign, options: RunOptions, stat
     from numpy.linalg import LinAlgError
 
     t, x = state
-    method, rtol, atol, budget = options.method, options.rtol, options.atol, options.budget
-    sample_until, record, bar, where = hooks.sample_until, hooks.record, hooks.bar, hooks.where
-    explain = options.explain
-    kwargs = {"jac": seg.jac} if method in IMPLICIT else {}
-    t_end = seg.t_end
     y_old, t_old = np.array(x), t
     try:
-        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-            solver = _solver_class(method)(seg.rhs, t, x, t_end, rtol=rtol, atol=atol, **kwargs)
+        solver = _start_solver(seg, t, x, options)
         g_old, d_old = start
         t_start = t
         while solver.status == "running":
-            with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-                message = solver.step()
-            if solver.status == "failed":
-                raise ConvergenceError(f"{method} stopped at {where(solver.t, seg.index)}: "
-                                       f"{str(message).rstrip('.')}")
-            stats["steps"] += 1
-            t_new, y_new = solver.t, np.array(solver.y)
-            if not np.all(np.isfinite(y_new)):
-                raise KernelError(f"{method}: state became NaN/Inf by {where(t_new, seg.index)}")
-            dense = solver.dense_output()
-            stats["dense"] = dense
+            t_new, y_new, dense = _take_step(solver, seg, options.method, stats, hooks.where)
             g_new, d_new = seg.values(t_new, y_new, dxdt=_end_rate(solver, seg, t_new, y_new))
-            try:
-                found = _scan(seg, dense, sign, (t_old, g_old, d_old), (t_new, g_new, d_new), t_start)
-            except LeftSurface as left:
-                info = seg.guards[left.k]
-                raise unnoticed(info.name, info.direction, seg.system.modes[seg.index], left.ta, left.tb,
-                                where(left.tb, seg.index)) from None
+            found = _scan_step(seg, dense, sign, (t_old, g_old, d_old), (t_new, g_new, d_new), t_start, hooks.where)
             if found is not None:
                 k, t_root, t_lo, t_hi = found
                 t_star, x_star = _locate(seg, dense, k, (t_root, t_lo, t_hi), (t_old, y_old), options)
-                stats["nfev"] += solver.nfev
-                stats["njev"] += getattr(solver, "njev", 0)
+                _count_evaluations(stats, solver)
                 return k, t_star, x_star
-            sample_until(t_new, dense, seg.index, inclusive=True)
-            record(t_new, y_new, seg.index)
-            if budget is not None:
-                budget.spend(1, lambda: where(t_new, seg.index))
-            bar.to(t_new)
+            _accepted(seg, (t_new, y_new, dense), options.budget, hooks)
             t_old, y_old, g_old, d_old = t_new, y_new, g_new, d_new
     except (LinAlgError, ZeroDivisionError, ValueError) as exc:
+        explain = options.explain
         why = diagnosis(seg.system, seg.index, t_old, y_old) or (explain(t_old, y_old) if explain is not None else "")
-        raise ConvergenceError(f"{method} failed near {where(t_old, seg.index)} ({exc})"
+        raise ConvergenceError(f"{options.method} failed near {hooks.where(t_old, seg.index)} ({exc})"
                                + (f"; {why}" if why else "")) from exc
-    stats["nfev"] += solver.nfev
-    stats["njev"] += getattr(solver, "njev", 0)
+    _count_evaluations(stats, solver)
     stats["y_end"] = np.array(solver.y)
     return None
+
+
+def _start_solver(seg, t: float, x, options: RunOptions):
+    """scipy's stepper of ``options.method`` on the mode's dx/dt from (t, x) towards t_end."""
+    kwargs = {"jac": seg.jac} if options.method in IMPLICIT else {}
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        return _solver_class(options.method)(seg.rhs, t, x, seg.t_end, rtol=options.rtol, atol=options.atol,
+                                             **kwargs)
+
+
+def _take_step(solver, seg, method: str, stats: dict, where) -> tuple:
+    """One accepted step: (t, y, the step's dense output, also kept as stats['dense']); ConvergenceError when
+    the stepper fails, KernelError when the state is not finite."""
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        message = solver.step()
+    if solver.status == "failed":
+        raise ConvergenceError(f"{method} stopped at {where(solver.t, seg.index)}: "
+                               f"{str(message).rstrip('.')}")
+    stats["steps"] += 1
+    t_new, y_new = solver.t, np.array(solver.y)
+    if not np.all(np.isfinite(y_new)):
+        raise KernelError(f"{method}: state became NaN/Inf by {where(t_new, seg.index)}")
+    dense = solver.dense_output()
+    stats["dense"] = dense
+    return t_new, y_new, dense
+
+
+def _scan_step(seg, dense, sign, a, b, t_start, where):
+    """:func:`_scan` of the step [a, b], a guard that left its surface unnoticed raised as its error."""
+    try:
+        return _scan(seg, dense, sign, a, b, t_start)
+    except LeftSurface as left:
+        info = seg.guards[left.k]
+        raise unnoticed(info.name, info.direction, seg.system.modes[seg.index], left.ta, left.tb,
+                        where(left.tb, seg.index)) from None
+
+
+def _accepted(seg, step: tuple, budget, hooks: _Hooks) -> None:
+    """A step (t, y, dense output) without an event: its samples and record, one unit of the budget, the bar."""
+    t_new, y_new, dense = step
+    hooks.sample_until(t_new, dense, seg.index, inclusive=True)
+    hooks.record(t_new, y_new, seg.index)
+    if budget is not None:
+        budget.spend(1, lambda: hooks.where(t_new, seg.index))
+    hooks.bar.to(t_new)
+
+
+def _count_evaluations(stats: dict, solver) -> None:
+    stats["nfev"] += solver.nfev
+    stats["njev"] += getattr(solver, "njev", 0)
 
 
 def _scan(seg, dense, sign, a, b, t_start):

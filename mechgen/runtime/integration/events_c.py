@@ -389,89 +389,107 @@ def integrate_hybrid_c(system, x0, t_end: float, *, mode: int | None = None, opt
     (``extra["loop"] = "c"``; ``nfev`` counts every evaluation of dx/dt, ``guard_evaluations`` every one of the
     guards). CompilerUnavailable when the loop cannot run ``system`` (:func:`c_loop_problem` says why)."""
     options = RunOptions.of(options, **changes)
-    budget, rules, stop_after = options.budget, options.rules, options.stop_after
     why = c_loop_problem(system, "DOP853")
     if why is not None:
         raise CompilerUnavailable(why)
     lib = loop_library(system.n, system.m)
     tables = _tables(system)
     t_end = float(t_end)
-    n, m = system.n, system.m
-    nx = 2 * n + m
+    nx = 2 * system.n + system.m
     x0 = np.array(x0, dtype=float).reshape(-1)
     if x0.size != nx:
         raise ValueError(f"x0 has {x0.size} entries for a state (q, v, z) of {nx}")
     start = system.initial_mode if mode is None else int(mode)
     if not 0 <= start < len(system.modes):
         raise ValueError(f"mode {start} is not a mode index of {len(system.modes)} modes")
-    names = system.modes
-    t_eval = None if options.t_eval is None else np.ascontiguousarray(options.t_eval, dtype=float).reshape(-1)
-    zeno_span = rules.zeno_span if rules.zeno_span is not None else 1e-9 * t_end
-    params = np.ascontiguousarray(system.params, dtype=float)
-    ng = max(1, tables.max_guards)
+    loop = _CLoop(system, tables, t_end, start, options)
+    loop.arrays["x"][...] = x0
+    with Progress(t_end, desc=options.desc, unit="t", enabled=options.progress) as bar:
+        terminated = loop.drive(lib, bar)
+    loop.new_events()
+    return loop.trajectory(terminated)
 
-    problem = _problem(system, tables, params, options, t_end)
-    problem.zeno_span, problem.pause = float(zeno_span), int(stop_after is not None)
-    flow = getattr(system, "flow", None)  # (fn, data) addresses of a provider of dx/dt (a continuum)
-    if flow is not None:
-        problem.flow, problem.flow_data = flow
-    if t_eval is not None:  # (params and t_eval stay referenced here while the loop reads them)
-        problem.n_eval, problem.t_eval = (len(t_eval), t_eval.ctypes.data) if len(t_eval) else (-1, None)
-    state = CState(phase=-1, mode=start, t=0.0)
-    buffers = _Buffers(problem, state, nx, ng, max(2, rules.zeno_events + 1),
-                       len(t_eval) if t_eval is not None else FIRST_ROWS[0], FIRST_ROWS[1])
-    arrays = buffers.arrays
-    x, err_x = arrays["x"], arrays["err_x"]
-    x[...] = x0
-    events: list[Event] = []
 
-    def where(tk: float, seg: int) -> str:
-        mode = "" if getattr(system, "smooth", False) else f" in mode {names[seg]}"
-        return f"t = {tk:.9g} of t_end = {t_end:.6g}{mode}"
+class _CLoop:
+    """One run of the C loop: the problem and state that ``mgh_run`` reads and writes, the arrays they point into
+    (``params``, ``t_eval`` and the buffers: kept referenced here while the loop runs) and the events read back."""
 
-    def new_events() -> None:
-        for e in range(len(events), state.n_events):
+    def __init__(self, system, tables: _Tables, t_end: float, start: int, options: RunOptions) -> None:
+        self.system, self.tables, self.t_end, self.options = system, tables, t_end, options
+        rules = options.rules
+        self.t_eval = None if options.t_eval is None else np.ascontiguousarray(options.t_eval, dtype=float).reshape(-1)
+        self.zeno_span = rules.zeno_span if rules.zeno_span is not None else 1e-9 * t_end
+        self.params = np.ascontiguousarray(system.params, dtype=float)
+        self.problem = problem = _problem(system, tables, self.params, options, t_end)
+        problem.zeno_span, problem.pause = float(self.zeno_span), int(options.stop_after is not None)
+        flow = getattr(system, "flow", None)  # (fn, data) addresses of a provider of dx/dt (a continuum)
+        if flow is not None:
+            problem.flow, problem.flow_data = flow
+        t_eval = self.t_eval
+        if t_eval is not None:
+            problem.n_eval, problem.t_eval = (len(t_eval), t_eval.ctypes.data) if len(t_eval) else (-1, None)
+        self.state = CState(phase=-1, mode=start, t=0.0)
+        self.buffers = _Buffers(problem, self.state, 2 * system.n + system.m, max(1, tables.max_guards),
+                                max(2, rules.zeno_events + 1), len(t_eval) if t_eval is not None else FIRST_ROWS[0],
+                                FIRST_ROWS[1])
+        self.arrays = self.buffers.arrays
+        self.events: list[Event] = []
+
+    def where(self, tk: float, seg: int) -> str:
+        mode = "" if getattr(self.system, "smooth", False) else f" in mode {self.system.modes[seg]}"
+        return f"t = {tk:.9g} of t_end = {self.t_end:.6g}{mode}"
+
+    def new_events(self) -> None:
+        """The events the loop has logged since the last call, appended to ``events``."""
+        arrays = self.arrays
+        for e in range(len(self.events), self.state.n_events):
             target = int(arrays["e_target"][e])
             source = int(arrays["e_source"][e])
-            events.append(Event(float(arrays["e_t"][e]), source, None if target < 0 else target,
-                                tables.names[source][int(arrays["e_guard"][e])],
-                                arrays["e_before"][e].copy(), arrays["e_after"][e].copy()))
+            self.events.append(Event(float(arrays["e_t"][e]), source, None if target < 0 else target,
+                                     self.tables.names[source][int(arrays["e_guard"][e])],
+                                     arrays["e_before"][e].copy(), arrays["e_after"][e].copy()))
 
-    terminated = False
-    with Progress(t_end, desc=options.desc, unit="t", enabled=options.progress) as bar:
+    def run(self, lib) -> int:
+        """One call of mgh_run (within the step budget left), its steps spent; raises its error (rc < 0)."""
+        budget, state = self.options.budget, self.state
+        if budget is not None and budget.limit is not None:
+            self.problem.budget_left = max(0, budget.limit - budget.used)
+        rc = lib.mgh_run(ctypes.byref(self.problem), ctypes.byref(state))
+        if state.counted and budget is not None:
+            budget.spend(state.counted, lambda: self.where(state.t, state.mode))
+        if rc < 0:
+            self.new_events()
+            error = _error(rc, self)
+            if isinstance(error, ZenoApproach):  # the run so far, up to the event that made it Zeno
+                raise error.with_trajectory(_zeno_trajectory(self.arrays, state, self.events))
+            raise error
+        return rc
+
+    def drive(self, lib, bar) -> bool:
+        """Call the loop until it is done (growing the buffers it fills, asking ``stop_after`` where it pauses);
+        whether the run was terminated (a terminal event or stop_after)."""
         while True:
-            if budget is not None and budget.limit is not None:
-                problem.budget_left = max(0, budget.limit - budget.used)
-            rc = lib.mgh_run(ctypes.byref(problem), ctypes.byref(state))
-            if state.counted and budget is not None:
-                budget.spend(state.counted, lambda: where(state.t, state.mode))
-            if rc < 0:
-                new_events()
-                error = _error(rc, system, state, err_x, where, options, zeno_span)
-                if isinstance(error, ZenoApproach):  # the run so far, up to the event that made it Zeno
-                    raise error.with_trajectory(_zeno_trajectory(arrays, state, events))
-                raise error
-            bar.to(state.t)
+            rc = self.run(lib)
+            bar.to(self.state.t)
             if rc == FULL_SAMPLES:
-                buffers.grow("s")
+                self.buffers.grow("s")
             elif rc == FULL_EVENTS:
-                buffers.grow("e")
+                self.buffers.grow("e")
             elif rc == PAUSED:
-                new_events()
-                if stop_after(events[-1]):
-                    terminated = True
-                    break
+                self.new_events()
+                if self.options.stop_after(self.events[-1]):
+                    return True
             elif rc == TERMINATED:
-                terminated = True
-                break
+                return True
             elif rc == DONE:
-                break
-    new_events()
-    count = state.n_samples
-    return HybridTrajectory(arrays["s_t"][:count].copy(), arrays["s_x"][:count].copy(),
-                            arrays["s_mode"][:count].astype(int), tuple(events), int(state.mode), float(state.t),
-                            x.copy(), terminated, int(state.steps), int(state.nfev), 0, int(state.nguard),
-                            {"loop": "c", "rate_evaluations": int(state.nrate)})
+                return False
+
+    def trajectory(self, terminated: bool) -> HybridTrajectory:
+        arrays, state, count = self.arrays, self.state, self.state.n_samples
+        return HybridTrajectory(arrays["s_t"][:count].copy(), arrays["s_x"][:count].copy(),
+                                arrays["s_mode"][:count].astype(int), tuple(self.events), int(state.mode),
+                                float(state.t), arrays["x"].copy(), terminated, int(state.steps), int(state.nfev), 0,
+                                int(state.nguard), {"loop": "c", "rate_evaluations": int(state.nrate)})
 
 
 def _zeno_trajectory(arrays: dict, state: CState, events: list) -> HybridTrajectory:
@@ -484,10 +502,41 @@ def _zeno_trajectory(arrays: dict, state: CState, events: list) -> HybridTraject
                             {"loop": "c", "rate_evaluations": int(state.nrate)})
 
 
-def _error(rc: int, system, state: CState, err_x: np.ndarray, where, options: RunOptions,
-           zeno_span: float) -> Exception:
+def _error(rc: int, loop: _CLoop) -> Exception:
     """The exception the Python loop raises for the C loop's error code ``rc``."""
-    rules, explain = options.rules, options.explain
+    if rc in (E_KERNEL, E_RHS, E_STATE, E_RESET, E_GUARD):
+        return _kernel_error(rc, loop)
+    state, where, rules = loop.state, loop.where, loop.options.rules
+    system, t, seg = loop.system, float(state.err_t), int(state.err_mode)
+    if rc in (E_SINGULAR, E_SMALL):
+        if rc == E_SMALL:
+            return ConvergenceError(f"DOP853 stopped at {where(t, seg)}: Required step size is less than "
+                                    "spacing between numbers")
+        err_x, explain = loop.arrays["err_x"], loop.options.explain
+        why = diagnosis(system, seg, t, err_x.copy()) or (explain(t, err_x.copy()) if explain is not None else "")
+        return ConvergenceError(f"DOP853 failed near {where(t, seg)} (Singular matrix)" + (f"; {why}" if why else ""))
+    if rc == E_EVENTS:
+        return BudgetExceeded(f"events: more than max_events = {rules.max_events:,} events", key="max_events",
+                              reached=where(t, seg))
+    if rc == E_ZENO:
+        count = max(2, rules.zeno_events + 1)
+        return ZenoApproach(f"events: {count} events within {state.err_span:.3g} (more than zeno_events = "
+                            f"{rules.zeno_events} within zeno_span = {loop.zeno_span:.3g}): a Zeno or chattering "
+                            f"approach (guard {system.guards(seg)[state.err_guard].name} of mode {system.modes[seg]}); "
+                            f"{ZENO_HINT}", key="zeno_events", reached=where(t, seg))
+    if rc == E_LEFT:
+        guard = system.guards(seg)[state.err_guard]
+        return unnoticed(guard.name, guard.direction, system.modes[seg], float(state.err_span), t, where(t, seg))
+    if rc == E_BUDGET:
+        return BudgetExceeded("DOP853 steps: stopped by the step budget", key="max_steps", reached=where(t, seg))
+    if rc == E_MEMORY:
+        return MemoryError("the C event loop could not allocate its workspace")
+    return RuntimeError(f"the C event loop refused its input (code {rc})")
+
+
+def _kernel_error(rc: int, loop: _CLoop) -> KernelError:
+    """The KernelError of a kernel's error code or a NaN/Inf (in dx/dt, the state, a reset or a guard)."""
+    state, where, system, err_x = loop.state, loop.where, loop.system, loop.arrays["err_x"]
     t, seg = float(state.err_t), int(state.err_mode)
     model = system.metadata.model
     if rc == E_KERNEL:
@@ -502,29 +551,5 @@ def _error(rc: int, system, state: CState, err_x: np.ndarray, where, options: Ru
     if rc == E_RESET:
         return KernelError(f"reset of guard {system.guards(seg)[state.err_guard].name} gave NaN/Inf at "
                            f"{where(t, seg)}")
-    if rc == E_GUARD:
-        return KernelError(f"guard {system.guards(seg)[state.err_guard].name} of {model} gave NaN/Inf at "
-                           f"{where(t, seg)}, x = {err_x[:6]}")
-    if rc in (E_SINGULAR, E_SMALL):
-        if rc == E_SMALL:
-            return ConvergenceError(f"DOP853 stopped at {where(t, seg)}: Required step size is less than "
-                                    "spacing between numbers")
-        why = diagnosis(system, seg, t, err_x.copy()) or (explain(t, err_x.copy()) if explain is not None else "")
-        return ConvergenceError(f"DOP853 failed near {where(t, seg)} (Singular matrix)" + (f"; {why}" if why else ""))
-    if rc == E_EVENTS:
-        return BudgetExceeded(f"events: more than max_events = {rules.max_events:,} events", key="max_events",
-                              reached=where(t, seg))
-    if rc == E_ZENO:
-        count = max(2, rules.zeno_events + 1)
-        return ZenoApproach(f"events: {count} events within {state.err_span:.3g} (more than zeno_events = "
-                            f"{rules.zeno_events} within zeno_span = {zeno_span:.3g}): a Zeno or chattering approach "
-                            f"(guard {system.guards(seg)[state.err_guard].name} of mode {system.modes[seg]}); "
-                            f"{ZENO_HINT}", key="zeno_events", reached=where(t, seg))
-    if rc == E_LEFT:
-        guard = system.guards(seg)[state.err_guard]
-        return unnoticed(guard.name, guard.direction, system.modes[seg], float(state.err_span), t, where(t, seg))
-    if rc == E_BUDGET:
-        return BudgetExceeded("DOP853 steps: stopped by the step budget", key="max_steps", reached=where(t, seg))
-    if rc == E_MEMORY:
-        return MemoryError("the C event loop could not allocate its workspace")
-    return RuntimeError(f"the C event loop refused its input (code {rc})")
+    return KernelError(f"guard {system.guards(seg)[state.err_guard].name} of {model} gave NaN/Inf at "
+                       f"{where(t, seg)}, x = {err_x[:6]}")

@@ -218,28 +218,33 @@ def fit_speed_polynomial(evaluate, lo: float, hi: float, *, rtol: float = 1e-12,
     if any(set(d) != set(keys) for d in (at_hi, at_probe)):
         return None
     scale = {k: max(matrix_norm(d[k]) for d in (at_lo, at_hi, at_probe)) for k in keys}
-
-    def fitted(terms: dict) -> SpeedPolynomial | None:
-        for key, coefs in terms.items():
-            for k in range(1, len(coefs)):
-                if matrix_norm(coefs[k]) <= 1e-14 * scale[key]:
-                    coefs[k] = None
-            if matrix_norm(_evaluate({key: coefs}, probe)[key] - at_probe[key]) > rtol * scale[key]:
-                return None
-            while coefs[-1] is None and len(coefs) > 1:
-                coefs.pop()
-        return SpeedPolynomial(terms, center, half)
-
     # linear first (three evaluations), then quadratic through lo, centre, hi (the probe checks either)
-    poly = fitted({k: [0.5 * (at_hi[k] + at_lo[k]), 0.5 * (at_hi[k] - at_lo[k])] for k in keys})
+    poly = _fitted({k: [0.5 * (at_hi[k] + at_lo[k]), 0.5 * (at_hi[k] - at_lo[k])] for k in keys}, scale,
+                   (probe, at_probe, rtol), center, half)
     if poly is not None:
         return poly
     at_mid = evaluate(center)
     if set(at_mid) != set(keys):
         return None
     scale = {k: max(scale[k], matrix_norm(at_mid[k])) for k in keys}
-    return fitted({k: [at_mid[k], 0.5 * (at_hi[k] - at_lo[k]), 0.5 * (at_hi[k] + at_lo[k]) - at_mid[k]]
-                   for k in keys})
+    return _fitted({k: [at_mid[k], 0.5 * (at_hi[k] - at_lo[k]), 0.5 * (at_hi[k] + at_lo[k]) - at_mid[k]]
+                    for k in keys}, scale, (probe, at_probe, rtol), center, half)
+
+
+def _fitted(terms: dict, scale: dict, check: tuple, center: float, half: float) -> SpeedPolynomial | None:
+    """The SpeedPolynomial of the coefficient lists ``terms`` (in t = (w - center) / half), coefficients below
+    1e-14 of the matrix's ``scale`` dropped, when every matrix matches its sample at the probe:
+    ``check`` = (probe t, the matrices there, rtol relative to ``scale``); else None."""
+    probe, at_probe, rtol = check
+    for key, coefs in terms.items():
+        for k in range(1, len(coefs)):
+            if matrix_norm(coefs[k]) <= 1e-14 * scale[key]:
+                coefs[k] = None
+        if matrix_norm(_evaluate({key: coefs}, probe)[key] - at_probe[key]) > rtol * scale[key]:
+            return None
+        while coefs[-1] is None and len(coefs) > 1:
+            coefs.pop()
+    return SpeedPolynomial(terms, center, half)
 
 
 # ----------------------------------------------------------------------------------------- reduced model
@@ -374,38 +379,63 @@ def _gyroscopic_modes(M: np.ndarray, G: np.ndarray, K: np.ndarray, count: int) -
 # ------------------------------------------------------------------------------------------- tracking
 
 
-def _track(speeds, cand_s, cand_V, count: int, x_index, y_index, freq_weight: float, cluster_tol: float,
-           planar_tol: float):
+@dataclass(frozen=True)
+class _Tracking:
+    """What the tracking needs besides the candidates: the whirl stations (lateral dofs) and the options
+    ``freq_weight``, ``cluster_tol``, ``planar_tol`` of :class:`CampbellOptions`."""
+
+    x_index: object
+    y_index: object
+    freq_weight: float
+    cluster_tol: float
+    planar_tol: float
+
+
+def _first_curves(s0: np.ndarray, V0: np.ndarray, V1, count: int, tracking: _Tracking):
+    """(candidate index of each curve at the first speed, the shapes V0 with degenerate clusters aligned to
+    the next speed's modes V1, None for a single speed). Curves are numbered by cluster, then whirl
+    (backward before forward within a cluster), then wd."""
+    if V1 is not None:
+        V0 = _align(s0, V0, V1, tracking.cluster_tol)
+    sign0 = whirl_sign(V0, tracking.x_index, tracking.y_index, planar_tol=tracking.planar_tol)
+    cluster_id = np.empty(len(s0), dtype=int)
+    for c, J in enumerate(_clusters(s0, tracking.cluster_tol)):
+        cluster_id[J] = c
+    return np.lexsort((s0.imag, sign0, cluster_id))[:count], V0
+
+
+def _predicted(speeds, eig: np.ndarray, i: int) -> np.ndarray:
+    """The curves' eigenvalues at speed i + 1 extrapolated linearly from speeds i - 1, i (speed i alone at i = 0)."""
+    if i == 0:
+        return eig[0]
+    h = (speeds[i + 1] - speeds[i]) / (speeds[i] - speeds[i - 1])
+    return eig[i] + h * (eig[i] - eig[i - 1])
+
+
+def _match(s: np.ndarray, V: np.ndarray, shapes: np.ndarray, pred: np.ndarray, tracking: _Tracking):
+    """One step's assignment of the curves (``shapes``, predicted eigenvalues ``pred``) to the candidates
+    (s, V) on the cost of the module docstring: (rows, cols, V aligned to the curves, MAC matrix)."""
+    V = _align(s, V, shapes, tracking.cluster_tol)
+    mac_ij = mac_matrix(shapes, V)
+    dist = np.abs(s[None, :] - pred[:, None]) / np.maximum(np.abs(pred), 1e-300)[:, None]
+    from scipy.optimize import linear_sum_assignment  # loaded on use (startup)
+
+    rows, cols = linear_sum_assignment((1.0 - mac_ij) + tracking.freq_weight * dist)
+    return rows, cols, V, mac_ij
+
+
+def _track(speeds, cand_s, cand_V, count: int, tracking: _Tracking):
     """Follow ``count`` curves over the candidates: (eigenvalues, shapes, mac, chosen candidate per speed)."""
-    cand_V = list(cand_V)
     S = len(speeds)
     n = cand_V[0].shape[0]
-    # first speed: resolve degenerate pairs with the next speed's modes, then number the curves
-    if S > 1:
-        cand_V[0] = _align(cand_s[0], cand_V[0], cand_V[1], cluster_tol)
-    sign0 = whirl_sign(cand_V[0], x_index, y_index, planar_tol=planar_tol)
-    cluster_id = np.empty(len(cand_s[0]), dtype=int)
-    for c, J in enumerate(_clusters(cand_s[0], cluster_tol)):
-        cluster_id[J] = c
-    start = np.lexsort((cand_s[0].imag, sign0, cluster_id))[:count]
-
+    start, V0 = _first_curves(cand_s[0], cand_V[0], cand_V[1] if S > 1 else None, count, tracking)
     eig = np.empty((S, count), dtype=complex)
     shp = np.empty((S, n, count), dtype=complex)
     mac = np.ones((S, count))
     chosen = np.empty((S, count), dtype=int)
-    eig[0], shp[0], chosen[0] = cand_s[0][start], cand_V[0][:, start], start
+    eig[0], shp[0], chosen[0] = cand_s[0][start], V0[:, start], start
     for i in range(S - 1):
-        if i == 0:
-            pred = eig[0]
-        else:
-            h = (speeds[i + 1] - speeds[i]) / (speeds[i] - speeds[i - 1])
-            pred = eig[i] + h * (eig[i] - eig[i - 1])
-        V = _align(cand_s[i + 1], cand_V[i + 1], shp[i], cluster_tol)
-        mac_ij = mac_matrix(shp[i], V)
-        dist = np.abs(cand_s[i + 1][None, :] - pred[:, None]) / np.maximum(np.abs(pred), 1e-300)[:, None]
-        from scipy.optimize import linear_sum_assignment  # loaded on use (startup)
-
-        rows, cols = linear_sum_assignment((1.0 - mac_ij) + freq_weight * dist)
+        rows, cols, V, mac_ij = _match(cand_s[i + 1], cand_V[i + 1], shp[i], _predicted(speeds, eig, i), tracking)
         eig[i + 1, rows], shp[i + 1][:, rows] = cand_s[i + 1][cols], V[:, cols]
         mac[i + 1, rows] = mac_ij[rows, cols]
         chosen[i + 1, rows] = cols
@@ -474,26 +504,60 @@ def campbell(matrices_at, speeds, count: int, options: CampbellOptions | None = 
     eta^2: when 1e3 eta^2 is) and no curve's MAC to the previous speed is below ``mac_min``.
     """
     opts = CampbellOptions.of(options, **overrides)
-    sparse, spare, sigma, freq_weight = opts.sparse, opts.spare, opts.sigma, opts.freq_weight
-    cluster_tol, planar_tol, method = opts.cluster_tol, opts.planar_tol, opts.method
-    residual_tol, mac_min, budget = opts.residual_tol, opts.mac_min, opts.budget
-    _check_method(method)
+    parallel = _parallel(opts)
+    speeds = _speed_grid(speeds)
+    _check_count(count)
+    spare = max(2, count // 2) if opts.spare is None else opts.spare
+    first, n = _first_matrices(matrices_at, speeds, count)
+    station_indices(x_index, y_index, n)
+    m = min(count + int(spare), n)
+    solve = (n, m, count, opts.sparse, opts.sigma)
+    poly = _polynomial(matrices_at, opts.method)
+    reduced = not parallel and poly is not None and (opts.method == "reduced" or (
+        opts.method == "auto" and len(speeds) >= REDUCED_MIN_SPEEDS and n >= REDUCED_MIN_RATIO * m))
+    tracking = _Tracking(x_index, y_index, opts.freq_weight, opts.cluster_tol, opts.planar_tol)
+    model = None
+    if reduced:
+        eig, shp, mac, model, n_exact = _campbell_reduced(poly, speeds, first, solve, opts, tracking)
+    else:
+        found = (solve_speeds(matrices_at, first, speeds, solve, opts.executor, opts.budget) if parallel
+                 else _solve_serial(matrices_at, first, speeds, solve, opts.budget))
+        eig, shp, mac, _ = _track(speeds, [dm.eigenvalues for dm in found], [dm.shapes for dm in found], count,
+                                  tracking)
+        n_exact = len(speeds)
+    return _result(speeds, eig, shp, mac, tracking, m, model, n_exact)
+
+
+def _parallel(opts: CampbellOptions) -> bool:
+    """Whether the options' executor runs the speeds in parallel (checks the method and refuses 'reduced' there)."""
+    _check_method(opts.method)
     parallel = opts.executor is not None and opts.executor.kind != "serial"
-    if parallel and method == "reduced":
+    if parallel and opts.method == "reduced":
         raise InputError(f"method 'reduced' carries its basis from speed to speed and cannot run on executor "
                          f"{opts.executor.kind!r}", key="executor",
                          expected="executor 'serial' for method 'reduced', or method 'exact' (or 'auto': exact "
                                   "solves at every speed on a parallel executor)")
+    return parallel
+
+
+def _speed_grid(speeds) -> np.ndarray:
+    """``speeds`` as a 1-D float array, checked: non-empty, finite, strictly increasing."""
     speeds = np.asarray(speeds, dtype=float)
     if speeds.ndim != 1 or speeds.size == 0 or not np.all(np.isfinite(speeds)):
         raise InputError("speeds must be a non-empty list of finite numbers", key="speeds",
                          expected="a 1-D array of increasing speeds")
     if speeds.size > 1 and np.any(np.diff(speeds) <= 0):
         raise InputError("speeds are not strictly increasing", key="speeds", expected="increasing speeds")
+    return speeds
+
+
+def _check_count(count) -> None:
     if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
         raise InputError(f"count is {count!r}", key="count", expected="a positive integer")
-    if spare is None:
-        spare = max(2, count // 2)
+
+
+def _first_matrices(matrices_at, speeds: np.ndarray, count: int) -> tuple[dict, int]:
+    """(the matrices at the first speed, the number of dofs n), checked: a dict with a square 'M', count <= n."""
     first = matrices_at(float(speeds[0]))
     if not isinstance(first, dict) or "M" not in first or np.ndim(first["M"]) != 2:
         raise InputError(f"matrices_at({float(speeds[0])!r}) returned {type(first).__name__}", key="matrices_at",
@@ -502,45 +566,43 @@ def campbell(matrices_at, speeds, count: int, options: CampbellOptions | None = 
     if count > n:
         raise InputError(f"count {count} is larger than the {n} modes a system of {n} degrees of freedom has",
                          key="count", expected=f"at most {n}")
-    station_indices(x_index, y_index, n)
-    m = min(count + int(spare), n)
-    S = len(speeds)
+    return first, n
+
+
+def _polynomial(matrices_at, method: str):
+    """``matrices_at`` when it is a SpeedPolynomial with terms M, C, K (the reduced path's input), else None;
+    method 'reduced' without one is refused."""
     poly = matrices_at if isinstance(matrices_at, SpeedPolynomial) else None
-    if method == "reduced" and (poly is None or not {"M", "C", "K"} <= set(poly.terms)):
+    usable = poly is not None and {"M", "C", "K"} <= set(poly.terms)
+    if method == "reduced" and not usable:
         raise InputError("method 'reduced' needs the matrices as a SpeedPolynomial with keys M, C, K",
                          key="matrices_at", expected="fit_speed_polynomial(...) or method='exact'")
-    reduced = not parallel and poly is not None and {"M", "C", "K"} <= set(poly.terms) and (
-        method == "reduced" or (method == "auto" and S >= REDUCED_MIN_SPEEDS and n >= REDUCED_MIN_RATIO * m))
-    track = dict(x_index=x_index, y_index=y_index, freq_weight=freq_weight, cluster_tol=cluster_tol,
-                 planar_tol=planar_tol)
-    model = None
-    if reduced:
-        eig, shp, mac, model, n_exact = _campbell_reduced(poly, speeds, count, m, n, sparse, sigma, first,
-                                                          residual_tol, mac_min, track, budget)
-    elif parallel:
-        found = solve_speeds(matrices_at, first, speeds, (n, m, count, sparse, sigma), opts.executor, budget)
-        eig, shp, mac, _ = _track(speeds, [dm.eigenvalues for dm in found], [dm.shapes for dm in found], count,
-                                  **track)
-        n_exact = S
-    else:
-        found = []
-        for i, w in enumerate(speeds):
-            found.append(_modes_at(first if i == 0 else matrices_at(float(w)), float(w), n, m, count, sparse, sigma))
-            if budget is not None:
-                budget.project(i + 1, S, lambda: f"{i + 1:,} of {S:,} speeds (up to {float(w):g})")
-        eig, shp, mac, _ = _track(speeds, [dm.eigenvalues for dm in found], [dm.shapes for dm in found], count,
-                                  **track)
-        n_exact = S
+    return poly if usable else None
 
-    labels = [whirl(shp[i], x_index, y_index, planar_tol=planar_tol) for i in range(S)]
+
+def _solve_serial(matrices_at, first: dict, speeds: np.ndarray, solve: tuple, budget) -> list:
+    """The DampedModes of every speed, here, in order; ``budget`` (or None) projects the diagram's time."""
+    S = len(speeds)
+    found = []
+    for i, w in enumerate(speeds):
+        found.append(_modes_at(first if i == 0 else matrices_at(float(w)), float(w), *solve))
+        if budget is not None:
+            budget.project(i + 1, S, lambda: f"{i + 1:,} of {S:,} speeds (up to {float(w):g})")
+    return found
+
+
+def _result(speeds, eig, shp, mac, tracking: _Tracking, m: int, model, n_exact: int) -> CampbellResult:
+    """The CampbellResult of the tracked curves: whirl labels, wd, log decrement, damping ratio."""
+    labels = [whirl(shp[i], tracking.x_index, tracking.y_index, planar_tol=tracking.planar_tol)
+              for i in range(len(speeds))]
     wd = eig.imag
     wn = np.abs(eig)
     return CampbellResult(
         speeds=speeds, frequencies=wd, eigenvalues=eig, whirl=labels,
         log_dec=-2.0 * np.pi * eig.real / wd + 0.0, damping_ratio=-eig.real / np.where(wn > 0, wn, 1.0),
-        shapes=shp, mac=mac, x_index=tuple(np.atleast_1d(x_index).tolist()),
-        y_index=tuple(np.atleast_1d(y_index).tolist()), candidates=m,
-        method="reduced" if reduced else "exact", exact_solves=n_exact,
+        shapes=shp, mac=mac, x_index=tuple(np.atleast_1d(tracking.x_index).tolist()),
+        y_index=tuple(np.atleast_1d(tracking.y_index).tolist()), candidates=m,
+        method="exact" if model is None else "reduced", exact_solves=n_exact,
         basis_size=0 if model is None else model.size, reduced=model)
 
 
@@ -575,64 +637,100 @@ def solve_speeds(matrices_at, first: dict, speeds, solve: tuple, executor, budge
     return run.results
 
 
-def _campbell_reduced(poly, speeds, count, m, n, sparse, sigma, first, residual_tol, mac_min, track, budget=None):
-    """Reduced-basis candidates with the safeguard (module docstring): (eig, shp, mac, model, exact solves);
-    ``budget`` (or None) is checked at every full-size solve."""
-    S = len(speeds)
-    model = ReducedModel(poly, n)
-    found: list = [None] * S
-    eta: list = [None] * S
-    exact: set = set()
+class _ReducedRun:
+    """The state of a reduced-basis diagram (module docstring): the basis, every speed's candidates and their
+    backward errors (zero at a full-size solve), and the speeds solved at full size.
 
-    def solve_exact(i: int) -> None:
-        dm = _modes_at(first if i == 0 else poly(float(speeds[i])), float(speeds[i]), n, m, count, sparse, sigma)
-        found[i], eta[i] = dm, np.zeros(len(dm.eigenvalues))
-        exact.add(i)
-        model.enrich(dm.shapes)
-        if budget is not None:
-            budget.check_time(lambda: f"{len(exact)} full-size solves of {S:,} speeds")
+    ``solve`` is (n, m, count, sparse, sigma) as for :func:`speed_modes`; ``budget`` (or None) is checked at
+    every full-size solve."""
 
-    for i in sorted({0, S - 1}):
-        solve_exact(i)
-    todo = [i for i in range(S) if i not in exact]
-    while True:
+    def __init__(self, poly: SpeedPolynomial, speeds: np.ndarray, first: dict, solve: tuple, budget) -> None:
+        self.poly, self.speeds, self.first, self.solve, self.budget = poly, speeds, first, solve, budget
+        self.m, self.count = solve[1], solve[2]
+        self.model = ReducedModel(poly, solve[0])
+        self.found: list = [None] * len(speeds)
+        self.eta: list = [None] * len(speeds)
+        self.exact: set = set()
+
+    def solve_exact(self, i: int) -> None:
+        """Speed i at full size; its modes enrich the basis."""
+        w = float(self.speeds[i])
+        dm = _modes_at(self.first if i == 0 else self.poly(w), w, *self.solve)
+        self.found[i], self.eta[i] = dm, np.zeros(len(dm.eigenvalues))
+        self.exact.add(i)
+        self.model.enrich(dm.shapes)
+        if self.budget is not None:
+            self.budget.check_time(lambda: f"{len(self.exact)} full-size solves of {len(self.speeds):,} speeds")
+
+    def solve_reduced(self, todo: list) -> None:
+        """The speeds ``todo`` (those not solved at full size) on the basis; at full size where the basis
+        gives fewer than ``count`` oscillatory modes."""
         for i in todo:
-            if i in exact:
+            if i in self.exact:
                 continue
-            dm = model.modes(float(speeds[i]), m)
-            if len(dm.eigenvalues) < count:
-                solve_exact(i)
+            w = float(self.speeds[i])
+            dm = self.model.modes(w, self.m)
+            if len(dm.eigenvalues) < self.count:
+                self.solve_exact(i)
                 continue
-            found[i] = dm
-            eta[i] = model.backward_errors(float(speeds[i]), dm.eigenvalues, dm.shapes)
-        eig, shp, mac, chosen = _track(speeds, [dm.eigenvalues for dm in found], [dm.shapes for dm in found],
-                                       count, **track)
+            self.found[i] = dm
+            self.eta[i] = self.model.backward_errors(w, dm.eigenvalues, dm.shapes)
+
+    def failing(self, mac: np.ndarray, chosen: np.ndarray, opts: CampbellOptions, cluster_tol: float) -> dict:
+        """{speed index: worst backward error} of the reduced speeds the safeguard refuses (eta above
+        ``residual_tol``, or a MAC to a neighbour speed below ``mac_min``)."""
+        S = len(self.speeds)
         bad = {}
         for i in range(S):
-            if i in exact:
+            if i in self.exact:
                 continue
-            s = found[i].eigenvalues
+            s = self.found[i].eigenvalues
             worst = np.zeros(len(s))  # the backward error of a degenerate cluster's worst member
-            for J in _clusters(s, track["cluster_tol"]):
-                worst[J] = eta[i][J].max()
-            ok = model.accepted(worst[chosen[i]], residual_tol)
-            nxt = mac[i + 1] if i + 1 < S else np.ones(count)
-            if not ok.all() or mac[i].min() < mac_min or nxt.min() < mac_min:
+            for J in _clusters(s, cluster_tol):
+                worst[J] = self.eta[i][J].max()
+            ok = self.model.accepted(worst[chosen[i]], opts.residual_tol)
+            nxt = mac[i + 1] if i + 1 < S else np.ones(self.count)
+            if not ok.all() or mac[i].min() < opts.mac_min or nxt.min() < opts.mac_min:
                 bad[i] = float(worst[chosen[i]].max())
-        if not bad:
-            return eig, shp, mac, model, len(exact)
-        # solve exactly at the worst speed of every run of consecutive failing speeds, enrich, redo the rest
-        runs: list[list[int]] = []
-        for i in sorted(bad):
-            if runs and i == runs[-1][-1] + 1:
-                runs[-1].append(i)
-            else:
-                runs.append([i])
-        if len(exact) + len(runs) > S // 2:  # the basis keeps failing: solve every failing speed at full size
+        return bad
+
+    def refine(self, bad: dict) -> list:
+        """Solve exactly at the worst speed of every run of consecutive failing speeds (at every failing speed
+        when the basis keeps failing) and enrich; returns the failing speeds left to solve again."""
+        runs = _consecutive_runs(sorted(bad))
+        if len(self.exact) + len(runs) > len(self.speeds) // 2:  # the basis keeps failing
             runs = [[i] for i in bad]
         for run in runs:
-            solve_exact(max(run, key=lambda i: bad[i]))
-        todo = [i for i in bad if i not in exact]
+            self.solve_exact(max(run, key=lambda i: bad[i]))
+        return [i for i in bad if i not in self.exact]
+
+
+def _consecutive_runs(indices: list) -> list[list[int]]:
+    """Increasing ``indices`` split into runs of consecutive integers."""
+    runs: list[list[int]] = []
+    for i in indices:
+        if runs and i == runs[-1][-1] + 1:
+            runs[-1].append(i)
+        else:
+            runs.append([i])
+    return runs
+
+
+def _campbell_reduced(poly, speeds, first: dict, solve: tuple, opts: CampbellOptions, tracking: _Tracking):
+    """Reduced-basis candidates with the safeguard (module docstring): (eig, shp, mac, model, exact solves)."""
+    run = _ReducedRun(poly, speeds, first, solve, opts.budget)
+    S = len(speeds)
+    for i in sorted({0, S - 1}):
+        run.solve_exact(i)
+    todo = [i for i in range(S) if i not in run.exact]
+    while True:
+        run.solve_reduced(todo)
+        eig, shp, mac, chosen = _track(speeds, [dm.eigenvalues for dm in run.found],
+                                       [dm.shapes for dm in run.found], run.count, tracking)
+        bad = run.failing(mac, chosen, opts, tracking.cluster_tol)
+        if not bad:
+            return eig, shp, mac, run.model, len(run.exact)
+        todo = run.refine(bad)
 
 
 def _pick(dm: DampedModes, ref: np.ndarray, pred: complex) -> float:

@@ -305,21 +305,31 @@ class _Budget:
         self.limit, self.used = int(limit), 0
 
 
-def _flow(problem: BVP, s0, s1, y0, p, cols, *, rtol, atol, method, budget, blowup, dense=False):
-    """Integrate y from s0 to s1, with the variational equations for the columns ``cols``
-    (None: none; else a list of parameter indices for Psi). Returns (y1, Phi, Psi, sol)."""
-    n = problem.n
-    var = cols is not None
-    ncol = 1 + (n + len(cols) if var else 0)
+def _flow(problem: BVP, span, y0, p, cols, opts: dict, dense=False):
+    """Integrate y from s0 to s1 (``span``), with the variational equations for the columns ``cols``
+    (None: none; else a list of parameter indices for Psi), as the options ``opts`` of :func:`ivp_options`
+    say. Returns (y1, Phi, Psi, sol)."""
+    system = _FlowRhs(problem, p, cols, opts["budget"], opts["blowup"])
+    kwargs = {"jac": system.jac} if opts["method"] in _IMPLICIT else {}
+    try:
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore", RuntimeWarning)
+            from scipy.integrate import solve_ivp  # loaded on use (startup)
 
-    def guard(out):
-        budget.used += 1
-        if budget.used > budget.limit:
-            raise BudgetSpent()
-        if not np.isfinite(out).all():
-            raise IVPFailure("the right-hand side overflowed (NaN or Inf)")
-        return out
+            sol = solve_ivp(system.rhs, span, system.start(y0), method=opts["method"], rtol=opts["rtol"],
+                            atol=opts["atol"], dense_output=dense, **kwargs)
+    except (ValueError, np.linalg.LinAlgError, ZeroDivisionError, OverflowError) as exc:
+        raise IVPFailure(f"the integrator failed ({exc})") from exc
+    if sol.status != 0:
+        raise IVPFailure(f"the integrator stopped at s = {sol.t[-1]:.6g} ({sol.message})")
+    z1 = sol.y[:, -1]
+    if not np.all(np.isfinite(z1)):
+        raise IVPFailure("the trajectory is not finite")
+    return (*system.end(z1), sol)
 
+
+def _point_functions(problem: BVP, p):
+    """(f, f_y, f_p) at one point (s, y) with the parameters p: shapes (n,), (n, n), (n, n_p)."""
     f, f_y, f_p = problem.f, problem.f_y, problem.f_p
     if problem.vectorized:
         def f1(s, y):
@@ -339,60 +349,75 @@ def _flow(problem: BVP, s0, s1, y0, p, cols, *, rtol, atol, method, budget, blow
 
         def fp1(s, y):
             return np.asarray(f_p(s, y, p), float)
+    return f1, fy1, fp1
 
-    if var:
-        cols = list(cols)
 
-        def rhs(s, z):
-            Z = z.reshape(n, ncol, order="F")
-            y = Z[:, 0]
-            if np.abs(y).max() > blowup:
-                raise IVPFailure("the trajectory overflowed (|y| beyond %.0e)" % blowup)
-            fy = fy1(s, y)
-            out = np.empty_like(Z)
-            out[:, 0] = f1(s, y)
-            out[:, 1:] = fy @ Z[:, 1:]
-            if cols:
-                out[:, 1 + n:] += fp1(s, y)[:, cols]
-            return guard(out.ravel(order="F"))
+class _FlowRhs:
+    """The right-hand side of y' = f(s, y, p) for solve_ivp, with the variational equations
+    Phi' = f_y Phi, Psi' = f_y Psi + f_p[:, cols] when ``cols`` is not None (z = (y, Phi, Psi) column-major,
+    Phi(s0) = I, Psi(s0) = 0); every evaluation counts against ``budget``, and a state beyond ``blowup`` or a
+    value that is not finite raises IVPFailure."""
 
-        def jac(s, z):
-            # block-diagonal, without the second derivatives of f: enough for Newton inside Radau/BDF
-            fy = fy1(s, z[:n])
-            return np.kron(np.eye(ncol), fy) if n * ncol <= 120 else sps.kron(sps.identity(ncol), fy, format="csc")
+    def __init__(self, problem: BVP, p, cols, budget, blowup) -> None:
+        self.n = n = problem.n
+        self.var = cols is not None
+        self.ncol = 1 + (n + len(cols) if self.var else 0)
+        self.cols = list(cols) if self.var else None
+        self.f1, self.fy1, self.fp1 = _point_functions(problem, p)
+        self.budget, self.blowup = budget, blowup
 
-        Z0 = np.zeros((n, ncol))
+    def guard(self, out):
+        budget = self.budget
+        budget.used += 1
+        if budget.used > budget.limit:
+            raise BudgetSpent()
+        if not np.isfinite(out).all():
+            raise IVPFailure("the right-hand side overflowed (NaN or Inf)")
+        return out
+
+    def start(self, y0):
+        """z(s0)."""
+        if not self.var:
+            return np.asarray(y0, float)
+        n = self.n
+        Z0 = np.zeros((n, self.ncol))
         Z0[:, 0] = y0
         Z0[:, 1:1 + n] = np.eye(n)
-        z0 = Z0.ravel(order="F")
-    else:
-        def rhs(s, y):
-            if np.abs(y).max() > blowup:
-                raise IVPFailure("the trajectory overflowed (|y| beyond %.0e)" % blowup)
-            return guard(f1(s, y))
+        return Z0.ravel(order="F")
 
-        def jac(s, y):
-            return fy1(s, y)
+    def rhs(self, s, z):
+        if not self.var:
+            if np.abs(z).max() > self.blowup:
+                raise IVPFailure("the trajectory overflowed (|y| beyond %.0e)" % self.blowup)
+            return self.guard(self.f1(s, z))
+        n = self.n
+        Z = z.reshape(n, self.ncol, order="F")
+        y = Z[:, 0]
+        if np.abs(y).max() > self.blowup:
+            raise IVPFailure("the trajectory overflowed (|y| beyond %.0e)" % self.blowup)
+        fy = self.fy1(s, y)
+        out = np.empty_like(Z)
+        out[:, 0] = self.f1(s, y)
+        out[:, 1:] = fy @ Z[:, 1:]
+        if self.cols:
+            out[:, 1 + n:] += self.fp1(s, y)[:, self.cols]
+        return self.guard(out.ravel(order="F"))
 
-        z0 = np.asarray(y0, float)
-    kwargs = {"jac": jac} if method in _IMPLICIT else {}
-    try:
-        with warnings.catch_warnings(), np.errstate(all="ignore"):
-            warnings.simplefilter("ignore", RuntimeWarning)
-            from scipy.integrate import solve_ivp  # loaded on use (startup)
+    def jac(self, s, z):
+        if not self.var:
+            return self.fy1(s, z)
+        # block-diagonal, without the second derivatives of f: enough for Newton inside Radau/BDF
+        n, ncol = self.n, self.ncol
+        fy = self.fy1(s, z[:n])
+        return np.kron(np.eye(ncol), fy) if n * ncol <= 120 else sps.kron(sps.identity(ncol), fy, format="csc")
 
-            sol = solve_ivp(rhs, (s0, s1), z0, method=method, rtol=rtol, atol=atol, dense_output=dense, **kwargs)
-    except (ValueError, np.linalg.LinAlgError, ZeroDivisionError, OverflowError) as exc:
-        raise IVPFailure(f"the integrator failed ({exc})") from exc
-    if sol.status != 0:
-        raise IVPFailure(f"the integrator stopped at s = {sol.t[-1]:.6g} ({sol.message})")
-    z1 = sol.y[:, -1]
-    if not np.all(np.isfinite(z1)):
-        raise IVPFailure("the trajectory is not finite")
-    if not var:
-        return z1, None, None, sol
-    Z1 = z1.reshape(n, ncol, order="F")
-    return Z1[:, 0], Z1[:, 1:1 + n], Z1[:, 1 + n:], sol
+    def end(self, z1):
+        """(y1, Phi, Psi) from z(s1) (Phi, Psi None without the variational equations)."""
+        if not self.var:
+            return z1, None, None
+        n = self.n
+        Z1 = z1.reshape(n, self.ncol, order="F")
+        return Z1[:, 0], Z1[:, 1:1 + n], Z1[:, 1 + n:]
 
 
 @dataclass(frozen=True)
@@ -495,26 +520,32 @@ def _newton_loop(evaluate, x0, *, solve, tol, max_iter, method):
                                    "parameter without a boundary condition), the guess is degenerate, or the "
                                    "problem is too ill-conditioned for this method (use more shooting nodes or "
                                    "collocation)") from None
-        alpha, why = 1.0, ""
-        while True:
-            trial = x + alpha * dx
-            try:
-                r_t, J_t = evaluate(trial)
-                n_t = float(np.linalg.norm(r_t))
-            except IVPFailure as exc:
-                n_t, why = np.inf, str(exc)
-            if n_t <= (1.0 - 1e-4 * alpha) * norm:
-                break
-            alpha *= 0.5
-            if alpha < 2.0 ** -24:
-                extra = f"; the trial trajectories fail: {why}" if why and not np.isfinite(n_t) else ""
-                raise ConvergenceError(f"{method}: the line search found no decrease of the residual at "
-                                       f"iteration {it}; residual norm {norm:.3g} > tol {tol:.1e}{extra}. The "
-                                       "problem is too ill-conditioned for this method or the tolerance is "
-                                       "below the integration error")
-        x, r, J, norm = trial, r_t, J_t, n_t
+        x, r, J, norm = _line_search(evaluate, (x, dx, norm), tol, it, method)
         history.append(norm)
     return x, it, norm, J
+
+
+def _line_search(evaluate, step: tuple, tol: float, it: int, method: str) -> tuple:
+    """Backtracking from x along the Newton step dx (``step`` = (x, dx, ||R(x)||)) until ||R|| decreases by
+    the Armijo factor 1 - 1e-4 alpha: (x + alpha dx, R, J, ||R||) there; ConvergenceError below alpha = 2^-24."""
+    x, dx, norm = step
+    alpha, why = 1.0, ""
+    while True:
+        trial = x + alpha * dx
+        try:
+            r_t, J_t = evaluate(trial)
+            n_t = float(np.linalg.norm(r_t))
+        except IVPFailure as exc:
+            n_t, why = np.inf, str(exc)
+        if n_t <= (1.0 - 1e-4 * alpha) * norm:
+            return trial, r_t, J_t, n_t
+        alpha *= 0.5
+        if alpha < 2.0 ** -24:
+            extra = f"; the trial trajectories fail: {why}" if why and not np.isfinite(n_t) else ""
+            raise ConvergenceError(f"{method}: the line search found no decrease of the residual at "
+                                   f"iteration {it}; residual norm {norm:.3g} > tol {tol:.1e}{extra}. The "
+                                   "problem is too ill-conditioned for this method or the tolerance is "
+                                   "below the integration error")
 
 
 # ----------------------------------------------------------------------------- single shooting
@@ -536,18 +567,31 @@ def shoot(problem: BVP, guess, *, p=None, tol: float = 1e-10, max_iter: int = 40
     p = full_parameters(problem, p)
     y0 = _state(problem, guess, "guess")
     problem.check(y0, p)
-    opts = ivp_options(problem, options)
-    n, unk = problem.n, list(problem.unknown)
-    a, b = problem.interval
+    shot = _SingleShot(problem, p, ivp_options(problem, options))
+    x0 = np.concatenate([y0, p[shot.unk]])
+    x, it, norm, _ = _damped_newton(shot.evaluate, x0, solve=_dense_solve, tol=tol, max_iter=max_iter,
+                                    method="single shooting")
+    return shot.result(x, it, norm)
 
-    def unpack(x):
-        q = p.copy()
-        q[unk] = x[n:]
+
+class _SingleShot:
+    """Single shooting's residual g(y(a), y(b), p) with y(b) the flow of x = (y(a), p[unknown]) and its
+    Jacobian [G_a + G_b Phi, G_b Psi + G_p] (the variational equations); ``opts`` as :func:`ivp_options`'s."""
+
+    def __init__(self, problem: BVP, p, opts: dict) -> None:
+        self.problem, self.p, self.opts = problem, p, opts
+        self.unk = list(problem.unknown)
+
+    def unpack(self, x):
+        n = self.problem.n
+        q = self.p.copy()
+        q[self.unk] = x[n:]
         return x[:n], q
 
-    def evaluate(x):
-        ya, q = unpack(x)
-        yb, Phi, Psi, _ = _flow(problem, a, b, ya, q, unk, **opts)
+    def evaluate(self, x):
+        problem, unk = self.problem, self.unk
+        ya, q = self.unpack(x)
+        yb, Phi, Psi, _ = _flow(problem, problem.interval, ya, q, unk, self.opts)
         R = problem.bc(ya, yb, q)
         Ga, Gb, Gp = problem.bc_jac(ya, yb, q)
         J = np.hstack([Ga + Gb @ Phi, Gb @ Psi + Gp[:, unk]])
@@ -555,17 +599,15 @@ def shoot(problem: BVP, guess, *, p=None, tol: float = 1e-10, max_iter: int = 40
             raise IVPFailure("the boundary residual or its Jacobian is not finite")
         return R, J
 
-    x0 = np.concatenate([y0, p[unk]])
-    x, it, norm, _ = _damped_newton(evaluate, x0, solve=_dense_solve, tol=tol, max_iter=max_iter,
-                                    method="single shooting")
-    ya, q = unpack(x)
-    opts["budget"].used = 0
-    try:
-        _, _, _, sol = _flow(problem, a, b, ya, q, None, dense=True, **opts)
-    except (IVPFailure, BudgetSpent) as exc:  # pragma: no cover - the same trajectory just succeeded
-        raise ConvergenceError(f"single shooting: the final trajectory failed: {exc}") from None
-    dense = sol.sol
-    return BVPResult(sol.t, sol.y, q, norm, it, "single shooting", dense)
+    def result(self, x, it: int, norm: float) -> BVPResult:
+        """The BVPResult of the converged x: its trajectory integrated again with dense output."""
+        ya, q = self.unpack(x)
+        self.opts["budget"].used = 0
+        try:
+            _, _, _, sol = _flow(self.problem, self.problem.interval, ya, q, None, self.opts, dense=True)
+        except (IVPFailure, BudgetSpent) as exc:  # pragma: no cover - the same trajectory just succeeded
+            raise ConvergenceError(f"single shooting: the final trajectory failed: {exc}") from None
+        return BVPResult(sol.t, sol.y, q, norm, it, "single shooting", sol.sol)
 
 
 # ----------------------------------------------------------------------------- multiple shooting
@@ -635,7 +677,7 @@ class ShootingResidual:
         R = np.empty(self.size)
         vals, dpar = [], np.zeros((self.size, len(cols)))
         for j in range(K):
-            y1, Phi, Psi, _ = _flow(prob, nodes[j], nodes[j + 1], Y[:, j], q, cols if jac else None, **self.opts)
+            y1, Phi, Psi, _ = _flow(prob, (nodes[j], nodes[j + 1]), Y[:, j], q, cols if jac else None, self.opts)
             R[j * n:(j + 1) * n] = y1 - Y[:, j + 1]
             if jac:
                 vals += [Phi.ravel(), -np.eye(n).ravel()]
@@ -673,7 +715,7 @@ class ShootingResidual:
         Y, q = self.split(x, p)
         ss, ys, pieces = [], [], []
         for j in range(K):
-            _, _, _, sol = _flow(prob, nodes[j], nodes[j + 1], Y[:, j], q, None, dense=True, **self.opts)
+            _, _, _, sol = _flow(prob, (nodes[j], nodes[j + 1]), Y[:, j], q, None, self.opts, dense=True)
             ss.append(sol.t if j == 0 else sol.t[1:])
             ys.append(sol.y if j == 0 else sol.y[:, 1:])
             pieces.append(sol.sol)
@@ -728,39 +770,53 @@ def collocate(problem: BVP, mesh, guess, *, p=None, tol: float = 1e-8, bc_tol: f
         raise InputError(f"{problem.name}: the mesh runs from {mesh[0]} to {mesh[-1]}, not over the interval "
                          f"({a}, {b})", key="mesh", expected="a mesh from a to b")
     problem.check(Y[:, 0], p)
-    unk, k = list(problem.unknown), problem.k
-
-    def full(pu):
-        q = p.copy()
-        q[unk] = pu
-        return q
-
-    def fun(s, y, pu=()):
-        return problem.fv(s, y, full(pu))
-
-    def fun_jac(s, y, pu=()):
-        q = full(pu)
-        Jy = problem.f_yv(s, y, q)
-        return (Jy, problem.f_pv(s, y, q)[:, unk, :]) if k else Jy
-
-    def bc(ya, yb, pu=()):
-        return problem.bc(ya, yb, full(pu))
-
-    def bc_jac(ya, yb, pu=()):
-        Ga, Gb, Gp = problem.bc_jac(ya, yb, full(pu))
-        return (Ga, Gb, Gp[:, unk]) if k else (Ga, Gb)
-
-    kwargs = {"p": p[unk]} if k else {}
+    funs = _SolveBVPFunctions(problem, p)
+    kwargs = {"p": p[funs.unk]} if funs.k else {}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         try:
             from scipy.integrate import solve_bvp  # loaded on use (startup)
 
-            sol = solve_bvp(fun, bc, mesh, Y, fun_jac=fun_jac, bc_jac=bc_jac, tol=tol,
+            sol = solve_bvp(funs.fun, funs.bc, mesh, Y, fun_jac=funs.fun_jac, bc_jac=funs.bc_jac, tol=tol,
                             bc_tol=tol if bc_tol is None else bc_tol, max_nodes=max_nodes, **kwargs)
         except (ValueError, np.linalg.LinAlgError) as exc:
             raise ConvergenceError(f"collocation (solve_bvp) failed: {exc}") from None
-    q = full(sol.p) if k else p.copy()
+    q = funs.full(sol.p) if funs.k else p.copy()
+    return _collocation_result(problem, sol, q, tol)
+
+
+class _SolveBVPFunctions:
+    """The problem's f, f_y, g and Jacobians in solve_bvp's form: the unknown parameters p[unknown] passed
+    separately (as ``pu``; none when the problem has no unknown parameters), the others fixed at p."""
+
+    def __init__(self, problem: BVP, p) -> None:
+        self.problem, self.p = problem, p
+        self.unk, self.k = list(problem.unknown), problem.k
+
+    def full(self, pu):
+        q = self.p.copy()
+        q[self.unk] = pu
+        return q
+
+    def fun(self, s, y, pu=()):
+        return self.problem.fv(s, y, self.full(pu))
+
+    def fun_jac(self, s, y, pu=()):
+        q = self.full(pu)
+        Jy = self.problem.f_yv(s, y, q)
+        return (Jy, self.problem.f_pv(s, y, q)[:, self.unk, :]) if self.k else Jy
+
+    def bc(self, ya, yb, pu=()):
+        return self.problem.bc(ya, yb, self.full(pu))
+
+    def bc_jac(self, ya, yb, pu=()):
+        Ga, Gb, Gp = self.problem.bc_jac(ya, yb, self.full(pu))
+        return (Ga, Gb, Gp[:, self.unk]) if self.k else (Ga, Gb)
+
+
+def _collocation_result(problem: BVP, sol, q, tol: float) -> BVPResult:
+    """The BVPResult of solve_bvp's solution with parameters q: residual = max(largest relative collocation
+    residual, largest |g|); ConvergenceError when solve_bvp failed or the residual is not finite."""
     rms = float(np.max(sol.rms_residuals)) if sol.rms_residuals.size else np.inf
     bc_res = float(np.max(np.abs(problem.bc(sol.y[:, 0], sol.y[:, -1], q))))
     res = max(rms, bc_res)

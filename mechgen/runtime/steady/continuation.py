@@ -202,44 +202,8 @@ def _factor(system, Fu, Fl, row):
     SuperLU when Fu is sparse, or dense LU. Raises _Singular."""
     own = _own(system, "bordered")
     if own is not None:
-        try:
-            solve = own(Fu, Fl, row)
-        except _SOLVER_ERRORS as exc:
-            raise _Singular(str(exc)) from exc
-
-        def checked(rhs):
-            try:
-                return solve(rhs)
-            except _SOLVER_ERRORS as exc:
-                raise _Singular(str(exc)) from exc
-
-        return checked
-    n = Fl.size
-    if sps.issparse(Fu):
-        A = sps.vstack([sps.hstack([Fu, sps.csc_matrix(Fl.reshape(n, 1))]),
-                        sps.csr_matrix(row.reshape(1, n + 1))], format="csc")
-        if not np.all(np.isfinite(A.data)):
-            raise _Singular("the Jacobian is not finite")
-        try:
-            lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A")  # banded blocks + border: 8x less fill than COLAMD
-        except RuntimeError as exc:
-            raise _Singular(str(exc)) from exc
-        solve = lu.solve
-    else:
-        A = np.vstack([np.hstack([Fu, Fl[:, None]]), row[None, :]])
-        if not np.all(np.isfinite(A)):
-            raise _Singular("the Jacobian is not finite")
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("error", sla.LinAlgWarning)
-                lu = sla.lu_factor(A, check_finite=False)
-        except (np.linalg.LinAlgError, ValueError, sla.LinAlgWarning) as exc:
-            raise _Singular(str(exc)) from exc
-        if np.min(np.abs(np.diag(lu[0]))) <= 1e-14 * max(np.abs(A).max(), 1e-300):
-            raise _Singular("a zero pivot")
-
-        def solve(rhs):
-            return sla.lu_solve(lu, rhs, check_finite=False)
+        return _own_factor(own, Fu, Fl, row)
+    solve = _sparse_factor(Fu, Fl, row) if sps.issparse(Fu) else _dense_factor(Fu, Fl, row)
 
     def finite(rhs):
         x = solve(rhs)
@@ -248,6 +212,56 @@ def _factor(system, Fu, Fl, row):
         return x
 
     return finite
+
+
+def _own_factor(own, Fu, Fl, row):
+    """The system's own bordered solver ``own(Fu, Fl, row)``, its solver errors raised as _Singular."""
+    try:
+        solve = own(Fu, Fl, row)
+    except _SOLVER_ERRORS as exc:
+        raise _Singular(str(exc)) from exc
+
+    def checked(rhs):
+        try:
+            return solve(rhs)
+        except _SOLVER_ERRORS as exc:
+            raise _Singular(str(exc)) from exc
+
+    return checked
+
+
+def _sparse_factor(Fu, Fl, row):
+    """SuperLU's solve of the bordered matrix with a sparse Fu. Raises _Singular."""
+    n = Fl.size
+    A = sps.vstack([sps.hstack([Fu, sps.csc_matrix(Fl.reshape(n, 1))]),
+                    sps.csr_matrix(row.reshape(1, n + 1))], format="csc")
+    if not np.all(np.isfinite(A.data)):
+        raise _Singular("the Jacobian is not finite")
+    try:
+        lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A")  # banded blocks + border: 8x less fill than COLAMD
+    except RuntimeError as exc:
+        raise _Singular(str(exc)) from exc
+    return lu.solve
+
+
+def _dense_factor(Fu, Fl, row):
+    """Dense LU's solve of the bordered matrix. Raises _Singular (also at a pivot below 1e-14 max |A|)."""
+    A = np.vstack([np.hstack([Fu, Fl[:, None]]), row[None, :]])
+    if not np.all(np.isfinite(A)):
+        raise _Singular("the Jacobian is not finite")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", sla.LinAlgWarning)
+            lu = sla.lu_factor(A, check_finite=False)
+    except (np.linalg.LinAlgError, ValueError, sla.LinAlgWarning) as exc:
+        raise _Singular(str(exc)) from exc
+    if np.min(np.abs(np.diag(lu[0]))) <= 1e-14 * max(np.abs(A).max(), 1e-300):
+        raise _Singular("a zero pivot")
+
+    def solve(rhs):
+        return sla.lu_solve(lu, rhs, check_finite=False)
+
+    return solve
 
 
 class _Linearisation:
@@ -399,38 +413,49 @@ def continuation(system, u0, lam0: float, options: ContinuationOptions | None = 
     """
     opts = ContinuationOptions.of(options, **overrides)
     opts.check()
-    lam_min, lam_max, tol, max_corrector = opts.lam_min, opts.lam_max, opts.tol, opts.max_corrector
     lam0 = float(lam0)
     u = _check_system(system, u0, lam0)
-    if not lam_min <= lam0 <= lam_max:
-        raise InputError(f"continuation: lam0 = {lam0} lies outside [{lam_min}, {lam_max}]", key="lam0",
+    if not opts.lam_min <= lam0 <= opts.lam_max:
+        raise InputError(f"continuation: lam0 = {lam0} lies outside [{opts.lam_min}, {opts.lam_max}]", key="lam0",
                          expected="a start inside the lam range")
-    n = u.size
-    w = _weights(system, n + 1)
-    e_lam = np.zeros(n + 1)
-    e_lam[-1] = 1.0
+    w = _weights(system, u.size + 1)
     if start_tangent is not None:
         return _run(system, np.append(u, lam0), _unit(w, start_tangent), callback, opts, until)
-    got = _correct(system, np.append(u, lam0), e_lam, lam0, tol=tol, max_iter=4 * max_corrector)
+    x, lin = _corrected_start(system, u, lam0, opts)
+    t = _start_tangent(lin, w)
+    if t[-1] * opts.direction < 0:
+        t = -t
+    return _run(system, x, t, callback, opts, until)
+
+
+def _corrected_start(system, u, lam0: float, opts: ContinuationOptions):
+    """(x, linearisation) of the start corrected onto the branch by Newton at fixed lam0 (4 x max_corrector
+    steps); ConvergenceError when it fails."""
+    e_lam = np.zeros(u.size + 1)
+    e_lam[-1] = 1.0
+    got = _correct(system, np.append(u, lam0), e_lam, lam0, tol=opts.tol, max_iter=4 * opts.max_corrector)
     if got is None:
         F = _eval(system, u, lam0, jac=False)[0]
         raise ConvergenceError(f"continuation of {getattr(system, 'name', 'F')}: the start (lam = {lam0:.6g}, "
                                f"||F|| = {np.linalg.norm(F):.3g}) could not be corrected onto the branch (Newton at "
                                "fixed lam failed: a bad start or a fold exactly at the start)")
     x, _, lin = got
-    t = None
-    for ref in (e_lam, np.random.default_rng(0).standard_normal(n + 1)):
+    return x, lin
+
+
+def _start_tangent(lin, w):
+    """The unit tangent at the start, with the bordering row e_lam (or, where that is singular, a fixed random
+    row); ConvergenceError at a branch point ([F_u, F_lam] rank deficient)."""
+    size = lin.Fl.size + 1
+    e_lam = np.zeros(size)
+    e_lam[-1] = 1.0
+    for ref in (e_lam, np.random.default_rng(0).standard_normal(size)):
         try:
-            t = _tangent(lin, ref, w)
-            break
+            return _tangent(lin, ref, w)
         except _Singular:
             continue
-    if t is None:
-        raise ConvergenceError("continuation: no tangent at the start ([F_u, F_lam] is rank deficient: a "
-                               "branch point)")
-    if t[-1] * opts.direction < 0:
-        t = -t
-    return _run(system, x, t, callback, opts, until)
+    raise ConvergenceError("continuation: no tangent at the start ([F_u, F_lam] is rank deficient: a "
+                           "branch point)")
 
 
 def closes(w, xs: list, ts: list, step: float) -> bool:
@@ -457,96 +482,139 @@ def _unit(w, t) -> np.ndarray:
 
 def _run(system, x, t, callback, opts: ContinuationOptions, until: Callable | None = None) -> Branch:
     """The steps of :func:`continuation` from the point x on the branch with the unit tangent t."""
-    ds, ds_min, ds_max, max_points = opts.ds, opts.ds_min, opts.ds_max, opts.max_points
-    lam_min, lam_max, tol, max_corrector, grow = opts.lam_min, opts.lam_max, opts.tol, opts.max_corrector, opts.grow
-    max_turn, locate_folds = opts.max_turn, opts.locate_folds
-    n = x.size - 1
-    w = _weights(system, n + 1)
-    e_lam = np.zeros(n + 1)
-    e_lam[-1] = 1.0
-    xs, ts, arc = [x], [t], [0.0]
-    data = [callback(x[:n].copy(), x[n]) if callback else None]
-    folds = []
-    cos_turn = math.cos(max_turn)
-    status, message = "max_points", f"reached max_points = {max_points}"
-    step = ds
-    bar = Progress(max_points, desc="continuation", unit="point", enabled=opts.progress)
-    while len(xs) < max_points:
-        x_i, t_i = xs[-1], ts[-1]
-        bar.to(len(xs))
+    walk = _Walk(system, x, t, callback, opts)
+    n = walk.n
+    status, message = "max_points", f"reached max_points = {opts.max_points}"
+    step = opts.ds
+    bar = Progress(opts.max_points, desc="continuation", unit="point", enabled=opts.progress)
+    while len(walk.xs) < opts.max_points:
+        x_i = walk.xs[-1]
+        bar.to(len(walk.xs))
         if opts.budget is not None:
-            opts.budget.check_time(lambda: f"{len(xs)} branch points, lam = {x_i[n]:.10g}")
-        row = _row(w, t_i)
-        pred = x_i + step * t_i
-        if len(xs) > 1 and arc[-1] > arc[-2]:  # second order: x'' ~ (t_i - t_{i-1}) / (s_i - s_{i-1})
-            pred += 0.5 * step ** 2 / (arc[-1] - arc[-2]) * (t_i - ts[-2])
-        got = _correct(system, pred, row, row @ x_i + step, tol=tol, max_iter=max_corrector)
-        ok = got is not None
-        if ok:
-            x_new, iters, lin = got
-            try:
-                t_new = _tangent(lin, row, w)
-            except _Singular:
-                ok = False
-            else:
-                ok = t_new @ row >= cos_turn
-        if not ok:
+            opts.budget.check_time(lambda: f"{len(walk.xs)} branch points, lam = {x_i[n]:.10g}")
+        row = _row(walk.w, walk.ts[-1])
+        got = walk.advance(step, row)
+        if got is None:
             step *= 0.5
-            if step < ds_min:
-                status = "min_step"
-                message = (f"the step fell below ds_min = {ds_min:.3g} at lam = {x_i[n]:.10g} (the corrector fails "
-                           "or the branch turns too sharply: a singular point, or tol below the residual's noise)")
+            if step < opts.ds_min:
+                status, message = "min_step", _min_step_message(opts.ds_min, x_i[n])
                 break
             continue
+        x_new, iters, t_new = got
         ended = until(x_new[:n].copy(), float(x_new[n])) if until is not None else None
         if ended is not None:
             status, message = ended
             break
-        # a fold between x_i and x_new?
-        if locate_folds and t_i[n] * t_new[n] < 0:
-            fold = _locate_fold(system, x_i, t_i, step, tol=tol, max_corrector=max_corrector, w=w)
-            if fold is None:
-                lam_f = max(x_i[n], x_new[n]) if t_i[n] > 0 else min(x_i[n], x_new[n])
-                fold = Fold(x_new[:n].copy(), float(lam_f), len(xs) - 1, t_new, located=False)
-            else:
-                fold = Fold(fold[0][:n].copy(), float(fold[0][n]), len(xs) - 1, fold[1], True)
-            if lam_min <= fold.lam <= lam_max:
-                folds.append(fold)
-        if not lam_min <= x_new[n] <= lam_max:
-            bound = lam_max if x_new[n] > lam_max else lam_min
-            status = "lam_max" if bound == lam_max else "lam_min"
-            message = f"lam left [{lam_min}, {lam_max}] after lam = {x_i[n]:.10g}"
-            theta = (bound - x_i[n]) / (x_new[n] - x_i[n])
-            end = _correct(system, x_i + theta * (x_new - x_i), e_lam, bound, tol=tol, max_iter=max_corrector,
-                           polish=True)
-            if end is not None and (t_i[n] * t_new[n] > 0):
-                x_end, _, lin = end
-                try:
-                    t_end = _tangent(lin, row, w)
-                except _Singular:
-                    t_end = t_new
-                xs.append(x_end)
-                ts.append(t_end)
-                arc.append(arc[-1] + _norm(w, x_end - x_i))
-                data.append(callback(x_end[:n].copy(), x_end[n]) if callback else None)
-                message = f"lam reached the bound {bound:.10g}"
+        walk.note_fold(step, x_new, t_new)
+        if not opts.lam_min <= x_new[n] <= opts.lam_max:
+            status, message = walk.end_at_bound(x_new, t_new, row)
             break
-        xs.append(x_new)
-        ts.append(t_new)
-        arc.append(arc[-1] + step)
-        data.append(callback(x_new[:n].copy(), x_new[n]) if callback else None)
-        if closes(w, xs, ts, step):
+        walk.keep(x_new, t_new, step)
+        if closes(walk.w, walk.xs, walk.ts, step):
             status = "closed"
-            message = (f"the branch closed on itself after {len(xs) - 1} points (back at its start, lam = "
-                       f"{xs[0][n]:.10g}, going the same way: an isola)")
+            message = (f"the branch closed on itself after {len(walk.xs) - 1} points (back at its start, lam = "
+                       f"{walk.xs[0][n]:.10g}, going the same way: an isola)")
             break
-        if iters <= 3:
-            step = min(step * grow, ds_max)
-        elif iters >= max(4, max_corrector - 2):
-            step = max(0.7 * step, ds_min)
+        step = _next_step(step, iters, opts)
     bar.close()
-    X, T = np.array(xs), np.array(ts)
-    return Branch(X[:, :n], X[:, n], np.array(arc), T, tuple(folds), tuple(data), status, message, system)
+    return walk.branch(status, message)
+
+
+def _min_step_message(ds_min: float, lam: float) -> str:
+    return (f"the step fell below ds_min = {ds_min:.3g} at lam = {lam:.10g} (the corrector fails or the branch "
+            "turns too sharply: a singular point, or tol below the residual's noise)")
+
+
+def _next_step(step: float, iters: int, opts: ContinuationOptions) -> float:
+    """The step after a correction in ``iters`` Newton steps: x grow (to ds_max) after at most 3, x 0.7 (to
+    ds_min) after max(4, max_corrector - 2) or more, else unchanged."""
+    if iters <= 3:
+        return min(step * opts.grow, opts.ds_max)
+    if iters >= max(4, opts.max_corrector - 2):
+        return max(0.7 * step, opts.ds_min)
+    return step
+
+
+class _Walk:
+    """The growing branch of :func:`_run`: accepted points ``xs`` = (u, lam), their unit tangents ``ts``,
+    arclengths ``arc``, callback values ``data`` and the folds found so far; ``w`` the arclength weights."""
+
+    def __init__(self, system, x, t, callback, opts: ContinuationOptions) -> None:
+        self.system, self.callback, self.opts = system, callback, opts
+        self.n = n = x.size - 1
+        self.w = _weights(system, n + 1)
+        self.xs, self.ts, self.arc = [x], [t], [0.0]
+        self.data = [callback(x[:n].copy(), x[n]) if callback else None]
+        self.folds: list = []
+
+    def keep(self, x, t, length: float) -> None:
+        """Accept the point x with tangent t, ``length`` (arclength) after the last."""
+        n = self.n
+        self.xs.append(x)
+        self.ts.append(t)
+        self.arc.append(self.arc[-1] + length)
+        self.data.append(self.callback(x[:n].copy(), x[n]) if self.callback else None)
+
+    def advance(self, step: float, row):
+        """(x_new, corrector iterations, t_new) a ``step`` on from the last point (predictor with the
+        curvature of the last two tangents, corrector on the row W t_i), or None when the corrector or the
+        tangent fails or the tangent turns by more than max_turn."""
+        x_i, t_i, opts = self.xs[-1], self.ts[-1], self.opts
+        pred = x_i + step * t_i
+        if len(self.xs) > 1 and self.arc[-1] > self.arc[-2]:  # second order: x'' ~ (t_i - t_{i-1}) / (s_i - s_{i-1})
+            pred += 0.5 * step ** 2 / (self.arc[-1] - self.arc[-2]) * (t_i - self.ts[-2])
+        got = _correct(self.system, pred, row, row @ x_i + step, tol=opts.tol, max_iter=opts.max_corrector)
+        if got is None:
+            return None
+        x_new, iters, lin = got
+        try:
+            t_new = _tangent(lin, row, self.w)
+        except _Singular:
+            return None
+        return (x_new, iters, t_new) if t_new @ row >= math.cos(opts.max_turn) else None
+
+    def note_fold(self, step: float, x_new, t_new) -> None:
+        """Record the fold between the last point and x_new when t_lam changes sign there (located by
+        :func:`_locate_fold` when asked and possible, else at the extreme lam of the two points)."""
+        x_i, t_i, n, opts = self.xs[-1], self.ts[-1], self.n, self.opts
+        if not (opts.locate_folds and t_i[n] * t_new[n] < 0):
+            return
+        fold = _locate_fold(self.system, x_i, t_i, step, tol=opts.tol, max_corrector=opts.max_corrector, w=self.w)
+        if fold is None:
+            lam_f = max(x_i[n], x_new[n]) if t_i[n] > 0 else min(x_i[n], x_new[n])
+            fold = Fold(x_new[:n].copy(), float(lam_f), len(self.xs) - 1, t_new, located=False)
+        else:
+            fold = Fold(fold[0][:n].copy(), float(fold[0][n]), len(self.xs) - 1, fold[1], True)
+        if opts.lam_min <= fold.lam <= opts.lam_max:
+            self.folds.append(fold)
+
+    def end_at_bound(self, x_new, t_new, row) -> tuple[str, str]:
+        """(status, message) where x_new has left [lam_min, lam_max]: the last point is put on the bound
+        (corrected at fixed lam, polished) unless that fails or a fold lies between."""
+        x_i, t_i, n, opts = self.xs[-1], self.ts[-1], self.n, self.opts
+        bound = opts.lam_max if x_new[n] > opts.lam_max else opts.lam_min
+        status = "lam_max" if bound == opts.lam_max else "lam_min"
+        message = f"lam left [{opts.lam_min}, {opts.lam_max}] after lam = {x_i[n]:.10g}"
+        theta = (bound - x_i[n]) / (x_new[n] - x_i[n])
+        e_lam = np.zeros(n + 1)
+        e_lam[-1] = 1.0
+        end = _correct(self.system, x_i + theta * (x_new - x_i), e_lam, bound, tol=opts.tol,
+                       max_iter=opts.max_corrector, polish=True)
+        if end is not None and (t_i[n] * t_new[n] > 0):
+            x_end, _, lin = end
+            try:
+                t_end = _tangent(lin, row, self.w)
+            except _Singular:
+                t_end = t_new
+            self.keep(x_end, t_end, _norm(self.w, x_end - x_i))
+            message = f"lam reached the bound {bound:.10g}"
+        return status, message
+
+    def branch(self, status: str, message: str) -> Branch:
+        X, T = np.array(self.xs), np.array(self.ts)
+        n = self.n
+        return Branch(X[:, :n], X[:, n], np.array(self.arc), T, tuple(self.folds), tuple(self.data), status, message,
+                      self.system)
 
 
 def _segment_point(system, x_i, t_i, sigma, *, tol, max_corrector, w=None):
@@ -643,50 +711,74 @@ def minimize_along_branch(branch: Branch, output: Callable, *, gradient: Callabl
     """
     if kind not in ("min", "max"):
         raise InputError(f"minimize_along_branch: kind = {kind!r}", key="kind", expected="'min' or 'max'")
-    system = branch.system
-    m, n = branch.u.shape
+    m = branch.u.shape[0]
     if m < 3:
         raise InputError(f"minimize_along_branch: the branch has {m} points", key="branch",
                          expected="at least 3 points")
+    j = _sampled_extremum(branch, output, kind)
+    h = fd_step if fd_step is not None else 1e-5 * max(float(np.min(np.diff(branch.arclength)[j - 1:j + 1])), 1e-8)
+    slope = _BranchSlope(branch, output, gradient, h, 1e-10 if tol is None else tol)
+    for i in (j - 1, j):
+        found = slope.extremum(i, kind)
+        if found is not None:
+            return found
+    raise ConvergenceError(f"minimize_along_branch: d phi/ds does not change sign around the sampled {kind}imum at "
+                           f"lam = {branch.lam[j]:.6g} (a kink, or the branch is too coarse there)")
+
+
+def _sampled_extremum(branch: Branch, output: Callable, kind: str) -> int:
+    """The index of the branch point with the smallest (kind 'min') or largest output; ConvergenceError at an end."""
+    m = branch.u.shape[0]
     sign = 1.0 if kind == "min" else -1.0
     vals = np.array([float(output(branch.u[j], branch.lam[j])) for j in range(m)])
     j = int(np.argmin(sign * vals))
     if j == 0 or j == m - 1:
         raise ConvergenceError(f"minimize_along_branch: the {kind}imum of the sampled output ({vals[j]:.6g}) is at "
                                f"an end of the branch (lam = {branch.lam[j]:.6g}); continue the branch further")
-    tol = 1e-10 if tol is None else tol
-    w = _weights(system, n + 1)
-    X = np.hstack([branch.u, branch.lam[:, None]])
-    T = branch.tangents
-    h = fd_step if fd_step is not None else 1e-5 * max(float(np.min(np.diff(branch.arclength)[j - 1:j + 1])), 1e-8)
+    return j
 
-    def point(i, sigma):
+
+class _BranchSlope:
+    """d phi/ds at the corrected point at arclength parameter sigma on the branch's segment i: grad phi . t
+    with ``gradient``, else the central difference of phi = output(u, lam) over sigma +- h."""
+
+    def __init__(self, branch: Branch, output: Callable, gradient: Callable | None, h: float, tol: float) -> None:
+        self.system, self.output, self.gradient, self.h, self.tol = branch.system, output, gradient, h, tol
+        self.n = n = branch.u.shape[1]
+        self.w = _weights(branch.system, n + 1)
+        self.X = np.hstack([branch.u, branch.lam[:, None]])
+        self.T = branch.tangents
+
+    def point(self, i: int, sigma: float):
+        """(x, t) at sigma on segment i (the branch point itself at sigma = 0)."""
         if sigma == 0.0:
-            return X[i], T[i]
-        return _segment_point(system, X[i], T[i], sigma, tol=tol, max_corrector=10, w=w)
+            return self.X[i], self.T[i]
+        return _segment_point(self.system, self.X[i], self.T[i], sigma, tol=self.tol, max_corrector=10, w=self.w)
 
-    def slope(i, sigma):
-        if gradient is not None:
-            x, t = point(i, sigma)
-            gu, gl = gradient(x[:n], x[n])
+    def __call__(self, i: int, sigma: float) -> float:
+        n, h, output = self.n, self.h, self.output
+        if self.gradient is not None:
+            x, t = self.point(i, sigma)
+            gu, gl = self.gradient(x[:n], x[n])
             return float(np.dot(np.asarray(gu, float).ravel(), t[:n]) + gl * t[n])
-        xp, _ = point(i, sigma + h)
-        xm, _ = point(i, sigma - h) if sigma - h != 0.0 else (X[i], None)
+        xp, _ = self.point(i, sigma + h)
+        xm, _ = self.point(i, sigma - h) if sigma - h != 0.0 else (self.X[i], None)
         return (float(output(xp[:n], xp[n])) - float(output(xm[:n], xm[n]))) / (2 * h)
 
-    for i in (j - 1, j):
-        length = float(_row(w, T[i]) @ (X[i + 1] - X[i]))
+    def extremum(self, i: int, kind: str) -> Extremum | None:
+        """The zero of d phi/ds on segment i (Brent), None without a sign change; ConvergenceError when
+        correcting points fails."""
+        n, X = self.n, self.X
+        length = float(_row(self.w, self.T[i]) @ (X[i + 1] - X[i]))
         try:
-            a, b = slope(i, 0.0), slope(i, length)
+            a, b = self(i, 0.0), self(i, length)
             if a * b > 0:
-                continue
+                return None
             from scipy.optimize import brentq  # loaded on use (startup)
 
-            sigma = brentq(lambda s: slope(i, s), 0.0, length, xtol=1e-13 * max(1.0, length), maxiter=100)
-            x, _ = point(i, sigma)
-            return Extremum(x[:n].copy(), float(x[n]), float(output(x[:n], x[n])), kind, i, abs(slope(i, sigma)))
+            sigma = brentq(lambda s: self(i, s), 0.0, length, xtol=1e-13 * max(1.0, length), maxiter=100)
+            x, _ = self.point(i, sigma)
+            return Extremum(x[:n].copy(), float(x[n]), float(self.output(x[:n], x[n])), kind, i, abs(self(i, sigma)))
         except (_Singular, ValueError, RuntimeError) as exc:
             raise ConvergenceError(f"minimize_along_branch: correcting points near lam = {X[i][n]:.6g} failed "
                                    f"({exc})") from None
-    raise ConvergenceError(f"minimize_along_branch: d phi/ds does not change sign around the sampled {kind}imum at "
-                           f"lam = {branch.lam[j]:.6g} (a kink, or the branch is too coarse there)")

@@ -132,7 +132,20 @@ def steady_bvp(field_system) -> SteadyBVP:
     st = field_system.steady_form()
     fields, names, length_index, fixed_length = _layout(field_system)
     n = len(fields)
-    bc = st.outputs(np.zeros(n), np.ones(n))  # boundary values depend on parameters only (unit slopes: finite)
+    start, end = _lagrangian_conditions(field_system, fields, st.outputs(np.zeros(n), np.ones(n)))
+    rhs = _LagrangianRates(st, n, length_index, fixed_length)
+    g, g_ya, g_yb, g_p = _end_conditions(start, end, 2 * n, len(names))
+    problem = BVP(rhs.f, rhs.f_y, g, g_ya, g_yb, (0.0, 1.0), 2 * n, n_p=len(names), f_p=rhs.f_p if names else None,
+                  g_p=g_p if names else None, vectorized=True,
+                  name=f"steady state of {field_system.metadata.model}")
+    return SteadyBVP(problem, fields, fixed_length, st, names, length_index,
+                     np.array(field_system.params, float))
+
+
+def _lagrangian_conditions(field_system, fields, bc: dict) -> tuple[list, list]:
+    """The (index into y = (u, u_s), value) pairs fixed at the start and at the end, from the model's
+    constraints and the boundary values ``bc`` (the outputs bc_<field>_<order>_<end>); 2n of them."""
+    n = len(fields)
     conditions = []
     for f, k, at in field_system.field_meta.constraints:
         if k > 1:
@@ -145,80 +158,82 @@ def steady_bvp(field_system) -> SteadyBVP:
                          expected="n conditions per field pair: values or slopes at the two ends")
     start = [(i, v) for i, at, v in conditions if at == "start"]
     end = [(i, v) for i, at, v in conditions if at == "end"]
-    residual, tangent = st.kernels["residual"], st.kernels["tangent"]
+    return start, end
 
-    def L_of(p):
-        return p[length_index] if length_index is not None else fixed_length
 
-    def accelerations(s_pts, y, p, with_jacobian: bool):
+class _LagrangianRates:
+    """dy/dsigma = f(sigma, y, p) = L F(L sigma, y), y = (u, u_s), F = (u_s, u_ss) with u_ss = -H^-1 r(u, u_s, 0)
+    from the steady form ``st``'s kernels, and its Jacobians f_y (exact) and f_p; L = p[length_index] or the
+    fixed length."""
+
+    def __init__(self, st, n: int, length_index, fixed_length) -> None:
+        self.n, self.length_index, self.fixed_length = n, length_index, fixed_length
+        self.residual, self.tangent = st.kernels["residual"], st.kernels["tangent"]
+        self.impl = None
+        self.at_params = st  # the steady form at the parameters of the last single-state call
+
+    def L_of(self, p):
+        return p[self.length_index] if self.length_index is not None else self.fixed_length
+
+    def accelerations(self, s_pts, y, p, with_jacobian: bool):
         """u_ss = -H^-1 r(u, u_s, 0) at every point (batched kernels), and optionally
         d u_ss / d y = -H^-1 [r_u, r_us] at that u_ss (prepared kernel calls, the last
         batches memoised: mechgen.runtime.steady.steady_kernels)."""
-        impl = getattr(accelerations, "impl", None)
-        if impl is None:
+        if self.impl is None:
             from mechgen.runtime.steady.steady_kernels import SteadyAccelerations
 
-            impl = accelerations.impl = SteadyAccelerations(residual, tangent, n)
+            self.impl = SteadyAccelerations(self.residual, self.tangent, self.n)
         if not with_jacobian:
-            return impl.accelerations(s_pts, y, p), None
-        return impl.jacobian(s_pts, y, p)
+            return self.impl.accelerations(s_pts, y, p), None
+        return self.impl.jacobian(s_pts, y, p)
 
-    at_params = [st]  # the steady form at the parameters of the last single-state call
-
-    def use(p):
+    def use(self, p):
         """The steady form with the parameters p for the single-state kernels (shooting's hot path): the last
         one again when p has not changed, else a new system sharing its kernels and prepared calls."""
-        if not np.array_equal(at_params[0].params, p):
-            at_params[0] = at_params[0].with_param_vector(p)
-        return at_params[0]
+        if not np.array_equal(self.at_params.params, p):
+            self.at_params = self.at_params.with_param_vector(p)
+        return self.at_params
 
-    def F(s_pts, y, p):
+    def F(self, s_pts, y, p):
         if y.shape[1] == 1:  # one state (shooting): the prepared single-state kernels
-            return use(p).rhs(float(np.ravel(s_pts)[0]), y[:, 0])[:, None]
-        acc, _ = accelerations(s_pts, y, p, False)
-        return np.vstack([y[n:], acc.T])
+            return self.use(p).rhs(float(np.ravel(s_pts)[0]), y[:, 0])[:, None]
+        acc, _ = self.accelerations(s_pts, y, p, False)
+        return np.vstack([y[self.n:], acc.T])
 
-    def f(sigma, y, p):
-        L = L_of(p)
-        return L * F(L * np.asarray(sigma), y, p)
+    def f(self, sigma, y, p):
+        L = self.L_of(p)
+        return L * self.F(L * np.asarray(sigma), y, p)
 
-    def f_y(sigma, y, p):
-        L = L_of(p)
+    def f_y(self, sigma, y, p):
+        L, n = self.L_of(p), self.n
         if y.shape[1] == 1:
-            return L * use(p).jacobian(L * float(np.ravel(sigma)[0]), y[:, 0])[:, :, None]
-        _, jac = accelerations(L * np.asarray(sigma), y, p, True)
+            return L * self.use(p).jacobian(L * float(np.ravel(sigma)[0]), y[:, 0])[:, :, None]
+        _, jac = self.accelerations(L * np.asarray(sigma), y, p, True)
         J = np.zeros((2 * n, 2 * n, y.shape[1]))
         J[:n, n:] = np.eye(n)[:, :, None]
         J[n:] = np.transpose(jac, (1, 2, 0))
         return L * J
 
-    def f_p(sigma, y, p, cols=None):
+    def f_p(self, sigma, y, p, cols=None):
         """d f / d p (columns ``cols``, default all) for continuation's F_lam: f = L [u_s; u_ss],
         d u_ss / d p_j = -H^-1 d r / d p_j at the actual u_ss (central differences of the residual,
         relative steps 1e-6), plus [u_s; u_ss] for the length parameter."""
         p = np.asarray(p, float)
         cols = range(len(p)) if cols is None else [int(j) for j in cols]
-        m = y.shape[1]
+        n, m = self.n, y.shape[1]
         out = np.zeros((2 * n, len(cols), m))
         if not len(cols):
             return out
         if m == 1:  # one state (shooting's variational equations): differences of f
-            return _differences(f, sigma, y, p, cols)
+            return _differences(self.f, sigma, y, p, cols)
         sigma = np.asarray(sigma, float)
-        L = L_of(p)
-        accelerations(L * sigma, y, p, False)  # the memoised batch (and the implementation)
-        d_acc = accelerations.impl.parameter_derivatives(lambda q: L_of(q) * sigma, y, p, cols)
+        L = self.L_of(p)
+        self.accelerations(L * sigma, y, p, False)  # the memoised batch (and the implementation)
+        d_acc = self.impl.parameter_derivatives(lambda q: self.L_of(q) * sigma, y, p, cols)
         out[n:] = L * np.transpose(d_acc, (1, 2, 0))
-        if length_index is not None and length_index in cols:
-            out[:, list(cols).index(length_index)] += F(L * sigma, y, p)
+        if self.length_index is not None and self.length_index in cols:
+            out[:, list(cols).index(self.length_index)] += self.F(L * sigma, y, p)
         return out
-
-    g, g_ya, g_yb, g_p = _end_conditions(start, end, 2 * n, len(names))
-    problem = BVP(f, f_y, g, g_ya, g_yb, (0.0, 1.0), 2 * n, n_p=len(names), f_p=f_p if names else None,
-                  g_p=g_p if names else None, vectorized=True,
-                  name=f"steady state of {field_system.metadata.model}")
-    return SteadyBVP(problem, fields, fixed_length, st, names, length_index,
-                     np.array(field_system.params, float))
 
 
 def hamiltonian_bvp(field_system) -> SteadyBVP:
@@ -238,6 +253,19 @@ def hamiltonian_bvp(field_system) -> SteadyBVP:
     reader = SteadyBVP(None, fields, fixed_length, SimpleNamespace(kernels=kernels), names, length_index, params0,
                        form="hamiltonian")
     bc = kernels["outputs"].evaluate(reader._state(np.ones((2 * n, 1)), np.zeros(1), params0))
+    start, end = _hamiltonian_conditions(field_system, fields, bc)
+    rhs = _HamiltonianRates(reader, kernels["rates"], kernels["rates_tangent"])
+    g, g_ya, g_yb, g_p = _end_conditions(start, end, 2 * n, len(names))
+    problem = BVP(rhs.f, rhs.f_y, g, g_ya, g_yb, (0.0, 1.0), 2 * n, n_p=len(names), f_p=rhs.f_p if names else None,
+                  g_p=g_p if names else None, vectorized=True,
+                  name=f"steady state of {field_system.metadata.model} (Hamiltonian form)")
+    return replace(reader, problem=problem)
+
+
+def _hamiltonian_conditions(field_system, fields, bc: dict) -> tuple[list, list]:
+    """The (field index, value) pairs fixed at the start and at the end (field values only; every field's
+    value at both ends) from the model's constraints and the boundary-value outputs ``bc``."""
+    n = len(fields)
     start, end = [], []
     for f, k, at in field_system.field_meta.constraints:
         if k > 0:
@@ -248,32 +276,33 @@ def hamiltonian_bvp(field_system) -> SteadyBVP:
         raise InputError(f"the Hamiltonian steady BVP of {field_system.metadata.model} has {len(start) + len(end)} "
                          f"boundary conditions for {2 * n} unknowns", key="boundary",
                          expected="every field's value fixed at both ends")
-    rates, tangent = kernels["rates"], kernels["rates_tangent"]
+    return start, end
 
-    def L_of(p):
-        return p[length_index] if length_index is not None else fixed_length
 
-    def state(sigma, y, p):
-        L = L_of(p)
-        return L, reader._state(np.asarray(y, float).reshape(2 * n, -1), L * np.atleast_1d(sigma), p)
+class _HamiltonianRates:
+    """dy/dsigma = f(sigma, y, p) = L rates(L sigma, y), y = (u, n), with f_y = L rates_z (the rates' tangent
+    kernel) and f_p by central differences; ``reader`` (a SteadyBVP) lays out the kernels' state and L."""
 
-    def f(sigma, y, p):
-        L, st = state(sigma, y, p)
-        return L * rates.evaluate(st)["g"].reshape(-1, 2 * n).T
+    def __init__(self, reader: SteadyBVP, rates, tangent) -> None:
+        self.reader, self.rates, self.tangent, self.n = reader, rates, tangent, reader.n
 
-    def f_y(sigma, y, p):
-        L, st = state(sigma, y, p)
-        return L * np.transpose(tangent.evaluate(st)["g_z"].reshape(-1, 2 * n, 2 * n), (1, 2, 0))
+    def state(self, sigma, y, p):
+        reader = self.reader
+        L = p[reader.length_index] if reader.length_index is not None else reader.length
+        return L, reader._state(np.asarray(y, float).reshape(2 * self.n, -1), L * np.atleast_1d(sigma), p)
 
-    def f_p(sigma, y, p, cols=None):
+    def f(self, sigma, y, p):
+        L, st = self.state(sigma, y, p)
+        return L * self.rates.evaluate(st)["g"].reshape(-1, 2 * self.n).T
+
+    def f_y(self, sigma, y, p):
+        L, st = self.state(sigma, y, p)
+        n2 = 2 * self.n
+        return L * np.transpose(self.tangent.evaluate(st)["g_z"].reshape(-1, n2, n2), (1, 2, 0))
+
+    def f_p(self, sigma, y, p, cols=None):
         """d f / d p (columns ``cols``, default all) by central differences (relative steps 1e-6)."""
-        return _differences(f, sigma, y, p, cols)
-
-    g, g_ya, g_yb, g_p = _end_conditions(start, end, 2 * n, len(names))
-    problem = BVP(f, f_y, g, g_ya, g_yb, (0.0, 1.0), 2 * n, n_p=len(names), f_p=f_p if names else None,
-                  g_p=g_p if names else None, vectorized=True,
-                  name=f"steady state of {field_system.metadata.model} (Hamiltonian form)")
-    return replace(reader, problem=problem)
+        return _differences(self.f, sigma, y, p, cols)
 
 
 def stress_guess(bvp: SteadyBVP, sigma: np.ndarray, y: np.ndarray, *, iterations: int = 30) -> np.ndarray:
@@ -353,27 +382,38 @@ def holding(bvp: SteadyBVP, output: str, at: str, value: float, free: str) -> St
         raise InputError(f"hold: {free!r} is not a free parameter of the compiled kernels", key="free",
                          expected=f"one of: {', '.join(bvp.params) or 'none'}")
     base = bvp.problem
-    index = bvp.params.index(free)
-    sigma_end = 0.0 if at == "start" else 1.0
+    held = _HeldOutput(bvp, output, at, value)
+    problem = replace(base, g=held.g, g_ya=held.g_ya, g_yb=held.g_yb, g_p=held.g_p, unknown=(bvp.params.index(free),),
+                      name=f"{base.name} with {output} at the {at} = {value:g} ({free} free)")
+    return replace(bvp, problem=problem)
 
-    def out(y, p):
+
+class _HeldOutput:
+    """The boundary conditions of ``bvp`` and one more, out(y(end), p) - value = 0 with out the model's output
+    ``output`` at the ``at`` end ('start' or 'end'), and their Jacobians (central differences of out)."""
+
+    def __init__(self, bvp: SteadyBVP, output: str, at: str, value: float) -> None:
+        self.bvp, self.base, self.output, self.at, self.value = bvp, bvp.problem, output, at, value
+        self.sigma_end = 0.0 if at == "start" else 1.0
+        self.last: dict = {}
+
+    def out(self, y, p) -> float:
+        bvp = self.bvp
         L = bvp.length_of(SimpleNamespace(p=p))
-        state = bvp._state(np.asarray(y, float).reshape(-1, 1), np.array([L * sigma_end]), p)
+        state = bvp._state(np.asarray(y, float).reshape(-1, 1), np.array([L * self.sigma_end]), p)
         values = bvp.system.kernels["outputs"].evaluate(state, check=False)  # NaN fails Newton's own checks
-        if output not in values:
-            raise InputError(f"hold: the model has no output {output!r}", key="hold",
+        if self.output not in values:
+            raise InputError(f"hold: the model has no output {self.output!r}", key="hold",
                              expected=", ".join(k for k in values if not k.startswith("bc_")))
-        return float(np.ravel(values[output])[0])
+        return float(np.ravel(values[self.output])[0])
 
-    last: dict = {}
-
-    def d_out(y, p):
+    def d_out(self, y, p):
         """(d out/dy, d out/dp) by central differences; the last pair is kept (g_ya, g_yb, g_p ask alike)."""
         y, p = np.asarray(y, float), np.asarray(p, float)
         key = (y.tobytes(), p.tobytes())
-        if key in last:
-            return last[key]
-        last.clear()
+        if key in self.last:
+            return self.last[key]
+        self.last.clear()
         dy, dp = np.zeros(len(y)), np.zeros(len(p))
         for vec, grad in ((y, dy), (p, dp)):
             for j in range(len(vec)):
@@ -383,26 +423,23 @@ def holding(bvp: SteadyBVP, output: str, at: str, value: float, free: str) -> St
                 down[j] -= step
                 args = (up, p) if vec is y else (y, up)
                 back = (down, p) if vec is y else (y, down)
-                grad[j] = (out(*args) - out(*back)) / (2 * step)
-        last[key] = (dy, dp)
+                grad[j] = (self.out(*args) - self.out(*back)) / (2 * step)
+        self.last[key] = (dy, dp)
         return dy, dp
 
-    end_y = (lambda ya, yb: ya) if at == "start" else (lambda ya, yb: yb)
+    def end_y(self, ya, yb):
+        return ya if self.at == "start" else yb
 
-    def g(ya, yb, p):
-        return np.append(base.g(ya, yb, p), out(end_y(ya, yb), p) - value)
+    def g(self, ya, yb, p):
+        return np.append(self.base.g(ya, yb, p), self.out(self.end_y(ya, yb), p) - self.value)
 
-    def g_ya(ya, yb, p):
-        row = d_out(ya, p)[0] if at == "start" else np.zeros(len(ya))
-        return np.vstack([base.g_ya(ya, yb, p), row])
+    def g_ya(self, ya, yb, p):
+        row = self.d_out(ya, p)[0] if self.at == "start" else np.zeros(len(ya))
+        return np.vstack([self.base.g_ya(ya, yb, p), row])
 
-    def g_yb(ya, yb, p):
-        row = d_out(yb, p)[0] if at == "end" else np.zeros(len(yb))
-        return np.vstack([base.g_yb(ya, yb, p), row])
+    def g_yb(self, ya, yb, p):
+        row = self.d_out(yb, p)[0] if self.at == "end" else np.zeros(len(yb))
+        return np.vstack([self.base.g_yb(ya, yb, p), row])
 
-    def g_p(ya, yb, p):
-        return np.vstack([base.g_p(ya, yb, p), d_out(end_y(ya, yb), p)[1]])
-
-    problem = replace(base, g=g, g_ya=g_ya, g_yb=g_yb, g_p=g_p, unknown=(index,),
-                      name=f"{base.name} with {output} at the {at} = {value:g} ({free} free)")
-    return replace(bvp, problem=problem)
+    def g_p(self, ya, yb, p):
+        return np.vstack([self.base.g_p(ya, yb, p), self.d_out(self.end_y(ya, yb), p)[1]])
