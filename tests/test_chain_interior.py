@@ -189,13 +189,15 @@ def test_recomputed_bond_values_equal_the_numpy_kernel_exactly(ends):
 
 def test_native_tuning_builds_another_library_with_the_same_values(monkeypatch):
     """$MECHGEN_NATIVE=1 builds for the host processor (-march=native, no FMA contraction), under another build key
-    that names the processor: the force equals the default build's bit for bit."""
+    that names the processor: the force equals the portable build's ($MECHGEN_NATIVE=0) bit for bit."""
     from mechgen.codegen import build
 
     model = _chain("fixed", onsite=False)
     spec = specialize(model, {"N": 2000, **VALUES})
     u = np.random.default_rng(6).normal(scale=0.3, size=(3, 2000))
     probe = "double mg_probe(double x);\ndouble mg_probe(double x) { return 2.0 * x; }\n"
+    monkeypatch.setenv(build.NATIVE_ENV, "0")
+    assert build.native_tuning() == ((), ())
     default, _ = compile_model(model, spec, kernels={"force"}, backend="c")
     generic = build.build_shared(probe, stem="native_probe")
     monkeypatch.setenv(build.NATIVE_ENV, "1")
@@ -203,3 +205,19 @@ def test_native_tuning_builds_another_library_with_the_same_values(monkeypatch):
     assert build.build_shared(probe, stem="native_probe") != generic      # another cache entry
     native, _ = compile_model(model, spec, kernels={"force"}, backend="c")
     assert np.array_equal(native.call("force", q=u)["f"], default.call("force", q=u)["f"])
+
+
+def test_the_host_tuning_is_the_default_where_the_processor_names_its_instructions(monkeypatch):
+    """Unset, $MECHGEN_NATIVE means the host tuning where /proc/cpuinfo names the instruction sets (two processors
+    that differ in them never share a build key), and a portable build where it does not; a compiler that rejects
+    the flags gets the portable build too."""
+    from mechgen.codegen import build
+
+    monkeypatch.delenv(build.NATIVE_ENV, raising=False)
+    tuned = (build.NATIVE_FLAGS, (build.processor_identity(),))
+    assert build.native_tuning() == (tuned if build.processor_names_its_instructions() else ((), ()))
+    monkeypatch.setattr(build, "processor_identity", lambda: "arm64 | arm")
+    assert not build.processor_names_its_instructions() and build.native_tuning() == ((), ())
+    monkeypatch.setenv(build.NATIVE_ENV, "1")
+    monkeypatch.setattr(build, "trivial_problem", lambda *args: "error: unrecognized option '-march=native'")
+    assert build.native_tuning("cc") == ((), ())

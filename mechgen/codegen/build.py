@@ -57,7 +57,8 @@ COMPILE_TIMEOUT = 120.0
 VERSION_TIMEOUT = 30.0
 _STEM_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,63}")
 MGCALL_SOURCE = Path(__file__).parent / "templates" / "c99" / "mgcall.c"
-#: environment variable: "1" builds every library for this machine's processor (:data:`NATIVE_FLAGS`)
+#: environment variable: "0" builds every library portably, "1" for this machine's processor (:data:`NATIVE_FLAGS`),
+#: unset: for this machine's processor where it names its instruction sets (:func:`native_tuning`)
 NATIVE_ENV = "MECHGEN_NATIVE"
 #: the host tuning: the processor's vector instructions (GCC and Clang vectorise the chain loops with them: the
 #: FPU force kernel at N = 10^6 in 291 us instead of 514 with AVX-512), and no contraction of a*b + c into an FMA,
@@ -307,7 +308,7 @@ def _build_entry(source: str, *, stem: str, output_name: str, cflags: Sequence[s
         raise CompilerUnavailable(f"CC={cc!r} does not run ({cc} --version failed)" if cc else
                                   "no working C compiler found (set CC, or install cc/gcc/clang)")
     command, identity = found
-    tuning, processor = native_tuning()
+    tuning, processor = native_tuning(command)
     cflags, include_dirs, ldflags = tuple(cflags) + tuning, tuple(map(str, include_dirs)), tuple(ldflags)
     extra_key = tuple(extra_key) + processor
     # the file names are part of the entry: the same source under another stem is another entry
@@ -342,13 +343,29 @@ def _build_entry(source: str, *, stem: str, output_name: str, cflags: Sequence[s
     return entry / output_name
 
 
-def native_tuning() -> tuple[tuple[str, ...], tuple[str, ...]]:
-    """(flags, key parts) of the host tuning $MECHGEN_NATIVE=1 asks for: :data:`NATIVE_FLAGS`, keyed by
-    :func:`processor_identity` (a cache shared by machines of other processors never hands one theirs); both
-    empty otherwise."""
-    if os.environ.get(NATIVE_ENV, "") != "1":
+def native_tuning(command: str | None = None) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """(flags, key parts) of the host tuning: :data:`NATIVE_FLAGS`, keyed by :func:`processor_identity` (a cache
+    shared by machines of other processors never hands one theirs); both empty for a portable build.
+
+    The default where the processor names its instruction sets (/proc/cpuinfo's flags or Features, so that two
+    processors that differ in them never share a build) and ``command`` (the compiler, when given) builds a
+    library with them; $MECHGEN_NATIVE=0 asks for portable builds everywhere, =1 for the tuning wherever the
+    compiler takes the flags. A peer such as numba compiles for the host as well: this is the like-for-like
+    build (issue 30: the chain loops vectorise with the processor's widest instructions)."""
+    choice = os.environ.get(NATIVE_ENV, "")
+    if choice == "0" or (choice != "1" and not processor_names_its_instructions()):
+        return (), ()
+    if command is not None and trivial_problem(command, DEFAULT_CFLAGS + NATIVE_FLAGS, (), ()):
+        log.info("%s does not build with %s: portable builds", command, " ".join(NATIVE_FLAGS))
         return (), ()
     return NATIVE_FLAGS, (processor_identity(),)
+
+
+def processor_names_its_instructions() -> bool:
+    """Whether :func:`processor_identity` holds the processor's instruction sets (Linux: flags on x86, Features
+    on ARM)."""
+    identity = processor_identity()
+    return " flags: " in identity or " Features: " in identity
 
 
 @lru_cache(maxsize=1)
