@@ -225,8 +225,6 @@ def _dense_interior(ctx: _Ctx, out_len: dict) -> list[str]:
         lines += _zero(out, f"zlo_{out}", f"zhi_{out}", out_len[port])
     if not ctx.carried:
         return lines + _for("lo", "hi", _interior_body(ctx, affine=False))
-    if _splittable(ctx):
-        return lines + _split_interior(ctx)
     return lines + _recomputed_interior(ctx)
 
 
@@ -285,57 +283,6 @@ def _recomputed_interior(ctx: _Ctx) -> list[str]:
         last.append(_store_carry(target, "=" if port in ctx.dense else "+=", name, ctx.negated))
     return (["if (hi > lo) {", "    const long e = lo;"] + ["    " + line for line in first] + ["}"]
             + _for("lo + 1", "hi", loop)
-            + ["if (hi > lo) {", "    const long e = hi;"] + ["    " + line for line in last] + ["}"])
-
-
-#: iterations per chunk of a split interior (two buffers of this many doubles on the stack: 4 kB, in L1)
-CHUNK = 256
-
-
-def _splittable(ctx: _Ctx) -> bool:
-    """Whether every write of the block goes to a carried site vector as one term per offset (a bond's two ends):
-    then its interior can run split (:func:`_split_interior`) with the values of the recomputed one."""
-    groups = _grouped(ctx.block)
-    return all(port in ctx.carried and relative and len(exprs) == 1
-               for (port, _, sparse, relative, _), exprs in groups.items()) and all(
-        not sparse for (_, _, sparse, _, _) in groups)
-
-
-def _split_interior(ctx: _Ctx) -> list[str]:
-    """The interior of a bond block, split in two vectorisable loops per chunk of :data:`CHUNK` iterations.
-
-    Iteration e stores site e + k = own(e) + carried(e - 1), where own is its offset-k part and carried its
-    offset-(k+1) part. Pass 1 computes both parts of iterations e0 - 1 ... e1 - 1 into two stack buffers, each
-    iteration's operations once and none carried from one iteration to the next; pass 2 combines them. Both loops
-    vectorise, and the values are the recomputed interior's (the same operations in the same order): the FPU
-    force computes each bond once instead of twice (:func:`_recomputed_interior`). As there, the first interior
-    iteration has nothing carried in, and the last iteration's carried part is stored after the loop."""
-    core, values = _interior_parts(ctx, affine=False)
-    declared = [line for line in core if _DECLARED.match(line)]
-    first = [f"double {name} = 0.0;" for name in values] + core + [f"{n} = {v};" for n, v in values.items()]
-    groups = [(port, where, exprs) for (port, where, _, _, _), exprs in _grouped(ctx.block).items()]
-    own = {port: exprs for port, where, exprs in groups if where == ctx.carried[port]}
-    fill = list(declared)
-    fill += [f"own_{ctx.out[p]}[e - e0 + 1] = {_text(exprs)};" for p, exprs in own.items()]
-    fill += [f"{name}_buf[e - e0 + 1] = {value};" for name, value in values.items()]
-    combine = []
-    for port, k in ctx.carried.items():
-        out, name = ctx.out[port], f"carry_{ctx.out[port]}"
-        value = _sum([f"own_{out}[e - e0 + 1]", f"-{name}_buf[e - e0]"] if name in ctx.negated
-                     else [f"{name}_buf[e - e0]", f"own_{out}[e - e0 + 1]"])
-        combine.append(f"{out}[{_site(k, ctx.periodic, False)}] {'=' if port in ctx.dense else '+='} {value};")
-    buffers = [f"double own_{ctx.out[p]}[{CHUNK} + 1];" for p in own]
-    buffers += [f"double {name}_buf[{CHUNK} + 1];" for name in values]
-    chunk = (["const long e1 = e0 + " + str(CHUNK) + " < hi ? e0 + " + str(CHUNK) + " : hi;"] + buffers
-             + _for("e0 - 1", "e1", fill) + _for("e0", "e1", combine))
-    last = _previous_iteration(ctx, list(values.values()))
-    for port, k in ctx.carried.items():
-        name = f"carry_{ctx.out[port]}"
-        last.append(f"const double {name} = {_suffixed(ctx, values[name])};")
-        last.append(_store_carry(f"{ctx.out[port]}[{_plus('hi', k)}]", "=" if port in ctx.dense else "+=", name,
-                                 ctx.negated))
-    return (["if (hi > lo) {", "    const long e = lo;"] + ["    " + line for line in first] + ["}"]
-            + [f"for (long e0 = lo + 1; e0 < hi; e0 += {CHUNK}) {{"] + ["    " + line for line in chunk] + ["}"]
             + ["if (hi > lo) {", "    const long e = hi;"] + ["    " + line for line in last] + ["}"])
 
 
