@@ -218,6 +218,34 @@ def test_the_host_tuning_is_the_default_where_the_processor_names_its_instructio
     assert build.native_tuning() == (tuned if build.processor_names_its_instructions() else ((), ()))
     monkeypatch.setattr(build, "processor_identity", lambda: "arm64 | arm")
     assert not build.processor_names_its_instructions() and build.native_tuning() == ((), ())
+
+
+def test_a_compiler_that_rejects_the_host_tuning_builds_portably(tmp_path, monkeypatch):
+    """CC rejects -march=native (an old or cross compiler): the build is done portably, the compiler is not taken
+    for unusable (no numpy fallback), and the probe runs only once a build has failed."""
+    import ctypes
+    import shutil
+
+    from mechgen.codegen import build
+
+    real = shutil.which("cc") or shutil.which("gcc")
+    if real is None:
+        pytest.skip("no C compiler")
+    fake = tmp_path / "oldcc"
+    fake.write_text(f'#!/bin/sh\nfor a in "$@"; do [ "$a" = "-march=native" ] && '
+                    f'{{ echo "oldcc: unrecognized option $a" >&2; exit 1; }}; done\nexec {real} "$@"\n')
+    fake.chmod(0o755)
+    monkeypatch.setenv("MECHGEN_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setenv("CC", str(fake))
     monkeypatch.setenv(build.NATIVE_ENV, "1")
-    monkeypatch.setattr(build, "trivial_problem", lambda *args: "error: unrecognized option '-march=native'")
-    assert build.native_tuning("cc") == ((), ())
+    build.reset_compiler_cache()
+    try:
+        probe = "double mg_probe(double x);\ndouble mg_probe(double x) { return 3.0 * x; }\n"
+        lib = build.load_shared(probe, stem="oldcc_probe")
+        lib.mg_probe.restype, lib.mg_probe.argtypes = ctypes.c_double, [ctypes.c_double]
+        assert lib.mg_probe(2.0) == 6.0
+        monkeypatch.setenv(build.NATIVE_ENV, "0")  # the portable build's entry is the one that was made: a hit
+        compiles = build.STATS["compile"]
+        assert build.build_shared(probe, stem="oldcc_probe").is_file() and build.STATS["compile"] == compiles
+    finally:
+        build.reset_compiler_cache()

@@ -88,6 +88,7 @@ def reset_compiler_cache() -> None:
     """Forget the compilers found so far (tests change ``CC``/``PATH``)."""
     _compilers.clear()
     _trivial.clear()
+    _NATIVE_REJECTED.clear()
 
 
 def _probe(command: str) -> tuple[str, str] | None:
@@ -300,17 +301,38 @@ def _build_error(message: str, stderr: str, key: str, stem: str, source: str) ->
 
 def _build_entry(source: str, *, stem: str, output_name: str, cflags: Sequence[str],
                  include_dirs: Sequence[str], ldflags: Sequence[str], extra_key: Sequence[str] = ()) -> Path:
-    """Build ``source`` into ``output_name`` inside a cache entry; return the output's path."""
+    """Build ``source`` into ``output_name`` inside a cache entry; return the output's path. With the host tuning
+    (:func:`native_tuning`) first; a compiler that cannot build even a trivial library with it is asked once per
+    process, on a failed build only, and the build is done portably (the probe costs nothing on a cache hit)."""
     _check_stem(stem)
     found = _compiler()
     if found is None:
         cc = os.environ.get("CC")
         raise CompilerUnavailable(f"CC={cc!r} does not run ({cc} --version failed)" if cc else
                                   "no working C compiler found (set CC, or install cc/gcc/clang)")
-    command, identity = found
-    tuning, processor = native_tuning(command)
-    cflags, include_dirs, ldflags = tuple(cflags) + tuning, tuple(map(str, include_dirs)), tuple(ldflags)
-    extra_key = tuple(extra_key) + processor
+    command, _ = found
+    tuning = native_tuning() if command not in _NATIVE_REJECTED else ((), ())
+    try:
+        return _build_tuned(source, stem, output_name, (cflags, include_dirs, ldflags, extra_key), found, tuning)
+    except _NativeRejected:
+        _NATIVE_REJECTED.add(command)
+        log.info("%s does not build with %s: portable builds", command, " ".join(NATIVE_FLAGS))
+        return _build_tuned(source, stem, output_name, (cflags, include_dirs, ldflags, extra_key), found, ((), ()))
+
+
+class _NativeRejected(Exception):
+    """The compiler builds no library with the host tuning's flags (an old or cross compiler)."""
+
+
+#: compilers (commands) found in this process to reject :data:`NATIVE_FLAGS`
+_NATIVE_REJECTED: set = set()
+
+
+def _build_tuned(source: str, stem: str, output_name: str, flags: tuple, found: tuple, tuning: tuple) -> Path:
+    """:func:`_build_entry` with ``tuning`` = (flags, key parts) of :func:`native_tuning`."""
+    (cflags, include_dirs, ldflags, extra_key), (command, identity) = flags, found
+    cflags, include_dirs, ldflags = tuple(cflags) + tuning[0], tuple(map(str, include_dirs)), tuple(ldflags)
+    extra_key = tuple(extra_key) + tuning[1]
     # the file names are part of the entry: the same source under another stem is another entry
     key = build_key(source, cflags, include_dirs, ldflags, identity, stem, output_name, *extra_key)
     source_name = f"lib{stem}.c"
@@ -328,6 +350,8 @@ def _build_entry(source: str, *, stem: str, output_name: str, cflags: Sequence[s
             raise _build_error(f"C compiler timed out after {COMPILE_TIMEOUT:.0f} s", stderr, key, stem,
                                source) from exc
         if done.returncode != 0:
+            if tuning[0] and trivial_problem(command, DEFAULT_CFLAGS + tuning[0], (), ()):
+                raise _NativeRejected(command)
             if tmp.is_dir():  # (not when the cache was removed meanwhile: the cache layer retries)
                 unusable = trivial_problem(command, cflags, include_dirs, ldflags)
                 if unusable:
@@ -343,20 +367,17 @@ def _build_entry(source: str, *, stem: str, output_name: str, cflags: Sequence[s
     return entry / output_name
 
 
-def native_tuning(command: str | None = None) -> tuple[tuple[str, ...], tuple[str, ...]]:
+def native_tuning() -> tuple[tuple[str, ...], tuple[str, ...]]:
     """(flags, key parts) of the host tuning: :data:`NATIVE_FLAGS`, keyed by :func:`processor_identity` (a cache
     shared by machines of other processors never hands one theirs); both empty for a portable build.
 
     The default where the processor names its instruction sets (/proc/cpuinfo's flags or Features, so that two
-    processors that differ in them never share a build) and ``command`` (the compiler, when given) builds a
-    library with them; $MECHGEN_NATIVE=0 asks for portable builds everywhere, =1 for the tuning wherever the
-    compiler takes the flags. A peer such as numba compiles for the host as well: this is the like-for-like
-    build (issue 30: the chain loops vectorise with the processor's widest instructions)."""
+    processors that differ in them never share a build); $MECHGEN_NATIVE=0 asks for portable builds everywhere,
+    =1 for the tuning everywhere. A compiler that rejects the flags builds portably (:func:`_build_entry`). A peer
+    such as numba compiles for the host as well: this is the like-for-like build (issue 30: the chain loops
+    vectorise with the processor's widest instructions)."""
     choice = os.environ.get(NATIVE_ENV, "")
     if choice == "0" or (choice != "1" and not processor_names_its_instructions()):
-        return (), ()
-    if command is not None and trivial_problem(command, DEFAULT_CFLAGS + NATIVE_FLAGS, (), ()):
-        log.info("%s does not build with %s: portable builds", command, " ".join(NATIVE_FLAGS))
         return (), ()
     return NATIVE_FLAGS, (processor_identity(),)
 
