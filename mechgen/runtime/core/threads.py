@@ -11,7 +11,6 @@ exactly). Sweep worker processes run on one thread each (the parallelism is the 
 from __future__ import annotations
 
 import importlib.abc
-import importlib.machinery
 import os
 import sys
 import threading
@@ -114,10 +113,13 @@ class _ScipyWatch(importlib.abc.MetaPathFinder):
     def find_spec(self, name, path, target=None):
         if name not in self.WATCHED:
             return None
-        spec = importlib.machinery.PathFinder.find_spec(name, path, target)
-        if spec is not None and spec.loader is not None:
-            spec.loader = _NotifyingLoader(spec.loader)
-        return spec
+        for finder in [f for f in sys.meta_path if f is not self]:  # the finders that would have found it
+            spec = finder.find_spec(name, path, target) if hasattr(finder, "find_spec") else None
+            if spec is not None:
+                if spec.loader is not None:
+                    spec.loader = _NotifyingLoader(spec.loader)
+                return spec
+        return None
 
 
 def blas_threads_for(unknowns: int):
