@@ -1,6 +1,10 @@
 """Rerun safety (issue 11, item 3): compiled systems are immutable, so a scene run twice in one process, or its
-analyses run in another order, gives the same numbers."""
+analyses run in another order, gives the same numbers.
+
+The second run of each shipped scene also draws its figures, each audited as it is saved (tests/figure_audit.py,
+issue 26, item 6): every scene's figures are checked without running any scene a third time."""
 import dataclasses
+import importlib.util
 import math
 from pathlib import Path
 
@@ -46,6 +50,11 @@ SMALLER = {"fpu_large": {"params": {"N": 100_000}},
            "balloon_stability": {"analysis": {"branch": {"max_points": 40}}}}
 
 
+#: the shipped scenes that draw nothing: a cross-section's 6 x 6 stiffness, and steady states with a located
+#: stability boundary, are numbers, which the summary prints
+NO_FIGURES = ("curved_beam_stiffness", "rate_state_slider")
+
+
 def by_name(results: dict) -> dict:
     return {a["name"]: (a["kind"], {k: v for k, v in a["outputs"].items() if k not in MEASURED})
             for a in results["analyses"]}
@@ -53,7 +62,10 @@ def by_name(results: dict) -> dict:
 
 @pytest.mark.slow
 @pytest.mark.parametrize("scene", SCENES, ids=[p.stem for p in SCENES])
-def test_every_scene_run_twice_gives_identical_outputs(scene):
+def test_every_scene_run_twice_gives_identical_outputs(scene, tmp_path):
+    """Identical outputs; then the second run's figures, each complete (titles, labels, legends, no axis scaled to
+    round-off)."""
+    stem = scene.stem
     if scene.stem in SMALLER:      # the same analyses on a smaller size: rerun identity does not depend on it
         import tomllib
 
@@ -71,6 +83,22 @@ def test_every_scene_run_twice_gives_identical_outputs(scene):
         assert first[key] == second[key]
     assert [a["name"] for a in first["analyses"]] == [a["name"] for a in second["analyses"]]
     assert_same(by_name(first), by_name(second), first["scene"])
+    check_figures(stem, second, tmp_path)
+
+
+def check_figures(stem: str, results: dict, folder: Path) -> None:
+    """The scene's figures drawn from its results (as ``mechgen run --plot`` draws them), each audited."""
+    if importlib.util.find_spec("matplotlib") is None:
+        return
+    from figure_audit import audited_savefig
+
+    from mechgen.scene.plots import plot_results
+
+    with audited_savefig({}) as seen:
+        written = plot_results(results, folder)
+    assert bool(seen) == (stem not in NO_FIGURES), f"{stem}: figures {sorted(seen)}"
+    assert all(path.stat().st_size > 0 for path in written)
+    assert {name: found for name, found in seen.items() if found} == {}, stem
 
 
 def _split(text: str) -> tuple[str, list[str]]:
