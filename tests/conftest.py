@@ -1,4 +1,4 @@
-"""Shared fixtures: every test uses a private compile cache."""
+"""Shared fixtures: the test session uses a private compile cache (never the user's)."""
 import os
 
 import pytest
@@ -6,8 +6,17 @@ import pytest
 
 @pytest.fixture(autouse=True, scope="session")
 def _private_cache(tmp_path_factory):
+    """One fresh compile cache for the session, shared by pytest-xdist's workers (their common base folder), so
+    that a model is built once per session rather than once per worker: the cache is built for concurrent
+    processes (mechgen/codegen/cache.py: entries published by one rename, no lock files), and tests that
+    damage or count a cache set their own MECHGEN_CACHE. MECHGEN_TEST_SHARED_CACHE=1 keeps the caller's."""
     if "MECHGEN_CACHE" not in os.environ or os.environ.get("MECHGEN_TEST_SHARED_CACHE") != "1":
-        os.environ["MECHGEN_CACHE"] = str(tmp_path_factory.mktemp("mechgen-cache"))
+        base = tmp_path_factory.getbasetemp()
+        if os.environ.get("PYTEST_XDIST_WORKER"):
+            base = base.parent  # the session's folder, shared by its workers (gw0, gw1 ... below it)
+        cache = base / "mechgen-cache"
+        cache.mkdir(exist_ok=True)
+        os.environ["MECHGEN_CACHE"] = str(cache)
     yield
 
 

@@ -251,16 +251,18 @@ static int rhs(const mgr_problem *P_, mgr_state *S, mgr_work *w, double t, const
 {
     long n = w->n, nz = w->nx - 2 * n, i;
     int rc;
-    if ((rc = mass_and_residual(P_, S, w, t, x)) != 0)
-        return rc;
-    if (mg_lu_factor(n, w->M, w->piv_r + w->nx)) {
-        fail_at(S, w, t, x);
-        S->err_kind = 0;
-        return MGR_E_SINGULAR;
+    if (n > 0) {   /* n = 0: a model of internal variables only, dx/dt = rates */
+        if ((rc = mass_and_residual(P_, S, w, t, x)) != 0)
+            return rc;
+        if (mg_lu_factor(n, w->M, w->piv_r + w->nx)) {
+            fail_at(S, w, t, x);
+            S->err_kind = 0;
+            return MGR_E_SINGULAR;
+        }
+        mg_lu_apply(n, w->M, w->piv_r + w->nx, w->B);
+        memcpy(f, x + n, (size_t)n * sizeof(double));
+        memcpy(f + n, w->B, (size_t)n * sizeof(double));
     }
-    mg_lu_apply(n, w->M, w->piv_r + w->nx, w->B);
-    memcpy(f, x + n, (size_t)n * sizeof(double));
-    memcpy(f + n, w->B, (size_t)n * sizeof(double));
     if (nz > 0) {
         if ((rc = kcall(P_, S, w, MGR_K_RATES, x, NULL, t)) != 0)
             return rc;
@@ -282,6 +284,8 @@ static int jacobian(const mgr_problem *P_, mgr_state *S, mgr_work *w, double t, 
     const double *blk;
     int rc;
     memset(w->J, 0, (size_t)(nx * nx) * sizeof(double));
+    if (n == 0)   /* internal variables only: no mass rows */
+        goto rates_rows;
     if ((rc = kcall(P_, S, w, MGR_K_TANGENT, x, f + n, t)) != 0)
         return rc;
     memcpy(w->M, picked(w, P_, MGR_K_TANGENT, 0), (size_t)(n * n) * sizeof(double));
@@ -306,6 +310,7 @@ static int jacobian(const mgr_problem *P_, mgr_state *S, mgr_work *w, double t, 
     }
     for (i = 0; i < n; ++i)
         w->J[i * nx + n + i] = 1.0;
+rates_rows:
     if (m > 0) {
         if ((rc = kcall(P_, S, w, MGR_K_RATES_TANGENT, x, NULL, t)) != 0)
             return rc;
@@ -632,9 +637,10 @@ static int check_problem(const mgr_problem *P_)
     const mgr_kernel *K = P_->kernels;
     const long need[MGR_NK][MGR_PICKS] = {
         {n, n * n, -1, -1}, {n, -1, -1, -1}, {n * n, n * n, n * n, n * m}, {nz, -1, -1, -1}, {m * n, m * n, m * m, -1}};
-    if (n < 1 || m < 0 || P_->extra < 0 || P_->rtol <= 0 || P_->n_eval < 0 || (P_->n_eval > 0 && P_->s_x == NULL))
+    if (n < 0 || m < 0 || P_->extra < 0 || 2 * n + nz < 1 || P_->rtol <= 0 || P_->n_eval < 0
+        || (P_->n_eval > 0 && P_->s_x == NULL))
         return 1;
-    if (K[MGR_K_TANGENT].fn == NULL || (K[MGR_K_FLOW].fn == NULL && K[MGR_K_RESIDUAL].fn == NULL)
+    if ((n > 0 && (K[MGR_K_TANGENT].fn == NULL || (K[MGR_K_FLOW].fn == NULL && K[MGR_K_RESIDUAL].fn == NULL)))
         || (nz > 0 && K[MGR_K_RATES].fn == NULL) || (m > 0 && K[MGR_K_RATES_TANGENT].fn == NULL))
         return 1;
     for (k = 0; k < MGR_NK; ++k) {

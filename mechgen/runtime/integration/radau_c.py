@@ -103,9 +103,10 @@ def forget_library() -> None:
 
 def loop_kernels(system, extra: int) -> dict:
     """The kernels the loop calls, by its names (module doc): ``rates`` is ``energy_rates`` when the state carries
-    ``extra`` integrals; ``flow`` when the system has it, else ``residual``."""
+    ``extra`` integrals; ``flow`` when the system has it, else ``residual``; neither, nor ``tangent``, for a model
+    of internal variables only (n = 0: dx/dt is the rates)."""
     first = "flow" if "flow" in system.kernels else "residual"
-    names = {first: first, "tangent": "tangent"}
+    names = {first: first, "tangent": "tangent"} if system.n else {}
     if system.m or extra:
         names["rates"] = "energy_rates" if extra else "rates"
     if system.m:
@@ -128,7 +129,8 @@ def kernel_problem(system, names: dict) -> str | None:
 
 def radau_loop_problem(system, rtol=1e-8, atol=1e-10, extra: int = 0) -> str | None:
     """Why the compiled Radau loop cannot integrate ``system`` (None when it can): a smooth lumped system of the
-    C backend with n >= 1 and at most MAX_STATES first-order states, scalar tolerances, a C compiler."""
+    C backend with at least one and at most MAX_STATES first-order states (a model of internal variables only, n = 0,
+    included), scalar tolerances, a C compiler."""
     if hasattr(system, "modes"):
         return "the system has modes (the compiled Radau loop integrates smooth models)"
     if system.is_lattice or system.is_field:
@@ -138,8 +140,8 @@ def radau_loop_problem(system, rtol=1e-8, atol=1e-10, extra: int = 0) -> str | N
     if np.ndim(rtol) or np.ndim(atol):
         return "the compiled Radau loop takes scalar tolerances rtol and atol only"
     size = 2 * system.n + system.m + extra
-    if system.n < 1 or size > MAX_STATES:
-        return f"the compiled Radau loop takes 1 to {MAX_STATES // 2} coordinates and at most {MAX_STATES} states"
+    if 2 * system.n + system.m < 1 or size > MAX_STATES:
+        return f"the compiled Radau loop takes 1 to {MAX_STATES} states"
     why = kernel_problem(system, loop_kernels(system, extra))
     return why if why is not None else library()[1]
 
@@ -223,11 +225,13 @@ def drive(lib, system, problem: CProblem, state: CState, keep: dict, options) ->
 
 
 def explanation(rc: int, system, state: CState, keep: dict, options) -> str:
-    """``options.explain`` at the failing state, or at the last accepted one when that is not finite (as the
-    Python path explains), for the failures a state can explain; "" otherwise."""
-    if options.explain is None or rc not in (E_RHS, E_JAC, E_SINGULAR):
+    """``options.explain`` at the failing state, or at the last accepted one when that is not finite or the step
+    size collapsed there (as the Python path explains), for the failures a state can explain; "" otherwise."""
+    if options.explain is None or rc not in (E_RHS, E_JAC, E_SINGULAR, E_SMALL):
         return ""
     size = 2 * system.n + system.m
+    if rc == E_SMALL:
+        return options.explain(float(state.t), keep["x"][:size].copy())
     x = keep["err_x"][:size].copy()
     if np.all(np.isfinite(x)):
         return options.explain(float(state.err_t), x)
@@ -257,7 +261,8 @@ def failure(rc: int, system, state: CState, keep: dict, t_end: float, options) -
         what = "the mass matrix M = dr/da" if state.err_kind == 0 else "Radau's Newton matrix"
         return ConvergenceError(f"Radau failed at {where} (Singular matrix: {what}){tail}")
     if rc == E_SMALL:
-        return ConvergenceError(f"Radau stopped at {where}: Required step size is less than spacing between numbers")
+        return ConvergenceError(f"Radau stopped at {where}: Required step size is less than spacing between "
+                                f"numbers{tail}")
     if rc == E_BUDGET:
         return BudgetExceeded("Radau steps: stopped by the step budget", key="max_steps", reached=where)
     if rc == E_MEMORY:
