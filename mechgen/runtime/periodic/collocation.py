@@ -45,6 +45,7 @@ without an explicit integrator's step limits).
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field, replace
 
 from math import factorial as math_factorial
@@ -60,9 +61,11 @@ sps = lazy_module("scipy.sparse")
 DEGREE = 4
 
 
+@functools.lru_cache(maxsize=8)
 def interval_tables(m: int = DEGREE) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(zeta (m,), L (m x (m+1)), D (m x (m+1))): the Gauss points on [0, 1] and the Lagrange polynomials of the m + 1
-    equally spaced nodes j/m, and their derivatives, at those points."""
+    equally spaced nodes j/m, and their derivatives, at those points. Computed once per m (each residual and
+    Jacobian of a continuation reads them), read-only."""
     xg, _ = np.polynomial.legendre.leggauss(m)
     zeta = (xg + 1) / 2
     nodes = np.arange(m + 1) / m
@@ -75,6 +78,8 @@ def interval_tables(m: int = DEGREE) -> tuple[np.ndarray, np.ndarray, np.ndarray
         for skip in range(m):
             rest = np.delete(others, skip)
             D[:, j] += np.prod(zeta[:, None] - rest[None, :], axis=1) / denominator
+    for table in (zeta, L, D):
+        table.flags.writeable = False
     return zeta, L, D
 
 
@@ -300,17 +305,28 @@ class Collocation:
         """Phi(T) of the orbit u from the collocation equations (module doc): P_i = -(B_rest^-1 B_start) at the end
         node, B the rows of interval i's points in the columns of its start node and of its other m nodes."""
         _, J = self.residual_jacobian(u)
-        J = J.tocsr() if sps.issparse(J) else np.asarray(J)
-        d, m = self.state_size, DEGREE
+        d = self.state_size
         Phi = np.eye(d)
-        for i, nodes in enumerate(self.node_index()):
-            rows = np.arange(i * m * d, (i + 1) * m * d)
-            cols = (nodes[:, None] * d + np.arange(d)[None, :]).ravel()
-            block = J[rows][:, cols]
-            block = block.toarray() if sps.issparse(block) else block
+        for block in self.interval_blocks(J):
             step = -np.linalg.solve(block[:, d:], block[:, :d])[-d:]
             Phi = step @ Phi
         return Phi
+
+    def interval_blocks(self, J) -> np.ndarray:
+        """(mesh, m d, (m + 1) d): each interval's rows of the collocation Jacobian J in the columns of its m + 1
+        nodes (node_index's order), dense; gathered from J's nonzeros in one pass (a node j of interval i is
+        global node (i m + j) mod nodes)."""
+        d, m, mesh, nodes = self.state_size, DEGREE, self.mesh, self.nodes
+        coo = J.tocoo() if sps.issparse(J) else sps.coo_matrix(np.asarray(J))
+        keep = (coo.row < mesh * m * d) & (coo.col < nodes * d)  # not the phase row, nor T's or a parameter's column
+        r, c, v = coo.row[keep], coo.col[keep], coo.data[keep]
+        i = r // (m * d)
+        j = (c // d - i * m) % nodes
+        blocks = np.zeros((mesh, m * d, (m + 1) * d))
+        for wrap in (0, nodes) if nodes <= m else (0,):  # one interval: its last node is its first
+            ok = j + wrap <= m
+            np.add.at(blocks, (i[ok], r[ok] - i[ok] * m * d, (j[ok] + wrap) * d + c[ok] % d), v[ok])
+        return blocks
 
     def frequency_derivative(self, u: np.ndarray) -> np.ndarray:
         """dR/domega of a forced orbit at fixed parameters (central differences, step 1e-6 omega)."""
