@@ -4,10 +4,10 @@ stick-slip limit cycle of the inertial rate-and-state slider, and smooth models 
 References, each independent of mechgen:
 * the stick-slip cycle: a long run of the slider's equations written by hand in the test (the model doc's
   phi' = sigma (f - a phi - b psi) / (m V_ref e^phi), f' = k (V2 - V_ref e^phi) / sigma, psi' of the aging or slip
-  law) by scipy's Radau from the step V1 -> V2, its period the distance between successive upward crossings of phi
-  through ln(V2 / V_ref) (each located by brentq on the dense output) after the transient has died out; the
-  transient itself measures the non-trivial multiplier: the deviations of the crossing periods from the limit shrink
-  by mu_2 per cycle (the third multiplier is ~0);
+  law) by scipy's LSODA (ODEPACK's Adams/BDF, rtol 1e-13) from the step V1 -> V2, its period the distance between
+  successive upward crossings of phi through ln(V2 / V_ref) (each located by brentq on the dense output) after the
+  transient has died out; the transient itself measures the non-trivial multiplier: the deviations of the crossing
+  periods from the limit shrink by mu_2 per cycle (the third multiplier is ~0);
 * the first-order van der Pol oscillator x' = y, y' = mu (1 - x^2) y - x at mu = 1: the period 6.6632868593231
   (Andersen & Geer, SIAM J. Appl. Math. 42 (1982)), its non-trivial multiplier exp(mu int_0^T (1 - x^2) dt)
   (Liouville: the trace of the Jacobian) carried by scipy beside the state;
@@ -104,10 +104,12 @@ def slider_rhs(law: str):
 
 @functools.cache
 def reference_periods(law: str, t_end: float = 330.0) -> np.ndarray:
-    """The distances between successive upward crossings of phi = ln(V2/V_ref) in a Radau run from the step."""
+    """The distances between successive upward crossings of phi = ln(V2/V_ref) in a run from the step by scipy's
+    LSODA at rtol 1e-13 (ODEPACK, compiled: 2 s where scipy's Radau at rtol 1e-11 takes 20 s for the same periods,
+    measured to agree within 5e-11 relative)."""
     before = math.log(SLIDER["V1"] / SLIDER["V_ref"])
     sol = si.solve_ivp(slider_rhs(law), (0.0, t_end), [before, -before, (SLIDER["a"] - SLIDER["b"]) * before],
-                       method="Radau", rtol=1e-11, atol=1e-12, dense_output=True)
+                       method="LSODA", rtol=1e-13, atol=1e-14, dense_output=True)
     assert sol.status == 0
     level = math.log(SLIDER["V2"] / SLIDER["V_ref"])
     t = np.linspace(0.0, t_end, 200_001)
@@ -124,16 +126,16 @@ def aging():
 
 @pytest.mark.slow
 @pytest.mark.parametrize("law", ["aging", "slip"])
-def test_stick_slip_period_and_multiplier_against_a_long_radau_run(law):
-    """The cycle by collocation (100 intervals, adapted twice, from a rough state) against the hand-written Radau
+def test_stick_slip_period_and_multiplier_against_a_long_lsoda_run(law):
+    """The cycle by collocation (100 intervals, adapted twice, from a rough state) against the hand-written LSODA
     run from the step (15 cycles). The run's periods approach the cycle's geometrically, by mu_2 per cycle (the
     third multiplier is ~0): the ratio of successive differences of its periods is mu_2, and Aitken's extrapolation
     of three successive periods T_inf = T_3 - (T_3 - T_2)^2 / ((T_3 - T_2) - (T_2 - T_1)) the cycle's period. The period
-    to 1e-9 relative (measured 1e-11 aging, 1e-12 slip: what is left is Radau's rtol 1e-11 and the next order of the
-    transient); the trivial multiplier 1 to 1e-6; mu_2 against the median ratio of the last five differences (5e-3:
-    their scatter, measured +-1e-3, from Radau's error on differences of 1e-6 s; mu_2 measured 0.3525 aging, 0.164
-    slip). Differences below 1e-8 T (the slip law's transient is gone within 10 cycles) are the run's noise and left
-    out of both."""
+    to 1e-9 relative (measured 5e-11 aging, 2.5e-11 slip: what is left is the run's rtol 1e-13 over 15 cycles and
+    the next order of the transient); the trivial multiplier 1 to 1e-6; mu_2 against the median ratio of the last
+    five differences (5e-3: their scatter, measured +-1e-4, from the run's error on differences of 1e-6 s; mu_2
+    measured 0.3525 aging, 0.164 slip). Differences below 1e-8 T (the slip law's transient is gone within 10
+    cycles) are the run's noise and left out of both."""
     periods = reference_periods(law)
     d = np.diff(periods)
     T_ref = aitken_period(periods)
@@ -167,7 +169,7 @@ def k_critical() -> float:
 def test_the_scene_finds_the_cycle_from_its_simulate_and_follows_it_in_k():
     """scenes/rate_state_stick_slip.toml: "cycle" starts from the last cycle of the simulate "cycles" (601 samples
     over 300 s: the slip falls between samples, so the guess is re-integrated over one period from its state) and
-    finds the aging-law period of the hand-written Radau run (1e-9 relative, as above). "cycle_in_k" follows it in
+    finds the aging-law period of the hand-written LSODA run (1e-9 relative, as above). "cycle_in_k" follows it in
     k: stable, its period falling, up to one cyclic fold (LPC) just above k_c (a subcritical Hopf point: measured
     k = 5.0746e9 = 1.0049 k_c), then unstable, shrinking onto steady sliding, where the branch ends (status
     ``equilibrium``) at the Hopf point of the linear theory: k_c (1e-4 relative, measured 1.4e-5) with the neutral

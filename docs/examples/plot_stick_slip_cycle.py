@@ -23,10 +23,10 @@ mechgen: the shipped scene ``scenes/rate_state_stick_slip.toml`` through :func:`
 last cycle: one period re-integrated from its state and closed by a Poincaré section, the first mesh adapted to that
 guess, AUTO's integral phase condition); ``cycle_in_k`` continues it in k.
 
-Reference: the same three equations written out here and run by scipy's Radau from the velocity step for 15 cycles;
-the period is Aitken's limit of the distances between successive upward crossings of
-:math:`\\phi = \\ln(V_2/V_*)`, and the ratio of their successive differences is the non-trivial Floquet multiplier
-(the transient shrinks by it each cycle). J. R. Rice and A. Ruina, J. Appl. Mech. 50 (1983) 343; A. Ruina,
+Reference: the same three equations written out here and run by scipy's LSODA (ODEPACK's Adams/BDF switching, rtol
+1e-13) from the velocity step for 15 cycles; the period is Aitken's limit of the distances between successive upward
+crossings of :math:`\\phi = \\ln(V_2/V_*)`, and the ratio of their successive differences is the non-trivial Floquet
+multiplier (the transient shrinks by it each cycle). J. R. Rice and A. Ruina, J. Appl. Mech. 50 (1983) 343; A. Ruina,
 J. Geophys. Res. 88 (1983) 10359. The tests: ``tests/test_stick_slip_cycle.py``.
 """
 import math
@@ -55,11 +55,11 @@ def rhs(t, x):
 
 
 # %%
-# The reference: a long Radau run from the step V1 -> V2 and the period read off its crossings.
+# The reference: a long LSODA run from the step V1 -> V2 and the period read off its crossings.
 start = time.perf_counter()
 before = math.log(p["V1"] / p["V_ref"])
-run = si.solve_ivp(rhs, (0.0, 330.0), [before, -before, (p["a"] - p["b"]) * before], method="Radau",
-                   rtol=1e-11, atol=1e-12, dense_output=True)
+run = si.solve_ivp(rhs, (0.0, 330.0), [before, -before, (p["a"] - p["b"]) * before], method="LSODA",
+                   rtol=1e-13, atol=1e-14, dense_output=True)
 level = math.log(p["V2"] / p["V_ref"])
 grid = np.linspace(0.0, 330.0, 200_001)
 above = run.sol(grid)[0] - level
@@ -69,7 +69,7 @@ periods = np.diff(crossings)
 d = np.diff(periods)
 T_ref = periods[-1] - d[-1] ** 2 / (d[-1] - d[-2])  # Aitken's limit
 mu_ref = d[-1] / d[-2]
-print(f"reference (scipy Radau, {time.perf_counter() - start:.1f} s): period {T_ref:.10f} s, last periods "
+print(f"reference (scipy LSODA, {time.perf_counter() - start:.1f} s): period {T_ref:.10f} s, last periods "
       f"{np.round(periods[-3:], 9)}, multiplier from the transient {mu_ref:.6f}")
 
 # %%
@@ -121,7 +121,7 @@ ref_t = np.linspace(crossings[-2], crossings[-1], 4001)
 ref_V = p["V_ref"] * np.exp(run.sol(ref_t)[0])
 ref_shift = ref_t[int(np.argmax(ref_V))]
 axes[0].semilogy(t - shift, V, label="mechgen (collocation)")
-axes[0].semilogy(ref_t - ref_shift, ref_V, "k--", lw=1, label="scipy Radau, last cycle")
+axes[0].semilogy(ref_t - ref_shift, ref_V, "k--", lw=1, label="scipy LSODA, last cycle")
 axes[0].set_xlabel("t - t(V max) [s]")
 axes[0].set_ylabel("slip rate V [m/s]")
 axes[0].set_title(f"The cycle: T = {cycle['period']:.6f} s (error {error:.0e})")
