@@ -21,7 +21,6 @@ import numpy as np
 import pytest
 
 import mechgen
-from mechgen.runtime.core.integrate import integrate_first_order
 
 BASE = {"a": 0.01, "b": 0.015, "D_c": 1e-5, "sigma": 1e7, "mu0": 0.6, "V1": 1e-6, "V2": 1e-5, "V_ref": 1e-6}
 
@@ -69,10 +68,8 @@ def test_small_mass_tends_to_the_quasi_static_slider():
 def _run(law: str, factor: float, t_end: float):
     p = {**BASE, "m": 1e8}
     system = mechgen.compile("rate_state_inertial", {**p, "law": law, "k": factor * k_critical(p)}, backend="c")
-    x0 = np.asarray(system.call("initial")["x"], float).ravel()
-    traj = integrate_first_order(system.rhs, x0, t_end, jac=system.jacobian, method="Radau", rtol=1e-8, atol=1e-12,
-                                 t_eval=np.linspace(0.0, t_end, int(20 * t_end) + 1))
-    return np.asarray(traj.t), (traj.x if traj.x.shape[0] == len(traj.t) else traj.x.T)
+    run = mechgen.simulate(system, t_end=t_end, method="Radau", rtol=1e-8, atol=1e-12, samples=int(20 * t_end) + 1)
+    return np.asarray(run["t"]), np.column_stack([run["trajectory"][name] for name in ("phi", "psi", "f")])
 
 
 @pytest.mark.parametrize("law", ["aging", "slip"])
