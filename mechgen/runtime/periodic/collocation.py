@@ -227,19 +227,22 @@ class Collocation:
         rq, rv, ra = (np.asarray(tan[k], float).reshape(-1, n, n) for k in ("r_q", "r_v", "r_a"))
         size = self.nodes * 2 * n
         J = np.zeros((self.mesh * m * 2 * n + self.autonomous, size + self.autonomous))
+        # point c = i m + k and its interval's local node j: the 2n x 2n block
+        # [[D_kj / h_i I, -T L_kj I], [r_q L_kj, r_v L_kj + r_a D_kj / (h_i T)]], all blocks at once
+        P = self.mesh * m
+        k, h = np.tile(np.arange(m), self.mesh), np.repeat(widths, m)
+        Lp, Dp = L[k][:, :, None, None], D[k][:, :, None, None]  # P x (m + 1) x 1 x 1
+        hp = h[:, None, None, None]
         eye = np.eye(n)
-        index = self.node_index()
-        for i in range(self.mesh):
-            h = widths[i]
-            for k in range(m):
-                c = i * m + k
-                rows = slice(c * 2 * n, c * 2 * n + n), slice(c * 2 * n + n, (c + 1) * 2 * n)
-                for j in range(m + 1):
-                    g = index[i, j] * 2 * n
-                    J[rows[0], g:g + n] += D[k, j] / h * eye
-                    J[rows[0], g + n:g + 2 * n] += -T * L[k, j] * eye
-                    J[rows[1], g:g + n] += rq[c] * L[k, j]
-                    J[rows[1], g + n:g + 2 * n] += rv[c] * L[k, j] + ra[c] * D[k, j] / (h * T)
+        blocks = np.empty((P, m + 1, 2 * n, 2 * n))
+        blocks[:, :, :n, :n] = Dp / hp * eye
+        blocks[:, :, :n, n:] = -T * Lp * eye
+        blocks[:, :, n:, :n] = rq[:, None] * Lp
+        blocks[:, :, n:, n:] = rv[:, None] * Lp + ra[:, None] * Dp / (hp * T)
+        nodes = np.repeat(self.node_index(), m, axis=0)  # P x (m + 1)
+        rows = np.arange(P)[:, None, None, None] * 2 * n + np.arange(2 * n)[None, None, :, None]
+        cols = nodes[:, :, None, None] * 2 * n + np.arange(2 * n)[None, None, None, :]
+        np.add.at(J, (np.broadcast_to(rows, blocks.shape), np.broadcast_to(cols, blocks.shape)), blocks)
         R = self.residual(u)
         if self.autonomous:
             column = np.hstack([-at["v"], -np.einsum("cij,cj->ci", ra, at["dv"]) / T**2]).ravel()
