@@ -89,6 +89,21 @@ def repeat_times(fn: Callable, repeats: int, min_time: float = 0.0) -> list[floa
 
 
 @contextlib.contextmanager
+def interleaved_rounds(sides: dict, repeats: int) -> dict:
+    """{side: (its seconds per round, its last value)} of the callables ``sides``: one untimed warm-up call of each
+    (builds, imports and first loads excluded on every side), then ``repeats`` rounds that call every side once,
+    the order reversed every other round, so that the machine's load falls on all sides alike."""
+    values = {side: fn() for side, fn in sides.items()}
+    times: dict = {side: [] for side in sides}
+    order = list(sides)
+    for k in range(repeats):
+        for side in order if k % 2 == 0 else order[::-1]:
+            start = time.perf_counter()
+            values[side] = sides[side]()
+            times[side].append(time.perf_counter() - start)
+    return {side: (times[side], values[side]) for side in sides}
+
+
 def empty_cache():
     """Point $MECHGEN_CACHE at a fresh temporary directory for the duration (first-run timings)."""
     old = os.environ.get("MECHGEN_CACHE")

@@ -30,7 +30,7 @@ import statistics
 import time
 from pathlib import Path
 
-from mechgen.bench.common import (ROOT, environment, suite_report, user_path, user_path_markdown,
+from mechgen.bench.common import (ROOT, environment, interleaved_rounds, suite_report, user_path, user_path_markdown,
                                   write_csv, write_json, write_text)
 
 LAWS = ("aging", "slip")
@@ -88,23 +88,11 @@ def slider_rows(law: str, rtols, hand, repeats: int = 3) -> tuple[list[dict], fl
             s, t_end=T_END, method=m, rtol=rtol, atol=atol, samples=2).outputs["mu"])
             for method, system in systems.items()}
         sides["hand-written Radau"] = lambda: hand.mu_at_end(law, T_END, rtol=rtol, atol=atol, **numeric)
-        for side, (seconds, mu) in interleaved_medians(sides, repeats).items():
-            rows.append({"law": law, "side": side, "rtol": rtol, "seconds": seconds, "error": abs(mu - reference),
+        for side, (times, mu) in interleaved_rounds(sides, repeats).items():
+            rows.append({"law": law, "side": side, "rtol": rtol, "seconds": statistics.median(times),
+                         "error": abs(mu - reference),
                          "rounds": repeats})
     return rows, abs(check - reference)
-
-
-def interleaved_medians(sides: dict, repeats: int) -> dict:
-    """{side: (median wall time over ``repeats`` rounds, its last value)}: one untimed warm-up call of each side
-    (builds, imports, first loads excluded on both sides), then rounds that call every side once in turn."""
-    times = {side: [] for side in sides}
-    values = {side: fn() for side, fn in sides.items()}
-    for _ in range(repeats):
-        for side, fn in sides.items():
-            start = time.perf_counter()
-            values[side] = fn()
-            times[side].append(time.perf_counter() - start)
-    return {side: (statistics.median(times[side]), values[side]) for side in sides}
 
 
 def equal_accuracy(rows: list[dict], side: str) -> float | None:

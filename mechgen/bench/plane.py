@@ -48,12 +48,11 @@ from __future__ import annotations
 
 import statistics
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 
-from mechgen.bench.common import blas_threads, environment, suite_report, write_json, write_text
+from mechgen.bench.common import blas_threads, environment, interleaved_rounds, suite_report, write_json, write_text
 
 E_MODULUS, NU = 1.0, 0.3
 JETS = ((0, "x"), (0, "y"), (1, "x"), (1, "y"))
@@ -168,15 +167,10 @@ class Theirs:
 
 
 def interleaved(ours, theirs, repeats: int) -> tuple[list, list]:
-    """Per-call seconds of ``repeats`` rounds, ours then theirs, the order swapped every round (warm-ups excluded)."""
-    ours(), theirs()
-    a, b = [], []
-    for k in range(repeats):
-        for which, fn, store in ((0, ours, a), (1, theirs, b))[:: 1 if k % 2 == 0 else -1]:
-            start = time.perf_counter()
-            fn()
-            store.append(time.perf_counter() - start)
-    return a, b
+    """Per-call seconds of ``repeats`` rounds, ours then theirs, the order swapped every round (warm-ups excluded:
+    mechgen.bench.common.interleaved_rounds)."""
+    rounds = interleaved_rounds({"ours": ours, "theirs": theirs}, repeats)
+    return rounds["ours"][0], rounds["theirs"][0]
 
 
 def compare(unknowns: int, element: str, repeats: int) -> dict:
