@@ -88,7 +88,6 @@ def repeat_times(fn: Callable, repeats: int, min_time: float = 0.0) -> list[floa
     return out
 
 
-@contextlib.contextmanager
 def interleaved_rounds(sides: dict, repeats: int) -> dict:
     """{side: (its seconds per round, its last value)} of the callables ``sides``: one untimed warm-up call of each
     (builds, imports and first loads excluded on every side), then ``repeats`` rounds that call every side once,
@@ -104,6 +103,7 @@ def interleaved_rounds(sides: dict, repeats: int) -> dict:
     return {side: (times[side], values[side]) for side in sides}
 
 
+@contextlib.contextmanager
 def empty_cache():
     """Point $MECHGEN_CACHE at a fresh temporary directory for the duration (first-run timings)."""
     old = os.environ.get("MECHGEN_CACHE")
