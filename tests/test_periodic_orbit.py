@@ -653,3 +653,31 @@ def test_internal_variables_guess_and_refusals(tmp_path):
     with pytest.raises(InputError) as err:
         mechgen.periodic_orbit(system, method="harmonic_balance", period=3.0, z0={"z1": 0.4})
     assert err.value.key.endswith("method") and "internal variables" in str(err.value)
+
+
+@pytest.mark.parametrize("block_bytes", [None, 3000, 1])
+def test_interval_blocks_are_the_jacobians_rows_and_node_columns(monkeypatch, block_bytes):
+    """Collocation.interval_blocks (the monodromy's input) against scipy's own indexing J[rows][:, cols] of a random
+    sparse J, interval by interval: one interval (its last node its first), two, five and seven, gathered all at once
+    and in chunks of two intervals and of one (BLOCK_BYTES)."""
+    import scipy.sparse as sps
+
+    from mechgen.runtime.periodic import collocation
+    from mechgen.runtime.periodic.collocation import DEGREE, Collocation
+
+    if block_bytes is not None:
+        monkeypatch.setattr(collocation, "BLOCK_BYTES", block_bytes)
+
+    class ThreeStates:  # x = (q, v, z): n = 1 coordinate, m = 1 internal variable
+        n, m = 1, 1
+
+    for mesh in (1, 2, 5, 7):
+        problem = Collocation(ThreeStates(), mesh, None)
+        d, size = problem.state_size, mesh * DEGREE * problem.state_size + 1
+        J = sps.random(size, size, density=0.3, random_state=mesh, format="csr")
+        blocks = list(problem.interval_blocks(J))
+        assert len(blocks) == mesh
+        for i, nodes in enumerate(problem.node_index()):
+            cols = (nodes[:, None] * d + np.arange(d)[None, :]).ravel()
+            expected = J[np.arange(i * DEGREE * d, (i + 1) * DEGREE * d)][:, cols].toarray()
+            np.testing.assert_array_equal(blocks[i], expected)

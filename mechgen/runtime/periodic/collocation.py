@@ -59,6 +59,8 @@ sps = lazy_module("scipy.sparse")
 
 #: the polynomial degree m on each interval (m Gauss points: order 2m = 8 at the mesh points)
 DEGREE = 4
+#: the most bytes of dense interval blocks the monodromy gathers at a time (Collocation.interval_blocks)
+BLOCK_BYTES = 32 << 20
 
 
 @functools.lru_cache(maxsize=8)
@@ -315,21 +317,29 @@ class Collocation:
             Phi = step @ Phi
         return Phi
 
-    def interval_blocks(self, J) -> np.ndarray:
-        """(mesh, m d, (m + 1) d): each interval's rows of the collocation Jacobian J in the columns of its m + 1
-        nodes (node_index's order), dense; gathered from J's nonzeros in one pass (a node j of interval i is
-        global node (i m + j) mod nodes)."""
+    def interval_blocks(self, J):
+        """Each interval's rows of the collocation Jacobian J in the columns of its m + 1 nodes (node_index's
+        order), dense m d x (m + 1) d, in interval order: gathered from J's nonzeros in one pass (a node j of
+        interval i is global node (i m + j) mod nodes), BLOCK_BYTES of blocks at a time."""
         d, m, mesh, nodes = self.state_size, DEGREE, self.mesh, self.nodes
         coo = J.tocoo() if sps.issparse(J) else sps.coo_matrix(np.asarray(J))
         keep = (coo.row < mesh * m * d) & (coo.col < nodes * d)  # not the phase row, nor T's or a parameter's column
         r, c, v = coo.row[keep], coo.col[keep], coo.data[keep]
+        order = np.argsort(r, kind="stable")
+        r, c, v = r[order], c[order], v[order]
         i = r // (m * d)
         j = (c // d - i * m) % nodes
-        blocks = np.zeros((mesh, m * d, (m + 1) * d))
-        for wrap in (0, nodes) if nodes <= m else (0,):  # one interval: its last node is its first
-            ok = j + wrap <= m
-            np.add.at(blocks, (i[ok], r[ok] - i[ok] * m * d, (j[ok] + wrap) * d + c[ok] % d), v[ok])
-        return blocks
+        per = max(1, BLOCK_BYTES // (8 * m * d * (m + 1) * d))  # intervals per chunk
+        for first in range(0, mesh, per):
+            count = min(per, mesh - first)
+            lo, hi = np.searchsorted(i, [first, first + count])
+            blocks = np.zeros((count, m * d, (m + 1) * d))
+            ii, rr, jj, cc, vv = i[lo:hi] - first, r[lo:hi], j[lo:hi], c[lo:hi], v[lo:hi]
+            for wrap in (0, nodes) if nodes <= m else (0,):  # one interval: its last node is its first
+                ok = jj + wrap <= m
+                np.add.at(blocks, (ii[ok], rr[ok] - (ii[ok] + first) * m * d, (jj[ok] + wrap) * d + cc[ok] % d),
+                          vv[ok])
+            yield from blocks
 
     def frequency_derivative(self, u: np.ndarray) -> np.ndarray:
         """dR/domega of a forced orbit at fixed parameters (central differences, step 1e-6 omega)."""
