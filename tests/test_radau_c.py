@@ -73,11 +73,11 @@ def scipy_radau(fun, jac, x0, t_end: float, t_eval: np.ndarray, rtol: float, ato
     return np.vstack(rows), counts
 
 
-def same_run(system, fun, jac, x0, t_end: float, samples: int = 201, rtol: float = 1e-10):
+def same_run(system, fun, jac, x0, t_end: float, samples: int = 201, rtol: float = 1e-10, atol=1e-12):
     """Run both loops; assert the same counts and samples; return (t, samples)."""
     t_eval = np.linspace(0.0, t_end, samples)
-    t, X, counts = integrate_radau_c(system, x0, t_end, RunOptions(rtol=rtol, atol=1e-12, t_eval=t_eval))
-    ref, ref_counts = scipy_radau(fun, jac, x0, t_end, t_eval, rtol, 1e-12)
+    t, X, counts = integrate_radau_c(system, x0, t_end, RunOptions(rtol=rtol, atol=atol, t_eval=t_eval))
+    ref, ref_counts = scipy_radau(fun, jac, x0, t_end, t_eval, rtol, atol)
     assert counts == ref_counts
     np.testing.assert_array_equal(t, t_eval)
     np.testing.assert_allclose(X, ref, rtol=0, atol=SAME * np.max(np.abs(ref)))
@@ -162,6 +162,23 @@ def test_a_model_of_internal_variables_only():
         return np.array([[0.0, 1.0], [-2 * mu * z[0] * z[1] - 1, mu * (1 - z[0] ** 2)]])
 
     same_run(system, fun, jac, np.array([2.0, 0.0]), 7.0, rtol=1e-8)
+
+
+def test_an_absolute_tolerance_per_state_as_scipys():
+    """atol given per state (scipy's array atol; the periodic-orbit guess scales it by each state's range): the stiff
+    pair above, the same steps, counts and samples as scipy's Radau with that array at three rtol, and not those of
+    a scalar atol; a wrong length is refused (the loop's problem says why)."""
+    system = compiled(two_rates())
+    x0 = np.array([1.0, 1.0, 0.0, 0.0])
+    for atol in ([1e-6, 1e-12, 1e-9, 1e-12], [1e-12, 1e-6, 1e-12, 1e-8]):
+        for rtol in (1e-10, 1e-8, 1e-6):
+            same_run(system, system.rhs, system.jacobian, x0, 1.0, rtol=rtol, atol=np.array(atol))
+    t_eval = np.linspace(0.0, 1.0, 11)
+    steps = {a: integrate_radau_c(system, x0, 1.0, RunOptions(rtol=1e-10, atol=np.array(a) if a[1:] else a[0],
+                                                              t_eval=t_eval))[2]["steps"]
+             for a in ((1e-12, 1e-6, 1e-12, 1e-8), (1e-12,), (1e-6,))}
+    assert len(set(steps.values())) == 3, steps
+    assert "one per state" in radau_loop_problem(system, 1e-6, np.ones(3))
 
 
 def test_the_rate_state_slider_runs_compiled_and_agrees_with_scipys():

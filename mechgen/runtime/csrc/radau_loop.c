@@ -75,6 +75,7 @@ typedef struct {
     double *s_x;
     long budget_left;          /* accepted steps allowed (-1: no limit) */
     long slice;                /* return MGR_SLICE after this many steps in one call (0: never) */
+    const double *atol_v;      /* nx absolute tolerances, one per state (NULL: atol for every state) */
 } mgr_problem;
 
 typedef struct {
@@ -332,6 +333,12 @@ rates_rows:
 }
 
 /* scipy's norm: the root mean square of a[i] / scale[i % nx] over `count` entries */
+/* the absolute tolerance of state j: scipy's atol, a scalar or one per state */
+static double abs_tol(const mgr_problem *P_, long j)
+{
+    return P_->atol_v ? P_->atol_v[j] : P_->atol;
+}
+
 static double rms(const double *a, const double *scale, long count, long nx)
 {
     long i;
@@ -467,7 +474,7 @@ static int error_estimate(const mgr_problem *P_, mgr_state *S, mgr_work *w, doub
     }
     mg_lu_apply(nx, w->LUr, w->piv_r, w->err);
     for (j = 0; j < nx; ++j)
-        w->scale[j] = P_->atol + fmax(fabs(w->y[j]), fabs(w->y_new[j])) * P_->rtol;
+        w->scale[j] = abs_tol(P_, j) + fmax(fabs(w->y[j]), fabs(w->y_new[j])) * P_->rtol;
     *error_norm = rms(w->err, w->scale, nx, nx);
     if (rejected && *error_norm > 1.0) {
         for (j = 0; j < nx; ++j)
@@ -489,7 +496,7 @@ static int newton(const mgr_problem *P_, mgr_state *S, mgr_work *w, double t, do
     long j;
     int rc;
     for (j = 0; j < w->nx; ++j)
-        w->scale[j] = P_->atol + fabs(w->y[j]) * P_->rtol;
+        w->scale[j] = abs_tol(P_, j) + fabs(w->y[j]) * P_->rtol;
     for (;;) {
         if (!w->lu_valid && (rc = factorise(S, w, h, t)) != 0)
             return rc;
@@ -600,7 +607,7 @@ static int initial_step(const mgr_problem *P_, mgr_state *S, mgr_work *w, double
     double interval = fabs(P_->t_end - w->t), d0, d1, d2, h0, h1;
     int rc;
     for (j = 0; j < nx; ++j)
-        w->scale[j] = P_->atol + fabs(w->y[j]) * P_->rtol;
+        w->scale[j] = abs_tol(P_, j) + fabs(w->y[j]) * P_->rtol;
     d0 = rms(w->y, w->scale, nx, nx);
     d1 = rms(w->f, w->scale, nx, nx);
     h0 = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;

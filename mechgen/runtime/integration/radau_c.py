@@ -59,7 +59,7 @@ class CProblem(ctypes.Structure):
     _fields_ = [("n", c_long), ("m", c_long), ("extra", c_long), ("kernels", CKernel * len(KERNELS)),
                 ("p", c_void_p), ("rtol", c_double), ("atol", c_double), ("t_end", c_double),
                 ("n_eval", c_long), ("t_eval", c_void_p), ("s_x", c_void_p), ("budget_left", c_long),
-                ("slice", c_long)]
+                ("slice", c_long), ("atol_v", c_void_p)]
 
 
 class CState(ctypes.Structure):
@@ -130,16 +130,16 @@ def kernel_problem(system, names: dict) -> str | None:
 def radau_loop_problem(system, rtol=1e-8, atol=1e-10, extra: int = 0) -> str | None:
     """Why the compiled Radau loop cannot integrate ``system`` (None when it can): a smooth lumped system of the
     C backend with at least one and at most MAX_STATES first-order states (a model of internal variables only, n = 0,
-    included), scalar tolerances, a C compiler."""
+    included), a scalar rtol, an atol that is a scalar or one per state (scipy's), a C compiler."""
     if hasattr(system, "modes"):
         return "the system has modes (the compiled Radau loop integrates smooth models)"
     if system.is_lattice or system.is_field:
         return "the compiled Radau loop integrates lumped systems only"
     if getattr(system, "backend", None) != "c":
         return f"the system's kernels are {getattr(system, 'backend', 'unknown')} ones, not compiled C"
-    if np.ndim(rtol) or np.ndim(atol):
-        return "the compiled Radau loop takes scalar tolerances rtol and atol only"
     size = 2 * system.n + system.m + extra
+    if np.ndim(rtol) or np.ndim(atol) > 1 or (np.ndim(atol) == 1 and np.size(atol) != size):
+        return f"the compiled Radau loop takes a scalar rtol and a scalar atol or {size} of them (one per state)"
     if 2 * system.n + system.m < 1 or size > MAX_STATES:
         return f"the compiled Radau loop takes 1 to {MAX_STATES} states"
     why = kernel_problem(system, loop_kernels(system, extra))
@@ -163,14 +163,16 @@ def kernel_struct(kernel, picks: tuple) -> CKernel:
 def problem_of(system, x0: np.ndarray, t_end: float, options, extra: int) -> tuple[CProblem, dict]:
     """The C problem of a run and the arrays it points into (kept alive by the caller)."""
     names = loop_kernels(system, extra)
-    problem = CProblem(n=system.n, m=system.m, extra=extra, rtol=float(options.rtol), atol=float(options.atol),
-                       t_end=float(t_end), budget_left=-1, slice=SLICE)
+    atol = np.array(options.atol, dtype=float)  # 0-d (one for every state) or one per state (a contiguous copy)
+    problem = CProblem(n=system.n, m=system.m, extra=extra, rtol=float(options.rtol),
+                       atol=float(atol) if atol.ndim == 0 else 0.0, t_end=float(t_end), budget_left=-1, slice=SLICE)
     for slot, (kind, picks) in enumerate(KERNELS):
         if kind in names:
             problem.kernels[slot] = kernel_struct(system.kernels[names[kind]], picks)
     t_eval = np.ascontiguousarray([] if options.t_eval is None else options.t_eval, dtype=float).reshape(-1)
     keep = {"p": np.ascontiguousarray(system.params, dtype=float), "t_eval": t_eval,
-            "s_x": np.zeros((len(t_eval), x0.size)), "x": x0.copy(), "err_x": np.zeros(x0.size)}
+            "s_x": np.zeros((len(t_eval), x0.size)), "x": x0.copy(), "err_x": np.zeros(x0.size), "atol": atol}
+    problem.atol_v = atol.ctypes.data if atol.ndim else None
     problem.p = keep["p"].ctypes.data if keep["p"].size else None
     problem.n_eval, problem.t_eval = len(t_eval), t_eval.ctypes.data if len(t_eval) else None
     problem.s_x = keep["s_x"].ctypes.data if len(t_eval) else None

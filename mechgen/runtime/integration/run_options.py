@@ -33,7 +33,7 @@ class RunOptions(Options):
     Attributes:
         method: scipy's integrator (BDF, Radau, LSODA, RK45, DOP853); the compiled loops step DOP853, and a smooth
             lumped model's Radau (mechgen.runtime.integration.radau_c).
-        rtol, atol: the integrator's tolerances.
+        rtol, atol: the integrator's tolerances (atol: a scalar, or one per state where the loop takes that).
         t_eval: the sample times (sorted, in [0, t_end]); None: every step end (and both sides of each event).
         budget: counts accepted steps and wall time (mechgen.runtime.core.budget.Budget), or None.
         rules: the bounds of the events (:class:`EventRules`).
