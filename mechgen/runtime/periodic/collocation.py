@@ -202,19 +202,26 @@ class Collocation:
 
     def phase_row(self) -> np.ndarray:
         """The phase condition's gradient in the node states (it is linear in them): e_{n+p} at node 0, or the
-        integral condition's Gauss quadrature sum_i h_i sum_k w_k l_j(zeta_k) x_ref'(tau_ik) gathered per node."""
+        integral condition's Gauss quadrature sum_i h_i sum_k w_k l_j(zeta_k) x_ref'(tau_ik) gathered per node.
+        Computed once per problem (it depends on the mesh and the reference only), read-only."""
+        return self.phase_gradient
+
+    @functools.cached_property
+    def phase_gradient(self) -> np.ndarray:
+        """:meth:`phase_row`'s vector, built on first use."""
         d = self.state_size
         row = np.zeros(self.nodes * d)
         if self.reference is None:
             row[self.system.n + self.phase] = 1.0
-            return row
-        _, L, D = interval_tables()
-        weights = np.polynomial.legendre.leggauss(DEGREE)[1] / 2
-        index = self.node_index()
-        ref = np.asarray(self.reference, float).reshape(self.nodes, d)[index]  # mesh x (m + 1) x d
-        slopes = np.einsum("kj,ijd->ikd", D, ref) / self.widths[:, None, None]  # dx_ref/dtau at the points
-        share = np.einsum("k,kj,ikd->ijd", weights, L, slopes) * self.widths[:, None, None]
-        np.add.at(row.reshape(self.nodes, d), index, share)
+        else:
+            _, L, D = interval_tables()
+            weights = np.polynomial.legendre.leggauss(DEGREE)[1] / 2
+            index = self.node_index()
+            ref = np.asarray(self.reference, float).reshape(self.nodes, d)[index]  # mesh x (m + 1) x d
+            slopes = np.einsum("kj,ijd->ikd", D, ref) / self.widths[:, None, None]  # dx_ref/dtau at the points
+            share = np.einsum("k,kj,ikd->ijd", weights, L, slopes) * self.widths[:, None, None]
+            np.add.at(row.reshape(self.nodes, d), index, share)
+        row.flags.writeable = False
         return row
 
     def residual_jacobian(self, u: np.ndarray) -> tuple:
