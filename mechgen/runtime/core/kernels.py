@@ -72,6 +72,10 @@ class Kernel:
         self._binder = binder
         self._function = function
         self.output_names = [p["name"] for p in spec["outputs"]]
+        #: (name, batched, integer) of each input port, in order
+        self._ports = tuple((p["name"], bool(p["batched"]), bool(p["integer"])) for p in spec["inputs"])
+        #: the port lengths of a kernel without sizes, once known (Kernel._lengths)
+        self._fixed: tuple | None = None
 
     def casadi_function(self, sizes: dict | None = None):
         """The casadi.Function of a CasADi kernel at ``sizes`` (built once per sizes), to be called on CasADi
@@ -81,47 +85,69 @@ class Kernel:
                               "casadi.Function")
         return self._function(dict(sizes or {}))
 
+    def _lengths(self, sizes: dict) -> tuple[tuple, tuple]:
+        """(input lengths, output lengths) at ``sizes``, in port order (those of a kernel without sizes once)."""
+        if not sizes and self._fixed is not None:
+            return self._fixed
+        lengths = (tuple(extent(p["extent"], sizes) for p in self.spec["inputs"]),
+                   tuple(extent(p["extent"], sizes) for p in self.spec["outputs"]))
+        if not sizes:
+            self._fixed = lengths
+        return lengths
+
     def _arrays(self, inputs: dict, sizes: dict) -> tuple[list, int, bool]:
-        """Input arrays in port order; a missing batched state port is zero."""
+        """Input arrays in port order; a missing batched state port is zero. A batched port given as one row is
+        repeated to the batch's rows (contiguous); one given as (nbatch, length) is passed as it is."""
         ins, nbatch, batched = [], 1, False
-        for port in self.spec["inputs"]:
-            if port["name"] not in inputs and port["batched"] and not port["integer"]:
-                ins.append(np.zeros(0))
+        for name, is_batched, integer in self._ports:
+            if is_batched and not integer and name not in inputs:
+                ins.append(None)
                 continue
-            arr = np.asarray(inputs[port["name"]], dtype=np.int64 if port["integer"] else np.float64)
-            if port["batched"] and arr.ndim == 2:
+            arr = np.asarray(inputs[name], dtype=np.int64 if integer else np.float64)
+            if is_batched and arr.ndim == 2:
                 nbatch, batched = arr.shape[0], True
             ins.append(arr)
-        for k, port in enumerate(self.spec["inputs"]):
-            length = extent(port["extent"], sizes)
-            if port["batched"]:
-                ins[k] = np.ascontiguousarray(np.broadcast_to(ins[k].reshape(-1, length) if ins[k].size else
-                                                              np.zeros((1, length)), (nbatch, length)))
-            elif ins[k].size != length:
-                raise KernelError(f"kernel {self.name}: input {port['name']} has {ins[k].size} entries, "
-                                  f"expected {length}")
+        for k, ((name, is_batched, _), length) in enumerate(zip(self._ports, self._lengths(sizes)[0])):
+            arr = ins[k]
+            if is_batched:
+                if arr is None or not arr.size:
+                    ins[k] = np.zeros((nbatch, length))
+                    continue
+                arr = arr.reshape(-1, length)
+                if arr.shape[0] != nbatch:
+                    arr = np.broadcast_to(arr, (nbatch, length))
+                ins[k] = arr if arr.flags.c_contiguous else np.ascontiguousarray(arr)
+            elif arr.size != length:
+                raise KernelError(f"kernel {self.name}: input {name} has {arr.size} entries, expected {length}")
+            elif not arr.flags.c_contiguous:
+                ins[k] = np.ascontiguousarray(arr)
         return ins, nbatch, batched
 
     def evaluate(self, inputs: dict, sizes: dict | None = None, *, check: bool = True) -> dict:
         """Outputs for ``inputs`` (name -> array); batched ports may be (nbatch, length)."""
         sizes = sizes or {}
         ins, nbatch, batched = self._arrays(inputs, sizes)
-        outs = [np.zeros((nbatch, extent(p["extent"], sizes))) for p in self.spec["outputs"]]
+        outs = [np.zeros((nbatch, length)) for length in self._lengths(sizes)[1]]
         rc = self._impl(ins, outs, sizes, nbatch)
         if rc:
             raise KernelError(f"kernel {self.name} returned error code {rc}")
         if check:
             for port, arr in zip(self.spec["outputs"], outs):
-                if not np.all(np.isfinite(arr)):
-                    shown = {k: np.asarray(v).ravel()[:6].tolist() for k, v in inputs.items()
-                             if not k.startswith("slots")}
-                    flat = arr.reshape(nbatch, -1)
-                    bad = int(np.flatnonzero(~np.isfinite(flat))[0])
-                    batch, entry = divmod(bad, flat.shape[1])
-                    where = f"entry {entry} of {flat.shape[1]}" + (f" in batch row {batch}" if batched else "")
-                    raise KernelError(f"kernel {self.name} produced NaN/Inf in output {port['name']} ({where}, "
-                                      f"row-major, = {flat.ravel()[bad]}) at inputs {shown}")
-        return {p["name"]: (a if batched else a[0]) for p, a in zip(self.spec["outputs"], outs)}
+                if not np.isfinite(arr).all():
+                    raise self._not_finite(port["name"], arr, inputs, nbatch, batched)
+        if batched:
+            return dict(zip(self.output_names, outs))
+        return {name: a[0] for name, a in zip(self.output_names, outs)}
+
+    def _not_finite(self, port: str, arr: np.ndarray, inputs: dict, nbatch: int, batched: bool) -> KernelError:
+        """The error of an output with NaN/Inf: where (row-major entry, batch row) and the inputs."""
+        shown = {k: np.asarray(v).ravel()[:6].tolist() for k, v in inputs.items() if not k.startswith("slots")}
+        flat = arr.reshape(nbatch, -1)
+        bad = int(np.flatnonzero(~np.isfinite(flat))[0])
+        batch, entry = divmod(bad, flat.shape[1])
+        where = f"entry {entry} of {flat.shape[1]}" + (f" in batch row {batch}" if batched else "")
+        return KernelError(f"kernel {self.name} produced NaN/Inf in output {port} ({where}, row-major, = "
+                           f"{flat.ravel()[bad]}) at inputs {shown}")
 
     def bind(self, inputs: dict, outputs: dict, sizes: dict | None = None) -> Callable[[], int]:
         """A no-argument callable evaluating into ``outputs`` (contiguous float64 arrays) in place."""
@@ -152,6 +178,23 @@ def numpy_kernels(module) -> dict[str, Kernel]:
     return {name: Kernel(spec, impl_of(getattr(module, f"mg_{name}")), "numpy") for name, spec in module.SPEC.items()}
 
 
+#: the address given for an empty array (a valid one, never read or written: the port has no entries)
+EMPTY = np.zeros(1)
+EMPTY.flags.writeable = False
+EMPTY_ADDRESS = EMPTY.ctypes.data
+
+
+def data_address(a: np.ndarray) -> int:
+    """The address of a contiguous array's data: ctypes.addressof on its buffer (a third of numpy's
+    ``a.ctypes.data``) for a writable one, numpy's for a read-only one (it exports no writable buffer), and
+    EMPTY's for an empty one."""
+    if not a.size:
+        return EMPTY_ADDRESS
+    if a.flags.writeable and a.flags.c_contiguous:
+        return ctypes.addressof(ctypes.c_char.from_buffer(a))
+    return a.ctypes.data
+
+
 def c_kernels(lib: ctypes.CDLL, spec: dict, caller) -> dict[str, Kernel]:
     """Kernels of a loaded C library; ``caller.bind`` makes the prepared calls."""
     kernels = {}
@@ -160,8 +203,8 @@ def c_kernels(lib: ctypes.CDLL, spec: dict, caller) -> dict[str, Kernel]:
         size_names = kspec["sizes"]
 
         def binder(ins, outs, sizes, nbatch, address=address, size_names=size_names):
-            ptrs_in = [a.ctypes.data for a in ins]
-            ptrs_out = [o.ctypes.data for o in outs]
+            ptrs_in = [data_address(a) for a in ins]
+            ptrs_out = [data_address(o) for o in outs]
             return caller.bind(address, ptrs_in, ptrs_out, [int(sizes[n]) for n in size_names], nbatch,
                                (ins, outs, lib))
 
