@@ -22,6 +22,8 @@
 """
 from __future__ import annotations
 
+import functools
+
 from dataclasses import dataclass
 
 import numpy as np
@@ -210,6 +212,8 @@ class Reduction:
             C = self.multiplier_rows
             q = np.zeros(self.n) if q is None else np.asarray(q, float)
             return np.concatenate([r + C.T @ q[self.ndof:], C @ q[:self.ndof]])
+        if self.keep is not None:  # Z^T r of a column selection Z (each kept row once, times 1.0: exact)
+            return np.asarray(r, float)[self.keep]
         return r if self.Z is None else self.Z.T @ r
 
     def _bordered(self, A, border: bool):
@@ -231,9 +235,30 @@ class Reduction:
         if self.Z is None:
             return A
         if self.keep is not None:  # a column selection: slicing, not two sparse products
-            return A[self.keep][:, self.keep] if sps.issparse(A) else A[np.ix_(self.keep, self.keep)]
+            return self.kept(A) if sps.issparse(A) else A[np.ix_(self.keep, self.keep)]
         out = self.Z.T @ A @ self.Z
         return sps.csr_matrix(out) if sps.issparse(out) else np.asarray(out)
+
+    @functools.cached_property
+    def kept_index(self) -> np.ndarray:
+        """For each dof, its place among the kept ones (-1: eliminated); read-only."""
+        index = np.full(self.ndof, -1, np.int64)
+        index[self.keep] = np.arange(len(self.keep))
+        index.flags.writeable = False
+        return index
+
+    def kept(self, A):
+        """A[keep][:, keep] of a sparse A as CSR, in one pass over A's entries (scipy's two fancy indexings build
+        an intermediate matrix and check both: they were most of a small continuum's right-hand side)."""
+        A = A.tocsr() if A.format != "csr" else A
+        index = self.kept_index
+        rows = np.repeat(index, np.diff(A.indptr))
+        cols = index[A.indices]
+        on = (rows >= 0) & (cols >= 0)
+        n = len(self.keep)
+        indptr = np.zeros(n + 1, np.int64)
+        np.cumsum(np.bincount(rows[on], minlength=n), out=indptr[1:])
+        return sps.csr_matrix((A.data[on], cols[on], indptr), shape=(n, n))
 
     def penalty_force(self, x: np.ndarray, penalty) -> np.ndarray:
         """C^T diag(penalty) C x (zero without penalty rows)."""
