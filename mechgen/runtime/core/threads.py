@@ -52,38 +52,42 @@ def _scipy_loaded() -> bool:
 
 
 class OneThreadBlas:
-    """A context in which every loaded BLAS runs on one thread, and one that loads inside it too."""
+    """A context in which every loaded BLAS runs on one thread, and one that loads inside it too.
+
+    The contexts in force at once (nested, or entered from several threads) share one limit: the first to
+    enter saves the libraries' thread counts and sets one thread, the last to leave restores the saved counts.
+    (Each restoring the counts it had found, two threads leaving out of order restored each other's: the later
+    one left every library on one thread for the rest of the process.)
+    """
 
     def __enter__(self):
         with _LOCK:
-            self._limits = [controller().limit(limits=1, user_api="blas")]
-            self._key = _CONTROLLER_KEY
-            if not _IN_FORCE and not self._key:
-                sys.meta_path.insert(0, _WATCH)
+            if not _IN_FORCE:
+                _SHARED["limits"] = [controller().limit(limits=1, user_api="blas")]
+                _SHARED["key"] = _CONTROLLER_KEY
+                if not _SHARED["key"]:
+                    sys.meta_path.insert(0, _WATCH)
             _IN_FORCE.append(self)
         return self
 
-    def extend(self) -> None:
-        """Limit the libraries loaded since the context was entered (called by :func:`library_loaded`)."""
-        if _scipy_loaded() != self._key:
-            self._limits.append(controller().limit(limits=1, user_api="blas"))
-            self._key = _CONTROLLER_KEY
-
     def __exit__(self, *exc) -> None:
         with _LOCK:
-            for limit in reversed(self._limits):
-                limit.restore_original_limits()
             _IN_FORCE.remove(self)
-            if not _IN_FORCE and _WATCH in sys.meta_path:
-                sys.meta_path.remove(_WATCH)
+            if not _IN_FORCE:
+                for limit in reversed(_SHARED["limits"]):
+                    limit.restore_original_limits()
+                _SHARED["limits"] = []
+                if _WATCH in sys.meta_path:
+                    sys.meta_path.remove(_WATCH)
 
 
 def library_loaded() -> None:
-    """scipy.linalg or scipy.sparse.linalg (which bring scipy's own BLAS) was just imported: the limits in force
-    take it in, so that scipy's dense work inside a one-thread limit runs on one thread as numpy's does."""
+    """scipy.linalg or scipy.sparse.linalg (which bring scipy's own BLAS) was just imported: the limit in force
+    takes it in, so that scipy's dense work inside a one-thread limit runs on one thread as numpy's does."""
     with _LOCK:
-        for context in _IN_FORCE:
-            context.extend()
+        if _IN_FORCE and _scipy_loaded() != _SHARED["key"]:
+            _SHARED["limits"].append(controller().limit(limits=1, user_api="blas"))
+            _SHARED["key"] = _CONTROLLER_KEY
 
 
 class _NotifyingLoader:
@@ -145,5 +149,8 @@ _CONTROLLER = None
 _CONTROLLER_KEY = False
 _WORKER_LIMIT = None
 _IN_FORCE: list[OneThreadBlas] = []
+#: the limit the contexts in force share: its threadpoolctl limits (the first set on entry, then one per library
+#: loaded since) and whether scipy's BLAS was loaded when it was last extended
+_SHARED: dict = {"limits": [], "key": False}
 _LOCK = threading.RLock()
 _WATCH = _ScipyWatch()
