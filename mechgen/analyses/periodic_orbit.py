@@ -65,9 +65,10 @@ Methods (``method``; left out: ``harmonic_balance`` when ``harmonics`` is given,
   g the generated ``rates`` kernel (its Jacobian from ``rates_tangent``), each point's rows weighted by its
   interval's width, the Jacobian sparse (SuperLU); autonomous, the phase condition is AUTO's integral one,
   int_0^1 x(tau) . x_ref'(tau) dtau = 0 against the starting guess x_ref (then the previous solution at each
-  adaptation). Its guess is one period re-integrated (scipy's Radau, the exact Jacobian) from the guess's state at
-  t = 0 (``z0`` / ``q0`` / ``v0``, or the ``from`` simulate's state at its second-to-last maximum), cut at its slowest
-  point and closed by a Poincare section there (mechgen.runtime.periodic.cycle_guess: a stiff cycle's fast phase,
+  adaptation). Its guess is one period re-integrated (Radau IIA with the exact Jacobian, in the compiled loop where
+  it runs) from the guess's state at t = 0 (``z0`` / ``q0`` / ``v0``, or the ``from`` simulate's state at its
+  second-to-last maximum), cut at its slowest point and closed by a Poincare section there
+  (mechgen.runtime.periodic.cycle_guess: a stiff cycle's fast phase,
   such as a stick-slip cycle's slip, falls between a simulate's samples, and the maxima's distance guesses the
   period to a sample's width), and the first mesh already equidistributes the guess's monitor (from 4 x ``mesh``
   uniform intervals). A stiff cycle wants ``mesh`` of 50 to 100 and ``adapt`` = 2 (the stick-slip cycle of
