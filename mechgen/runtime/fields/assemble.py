@@ -82,6 +82,16 @@ def element_vectors(tables: np.ndarray, weights: np.ndarray, rho: np.ndarray) ->
     return np.einsum("eqal,eqa->el", tables * weights[:, :, None, None], rho, optimize=True)
 
 
+def element_vectors_stack(tables: np.ndarray, weights: np.ndarray, rho: np.ndarray) -> np.ndarray:
+    """r_ke[l] = sum_q w sum_a B rho_k for a stack of coefficients rho[k, e, q, a]: :func:`element_vectors` of
+    each k in one product (one einsum path, one matrix product)."""
+    shared = shared_table(tables)
+    if shared is not None:
+        ne, nq, na, nl = tables.shape
+        return (weights[:, :, None] * rho).reshape(len(rho), ne, nq * na) @ shared.reshape(nq * na, nl)
+    return np.einsum("eqal,keqa->kel", tables * weights[:, :, None, None], rho, optimize=True)
+
+
 class Assembler:
     """Scatters element vectors and matrices into global dofs (CSR pattern built once)."""
 

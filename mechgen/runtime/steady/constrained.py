@@ -34,7 +34,7 @@ import numpy as np
 from mechgen.errors import InputError
 from mechgen.runtime.core.lazy_import import lazy_module
 from mechgen.runtime.core.memory import require_dense
-from mechgen.runtime.fields.assemble import element_matrices, element_vectors
+from mechgen.runtime.fields.assemble import element_matrices, element_vectors_stack
 
 sla = lazy_module("scipy.linalg")
 
@@ -96,11 +96,12 @@ def constrained_linear(system, bvp, result, jets: np.ndarray, multipliers: int |
 
 
 def _multiplier_rows(system, values: np.ndarray, m: int) -> np.ndarray:
-    """B_kl = sum_points w psi_k (values . Phi_l) over the reduced unknowns, psi_k = cos(k pi s / L), k < m."""
+    """B_kl = sum_points w psi_k (values . Phi_l) over the reduced unknowns, psi_k = cos(k pi s / L), k < m (the m
+    element-vector sets in one product)."""
     disc = system.disc
-    rows = [system.assembler.vector(element_vectors(disc.tables, disc.weights,
-                                                    np.cos(k * np.pi * disc.points / disc.length)[..., None] * values))
-            for k in range(m)]
+    psi = np.cos(np.arange(m).reshape((m,) + (1,) * disc.points.ndim) * np.pi * disc.points / disc.length)
+    stack = element_vectors_stack(disc.tables, disc.weights, psi[..., None] * values)
+    rows = [system.assembler.vector(vectors) for vectors in stack]
     return _reduce_rows(system.reduction, np.array(rows, float))
 
 
