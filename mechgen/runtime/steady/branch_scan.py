@@ -143,8 +143,10 @@ def _solver(system, x):
     return F, factor
 
 
-def point_between(system, xa, xb, theta: float, *, tol: float = 1e-10, max_iter: int = 25) -> np.ndarray:
-    """The branch point x(theta) between the branch points xa and xb (see the module doc)."""
+def point_between(system, xa, xb, theta: float, *, tol: float = 1e-10, max_iter: int = 25,
+                  start: np.ndarray | None = None) -> np.ndarray:
+    """The branch point x(theta) between the branch points xa and xb (see the module doc); Newton starts from
+    ``start`` (default: the chord's point xa + theta (xb - xa))."""
     xa, xb = np.asarray(xa, float), np.asarray(xb, float)
     chord = xb - xa
     length = float(np.linalg.norm(chord))
@@ -152,7 +154,7 @@ def point_between(system, xa, xb, theta: float, *, tol: float = 1e-10, max_iter:
         return xa.copy()
     row = chord / length
     target = float(row @ xa) + theta * length
-    x = xa + theta * chord
+    x = xa + theta * chord if start is None else np.array(start, float)
     done = False
     for _ in range(max_iter):
         try:
@@ -191,12 +193,15 @@ def crossing(system, xa, xb, g, *, xtol: float = 1e-12) -> np.ndarray:
 
 def switch(system, xa, xb, label, label_a, *, tol: float = 1e-9) -> np.ndarray:
     """The branch point between xa and xb where label(x) stops being ``label_a`` (bisection in theta to ``tol``;
-    returns the point at the middle of the last bracket)."""
-    lo, hi = 0.0, 1.0
+    returns the point at the middle of the last bracket). Each bisection point's Newton starts from the middle
+    of its bracket's two branch points (the chord's point is farther from the branch: more iterations)."""
+    xa, xb = np.asarray(xa, float), np.asarray(xb, float)
+    lo, hi, x_lo, x_hi = 0.0, 1.0, xa, xb
     while hi - lo > tol:
         mid = 0.5 * (lo + hi)
-        if label(point_between(system, xa, xb, mid)) == label_a:
-            lo = mid
+        x = point_between(system, xa, xb, mid, start=0.5 * (x_lo + x_hi))
+        if label(x) == label_a:
+            lo, x_lo = mid, x
         else:
-            hi = mid
-    return point_between(system, xa, xb, 0.5 * (lo + hi))
+            hi, x_hi = mid, x
+    return point_between(system, xa, xb, 0.5 * (lo + hi), start=0.5 * (x_lo + x_hi))
