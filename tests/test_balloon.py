@@ -25,10 +25,6 @@ from mechgen.runtime.linear.stability import stability
 from mechgen.runtime.steady.steady_bvp import solve_steady, steady_bvp
 from mechgen.symbolic.specialize import specialize
 
-# one worker holds the session's balloon_branches run (conftest's fixture, about 12 s) for both balloon
-# modules, instead of each worker that draws one of their tests running it again
-pytestmark = pytest.mark.xdist_group("balloon_branches")
-
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 import balloon_handwritten as reference  # noqa: E402
 

@@ -26,10 +26,6 @@ import pytest
 
 from mechgen.cli import main
 
-# one worker holds the session's balloon_branches run (conftest's fixture, about 12 s) for both balloon
-# modules, instead of each worker that draws one of their tests running it again
-pytestmark = pytest.mark.xdist_group("balloon_branches")
-
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 import balloon_handwritten as reference  # noqa: E402

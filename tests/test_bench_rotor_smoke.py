@@ -10,9 +10,6 @@ import pytest
 from mechgen.bench.rotor import COUNT, TOL, run_rotor_benchmarks
 from bench_reports import check_standard_reports
 
-# one worker pays ROSS's import and its numba JIT (about 12 s) for both ROSS modules
-pytestmark = pytest.mark.xdist_group("ross")
-
 HAVE_ROSS = importlib.util.find_spec("ross") is not None
 
 

@@ -22,9 +22,6 @@ from rotors import shaft
 from mechgen.runtime.linear.damped import damped_modes, whirl
 from mechgen.runtime.fields.mesh import Layout, Part, Segment
 
-# one worker pays ROSS's import and its numba JIT (about 12 s) for both ROSS modules
-pytestmark = pytest.mark.xdist_group("ross")
-
 DATA = Path(__file__).resolve().parents[1] / "benchmarks" / "ross_data" / "ross_reference.json"
 SPEEDS = ("0.0", "500.0", "1000.0", "2000.0")
 
