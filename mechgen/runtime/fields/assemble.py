@@ -74,17 +74,13 @@ def element_matrices(tables: np.ndarray, weights: np.ndarray, coeff: np.ndarray,
 
 
 def element_vectors(tables: np.ndarray, weights: np.ndarray, rho: np.ndarray) -> np.ndarray:
-    """r_e[l] = sum_q w sum_a B rho."""
-    shared = shared_table(tables)
-    if shared is not None:
-        ne, nq, na, nl = tables.shape
-        return (weights[:, :, None] * rho).reshape(ne, nq * na) @ shared.reshape(nq * na, nl)
-    return np.einsum("eqal,eqa->el", tables * weights[:, :, None, None], rho, optimize=True)
+    """r_e[l] = sum_q w sum_a B rho (:func:`element_vectors_stack` of the one set rho)."""
+    return element_vectors_stack(tables, weights, np.asarray(rho)[None])[0]
 
 
 def element_vectors_stack(tables: np.ndarray, weights: np.ndarray, rho: np.ndarray) -> np.ndarray:
-    """r_ke[l] = sum_q w sum_a B rho_k for a stack of coefficients rho[k, e, q, a]: :func:`element_vectors` of
-    each k in one product (one einsum path, one matrix product)."""
+    """r_ke[l] = sum_q w_eq sum_a B[e, q, a, l] rho[k, e, q, a] for a stack of coefficient sets rho[k] (all k in
+    one matrix product on a shared table, else one einsum)."""
     shared = shared_table(tables)
     if shared is not None:
         ne, nq, na, nl = tables.shape

@@ -204,10 +204,10 @@ class Collocation:
         """The phase condition's gradient in the node states (it is linear in them): e_{n+p} at node 0, or the
         integral condition's Gauss quadrature sum_i h_i sum_k w_k l_j(zeta_k) x_ref'(tau_ik) gathered per node.
         Computed once per problem (it depends on the mesh and the reference only), read-only."""
-        return self.phase_gradient
+        return self._phase_row
 
     @functools.cached_property
-    def phase_gradient(self) -> np.ndarray:
+    def _phase_row(self) -> np.ndarray:
         """:meth:`phase_row`'s vector, built on first use."""
         d = self.state_size
         row = np.zeros(self.nodes * d)
