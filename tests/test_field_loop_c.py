@@ -228,7 +228,10 @@ def test_where_the_compiled_loop_cannot_run(model_file, plain):
 def test_auto_weighs_a_large_continuums_largest_rates(plain):
     """Above 400 first-order states, auto's estimate is ARPACK's 6 largest eigenvalues of the sparse linearisation:
     against the dense eigenvalues of FieldSystem.jacobian, the fastest rate and (c / 2 rho = 0.15 for every mode of
-    the string on its viscous foundation) the fastest decay agree to 1e-6; auto then runs DOP853 in the C loop, and
+    the string on its viscous foundation) the fastest decay agree, the rate to 1e-6 and the decay to 1e-5 (ARPACK stops
+    at a residual of tol |lambda|max = 1e-10 * 1146, 8e-7 of the decay, which the damped operator's non-normality
+    magnifies: random start vectors gave up to 4.3e-6; the fixed start vector gives 6e-10, and auto's threshold
+    needs percent); the estimate is the same on every call (a fixed start vector); auto then runs DOP853 in the C loop, and
     DOP853 over a t_end whose stability alone needs twice max_steps is refused before the first step."""
     system = plain.with_params(N=120, c=0.3)
     x0 = np.concatenate([0.01 * np.sin(np.arange(system.n)), np.zeros(system.n)])
@@ -236,7 +239,8 @@ def test_auto_weighs_a_large_continuums_largest_rates(plain):
     largest = simulate_flow.start_rates(system, x0)
     dense = np.linalg.eigvals(system.jacobian(0.0, x0))
     assert np.abs(largest).max() == pytest.approx(np.abs(dense).max(), rel=1e-6)
-    assert np.max(-largest.real) == pytest.approx(np.max(-dense.real), rel=1e-6)
+    assert np.max(-largest.real) == pytest.approx(np.max(-dense.real), rel=1e-5)
+    np.testing.assert_array_equal(simulate_flow.start_rates(system, x0), largest)
     assert np.max(-dense.real) == pytest.approx(0.15, rel=1e-9)
     r = mechgen.simulate(system, t_end=0.01, initial_mode=1, amplitude=0.1, samples=3)
     assert (r["method"], r["loop"]) == ("DOP853", "c")

@@ -106,7 +106,8 @@ def _lowest_frequencies(M, K, fixed=(0, 1), count: int = COUNT) -> np.ndarray:
 
     keep = np.setdiff1d(np.arange(M.shape[0]), fixed)
     M, K = sps.csc_matrix(M)[keep][:, keep], sps.csc_matrix(K)[keep][:, keep]
-    lam = spla.eigsh(K, k=count, M=M, sigma=0.0, which="LM", return_eigenvectors=False)
+    start = np.random.default_rng(0).standard_normal(K.shape[0])  # fixed: the same figures every run
+    lam = spla.eigsh(K, k=count, M=M, sigma=0.0, which="LM", return_eigenvectors=False, v0=start)
     return np.sqrt(np.sort(lam))
 
 
