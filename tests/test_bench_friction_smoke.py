@@ -3,10 +3,13 @@ asserted; the errors it reports are checked: the imposed step against its closed
 reference against CVODES at the same tight tolerance)."""
 import json
 
+import pytest
+
 from mechgen.cli import main
 from bench_reports import check_standard_reports
 
 
+@pytest.mark.slow  # the quick benchmark run
 def test_quick_friction_benchmark_writes_reports(tmp_path):
     assert main(["bench", "friction", "--quick", "--out", str(tmp_path)]) == 0
     data = json.loads((tmp_path / "friction.json").read_text())

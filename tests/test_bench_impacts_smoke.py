@@ -2,10 +2,13 @@
 asserted; the errors it reports are checked against the closed forms' accuracy)."""
 import json
 
+import pytest
+
 from mechgen.cli import main
 from bench_reports import check_standard_reports
 
 
+@pytest.mark.slow  # the quick benchmark run
 def test_quick_impact_benchmark_writes_reports(tmp_path):
     assert main(["bench", "impacts", "--quick", "--out", str(tmp_path)]) == 0
     data = json.loads((tmp_path / "impacts.json").read_text())

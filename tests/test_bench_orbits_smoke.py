@@ -9,6 +9,7 @@ from bench_reports import check_standard_reports
 from mechgen.cli import main
 
 
+@pytest.mark.slow  # the quick benchmark run
 def test_quick_orbit_benchmark_writes_reports(tmp_path):
     assert main(["bench", "orbits", "--quick", "--out", str(tmp_path)]) == 0
     data = json.loads((tmp_path / "orbits.json").read_text())

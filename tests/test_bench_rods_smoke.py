@@ -28,6 +28,7 @@ def test_section_mapping_matches_pyelastica():
     assert got["mass_second_moment_over_rho_dl"] == pytest.approx([got["I"], got["I"], got["J"]], rel=1e-14)
 
 
+@pytest.mark.slow  # the quick benchmark run
 def test_quick_run_writes_the_reports(tmp_path):
     res = REGISTRY["rods"].run(tmp_path, quick=True)
     for name in REGISTRY["rods"].reports:

@@ -5,9 +5,12 @@ reference before timing it, so this also checks generated C against hand C.
 """
 import json
 
+import pytest
+
 from mechgen.cli import main
 
 
+@pytest.mark.slow  # the quick benchmark run
 def test_quick_benchmark_writes_reports(tmp_path, capsys):
     assert main(["bench", "fpu", "beam", "--quick", "--out", str(tmp_path)]) == 0  # rotor: its own smoke test
     data = json.loads((tmp_path / "fpu_kernels.json").read_text())

@@ -66,6 +66,7 @@ def build_site(work: Path) -> Path:
     return out
 
 
+@pytest.mark.slow  # the gallery's scripts: about 140 s
 def test_site(tmp_path):
     """One build, then each check of the built site (one test rather than a shared fixture: pytest-xdist would
     build the site once per worker that holds a test needing it)."""
