@@ -180,6 +180,7 @@ def test_generated_bvp_jacobians_match_central_differences(law):
     assert errors["f_y"] < 1e-7 and errors["f_p"] < 1e-6
 
 
+@pytest.mark.slow
 def test_branches_scene_locates_the_minimum_eyelet_tension(balloon_branches_run):
     """scenes/balloon_branches.toml: the single-loop branch by continuation in lambda0 with stability at every
     point; p_e,min against the hand-written reference's minimum (balloon_notes.md: 14.70509 at -0.08853), the

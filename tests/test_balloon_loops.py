@@ -64,6 +64,7 @@ def _tension_vector(point: dict) -> tuple[float, float, float]:
     return scale * point["x_s_start"], scale * point["z_s_start"], l0
 
 
+@pytest.mark.slow
 def test_loop_counts_equal_the_reference_loop_count_on_the_same_balloons(branches):
     """Every 25th point of the three multi-loop families (both arms, 1.5 to 4 loops): the hand-written shooting
     converges to the same balloon from its tension vector, and its loop_count equals the model's loops."""
@@ -83,6 +84,7 @@ def test_loop_counts_equal_the_reference_loop_count_on_the_same_balloons(branche
     assert len(switches) == 1 and switches[0][0] < HALF_TO_WHOLE < switches[0][1]
 
 
+@pytest.mark.slow
 def test_balloons_at_tension_are_the_reference_balloons_at_p_e_5(branches):
     """Every balloon with p_e = 5 up to 4 loops (lambda0 <= 0.6), with its loop count, against the reference's
     balloons_at_pe; single loops are excluded by the single-loop branch's minimum p_e."""

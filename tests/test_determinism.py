@@ -11,6 +11,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from mechgen.pipeline import GENERATED
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -46,6 +48,7 @@ def test_generation_is_byte_identical_across_processes(tmp_path):
         assert path.read_bytes() == (GENERATED / path.relative_to(tmp_path / "a")).read_bytes()
 
 
+@pytest.mark.slow
 def test_committed_generated_code_is_current():
     from mechgen.regen import regen
 

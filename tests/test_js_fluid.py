@@ -136,6 +136,7 @@ def oldroyd_b_start_up(t: np.ndarray, G: float, Re: float, terms: int = 4000) ->
     return Q
 
 
+@pytest.mark.slow
 def test_start_up_flow_matches_the_oldroyd_b_series():
     """simulate of the first-order fields from rest (BDF on q' = v(q)): Q(t) with its elastic overshoot against the
     series, at the P2 rate (over 12 per halving of the elements), 2e-7 at N = 32."""

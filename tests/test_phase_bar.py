@@ -102,6 +102,7 @@ def _trilinear(g, gM, gm, gT):
     return g - gT
 
 
+@pytest.mark.slow
 def test_trilinear_maxwell_stress_against_an_independent_equal_area_solve(trilinear):
     gM, gm, gT = 0.02, 0.07, 0.06
     r = mechgen.phase_boundary(trilinear.with_params(gamma_M=gM, gamma_m=gm, gamma_T=gT), strain_range=[-0.01, 0.12])

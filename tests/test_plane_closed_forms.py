@@ -188,6 +188,7 @@ def annulus_sym():
     return ur, ut, polar_stress(ur, ut)
 
 
+@pytest.mark.slow
 def test_annulus_equations_symbolic(annulus_sym):
     """Polar equilibrium with f_r = -rho_g sin(theta), f_theta = -rho_g cos(theta) (the paper's eqs. 4-5),
     sigma_rr = sigma_rt = 0 on r = a, u = 0 on r = b, and the paper's disk in the limit a -> 0."""

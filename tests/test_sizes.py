@@ -75,6 +75,7 @@ def dense_bytes_of(n: int) -> int:
     return 8 * n * n
 
 
+@pytest.mark.slow
 def test_string_lowest_modes_at_2e5_elements_sparse():
     """N = 2e5 elements (4e5 unknowns): the six lowest modes against the closed form, in far less memory
     than one dense matrix (1.3e12 bytes)."""

@@ -60,6 +60,7 @@ def test_observed_order(chain, name):
         assert orders[-1] < design + 0.7, (name, errors, orders)
 
 
+@pytest.mark.slow
 def test_energy_bounded_no_drift_over_a_million_steps():
     """Leapfrog, 10^6 steps of a 4-mass linear chain: |E - E0|/E0 stays O(dt^2), with no secular growth."""
     n = 4
