@@ -20,8 +20,9 @@ Euler: numerical dissipation of the stiff shear/axial modes a sudden load excite
 finite differences).
 
 Newton (mechgen.runtime.rods.dynamics): a factorised band Jacobian kept while each correction is at most
-REFRESH = 0.2 times the one before and taken again at the current iterate as soon as one is larger (or a
-kept Jacobian's full correction fails the monotonicity test); a step that still fails is split in halves
+REFRESH = 0.5 times the one before and the corrections still needed at that rate cost less than a new
+Jacobian (JACOBIAN_COST = 10 corrections), taken again at the current iterate otherwise (or when a kept
+Jacobian's full correction fails the monotonicity test); a step that still fails is split in halves
 (``splits``).
 
 Outputs: ``t`` (s), ``tip_trajectory`` (n x 3, m), ``tip_rotations`` (rad about the bending axis per saved

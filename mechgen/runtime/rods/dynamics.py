@@ -46,8 +46,9 @@ whose Jacobian is CasADi's AD of the element energy's gradient and of the nodes'
 local; finite differences over three colours of nodes with ``jacobian="fd"``), factorised and kept over
 iterations and steps while the corrections contract fast (simplified Newton). The refresh rule
 (:meth:`_Solver.attempt`): the Jacobian is taken again at the current iterate as soon as one correction
-contracts slower than REFRESH = 0.2 (at any iteration, the first of a step included) or a kept Jacobian's
-full correction fails the monotonicity test; only a Jacobian taken at the current iterate damps the step.
+contracts slower than REFRESH = 0.5, or the corrections still needed at the rate seen would cost more than a
+new Jacobian (JACOBIAN_COST = 10 corrections; at any iteration, the first of a step included), or a kept
+Jacobian's full correction fails the monotonicity test; only a Jacobian taken at the current iterate damps the step.
 A step that does not converge even so is split in two, down to 2^-12 of dt, before a ConvergenceError names
 the time reached.
 
@@ -63,6 +64,7 @@ from __future__ import annotations
 
 import ctypes
 import logging
+import math
 from dataclasses import dataclass, field
 from functools import lru_cache
 
@@ -80,10 +82,25 @@ from mechgen.runtime.rods.ends import ENDS
 BAND = 11
 log = logging.getLogger("mechgen")
 MAX_SPLITS = 12
-#: simplified Newton's largest accepted contraction rate |dz_k+1|/|dz_k| before the Jacobian is taken again at the
-#: current iterate. A Jacobian costs about 6 residual solves (N = 40: 0.31 ms against 0.06 ms), so a rate of
-#: 0.2, which gains 7 digits in 10 corrections, is about where taking it again starts to pay.
-REFRESH = 0.2
+#: simplified Newton's largest accepted contraction rate |dz_k+1|/|dz_k|: above it the Jacobian is taken again at
+#: the current iterate whatever the corrections still needed (a kept Jacobian that at best halves the error is far
+#: off the current one)
+REFRESH = 0.5
+#: what a Jacobian costs, in corrections (each a residual and a band solve): N = 40, 0.45 ms against 0.045 ms
+#: measured. Below REFRESH, the Jacobian is taken again when the corrections a kept one still needs
+#: (:func:`stale_corrections`) cost more.
+JACOBIAN_COST = 10.0
+
+
+def stale_corrections(rate: float, size: float, tol: float) -> float:
+    """How many more corrections a kept Jacobian needs, at contraction ``rate``, from a correction of ``size``
+    until the error estimate size rate^k rate / (1 - rate) is below ``tol``: log(tol (1 - rate) / (size rate)) /
+    log(rate) (infinite for rate >= 1)."""
+    if rate >= 1.0:
+        return float("inf")
+    if rate <= 0.0 or size <= 0.0:
+        return 0.0
+    return max(math.log(tol * (1.0 - rate) / (size * rate)) / math.log(rate), 0.0)
 
 
 SOURCE = csrc.path("rod_elements.c")
@@ -549,7 +566,8 @@ class _Solver:
         Newton's corrections dz = -J^-1 r(z) use a factorised Jacobian J taken at some iterate, possibly of an
         earlier step (simplified Newton), and the refresh rule is: J is taken again at the current iterate z
         whenever (a) the corrections contract slower than REFRESH, |dz_k+1| > REFRESH |dz_k|, at any iteration
-        (the first one of a step included) or (b) the full correction fails the monotonicity test below, unless
+        (the first one of a step included), or the corrections J still needs at the rate seen (stale_corrections)
+        would cost more than JACOBIAN_COST, or (b) the full correction fails the monotonicity test below, unless
         J was already taken at this z. With J taken at z, (b) is Deuflhard's damped Newton (natural monotonicity
         test): lam dz is accepted when the next correction, J^-1 r(z + lam dz) with the same J, is at most
         (1 - lam/4) |dz|, else lam is halved (down to 1/64; below it the step fails and is split). So a stale J
@@ -582,7 +600,7 @@ class _Solver:
                 # the last correction is taken (its size bounds the error of z); the wrench of the loads is
                 # the one at z, off by O(|dzt|)
                 return z + dzt, Fx, Mx
-            if rate > REFRESH:
+            if rate > REFRESH or stale_corrections(rate, new, self.tol) > JACOBIAN_COST:
                 self._factor(st, z, dt, r)
                 here = True
                 dzt, new = self._solve(r)
