@@ -373,6 +373,44 @@ def test_van_der_pol_limit_cycle_from_its_hopf_point():
     assert last["amplitude"]["x"] == pytest.approx(-best.fun, abs=1e-8)
 
 
+@pytest.mark.parametrize("step", [0.1, 0.3])
+def test_a_branch_that_steps_through_the_hopf_point_ends_there_without_a_fold(tmp_path, step):
+    """The limit cycles of x'' - (mu - x^2) x' + x = 0 followed from mu = 1 down towards their Hopf point at mu = 0
+    with steps large enough to cross it: near it the orbits are A cos(t) + O(A^2) with mu even in A, so a step
+    across A = 0 lands on the same orbit half a period on, where mu turns back. The branch must end there (status
+    equilibrium, mu decreasing all along, no cyclic fold). Before, it reported an LPC at mu = 0.035 and went back
+    up to mu = 85 along the same orbits. Reference: x = sqrt(mu) y with y van der Pol's cycle of parameter mu,
+    whose amplitude is 2 + O(mu^2): the last orbit's amplitude is 2 sqrt(mu) to 1e-4 at mu < 0.1."""
+    path = tmp_path / "vdp_down.toml"
+    path.write_text(f"""model = "van_der_pol_hopf"
+backend = "c"
+[params]
+mu = 1.0
+[[analysis]]
+name = "cycle"
+kind = "periodic_orbit"
+method = "collocation"
+mesh = 40
+period = 6.6
+q0 = {{ x = 2.0 }}
+[[analysis]]
+name = "down"
+kind = "continuation"
+about = "cycle"
+parameter = "mu"
+stop = -0.5
+step = {step}
+max_step = 1.0
+""")
+    down = mechgen.run(str(path))["analyses"][1]["outputs"]
+    assert down["status"] == "equilibrium" and down["special_points"] == [] and down["folds"] == []
+    mu = np.array([point["mu"] for point in down["branch"]])
+    assert np.all(np.diff(mu) < 0) and 0.0 < mu[-1] < 0.1
+    last = down["branch"][-1]
+    assert last["amplitude"]["x"] == pytest.approx(2.0 * np.sqrt(last["mu"]), rel=1e-4)
+    assert last["period"] == pytest.approx(2 * np.pi, rel=0.01)
+
+
 def test_bisection_is_bounded_when_corrected_points_leave_the_bracket(monkeypatch):
     """A fold cascade (js_fluid past its first fold) once made the BP bisection loop for minutes: the points corrected
     onto the branch jumped to another sheet, so the bracket's length never shrank. The location now stops after

@@ -10,7 +10,9 @@ p0^2: the arclength measures the parameter's relative change against the orbit's
 within the step control's reach; ``step`` and ``max_step`` are in those units, p0 times the orbit's change where the
 branch turns). An autonomous orbit's branch ends where its orbits shrink to an equilibrium (status ``equilibrium``:
 a Hopf point, the orbits' size, the largest range of a state component over the period relative to the first
-orbit's, at a local minimum below 0.1), at its smallest orbit, rather than return through it. A forced orbit whose
+orbit's, at a local minimum below 0.1), at its smallest orbit, rather than return through it; a step that passed
+through the equilibrium (the new orbit is the last one half a period on: their deviations from their means are
+anti-correlated) ends it at the last orbit before, with no fold recorded for the parameter's turn there. A forced orbit whose
 ``frequency`` is an expression of the continued parameter (``frequency = "w"``, continued in ``w``) has its period
 follow it; otherwise the forcing's frequency stays as it was.
 
@@ -68,28 +70,47 @@ SIZE_PHASES = 256
 
 
 class Collapse:
-    """``until`` of an autonomous orbit's branch (mechgen.runtime.steady.continuation): the orbits' size, the largest
-    range over the period of a state component relative to the first orbit's, at each accepted point; the branch
-    ends at the smallest orbit when the size, below COLLAPSE, starts to grow again (the orbits shrank to an
-    equilibrium, a Hopf point, and the branch would return through it along the same orbits)."""
+    """``until`` of an autonomous orbit's branch (mechgen.runtime.steady.continuation): the branch ends where its
+    orbits shrink onto an equilibrium (a Hopf point), from where it would only return along the same orbits.
+
+    At each accepted point: the orbit's deviation from its mean over SIZE_PHASES phases of the period, d(phase)
+    (each state component relative to the first orbit's range), and its size, the largest range. The branch ends
+
+    * when a step passed through the equilibrium: near a Hopf point the orbits are u_eq + A v(phase) + O(A^2), and
+      a step across A = 0 lands on the same orbit with A < 0, phase-shifted by half a period, where the parameter
+      (even in A) turns back. So the deviations of the two orbits are anti-correlated, sum d_last . d_new < 0,
+      where along a branch they agree (+1 in the limit of small steps). The branch ends at the last orbit before
+      the passage, and the turn of the parameter (no cyclic fold: both orbits shrink onto one point) is not
+      recorded;
+    * or at the smallest orbit, when the size, below COLLAPSE, starts to grow again."""
 
     def __init__(self, orbits: Orbits, branch: OrbitBranch, u0: np.ndarray, p0: float) -> None:
         self.orbits, self.branch = orbits, branch
-        self.first = self.ranges(u0, p0) + 1e-300
+        deviation = self.deviation(u0, p0)
+        self.first = np.ptp(deviation, axis=0) + 1e-300
+        self.deviations = [deviation / self.first]
         self.sizes, self.last = [1.0], float(p0)
 
-    def ranges(self, u: np.ndarray, p: float) -> np.ndarray:
+    def deviation(self, u: np.ndarray, p: float) -> np.ndarray:
+        """The states at SIZE_PHASES phases of the period less their mean (their units)."""
         problem = self.branch.problem(p)
         T = self.orbits.period(problem, u)
-        return np.ptp(self.orbits.states(problem, u, T * np.arange(SIZE_PHASES) / SIZE_PHASES), axis=0)
+        states = self.orbits.states(problem, u, T * np.arange(SIZE_PHASES) / SIZE_PHASES)
+        return states - states.mean(axis=0)
 
     def __call__(self, u: np.ndarray, p: float):
-        size = float(np.max(self.ranges(u, p) / self.first))
+        deviation = self.deviation(u, p) / self.first
+        size = float(np.max(np.ptp(deviation, axis=0)))
+        if float(np.sum(deviation * self.deviations[-1])) < 0.0:
+            return ("equilibrium", f"the orbits shrank onto an equilibrium between {self.orbits.name} = "
+                    f"{self.last:.10g} and {float(p):.10g} (a Hopf point; the step passed through it): the branch "
+                    f"ends at its last orbit before it, {self.sizes[-1]:.3g} of the first orbit's size")
         if len(self.sizes) > 1 and self.sizes[-1] < min(COLLAPSE, self.sizes[-2], size):
             return ("equilibrium", f"the orbits shrank to an equilibrium near {self.orbits.name} = {self.last:.10g} "
                     f"(a Hopf point): the branch ends at its smallest orbit, {self.sizes[-1]:.3g} of the first "
                     "orbit's size")
         self.sizes.append(size)
+        self.deviations.append(deviation)
         self.last = float(p)
         return None
 
