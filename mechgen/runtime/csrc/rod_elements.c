@@ -264,3 +264,73 @@ double mgr_band_solve(long n, long kl, long ku, const double *ab, const int *ipi
     }
     return size;
 }
+
+/* Simplified Newton's corrections within one step: dynamics._Solver.attempt's loop between two Jacobians, the same
+ * operations in the same order (so the same iterates bit for bit). Each pass tries z + lam dz for lam = 1, 1/2, ...
+ * (halved only while the factors were taken at z, down to 1/64) until the next correction dzt = -J^-1 r(z + lam dz)
+ * passes |dzt| <= (1 - lam/4) |dz|; then z = z + lam dz, and the step has converged when lam = 1 and |dzt| is below
+ * tol / 100 or its error estimate |dzt| rate / (1 - rate) below tol (z + dzt returned). The factors are to be taken
+ * again at z (returned to the caller, which factors, solves and calls again) when no trial passes with factors of an
+ * earlier iterate, or when the corrections contract slower than `refresh` or would still need more than
+ * `jacobian_cost` corrections at the rate seen (dynamics.stale_corrections). */
+typedef struct {
+    long size, kl, ku;                          /* 6 n unknowns; LAPACK band widths */
+    const double *ab;                           /* dgbtrf's band factors of the Jacobian held (column-major) */
+    const int *ipiv;                            /* their pivots (0-based) */
+    const double *scale;                        /* the correction's units (L and rad), size */
+    double tol, refresh, jacobian_cost;         /* dynamics.py's tol, REFRESH and JACOBIAN_COST */
+    long passes;                                /* in: passes left in the attempt; decremented */
+    long here;                                  /* in/out: 1 when the factors were taken at z */
+    double *z, *r, *Fx, *Mx;                    /* in/out: the iterate, its residual and external wrench */
+    double *dz;                                 /* in/out: the correction at z */
+    double dz_size;                             /* in/out: its size */
+    double *zt, *dzt;                           /* work: a trial and its correction */
+    long solves;                                /* out: band solves done (added to) */
+} mgr_newton;
+
+long mgr_newton_layout(void) { return (long)sizeof(mgr_newton); }
+
+enum { MGR_CONVERGED = 0, MGR_NEED_JACOBIAN = 1, MGR_FAILED = 2 };
+
+/* log(tol (1 - rate) / (size rate)) / log(rate), at least 0; infinite for rate >= 1 (dynamics.stale_corrections) */
+static double stale_corrections(double rate, double size, double tol) {
+    if (rate >= 1.0) return INFINITY;
+    if (rate <= 0.0 || size <= 0.0) return 0.0;
+    double k = log(tol * (1.0 - rate) / (size * rate)) / log(rate);
+    return k > 0.0 ? k : 0.0;
+}
+
+int mgr_corrections(const mgr_step *s, mgr_newton *w) {
+    long m = w->size, nn = 3 * s->n;
+    mgr_step t = *s;                            /* the residual at the trials: batch 1, z = zt */
+    t.z = w->zt;
+    while (w->passes > 0) {
+        --w->passes;
+        double lam = 1.0, next = 0.0;
+        int accepted = 0;
+        for (;;) {
+            for (long i = 0; i < m; ++i) w->zt[i] = w->z[i] + lam * w->dz[i];
+            mgr_residual(&t);
+            next = mgr_band_solve(m, w->kl, w->ku, w->ab, w->ipiv, t.r, w->scale, w->dzt);
+            ++w->solves;
+            if (isfinite(next) && next <= (1.0 - lam / 4.0) * w->dz_size) { accepted = 1; break; }
+            lam *= 0.5;
+            if (!w->here || lam < 1.0 / 64.0) break;
+        }
+        if (!accepted) return w->here ? MGR_FAILED : MGR_NEED_JACOBIAN;
+        memcpy(w->z, w->zt, (size_t)m * sizeof(double));
+        memcpy(w->r, t.r, (size_t)m * sizeof(double));
+        memcpy(w->Fx, t.Fx, (size_t)nn * sizeof(double));
+        memcpy(w->Mx, t.Mx, (size_t)nn * sizeof(double));
+        w->here = 0;
+        double rate = next / (w->dz_size > 1e-300 ? w->dz_size : 1e-300);
+        if (lam == 1.0 && (next < 0.01 * w->tol || (rate < 1.0 && next * rate / (1.0 - rate) < w->tol))) {
+            for (long i = 0; i < m; ++i) w->z[i] += w->dzt[i];
+            return MGR_CONVERGED;
+        }
+        if (rate > w->refresh || stale_corrections(rate, next, w->tol) > w->jacobian_cost) return MGR_NEED_JACOBIAN;
+        memcpy(w->dz, w->dzt, (size_t)m * sizeof(double));
+        w->dz_size = next;
+    }
+    return MGR_FAILED;
+}

@@ -30,12 +30,30 @@ class CStep(ctypes.Structure):
                 ("r", c_void_p), ("Fx", c_void_p), ("Mx", c_void_p)]
 
 
+class CNewton(ctypes.Structure):
+    """The Python mirror of rod_elements.c's mgr_newton (field for field)."""
+
+    _fields_ = [("size", c_long), ("kl", c_long), ("ku", c_long), ("ab", c_void_p), ("ipiv", c_void_p),
+                ("scale", c_void_p), ("tol", c_double), ("refresh", c_double), ("jacobian_cost", c_double),
+                ("passes", c_long), ("here", c_long), ("z", c_void_p), ("r", c_void_p), ("Fx", c_void_p),
+                ("Mx", c_void_p), ("dz", c_void_p), ("dz_size", c_double), ("zt", c_void_p), ("dzt", c_void_p),
+                ("solves", c_long)]
+
+
+#: mgr_corrections' outcomes
+CONVERGED, NEED_JACOBIAN, FAILED = 0, 1, 2
+
+
 def declare(lib) -> bool:
-    """Set the argument types of mgr_residual, mgr_record and mgr_rotate on ``lib``; False when the C structure's size
-    differs from :class:`CStep` (then the numpy path runs)."""
+    """Set the argument types of mgr_residual, mgr_record, mgr_rotate, mgr_band_solve and mgr_corrections on
+    ``lib``; False when a C structure's size differs from its mirror (:class:`CStep`, :class:`CNewton`: then the
+    numpy path runs)."""
     lib.mgr_layout.argtypes, lib.mgr_layout.restype = [], c_long
-    if lib.mgr_layout() != ctypes.sizeof(CStep):
+    lib.mgr_newton_layout.argtypes, lib.mgr_newton_layout.restype = [], c_long
+    if lib.mgr_layout() != ctypes.sizeof(CStep) or lib.mgr_newton_layout() != ctypes.sizeof(CNewton):
         return False
+    lib.mgr_corrections.argtypes = [ctypes.POINTER(CStep), ctypes.POINTER(CNewton)]
+    lib.mgr_corrections.restype = ctypes.c_int
     lib.mgr_residual.argtypes, lib.mgr_residual.restype = [ctypes.POINTER(CStep)], ctypes.c_int
     lib.mgr_record.argtypes = [c_long, c_double, c_double] + [c_void_p] * 10
     lib.mgr_record.restype = ctypes.c_int
@@ -74,20 +92,63 @@ class StepResidual:
             s.load = None
         self.ref = ctypes.byref(s)
 
-    def __call__(self, st, z: np.ndarray, dt: float, load: np.ndarray | None = None):
-        """(r (batch, n, 6), Fx, Mx (batch, n, 3)), fresh arrays, at increments z (batch, n, 6) from state ``st``
-        over dt (s); ``load``: the lumped position-dependent load at x + alpha dx (batch, n, 6), when there is one."""
+    def load(self, st, dt: float) -> None:
+        """Copy the state ``st`` at the step's start and its length dt (s) into the buffers."""
         k = self.keep
         np.copyto(k["x"], st.x)
         np.copyto(k["R"], st.R)
         np.copyto(k["v"], st.v)
         np.copyto(k["w"], st.w)
+        self.s.dt = dt
+
+    def __call__(self, st, z: np.ndarray, dt: float, load: np.ndarray | None = None):
+        """(r (batch, n, 6), Fx, Mx (batch, n, 3)), fresh arrays, at increments z (batch, n, 6) from state ``st``
+        over dt (s); ``load``: the lumped position-dependent load at x + alpha dx (batch, n, 6), when there is one."""
+        k = self.keep
+        self.load(st, dt)
         np.copyto(k["z"], z)
         if load is not None:
             np.copyto(k["load"], load)
-        self.s.dt = dt
         self.lib.mgr_residual(self.ref)
         return k["r"].copy(), k["Fx"].copy(), k["Mx"].copy()
+
+
+class Corrections:
+    """mgr_corrections (simplified Newton's loop within one step, between two Jacobians) on the residual of a
+    :class:`StepResidual` of batch 1 and buffers of its own, made once per rod."""
+
+    def __init__(self, step: StepResidual, scale: np.ndarray, band: int) -> None:
+        if step.batch != 1:
+            raise ValueError("the compiled corrections take one increment at a time (batch 1)")
+        n = step.n
+        self.step, self.lib, self.n = step, step.lib, n
+        self.scale = np.ascontiguousarray(scale, dtype=float)
+        self.z, self.r, self.dz, self.zt, self.dzt = (np.zeros((n, 6)) for _ in range(5))
+        self.Fx, self.Mx = np.zeros((n, 3)), np.zeros((n, 3))
+        self.w = CNewton(size=6 * n, kl=band, ku=band, scale=self.scale.ctypes.data, z=self.z.ctypes.data, r=self.r.ctypes.data,
+                         Fx=self.Fx.ctypes.data, Mx=self.Mx.ctypes.data, dz=self.dz.ctypes.data,
+                         zt=self.zt.ctypes.data, dzt=self.dzt.ctypes.data)
+        self.ref = ctypes.byref(self.w)
+
+    def start(self, st, dt: float, iterate: tuple, rule: tuple) -> None:
+        """A step's attempt from state ``st`` over dt at the ``iterate`` (z, r, Fx, Mx: the increments, their
+        residual and external wrench) under the ``rule`` (tol, refresh, jacobian_cost, passes: the tolerance, the
+        refresh rule's constants and the most passes of the loop; dynamics._Solver.attempt)."""
+        self.step.load(st, dt)
+        for buf, a in zip((self.z, self.r, self.Fx, self.Mx), iterate):
+            np.copyto(buf, a)
+        w = self.w
+        w.tol, w.refresh, w.jacobian_cost, w.passes = rule
+
+    def run(self, lu: np.ndarray, piv: np.ndarray, dz: np.ndarray, size: float, here: bool) -> tuple[int, int]:
+        """(outcome, band solves done) of the loop from the correction dz of ``size`` at the current iterate, with
+        the band factors (lu, piv) of LAPACK dgbtrf (taken at the iterate when ``here``). On CONVERGED ``z`` holds
+        the increments and ``Fx``, ``Mx`` the wrench; on NEED_JACOBIAN ``z`` and ``r`` the iterate to take it at."""
+        w = self.w
+        np.copyto(self.dz, dz.reshape(self.n, 6))
+        w.ab, w.ipiv, w.dz_size, w.here, w.solves = lu.ctypes.data, piv.ctypes.data, size, int(here), 0
+        outcome = self.lib.mgr_corrections(self.step.ref, self.ref)
+        return int(outcome), int(w.solves)
 
 
 class Recorder:
@@ -145,4 +206,5 @@ def rotate(lib, R: np.ndarray, theta: np.ndarray) -> np.ndarray:
     return out
 
 
-__all__ = ["BandSolve", "CStep", "StepResidual", "declare", "Recorder", "rotate"]
+__all__ = ["BandSolve", "CNewton", "CONVERGED", "Corrections", "CStep", "FAILED", "NEED_JACOBIAN", "StepResidual",
+           "declare", "Recorder", "rotate"]

@@ -57,8 +57,10 @@ configuration, element forces, loads, inertial, gyroscopic, damping and fixed ro
 band factors with its size (:meth:`_Solver._solve`), a saved point's energies and turning angle
 (:meth:`Discrete.saved_point`) and a step's new rotations (:func:`advance`) are one ctypes call each into
 runtime/csrc/rod_elements.c on buffers made once (mechgen.runtime.rods.compiled): about 11 us a residual at
-N = 40 against 45-55 us in numpy. The numpy path (:meth:`Discrete.residual_numpy`, scipy's dgbtrs) is the
-reference they are tested against (equal to round-off) and runs without a compiler.
+N = 40 against 45-55 us in numpy. So are a step's corrections between two Jacobians (:meth:`_Solver.attempt`'s
+loop: rod_elements.c's mgr_corrections, the same operations in the same order, so the same iterates bit for bit;
+1.15x the whole run at N = 20-40) where the loads need no Python. The numpy path (:meth:`Discrete.residual_numpy`,
+scipy's dgbtrs) and the Python loop are the references they are tested against and run without a compiler.
 """
 from __future__ import annotations
 
@@ -90,6 +92,9 @@ REFRESH = 0.5
 #: measured. Below REFRESH, the Jacobian is taken again when the corrections a kept one still needs
 #: (:func:`stale_corrections`) cost more.
 JACOBIAN_COST = 10.0
+#: attempt's corrections in one C call between two Jacobians where they can be (False: the Python loop, their
+#: reference)
+COMPILED_CORRECTIONS = True
 
 
 def stale_corrections(rate: float, size: float, tol: float) -> float:
@@ -115,7 +120,7 @@ def element_library():
     try:
         lib = load_shared(csrc.source(SOURCE), stem="mgrod", ldflags=("-lm",),
                           symbols=("mgr_internal", "mgr_residual", "mgr_record", "mgr_rotate", "mgr_band_solve",
-                                   "mgr_layout"))
+                                   "mgr_layout", "mgr_corrections", "mgr_newton_layout"))
     except (CompilerUnavailable, BuildError, OSError) as exc:
         log.info("C rod elements unavailable (%s): numpy forces", exc)
         return None
@@ -585,6 +590,9 @@ class _Solver:
             return None
         if size < 0.01 * self.tol:
             return z, Fx, Mx
+        loop = self._compiled_loop()
+        if loop is not None:
+            return self._corrections_compiled(loop, st, dt, z, r, Fx, Mx, dz, size, here)
         for _ in range(self.max_iter):
             lam, zt, rt, Fxt, Mxt, dzt, new = self._damped(st, dt, z, dz, size, here)
             if lam is None:
@@ -607,6 +615,38 @@ class _Solver:
             dz, size = dzt, new
         self.lu = None
         return None
+
+    def _compiled_loop(self):
+        """The compiled loop of :meth:`attempt` (compiled_step.Corrections) where the residual and the band solve
+        are compiled and the loads need no Python (a position-dependent load is a Python callable), else None."""
+        disc = self.disc
+        if not COMPILED_CORRECTIONS or self.band is None or (disc.body.rod.load is not None
+                                                              and disc.uniform_load is None):
+            return None
+        got = disc._evaluators.get("corrections")
+        if got is None:
+            step = disc._evaluators.get(("residual", 1))
+            if step is None:
+                return None
+            got = disc._evaluators["corrections"] = compiled_step.Corrections(step, self.scale, BAND)
+        return got
+
+    def _corrections_compiled(self, loop, st: State, dt: float, z, r, Fx, Mx, dz, size: float, here: bool):
+        """:meth:`attempt`'s loop in one C call between two Jacobians (rod_elements.c's mgr_corrections: the same
+        operations in the same order, so the same iterates as the Python loop bit for bit)."""
+        loop.start(st, dt, (z, r, Fx, Mx), (self.tol, REFRESH, JACOBIAN_COST, self.max_iter))
+        while True:
+            outcome, solves = loop.run(self.lu, self.piv, dz, size, here)
+            self.iterations += solves
+            if outcome == compiled_step.CONVERGED:
+                return loop.z.copy(), loop.Fx.copy(), loop.Mx.copy()
+            if outcome == compiled_step.FAILED:
+                self.lu = None
+                return None
+            z, r = loop.z.copy(), loop.r.copy()      # NEED_JACOBIAN: take it at the current iterate
+            self._factor(st, z, dt, r)
+            here = True
+            dz, size = self._solve(r)
 
     def _damped(self, st: State, dt: float, z: np.ndarray, dz: np.ndarray, size: float, here: bool):
         """The first lam = 1, 1/2, ... >= 1/64 whose next correction passes |dz(z + lam dz)| <= (1 - lam/4)
