@@ -231,7 +231,8 @@ def test_auto_weighs_a_large_continuums_largest_rates(plain):
     the string on its viscous foundation) the fastest decay agree, the rate to 1e-6 and the decay to 1e-5 (ARPACK stops
     at a residual of tol |lambda|max = 1e-10 * 1146, 8e-7 of the decay, which the damped operator's non-normality
     magnifies: random start vectors gave up to 4.3e-6; the fixed start vector gives 6e-10, and auto's threshold
-    needs percent); the estimate is the same on every call (a fixed start vector); auto then runs DOP853 in the C loop, and
+    needs percent); the estimate is the same on every call (a fixed start vector); auto then runs DOP853 in the C
+    loop, and
     DOP853 over a t_end whose stability alone needs twice max_steps is refused before the first step."""
     system = plain.with_params(N=120, c=0.3)
     x0 = np.concatenate([0.01 * np.sin(np.arange(system.n)), np.zeros(system.n)])

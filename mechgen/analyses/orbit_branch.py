@@ -12,9 +12,9 @@ branch turns). An autonomous orbit's branch ends where its orbits shrink to an e
 a Hopf point, the orbits' size, the largest range of a state component over the period relative to the first
 orbit's, at a local minimum below 0.1), at its smallest orbit, rather than return through it; a step that passed
 through the equilibrium (the new orbit is the last one half a period on: their deviations from their means are
-anti-correlated) ends it at the last orbit before, with no fold recorded for the parameter's turn there. A forced orbit whose
-``frequency`` is an expression of the continued parameter (``frequency = "w"``, continued in ``w``) has its period
-follow it; otherwise the forcing's frequency stays as it was.
+anti-correlated) ends it at the last orbit before, with no fold recorded for the parameter's turn there. A
+forced orbit whose ``frequency`` is an expression of the continued parameter (``frequency = "w"``, continued in
+``w``) has its period follow it; otherwise the forcing's frequency stays as it was.
 
 Outputs: ``branch`` (per point: the parameter, ``period``, ``frequency``, ``amplitude`` ({coordinate: max |q| over
 the period}, then each internal variable's), ``start`` (the state at t = 0: each coordinate and

@@ -193,8 +193,8 @@ OUTPUTS: dict[str, tuple[OutputDoc, ...]] = {
         _o("points", "scalar (int)", "-", "How many branch points."),
         _o("status", "string, or {start: string}", "-", "Why the branch ended (``lam_max``, ``bounds``, "
            "``max_points`` ...; per start with several; about an autonomous ``periodic_orbit``, ``equilibrium``: "
-           "the orbits shrank onto an equilibrium, a Hopf point, and the branch ends at its smallest orbit, or at its last "
-           "orbit before a step that passed through the equilibrium)."),
+           "the orbits shrank onto an equilibrium, a Hopf point, and the branch ends at its smallest orbit, or at its "
+           "last orbit before a step that passed through the equilibrium)."),
         _o("folds", "list of branch points", "the outputs'", "The turning points in the parameter."),
         _o("stability_changes", "list of {..., from, to}", "the outputs'", "With ``stability``: where the "
            "verdict changes between consecutive points, located by bisection along the branch."),

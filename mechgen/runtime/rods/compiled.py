@@ -125,8 +125,8 @@ class Corrections:
         self.scale = np.ascontiguousarray(scale, dtype=float)
         self.z, self.r, self.dz, self.zt, self.dzt = (np.zeros((n, 6)) for _ in range(5))
         self.Fx, self.Mx = np.zeros((n, 3)), np.zeros((n, 3))
-        self.w = CNewton(size=6 * n, kl=band, ku=band, scale=self.scale.ctypes.data, z=self.z.ctypes.data, r=self.r.ctypes.data,
-                         Fx=self.Fx.ctypes.data, Mx=self.Mx.ctypes.data, dz=self.dz.ctypes.data,
+        self.w = CNewton(size=6 * n, kl=band, ku=band, scale=self.scale.ctypes.data, z=self.z.ctypes.data,
+                         r=self.r.ctypes.data, Fx=self.Fx.ctypes.data, Mx=self.Mx.ctypes.data, dz=self.dz.ctypes.data,
                          zt=self.zt.ctypes.data, dzt=self.dzt.ctypes.data)
         self.ref = ctypes.byref(self.w)
 
