@@ -1,6 +1,6 @@
 """``python -m mechgen`` is the ``mechgen`` command."""
 import sys
 
-from mechgen.cli import main
+from mechgen.cli import console
 
-sys.exit(main())
+sys.exit(console())

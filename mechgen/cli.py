@@ -277,8 +277,25 @@ COMMANDS = {"run": _cmd_run, "models": _cmd_models, "show": _cmd_show, "regen": 
             "export": _cmd_export}
 
 
+#: how long OpenBLAS's idle threads spin-wait for the next call before they sleep in a ``mechgen`` process: 2^20
+#: cycles (about 0.4 ms) against OpenBLAS's 2^28 (about 0.1 s). At load, numpy's OpenBLAS starts its threads and
+#: they spin for that long: a cached ``mechgen run scenes/laval_rotor.toml`` spent 0.36-0.48 s of CPU against
+#: 0.26-0.35 s at 2^20 (as with one thread), and those spinning threads take a busy machine's cores from other
+#: work. Kept as the user sets it (OPENBLAS_THREAD_TIMEOUT, 4 ... 30).
+BLAS_SPIN = "20"
+
+
+def console() -> int:
+    """The ``mechgen`` command (and ``python -m mechgen``): :func:`main` in a process of its own, whose OpenBLAS
+    threads spin for :data:`BLAS_SPIN` unless the environment says otherwise. Set before numpy loads OpenBLAS
+    (mechgen.cli imports no numpy); it changes no number, only how long idle threads burn CPU."""
+    if "numpy" not in sys.modules:
+        os.environ.setdefault("OPENBLAS_THREAD_TIMEOUT", BLAS_SPIN)
+    return main()
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``mechgen`` console script."""
+    """Entry point of the ``mechgen`` command (argv: its arguments; None: sys.argv's)."""
     parser = _parser()
     try:
         args = parser.parse_args(argv)

@@ -150,3 +150,22 @@ def test_plot_continuum_shapes_and_sweep(tmp_path, capsys):
     pngs = sorted(p.name for p in tmp_path.glob("*.png"))
     assert pngs == ["beam_modes_boundary_conditions.png", "beam_modes_modes.png", "beam_modes_modes_shapes.png"]
     assert all((tmp_path / p).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for p in pngs)
+
+
+@pytest.mark.parametrize("given", [None, "8"])
+def test_the_command_shortens_openblas_idle_spin_unless_the_user_set_it(given):
+    """The ``mechgen`` command (cli.console, also ``python -m mechgen``) sets OPENBLAS_THREAD_TIMEOUT to BLAS_SPIN
+    before numpy loads OpenBLAS (mechgen.cli imports no numpy), and keeps a value the user set; ``main`` called in
+    a process of the user's own changes nothing."""
+    from mechgen import cli
+
+    probe = ("import contextlib, io, os, sys\nfrom mechgen import cli\nloaded = 'numpy' in sys.modules\n"
+             "sys.argv = ['mechgen', '--version']\nwith contextlib.redirect_stdout(io.StringIO()):\n    cli.{entry}()\n"
+             "print(loaded, os.environ.get('OPENBLAS_THREAD_TIMEOUT'))")
+    env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_THREAD_TIMEOUT"}
+    if given is not None:
+        env["OPENBLAS_THREAD_TIMEOUT"] = given
+    for entry, expected in (("console", given or cli.BLAS_SPIN), ("main", given)):
+        out = subprocess.run([sys.executable, "-c", probe.format(entry=entry)], env=env, capture_output=True,
+                             text=True, check=True).stdout.split()
+        assert out == ["False", str(expected)]
