@@ -18,12 +18,15 @@ from __future__ import annotations
 import sys
 from dataclasses import dataclass, replace
 from pathlib import Path
-
 from typing import Callable
 
 from mechgen.errors import ModelError
+from mechgen.symbolic.discretisations import DISCRETISATIONS
+from mechgen.symbolic.hybrid import DIRECTIONS, Guard, ModeScope
 from mechgen.symbolic.names import RESERVED, check_identifier, name_clash_error, output_clash
 from mechgen.symbolic.params import Namespace, Param
+from mechgen.symbolic.plane_domain import ELEMENTS, SHAPES, Domain, PlaneSpec
+from mechgen.symbolic.rod import RodSpec
 
 ARG_NAMES = ("q", "v", "z", "p", "t")
 
@@ -302,7 +305,6 @@ class Model:
         The ``rod`` kernel evaluates sigma = K (f - f0), C = d sigma/df, W, f0, the load and d load/dr, L
         and M; the ``rod_statics`` analysis solves the rod's equilibrium, ``rod_dynamics`` its motion.
         """
-        from mechgen.symbolic.rod import RodSpec
 
         if self.rod_spec is not None:
             raise ModelError(f"model {self.name} declares its rod twice", file=self.file, key="rod",
@@ -348,7 +350,6 @@ class Model:
         :meth:`potential_density`, :meth:`dissipation_density` or :meth:`weak_form`; a model has either
         coordinates or fields, not both.
         """
-        from mechgen.symbolic.discretisations import DISCRETISATIONS
 
         if self.continuum is not None or self.coordinate_names or self.chain_spec:
             raise ModelError(f"model {self.name} already declares its unknowns", file=self.file, key="field",
@@ -381,7 +382,6 @@ class Model:
         (the degree of the rule, 0: twice the element's); a ``slit_plate`` also ``grading`` (power grading of
         the cells toward the crack tips, 1: uniform).
         """
-        from mechgen.symbolic.plane_domain import ELEMENTS, SHAPES, Domain, PlaneSpec
 
         if self.plane_spec is not None or self.continuum is not None or self.coordinate_names or self.chain_spec:
             raise ModelError(f"model {self.name} already declares its unknowns", file=self.file, key="plane",
@@ -787,7 +787,6 @@ class Model:
             def floor(q):
                 return q.y
         """
-        from mechgen.symbolic.hybrid import ModeScope
 
         if self.continuum is not None or self.chain_spec is not None:
             raise ModelError(f"mode {name!r} of model {self.name}: modes are for lumped models", file=self.file,
@@ -831,7 +830,6 @@ class Model:
             def at_rest(v):
                 return v.x
         """
-        from mechgen.symbolic.hybrid import Guard, DIRECTIONS
 
         def register(fn: Callable) -> Callable:
             if direction not in DIRECTIONS:
