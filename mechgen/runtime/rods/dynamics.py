@@ -592,7 +592,7 @@ class _Solver:
             return z, Fx, Mx
         loop = self._compiled_loop()
         if loop is not None:
-            return self._corrections_compiled(loop, st, dt, z, r, Fx, Mx, dz, size, here)
+            return self._corrections_compiled(loop, st, dt, (z, r, Fx, Mx), (dz, size, here))
         for _ in range(self.max_iter):
             lam, zt, rt, Fxt, Mxt, dzt, new = self._damped(st, dt, z, dz, size, here)
             if lam is None:
@@ -631,10 +631,12 @@ class _Solver:
             got = disc._evaluators["corrections"] = compiled_step.Corrections(step, self.scale, BAND)
         return got
 
-    def _corrections_compiled(self, loop, st: State, dt: float, z, r, Fx, Mx, dz, size: float, here: bool):
+    def _corrections_compiled(self, loop, st: State, dt: float, iterate: tuple, correction: tuple):
         """:meth:`attempt`'s loop in one C call between two Jacobians (rod_elements.c's mgr_corrections: the same
-        operations in the same order, so the same iterates as the Python loop bit for bit)."""
-        loop.start(st, dt, (z, r, Fx, Mx), (self.tol, REFRESH, JACOBIAN_COST, self.max_iter))
+        operations in the same order, so the same iterates as the Python loop bit for bit), from the ``iterate``
+        (z, r, Fx, Mx) and its ``correction`` (dz, its size, whether the factors were taken at z)."""
+        loop.start(st, dt, iterate, (self.tol, REFRESH, JACOBIAN_COST, self.max_iter))
+        dz, size, here = correction
         while True:
             outcome, solves = loop.run(self.lu, self.piv, dz, size, here)
             self.iterations += solves
